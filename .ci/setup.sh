@@ -1,0 +1,21 @@
+# Sourced by ./demo.sh and ./test.sh: install what a fresh Debian 12 machine
+# lacks (apt-get, sudo when not root) and build the Release tree in build/.
+SPH2D_PACKAGES="g++ cmake make pkg-config libbox2d-dev libosmesa6-dev libpng-dev libeigen3-dev doctest-dev nlohmann-json3-dev"
+
+sph2d_install() {
+  local missing=() p sudo=""
+  for p in $SPH2D_PACKAGES; do
+    dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+  done
+  if [ "${#missing[@]}" -gt 0 ]; then
+    echo "installing: ${missing[*]}"
+    [ "$(id -u)" -ne 0 ] && sudo="sudo"
+    $sudo apt-get update -qq
+    DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}"
+  fi
+}
+
+sph2d_build() {
+  cmake -S . -B build -DCMAKE_BUILD_TYPE=Release >/dev/null
+  cmake --build build -j"$(nproc)"
+}

@@ -1,0 +1,18 @@
+#!/usr/bin/env bash
+# Installs what is missing, builds (Release), and renders the default scene
+# (the dam break) to out/dam_break/frame_NNNNN.png. Extra arguments go to
+# `sph2d run` (e.g. ./demo.sh --frames 60 --threads 2).
+set -euo pipefail
+cd "$(dirname "$0")"
+source .ci/setup.sh
+sph2d_install
+sph2d_build
+scene="assets/scenes/dam_break.json"
+out="out/dam_break"
+rm -rf "$out"
+start=$(date +%s%N)
+./build/app/sph2d run "$scene" --out "$out" "$@"
+ms=$(( ($(date +%s%N) - start) / 1000000 ))
+count=$(find "$out" -name 'frame_*.png' | wc -l)
+printf 'demo: %d frames in %s/ (frame_00000.png ...), %d.%03d s wall for simulation, rendering and PNG (build excluded)\n' \
+  "$count" "$out" $((ms / 1000)) $((ms % 1000))

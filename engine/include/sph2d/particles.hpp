@@ -1,0 +1,45 @@
+// sph2d/particles.hpp — structure-of-arrays particle storage.
+//
+// Hot fields (read every substep by the neighbour passes) are contiguous
+// arrays; the order of particles changes when the grid reorders them for
+// locality, so a game holds particles by `id`, which never changes.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "sph2d/math.hpp"
+
+namespace sph2d {
+
+/// All per-particle data of a fluid. Index i is a storage slot; id[i] is stable.
+struct Particles {
+  std::vector<Vec2> x;            ///< position, relative to World::origin() [m]
+  std::vector<Vec2> v;            ///< velocity [m/s]
+  std::vector<Vec2> a;            ///< acceleration of the current substep [m/s²]
+  std::vector<Vec2> xPrev;        ///< position before the last integration (swept collision)
+  std::vector<Real> rho;          ///< density [kg/m³]
+  std::vector<Real> p;            ///< pressure [Pa]
+  std::vector<std::uint32_t> id;  ///< stable identifier
+
+  /// Number of particles.
+  std::size_t size() const { return x.size(); }
+  /// Appends one particle at rest-density with zero pressure.
+  void push(const Vec2& pos, const Vec2& vel, std::uint32_t pid, Real rho0) {
+    x.push_back(pos);
+    v.push_back(vel);
+    a.push_back(Vec2::Zero());
+    xPrev.push_back(pos);
+    rho.push_back(rho0);
+    p.push_back(0);
+    id.push_back(pid);
+  }
+  /// Bytes held by the particle arrays (capacity, not size).
+  std::size_t bytes() const {
+    return (x.capacity() + v.capacity() + a.capacity() + xPrev.capacity()) * sizeof(Vec2) +
+           (rho.capacity() + p.capacity()) * sizeof(Real) + id.capacity() * sizeof(std::uint32_t);
+  }
+};
+
+}  // namespace sph2d

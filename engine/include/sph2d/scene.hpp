@@ -1,0 +1,113 @@
+// sph2d/scene.hpp — scene definitions (Def structs with defaults) and the
+// JSON scene loader. Every key is documented in docs/SCENES.md.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "sph2d/math.hpp"
+
+namespace sph2d {
+
+/// A bad scene file: says which file, where, which key and what is allowed.
+class SceneError : public std::runtime_error {
+ public:
+  /// Builds the error; `what()` is "file:line:col: key: message".
+  SceneError(std::string file, int line, int column, std::string key, std::string message);
+  std::string file;     ///< the scene file
+  int line = 0;         ///< 1-based line (0 when unknown)
+  int column = 0;       ///< 1-based column (0 when unknown)
+  std::string key;      ///< key path, e.g. "boundaries[0].fixtures[2].radius"
+  std::string message;  ///< what is wrong and what is allowed
+};
+
+/// One fixture of a static body (Box2D 2.4.1 shapes).
+struct ShapeDef {
+  /// Box2D shape kinds that scenes may use.
+  enum class Type { Box, Polygon, Circle, Edge, Chain };
+  Type type = Type::Box;
+  Vec2d center{0, 0};            ///< box / circle centre in body coordinates
+  double angle = 0;              ///< box rotation in the body [rad]
+  Vec2d halfSize{0.5, 0.5};      ///< box half extents
+  std::vector<Vec2d> vertices;   ///< polygon / edge (2) / chain vertices in body coordinates
+  double radius = 0.5;           ///< circle radius
+  bool loop = false;             ///< chain closes on itself
+  double friction = 0.2;         ///< fixture friction (Box2D and fluid)
+  double restitution = 0.0;      ///< fixture restitution (Box2D and fluid)
+};
+
+/// A static Box2D body with its fixtures.
+struct BodyDef {
+  Vec2d position{0, 0};          ///< body origin in world coordinates [m]
+  double angle = 0;              ///< body rotation [rad]
+  std::vector<ShapeDef> fixtures;
+};
+
+/// A rectangle of fluid filled on a square lattice.
+struct FluidBlockDef {
+  Vec2d min{0, 0};               ///< lower-left corner [m]
+  Vec2d max{1, 1};               ///< upper-right corner [m]
+  Vec2d velocity{0, 0};          ///< initial velocity [m/s]
+};
+
+/// Pressure solver and its numerical parameters.
+struct SolverDef {
+  std::string type = "muller2003";  ///< pressure solver
+  double spacing = 0.02;            ///< particle spacing dx [m]
+  double supportRatio = 2.5;        ///< kernel support R = supportRatio · dx
+  double restDensity = 1000;        ///< ρ0 [kg/m³]
+  double soundSpeed = 25;           ///< c: p = c²(ρ − ρ0) (stiffness K = c²) [m/s]
+  double viscosity = 0.01;          ///< kinematic viscosity ν [m²/s] (muller2003 heats up below ~0.005)
+  double cfl = 0.25;                ///< dt ≤ cfl · R / (c + v_max)
+  int maxSubsteps = 400;            ///< cap per frame; beyond it the frame advances less time
+  bool clampNegativePressure = true;///< p = max(p, 0): no tension at the free surface
+  int reorderInterval = 1;          ///< reorder particles along the grid every N substeps (0: never)
+  double maxSpeed = 500;            ///< the guard stops a run above this speed [m/s]
+};
+
+/// The world rectangle the image shows (aspect preserved by widening).
+struct CameraDef {
+  Vec2d min{0, 0};
+  Vec2d max{0, 0};
+  bool automatic = true;            ///< fit the boundaries when no camera is given
+};
+
+/// Renderer settings (used by sph2d::render; the engine ignores them).
+struct RenderDef {
+  int width = 960;
+  int height = 540;
+  std::string mode = "liquid";      ///< "liquid" or "particles"
+  std::array<double, 3> background{0.06, 0.07, 0.09};
+  std::array<double, 3> water{0.10, 0.45, 0.85};
+  std::array<double, 3> solid{0.55, 0.52, 0.48};
+  double splatRadius = 2.0;         ///< splat radius in particle spacings
+  CameraDef camera;
+};
+
+/// A whole scene: the solids, the fluid, the solver, the clock and the camera.
+struct SceneDef {
+  std::string name = "scene";
+  std::string path;                 ///< file it came from ("" when built in code)
+  Vec2d gravity{0, -9.81};
+  SolverDef solver;
+  std::vector<BodyDef> bodies;
+  std::vector<FluidBlockDef> blocks;
+  double fps = 60;                  ///< frames per simulated second
+  double duration = 4;              ///< simulated seconds the app renders
+  std::size_t maxParticles = 4000000;///< refuse scenes with more particles than this
+  RenderDef render;
+};
+
+/// Loads and validates a scene file. Throws SceneError.
+SceneDef loadScene(const std::string& path);
+
+/// Parses scene JSON text; `file` names it in errors. Throws SceneError.
+SceneDef parseScene(const std::string& text, const std::string& file);
+
+/// Number of particles the blocks of `scene` will create.
+std::size_t countBlockParticles(const SceneDef& scene);
+
+}  // namespace sph2d

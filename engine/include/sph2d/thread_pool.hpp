@@ -1,0 +1,68 @@
+// sph2d/thread_pool.hpp — the job system every stage runs on.
+//
+// Work is cut into fixed blocks whose boundaries depend only on the item
+// count and the block size, never on the thread count. Threads claim blocks
+// dynamically, but each block writes only its own items (gathers), and
+// reductions keep one partial result per block and combine them in block
+// order on the calling thread. So results are bit-identical for any number of
+// threads.
+#pragma once
+
+#include <atomic>
+#include <condition_variable>
+#include <cstddef>
+#include <exception>
+#include <functional>
+#include <mutex>
+#include <thread>
+#include <vector>
+
+namespace sph2d {
+
+/// A small fork-join pool: the calling thread plus `threads − 1` workers.
+class ThreadPool {
+ public:
+  /// Creates the pool; `threads` = 0 means all hardware threads.
+  explicit ThreadPool(int threads = 0);
+  /// Joins the workers.
+  ~ThreadPool();
+  ThreadPool(const ThreadPool&) = delete;
+  ThreadPool& operator=(const ThreadPool&) = delete;
+
+  /// Number of threads that run jobs (workers + the caller).
+  int size() const { return static_cast<int>(workers_.size()) + 1; }
+
+  /// Calls fn(begin, end) for every block [k·block, min(n, (k+1)·block)).
+  /// Returns when all blocks are done; rethrows the first exception thrown.
+  void parallelFor(std::size_t n, std::size_t block, const std::function<void(std::size_t, std::size_t)>& fn);
+
+  /// Deterministic reduction: blockFn(begin, end) → T per block, then
+  /// combine(acc, part) over blocks in increasing order starting from init.
+  template <class T, class BlockFn, class Combine>
+  T reduce(std::size_t n, std::size_t block, T init, BlockFn blockFn, Combine combine) {
+    const std::size_t blocks = n == 0 ? 0 : (n + block - 1) / block;
+    std::vector<T> parts(blocks, init);
+    parallelFor(n, block, [&](std::size_t b, std::size_t e) { parts[b / block] = blockFn(b, e); });
+    T acc = init;
+    for (const T& p : parts) acc = combine(acc, p);
+    return acc;
+  }
+
+ private:
+  void workerLoop();
+  void runBlocks();
+
+  std::vector<std::thread> workers_;
+  std::mutex mutex_;
+  std::condition_variable wake_;
+  std::atomic<unsigned long long> epoch_{0};
+  std::atomic<int> busy_{0};
+  std::atomic<std::size_t> next_{0};
+  std::atomic<bool> stop_{false};
+  const std::function<void(std::size_t, std::size_t)>* fn_ = nullptr;
+  std::size_t n_ = 0, block_ = 1;
+  std::mutex errorMutex_;
+  std::exception_ptr error_;
+};
+
+}  // namespace sph2d

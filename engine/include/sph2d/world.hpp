@@ -1,0 +1,121 @@
+// sph2d/world.hpp — the fluid world a game or the app steps frame by frame.
+//
+//   SceneDef ──> World(scene) ──> stepFrame() ──> particles(), stateHash()
+//
+// A World owns its particles, its job system and (unless a game attaches its
+// own) a b2World of static bodies. One stepFrame() advances 1/fps seconds in
+// CFL-limited substeps; each substep runs the stages listed in
+// docs/ARCHITECTURE.md.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "sph2d/boundary.hpp"
+#include "sph2d/particles.hpp"
+#include "sph2d/scene.hpp"
+
+class b2World;
+
+namespace sph2d {
+
+/// A run that went wrong: which stage, which particle and its values.
+class SimulationError : public std::runtime_error {
+ public:
+  /// Builds the error with a full diagnosis in what().
+  SimulationError(const std::string& what, std::string stage, std::uint32_t particleId, std::uint64_t step,
+                  double time);
+  std::string stage;          ///< stage that produced the bad value
+  std::uint32_t particleId;   ///< id of the first bad particle
+  std::uint64_t step;         ///< substep counter
+  double time;                ///< simulated time [s]
+};
+
+/// Options of a World that are not part of the scene.
+struct WorldOptions {
+  int threads = 0;            ///< job-system threads; 0 = all hardware threads
+};
+
+/// Time and call count of one stage.
+struct StageTiming {
+  std::string name;
+  double seconds = 0;
+  std::uint64_t calls = 0;
+};
+
+/// Density error of the fluid, relative to ρ0.
+struct DensityStats {
+  double meanError = 0;  ///< mean of max(ρ − ρ0, 0)/ρ0 over particles (compression)
+  double maxError = 0;   ///< max of |ρ − ρ0|/ρ0 over particles with a full neighbourhood
+  double meanDensity = 0;
+};
+
+/// The fluid simulation.
+class World {
+ public:
+  /// Builds the world of a scene: its own b2World, the fluid blocks, the solver.
+  explicit World(const SceneDef& scene, const WorldOptions& options = {});
+  ~World();
+  World(const World&) = delete;
+  World& operator=(const World&) = delete;
+
+  /// Advances one frame (1/fps seconds) in CFL substeps. Throws SimulationError.
+  void stepFrame();
+  /// Advances `dt` seconds in CFL substeps. Throws SimulationError.
+  void step(double dt);
+
+  /// The particles (local frame; add origin() for world coordinates).
+  const Particles& particles() const;
+  /// Number of particles.
+  std::size_t particleCount() const;
+  /// Offset of the local frame in world coordinates [m].
+  Vec2d origin() const;
+  /// World position of particle slot i.
+  Vec2d worldPosition(std::size_t i) const;
+  /// The solids, in the local frame.
+  const std::vector<Collider>& colliders() const;
+  /// Boundary samples (layers of dummy particles inside the solids), in the local frame.
+  const std::vector<Vec2>& boundarySamples() const;
+  /// The Box2D world the fluid collides with.
+  b2World& box2d();
+  /// The scene this world was built from.
+  const SceneDef& scene() const;
+
+  /// Simulated time [s].
+  double time() const;
+  /// Frames stepped.
+  std::uint64_t frame() const;
+  /// Substeps taken.
+  std::uint64_t substeps() const;
+  /// Substeps of the last frame.
+  int lastFrameSubsteps() const;
+  /// Particle mass [kg] (all particles share it).
+  Real particleMass() const;
+  /// Kernel support R [m].
+  Real support() const;
+  /// Particle spacing dx [m].
+  Real spacing() const;
+  /// Threads of the job system.
+  int threads() const;
+
+  /// XXH64 of (id, position, velocity) in id order, plus the origin.
+  std::uint64_t stateHash() const;
+  /// Density error statistics of the current state.
+  DensityStats densityStats() const;
+  /// Kinetic energy ½ Σ m |v|² [J per metre of depth].
+  double kineticEnergy() const;
+  /// Per-stage wall time and calls since construction.
+  std::vector<StageTiming> timings() const;
+  /// Messages the world wants the user to see (substep cap hits, dropped particles); cleared on read.
+  std::vector<std::string> takeWarnings();
+
+  struct Impl;
+
+ private:
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace sph2d

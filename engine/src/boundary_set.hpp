@@ -1,0 +1,68 @@
+// boundary_set.hpp (internal) — what the fluid knows of the Box2D solids.
+//
+// Built from the static fixtures of a b2World (queried once, over the whole
+// world, when the World is created): a list of Colliders in the local frame,
+// a coarse bin grid over them for the per-particle broad phase, and boundary
+// samples: layers of dummy particles that fill each solid to the depth of the
+// kernel support (Adami, Hu & Adams 2012, "A generalized wall boundary
+// condition for SPH"; sampling as in Akinci et al. 2012). Layers lie at
+// depths dx/2, 3dx/2, ... below each face, so a particle half a spacing from
+// a wall sees the same density as one in the bulk: no gap at the wall. Each
+// sample has the volume it stands for (its share of the layer). A
+// zero-thickness edge gets layers on both sides, and a particle counts only
+// the layers on the far side of the edge's line.
+//
+// resolve() is the swept collision: a particle that crossed a surface during
+// the substep (ray from its previous position) is put back on the side it
+// came from, then kept `clearance` away from every surface; its velocity
+// follows the fixture's restitution and Coulomb friction.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "grid.hpp"
+#include "sph2d/boundary.hpp"
+#include "sph2d/kernels.hpp"
+
+class b2World;
+
+namespace sph2d {
+
+struct BoundarySet {
+  std::vector<Collider> colliders;
+  std::vector<Vec2> samples;   ///< boundary sample positions (local frame)
+  std::vector<Real> volume;    ///< Ψ_b [m²]: the area the sample stands for
+  /// For samples of a two-sided segment: the segment's unit normal n and offset
+  /// c (n·x = c), signed so that the sample is on the negative side. A particle
+  /// counts the sample only when n·x_i − c > 0. Zero normal for solid samples.
+  std::vector<Vec2> sideNormal;
+  std::vector<Real> sideOffset;
+  Grid sampleGrid;
+
+  /// True when sample k is visible from position x (always, unless it belongs to a segment's far side).
+  bool visible(std::size_t k, const Vec2& x) const {
+    const Vec2& n = sideNormal[k];
+    return (n.x() == 0 && n.y() == 0) || n.dot(x) - sideOffset[k] > 0;
+  }
+
+  // Broad phase over colliders.
+  Vec2 binLo = Vec2::Zero();
+  Real binSize = 1, invBin = 1;
+  int bnx = 0, bny = 0;
+  std::vector<std::uint32_t> binStart, binItems;
+
+  /// Collects every static fixture of `world` as colliders in the frame shifted by −origin.
+  void collect(b2World& world, const Vec2d& origin);
+  /// Fills every collider with layers of samples at spacing dx down to depth `depth`.
+  void sample(Real dx, Real depth, ThreadPool& pool);
+  /// Builds the collider bins.
+  void buildBins(Real binSizeHint);
+  /// Depth of p inside any solid collider (polygon or circle); ≤ 0 when outside all.
+  Real insideDepth(const Vec2& p) const;
+  /// Swept collision of one particle (x, v) that moved from xOld. Returns true on contact.
+  bool resolve(Vec2& x, Vec2& v, const Vec2& xOld, Real clearance) const;
+};
+
+}  // namespace sph2d

@@ -1,0 +1,67 @@
+#include "grid.hpp"
+
+#include <cmath>
+#include <limits>
+
+namespace sph2d {
+
+void Grid::build(const Vec2* x, std::size_t n, Real minCell, ThreadPool& pool) {
+  struct Box {
+    Real x0, y0, x1, y1;
+  };
+  const Real inf = std::numeric_limits<Real>::infinity();
+  const Box init{inf, inf, -inf, -inf};
+  const Box box = pool.reduce(
+      n, 4096, init,
+      [&](std::size_t b, std::size_t e) {
+        Box bx = init;
+        for (std::size_t i = b; i < e; ++i) {
+          bx.x0 = std::min(bx.x0, x[i].x());
+          bx.y0 = std::min(bx.y0, x[i].y());
+          bx.x1 = std::max(bx.x1, x[i].x());
+          bx.y1 = std::max(bx.y1, x[i].y());
+        }
+        return bx;
+      },
+      [](Box a, Box b) { return Box{std::min(a.x0, b.x0), std::min(a.y0, b.y0), std::max(a.x1, b.x1), std::max(a.y1, b.y1)}; });
+
+  cell = minCell;
+  if (n == 0) {
+    lo = Vec2::Zero();
+    nx = ny = 1;
+  } else {
+    lo = Vec2(box.x0, box.y0);
+    const double ex = double(box.x1) - double(box.x0), ey = double(box.y1) - double(box.y0);
+    const double maxCells = std::max<double>(4.0 * double(n), 4096.0);
+    double c = minCell;
+    for (;;) {
+      const double cx = std::floor(ex / c) + 1, cy = std::floor(ey / c) + 1;
+      if (cx * cy <= maxCells) break;
+      c *= std::sqrt(cx * cy / maxCells) * 1.01;
+    }
+    cell = static_cast<Real>(c);
+    if (cell < minCell) cell = minCell;
+    invCell = Real(1) / cell;
+    nx = static_cast<int>(std::floor(ex * invCell)) + 1;
+    ny = static_cast<int>(std::floor(ey * invCell)) + 1;
+  }
+  invCell = Real(1) / cell;
+  const std::size_t cells = std::size_t(nx) * std::size_t(ny);
+
+  cellOf.resize(n);
+  pool.parallelFor(n, 4096, [&](std::size_t b, std::size_t e) {
+    for (std::size_t i = b; i < e; ++i)
+      cellOf[i] = std::uint32_t(coord(x[i].y(), lo.y(), ny)) * std::uint32_t(nx) + std::uint32_t(coord(x[i].x(), lo.x(), nx));
+  });
+  // Stable counting sort (serial: it is a few ms at a million particles).
+  cellStart.assign(cells + 1, 0);
+  for (std::size_t i = 0; i < n; ++i) ++cellStart[cellOf[i] + 1];
+  for (std::size_t c = 0; c < cells; ++c) cellStart[c + 1] += cellStart[c];
+  sorted.resize(n);
+  // Use `sorted` as the fill cursor source: a second pass writes in index order.
+  std::vector<std::uint32_t>& cursor = scratch_;
+  cursor.assign(cellStart.begin(), cellStart.end() - 1);
+  for (std::size_t i = 0; i < n; ++i) sorted[cursor[cellOf[i]]++] = std::uint32_t(i);
+}
+
+}  // namespace sph2d

@@ -1,0 +1,367 @@
+// Scene loading: JSON text → SceneDef, with every key checked against what is
+// allowed. Errors name file, line, column, key path and the allowed values.
+#include "sph2d/scene.hpp"
+
+#include <cmath>
+#include <fstream>
+#include <sstream>
+
+#include "json_reader.hpp"
+
+namespace sph2d {
+
+SceneError::SceneError(std::string file_, int line_, int column_, std::string key_, std::string message_)
+    : std::runtime_error([&] {
+        std::string w = file_;
+        if (line_ > 0) w += ":" + std::to_string(line_) + ":" + std::to_string(column_);
+        w += ": ";
+        if (!key_.empty()) w += "key '" + key_ + "': ";
+        return w + message_;
+      }()),
+      file(std::move(file_)),
+      line(line_),
+      column(column_),
+      key(std::move(key_)),
+      message(std::move(message_)) {}
+
+namespace {
+
+using nlohmann::json;
+
+std::string typeName(const json& j) {
+  switch (j.type()) {
+    case json::value_t::null: return "null";
+    case json::value_t::boolean: return "a boolean";
+    case json::value_t::number_integer:
+    case json::value_t::number_unsigned: return "an integer";
+    case json::value_t::number_float: return "a number";
+    case json::value_t::string: return "a string";
+    case json::value_t::array: return "an array";
+    case json::value_t::object: return "an object";
+    default: return "something else";
+  }
+}
+
+std::string join(const std::vector<std::string>& v) {
+  std::string s;
+  for (std::size_t i = 0; i < v.size(); ++i) s += (i ? ", " : "") + v[i];
+  return s;
+}
+
+std::string fmt(double v) {
+  std::ostringstream o;
+  o << v;
+  return o.str();
+}
+
+/// Typed, position-aware access to one JSON object of the scene.
+class Reader {
+ public:
+  Reader(const JsonDoc& doc, std::string file) : doc_(doc), file_(std::move(file)) {}
+
+  [[noreturn]] void fail(const std::string& path, const std::string& msg) const {
+    // Report the deepest known position along the path.
+    std::string p = path;
+    for (;;) {
+      auto it = doc_.where.find(p);
+      if (it != doc_.where.end()) throw SceneError(file_, it->second.first, it->second.second, path, msg);
+      const auto cut = p.find_last_of(".[");
+      if (cut == std::string::npos || cut == 0) break;
+      p = p.substr(0, cut);
+    }
+    throw SceneError(file_, 0, 0, path, msg);
+  }
+
+  static std::string sub(const std::string& path, const std::string& key) { return path.empty() ? key : path + "." + key; }
+
+  void requireObject(const json& j, const std::string& path) const {
+    if (!j.is_object()) fail(path, "expected an object, got " + typeName(j));
+  }
+  void checkKeys(const json& obj, const std::string& path, const std::vector<std::string>& allowed) const {
+    for (auto it = obj.begin(); it != obj.end(); ++it) {
+      bool ok = false;
+      for (const auto& a : allowed) ok = ok || a == it.key();
+      if (!ok) fail(sub(path, it.key()), "unknown key '" + it.key() + "'; allowed keys: " + join(allowed));
+    }
+  }
+  double number(const json& obj, const std::string& path, const std::string& key, double def, double lo, double hi,
+                bool loOpen = false) const {
+    if (!obj.contains(key)) return def;
+    const json& j = obj.at(key);
+    const std::string p = sub(path, key);
+    if (!j.is_number()) fail(p, "expected a number, got " + typeName(j));
+    const double v = j.get<double>();
+    const bool below = loOpen ? !(v > lo) : !(v >= lo);
+    if (!std::isfinite(v) || below || v > hi)
+      fail(p, "value " + fmt(v) + " is out of range; allowed: " + (loOpen ? "> " : ">= ") + fmt(lo) + " and <= " + fmt(hi));
+    return v;
+  }
+  int integer(const json& obj, const std::string& path, const std::string& key, int def, int lo, int hi) const {
+    if (!obj.contains(key)) return def;
+    const json& j = obj.at(key);
+    const std::string p = sub(path, key);
+    if (!j.is_number_integer()) fail(p, "expected an integer, got " + typeName(j));
+    const long long v = j.get<long long>();
+    if (v < lo || v > hi) fail(p, "value " + std::to_string(v) + " is out of range; allowed: " + std::to_string(lo) + " to " + std::to_string(hi));
+    return static_cast<int>(v);
+  }
+  bool boolean(const json& obj, const std::string& path, const std::string& key, bool def) const {
+    if (!obj.contains(key)) return def;
+    const json& j = obj.at(key);
+    if (!j.is_boolean()) fail(sub(path, key), "expected true or false, got " + typeName(j));
+    return j.get<bool>();
+  }
+  std::string string(const json& obj, const std::string& path, const std::string& key, const std::string& def,
+                     const std::vector<std::string>& allowed) const {
+    if (!obj.contains(key)) return def;
+    const json& j = obj.at(key);
+    const std::string p = sub(path, key);
+    if (!j.is_string()) fail(p, "expected a string, got " + typeName(j));
+    const std::string v = j.get<std::string>();
+    if (allowed.empty()) return v;
+    for (const auto& a : allowed)
+      if (a == v) return v;
+    fail(p, "'" + v + "' is not allowed; allowed values: " + join(allowed));
+  }
+  Vec2d vec2(const json& j, const std::string& p) const {
+    if (!j.is_array() || j.size() != 2 || !j[0].is_number() || !j[1].is_number())
+      fail(p, "expected [x, y] (two numbers), got " + (j.is_array() ? "an array of " + std::to_string(j.size()) : typeName(j)));
+    const Vec2d v(j[0].get<double>(), j[1].get<double>());
+    if (!std::isfinite(v.x()) || !std::isfinite(v.y())) fail(p, "coordinates must be finite");
+    return v;
+  }
+  Vec2d vec2(const json& obj, const std::string& path, const std::string& key, const Vec2d& def) const {
+    if (!obj.contains(key)) return def;
+    return vec2(obj.at(key), sub(path, key));
+  }
+  Vec2d requiredVec2(const json& obj, const std::string& path, const std::string& key) const {
+    if (!obj.contains(key)) fail(sub(path, key), "missing; expected [x, y]");
+    return vec2(obj.at(key), sub(path, key));
+  }
+  std::array<double, 3> color(const json& obj, const std::string& path, const std::string& key,
+                              const std::array<double, 3>& def) const {
+    if (!obj.contains(key)) return def;
+    const json& j = obj.at(key);
+    const std::string p = sub(path, key);
+    if (!j.is_array() || j.size() != 3) fail(p, "expected [r, g, b] with components in 0..1");
+    std::array<double, 3> c{};
+    for (int k = 0; k < 3; ++k) {
+      if (!j[k].is_number()) fail(p, "expected [r, g, b] with components in 0..1");
+      c[k] = j[k].get<double>();
+      if (!(c[k] >= 0 && c[k] <= 1)) fail(p, "colour components must be in 0..1");
+    }
+    return c;
+  }
+  std::vector<Vec2d> points(const json& obj, const std::string& path, const std::string& key) const {
+    const std::string p = sub(path, key);
+    if (!obj.contains(key)) fail(p, "missing; expected an array of [x, y] points");
+    const json& j = obj.at(key);
+    if (!j.is_array()) fail(p, "expected an array of [x, y] points, got " + typeName(j));
+    std::vector<Vec2d> out;
+    for (std::size_t i = 0; i < j.size(); ++i) out.push_back(vec2(j[i], p + "[" + std::to_string(i) + "]"));
+    return out;
+  }
+
+ private:
+  const JsonDoc& doc_;
+  std::string file_;
+};
+
+double cross(const Vec2d& a, const Vec2d& b) { return a.x() * b.y() - a.y() * b.x(); }
+
+ShapeDef readFixture(const Reader& r, const json& j, const std::string& path) {
+  r.requireObject(j, path);
+  ShapeDef s;
+  if (!j.contains("shape")) r.fail(Reader::sub(path, "shape"), "missing; allowed values: box, polygon, circle, edge, chain");
+  const std::string shape = r.string(j, path, "shape", "", {"box", "polygon", "circle", "edge", "chain"});
+  std::vector<std::string> keys = {"shape", "friction", "restitution"};
+  s.friction = r.number(j, path, "friction", s.friction, 0, 10);
+  s.restitution = r.number(j, path, "restitution", s.restitution, 0, 1);
+  if (shape == "box") {
+    s.type = ShapeDef::Type::Box;
+    keys.insert(keys.end(), {"center", "half_size", "angle"});
+    r.checkKeys(j, path, keys);
+    s.center = r.vec2(j, path, "center", s.center);
+    s.halfSize = r.requiredVec2(j, path, "half_size");
+    if (!(s.halfSize.x() > 0 && s.halfSize.y() > 0)) r.fail(Reader::sub(path, "half_size"), "both half sizes must be > 0");
+    s.angle = r.number(j, path, "angle", 0, -1e3, 1e3);
+  } else if (shape == "polygon") {
+    s.type = ShapeDef::Type::Polygon;
+    keys.insert(keys.end(), {"vertices"});
+    r.checkKeys(j, path, keys);
+    s.vertices = r.points(j, path, "vertices");
+    const std::string p = Reader::sub(path, "vertices");
+    if (s.vertices.size() < 3 || s.vertices.size() > 8) r.fail(p, "a polygon needs 3 to 8 vertices (Box2D 2.4.1), got " + std::to_string(s.vertices.size()));
+    double area = 0;
+    int sign = 0;
+    const std::size_t n = s.vertices.size();
+    for (std::size_t i = 0; i < n; ++i) {
+      const Vec2d& a = s.vertices[i];
+      const Vec2d& b = s.vertices[(i + 1) % n];
+      const Vec2d& c = s.vertices[(i + 2) % n];
+      area += cross(a, b);
+      const double turn = cross(b - a, c - b);
+      const int sg = turn > 1e-12 ? 1 : (turn < -1e-12 ? -1 : 0);
+      if (sg != 0) {
+        if (sign != 0 && sg != sign) r.fail(p, "the polygon must be convex (split a concave shape into several fixtures)");
+        sign = sg;
+      }
+    }
+    if (std::fabs(area) < 1e-10) r.fail(p, "the polygon has no area");
+  } else if (shape == "circle") {
+    s.type = ShapeDef::Type::Circle;
+    keys.insert(keys.end(), {"center", "radius"});
+    r.checkKeys(j, path, keys);
+    s.center = r.vec2(j, path, "center", s.center);
+    if (!j.contains("radius")) r.fail(Reader::sub(path, "radius"), "missing; expected a number > 0");
+    s.radius = r.number(j, path, "radius", 0, 0, 1e6, true);
+  } else if (shape == "edge") {
+    s.type = ShapeDef::Type::Edge;
+    keys.insert(keys.end(), {"vertices"});
+    r.checkKeys(j, path, keys);
+    s.vertices = r.points(j, path, "vertices");
+    if (s.vertices.size() != 2) r.fail(Reader::sub(path, "vertices"), "an edge needs exactly 2 vertices");
+    if ((s.vertices[0] - s.vertices[1]).norm() < 1e-6) r.fail(Reader::sub(path, "vertices"), "the edge has zero length");
+  } else {
+    s.type = ShapeDef::Type::Chain;
+    keys.insert(keys.end(), {"vertices", "loop"});
+    r.checkKeys(j, path, keys);
+    s.vertices = r.points(j, path, "vertices");
+    s.loop = r.boolean(j, path, "loop", false);
+    const std::size_t need = s.loop ? 3 : 2;
+    if (s.vertices.size() < need) r.fail(Reader::sub(path, "vertices"), std::string("a ") + (s.loop ? "looped" : "open") + " chain needs at least " + std::to_string(need) + " vertices");
+    for (std::size_t i = 1; i < s.vertices.size(); ++i)
+      if ((s.vertices[i] - s.vertices[i - 1]).norm() < 0.005)  // b2_linearSlop
+        r.fail(Reader::sub(path, "vertices[" + std::to_string(i) + "]"), "chain vertices closer than 0.005 m (Box2D's linear slop)");
+  }
+  return s;
+}
+
+}  // namespace
+
+std::size_t countBlockParticles(const SceneDef& scene) {
+  std::size_t n = 0;
+  const double dx = scene.solver.spacing;
+  for (const auto& b : scene.blocks) {
+    const double nx = std::floor((b.max.x() - b.min.x()) / dx + 1e-9);
+    const double ny = std::floor((b.max.y() - b.min.y()) / dx + 1e-9);
+    if (nx > 0 && ny > 0) n += static_cast<std::size_t>(nx) * static_cast<std::size_t>(ny);
+  }
+  return n;
+}
+
+SceneDef parseScene(const std::string& text, const std::string& file) {
+  const JsonDoc doc = parseJsonWithPositions(text, file);
+  const Reader r(doc, file);
+  const json& root = doc.root;
+  r.requireObject(root, "");
+  r.checkKeys(root, "", {"name", "gravity", "fps", "duration", "max_particles", "solver", "boundaries", "fluid", "render"});
+  SceneDef s;
+  s.path = file;
+  s.name = r.string(root, "", "name", s.name, {});
+  s.gravity = r.vec2(root, "", "gravity", s.gravity);
+  s.fps = r.number(root, "", "fps", s.fps, 1, 1000);
+  s.duration = r.number(root, "", "duration", s.duration, 0, 1e5);
+  s.maxParticles = static_cast<std::size_t>(r.number(root, "", "max_particles", double(s.maxParticles), 0, 1e8));
+
+  if (root.contains("solver")) {
+    const json& j = root.at("solver");
+    const std::string p = "solver";
+    r.requireObject(j, p);
+    r.checkKeys(j, p, {"type", "spacing", "support_ratio", "rest_density", "sound_speed", "viscosity", "cfl", "max_substeps",
+                       "clamp_negative_pressure", "reorder_interval", "max_speed"});
+    SolverDef& d = s.solver;
+    d.type = r.string(j, p, "type", d.type, {"muller2003"});
+    d.spacing = r.number(j, p, "spacing", d.spacing, 0, 10, true);
+    d.supportRatio = r.number(j, p, "support_ratio", d.supportRatio, 1.5, 4);
+    d.restDensity = r.number(j, p, "rest_density", d.restDensity, 0, 1e5, true);
+    d.soundSpeed = r.number(j, p, "sound_speed", d.soundSpeed, 0, 1e4, true);
+    d.viscosity = r.number(j, p, "viscosity", d.viscosity, 0, 100);
+    d.cfl = r.number(j, p, "cfl", d.cfl, 0, 1, true);
+    d.maxSubsteps = r.integer(j, p, "max_substeps", d.maxSubsteps, 1, 100000);
+    d.clampNegativePressure = r.boolean(j, p, "clamp_negative_pressure", d.clampNegativePressure);
+    d.reorderInterval = r.integer(j, p, "reorder_interval", d.reorderInterval, 0, 1000000);
+    d.maxSpeed = r.number(j, p, "max_speed", d.maxSpeed, 0, 1e6, true);
+  }
+
+  if (root.contains("boundaries")) {
+    const json& arr = root.at("boundaries");
+    if (!arr.is_array()) r.fail("boundaries", "expected an array of static bodies, got " + typeName(arr));
+    for (std::size_t b = 0; b < arr.size(); ++b) {
+      const std::string p = "boundaries[" + std::to_string(b) + "]";
+      const json& j = arr[b];
+      r.requireObject(j, p);
+      r.checkKeys(j, p, {"position", "angle", "fixtures"});
+      BodyDef body;
+      body.position = r.vec2(j, p, "position", body.position);
+      body.angle = r.number(j, p, "angle", 0, -1e3, 1e3);
+      if (!j.contains("fixtures")) r.fail(Reader::sub(p, "fixtures"), "missing; expected an array of fixtures");
+      const json& fx = j.at("fixtures");
+      if (!fx.is_array()) r.fail(Reader::sub(p, "fixtures"), "expected an array of fixtures, got " + typeName(fx));
+      for (std::size_t f = 0; f < fx.size(); ++f)
+        body.fixtures.push_back(readFixture(r, fx[f], p + ".fixtures[" + std::to_string(f) + "]"));
+      s.bodies.push_back(body);
+    }
+  }
+
+  if (root.contains("fluid")) {
+    const json& arr = root.at("fluid");
+    if (!arr.is_array()) r.fail("fluid", "expected an array of blocks, got " + typeName(arr));
+    for (std::size_t b = 0; b < arr.size(); ++b) {
+      const std::string p = "fluid[" + std::to_string(b) + "]";
+      const json& j = arr[b];
+      r.requireObject(j, p);
+      r.checkKeys(j, p, {"min", "max", "velocity"});
+      FluidBlockDef blk;
+      blk.min = r.requiredVec2(j, p, "min");
+      blk.max = r.requiredVec2(j, p, "max");
+      blk.velocity = r.vec2(j, p, "velocity", blk.velocity);
+      if (!(blk.max.x() > blk.min.x() && blk.max.y() > blk.min.y()))
+        r.fail(Reader::sub(p, "max"), "max must be greater than min in x and in y");
+      s.blocks.push_back(blk);
+    }
+  }
+
+  if (root.contains("render")) {
+    const json& j = root.at("render");
+    const std::string p = "render";
+    r.requireObject(j, p);
+    r.checkKeys(j, p, {"width", "height", "mode", "background", "water", "solid", "splat_radius", "camera"});
+    RenderDef& d = s.render;
+    d.width = r.integer(j, p, "width", d.width, 16, 8192);
+    d.height = r.integer(j, p, "height", d.height, 16, 8192);
+    d.mode = r.string(j, p, "mode", d.mode, {"liquid", "particles"});
+    d.background = r.color(j, p, "background", d.background);
+    d.water = r.color(j, p, "water", d.water);
+    d.solid = r.color(j, p, "solid", d.solid);
+    d.splatRadius = r.number(j, p, "splat_radius", d.splatRadius, 0.25, 8);
+    if (j.contains("camera")) {
+      const json& c = j.at("camera");
+      const std::string pc = "render.camera";
+      r.requireObject(c, pc);
+      r.checkKeys(c, pc, {"min", "max"});
+      d.camera.min = r.requiredVec2(c, pc, "min");
+      d.camera.max = r.requiredVec2(c, pc, "max");
+      d.camera.automatic = false;
+      if (!(d.camera.max.x() > d.camera.min.x() && d.camera.max.y() > d.camera.min.y()))
+        r.fail(Reader::sub(pc, "max"), "max must be greater than min in x and in y");
+    }
+  }
+
+  const std::size_t n = countBlockParticles(s);
+  if (n > s.maxParticles)
+    r.fail("solver.spacing", "spacing " + fmt(s.solver.spacing) + " fills the fluid blocks with " + std::to_string(n) +
+                                 " particles, more than max_particles = " + std::to_string(s.maxParticles) +
+                                 "; use a larger spacing or raise max_particles");
+  return s;
+}
+
+SceneDef loadScene(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw SceneError(path, 0, 0, "", "cannot open the scene file");
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  return parseScene(ss.str(), path);
+}
+
+}  // namespace sph2d

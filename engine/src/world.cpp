@@ -1,0 +1,370 @@
+#include "sph2d/world.hpp"
+
+#include <box2d/box2d.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <sstream>
+
+#include "sph2d/hash.hpp"
+#include "stages.hpp"
+
+namespace sph2d {
+
+SimulationError::SimulationError(const std::string& what, std::string stage_, std::uint32_t particleId_,
+                                 std::uint64_t step_, double time_)
+    : std::runtime_error(what), stage(std::move(stage_)), particleId(particleId_), step(step_), time(time_) {}
+
+namespace {
+
+enum StageId { kStageGrid, kStageDensity, kStagePressure, kStageForces, kStageIntegrate, kStageCollide, kStageCount };
+const char* const kStageNames[kStageCount] = {"grid", "density", "pressure", "forces", "integrate", "collide"};
+
+b2Vec2 bv(const Vec2d& v) { return b2Vec2(float(v.x()), float(v.y())); }
+
+void addBody(b2World& world, const BodyDef& def) {
+  b2BodyDef bd;
+  bd.type = b2_staticBody;
+  bd.position = bv(def.position);
+  bd.angle = float(def.angle);
+  b2Body* body = world.CreateBody(&bd);
+  for (const ShapeDef& s : def.fixtures) {
+    b2FixtureDef fd;
+    fd.friction = float(s.friction);
+    fd.restitution = float(s.restitution);
+    b2PolygonShape poly;
+    b2CircleShape circle;
+    b2EdgeShape edge;
+    b2ChainShape chain;
+    std::vector<b2Vec2> pts;
+    for (const Vec2d& v : s.vertices) pts.push_back(bv(v));
+    switch (s.type) {
+      case ShapeDef::Type::Box:
+        poly.SetAsBox(float(s.halfSize.x()), float(s.halfSize.y()), bv(s.center), float(s.angle));
+        fd.shape = &poly;
+        break;
+      case ShapeDef::Type::Polygon:
+        poly.Set(pts.data(), int(pts.size()));
+        fd.shape = &poly;
+        break;
+      case ShapeDef::Type::Circle:
+        circle.m_p = bv(s.center);
+        circle.m_radius = float(s.radius);
+        fd.shape = &circle;
+        break;
+      case ShapeDef::Type::Edge:
+        edge.SetTwoSided(pts[0], pts[1]);
+        fd.shape = &edge;
+        break;
+      case ShapeDef::Type::Chain:
+        if (s.loop) {
+          chain.CreateLoop(pts.data(), int(pts.size()));
+        } else {
+          const b2Vec2 prev = pts[0] + (pts[0] - pts[1]);
+          const b2Vec2 next = pts.back() + (pts.back() - pts[pts.size() - 2]);
+          chain.CreateChain(pts.data(), int(pts.size()), prev, next);
+        }
+        fd.shape = &chain;
+        break;
+    }
+    body->CreateFixture(&fd);
+  }
+}
+
+/// Σ W over a square lattice of spacing dx around one point (the point included).
+double latticeSum(const Poly6<double>& W, double dx, double yFrom) {
+  const int n = int(std::ceil(W.R / dx)) + 1;
+  double s = 0;
+  for (int j = -n; j <= n; ++j) {
+    const double y = j * dx;
+    if (y < yFrom - 1e-12) continue;
+    for (int i = -n; i <= n; ++i) s += W.value(std::sqrt(i * dx * i * dx + y * y));
+  }
+  return s;
+}
+
+}  // namespace
+
+struct World::Impl {
+  SceneDef scene;
+  ThreadPool pool;
+  std::unique_ptr<b2World> ownWorld;
+  b2World* b2 = nullptr;
+  Vec2d origin{0, 0};
+  Particles P;
+  Grid grid;
+  BoundarySet boundary;
+  Real dx = 0, R = 0, mass = 0;
+  double time = 0;
+  std::uint64_t frames = 0, steps = 0;
+  int lastSubsteps = 0;
+  Real lastAccel = 0;
+  std::uint32_t nextId = 0;
+  StageTiming timing[kStageCount];
+  std::vector<std::string> warnings;
+  std::vector<Vec2> scratchV;
+  std::vector<Real> scratchR;
+  std::vector<std::uint32_t> scratchU;
+
+  explicit Impl(const SceneDef& s, const WorldOptions& o) : scene(s), pool(o.threads) {
+    for (int k = 0; k < kStageCount; ++k) timing[k].name = kStageNames[k];
+  }
+
+  StepContext context(Real dt) {
+    const SolverDef& sd = scene.solver;
+    StepContext c{P, grid, boundary, pool, Poly6<Real>(R), Spiky<Real>(R), ViscosityKernel<Real>(R)};
+    c.dt = dt;
+    c.mass = mass;
+    c.rho0 = Real(sd.restDensity);
+    c.stiffness = Real(sd.soundSpeed * sd.soundSpeed);
+    c.mu = Real(sd.viscosity * sd.restDensity);
+    c.gravity = Vec2(Real(scene.gravity.x()), Real(scene.gravity.y()));
+    c.clampNegative = sd.clampNegativePressure;
+    c.clearance = Real(0.25) * dx;
+    c.maxSpeed = Real(sd.maxSpeed);
+    return c;
+  }
+
+  template <class F>
+  auto timed(StageId s, F&& f) {
+    const auto t0 = std::chrono::steady_clock::now();
+    if constexpr (std::is_void_v<decltype(f())>) {
+      f();
+      timing[s].seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+      ++timing[s].calls;
+    } else {
+      auto r = f();
+      timing[s].seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+      ++timing[s].calls;
+      return r;
+    }
+  }
+
+  [[noreturn]] void fail(StageId s, std::size_t slot) {
+    std::ostringstream o;
+    o.precision(9);
+    const Vec2d w = Vec2d(P.x[slot].x(), P.x[slot].y()) + origin;
+    o << "simulation stopped: non-finite or runaway value after stage '" << kStageNames[s] << "' at substep " << steps
+      << " (t = " << time << " s): particle id " << P.id[slot] << " position (" << w.x() << ", " << w.y()
+      << ") velocity (" << P.v[slot].x() << ", " << P.v[slot].y() << ") density " << P.rho[slot] << " pressure "
+      << P.p[slot] << " (speed limit solver.max_speed = " << scene.solver.maxSpeed << " m/s)";
+    throw SimulationError(o.str(), kStageNames[s], P.id[slot], steps, time);
+  }
+
+  Real stableDt() {
+    const SolverDef& sd = scene.solver;
+    const Real vmax = maxSpeedOf(P, pool);
+    Real dt = Real(sd.cfl) * R / (Real(sd.soundSpeed) + vmax);
+    if (lastAccel > 0) dt = std::min(dt, Real(0.25) * std::sqrt(R / lastAccel));
+    if (sd.viscosity > 0) dt = std::min(dt, Real(0.03) * R * R / Real(sd.viscosity));
+    return dt;
+  }
+
+  void substep(Real dt) {
+    StepContext c = context(dt);
+    const int every = scene.solver.reorderInterval;
+    const bool reorder = every > 0 && steps % std::uint64_t(every) == 0;
+    timed(kStageGrid, [&] { stageGrid(c, reorder, scratchV, scratchR, scratchU); });
+    std::size_t bad = timed(kStageDensity, [&] { return stageDensity(c); });
+    if (bad != kNone) fail(kStageDensity, bad);
+    timed(kStagePressure, [&] { stagePressure(c); });
+    bad = timed(kStageForces, [&] { return stageForces(c); });
+    if (bad != kNone) fail(kStageForces, bad);
+    lastAccel = maxAccelOf(P, pool);
+    bad = timed(kStageIntegrate, [&] { return stageIntegrate(c); });
+    if (bad != kNone) fail(kStageIntegrate, bad);
+    timed(kStageCollide, [&] { stageCollide(c); });
+    time += double(dt);
+    ++steps;
+  }
+
+  void advance(double frameDt) {
+    double remaining = frameDt;
+    int n = 0;
+    const int cap = scene.solver.maxSubsteps;
+    while (remaining > 1e-9 * frameDt) {
+      if (n == cap) {
+        std::ostringstream o;
+        o << "frame " << frames << ": substep cap solver.max_substeps = " << cap << " reached; simulated "
+          << (frameDt - remaining) << " s of " << frameDt << " s (the frame runs slow instead of unstable)";
+        warnings.push_back(o.str());
+        break;
+      }
+      const Real limit = stableDt();
+      const double k = std::ceil(remaining / double(limit) - 1e-9);
+      const double dt = k <= 1 ? remaining : remaining / k;
+      substep(Real(dt));
+      remaining -= double(Real(dt));
+      ++n;
+    }
+    lastSubsteps = n;
+  }
+};
+
+World::World(const SceneDef& scene, const WorldOptions& options) : impl_(std::make_unique<Impl>(scene, options)) {
+  Impl& w = *impl_;
+  const SolverDef& sd = scene.solver;
+  w.ownWorld = std::make_unique<b2World>(bv(scene.gravity));
+  w.b2 = w.ownWorld.get();
+  for (const BodyDef& b : scene.bodies) addBody(*w.b2, b);
+
+  // Local frame: the centre of the scene's box, rounded to 64 m, so that
+  // scenes far from the origin keep float precision.
+  bool any = false;
+  Vec2d lo(0, 0), hi(0, 0);
+  auto grow = [&](const Vec2d& p) {
+    lo = any ? lo.cwiseMin(p) : p;
+    hi = any ? hi.cwiseMax(p) : p;
+    any = true;
+  };
+  for (const auto& b : scene.blocks) {
+    grow(b.min);
+    grow(b.max);
+  }
+  for (const auto& b : scene.bodies) grow(b.position);
+  if (any) {
+    const Vec2d c = (lo + hi) * 0.5;
+    w.origin = Vec2d(std::round(c.x() / 64.0) * 64.0, std::round(c.y() / 64.0) * 64.0);
+  }
+
+  w.dx = Real(sd.spacing);
+  w.R = Real(sd.supportRatio * sd.spacing);
+  const Poly6<double> Wd(double(w.R));
+  // Mass so that a full square lattice at spacing dx has exactly ρ0.
+  const double full = latticeSum(Wd, sd.spacing, -1e300);
+  w.mass = Real(sd.restDensity / full);
+
+  w.boundary.collect(*w.b2, w.origin);
+  w.boundary.sample(w.dx, w.R, w.pool);
+  w.boundary.buildBins(Real(4) * w.R);
+  // Fluid blocks on a square lattice; particles inside solids are dropped.
+  std::size_t dropped = 0;
+  Vec2d dlo(0, 0), dhi(0, 0);
+  const Real rho0 = Real(sd.restDensity);
+  // Hydrostatic start: under gravity along −y, rows are placed closer with
+  // depth so that the block starts at the density the solver holds at rest
+  // (ρ = ρ0(1 + 2 g z / c²): p = c²(ρ − ρ0) and Müller's symmetric force
+  // recovers ∇p/2). Started uncompressed, a column would ring in its acoustic
+  // mode with a speed amplitude of about g·H/c.
+  const bool hydrostatic = scene.gravity.x() == 0 && scene.gravity.y() < 0;
+  const double gz = -scene.gravity.y(), c2 = sd.soundSpeed * sd.soundSpeed;
+  for (const FluidBlockDef& b : scene.blocks) {
+    const long nx = long(std::floor((b.max.x() - b.min.x()) / sd.spacing + 1e-9));
+    const long ny = long(std::floor((b.max.y() - b.min.y()) / sd.spacing + 1e-9));
+    std::vector<double> rowY(std::size_t(std::max(ny, 0L)));
+    double prevScale = 1;
+    for (long j = 0; j < ny; ++j) {
+      const double depth = (double(ny - j) - 0.5) * sd.spacing;
+      const double scale = hydrostatic ? 1.0 / (1.0 + 2.0 * gz * depth / c2) : 1.0;
+      rowY[std::size_t(j)] = j == 0 ? b.min.y() + 0.5 * sd.spacing * scale
+                                    : rowY[std::size_t(j - 1)] + 0.5 * sd.spacing * (prevScale + scale);
+      prevScale = scale;
+    }
+    for (long j = 0; j < ny; ++j)
+      for (long i = 0; i < nx; ++i) {
+        const Vec2d pw(b.min.x() + (i + 0.5) * sd.spacing, rowY[std::size_t(j)]);
+        const Vec2 p = Vec2(Real(pw.x() - w.origin.x()), Real(pw.y() - w.origin.y()));
+        if (w.boundary.insideDepth(p) > 0) {
+          dlo = dropped ? dlo.cwiseMin(pw) : pw;
+          dhi = dropped ? dhi.cwiseMax(pw) : pw;
+          ++dropped;
+          continue;
+        }
+        w.P.push(p, Vec2(Real(b.velocity.x()), Real(b.velocity.y())), w.nextId++, rho0);
+      }
+  }
+  if (dropped) {
+    std::ostringstream o;
+    o << "dropped " << dropped << " particles that the scene placed inside solids, in the box [" << dlo.x() << ", "
+      << dlo.y() << "] – [" << dhi.x() << ", " << dhi.y() << "]";
+    w.warnings.push_back(o.str());
+  }
+  // First density/pressure so that the initial state is complete for readers.
+  StepContext c = w.context(0);
+  stageGrid(c, false, w.scratchV, w.scratchR, w.scratchU);
+  stageDensity(c);
+  stagePressure(c);
+}
+
+World::~World() = default;
+
+void World::stepFrame() { step(1.0 / impl_->scene.fps); }
+
+void World::step(double dt) {
+  impl_->advance(dt);
+  ++impl_->frames;
+}
+
+const Particles& World::particles() const { return impl_->P; }
+std::size_t World::particleCount() const { return impl_->P.size(); }
+Vec2d World::origin() const { return impl_->origin; }
+Vec2d World::worldPosition(std::size_t i) const {
+  return Vec2d(impl_->P.x[i].x(), impl_->P.x[i].y()) + impl_->origin;
+}
+const std::vector<Collider>& World::colliders() const { return impl_->boundary.colliders; }
+const std::vector<Vec2>& World::boundarySamples() const { return impl_->boundary.samples; }
+b2World& World::box2d() { return *impl_->b2; }
+const SceneDef& World::scene() const { return impl_->scene; }
+double World::time() const { return impl_->time; }
+std::uint64_t World::frame() const { return impl_->frames; }
+std::uint64_t World::substeps() const { return impl_->steps; }
+int World::lastFrameSubsteps() const { return impl_->lastSubsteps; }
+Real World::particleMass() const { return impl_->mass; }
+Real World::support() const { return impl_->R; }
+Real World::spacing() const { return impl_->dx; }
+int World::threads() const { return impl_->pool.size(); }
+
+std::uint64_t World::stateHash() const {
+  const Particles& P = impl_->P;
+  std::vector<std::uint32_t> slotOf(impl_->nextId, 0xffffffffu);
+  for (std::size_t i = 0; i < P.size(); ++i) slotOf[P.id[i]] = std::uint32_t(i);
+  Xxh64 h;
+  h.update(impl_->origin.data(), sizeof(double) * 2);
+  for (std::uint32_t id = 0; id < impl_->nextId; ++id) {
+    const std::uint32_t s = slotOf[id];
+    if (s == 0xffffffffu) continue;
+    h.update(&id, sizeof id);
+    h.update(P.x[s].data(), sizeof(Real) * 2);
+    h.update(P.v[s].data(), sizeof(Real) * 2);
+  }
+  return h.digest();
+}
+
+DensityStats World::densityStats() const {
+  const Particles& P = impl_->P;
+  DensityStats s;
+  if (P.size() == 0) return s;
+  const double rho0 = impl_->scene.solver.restDensity;
+  double sumErr = 0, sumRho = 0, maxErr = 0;
+  for (std::size_t i = 0; i < P.size(); ++i) {
+    const double e = std::max(0.0, (double(P.rho[i]) - rho0) / rho0);
+    sumErr += e;
+    sumRho += P.rho[i];
+    maxErr = std::max(maxErr, e);
+  }
+  s.meanError = sumErr / double(P.size());
+  s.maxError = maxErr;
+  s.meanDensity = sumRho / double(P.size());
+  return s;
+}
+
+double World::kineticEnergy() const {
+  const Particles& P = impl_->P;
+  double e = 0;
+  for (std::size_t i = 0; i < P.size(); ++i) e += 0.5 * double(impl_->mass) * double(P.v[i].squaredNorm());
+  return e;
+}
+
+std::vector<StageTiming> World::timings() const {
+  return std::vector<StageTiming>(impl_->timing, impl_->timing + kStageCount);
+}
+
+std::vector<std::string> World::takeWarnings() {
+  std::vector<std::string> out;
+  out.swap(impl_->warnings);
+  return out;
+}
+
+}  // namespace sph2d

@@ -1,0 +1,4 @@
+#version 330 core
+// Solid pass: Box2D fixtures as triangles, already in NDC.
+layout(location = 0) in vec2 aPos;
+void main() { gl_Position = vec4(aPos, 0.0, 1.0); }

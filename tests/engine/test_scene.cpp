@@ -1,0 +1,91 @@
+// Scene loading: good scenes load, bad ones name file, line, column, key and what is allowed.
+#include <doctest/doctest.h>
+
+#include <string>
+
+#include "sph2d/scene.hpp"
+#include "test_util.hpp"
+
+using namespace sph2d;
+
+namespace {
+SceneError errorOf(const std::string& text) {
+  try {
+    parseScene(text, "bad.json");
+  } catch (const SceneError& e) {
+    return e;
+  }
+  FAIL("no SceneError for: " << text);
+  return SceneError("", 0, 0, "", "");
+}
+}  // namespace
+
+TEST_CASE("the default dam break scene loads with its documented values") {
+  const SceneDef s = test::scene("dam_break.json");
+  CHECK(s.name == "dam_break");
+  CHECK(s.blocks.size() == 1);
+  CHECK(s.bodies.size() == 1);
+  CHECK(s.bodies[0].fixtures.size() == 4);
+  CHECK(s.fps == 60);
+  CHECK(s.duration == 4);
+  CHECK(s.render.width == 960);
+  CHECK(s.render.height == 540);
+  const std::size_t n = countBlockParticles(s);
+  CHECK(n > 9000);
+  CHECK(n < 11000);
+}
+
+TEST_CASE("an unknown key names file, line, column, the key path and the allowed keys") {
+  const SceneError e = errorOf("{\n  \"solver\": {\n    \"spacing\": 0.02,\n    \"spacng\": 1\n  }\n}\n");
+  CHECK(e.file == "bad.json");
+  CHECK(e.line == 4);
+  CHECK(e.column == 5);
+  CHECK(e.key == "solver.spacng");
+  CHECK(std::string(e.what()).find("allowed keys: type, spacing") != std::string::npos);
+  CHECK(std::string(e.what()).rfind("bad.json:4:5: key 'solver.spacng'", 0) == 0);
+}
+
+TEST_CASE("a wrong type, a bad range and a bad choice are each reported at their key") {
+  SceneError e = errorOf("{\"fps\": \"sixty\"}");
+  CHECK(e.key == "fps");
+  CHECK(e.message.find("expected a number, got a string") != std::string::npos);
+
+  e = errorOf("{\"solver\": {\"spacing\": -0.1}}");
+  CHECK(e.key == "solver.spacing");
+  CHECK(e.message.find("> 0") != std::string::npos);
+
+  e = errorOf("{\"solver\": {\"type\": \"magic\"}}");
+  CHECK(e.message.find("allowed values: muller2003") != std::string::npos);
+
+  e = errorOf("{\"boundaries\": [{\"fixtures\": [{\"shape\": \"box\", \"half_size\": [1, 0]}]}]}");
+  CHECK(e.key == "boundaries[0].fixtures[0].half_size");
+
+  e = errorOf("{\"boundaries\": [{\"fixtures\": [{\"shape\": \"polygon\", \"vertices\": [[0,0],[2,0],[1,0.2],[2,2],[0,2]]}]}]}");
+  CHECK(e.message.find("convex") != std::string::npos);
+
+  e = errorOf("{\"fluid\": [{\"min\": [0, 0], \"max\": [1]}]}");
+  CHECK(e.key == "fluid[0].max");
+}
+
+TEST_CASE("invalid JSON reports the line and column of the fault") {
+  const SceneError e = errorOf("{\n  \"fps\": 60,\n  \"duration\": 4,,\n}\n");
+  CHECK(e.line == 3);
+  CHECK(e.column == 17);
+  CHECK(e.message.find("invalid JSON") != std::string::npos);
+}
+
+TEST_CASE("a spacing too small for the particle budget is refused with the count") {
+  const SceneError e = errorOf("{\"max_particles\": 1000, \"solver\": {\"spacing\": 0.01}, \"fluid\": [{\"min\": [0,0], \"max\": [1,1]}]}");
+  CHECK(e.key == "solver.spacing");
+  CHECK(e.message.find("10000 particles") != std::string::npos);
+}
+
+TEST_CASE("a missing scene file names the file") {
+  try {
+    loadScene("/nonexistent/scene.json");
+    FAIL("expected SceneError");
+  } catch (const SceneError& e) {
+    CHECK(e.file == "/nonexistent/scene.json");
+    CHECK(e.message.find("cannot open") != std::string::npos);
+  }
+}

@@ -1,0 +1,141 @@
+// The Müller 2003 step against Box2D walls: rest, the dam break, determinism.
+#include <doctest/doctest.h>
+
+#include <box2d/box2d.h>
+
+#include <cmath>
+
+#include "sph2d/world.hpp"
+#include "test_util.hpp"
+
+using namespace sph2d;
+
+namespace {
+
+/// Particles outside the tank's inner rectangle (plus a small tolerance).
+std::size_t outside(const World& w, double x0, double y0, double x1, double y1) {
+  std::size_t n = 0;
+  for (std::size_t i = 0; i < w.particleCount(); ++i) {
+    const Vec2d p = w.worldPosition(i);
+    if (!(p.x() >= x0 && p.x() <= x1 && p.y() >= y0 && p.y() <= y1)) ++n;
+  }
+  return n;
+}
+
+double frontX(const World& w) {
+  double m = -1e300;
+  for (std::size_t i = 0; i < w.particleCount(); ++i) m = std::max(m, w.worldPosition(i).x());
+  return m;
+}
+
+}  // namespace
+
+TEST_CASE("a resting column settles: density within 5 % of rho0, particles at rest") {
+  const SceneDef s = test::scene("tests/resting_column.json");
+  World w(s, WorldOptions{2});
+  const double H = 0.6, g = 9.81;
+  for (int f = 0; f < 120; ++f) w.stepFrame();  // 2 s
+  REQUIRE(test::allFiniteState(w));
+  const DensityStats d = w.densityStats();
+  MESSAGE("mean density " << d.meanDensity << ", mean compression " << d.meanError);
+  CHECK(std::fabs(d.meanDensity - 1000.0) / 1000.0 < 0.05);
+  double meanSpeed = 0;
+  for (std::size_t i = 0; i < w.particleCount(); ++i) meanSpeed += w.particles().v[i].norm();
+  meanSpeed /= double(w.particleCount());
+  MESSAGE("mean speed " << meanSpeed << " m/s against sqrt(gH) = " << std::sqrt(g * H));
+  CHECK(meanSpeed < 0.02 * std::sqrt(g * H));
+  CHECK(outside(w, 0, 0, 0.6, 1.3) == 0);
+}
+
+TEST_CASE("the dam break runs 1 s: no NaN, nothing leaves the tank, the front moves right") {
+  const SceneDef s = test::scene("tests/small_dam_break.json");
+  World w(s, WorldOptions{2});
+  const double front0 = frontX(w);
+  CHECK(w.kineticEnergy() == 0);
+  double sumY0 = 0;
+  for (std::size_t i = 0; i < w.particleCount(); ++i) sumY0 += w.worldPosition(i).y();
+  const std::size_t n0 = w.particleCount();
+  for (int f = 0; f < 60; ++f) w.stepFrame();
+  CHECK(w.time() == doctest::Approx(1.0).epsilon(1e-6));
+  REQUIRE(test::allFiniteState(w));
+  CHECK(w.particleCount() == n0);
+  CHECK(outside(w, 0, 0, 4, 3) == 0);
+  const double front = frontX(w);
+  MESSAGE("front moved from " << front0 << " to " << front << " m");
+  // Shallow-water theory puts the front speed at 2·sqrt(g·2) ≈ 8.9 m/s; the tank is 4 m long.
+  CHECK(front > front0 + 1.5);
+  // Kinetic energy is bounded by the potential energy released (viscosity and walls only remove energy).
+  double sumY = 0;
+  for (std::size_t i = 0; i < w.particleCount(); ++i) sumY += w.worldPosition(i).y();
+  const double released = double(w.particleMass()) * 9.81 * (sumY0 - sumY);
+  MESSAGE("kinetic " << w.kineticEnergy() << " J/m, potential released " << released << " J/m");
+  CHECK(released > 0);
+  CHECK(w.kineticEnergy() <= released);
+}
+
+TEST_CASE("the state hash is the same for 1, 2 and 3 threads and for two runs") {
+  const SceneDef s = test::scene("tests/small_dam_break.json");
+  std::uint64_t hashes[4];
+  const int threads[4] = {1, 2, 3, 2};
+  for (int k = 0; k < 4; ++k) {
+    World w(s, WorldOptions{threads[k]});
+    for (int f = 0; f < 20; ++f) w.stepFrame();
+    hashes[k] = w.stateHash();
+  }
+  CHECK(hashes[0] == hashes[1]);
+  CHECK(hashes[0] == hashes[2]);
+  CHECK(hashes[1] == hashes[3]);
+  // And the hash does see the state: one more frame changes it.
+  World w(s, WorldOptions{1});
+  for (int f = 0; f < 21; ++f) w.stepFrame();
+  CHECK(w.stateHash() != hashes[0]);
+}
+
+TEST_CASE("the walls are real Box2D fixtures of the world's b2World") {
+  const SceneDef s = test::scene("dam_break.json");
+  World w(s, WorldOptions{1});
+  int bodies = 0, fixtures = 0;
+  for (b2Body* b = w.box2d().GetBodyList(); b; b = b->GetNext()) {
+    ++bodies;
+    CHECK(b->GetType() == b2_staticBody);
+    for (b2Fixture* f = b->GetFixtureList(); f; f = f->GetNext()) ++fixtures;
+  }
+  CHECK(bodies == 1);
+  CHECK(fixtures == 4);
+  CHECK(w.colliders().size() == 4);
+  // A point inside the floor box is inside a fixture; the tank's middle is not.
+  bool inFloor = false, inMiddle = false;
+  for (b2Body* b = w.box2d().GetBodyList(); b; b = b->GetNext())
+    for (b2Fixture* f = b->GetFixtureList(); f; f = f->GetNext()) {
+      inFloor = inFloor || f->TestPoint(b2Vec2(2.0f, -0.1f));
+      inMiddle = inMiddle || f->TestPoint(b2Vec2(2.0f, 1.5f));
+    }
+  CHECK(inFloor);
+  CHECK_FALSE(inMiddle);
+}
+
+TEST_CASE("particles a scene places inside a solid are dropped with one warning") {
+  SceneDef s = test::scene("tests/resting_column.json");
+  s.blocks[0].min = Vec2d(-0.1, 0.0);  // 0.1 m of the block inside the left wall
+  World w(s, WorldOptions{1});
+  const auto warnings = w.takeWarnings();
+  REQUIRE(warnings.size() == 1);
+  CHECK(warnings[0].find("dropped") != std::string::npos);
+  CHECK(warnings[0].find("dropped 150 particles") != std::string::npos);  // 5 columns × 30 rows
+  CHECK(w.particleCount() == 30u * 30u);
+  for (std::size_t i = 0; i < w.particleCount(); ++i) CHECK(w.worldPosition(i).x() > 0);
+}
+
+TEST_CASE("the guard stops a run at the first non-finite value and names stage and particle") {
+  SceneDef s = test::scene("tests/small_dam_break.json");
+  s.gravity = Vec2d(0, std::nan(""));
+  World w(s, WorldOptions{2});
+  try {
+    w.stepFrame();
+    FAIL("expected SimulationError");
+  } catch (const SimulationError& e) {
+    CHECK(e.stage == "forces");
+    CHECK(e.step == 0);
+    CHECK(std::string(e.what()).find("particle id") != std::string::npos);
+  }
+}
