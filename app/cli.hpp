@@ -33,5 +33,7 @@ void installStopHandler();
 int cmdRun(const std::vector<std::string>& args);
 /// `sph2d info`.
 int cmdInfo(const std::vector<std::string>& args);
+/// `sph2d bench step`.
+int cmdBenchStep(const std::vector<std::string>& args);
 
 }  // namespace sph2d::cli

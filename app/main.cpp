@@ -23,6 +23,7 @@ const char* kMainHelp =
     "Usage:\n"
     "  sph2d run SCENE.json [options]   simulate a scene and write PNG frames\n"
     "  sph2d info SCENE.json            print what a scene will simulate\n"
+    "  sph2d bench step [options]       step throughput (particle-steps per second)\n"
     "  sph2d --help | COMMAND --help\n"
     "\n"
     "Exit codes: 0 ok, 1 runtime failure, 2 bad input, 3 simulation stopped by the guard, 130 interrupted.\n";
@@ -40,7 +41,13 @@ int main(int argc, char** argv) {
     args.erase(args.begin());
     if (cmd == "run") return cmdRun(args);
     if (cmd == "info") return cmdInfo(args);
-    throw UsageError("unknown command '" + cmd + "'; commands: run, info (see sph2d --help)");
+    if (cmd == "bench") {
+      const std::string what = args.empty() ? "" : args[0];
+      if (!args.empty()) args.erase(args.begin());
+      if (what == "step") return cmdBenchStep(args);
+      throw UsageError("unknown benchmark '" + what + "'; benchmarks: step (see sph2d bench step --help)");
+    }
+    throw UsageError("unknown command '" + cmd + "'; commands: run, info, bench (see sph2d --help)");
   } catch (const UsageError& e) {
     std::fprintf(stderr, "sph2d: %s\n", e.what());
     return 2;

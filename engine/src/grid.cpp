@@ -5,7 +5,9 @@
 
 namespace sph2d {
 
-void Grid::build(const Vec2* x, std::size_t n, Real minCell, ThreadPool& pool) {
+void Grid::build(const Vec2* x, std::size_t n, Real support, ThreadPool& pool, int cellsPerSupport) {
+  reach = std::max(1, cellsPerSupport);
+  const Real minCell = support / Real(reach);
   struct Box {
     Real x0, y0, x1, y1;
   };
@@ -32,7 +34,7 @@ void Grid::build(const Vec2* x, std::size_t n, Real minCell, ThreadPool& pool) {
   } else {
     lo = Vec2(box.x0, box.y0);
     const double ex = double(box.x1) - double(box.x0), ey = double(box.y1) - double(box.y0);
-    const double maxCells = std::max<double>(4.0 * double(n), 4096.0);
+    const double maxCells = std::max<double>(16.0 * double(n), 4096.0);
     double c = minCell;
     for (;;) {
       const double cx = std::floor(ex / c) + 1, cy = std::floor(ey / c) + 1;

@@ -21,11 +21,32 @@ namespace sph2d {
 
 constexpr std::size_t kNone = std::numeric_limits<std::size_t>::max();
 constexpr std::size_t kBlock = 256;  ///< particles per job block (fixed: results never depend on threads)
+static_assert(kBlock == 256, "NeighbourLists::kBlockSize must equal kBlock");
+
+/// Each particle's neighbours within the support (itself excluded), built
+/// once per substep and read by every later pass. Stored per job block so that
+/// blocks fill them in parallel without sharing; buffers keep their capacity,
+/// so after warm-up a step allocates nothing.
+struct NeighbourLists {
+  std::vector<std::vector<std::uint32_t>> perBlock;  ///< neighbour slots, block by block
+  std::vector<std::uint32_t> start;                  ///< offset of particle i's list in its block
+  std::vector<std::uint32_t> count;                  ///< number of neighbours of particle i
+  /// First neighbour slot of particle i.
+  const std::uint32_t* of(std::size_t i) const { return perBlock[i / kBlockSize].data() + start[i]; }
+  /// Total pairs (each counted from both sides).
+  std::size_t pairs() const {
+    std::size_t n = 0;
+    for (std::uint32_t c : count) n += c;
+    return n;
+  }
+  static constexpr std::size_t kBlockSize = 256;
+};
 
 /// Everything a stage needs for one substep.
 struct StepContext {
   Particles& P;
   Grid& grid;
+  NeighbourLists& nbr;
   const BoundarySet& boundary;
   ThreadPool& pool;
   Poly6<Real> poly6;            ///< density kernel
@@ -45,7 +66,9 @@ struct StepContext {
 /// Neighbour grid (counting sort) and, when `reorder`, the particle arrays permuted into cell order.
 void stageGrid(StepContext& c, bool reorder, std::vector<Vec2>& scratchV, std::vector<Real>& scratchR,
                std::vector<std::uint32_t>& scratchU);
-/// ρ_i = Σ_j m W_poly6(x_i − x_j) + Σ_b ρ0 γΨ_b W_poly6(x_i − x_b). Reads x; writes rho.
+/// Neighbour lists: the grid's candidates within R, compacted without branches. Reads x, grid; writes nbr.
+void stageNeighbours(StepContext& c);
+/// ρ_i = m W(0) + Σ_j m W_poly6(x_i − x_j) + Σ_b ρ0 Ψ_b W_poly6(x_i − x_b). Reads x, nbr; writes rho.
 std::size_t stageDensity(StepContext& c);
 /// p_i = K(ρ_i − ρ0), clamped at 0 when asked. Reads rho; writes p.
 void stagePressure(StepContext& c);

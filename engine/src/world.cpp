@@ -19,8 +19,8 @@ SimulationError::SimulationError(const std::string& what, std::string stage_, st
 
 namespace {
 
-enum StageId { kStageGrid, kStageDensity, kStagePressure, kStageForces, kStageIntegrate, kStageCollide, kStageCount };
-const char* const kStageNames[kStageCount] = {"grid", "density", "pressure", "forces", "integrate", "collide"};
+enum StageId { kStageGrid, kStageNeighbours, kStageDensity, kStagePressure, kStageForces, kStageIntegrate, kStageCollide, kStageCount };
+const char* const kStageNames[kStageCount] = {"grid", "neighbours", "density", "pressure", "forces", "integrate", "collide"};
 
 b2Vec2 bv(const Vec2d& v) { return b2Vec2(float(v.x()), float(v.y())); }
 
@@ -95,6 +95,7 @@ struct World::Impl {
   Vec2d origin{0, 0};
   Particles P;
   Grid grid;
+  NeighbourLists nbr;
   BoundarySet boundary;
   Real dx = 0, R = 0, mass = 0;
   double time = 0;
@@ -114,7 +115,7 @@ struct World::Impl {
 
   StepContext context(Real dt) {
     const SolverDef& sd = scene.solver;
-    StepContext c{P, grid, boundary, pool, Poly6<Real>(R), Spiky<Real>(R), ViscosityKernel<Real>(R)};
+    StepContext c{P, grid, nbr, boundary, pool, Poly6<Real>(R), Spiky<Real>(R), ViscosityKernel<Real>(R)};
     c.dt = dt;
     c.mass = mass;
     c.rho0 = Real(sd.restDensity);
@@ -167,6 +168,7 @@ struct World::Impl {
     const int every = scene.solver.reorderInterval;
     const bool reorder = every > 0 && steps % std::uint64_t(every) == 0;
     timed(kStageGrid, [&] { stageGrid(c, reorder, scratchV, scratchR, scratchU); });
+    timed(kStageNeighbours, [&] { stageNeighbours(c); });
     std::size_t bad = timed(kStageDensity, [&] { return stageDensity(c); });
     if (bad != kNone) fail(kStageDensity, bad);
     timed(kStagePressure, [&] { stagePressure(c); });
@@ -284,6 +286,7 @@ World::World(const SceneDef& scene, const WorldOptions& options) : impl_(std::ma
   // First density/pressure so that the initial state is complete for readers.
   StepContext c = w.context(0);
   stageGrid(c, false, w.scratchV, w.scratchR, w.scratchU);
+  stageNeighbours(c);
   stageDensity(c);
   stagePressure(c);
 }
@@ -360,6 +363,29 @@ double World::kineticEnergy() const {
 std::vector<StageTiming> World::timings() const {
   return std::vector<StageTiming>(impl_->timing, impl_->timing + kStageCount);
 }
+
+void World::resetTimings() {
+  for (auto& t : impl_->timing) {
+    t.seconds = 0;
+    t.calls = 0;
+  }
+}
+
+std::size_t World::neighbourPairs() const { return impl_->nbr.pairs(); }
+
+std::size_t World::memoryBytes() const {
+  const Impl& w = *impl_;
+  auto cap = [](const auto& v) { return v.capacity() * sizeof(v[0]); };
+  std::size_t b = w.P.bytes();
+  b += cap(w.grid.cellStart) + cap(w.grid.sorted) + cap(w.grid.cellOf) + cap(w.grid.scratch_);
+  b += cap(w.nbr.start) + cap(w.nbr.count);
+  for (const auto& v : w.nbr.perBlock) b += cap(v);
+  b += cap(w.scratchV) + cap(w.scratchR) + cap(w.scratchU);
+  b += cap(w.boundary.samples) + cap(w.boundary.volume) + cap(w.boundary.sideNormal) + cap(w.boundary.sideOffset);
+  return b;
+}
+
+void World::substep() { impl_->substep(impl_->stableDt()); }
 
 std::vector<std::string> World::takeWarnings() {
   std::vector<std::string> out;

@@ -2,6 +2,7 @@
 #include <doctest/doctest.h>
 
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <cstdio>
 #include <cstdlib>
@@ -23,7 +24,9 @@ struct Result {
 };
 
 Result run(const std::string& args) {
-  const std::string log = std::string(SPH2D_TEST_TMP) + "/cmd.log";
+  // CTest runs test cases in parallel processes: one log per process and call.
+  static int calls = 0;
+  const std::string log = std::string(SPH2D_TEST_TMP) + "/cmd_" + std::to_string(::getpid()) + "_" + std::to_string(++calls) + ".log";
   fs::create_directories(SPH2D_TEST_TMP);
   const std::string cmd = std::string("\"") + SPH2D_EXE + "\" " + args + " > \"" + log + "\" 2>&1";
   const int status = std::system(cmd.c_str());

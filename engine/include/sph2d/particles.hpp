@@ -21,6 +21,8 @@ struct Particles {
   std::vector<Vec2> xPrev;        ///< position before the last integration (swept collision)
   std::vector<Real> rho;          ///< density [kg/m³]
   std::vector<Real> p;            ///< pressure [Pa]
+  std::vector<Real> invRho;       ///< 1/ρ, set by the pressure stage (saves divisions in pair loops)
+  std::vector<Real> pOverRho;     ///< p/ρ, set by the pressure stage
   std::vector<std::uint32_t> id;  ///< stable identifier
 
   /// Number of particles.
@@ -33,12 +35,15 @@ struct Particles {
     xPrev.push_back(pos);
     rho.push_back(rho0);
     p.push_back(0);
+    invRho.push_back(1 / rho0);
+    pOverRho.push_back(0);
     id.push_back(pid);
   }
   /// Bytes held by the particle arrays (capacity, not size).
   std::size_t bytes() const {
     return (x.capacity() + v.capacity() + a.capacity() + xPrev.capacity()) * sizeof(Vec2) +
-           (rho.capacity() + p.capacity()) * sizeof(Real) + id.capacity() * sizeof(std::uint32_t);
+           (rho.capacity() + p.capacity() + invRho.capacity() + pOverRho.capacity()) * sizeof(Real) +
+           id.capacity() * sizeof(std::uint32_t);
   }
 };
 

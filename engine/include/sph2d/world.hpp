@@ -66,6 +66,8 @@ class World {
   void stepFrame();
   /// Advances `dt` seconds in CFL substeps. Throws SimulationError.
   void step(double dt);
+  /// Advances one CFL-limited substep (for benchmarks and tests). Throws SimulationError.
+  void substep();
 
   /// The particles (local frame; add origin() for world coordinates).
   const Particles& particles() const;
@@ -107,8 +109,14 @@ class World {
   DensityStats densityStats() const;
   /// Kinetic energy ½ Σ m |v|² [J per metre of depth].
   double kineticEnergy() const;
-  /// Per-stage wall time and calls since construction.
+  /// Per-stage wall time and calls since construction (or the last resetTimings()).
   std::vector<StageTiming> timings() const;
+  /// Zeroes the stage timings.
+  void resetTimings();
+  /// Neighbour pairs (each counted from both sides) of the last substep.
+  std::size_t neighbourPairs() const;
+  /// Bytes the world holds for its particles, grid, neighbour lists and boundary samples.
+  std::size_t memoryBytes() const;
   /// Messages the world wants the user to see (substep cap hits, dropped particles); cleared on read.
   std::vector<std::string> takeWarnings();
 
