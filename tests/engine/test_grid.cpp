@@ -1,0 +1,86 @@
+// The neighbour grid and lists find exactly the brute-force neighbour sets.
+#include <doctest/doctest.h>
+
+#include <algorithm>
+#include <cstdint>
+#include <random>
+#include <vector>
+
+#include "grid.hpp"
+#include "sph2d/thread_pool.hpp"
+
+using namespace sph2d;
+
+namespace {
+
+/// Deterministic uniform in [0, 1) from a 64-bit engine (portable across standard libraries).
+double unit(std::mt19937_64& rng) { return double(rng() >> 11) * (1.0 / 9007199254740992.0); }
+
+void expectSameAsBruteForce(const std::vector<Vec2>& x, Real R, int cellsPerSupport, ThreadPool& pool) {
+  Grid g;
+  g.build(x.data(), x.size(), R, pool, cellsPerSupport);
+  const Real R2 = R * R;
+  std::size_t mismatches = 0, pairs = 0;
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    std::vector<std::uint32_t> fromGrid, brute;
+    g.forCandidates(x[i], [&](std::uint32_t j) {
+      if ((x[i] - x[j]).squaredNorm() < R2) fromGrid.push_back(j);
+    });
+    for (std::size_t j = 0; j < x.size(); ++j)
+      if ((x[i] - x[j]).squaredNorm() < R2) brute.push_back(std::uint32_t(j));
+    std::sort(fromGrid.begin(), fromGrid.end());  // unique values: no ties
+    pairs += brute.size();
+    if (fromGrid != brute) ++mismatches;
+  }
+  CHECK(mismatches == 0);
+  CHECK(pairs >= x.size());  // every particle finds at least itself
+}
+
+}  // namespace
+
+TEST_CASE("grid neighbours equal brute force: random, clustered and degenerate inputs") {
+  ThreadPool pool(2);
+  std::mt19937_64 rng(12345);
+  const Real R = 0.05f;
+  for (int cps : {1, 2}) {
+    CAPTURE(cps);
+    // Uniform random.
+    std::vector<Vec2> x;
+    for (int i = 0; i < 1500; ++i) x.emplace_back(Real(unit(rng)), Real(unit(rng)));
+    expectSameAsBruteForce(x, R, cps, pool);
+    // Clustered: tight Gaussian-ish blobs.
+    x.clear();
+    for (int c = 0; c < 5; ++c) {
+      const double cx = unit(rng), cy = unit(rng);
+      for (int i = 0; i < 300; ++i) x.emplace_back(Real(cx + 0.02 * (unit(rng) - 0.5)), Real(cy + 0.02 * (unit(rng) - 0.5)));
+    }
+    expectSameAsBruteForce(x, R, cps, pool);
+    // All particles in one cell, many coincident.
+    x.assign(400, Vec2(0.3f, 0.3f));
+    for (int i = 0; i < 400; i += 2) x[i] += Vec2(Real(0.001 * unit(rng)), 0);
+    expectSameAsBruteForce(x, R, cps, pool);
+    // Exactly on cell borders (multiples of the cell size).
+    x.clear();
+    for (int j = 0; j < 30; ++j)
+      for (int i = 0; i < 30; ++i) x.emplace_back(Real(i) * R / Real(cps), Real(j) * R / Real(cps));
+    expectSameAsBruteForce(x, R, cps, pool);
+    // Far outside the usual range: a cluster at the origin and stragglers 10 km away.
+    x.clear();
+    for (int i = 0; i < 500; ++i) x.emplace_back(Real(0.2 * unit(rng)), Real(0.2 * unit(rng)));
+    for (int i = 0; i < 20; ++i) x.emplace_back(Real(1e4 + 0.03 * i), Real(-1e4));
+    x.emplace_back(-3e4f, 2e4f);
+    expectSameAsBruteForce(x, R, cps, pool);
+  }
+}
+
+TEST_CASE("grid build keeps its cell count bounded for a huge bounding box") {
+  ThreadPool pool(1);
+  std::vector<Vec2> x = {Vec2(0, 0), Vec2(1e6f, 1e6f), Vec2(0.01f, 0)};
+  Grid g;
+  g.build(x.data(), x.size(), 0.05f, pool, 2);
+  CHECK(double(g.nx) * double(g.ny) <= 4096.0 * 1.05);
+  CHECK(g.cell >= 0.025f);
+  int found = 0;
+  g.forCandidates(x[0], [&](std::uint32_t j) { found += (x[0] - x[j]).squaredNorm() < 0.0025f; });
+  CHECK(found == 2);
+}
