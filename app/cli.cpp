@@ -42,9 +42,9 @@ std::vector<int> parseIntList(const std::string& flag, const std::string& v, int
 void printProfile(const World& w) {
   double total = 0;
   for (const auto& t : w.timings()) total += t.seconds;
-  std::printf("%-12s %10s %10s %8s %7s\n", "stage", "calls", "seconds", "ms/call", "share");
+  std::printf("%-16s %10s %10s %8s %7s\n", "stage", "calls", "seconds", "ms/call", "share");
   for (const auto& t : w.timings())
-    std::printf("%-12s %10llu %10.3f %8.4f %6.1f%%\n", t.name.c_str(), (unsigned long long)t.calls, t.seconds,
+    std::printf("%-16s %10llu %10.3f %8.4f %6.1f%%\n", t.name.c_str(), (unsigned long long)t.calls, t.seconds,
                 t.calls ? 1e3 * t.seconds / double(t.calls) : 0.0, total > 0 ? 100.0 * t.seconds / total : 0.0);
 }
 

@@ -8,6 +8,8 @@
 #include <cstring>
 #include <sstream>
 
+#include "effects/effect.hpp"
+#include "solvers/solver.hpp"
 #include "sph2d/hash.hpp"
 #include "stages.hpp"
 
@@ -18,9 +20,6 @@ SimulationError::SimulationError(const std::string& what, std::string stage_, st
     : std::runtime_error(what), stage(std::move(stage_)), particleId(particleId_), step(step_), time(time_) {}
 
 namespace {
-
-enum StageId { kStageGrid, kStageNeighbours, kStageDensity, kStagePressure, kStageForces, kStageIntegrate, kStageCollide, kStageCount };
-const char* const kStageNames[kStageCount] = {"grid", "neighbours", "density", "pressure", "forces", "integrate", "collide"};
 
 b2Vec2 bv(const Vec2d& v) { return b2Vec2(float(v.x()), float(v.y())); }
 
@@ -87,7 +86,7 @@ double latticeSum(const Poly6<double>& W, double dx, double yFrom) {
 
 }  // namespace
 
-struct World::Impl {
+struct World::Impl final : StageRunner {
   SceneDef scene;
   ThreadPool pool;
   std::unique_ptr<b2World> ownWorld;
@@ -97,87 +96,79 @@ struct World::Impl {
   Grid grid;
   NeighbourLists nbr;
   BoundarySet boundary;
+  Scratch scratch;
+  std::unique_ptr<Solver> solver;
+  EffectList effects;
   Real dx = 0, R = 0, mass = 0;
   double time = 0;
   std::uint64_t frames = 0, steps = 0;
   int lastSubsteps = 0;
   Real lastAccel = 0;
   std::uint32_t nextId = 0;
-  StageTiming timing[kStageCount];
+  std::vector<StageTiming> timing;  ///< in the order stages first ran
   std::vector<std::string> warnings;
-  std::vector<Vec2> scratchV;
-  std::vector<Real> scratchR;
-  std::vector<std::uint32_t> scratchU;
 
-  explicit Impl(const SceneDef& s, const WorldOptions& o) : scene(s), pool(o.threads) {
-    for (int k = 0; k < kStageCount; ++k) timing[k].name = kStageNames[k];
-  }
+  explicit Impl(const SceneDef& s, const WorldOptions& o) : scene(s), pool(o.threads) {}
 
   StepContext context(Real dt) {
-    const SolverDef& sd = scene.solver;
-    StepContext c{P, grid, nbr, boundary, pool, Poly6<Real>(R), Spiky<Real>(R), ViscosityKernel<Real>(R)};
+    StepContext c{P, grid, nbr, boundary, pool, scratch, scene.solver};
+    c.R = R;
+    c.dx = dx;
     c.dt = dt;
     c.mass = mass;
-    c.rho0 = Real(sd.restDensity);
-    c.stiffness = Real(sd.soundSpeed * sd.soundSpeed);
-    c.mu = Real(sd.viscosity * sd.restDensity);
+    c.rho0 = Real(scene.solver.restDensity);
     c.gravity = Vec2(Real(scene.gravity.x()), Real(scene.gravity.y()));
-    c.clampNegative = sd.clampNegativePressure;
     c.clearance = Real(0.25) * dx;
-    c.maxSpeed = Real(sd.maxSpeed);
+    c.maxSpeed = Real(scene.solver.maxSpeed);
+    c.step = steps;
     return c;
   }
 
-  template <class F>
-  auto timed(StageId s, F&& f) {
-    const auto t0 = std::chrono::steady_clock::now();
-    if constexpr (std::is_void_v<decltype(f())>) {
-      f();
-      timing[s].seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-      ++timing[s].calls;
-    } else {
-      auto r = f();
-      timing[s].seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-      ++timing[s].calls;
-      return r;
-    }
+  StageTiming& timingOf(const char* name) {
+    for (auto& t : timing)
+      if (t.name == name) return t;
+    timing.push_back(StageTiming{name, 0, 0});
+    return timing.back();
   }
 
-  [[noreturn]] void fail(StageId s, std::size_t slot) {
+  void run(const char* name, const std::function<void()>& f) override {
+    const auto t0 = std::chrono::steady_clock::now();
+    f();
+    StageTiming& t = timingOf(name);
+    t.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    ++t.calls;
+  }
+
+  void checked(const char* name, const std::function<std::size_t()>& f) override {
+    std::size_t bad = kNone;
+    run(name, [&] { bad = f(); });
+    if (bad != kNone) fail(name, bad);
+  }
+
+  [[noreturn]] void fail(const char* stage, std::size_t slot) {
     std::ostringstream o;
     o.precision(9);
     const Vec2d w = Vec2d(P.x[slot].x(), P.x[slot].y()) + origin;
-    o << "simulation stopped: non-finite or runaway value after stage '" << kStageNames[s] << "' at substep " << steps
+    o << "simulation stopped: non-finite or runaway value after stage '" << stage << "' at substep " << steps
       << " (t = " << time << " s): particle id " << P.id[slot] << " position (" << w.x() << ", " << w.y()
       << ") velocity (" << P.v[slot].x() << ", " << P.v[slot].y() << ") density " << P.rho[slot] << " pressure "
       << P.p[slot] << " (speed limit solver.max_speed = " << scene.solver.maxSpeed << " m/s)";
-    throw SimulationError(o.str(), kStageNames[s], P.id[slot], steps, time);
+    throw SimulationError(o.str(), stage, P.id[slot], steps, time);
   }
 
   Real stableDt() {
-    const SolverDef& sd = scene.solver;
     const Real vmax = maxSpeedOf(P, pool);
-    Real dt = Real(sd.cfl) * R / (Real(sd.soundSpeed) + vmax);
-    if (lastAccel > 0) dt = std::min(dt, Real(0.25) * std::sqrt(R / lastAccel));
-    if (sd.viscosity > 0) dt = std::min(dt, Real(0.03) * R * R / Real(sd.viscosity));
+    const StepContext c = context(0);
+    Real dt = solver->maxTimeStep(c, vmax, lastAccel);
+    for (const auto& e : effects) dt = std::min(dt, e->maxTimeStep(c));
     return dt;
   }
 
   void substep(Real dt) {
     StepContext c = context(dt);
-    const int every = scene.solver.reorderInterval;
-    const bool reorder = every > 0 && steps % std::uint64_t(every) == 0;
-    timed(kStageGrid, [&] { stageGrid(c, reorder, scratchV, scratchR, scratchU); });
-    timed(kStageNeighbours, [&] { stageNeighbours(c); });
-    std::size_t bad = timed(kStageDensity, [&] { return stageDensity(c); });
-    if (bad != kNone) fail(kStageDensity, bad);
-    timed(kStagePressure, [&] { stagePressure(c); });
-    bad = timed(kStageForces, [&] { return stageForces(c); });
-    if (bad != kNone) fail(kStageForces, bad);
+    solver->substep(c, *this, effects);
     lastAccel = maxAccelOf(P, pool);
-    bad = timed(kStageIntegrate, [&] { return stageIntegrate(c); });
-    if (bad != kNone) fail(kStageIntegrate, bad);
-    timed(kStageCollide, [&] { stageCollide(c); });
+    run("collide", [&] { stageCollide(c); });
     time += double(dt);
     ++steps;
   }
@@ -208,6 +199,8 @@ struct World::Impl {
 World::World(const SceneDef& scene, const WorldOptions& options) : impl_(std::make_unique<Impl>(scene, options)) {
   Impl& w = *impl_;
   const SolverDef& sd = scene.solver;
+  w.solver = makeSolver(sd);
+  w.effects = makeEffects(scene);
   w.ownWorld = std::make_unique<b2World>(bv(scene.gravity));
   w.b2 = w.ownWorld.get();
   for (const BodyDef& b : scene.bodies) addBody(*w.b2, b);
@@ -246,11 +239,12 @@ World::World(const SceneDef& scene, const WorldOptions& options) : impl_(std::ma
   Vec2d dlo(0, 0), dhi(0, 0);
   const Real rho0 = Real(sd.restDensity);
   // Hydrostatic start: under gravity along −y, rows are placed closer with
-  // depth so that the block starts at the density the solver holds at rest
-  // (ρ = ρ0(1 + 2 g z / c²): p = c²(ρ − ρ0) and Müller's symmetric force
-  // recovers ∇p/2). Started uncompressed, a column would ring in its acoustic
-  // mode with a speed amplitude of about g·H/c.
-  const bool hydrostatic = scene.gravity.x() == 0 && scene.gravity.y() < 0;
+  // depth so that the block starts at the density the solver holds at rest,
+  // ρ = ρ0(1 + f g z / c²) with the solver's factor f (2 for muller2003, whose
+  // symmetric force recovers ∇p/2). Started uncompressed, a column would ring
+  // in its acoustic mode with a speed amplitude of about g·H/c.
+  const double hydroFactor = w.solver->hydrostaticFactor();
+  const bool hydrostatic = hydroFactor > 0 && scene.gravity.x() == 0 && scene.gravity.y() < 0;
   const double gz = -scene.gravity.y(), c2 = sd.soundSpeed * sd.soundSpeed;
   for (const FluidBlockDef& b : scene.blocks) {
     const long nx = long(std::floor((b.max.x() - b.min.x()) / sd.spacing + 1e-9));
@@ -259,7 +253,7 @@ World::World(const SceneDef& scene, const WorldOptions& options) : impl_(std::ma
     double prevScale = 1;
     for (long j = 0; j < ny; ++j) {
       const double depth = (double(ny - j) - 0.5) * sd.spacing;
-      const double scale = hydrostatic ? 1.0 / (1.0 + 2.0 * gz * depth / c2) : 1.0;
+      const double scale = hydrostatic ? 1.0 / (1.0 + hydroFactor * gz * depth / c2) : 1.0;
       rowY[std::size_t(j)] = j == 0 ? b.min.y() + 0.5 * sd.spacing * scale
                                     : rowY[std::size_t(j - 1)] + 0.5 * sd.spacing * (prevScale + scale);
       prevScale = scale;
@@ -285,10 +279,7 @@ World::World(const SceneDef& scene, const WorldOptions& options) : impl_(std::ma
   }
   // First density/pressure so that the initial state is complete for readers.
   StepContext c = w.context(0);
-  stageGrid(c, false, w.scratchV, w.scratchR, w.scratchU);
-  stageNeighbours(c);
-  stageDensity(c);
-  stagePressure(c);
+  w.solver->prepare(c);
 }
 
 World::~World() = default;
@@ -360,9 +351,7 @@ double World::kineticEnergy() const {
   return e;
 }
 
-std::vector<StageTiming> World::timings() const {
-  return std::vector<StageTiming>(impl_->timing, impl_->timing + kStageCount);
-}
+std::vector<StageTiming> World::timings() const { return impl_->timing; }
 
 void World::resetTimings() {
   for (auto& t : impl_->timing) {
@@ -380,7 +369,7 @@ std::size_t World::memoryBytes() const {
   b += cap(w.grid.cellStart) + cap(w.grid.sorted) + cap(w.grid.cellOf) + cap(w.grid.scratch_);
   b += cap(w.nbr.start) + cap(w.nbr.count);
   for (const auto& v : w.nbr.perBlock) b += cap(v);
-  b += cap(w.scratchV) + cap(w.scratchR) + cap(w.scratchU);
+  b += cap(w.scratch.v) + cap(w.scratch.r) + cap(w.scratch.u);
   b += cap(w.boundary.samples) + cap(w.boundary.volume) + cap(w.boundary.sideNormal) + cap(w.boundary.sideOffset);
   return b;
 }

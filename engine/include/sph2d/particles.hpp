@@ -7,6 +7,8 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <string>
+#include <utility>
 #include <vector>
 
 #include "sph2d/math.hpp"
@@ -25,8 +27,31 @@ struct Particles {
   std::vector<Real> pOverRho;     ///< p/ρ, set by the pressure stage
   std::vector<std::uint32_t> id;  ///< stable identifier
 
+  /// Optional per-particle scalar fields, created only by the solver or effect
+  /// that needs them (e.g. "age", "dfsph.alpha"), in creation order. Reordering
+  /// permutes them with the rest; push() gives new particles 0.
+  std::vector<std::pair<std::string, std::vector<Real>>> extra;
+
   /// Number of particles.
   std::size_t size() const { return x.size(); }
+  /// The optional field `name`, or nullptr when nothing created it.
+  std::vector<Real>* find(const std::string& name) {
+    for (auto& f : extra)
+      if (f.first == name) return &f.second;
+    return nullptr;
+  }
+  /// Const variant of find().
+  const std::vector<Real>* find(const std::string& name) const {
+    for (const auto& f : extra)
+      if (f.first == name) return &f.second;
+    return nullptr;
+  }
+  /// The optional field `name`, created (filled with `init`) on first use.
+  std::vector<Real>& field(const std::string& name, Real init = 0) {
+    if (auto* f = find(name)) return *f;
+    extra.emplace_back(name, std::vector<Real>(size(), init));
+    return extra.back().second;
+  }
   /// Appends one particle at rest-density with zero pressure.
   void push(const Vec2& pos, const Vec2& vel, std::uint32_t pid, Real rho0) {
     x.push_back(pos);
@@ -38,12 +63,15 @@ struct Particles {
     invRho.push_back(1 / rho0);
     pOverRho.push_back(0);
     id.push_back(pid);
+    for (auto& f : extra) f.second.push_back(0);
   }
   /// Bytes held by the particle arrays (capacity, not size).
   std::size_t bytes() const {
-    return (x.capacity() + v.capacity() + a.capacity() + xPrev.capacity()) * sizeof(Vec2) +
-           (rho.capacity() + p.capacity() + invRho.capacity() + pOverRho.capacity()) * sizeof(Real) +
-           id.capacity() * sizeof(std::uint32_t);
+    std::size_t b = (x.capacity() + v.capacity() + a.capacity() + xPrev.capacity()) * sizeof(Vec2) +
+                    (rho.capacity() + p.capacity() + invRho.capacity() + pOverRho.capacity()) * sizeof(Real) +
+                    id.capacity() * sizeof(std::uint32_t);
+    for (const auto& f : extra) b += f.second.capacity() * sizeof(Real);
+    return b;
   }
 };
 

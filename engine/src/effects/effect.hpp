@@ -1,0 +1,41 @@
+// effects/effect.hpp (internal) — an effect: a force the scene asks for.
+//
+// A scene's step runs only the effects the scene enables; an absent effect
+// has no object, allocates no particle field and runs no stage. Each effect
+// adds its acceleration to P.a after the solver's pressure force (or where
+// the solver calls applyEffects), and may limit the time step.
+#pragma once
+
+#include <limits>
+#include <memory>
+#include <vector>
+
+#include "stages.hpp"
+
+namespace sph2d {
+
+class Effect {
+ public:
+  virtual ~Effect() = default;
+  /// Stage name shown by --profile.
+  virtual const char* name() const = 0;
+  /// Adds this effect's acceleration to P.a. Returns the first bad slot or kNone.
+  virtual std::size_t apply(StepContext& c) = 0;
+  /// Largest stable time step this effect allows.
+  virtual Real maxTimeStep(const StepContext& c) const {
+    (void)c;
+    return std::numeric_limits<Real>::infinity();
+  }
+};
+
+using EffectList = std::vector<std::unique_ptr<Effect>>;
+
+/// The effects a scene enables, in a fixed order.
+EffectList makeEffects(const SceneDef& scene);
+
+/// Runs every effect as its own timed, guarded stage.
+inline void applyEffects(StepContext& c, StageRunner& run, const EffectList& effects) {
+  for (const auto& e : effects) run.checked(e->name(), [&] { return e->apply(c); });
+}
+
+}  // namespace sph2d

@@ -1,0 +1,176 @@
+// muller2003 — the SPH step of Müller, Charypar & Gross 2003, "Particle-based
+// fluid simulation for interactive applications" (seed 002), in 2D: poly6
+// density, p = K(ρ − ρ0) with K = c², the symmetric spiky pressure force
+// m (p_i + p_j)/(2ρ_j) ∇W, gravity, the scene's effects (viscosity: the
+// viscosity-kernel Laplacian), symplectic Euler. Walls: the boundary samples
+// act as frozen fluid in density and pressure.
+//
+// Measured property (docs/SCENES.md): the density and gradient kernels differ,
+// so the pressure force is not the gradient of an energy, and the symmetric
+// average recovers ∇p/2. A resting column needs ν ≳ 0.005 m²/s to stay calm,
+// and its pressure at rest grows by 2ρg per metre.
+#include <algorithm>
+#include <cmath>
+
+#include "solvers/solver.hpp"
+
+namespace sph2d {
+namespace {
+
+std::size_t density(StepContext& c, const Poly6<Real>& W) {
+  Particles& P = c.P;
+  const NeighbourLists& L = c.nbr;
+  const BoundarySet& B = c.boundary;
+  const bool hasBoundary = !B.samples.empty();
+  const Real self = W.valueR2(0);
+  return firstBad(c.pool, P.size(), [&](std::size_t b, std::size_t e) {
+    std::size_t bad = kNone;
+    for (std::size_t i = b; i < e; ++i) {
+      const Vec2 xi = P.x[i];
+      const std::uint32_t* nb = L.of(i);
+      const std::uint32_t cnt = L.count[i];
+      Real sum = self;
+      const Vec2* X = P.x.data();
+      for (std::uint32_t k = 0; k < cnt; ++k) {
+        const Vec2 xj = X[nb[k]];
+        const Real dx = xi.x() - xj.x(), dy = xi.y() - xj.y();
+        sum += W.valueR2(dx * dx + dy * dy);
+      }
+      Real rho = c.mass * sum;
+      if (hasBoundary) {
+        Real bs = 0;
+        B.sampleGrid.forCandidates(xi, [&](std::uint32_t k) {
+          if (B.visible(k, xi)) bs += B.volume[k] * W.valueR2((xi - B.samples[k]).squaredNorm());
+        });
+        rho += c.rho0 * bs;
+      }
+      P.rho[i] = rho;
+      if (!std::isfinite(rho) && bad == kNone) bad = i;
+    }
+    return bad;
+  });
+}
+
+void pressure(StepContext& c) {
+  const Real stiffness = Real(c.def.soundSpeed * c.def.soundSpeed);
+  const bool clampNegative = c.def.clampNegativePressure;
+  Particles& P = c.P;
+  c.pool.parallelFor(P.size(), 4096, [&](std::size_t b, std::size_t e) {
+    for (std::size_t i = b; i < e; ++i) {
+      Real p = stiffness * (P.rho[i] - c.rho0);
+      if (clampNegative && p < 0) p = 0;
+      P.p[i] = p;
+      P.invRho[i] = Real(1) / P.rho[i];
+      P.pOverRho[i] = p * P.invRho[i];
+    }
+  });
+}
+
+std::size_t pressureForce(StepContext& c, const Spiky<Real>& spiky) {
+  Particles& P = c.P;
+  const BoundarySet& B = c.boundary;
+  const bool hasBoundary = !B.samples.empty();
+  const Real R = spiky.R, R2 = R * R;
+  const Real tiny2 = Real(1e-12) * R2;
+  const Real spikyK = Real(-3) * spiky.c;  // dW/dr = −3c(R − r)²
+  const Real halfMass = Real(0.5) * c.mass;
+  const Vec2* X = P.x.data();
+  const Real* IR = P.invRho.data();
+  const Real* POR = P.pOverRho.data();
+  const std::uint32_t* ID = P.id.data();
+  return firstBad(c.pool, P.size(), [&](std::size_t b, std::size_t e) {
+    std::size_t bad = kNone;
+    for (std::size_t i = b; i < e; ++i) {
+      const Vec2 xi = P.x[i];
+      const Real rhoi = P.rho[i], pi = P.p[i];
+      const std::uint32_t idi = P.id[i];
+      // Σ m (p_i + p_j)/(2 ρ_j) ∇W (force density, Müller eq. 10), accumulated
+      // in scalars from raw arrays so the loop keeps everything in registers.
+      Real fpx = 0, fpy = 0;
+      const Real xix = xi.x(), xiy = xi.y();
+      const std::uint32_t* nb = c.nbr.of(i);
+      const std::uint32_t cnt = c.nbr.count[i];
+      for (std::uint32_t k = 0; k < cnt; ++k) {
+        const std::uint32_t j = nb[k];
+        Real dx = xix - X[j].x(), dy = xiy - X[j].y();
+        Real r2 = dx * dx + dy * dy;
+        if (r2 < tiny2) {  // coincident pair: a fixed, antisymmetric direction
+          const Vec2 t = tieBreakDirection(idi, ID[j]) * (Real(1e-6) * R);
+          dx = t.x();
+          dy = t.y();
+          r2 = dx * dx + dy * dy;
+        }
+        // One square root and one division per pair.
+        const Real invr = Real(1) / std::sqrt(r2);
+        const Real r = r2 * invr;
+        const Real a = R - r;
+        const Real irj = IR[j];
+        // Spiky gradient dW/dr · d/r, dW/dr = −3c(R − r)², times m (p_i + p_j)/(2 ρ_j).
+        const Real wp = spikyK * a * a * invr * (halfMass * (pi * irj + POR[j]));
+        fpx += dx * wp;
+        fpy += dy * wp;
+      }
+      const Vec2 fp(fpx, fpy);
+      const Real invRhoi = P.invRho[i];
+      Vec2 acc = -fp * invRhoi;
+      if (hasBoundary) {
+        // Boundary samples as frozen fluid of mass ρ0·Ψ_b whose pressure is the
+        // particle's own, extrapolated hydrostatically to the sample (Adami,
+        // Hu & Adams 2012). Müller's symmetric force recovers ∇p/2, so at rest
+        // this solver's pressure grows by 2ρg per metre: p_b = p_i + 2ρ_i g·(x_b − x_i).
+        Vec2 gb = Vec2::Zero();
+        B.sampleGrid.forCandidates(xi, [&](std::uint32_t k) {
+          const Vec2 d = xi - B.samples[k];
+          const Real r2 = d.squaredNorm();
+          if (r2 >= R2 || !B.visible(k, xi)) return;
+          const Real pb = std::max(Real(0), pi - Real(2) * rhoi * c.gravity.dot(d));
+          gb += spiky.gradient(d, std::sqrt(r2)) * (B.volume[k] * (pi + pb));
+        });
+        acc -= gb * (Real(0.5) * invRhoi);
+      }
+      acc += c.gravity;
+      P.a[i] = acc;
+      if (!allFinite(acc) && bad == kNone) bad = i;
+    }
+    return bad;
+  });
+}
+
+class Muller2003 final : public Solver {
+ public:
+  const char* name() const override { return "muller2003"; }
+  double hydrostaticFactor() const override { return 2.0; }
+
+  void prepare(StepContext& c) override {
+    stageGrid(c, false);
+    stageNeighbours(c);
+    density(c, Poly6<Real>(c.R));
+    pressure(c);
+  }
+
+  Real maxTimeStep(const StepContext& c, Real vmax, Real amax) const override {
+    Real dt = Real(c.def.cfl) * c.R / (Real(c.def.soundSpeed) + vmax);
+    if (amax > 0) dt = std::min(dt, Real(0.25) * std::sqrt(c.R / amax));
+    return dt;
+  }
+
+  void substep(StepContext& c, StageRunner& run, const EffectList& effects) override {
+    const Poly6<Real> W(c.R);
+    const Spiky<Real> S(c.R);
+    const int every = c.def.reorderInterval;
+    const bool reorder = every > 0 && c.step % std::uint64_t(every) == 0;
+    run.run("grid", [&] { stageGrid(c, reorder); });
+    run.run("neighbours", [&] { stageNeighbours(c); });
+    run.checked("density", [&] { return density(c, W); });
+    run.run("pressure", [&] { pressure(c); });
+    run.checked("pressure_force", [&] { return pressureForce(c, S); });
+    applyEffects(c, run, effects);
+    run.checked("integrate", [&] { return stageIntegrate(c); });
+  }
+};
+
+}  // namespace
+
+std::unique_ptr<Solver> makeMuller2003() { return std::make_unique<Muller2003>(); }
+
+}  // namespace sph2d

@@ -1,0 +1,141 @@
+// The stages every solver shares: grid, neighbour lists, integration,
+// collision, and the deterministic reductions.
+#include "stages.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace sph2d {
+
+namespace {
+
+template <class T>
+void permute(std::vector<T>& field, const std::vector<std::uint32_t>& order, std::vector<T>& scratch, ThreadPool& pool) {
+  scratch.resize(field.size());
+  pool.parallelFor(field.size(), 4096, [&](std::size_t b, std::size_t e) {
+    for (std::size_t k = b; k < e; ++k) scratch[k] = field[order[k]];
+  });
+  field.swap(scratch);
+}
+
+}  // namespace
+
+std::size_t firstBad(ThreadPool& pool, std::size_t n, const std::function<std::size_t(std::size_t, std::size_t)>& fn) {
+  return pool.reduce(n, kBlock, kNone, fn, [](std::size_t a, std::size_t b) { return std::min(a, b); });
+}
+
+Vec2 tieBreakDirection(std::uint32_t idi, std::uint32_t idj) {
+  const std::uint32_t lo = std::min(idi, idj), hi = std::max(idi, idj);
+  std::uint64_t h = (std::uint64_t(lo) << 32) | hi;
+  h ^= h >> 33;
+  h *= 0xff51afd7ed558ccdULL;
+  h ^= h >> 33;
+  const Real angle = Real(double(h % 3600) * (2 * 3.14159265358979323846 / 3600.0));
+  const Vec2 d(std::cos(angle), std::sin(angle));
+  return idi < idj ? d : Vec2(-d);
+}
+
+void stageGrid(StepContext& c, bool reorder) {
+  Particles& P = c.P;
+  c.grid.build(P.x.data(), P.size(), c.R, c.pool, 2);
+  if (!reorder) return;
+  const std::vector<std::uint32_t>& order = c.grid.sorted;
+  Scratch& s = c.scratch;
+  permute(P.x, order, s.v, c.pool);
+  permute(P.v, order, s.v, c.pool);
+  permute(P.a, order, s.v, c.pool);
+  permute(P.xPrev, order, s.v, c.pool);
+  permute(P.rho, order, s.r, c.pool);
+  permute(P.p, order, s.r, c.pool);
+  permute(P.invRho, order, s.r, c.pool);
+  permute(P.pOverRho, order, s.r, c.pool);
+  for (auto& f : P.extra) permute(f.second, order, s.r, c.pool);
+  permute(P.id, order, s.u, c.pool);
+  // After the permutation slot k is the k-th particle in cell order.
+  permute(c.grid.cellOf, order, s.u, c.pool);
+  for (std::size_t k = 0; k < c.grid.sorted.size(); ++k) c.grid.sorted[k] = std::uint32_t(k);
+}
+
+void stageNeighbours(StepContext& c) {
+  Particles& P = c.P;
+  const Grid& g = c.grid;
+  NeighbourLists& L = c.nbr;
+  const std::size_t n = P.size();
+  L.perBlock.resize((n + kBlock - 1) / kBlock);
+  L.start.resize(n);
+  L.count.resize(n);
+  const Real R2 = c.R * c.R;
+  c.pool.parallelFor(n, kBlock, [&](std::size_t b, std::size_t e) {
+    std::vector<std::uint32_t>& out = L.perBlock[b / kBlock];
+    std::size_t used = 0;
+    for (std::size_t i = b; i < e; ++i) {
+      const Vec2 xi = P.x[i];
+      L.start[i] = std::uint32_t(used);
+      g.forCandidateRanges(xi, [&](std::uint32_t kb, std::uint32_t ke) {
+        if (out.size() < used + (ke - kb)) out.resize(std::max(out.size() * 2, used + (ke - kb)));
+        std::uint32_t* dst = out.data();
+        const std::uint32_t* sorted = g.sorted.data();
+        const Vec2* X = P.x.data();
+        for (std::uint32_t k = kb; k < ke; ++k) {
+          const std::uint32_t j = sorted[k];
+          const Real dx = xi.x() - X[j].x(), dy = xi.y() - X[j].y();
+          const Real r2 = dx * dx + dy * dy;
+          dst[used] = j;  // written always, kept only when inside: no branch
+          used += std::size_t((r2 < R2) & (j != i));
+        }
+      });
+      L.count[i] = std::uint32_t(used - L.start[i]);
+    }
+  });
+}
+
+std::size_t stageIntegrate(StepContext& c) {
+  Particles& P = c.P;
+  const Real dt = c.dt;
+  const Real vmax2 = c.maxSpeed * c.maxSpeed;
+  return firstBad(c.pool, P.size(), [&](std::size_t b, std::size_t e) {
+    std::size_t bad = kNone;
+    for (std::size_t i = b; i < e; ++i) {
+      const Vec2 v = P.v[i] + P.a[i] * dt;
+      P.xPrev[i] = P.x[i];
+      P.v[i] = v;
+      P.x[i] = P.x[i] + v * dt;
+      if (bad == kNone && (!allFinite(P.x[i]) || !allFinite(v) || v.squaredNorm() > vmax2)) bad = i;
+    }
+    return bad;
+  });
+}
+
+void stageCollide(StepContext& c) {
+  Particles& P = c.P;
+  if (c.boundary.colliders.empty()) return;
+  c.pool.parallelFor(P.size(), kBlock, [&](std::size_t b, std::size_t e) {
+    for (std::size_t i = b; i < e; ++i) c.boundary.resolve(P.x[i], P.v[i], P.xPrev[i], c.clearance);
+  });
+}
+
+Real maxSpeedOf(const Particles& P, ThreadPool& pool) {
+  const Real m2 = pool.reduce(
+      P.size(), 4096, Real(0),
+      [&](std::size_t b, std::size_t e) {
+        Real m = 0;
+        for (std::size_t i = b; i < e; ++i) m = std::max(m, P.v[i].squaredNorm());
+        return m;
+      },
+      [](Real a, Real b) { return std::max(a, b); });
+  return std::sqrt(m2);
+}
+
+Real maxAccelOf(const Particles& P, ThreadPool& pool) {
+  const Real m2 = pool.reduce(
+      P.size(), 4096, Real(0),
+      [&](std::size_t b, std::size_t e) {
+        Real m = 0;
+        for (std::size_t i = b; i < e; ++i) m = std::max(m, P.a[i].squaredNorm());
+        return m;
+      },
+      [](Real a, Real b) { return std::max(a, b); });
+  return std::sqrt(m2);
+}
+
+}  // namespace sph2d
