@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "json_reader.hpp"
+#include "solvers/solver.hpp"
 
 namespace sph2d {
 
@@ -268,10 +269,13 @@ SceneDef parseScene(const std::string& text, const std::string& file) {
     const json& j = root.at("solver");
     const std::string p = "solver";
     r.requireObject(j, p);
-    r.checkKeys(j, p, {"type", "spacing", "support_ratio", "rest_density", "sound_speed", "viscosity", "cfl", "max_substeps",
-                       "clamp_negative_pressure", "reorder_interval", "max_speed"});
     SolverDef& d = s.solver;
-    d.type = r.string(j, p, "type", d.type, {"muller2003"});
+    d.type = r.string(j, p, "type", d.type, solverNames());
+    std::vector<std::string> keys = {"type", "spacing", "support_ratio", "rest_density", "sound_speed", "viscosity", "cfl",
+                                     "max_substeps", "clamp_negative_pressure", "reorder_interval", "max_speed"};
+    for (const SolverParam& sp : solverParams(d.type)) keys.push_back(sp.key);
+    r.checkKeys(j, p, keys);
+    for (const SolverParam& sp : solverParams(d.type)) d.params[sp.key] = r.number(j, p, sp.key, sp.def, sp.lo, sp.hi);
     d.spacing = r.number(j, p, "spacing", d.spacing, 0, 10, true);
     d.supportRatio = r.number(j, p, "support_ratio", d.supportRatio, 1.5, 4);
     d.restDensity = r.number(j, p, "rest_density", d.restDensity, 0, 1e5, true);
@@ -283,6 +287,9 @@ SceneDef parseScene(const std::string& text, const std::string& file) {
     d.reorderInterval = r.integer(j, p, "reorder_interval", d.reorderInterval, 0, 1000000);
     d.maxSpeed = r.number(j, p, "max_speed", d.maxSpeed, 0, 1e6, true);
   }
+
+  if (!root.contains("solver"))
+    for (const SolverParam& sp : solverParams(s.solver.type)) s.solver.params[sp.key] = sp.def;
 
   if (root.contains("boundaries")) {
     const json& arr = root.at("boundaries");

@@ -73,14 +73,11 @@ void addBody(b2World& world, const BodyDef& def) {
 }
 
 /// Σ W over a square lattice of spacing dx around one point (the point included).
-double latticeSum(const Poly6<double>& W, double dx, double yFrom) {
-  const int n = int(std::ceil(W.R / dx)) + 1;
+double latticeSum(const Solver& solver, double R, double dx) {
+  const int n = int(std::ceil(R / dx)) + 1;
   double s = 0;
-  for (int j = -n; j <= n; ++j) {
-    const double y = j * dx;
-    if (y < yFrom - 1e-12) continue;
-    for (int i = -n; i <= n; ++i) s += W.value(std::sqrt(i * dx * i * dx + y * y));
-  }
+  for (int j = -n; j <= n; ++j)
+    for (int i = -n; i <= n; ++i) s += solver.densityKernel(std::sqrt(double(i * i + j * j)) * dx, R);
   return s;
 }
 
@@ -196,8 +193,12 @@ struct World::Impl final : StageRunner {
   }
 };
 
-World::World(const SceneDef& scene, const WorldOptions& options) : impl_(std::make_unique<Impl>(scene, options)) {
+World::World(const SceneDef& sceneIn, const WorldOptions& options) : impl_(std::make_unique<Impl>(sceneIn, options)) {
   Impl& w = *impl_;
+  // A scene built in code may leave solver parameters out: give them their defaults.
+  for (const SolverParam& sp : solverParams(w.scene.solver.type))
+    if (!w.scene.solver.params.count(sp.key)) w.scene.solver.params[sp.key] = sp.def;
+  const SceneDef& scene = w.scene;
   const SolverDef& sd = scene.solver;
   w.solver = makeSolver(sd);
   w.effects = makeEffects(scene);
@@ -226,10 +227,8 @@ World::World(const SceneDef& scene, const WorldOptions& options) : impl_(std::ma
 
   w.dx = Real(sd.spacing);
   w.R = Real(sd.supportRatio * sd.spacing);
-  const Poly6<double> Wd(double(w.R));
   // Mass so that a full square lattice at spacing dx has exactly ρ0.
-  const double full = latticeSum(Wd, sd.spacing, -1e300);
-  w.mass = Real(sd.restDensity / full);
+  w.mass = Real(sd.restDensity / latticeSum(*w.solver, double(w.R), sd.spacing));
 
   w.boundary.collect(*w.b2, w.origin);
   w.boundary.sample(w.dx, w.R, w.pool);
@@ -240,12 +239,12 @@ World::World(const SceneDef& scene, const WorldOptions& options) : impl_(std::ma
   const Real rho0 = Real(sd.restDensity);
   // Hydrostatic start: under gravity along −y, rows are placed closer with
   // depth so that the block starts at the density the solver holds at rest,
-  // ρ = ρ0(1 + f g z / c²) with the solver's factor f (2 for muller2003, whose
-  // symmetric force recovers ∇p/2). Started uncompressed, a column would ring
+  // ρ = ρ0(1 + f g z) with the solver's factor f (2/c² for muller2003, whose
+  // symmetric force recovers ∇p/2; 1/c0² for wcsph). Started uncompressed, a column would ring
   // in its acoustic mode with a speed amplitude of about g·H/c.
   const double hydroFactor = w.solver->hydrostaticFactor();
   const bool hydrostatic = hydroFactor > 0 && scene.gravity.x() == 0 && scene.gravity.y() < 0;
-  const double gz = -scene.gravity.y(), c2 = sd.soundSpeed * sd.soundSpeed;
+  const double gz = -scene.gravity.y();
   for (const FluidBlockDef& b : scene.blocks) {
     const long nx = long(std::floor((b.max.x() - b.min.x()) / sd.spacing + 1e-9));
     const long ny = long(std::floor((b.max.y() - b.min.y()) / sd.spacing + 1e-9));
@@ -253,7 +252,7 @@ World::World(const SceneDef& scene, const WorldOptions& options) : impl_(std::ma
     double prevScale = 1;
     for (long j = 0; j < ny; ++j) {
       const double depth = (double(ny - j) - 0.5) * sd.spacing;
-      const double scale = hydrostatic ? 1.0 / (1.0 + hydroFactor * gz * depth / c2) : 1.0;
+      const double scale = hydrostatic ? 1.0 / (1.0 + hydroFactor * gz * depth) : 1.0;
       rowY[std::size_t(j)] = j == 0 ? b.min.y() + 0.5 * sd.spacing * scale
                                     : rowY[std::size_t(j - 1)] + 0.5 * sd.spacing * (prevScale + scale);
       prevScale = scale;

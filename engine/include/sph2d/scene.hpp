@@ -4,6 +4,7 @@
 
 #include <array>
 #include <cstdint>
+#include <map>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -66,6 +67,11 @@ struct SolverDef {
   bool clampNegativePressure = true;///< p = max(p, 0): no tension at the free surface
   int reorderInterval = 1;          ///< reorder particles along the grid every N substeps (0: never)
   double maxSpeed = 500;            ///< the guard stops a run above this speed [m/s]
+  /// Solver-specific parameters (each solver declares its keys, defaults and
+  /// ranges; the loader fills every declared key, with its default when absent).
+  std::map<std::string, double> params;
+  /// The value of solver parameter `key` (throws std::out_of_range if the solver has none).
+  double param(const std::string& key) const { return params.at(key); }
 };
 
 /// The world rectangle the image shows (aspect preserved by widening).

@@ -138,8 +138,12 @@ std::size_t pressureForce(StepContext& c, const Spiky<Real>& spiky) {
 
 class Muller2003 final : public Solver {
  public:
+  explicit Muller2003(const SolverDef& d) : c_(d.soundSpeed) {}
   const char* name() const override { return "muller2003"; }
-  double hydrostaticFactor() const override { return 2.0; }
+  // p = c²(ρ − ρ0) and the symmetric force recovers ∇p/2: ρ = ρ0(1 + 2 g z / c²).
+  double hydrostaticFactor() const override { return 2.0 / (c_ * c_); }
+
+  double densityKernel(double r, double R) const override { return Poly6<double>(R).value(r); }
 
   void prepare(StepContext& c) override {
     stageGrid(c, false);
@@ -167,10 +171,13 @@ class Muller2003 final : public Solver {
     applyEffects(c, run, effects);
     run.checked("integrate", [&] { return stageIntegrate(c); });
   }
+
+ private:
+  double c_;
 };
 
 }  // namespace
 
-std::unique_ptr<Solver> makeMuller2003() { return std::make_unique<Muller2003>(); }
+std::unique_ptr<Solver> makeMuller2003(const SolverDef& def) { return std::make_unique<Muller2003>(def); }
 
 }  // namespace sph2d

@@ -1,4 +1,5 @@
-// The solvers a scene can name.
+// The solvers a scene can name, and the extra scene keys each one accepts.
+// A new solver: one file in this folder with a make function, one entry below.
 #include <stdexcept>
 #include <string>
 
@@ -6,15 +7,50 @@
 
 namespace sph2d {
 
-std::unique_ptr<Solver> makeMuller2003();
+std::unique_ptr<Solver> makeMuller2003(const SolverDef& def);
+std::unique_ptr<Solver> makeWcsph(const SolverDef& def);
+
+namespace {
+
+struct Entry {
+  const char* name;
+  std::unique_ptr<Solver> (*make)(const SolverDef&);
+  std::vector<SolverParam> params;
+};
+
+const std::vector<Entry>& entries() {
+  static const std::vector<Entry> e = {
+      {"muller2003", &makeMuller2003, {}},
+      {"wcsph",
+       &makeWcsph,
+       {{"gamma", 7, 1, 10, "Tait exponent γ in p = B((ρ/ρ0)^γ − 1), B = ρ0c²/γ"},
+        {"alpha", 0.05, 0, 2, "Monaghan artificial viscosity α (Π = −α c h μ/ρ̄ for approaching pairs)"},
+        {"expected_speed", 0, 0, 1e4, "when > 0, the sound speed is 10 × this (m/s) instead of sound_speed"}}},
+  };
+  return e;
+}
+
+}  // namespace
 
 const std::vector<std::string>& solverNames() {
-  static const std::vector<std::string> names = {"muller2003"};
+  static const std::vector<std::string> names = [] {
+    std::vector<std::string> n;
+    for (const auto& e : entries()) n.push_back(e.name);
+    return n;
+  }();
   return names;
 }
 
+const std::vector<SolverParam>& solverParams(const std::string& type) {
+  static const std::vector<SolverParam> none;
+  for (const auto& e : entries())
+    if (type == e.name) return e.params;
+  return none;
+}
+
 std::unique_ptr<Solver> makeSolver(const SolverDef& def) {
-  if (def.type == "muller2003") return makeMuller2003();
+  for (const auto& e : entries())
+    if (def.type == e.name) return e.make(def);
   throw std::invalid_argument("unknown solver '" + def.type + "'");
 }
 

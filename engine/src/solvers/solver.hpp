@@ -19,9 +19,13 @@ class Solver {
   virtual ~Solver() = default;
   /// The scene name of this solver.
   virtual const char* name() const = 0;
-  /// f in ρ = ρ0(1 + f g z / c²): how much the solver compresses a column at
-  /// rest, used to start fluid blocks in hydrostatic equilibrium (0: none).
+  /// f in ρ = ρ0(1 + f·g·z) [s²/m²]: how much the solver compresses a column
+  /// at rest at depth z, used to start fluid blocks in hydrostatic
+  /// equilibrium (0: start uncompressed).
   virtual double hydrostaticFactor() const = 0;
+  /// The kernel the solver sums density with, W(r) for support R (double):
+  /// the World sets the particle mass so a square lattice has density ρ0.
+  virtual double densityKernel(double r, double R) const = 0;
   /// Density and pressure of the current positions (for a complete initial state).
   virtual void prepare(StepContext& c) = 0;
   /// Largest stable substep for the current state, given the largest speed and acceleration.
@@ -30,10 +34,21 @@ class Solver {
   virtual void substep(StepContext& c, StageRunner& run, const EffectList& effects) = 0;
 };
 
+/// One solver-specific scene key (under "solver").
+struct SolverParam {
+  std::string key;   ///< scene key
+  double def;        ///< default
+  double lo, hi;     ///< allowed range (inclusive)
+  std::string doc;   ///< one line for docs/SCENES.md and errors
+};
+
 /// The solver a scene names. Throws std::invalid_argument for an unknown name.
 std::unique_ptr<Solver> makeSolver(const SolverDef& def);
 
 /// The names makeSolver knows, for error messages and docs.
 const std::vector<std::string>& solverNames();
+
+/// The extra keys solver `type` accepts (empty for an unknown type).
+const std::vector<SolverParam>& solverParams(const std::string& type);
 
 }  // namespace sph2d

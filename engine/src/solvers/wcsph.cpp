@@ -1,0 +1,178 @@
+// wcsph — weakly compressible SPH with the Tait equation of state (Becker &
+// Teschner 2007, "Weakly compressible SPH for free surface flows"):
+// p = B((ρ/ρ0)^γ − 1), B = ρ0 c²/γ, c = 10·expected_speed when that is set,
+// else solver.sound_speed. Density by summation; the pressure acceleration is
+// the momentum- and energy-consistent form −Σ m (p_i/ρ_i² + p_j/ρ_j²) ∇W
+// (Monaghan 1992) with the same kernel as the density (Wendland C2, immune to
+// pairing: Dehnen & Aly 2012), plus Monaghan's artificial viscosity
+// Π_ij = −α c h μ_ij / ρ̄_ij for approaching pairs (h = R/2). Walls: boundary
+// samples are frozen fluid of mass ρ0Ψ_b with the particle's pressure
+// extrapolated hydrostatically (Adami, Hu & Adams 2012).
+//
+// Parameters (solver.*): gamma, alpha, expected_speed.
+#include <algorithm>
+#include <cmath>
+
+#include "solvers/solver.hpp"
+
+namespace sph2d {
+namespace {
+
+class Wcsph final : public Solver {
+ public:
+  explicit Wcsph(const SolverDef& d)
+      : gamma_(Real(d.param("gamma"))),
+        alpha_(Real(d.param("alpha"))),
+        c0_(Real(d.param("expected_speed") > 0 ? 10 * d.param("expected_speed") : d.soundSpeed)) {}
+
+  const char* name() const override { return "wcsph"; }
+  // Tait linearised at rest: ρ ≈ ρ0(1 + g z / c0²).
+  double hydrostaticFactor() const override { return 1.0 / (double(c0_) * double(c0_)); }
+
+  double densityKernel(double r, double R) const override { return WendlandC2<double>(R).value(r); }
+
+  void prepare(StepContext& c) override {
+    stageGrid(c, false);
+    stageNeighbours(c);
+    density(c, WendlandC2<Real>(c.R));
+    pressure(c);
+  }
+
+  Real maxTimeStep(const StepContext& c, Real vmax, Real amax) const override {
+    Real dt = Real(c.def.cfl) * c.R / (c0_ + vmax);
+    if (amax > 0) dt = std::min(dt, Real(0.25) * std::sqrt(c.R / amax));
+    return dt;
+  }
+
+  void substep(StepContext& c, StageRunner& run, const EffectList& effects) override {
+    const WendlandC2<Real> W(c.R);
+    const int every = c.def.reorderInterval;
+    const bool reorder = every > 0 && c.step % std::uint64_t(every) == 0;
+    run.run("grid", [&] { stageGrid(c, reorder); });
+    run.run("neighbours", [&] { stageNeighbours(c); });
+    run.checked("density", [&] { return density(c, W); });
+    run.run("pressure", [&] { pressure(c); });
+    run.checked("pressure_force", [&] { return pressureForce(c, W); });
+    applyEffects(c, run, effects);
+    run.checked("integrate", [&] { return stageIntegrate(c); });
+  }
+
+ private:
+  std::size_t density(StepContext& c, const WendlandC2<Real>& W) const {
+    Particles& P = c.P;
+    const Vec2* X = P.x.data();
+    const Real self = W.value(0);
+    const bool walls = !c.boundary.samples.empty();
+    return firstBad(c.pool, P.size(), [&](std::size_t b, std::size_t e) {
+      std::size_t bad = kNone;
+      for (std::size_t i = b; i < e; ++i) {
+        const Vec2 xi = X[i];
+        const std::uint32_t* nb = c.nbr.of(i);
+        const std::uint32_t cnt = c.nbr.count[i];
+        Real sum = self;
+        for (std::uint32_t k = 0; k < cnt; ++k) {
+          const Real dx = xi.x() - X[nb[k]].x(), dy = xi.y() - X[nb[k]].y();
+          sum += W.value(std::sqrt(dx * dx + dy * dy));
+        }
+        Real rho = c.mass * sum;
+        if (walls) rho += c.rho0 * boundaryVolumeSum(c.boundary, W, xi);
+        P.rho[i] = rho;
+        if (!std::isfinite(rho) && bad == kNone) bad = i;
+      }
+      return bad;
+    });
+  }
+
+  void pressure(StepContext& c) const {
+    Particles& P = c.P;
+    const Real B = c.rho0 * c0_ * c0_ / gamma_;
+    const bool clamp = c.def.clampNegativePressure;
+    c.pool.parallelFor(P.size(), 4096, [&](std::size_t b, std::size_t e) {
+      for (std::size_t i = b; i < e; ++i) {
+        Real p = B * (std::pow(P.rho[i] / c.rho0, gamma_) - Real(1));
+        if (clamp && p < 0) p = 0;
+        P.p[i] = p;
+        P.invRho[i] = Real(1) / P.rho[i];
+        P.pOverRho[i] = p * P.invRho[i] * P.invRho[i];  // p/ρ² for this solver's symmetric form
+      }
+    });
+  }
+
+  std::size_t pressureForce(StepContext& c, const WendlandC2<Real>& W) const {
+    Particles& P = c.P;
+    const BoundarySet& B = c.boundary;
+    const bool walls = !B.samples.empty();
+    const Real R = c.R, R2 = R * R, h = Real(0.5) * R;
+    const Real tiny2 = Real(1e-12) * R2;
+    const Real gradK = Real(-20) * W.s * W.invR * W.invR;  // ∇W = gradK (1 − q)³ d
+    const Real avK = alpha_ * c0_;  // Π = −α c μ / ρ̄ with μ = h v·x / (r² + 0.01h²)
+    const Real eta2 = Real(0.01) * h * h;
+    const Vec2* X = P.x.data();
+    const Vec2* V = P.v.data();
+    const Real* IR = P.invRho.data();
+    const Real* POR2 = P.pOverRho.data();
+    const std::uint32_t* ID = P.id.data();
+    return firstBad(c.pool, P.size(), [&](std::size_t b, std::size_t e) {
+      std::size_t bad = kNone;
+      for (std::size_t i = b; i < e; ++i) {
+        const Real xix = X[i].x(), xiy = X[i].y(), vix = V[i].x(), viy = V[i].y();
+        const Real pri = POR2[i], iri = IR[i];
+        Real ax = 0, ay = 0;
+        const std::uint32_t* nb = c.nbr.of(i);
+        const std::uint32_t cnt = c.nbr.count[i];
+        for (std::uint32_t k = 0; k < cnt; ++k) {
+          const std::uint32_t j = nb[k];
+          Real dx = xix - X[j].x(), dy = xiy - X[j].y();
+          Real r2 = dx * dx + dy * dy;
+          if (r2 < tiny2) {
+            const Vec2 t = tieBreakDirection(ID[i], ID[j]) * (Real(1e-6) * R);
+            dx = t.x();
+            dy = t.y();
+            r2 = dx * dx + dy * dy;
+          }
+          const Real q = std::sqrt(r2) * W.invR;
+          const Real a = Real(1) - q;
+          const Real g = gradK * a * a * a;  // ∇W = g·d
+          // Pressure: −m (p_i/ρ_i² + p_j/ρ_j²) ∇W.
+          Real coef = -c.mass * (pri + POR2[j]);
+          // Artificial viscosity for approaching pairs.
+          const Real vdotx = (vix - V[j].x()) * dx + (viy - V[j].y()) * dy;
+          if (vdotx < 0) {
+            const Real mu = h * vdotx / (r2 + eta2);
+            coef += c.mass * avK * mu * Real(2) / (Real(1) / iri + Real(1) / IR[j]);
+          }
+          ax += coef * g * dx;
+          ay += coef * g * dy;
+        }
+        Vec2 acc(ax, ay);
+        if (walls) {
+          const Real pi = P.p[i], rhoi = P.rho[i];
+          Vec2 gb = Vec2::Zero();
+          B.sampleGrid.forCandidates(X[i], [&](std::uint32_t s) {
+            const Vec2 d = X[i] - B.samples[s];
+            const Real rr = d.squaredNorm();
+            if (rr >= R2 || !B.visible(s, X[i])) return;
+            const Real q = std::sqrt(rr) * W.invR;
+            const Real a = Real(1) - q;
+            // p_b: the particle's pressure extrapolated hydrostatically to the sample.
+            const Real pb = std::max(Real(0), pi - rhoi * c.gravity.dot(d));
+            gb += d * (gradK * a * a * a * B.volume[s] * (pri + pb / (c.rho0 * c.rho0)));
+          });
+          acc -= gb * c.rho0;
+        }
+        acc += c.gravity;
+        P.a[i] = acc;
+        if (!allFinite(acc) && bad == kNone) bad = i;
+      }
+      return bad;
+    });
+  }
+
+  Real gamma_, alpha_, c0_;
+};
+
+}  // namespace
+
+std::unique_ptr<Solver> makeWcsph(const SolverDef& def) { return std::make_unique<Wcsph>(def); }
+
+}  // namespace sph2d
