@@ -238,6 +238,110 @@ ShapeDef readFixture(const Reader& r, const json& j, const std::string& path) {
   return s;
 }
 
+RegionDef readRegion(const Reader& r, const nlohmann::json& j, const std::string& path) {
+  RegionDef g;
+  g.min = r.requiredVec2(j, path, "min");
+  g.max = r.requiredVec2(j, path, "max");
+  if (!(g.max.x() > g.min.x() && g.max.y() > g.min.y())) r.fail(Reader::sub(path, "max"), "max must be greater than min in x and in y");
+  return g;
+}
+
+void readEffects(const Reader& r, const nlohmann::json& j, SceneDef& s) {
+  const std::string p = "effects";
+  r.requireObject(j, p);
+  r.checkKeys(j, p, {"xsph", "force_fields", "surface_tension", "lifetime", "sinks", "emitters", "budget"});
+  EffectsDef& e = s.effects;
+  if (j.contains("xsph")) {
+    const auto& x = j.at("xsph");
+    const std::string q = "effects.xsph";
+    r.requireObject(x, q);
+    r.checkKeys(x, q, {"c"});
+    e.xsph = true;
+    e.xsphC = r.number(x, q, "c", e.xsphC, 0, 1);
+  }
+  if (j.contains("force_fields")) {
+    const auto& a = j.at("force_fields");
+    if (!a.is_array()) r.fail("effects.force_fields", "expected an array of force fields, got " + typeName(a));
+    for (std::size_t k = 0; k < a.size(); ++k) {
+      const std::string q = "effects.force_fields[" + std::to_string(k) + "]";
+      r.requireObject(a[k], q);
+      r.checkKeys(a[k], q, {"acceleration", "min", "max"});
+      ForceFieldDef f;
+      f.acceleration = r.requiredVec2(a[k], q, "acceleration");
+      if (a[k].contains("min") || a[k].contains("max")) {
+        f.everywhere = false;
+        f.region = readRegion(r, a[k], q);
+      }
+      e.forceFields.push_back(f);
+    }
+  }
+  if (j.contains("surface_tension")) {
+    const auto& t = j.at("surface_tension");
+    const std::string q = "effects.surface_tension";
+    r.requireObject(t, q);
+    r.checkKeys(t, q, {"model", "sigma", "gamma", "threshold"});
+    e.surfaceTension = true;
+    e.tension.model = r.string(t, q, "model", e.tension.model, {"csf", "akinci"});
+    e.tension.sigma = r.number(t, q, "sigma", e.tension.sigma, 0, 1e4);
+    e.tension.gamma = r.number(t, q, "gamma", e.tension.gamma, 0, 1e4);
+    e.tension.threshold = r.number(t, q, "threshold", e.tension.threshold, 0, 10);
+  }
+  if (j.contains("lifetime")) {
+    const auto& t = j.at("lifetime");
+    const std::string q = "effects.lifetime";
+    r.requireObject(t, q);
+    r.checkKeys(t, q, {"max_age"});
+    e.lifetime = true;
+    if (!t.contains("max_age")) r.fail(Reader::sub(q, "max_age"), "missing; expected a number of seconds > 0");
+    e.maxAge = r.number(t, q, "max_age", e.maxAge, 0, 1e9, true);
+  }
+  if (j.contains("sinks")) {
+    const auto& a = j.at("sinks");
+    if (!a.is_array()) r.fail("effects.sinks", "expected an array of regions {min, max}, got " + typeName(a));
+    for (std::size_t k = 0; k < a.size(); ++k) {
+      const std::string q = "effects.sinks[" + std::to_string(k) + "]";
+      r.requireObject(a[k], q);
+      r.checkKeys(a[k], q, {"min", "max"});
+      e.sinks.push_back(readRegion(r, a[k], q));
+    }
+  }
+  if (j.contains("emitters")) {
+    const auto& a = j.at("emitters");
+    if (!a.is_array()) r.fail("effects.emitters", "expected an array of emitters, got " + typeName(a));
+    for (std::size_t k = 0; k < a.size(); ++k) {
+      const std::string q = "effects.emitters[" + std::to_string(k) + "]";
+      r.requireObject(a[k], q);
+      r.checkKeys(a[k], q, {"position", "direction", "width", "rate", "speed", "spread", "jitter", "start", "stop", "seed", "enabled"});
+      EmitterDef m;
+      m.position = r.requiredVec2(a[k], q, "position");
+      m.direction = r.vec2(a[k], q, "direction", m.direction);
+      if (m.direction.norm() < 1e-12) r.fail(Reader::sub(q, "direction"), "direction must not be zero");
+      m.direction.normalize();
+      m.width = r.number(a[k], q, "width", m.width, 0, 1e4);
+      m.rate = r.number(a[k], q, "rate", m.rate, 0, 1e8);
+      m.speed = r.number(a[k], q, "speed", m.speed, 0, 1e4);
+      m.spread = r.number(a[k], q, "spread", m.spread, 0, 6.2832);
+      m.jitter = r.number(a[k], q, "jitter", m.jitter, 0, 1);
+      m.start = r.number(a[k], q, "start", m.start, 0, 1e9);
+      m.stop = r.number(a[k], q, "stop", m.stop, 0, 1e30);
+      if (m.stop < m.start) r.fail(Reader::sub(q, "stop"), "stop must not be before start");
+      m.seed = std::uint64_t(r.number(a[k], q, "seed", double(m.seed), 0, 9007199254740992.0));
+      m.enabled = r.boolean(a[k], q, "enabled", m.enabled);
+      e.emitters.push_back(m);
+    }
+  }
+  if (j.contains("budget")) {
+    const auto& b = j.at("budget");
+    const std::string q = "effects.budget";
+    r.requireObject(b, q);
+    r.checkKeys(b, q, {"max_particles", "policy"});
+    e.budget = std::size_t(r.number(b, q, "max_particles", 0, 1, 1e8));
+    e.budgetPolicy = r.string(b, q, "policy", "stop_emitting", {"stop_emitting", "recycle_oldest"}) == "recycle_oldest"
+                         ? BudgetPolicy::RecycleOldest
+                         : BudgetPolicy::StopEmitting;
+  }
+}
+
 }  // namespace
 
 std::size_t countBlockParticles(const SceneDef& scene) {
@@ -256,7 +360,7 @@ SceneDef parseScene(const std::string& text, const std::string& file) {
   const Reader r(doc, file);
   const json& root = doc.root;
   r.requireObject(root, "");
-  r.checkKeys(root, "", {"name", "gravity", "fps", "duration", "max_particles", "solver", "boundaries", "fluid", "render"});
+  r.checkKeys(root, "", {"name", "gravity", "fps", "duration", "max_particles", "solver", "boundaries", "fluid", "effects", "render"});
   SceneDef s;
   s.path = file;
   s.name = r.string(root, "", "name", s.name, {});
@@ -328,6 +432,8 @@ SceneDef parseScene(const std::string& text, const std::string& file) {
       s.blocks.push_back(blk);
     }
   }
+
+  if (root.contains("effects")) readEffects(r, root.at("effects"), s);
 
   if (root.contains("render")) {
     const json& j = root.at("render");

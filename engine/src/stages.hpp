@@ -69,6 +69,8 @@ struct StepContext {
   Real clearance = 0;           ///< distance kept from solid surfaces
   Real maxSpeed = 0;            ///< the guard's runaway limit
   std::uint64_t step = 0;       ///< substep counter
+  double time = 0;              ///< simulated time at the start of the substep
+  Vec2d origin{0, 0};           ///< local frame offset (world = local + origin)
 };
 
 /// Runs named stages: times them and turns a bad slot into a SimulationError.

@@ -105,6 +105,20 @@ struct World::Impl final : StageRunner {
   std::vector<StageTiming> timing;  ///< in the order stages first ran
   std::vector<std::string> warnings;
 
+  // The particle system of seed 001: emitters, lifetimes, sinks, budget.
+  struct EmitterState {
+    EmitterDef def;
+    std::uint64_t rng = 0;      ///< SplitMix64 state, seeded per emitter
+    std::uint64_t emitted = 0;
+    bool warnedBudget = false;
+  };
+  std::vector<EmitterState> emitters;
+  std::size_t budget = 0;
+  std::uint64_t removed = 0;
+  std::vector<UserForce> userForces;
+  bool userForceEffect = false;
+  std::vector<unsigned char> dead;  ///< scratch: removal flags
+
   explicit Impl(const SceneDef& s, const WorldOptions& o) : scene(s), pool(o.threads) {}
 
   StepContext context(Real dt) {
@@ -118,7 +132,128 @@ struct World::Impl final : StageRunner {
     c.clearance = Real(0.25) * dx;
     c.maxSpeed = Real(scene.solver.maxSpeed);
     c.step = steps;
+    c.time = time;
+    c.origin = origin;
     return c;
+  }
+
+  static std::uint64_t splitmix(std::uint64_t& state) {
+    std::uint64_t z = (state += 0x9E3779B97F4A7C15ULL);
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ULL;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBULL;
+    return z ^ (z >> 31);
+  }
+  static double uniform(std::uint64_t& state) { return double(splitmix(state) >> 11) * (1.0 / 9007199254740992.0); }
+
+  /// Removes the flagged particles, keeping the order of the rest (stable, serial: deterministic).
+  void removeFlagged() {
+    std::size_t out = 0;
+    const std::size_t n = P.size();
+    for (std::size_t i = 0; i < n; ++i) {
+      if (dead[i]) continue;
+      if (out != i) {
+        P.x[out] = P.x[i];
+        P.v[out] = P.v[i];
+        P.a[out] = P.a[i];
+        P.xPrev[out] = P.xPrev[i];
+        P.rho[out] = P.rho[i];
+        P.p[out] = P.p[i];
+        P.invRho[out] = P.invRho[i];
+        P.pOverRho[out] = P.pOverRho[i];
+        P.id[out] = P.id[i];
+        for (auto& f : P.extra) f.second[out] = f.second[i];
+      }
+      ++out;
+    }
+    removed += n - out;
+    P.x.resize(out);
+    P.v.resize(out);
+    P.a.resize(out);
+    P.xPrev.resize(out);
+    P.rho.resize(out);
+    P.p.resize(out);
+    P.invRho.resize(out);
+    P.pOverRho.resize(out);
+    P.id.resize(out);
+    for (auto& f : P.extra) f.second.resize(out);
+  }
+
+  /// Removes the k particles with the smallest ids (the oldest).
+  void removeOldest(std::size_t k) {
+    if (k == 0 || P.size() == 0) return;
+    k = std::min(k, P.size());
+    std::vector<std::uint32_t> ids(P.id);
+    std::nth_element(ids.begin(), ids.begin() + std::ptrdiff_t(k - 1), ids.end());  // ids are unique: no ties
+    const std::uint32_t cut = ids[k - 1];
+    dead.assign(P.size(), 0);
+    for (std::size_t i = 0; i < P.size(); ++i) dead[i] = P.id[i] <= cut;
+    removeFlagged();
+  }
+
+  void emit(Real dt) {
+    const Real rho0 = Real(scene.solver.restDensity);
+    for (std::size_t e = 0; e < emitters.size(); ++e) {
+      EmitterState& s = emitters[e];
+      const EmitterDef& d = s.def;
+      if (!d.enabled || d.rate <= 0) continue;
+      const double tEnd = std::min(time + double(dt), d.stop);
+      if (tEnd <= d.start) continue;
+      // Emission k happens at start + k/rate; count those before tEnd.
+      const auto total = std::uint64_t(std::max(0.0, std::ceil(d.rate * (tEnd - d.start) - 1e-9)));
+      const Vec2d dir = d.direction;
+      const Vec2d across(-dir.y(), dir.x());
+      for (; s.emitted < total; ++s.emitted) {
+        if (P.size() >= budget) {
+          if (scene.effects.budgetPolicy == BudgetPolicy::RecycleOldest) {
+            removeOldest(P.size() - budget + 1);
+          } else {
+            if (!s.warnedBudget) {
+              std::ostringstream o;
+              o << "particle budget " << budget << " reached at t = " << time << " s: emitter " << e
+                << " pauses until particles leave (policy stop_emitting)";
+              warnings.push_back(o.str());
+              s.warnedBudget = true;
+            }
+            s.emitted = total;  // the missed particles are not owed later
+            break;
+          }
+        }
+        const double te = d.start + double(s.emitted) / d.rate;
+        const double u1 = uniform(s.rng), u2 = uniform(s.rng), u3 = uniform(s.rng);
+        const double ang = (u2 - 0.5) * d.spread;
+        const Vec2d vdir(dir.x() * std::cos(ang) - dir.y() * std::sin(ang), dir.x() * std::sin(ang) + dir.y() * std::cos(ang));
+        const double speed = d.speed * (1.0 + d.jitter * (2.0 * u3 - 1.0));
+        const Vec2d vel = vdir * speed;
+        // Placed where a particle emitted at te would be at the substep start,
+        // so that the stream is continuous after this substep's integration.
+        const Vec2d pw = d.position + across * ((u1 - 0.5) * d.width) + vel * (time - te);
+        P.push(Vec2(Real(pw.x() - origin.x()), Real(pw.y() - origin.y())), Vec2(Real(vel.x()), Real(vel.y())), nextId++, rho0);
+      }
+    }
+  }
+
+  void lifetimes(Real dt) {
+    std::vector<Real>& age = P.field("age");
+    const Real maxAge = Real(scene.effects.maxAge);
+    dead.assign(P.size(), 0);
+    bool any = false;
+    for (std::size_t i = 0; i < P.size(); ++i) {
+      age[i] += dt;
+      dead[i] = age[i] > maxAge;
+      any = any || dead[i];
+    }
+    if (any) removeFlagged();
+  }
+
+  void sinks() {
+    dead.assign(P.size(), 0);
+    bool any = false;
+    for (std::size_t i = 0; i < P.size(); ++i) {
+      const Vec2d w = Vec2d(P.x[i].x(), P.x[i].y()) + origin;
+      for (const RegionDef& r : scene.effects.sinks) dead[i] = dead[i] || r.contains(w);
+      any = any || dead[i];
+    }
+    if (any) removeFlagged();
   }
 
   StageTiming& timingOf(const char* name) {
@@ -162,10 +297,13 @@ struct World::Impl final : StageRunner {
   }
 
   void substep(Real dt) {
+    if (!emitters.empty()) run("emit", [&] { emit(dt); });
     StepContext c = context(dt);
     solver->substep(c, *this, effects);
     lastAccel = maxAccelOf(P, pool);
     run("collide", [&] { stageCollide(c); });
+    if (scene.effects.lifetime) run("lifetimes", [&] { lifetimes(dt); });
+    if (!scene.effects.sinks.empty()) run("sinks", [&] { sinks(); });
     time += double(dt);
     ++steps;
   }
@@ -202,6 +340,14 @@ World::World(const SceneDef& sceneIn, const WorldOptions& options) : impl_(std::
   const SolverDef& sd = scene.solver;
   w.solver = makeSolver(sd);
   w.effects = makeEffects(scene);
+  for (const EmitterDef& e : scene.effects.emitters) {
+    Impl::EmitterState st;
+    st.def = e;
+    st.rng = e.seed;
+    w.emitters.push_back(st);
+  }
+  w.budget = scene.effects.budget > 0 ? scene.effects.budget : scene.maxParticles;
+  if (scene.effects.lifetime) w.P.field("age");
   w.ownWorld = std::make_unique<b2World>(bv(scene.gravity));
   w.b2 = w.ownWorld.get();
   for (const BodyDef& b : scene.bodies) addBody(*w.b2, b);
@@ -360,6 +506,32 @@ void World::resetTimings() {
 }
 
 std::size_t World::neighbourPairs() const { return impl_->nbr.pairs(); }
+
+void World::setUserForces(const std::vector<UserForce>& forces) {
+  impl_->userForces = forces;
+  if (!impl_->userForceEffect && !forces.empty()) {
+    impl_->effects.push_back(makeUserForceEffect(&impl_->userForces));
+    impl_->userForceEffect = true;
+  }
+}
+
+void World::setEmitterEnabled(std::size_t index, bool enabled) { impl_->emitters.at(index).def.enabled = enabled; }
+
+std::uint64_t World::emittedCount(std::size_t index) const { return impl_->emitters.at(index).emitted; }
+
+std::uint64_t World::removedCount() const { return impl_->removed; }
+
+std::vector<std::string> World::particleFields() const {
+  std::vector<std::string> f = {"x", "v", "a", "xPrev", "rho", "p", "invRho", "pOverRho", "id"};
+  for (const auto& e : impl_->P.extra) f.push_back(e.first);
+  return f;
+}
+
+std::vector<std::string> World::stages() const {
+  std::vector<std::string> s;
+  for (const auto& t : impl_->timing) s.push_back(t.name);
+  return s;
+}
 
 std::size_t World::memoryBytes() const {
   const Impl& w = *impl_;

@@ -93,6 +93,67 @@ struct RenderDef {
   CameraDef camera;
 };
 
+/// An axis-aligned box region.
+struct RegionDef {
+  Vec2d min{0, 0};
+  Vec2d max{0, 0};
+  /// True when p lies inside (boundary included).
+  bool contains(const Vec2d& p) const { return p.x() >= min.x() && p.y() >= min.y() && p.x() <= max.x() && p.y() <= max.y(); }
+};
+
+/// A constant acceleration, everywhere or in a region (wind, currents).
+struct ForceFieldDef {
+  Vec2d acceleration{0, 0};   ///< m/s²
+  bool everywhere = true;     ///< false: only inside `region`
+  RegionDef region;
+};
+
+/// Surface tension. "csf": Müller et al. 2003's colour-field model;
+/// "akinci": cohesion + curvature of Akinci, Akinci & Teschner 2013.
+struct SurfaceTensionDef {
+  std::string model = "akinci";
+  double sigma = 0.0728;      ///< csf: surface tension coefficient [N/m]
+  double gamma = 1.0;         ///< akinci: cohesion/curvature strength (dimensionless scale of σ)
+  double threshold = 0.1;     ///< csf: |∇c| below threshold·(1/R) is not surface
+};
+
+/// An emitter of the particle system (seed 001): a nozzle at `position`
+/// of `width`, shooting along `direction`.
+struct EmitterDef {
+  Vec2d position{0, 0};
+  Vec2d direction{0, -1};     ///< normalised by the loader
+  double width = 0;           ///< nozzle width across the direction [m] (0: a point)
+  double rate = 100;          ///< particles per second
+  double speed = 2;           ///< m/s along the direction
+  double spread = 0;          ///< full cone angle of random directions [rad]
+  double jitter = 0;          ///< random speed variation, fraction of speed
+  double start = 0;           ///< s
+  double stop = 1e30;         ///< s
+  std::uint64_t seed = 1;     ///< per-emitter random seed: same seed, same particles
+  bool enabled = true;        ///< input events may switch it
+};
+
+/// What happens when the particle budget is reached.
+enum class BudgetPolicy {
+  StopEmitting,   ///< emitters emit nothing until particles leave (default)
+  RecycleOldest,  ///< the oldest particles (smallest ids) are removed to make room
+};
+
+/// The effects a scene calls for. Absent effects cost nothing.
+struct EffectsDef {
+  bool xsph = false;
+  double xsphC = 0.05;                      ///< XSPH velocity smoothing factor
+  std::vector<ForceFieldDef> forceFields;
+  bool surfaceTension = false;
+  SurfaceTensionDef tension;
+  bool lifetime = false;
+  double maxAge = 10;                       ///< s: older particles are removed
+  std::vector<RegionDef> sinks;
+  std::vector<EmitterDef> emitters;
+  std::size_t budget = 0;                   ///< particle budget (0: max_particles)
+  BudgetPolicy budgetPolicy = BudgetPolicy::StopEmitting;
+};
+
 /// A whole scene: the solids, the fluid, the solver, the clock and the camera.
 struct SceneDef {
   std::string name = "scene";
@@ -104,6 +165,7 @@ struct SceneDef {
   double fps = 60;                  ///< frames per simulated second
   double duration = 4;              ///< simulated seconds the app renders
   std::size_t maxParticles = 4000000;///< refuse scenes with more particles than this
+  EffectsDef effects;
   RenderDef render;
 };
 

@@ -46,6 +46,13 @@ struct StageTiming {
   std::uint64_t calls = 0;
 };
 
+/// A push/pull at a point, set at run time (the mouse of a game).
+struct UserForce {
+  Vec2d point{0, 0};   ///< world coordinates [m]
+  double radius = 0.5; ///< reach [m]
+  double strength = 0; ///< acceleration at the centre [m/s²]; > 0 pulls towards the point, < 0 pushes away
+};
+
 /// Density error of the fluid, relative to ρ0.
 struct DensityStats {
   double meanError = 0;  ///< mean of max(ρ − ρ0, 0)/ρ0 over particles (compression)
@@ -119,6 +126,21 @@ class World {
   std::size_t memoryBytes() const;
   /// Messages the world wants the user to see (substep cap hits, dropped particles); cleared on read.
   std::vector<std::string> takeWarnings();
+
+  /// Replaces the user forces (push/pull at points). The user_force stage
+  /// exists only once a force has been set.
+  void setUserForces(const std::vector<UserForce>& forces);
+  /// Enables or disables emitter `index` (scene order). Throws std::out_of_range.
+  void setEmitterEnabled(std::size_t index, bool enabled);
+  /// Particles emitted so far by emitter `index`.
+  std::uint64_t emittedCount(std::size_t index) const;
+  /// Particles removed so far by lifetimes, sinks and the budget policy.
+  std::uint64_t removedCount() const;
+  /// Names of the per-particle fields this world allocates (the fixed ones
+  /// and the optional ones its solver and effects created).
+  std::vector<std::string> particleFields() const;
+  /// Names of the stages a substep runs, in order (solver stages, effects, particle system).
+  std::vector<std::string> stages() const;
 
   struct Impl;
 

@@ -10,6 +10,7 @@
 #include <memory>
 #include <vector>
 
+#include "sph2d/world.hpp"
 #include "stages.hpp"
 
 namespace sph2d {
@@ -30,8 +31,13 @@ class Effect {
 
 using EffectList = std::vector<std::unique_ptr<Effect>>;
 
-/// The effects a scene enables, in a fixed order.
+/// The effects a scene enables, in a fixed order: viscosity, xsph, force
+/// fields, surface tension. (The particle system — emitters, lifetimes,
+/// sinks — runs in the World's emit and lifetime stages.)
 EffectList makeEffects(const SceneDef& scene);
+
+/// The effect that applies the current user forces (created when the first is set).
+std::unique_ptr<Effect> makeUserForceEffect(const std::vector<UserForce>* forces);
 
 /// Runs every effect as its own timed, guarded stage.
 inline void applyEffects(StepContext& c, StageRunner& run, const EffectList& effects) {

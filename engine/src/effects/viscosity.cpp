@@ -59,10 +59,6 @@ class LaplacianViscosity final : public Effect {
 
 }  // namespace
 
-EffectList makeEffects(const SceneDef& scene) {
-  EffectList out;
-  if (scene.solver.viscosity > 0) out.push_back(std::make_unique<LaplacianViscosity>(scene.solver.viscosity));
-  return out;
-}
+std::unique_ptr<Effect> makeLaplacianViscosity(double nu) { return std::make_unique<LaplacianViscosity>(nu); }
 
 }  // namespace sph2d

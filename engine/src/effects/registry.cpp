@@ -1,0 +1,21 @@
+// Which effects a scene's step runs, in a fixed order.
+#include "effects/effect.hpp"
+
+namespace sph2d {
+
+std::unique_ptr<Effect> makeLaplacianViscosity(double nu);
+std::unique_ptr<Effect> makeXsph(double c);
+std::unique_ptr<Effect> makeForceFields(const std::vector<ForceFieldDef>& fields);
+std::unique_ptr<Effect> makeSurfaceTension(const SurfaceTensionDef& def);
+
+EffectList makeEffects(const SceneDef& scene) {
+  EffectList out;
+  const EffectsDef& e = scene.effects;
+  if (scene.solver.viscosity > 0) out.push_back(makeLaplacianViscosity(scene.solver.viscosity));
+  if (e.xsph) out.push_back(makeXsph(e.xsphC));
+  if (!e.forceFields.empty()) out.push_back(makeForceFields(e.forceFields));
+  if (e.surfaceTension) out.push_back(makeSurfaceTension(e.tension));
+  return out;
+}
+
+}  // namespace sph2d
