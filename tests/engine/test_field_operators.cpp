@@ -376,7 +376,7 @@ TEST_CASE_TEMPLATE("convergence on a regular lattice at fixed R/dx = 3: Shepard 
 TEST_CASE_TEMPLATE("convergence on a jittered lattice (±0.1 dx): Shepard sample and corrected gradient are first order",
                    K, CubicSpline<double>, WendlandC2<double>) {
   const Orders o = measureOrders<K>(0.1);
-  // Overall order from n = 40 to 160; measured 1.26–1.33 (docs/KERNELS.md).
+  // Overall order from n = 40 to 160; measured 1.19–1.33 (docs/KERNELS.md).
   const double shep = study::order(o.e[0].shepard, o.e[0].dx, o.e[2].shepard, o.e[2].dx);
   const double gc = study::order(o.e[0].gradientCorr, o.e[0].dx, o.e[2].gradientCorr, o.e[2].dx);
   MESSAGE(std::string(K::name), ": jittered orders shepard ", shep, ", corrected gradient ", gc);

@@ -127,7 +127,7 @@ class NeighbourSearch {
   std::vector<std::uint32_t> sorted_;     // point indices in cell order (stable)
 };
 
-/// Tuning of FieldOperators; the defaults are what docs/KERNELS.md measured.
+/// Tuning of FieldOperators (docs/KERNELS.md uses the defaults).
 template <class T>
 struct FieldOperatorOptions {
   /// Smoothing length h of the Brookshaw/Morris denominator |x_ij|² + 0.01 h²;
