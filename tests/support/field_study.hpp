@@ -55,9 +55,13 @@ Lattice<T> makeLattice(int nx, int ny, double dx, double loX, double loY, double
 /// The smooth test field of the convergence study, A = sin(3x + 0.5) cos(2y − 0.3),
 /// chosen off the lattice's symmetry axes so no error cancels by symmetry.
 struct SmoothField {
+  /// A(x, y).
   static double value(double x, double y) { return std::sin(3 * x + 0.5) * std::cos(2 * y - 0.3); }
+  /// ∂A/∂x.
   static double dx(double x, double y) { return 3 * std::cos(3 * x + 0.5) * std::cos(2 * y - 0.3); }
+  /// ∂A/∂y.
   static double dy(double x, double y) { return -2 * std::sin(3 * x + 0.5) * std::sin(2 * y - 0.3); }
+  /// ∇²A = −13 A.
   static double laplacian(double x, double y) { return -13 * value(x, y); }
 };
 

@@ -79,6 +79,7 @@ struct ParticleView {
 /// candidates by distance. Rebuild after the positions move.
 class NeighbourSearch {
  public:
+  /// An empty search (no candidates until build()).
   NeighbourSearch() = default;
   /// Builds over x[0..n) for queries of radius `radius` (> 0). Throws
   /// std::invalid_argument on a non-positive radius or a non-finite position.
@@ -96,8 +97,8 @@ class NeighbourSearch {
   /// Calls f(j) for every indexed point j in the 3×3 cells around p (a superset
   /// of the points within radius()), in cell order then index order. A
   /// non-finite p has no candidates.
-  template <class T, class F>
-  void forCandidates(const Eigen::Matrix<T, 2, 1, Eigen::DontAlign>& p, F&& f) const {
+  template <class D, class F>
+  void forCandidates(const Eigen::MatrixBase<D>& p, F&& f) const {
     if (sorted_.empty()) return;
     const double px = double(p.x()), py = double(p.y());
     if (!std::isfinite(px) || !std::isfinite(py)) return;
