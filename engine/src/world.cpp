@@ -137,6 +137,79 @@ struct World::Impl final : StageRunner {
     return c;
   }
 
+  std::uint64_t boundarySignature = 0;
+
+  /// XXH64 of the static fixtures' identities and transforms: changes when the game edits its level.
+  std::uint64_t staticSignature() const {
+    Xxh64 h;
+    for (b2Body* body = b2->GetBodyList(); body; body = body->GetNext()) {
+      if (body->GetType() != b2_staticBody) continue;
+      const b2Transform& xf = body->GetTransform();
+      h.update(&xf, sizeof xf);
+      for (b2Fixture* f = body->GetFixtureList(); f; f = f->GetNext()) {
+        const void* ptr = f;
+        h.update(&ptr, sizeof ptr);
+        const int type = int(f->GetType());
+        h.update(&type, sizeof type);
+      }
+    }
+    return h.digest();
+  }
+
+  void rebuildBoundary() {
+    boundary.collect(*b2, origin);
+    boundary.sample(dx, R, pool);
+    boundary.buildBins(Real(4) * R);
+    boundarySignature = staticSignature();
+  }
+
+  /// Fills a block on the lattice of the spacing; particles inside solids are
+  /// dropped with one warning. With `hydrostaticStart`, rows are placed closer
+  /// with depth so the block starts at the density the solver holds at rest,
+  /// ρ = ρ0(1 + f g z) with the solver's factor f (2/c² for muller2003, whose
+  /// symmetric force recovers ∇p/2; 1/c0² for wcsph). Started uncompressed, a
+  /// column would ring in its acoustic mode with a speed amplitude of about g·H/c.
+  std::size_t fillBlock(const FluidBlockDef& b, bool hydrostaticStart) {
+    const SolverDef& sd = scene.solver;
+    const double hydroFactor = solver->hydrostaticFactor();
+    const bool hydrostatic = hydrostaticStart && hydroFactor > 0 && scene.gravity.x() == 0 && scene.gravity.y() < 0;
+    const double gz = -scene.gravity.y();
+    const Real rho0 = Real(sd.restDensity);
+    const long nx = long(std::floor((b.max.x() - b.min.x()) / sd.spacing + 1e-9));
+    const long ny = long(std::floor((b.max.y() - b.min.y()) / sd.spacing + 1e-9));
+    std::vector<double> rowY(std::size_t(std::max(ny, 0L)));
+    double prevScale = 1;
+    for (long j = 0; j < ny; ++j) {
+      const double depth = (double(ny - j) - 0.5) * sd.spacing;
+      const double scale = hydrostatic ? 1.0 / (1.0 + hydroFactor * gz * depth) : 1.0;
+      rowY[std::size_t(j)] = j == 0 ? b.min.y() + 0.5 * sd.spacing * scale
+                                    : rowY[std::size_t(j - 1)] + 0.5 * sd.spacing * (prevScale + scale);
+      prevScale = scale;
+    }
+    std::size_t added = 0, dropped = 0;
+    Vec2d dlo(0, 0), dhi(0, 0);
+    for (long j = 0; j < ny; ++j)
+      for (long i = 0; i < nx; ++i) {
+        const Vec2d pw(b.min.x() + (double(i) + 0.5) * sd.spacing, rowY[std::size_t(j)]);
+        const Vec2 p = Vec2(Real(pw.x() - origin.x()), Real(pw.y() - origin.y()));
+        if (boundary.insideDepth(p) > 0) {
+          dlo = dropped ? dlo.cwiseMin(pw) : pw;
+          dhi = dropped ? dhi.cwiseMax(pw) : pw;
+          ++dropped;
+          continue;
+        }
+        P.push(p, Vec2(Real(b.velocity.x()), Real(b.velocity.y())), nextId++, rho0);
+        ++added;
+      }
+    if (dropped) {
+      std::ostringstream o;
+      o << "dropped " << dropped << " particles that the scene placed inside solids, in the box [" << dlo.x() << ", "
+        << dlo.y() << "] – [" << dhi.x() << ", " << dhi.y() << "]";
+      warnings.push_back(o.str());
+    }
+    return added;
+  }
+
   static std::uint64_t splitmix(std::uint64_t& state) {
     std::uint64_t z = (state += 0x9E3779B97F4A7C15ULL);
     z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ULL;
@@ -332,6 +405,22 @@ struct World::Impl final : StageRunner {
 };
 
 World::World(const SceneDef& sceneIn, const WorldOptions& options) : impl_(std::make_unique<Impl>(sceneIn, options)) {
+  impl_->ownWorld = std::make_unique<b2World>(bv(sceneIn.gravity));
+  impl_->b2 = impl_->ownWorld.get();
+  for (const BodyDef& b : sceneIn.bodies) addBody(*impl_->b2, b);
+  init();
+}
+
+World::World(const SceneDef& sceneIn, b2World& gameWorld, const WorldOptions& options)
+    : impl_(std::make_unique<Impl>(sceneIn, options)) {
+  impl_->b2 = &gameWorld;
+  if (!sceneIn.bodies.empty())
+    impl_->warnings.push_back("the scene's " + std::to_string(sceneIn.bodies.size()) +
+                              " boundary bodies are ignored: the fluid uses the game's b2World");
+  init();
+}
+
+void World::init() {
   Impl& w = *impl_;
   // A scene built in code may leave solver parameters out: give them their defaults.
   for (const SolverParam& sp : solverParams(w.scene.solver.type))
@@ -348,9 +437,6 @@ World::World(const SceneDef& sceneIn, const WorldOptions& options) : impl_(std::
   }
   w.budget = scene.effects.budget > 0 ? scene.effects.budget : scene.maxParticles;
   if (scene.effects.lifetime) w.P.field("age");
-  w.ownWorld = std::make_unique<b2World>(bv(scene.gravity));
-  w.b2 = w.ownWorld.get();
-  for (const BodyDef& b : scene.bodies) addBody(*w.b2, b);
 
   // Local frame: the centre of the scene's box, rounded to 64 m, so that
   // scenes far from the origin keep float precision.
@@ -366,6 +452,9 @@ World::World(const SceneDef& sceneIn, const WorldOptions& options) : impl_(std::
     grow(b.max);
   }
   for (const auto& b : scene.bodies) grow(b.position);
+  if (!w.ownWorld)
+    for (b2Body* body = w.b2->GetBodyList(); body; body = body->GetNext())
+      if (body->GetType() == b2_staticBody) grow(Vec2d(body->GetPosition().x, body->GetPosition().y));
   if (any) {
     const Vec2d c = (lo + hi) * 0.5;
     w.origin = Vec2d(std::round(c.x() / 64.0) * 64.0, std::round(c.y() / 64.0) * 64.0);
@@ -376,52 +465,9 @@ World::World(const SceneDef& sceneIn, const WorldOptions& options) : impl_(std::
   // Mass so that a full square lattice at spacing dx has exactly ρ0.
   w.mass = Real(sd.restDensity / latticeSum(*w.solver, double(w.R), sd.spacing));
 
-  w.boundary.collect(*w.b2, w.origin);
-  w.boundary.sample(w.dx, w.R, w.pool);
-  w.boundary.buildBins(Real(4) * w.R);
+  w.rebuildBoundary();
   // Fluid blocks on a square lattice; particles inside solids are dropped.
-  std::size_t dropped = 0;
-  Vec2d dlo(0, 0), dhi(0, 0);
-  const Real rho0 = Real(sd.restDensity);
-  // Hydrostatic start: under gravity along −y, rows are placed closer with
-  // depth so that the block starts at the density the solver holds at rest,
-  // ρ = ρ0(1 + f g z) with the solver's factor f (2/c² for muller2003, whose
-  // symmetric force recovers ∇p/2; 1/c0² for wcsph). Started uncompressed, a column would ring
-  // in its acoustic mode with a speed amplitude of about g·H/c.
-  const double hydroFactor = w.solver->hydrostaticFactor();
-  const bool hydrostatic = hydroFactor > 0 && scene.gravity.x() == 0 && scene.gravity.y() < 0;
-  const double gz = -scene.gravity.y();
-  for (const FluidBlockDef& b : scene.blocks) {
-    const long nx = long(std::floor((b.max.x() - b.min.x()) / sd.spacing + 1e-9));
-    const long ny = long(std::floor((b.max.y() - b.min.y()) / sd.spacing + 1e-9));
-    std::vector<double> rowY(std::size_t(std::max(ny, 0L)));
-    double prevScale = 1;
-    for (long j = 0; j < ny; ++j) {
-      const double depth = (double(ny - j) - 0.5) * sd.spacing;
-      const double scale = hydrostatic ? 1.0 / (1.0 + hydroFactor * gz * depth) : 1.0;
-      rowY[std::size_t(j)] = j == 0 ? b.min.y() + 0.5 * sd.spacing * scale
-                                    : rowY[std::size_t(j - 1)] + 0.5 * sd.spacing * (prevScale + scale);
-      prevScale = scale;
-    }
-    for (long j = 0; j < ny; ++j)
-      for (long i = 0; i < nx; ++i) {
-        const Vec2d pw(b.min.x() + (i + 0.5) * sd.spacing, rowY[std::size_t(j)]);
-        const Vec2 p = Vec2(Real(pw.x() - w.origin.x()), Real(pw.y() - w.origin.y()));
-        if (w.boundary.insideDepth(p) > 0) {
-          dlo = dropped ? dlo.cwiseMin(pw) : pw;
-          dhi = dropped ? dhi.cwiseMax(pw) : pw;
-          ++dropped;
-          continue;
-        }
-        w.P.push(p, Vec2(Real(b.velocity.x()), Real(b.velocity.y())), w.nextId++, rho0);
-      }
-  }
-  if (dropped) {
-    std::ostringstream o;
-    o << "dropped " << dropped << " particles that the scene placed inside solids, in the box [" << dlo.x() << ", "
-      << dlo.y() << "] – [" << dhi.x() << ", " << dhi.y() << "]";
-    w.warnings.push_back(o.str());
-  }
+  for (const FluidBlockDef& b : scene.blocks) w.fillBlock(b, true);
   // First density/pressure so that the initial state is complete for readers.
   StepContext c = w.context(0);
   w.solver->prepare(c);
@@ -432,8 +478,65 @@ World::~World() = default;
 void World::stepFrame() { step(1.0 / impl_->scene.fps); }
 
 void World::step(double dt) {
+  // A game may edit its level between frames: re-read the static fixtures when they changed.
+  if (impl_->staticSignature() != impl_->boundarySignature) impl_->rebuildBoundary();
   impl_->advance(dt);
   ++impl_->frames;
+}
+
+void World::refreshBoundaries() { impl_->rebuildBoundary(); }
+
+void World::setGravity(const Vec2d& g) { impl_->scene.gravity = g; }
+
+std::size_t World::addBlock(const FluidBlockDef& block) { return impl_->fillBlock(block, false); }
+
+std::size_t World::removeParticlesInBox(const Vec2d& lo, const Vec2d& hi) {
+  Impl& w = *impl_;
+  const RegionDef r{lo, hi};
+  w.dead.assign(w.P.size(), 0);
+  std::size_t n = 0;
+  for (std::size_t i = 0; i < w.P.size(); ++i) {
+    w.dead[i] = r.contains(worldPosition(i));
+    n += w.dead[i];
+  }
+  if (n) w.removeFlagged();
+  return n;
+}
+
+std::vector<std::size_t> World::particlesInRadius(const Vec2d& c, double radius) const {
+  std::vector<std::size_t> out;
+  for (std::size_t i = 0; i < impl_->P.size(); ++i)
+    if ((worldPosition(i) - c).squaredNorm() <= radius * radius) out.push_back(i);
+  return out;
+}
+
+std::vector<std::size_t> World::particlesInBox(const Vec2d& lo, const Vec2d& hi) const {
+  std::vector<std::size_t> out;
+  const RegionDef r{lo, hi};
+  for (std::size_t i = 0; i < impl_->P.size(); ++i)
+    if (r.contains(worldPosition(i))) out.push_back(i);
+  return out;
+}
+
+World::FieldSample World::sampleAt(const Vec2d& point) const {
+  const Impl& w = *impl_;
+  const WendlandC2<double> W(double(w.R));
+  FieldSample s;
+  double rho = 0;
+  Vec2d vel(0, 0);
+  for (std::size_t i = 0; i < w.P.size(); ++i) {
+    const double r = (worldPosition(i) - point).norm();
+    if (r >= W.R) continue;
+    const double wv = W.value(r) * double(w.mass) / double(w.P.rho[i]);  // V_j W
+    s.weight += wv;
+    rho += wv * double(w.P.rho[i]);
+    vel += wv * Vec2d(w.P.v[i].x(), w.P.v[i].y());
+  }
+  if (s.weight > 0) {
+    s.density = rho / s.weight;
+    s.velocity = vel / s.weight;
+  }
+  return s;
 }
 
 const Particles& World::particles() const { return impl_->P; }

@@ -65,6 +65,12 @@ class World {
  public:
   /// Builds the world of a scene: its own b2World, the fluid blocks, the solver.
   explicit World(const SceneDef& scene, const WorldOptions& options = {});
+  /// Builds the fluid of `scene` in a b2World the game owns: every static
+  /// fixture of `gameWorld` is solid to the fluid. The World never steps,
+  /// changes or destroys `gameWorld` (it must outlive the World); the scene's
+  /// own `boundaries` are ignored, with a warning. Static bodies the game adds,
+  /// moves or removes later are picked up at the next frame.
+  World(const SceneDef& scene, b2World& gameWorld, const WorldOptions& options = {});
   ~World();
   World(const World&) = delete;
   World& operator=(const World&) = delete;
@@ -127,6 +133,30 @@ class World {
   /// Messages the world wants the user to see (substep cap hits, dropped particles); cleared on read.
   std::vector<std::string> takeWarnings();
 
+  /// Sets gravity [m/s²] from the next substep on (tilting the tank).
+  void setGravity(const Vec2d& g);
+  /// Adds a block of fluid on the lattice of the scene's spacing (particles
+  /// inside solids are skipped). Returns the number of particles added.
+  std::size_t addBlock(const FluidBlockDef& block);
+  /// Removes the particles inside the box [lo, hi] (world coordinates). Returns how many.
+  std::size_t removeParticlesInBox(const Vec2d& lo, const Vec2d& hi);
+  /// Slots of the particles within `radius` of `center` (world coordinates), in slot order.
+  std::vector<std::size_t> particlesInRadius(const Vec2d& center, double radius) const;
+  /// Slots of the particles inside the box [lo, hi] (world coordinates), in slot order.
+  std::vector<std::size_t> particlesInBox(const Vec2d& lo, const Vec2d& hi) const;
+  /// Shepard-normalised SPH samples at a world point: density [kg/m³] and velocity [m/s]
+  /// (Σ V_j A_j W / Σ V_j W over the fluid, Wendland C2 kernel of the world's support).
+  /// Where no particle is within the support, density 0 and velocity 0.
+  struct FieldSample {
+    double density = 0;
+    Vec2d velocity{0, 0};
+    double weight = 0;  ///< Σ V_j W: near 1 inside the fluid, 0 far from it
+  };
+  /// Samples the fluid's fields at `point`.
+  FieldSample sampleAt(const Vec2d& point) const;
+  /// Re-reads the static fixtures of the b2World now (stepFrame does it when they change).
+  void refreshBoundaries();
+
   /// Replaces the user forces (push/pull at points). The user_force stage
   /// exists only once a force has been set.
   void setUserForces(const std::vector<UserForce>& forces);
@@ -145,6 +175,7 @@ class World {
   struct Impl;
 
  private:
+  void init();
   std::unique_ptr<Impl> impl_;
 };
 
