@@ -292,6 +292,11 @@ struct World::Impl final : StageRunner {
           }
         }
         const double te = d.start + double(s.emitted) / d.rate;
+        // Rows across the nozzle: slot k % perRow, evenly spaced (randomly
+        // placed particles would overlap and blow the stream apart), with a
+        // small random offset of ±0.1 spacing.
+        const std::uint64_t perRow = std::max<std::uint64_t>(1, std::uint64_t(std::llround(d.width / double(dx))));
+        const double slot = (double(s.emitted % perRow) + 0.5) / double(perRow) - 0.5;
         const double u1 = uniform(s.rng), u2 = uniform(s.rng), u3 = uniform(s.rng);
         const double ang = (u2 - 0.5) * d.spread;
         const Vec2d vdir(dir.x() * std::cos(ang) - dir.y() * std::sin(ang), dir.x() * std::sin(ang) + dir.y() * std::cos(ang));
@@ -299,7 +304,7 @@ struct World::Impl final : StageRunner {
         const Vec2d vel = vdir * speed;
         // Placed where a particle emitted at te would be at the substep start,
         // so that the stream is continuous after this substep's integration.
-        const Vec2d pw = d.position + across * ((u1 - 0.5) * d.width) + vel * (time - te);
+        const Vec2d pw = d.position + across * (slot * d.width + (u1 - 0.5) * 0.2 * double(dx)) + vel * (time - te);
         P.push(Vec2(Real(pw.x() - origin.x()), Real(pw.y() - origin.y())), Vec2(Real(vel.x()), Real(vel.y())), nextId++, rho0);
       }
     }
@@ -479,12 +484,27 @@ void World::stepFrame() { step(1.0 / impl_->scene.fps); }
 
 void World::step(double dt) {
   // A game may edit its level between frames: re-read the static fixtures when they changed.
-  if (impl_->staticSignature() != impl_->boundarySignature) impl_->rebuildBoundary();
+  if (impl_->staticSignature() != impl_->boundarySignature) refreshBoundaries();
   impl_->advance(dt);
   ++impl_->frames;
 }
 
-void World::refreshBoundaries() { impl_->rebuildBoundary(); }
+void World::refreshBoundaries() {
+  Impl& w = *impl_;
+  w.rebuildBoundary();
+  // Particles a new solid buries are dropped (pushing them out would be an explosion).
+  w.dead.assign(w.P.size(), 0);
+  std::size_t n = 0;
+  for (std::size_t i = 0; i < w.P.size(); ++i) {
+    w.dead[i] = w.boundary.insideDepth(w.P.x[i]) > 0;
+    n += w.dead[i];
+  }
+  if (n) {
+    w.removeFlagged();
+    w.warnings.push_back("dropped " + std::to_string(n) + " particles now inside solids (the level changed at frame " +
+                         std::to_string(w.frames) + ")");
+  }
+}
 
 void World::setGravity(const Vec2d& g) { impl_->scene.gravity = g; }
 
