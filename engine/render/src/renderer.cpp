@@ -4,10 +4,14 @@
 #include <GL/glext.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdlib>
+#include <cstring>
 #include <fstream>
 #include <map>
+#include <mutex>
+#include <numeric>
 #include <sstream>
 #include <stdexcept>
 
@@ -19,6 +23,9 @@ namespace sph2d {
 const std::map<std::string, std::string>& embeddedShaders();
 
 namespace {
+
+using Clock = std::chrono::steady_clock;
+double msSince(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
 
 /// Shader text: $SPH2D_SHADER_DIR/name when that is set (for shader work), else the embedded copy.
 std::string shaderSource(const std::string& name) {
@@ -70,14 +77,18 @@ GLuint program(const std::string& vs, const std::string& fs) {
   return p;
 }
 
-GLuint target(GLenum internal, GLenum format, GLenum type, int w, int h, GLuint& tex) {
-  glGenTextures(1, &tex);
+void makeTexture(GLuint& tex, GLenum internal, GLenum format, GLenum type, int w, int h, GLint filter) {
+  if (!tex) glGenTextures(1, &tex);
   glBindTexture(GL_TEXTURE_2D, tex);
   glTexImage2D(GL_TEXTURE_2D, 0, GLint(internal), w, h, 0, format, type, nullptr);
-  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
-  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, filter);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, filter);
   glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
   glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+}
+
+GLuint target(GLenum internal, GLenum format, GLenum type, int w, int h, GLuint& tex) {
+  makeTexture(tex, internal, format, type, w, h, GL_NEAREST);
   GLuint fbo = 0;
   glGenFramebuffers(1, &fbo);
   glBindFramebuffer(GL_FRAMEBUFFER, fbo);
@@ -87,9 +98,88 @@ GLuint target(GLenum internal, GLenum format, GLenum type, int w, int h, GLuint&
   return fbo;
 }
 
+float smoothstepf(float e0, float e1, float x) {
+  const float t = std::min(1.0f, std::max(0.0f, (x - e0) / (e1 - e0)));
+  return t * t * (3.0f - 2.0f * t);
+}
+
+std::array<float, 3> color3(const std::array<double, 3>& c) { return {float(c[0]), float(c[1]), float(c[2])}; }
+
+// Environment variables recorded in manifests. Values that sph2d pins when unset come first.
+struct EnvPin {
+  const char* name;
+  const char* pinned;  // nullptr: record only
+};
+const EnvPin kEnv[] = {
+    {"GALLIUM_DRIVER", "llvmpipe"},  // softpipe rasterises point sprites differently
+    {"MESA_SHADER_CACHE_DISABLE", "true"},  // hermetic runs: nothing read from or written to ~/.cache
+    {"LP_NUM_THREADS", nullptr},  // measured: 0, 1, 2, 8 give identical pixels (docs/RENDERING.md)
+    {"LP_NATIVE_VECTOR_WIDTH", nullptr},  // measured: 128 and 256 give identical pixels
+    {"GALLIUM_OVERRIDE_CPU_CAPS", nullptr},  // changes pixels when it removes AVX/FMA (measured)
+    {"LP_DEBUG", nullptr},
+    {"LP_PERF", nullptr},
+    {"MESA_LOADER_DRIVER_OVERRIDE", nullptr},
+};
+
 }  // namespace
 
-std::vector<double> resolveCamera(const RenderDef& def, const World& world) {
+bool parseColorField(const std::string& s, ColorField& out) {
+  if (s == "speed") out = ColorField::Speed;
+  else if (s == "pressure") out = ColorField::Pressure;
+  else if (s == "density") out = ColorField::Density;
+  else if (s == "age") out = ColorField::Age;
+  else return false;
+  return true;
+}
+
+std::string colorFieldName(ColorField f) {
+  switch (f) {
+    case ColorField::Speed: return "speed";
+    case ColorField::Pressure: return "pressure";
+    case ColorField::Density: return "density";
+    case ColorField::Age: return "age";
+  }
+  return "?";
+}
+
+std::vector<EnvSetting> pinRenderEnvironment() {
+  static std::mutex m;
+  static std::vector<EnvSetting> record;
+  std::lock_guard<std::mutex> lock(m);
+  if (record.empty()) {
+    for (const EnvPin& e : kEnv) {
+      const char* v = std::getenv(e.name);
+      if (v) record.push_back({e.name, v, "user"});
+      else if (e.pinned) {
+        setenv(e.name, e.pinned, 1);
+        record.push_back({e.name, e.pinned, "sph2d"});
+      } else {
+        record.push_back({e.name, "", "unset"});
+      }
+    }
+  }
+  return record;
+}
+
+std::string cpuSummary() {
+  std::ifstream in("/proc/cpuinfo");
+  std::string line, model, flags;
+  while (std::getline(in, line) && (model.empty() || flags.empty())) {
+    auto value = [&] {
+      const auto c = line.find(':');
+      return c == std::string::npos ? std::string() : line.substr(std::min(line.size(), c + 2));
+    };
+    if (model.empty() && line.rfind("model name", 0) == 0) model = value();
+    if (flags.empty() && line.rfind("flags", 0) == 0) flags = " " + value() + " ";
+  }
+  std::string out = model.empty() ? "unknown CPU" : model;
+  out += ";";
+  for (const char* f : {"sse4_1", "avx", "avx2", "fma", "f16c", "avx512f"})
+    if (flags.find(std::string(" ") + f + " ") != std::string::npos) out += std::string(" ") + f;
+  return out;
+}
+
+std::vector<double> resolveCamera(const RenderDef& def, const RenderInput& in) {
   double x0, y0, x1, y1;
   if (!def.camera.automatic) {
     x0 = def.camera.min.x();
@@ -105,12 +195,13 @@ std::vector<double> resolveCamera(const RenderDef& def, const World& world) {
       hi = any ? hi.cwiseMax(p) : p;
       any = true;
     };
-    const Vec2d o = world.origin();
-    for (const Collider& c : world.colliders()) {
-      grow(c.lo.x() + o.x(), c.lo.y() + o.y());
-      grow(c.hi.x() + o.x(), c.hi.y() + o.y());
-    }
-    const Particles& P = world.particles();
+    const Vec2d o = in.origin;
+    if (in.colliders)
+      for (const Collider& c : *in.colliders) {
+        grow(c.lo.x() + o.x(), c.lo.y() + o.y());
+        grow(c.hi.x() + o.x(), c.hi.y() + o.y());
+      }
+    const Particles& P = *in.particles;
     for (std::size_t i = 0; i < P.size(); ++i) grow(P.x[i].x() + o.x(), P.x[i].y() + o.y());
     if (!any) {
       lo = Vec2d(-1, -1);
@@ -136,30 +227,65 @@ std::vector<double> resolveCamera(const RenderDef& def, const World& world) {
   return {x0, y0, x1, y1};
 }
 
+namespace {
+RenderInput inputOf(const World& world, const Real* age) {
+  RenderInput in;
+  in.particles = &world.particles();
+  in.origin = world.origin();
+  in.spacing = world.spacing();
+  in.colliders = &world.colliders();
+  in.age = age;
+  in.gravity = world.scene().gravity.norm();
+  in.frame = world.frame();
+  in.time = world.time();
+  return in;
+}
+}  // namespace
+
+std::vector<double> resolveCamera(const RenderDef& def, const World& world) {
+  return resolveCamera(def, inputOf(world, nullptr));
+}
+
 struct Renderer::Impl {
   RenderDef def;
+  RenderOptions opt;
+  bool liquid = true;
   OSMesaContext ctx = nullptr;
   unsigned char dummy[4] = {0, 0, 0, 0};
-  GLuint fieldTex = 0, fieldFbo = 0, colorTex = 0, colorFbo = 0;
-  GLuint splatProg = 0, compositeProg = 0, particleProg = 0, solidProg = 0;
-  GLuint vao = 0, posVbo = 0, valVbo = 0, solidVao = 0, solidVbo = 0, emptyVao = 0;
+  GLuint fieldTex = 0, fieldFbo = 0, colorTex = 0, colorFbo = 0, auxTex = 0;
+  GLuint splatProg = 0, compositeProg = 0, discProg = 0, solidProg = 0;
+  GLuint pointVao = 0, quadVao = 0, particleVbo = 0, cornerVbo = 0, solidVao = 0, solidVbo = 0, emptyVao = 0;
   GLsizei solidCount = 0;
   bool solidsBuilt = false;
+  float maxPoint = 255.0f;
   std::vector<double> cam;
   Frame frame;
-  std::vector<float> values;
+  std::vector<float> packed;           // x, y, value, weight per particle, id order
+  std::vector<std::uint32_t> order;    // slots in id order
+  std::vector<std::uint32_t> slotOfId;
+  std::vector<float> cover, aux;       // coarse grid: coverage; RG = depth above, local fill
+  int auxW = 0, auxH = 0, auxCell = 0;
   std::string rendererName;
+  RenderTimings timings;
+  bool quads = false;
+  std::array<double, 2> range{0, 1};
 
   void makeCurrent() {
     if (!OSMesaMakeCurrent(ctx, dummy, GL_UNSIGNED_BYTE, 1, 1)) throw std::runtime_error("OSMesaMakeCurrent failed");
   }
 
-  void buildSolids(const World& world) {
+  void stageEnd(double& slot, Clock::time_point& t) {
+    if (opt.profile) glFinish();
+    slot = msSince(t);
+    t = Clock::now();
+  }
+
+  void buildSolids(const RenderInput& in) {
     // Triangles in NDC (the camera is fixed for a run).
-    const Vec2d o = world.origin();
-    const double sx = 2.0 / (cam[2] - cam[0]), sy = -2.0 / (cam[3] - cam[1]);
+    const Vec2d o = in.origin;
+    const double sx = 2.0 / (cam[2] - cam[0]), sy = 2.0 / (cam[3] - cam[1]);
     auto ndc = [&](const Vec2& p) {
-      return std::array<float, 2>{float((p.x() + o.x() - cam[0]) * sx - 1.0), float(1.0 - (p.y() + o.y() - cam[1]) * (-sy))};
+      return std::array<float, 2>{float((p.x() + o.x() - cam[0]) * sx - 1.0), float(1.0 - (p.y() + o.y() - cam[1]) * sy)};
     };
     std::vector<float> tri;
     auto put = [&](const std::array<float, 2>& a) {
@@ -167,54 +293,175 @@ struct Renderer::Impl {
       tri.push_back(a[1]);
     };
     const double pxX = 2.0 / def.width, pxY = 2.0 / def.height;
-    for (const Collider& c : world.colliders()) {
-      if (c.kind == Collider::Kind::Polygon) {
-        for (std::size_t k = 1; k + 1 < c.vertices.size(); ++k) {
-          put(ndc(c.vertices[0]));
-          put(ndc(c.vertices[k]));
-          put(ndc(c.vertices[k + 1]));
+    if (in.colliders)
+      for (const Collider& c : *in.colliders) {
+        if (c.kind == Collider::Kind::Polygon) {
+          for (std::size_t k = 1; k + 1 < c.vertices.size(); ++k) {
+            put(ndc(c.vertices[0]));
+            put(ndc(c.vertices[k]));
+            put(ndc(c.vertices[k + 1]));
+          }
+        } else if (c.kind == Collider::Kind::Circle) {
+          const int n = 64;
+          for (int k = 0; k < n; ++k) {
+            const Real a0 = 2 * kPi<Real> * Real(k) / n, a1 = 2 * kPi<Real> * Real(k + 1) / n;
+            put(ndc(c.center));
+            put(ndc(c.center + c.radius * Vec2(std::cos(a0), std::sin(a0))));
+            put(ndc(c.center + c.radius * Vec2(std::cos(a1), std::sin(a1))));
+          }
+        } else {
+          // A zero-thickness segment drawn 3 px wide.
+          const auto a = ndc(c.vertices[0]), b = ndc(c.vertices[1]);
+          const double dxp = (b[0] - a[0]) / pxX, dyp = (b[1] - a[1]) / pxY;
+          const double len = std::sqrt(dxp * dxp + dyp * dyp);
+          if (len <= 0) continue;
+          const double nxp = -dyp / len * 1.5, nyp = dxp / len * 1.5;
+          const float ox = float(nxp * pxX), oy = float(nyp * pxY);
+          const std::array<float, 2> p0{a[0] + ox, a[1] + oy}, p1{a[0] - ox, a[1] - oy}, p2{b[0] + ox, b[1] + oy},
+              p3{b[0] - ox, b[1] - oy};
+          put(p0);
+          put(p1);
+          put(p2);
+          put(p2);
+          put(p1);
+          put(p3);
         }
-      } else if (c.kind == Collider::Kind::Circle) {
-        const int n = 64;
-        for (int k = 0; k < n; ++k) {
-          const Real a0 = 2 * kPi<Real> * Real(k) / n, a1 = 2 * kPi<Real> * Real(k + 1) / n;
-          put(ndc(c.center));
-          put(ndc(c.center + c.radius * Vec2(std::cos(a0), std::sin(a0))));
-          put(ndc(c.center + c.radius * Vec2(std::cos(a1), std::sin(a1))));
-        }
-      } else {
-        // A zero-thickness segment drawn 3 px wide.
-        const auto a = ndc(c.vertices[0]), b = ndc(c.vertices[1]);
-        double dxp = (b[0] - a[0]) / pxX, dyp = (b[1] - a[1]) / pxY;
-        const double len = std::sqrt(dxp * dxp + dyp * dyp);
-        if (len <= 0) continue;
-        const double nxp = -dyp / len * 1.5, nyp = dxp / len * 1.5;
-        const float ox = float(nxp * pxX), oy = float(nyp * pxY);
-        const std::array<float, 2> p0{a[0] + ox, a[1] + oy}, p1{a[0] - ox, a[1] - oy}, p2{b[0] + ox, b[1] + oy},
-            p3{b[0] - ox, b[1] - oy};
-        put(p0);
-        put(p1);
-        put(p2);
-        put(p2);
-        put(p1);
-        put(p3);
       }
-    }
     solidCount = GLsizei(tri.size() / 2);
     glBindVertexArray(solidVao);
     glBindBuffer(GL_ARRAY_BUFFER, solidVbo);
-    glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(tri.size() * sizeof(float)), tri.data(), GL_STATIC_DRAW);
+    glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(tri.size() * sizeof(float)), tri.empty() ? nullptr : tri.data(),
+                 GL_STATIC_DRAW);
     glEnableVertexAttribArray(0);
     glVertexAttribPointer(0, 2, GL_FLOAT, GL_FALSE, 0, nullptr);
     solidsBuilt = true;
   }
+
+  /// Slots in id order: a frame must not depend on how the engine stores particles.
+  void sortById(const Particles& P) {
+    const std::size_t n = P.size();
+    order.resize(n);
+    std::uint32_t maxId = 0;
+    for (std::size_t i = 0; i < n; ++i) maxId = std::max(maxId, P.id[i]);
+    if (n && std::size_t(maxId) < 4 * n + 64) {
+      const std::uint32_t none = 0xffffffffu;
+      slotOfId.assign(std::size_t(maxId) + 1, none);
+      bool unique = true;
+      for (std::size_t i = 0; i < n; ++i) {
+        std::uint32_t& s = slotOfId[P.id[i]];
+        if (s != none) unique = false;
+        s = std::uint32_t(i);
+      }
+      if (unique) {
+        std::size_t k = 0;
+        for (std::uint32_t s : slotOfId)
+          if (s != none) order[k++] = s;
+        return;
+      }
+    }
+    std::iota(order.begin(), order.end(), 0u);
+    std::stable_sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) { return P.id[a] < P.id[b]; });
+  }
+
+  float fade(const RenderInput& in, std::size_t slot) const {
+    if (!in.age) return 1.0f;
+    const float a = float(in.age[slot]);
+    if (!(opt.ageFadeEnd > opt.ageFadeStart)) return 1.0f;
+    return 1.0f - smoothstepf(float(opt.ageFadeStart), float(opt.ageFadeEnd), a);
+  }
+
+  double valueOf(const RenderInput& in, std::size_t i) const {
+    const Particles& P = *in.particles;
+    switch (opt.colorBy) {
+      case ColorField::Speed: return double(P.v[i].norm());
+      case ColorField::Pressure: return double(P.p[i]);
+      case ColorField::Density: return double(P.rho[i]);
+      case ColorField::Age: return in.age ? double(in.age[i]) : 0.0;
+    }
+    return 0.0;
+  }
+
+  /// The coarse grid: coverage per cell, then depth of water above and local fill.
+  void buildAux(const RenderInput& in, double pxPerM, const std::vector<float>& weight) {
+    const double spacingPx = in.spacing * pxPerM;
+    const int cell = std::max(4, int(std::ceil(spacingPx)));
+    const int w = (def.width + cell - 1) / cell, h = (def.height + cell - 1) / cell;
+    if (w != auxW || h != auxH || cell != auxCell) {
+      auxW = w;
+      auxH = h;
+      auxCell = cell;
+      makeTexture(auxTex, GL_RG32F, GL_RG, GL_FLOAT, w, h, GL_LINEAR);
+    }
+    cover.assign(std::size_t(w) * std::size_t(h), 0.0f);
+    const Particles& P = *in.particles;
+    const double cellM = cell / pxPerM;
+    const double x0 = cam[0] - in.origin.x(), y1 = cam[3] - in.origin.y();
+    const float areaShare = float((spacingPx * spacingPx) / (double(cell) * double(cell)));
+    for (std::size_t k = 0; k < order.size(); ++k) {
+      const std::size_t i = order[k];
+      const double cx = (double(P.x[i].x()) - x0) / cellM, cy = (y1 - double(P.x[i].y())) / cellM;
+      if (!(cx >= 0 && cy >= 0 && cx < w && cy < h)) continue;
+      cover[std::size_t(int(cy)) * std::size_t(w) + std::size_t(int(cx))] += areaShare * weight[k];
+    }
+    for (float& c : cover) c = std::min(c, 1.0f);
+    aux.assign(std::size_t(w) * std::size_t(h) * 2, 0.0f);
+    for (int x = 0; x < w; ++x) {
+      float above = 0;
+      for (int y = 0; y < h; ++y) {
+        const float c = cover[std::size_t(y) * std::size_t(w) + std::size_t(x)];
+        aux[(std::size_t(y) * std::size_t(w) + std::size_t(x)) * 2] = float((above + 0.5f * c) * cellM);
+        above += c;
+      }
+    }
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x) {
+        float s = 0;
+        int n = 0;
+        for (int dy = -1; dy <= 1; ++dy)
+          for (int dx = -1; dx <= 1; ++dx) {
+            const int xx = x + dx, yy = y + dy;
+            if (xx < 0 || yy < 0 || xx >= w || yy >= h) continue;
+            s += cover[std::size_t(yy) * std::size_t(w) + std::size_t(xx)];
+            ++n;
+          }
+        aux[(std::size_t(y) * std::size_t(w) + std::size_t(x)) * 2 + 1] = s / float(n);
+      }
+    glBindTexture(GL_TEXTURE_2D, auxTex);
+    glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+    glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, w, h, GL_RG, GL_FLOAT, aux.data());
+  }
+
+  void setSpriteUniforms(GLuint prog, const float scale[2], const float offset[2], float diameterPx) {
+    glUseProgram(prog);
+    glUniform2fv(glGetUniformLocation(prog, "uScale"), 1, scale);
+    glUniform2fv(glGetUniformLocation(prog, "uOffset"), 1, offset);
+    glUniform1f(glGetUniformLocation(prog, "uPointSize"), std::min(diameterPx, maxPoint));
+    glUniform1i(glGetUniformLocation(prog, "uQuads"), quads ? 1 : 0);
+    glUniform2f(glGetUniformLocation(prog, "uHalfNdc"), diameterPx / float(def.width), diameterPx / float(def.height));
+    glUniform1f(glGetUniformLocation(prog, "uRadiusPx"), 0.5f * diameterPx);
+  }
+
+  void drawSprites(GLsizei n) {
+    if (!n) return;
+    if (quads) {
+      glBindVertexArray(quadVao);
+      glDrawArraysInstanced(GL_TRIANGLE_STRIP, 0, 4, n);
+    } else {
+      glBindVertexArray(pointVao);
+      glDrawArrays(GL_POINTS, 0, n);
+    }
+  }
 };
 
-Renderer::Renderer(const RenderDef& def) : impl_(std::make_unique<Impl>()) {
+Renderer::Renderer(const RenderDef& def, const RenderOptions& options) : impl_(std::make_unique<Impl>()) {
   Impl& r = *impl_;
   r.def = def;
-  // Hermetic runs: no shader cache under $HOME.
-  setenv("MESA_SHADER_CACHE_DISABLE", "true", 0);
+  r.opt = options;
+  const std::string mode = options.mode.empty() ? def.mode : options.mode;
+  if (mode != "liquid" && mode != "particles")
+    throw std::runtime_error("unknown render mode '" + mode + "' (liquid or particles)");
+  r.liquid = mode == "liquid";
+  pinRenderEnvironment();
   const int attribs[] = {OSMESA_FORMAT, OSMESA_RGBA, OSMESA_DEPTH_BITS, 0, OSMESA_STENCIL_BITS, 0, OSMESA_ACCUM_BITS, 0,
                          OSMESA_PROFILE, OSMESA_CORE_PROFILE, OSMESA_CONTEXT_MAJOR_VERSION, 3,
                          OSMESA_CONTEXT_MINOR_VERSION, 3, 0};
@@ -225,17 +472,42 @@ Renderer::Renderer(const RenderDef& def) : impl_(std::make_unique<Impl>()) {
   const char* ren = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
   const char* ver = reinterpret_cast<const char*>(glGetString(GL_VERSION));
   r.rendererName = std::string(ren ? ren : "?") + " / " + (ver ? ver : "?");
+  GLfloat range[2] = {1, 255};
+  glGetFloatv(GL_POINT_SIZE_RANGE, range);
+  r.maxPoint = std::max(1.0f, range[1]);
 
-  r.fieldFbo = target(GL_R32F, GL_RED, GL_FLOAT, def.width, def.height, r.fieldTex);
+  r.fieldFbo = target(GL_RG32F, GL_RG, GL_FLOAT, def.width, def.height, r.fieldTex);
   r.colorFbo = target(GL_RGBA8, GL_RGBA, GL_UNSIGNED_BYTE, def.width, def.height, r.colorTex);
   r.splatProg = program("splat.vert", "splat.frag");
   r.compositeProg = program("fullscreen.vert", "composite.frag");
-  r.particleProg = program("splat.vert", "particles.frag");
+  r.discProg = program("splat.vert", "particles.frag");
   r.solidProg = program("solid.vert", "solid.frag");
 
-  glGenVertexArrays(1, &r.vao);
-  glGenBuffers(1, &r.posVbo);
-  glGenBuffers(1, &r.valVbo);
+  glGenBuffers(1, &r.particleVbo);
+  glGenBuffers(1, &r.cornerVbo);
+  const float corners[8] = {-1, -1, 1, -1, -1, 1, 1, 1};
+  glBindBuffer(GL_ARRAY_BUFFER, r.cornerVbo);
+  glBufferData(GL_ARRAY_BUFFER, sizeof corners, corners, GL_STATIC_DRAW);
+  // Points: one vertex per particle. Quads: four corners per instance, the particle per instance.
+  for (int q = 0; q < 2; ++q) {
+    GLuint& vao = q ? r.quadVao : r.pointVao;
+    glGenVertexArrays(1, &vao);
+    glBindVertexArray(vao);
+    glBindBuffer(GL_ARRAY_BUFFER, r.particleVbo);
+    const GLsizei stride = 4 * sizeof(float);
+    glEnableVertexAttribArray(0);
+    glVertexAttribPointer(0, 2, GL_FLOAT, GL_FALSE, stride, nullptr);
+    glEnableVertexAttribArray(1);
+    glVertexAttribPointer(1, 1, GL_FLOAT, GL_FALSE, stride, reinterpret_cast<const void*>(2 * sizeof(float)));
+    glEnableVertexAttribArray(2);
+    glVertexAttribPointer(2, 1, GL_FLOAT, GL_FALSE, stride, reinterpret_cast<const void*>(3 * sizeof(float)));
+    if (q) {
+      for (GLuint a = 0; a < 3; ++a) glVertexAttribDivisor(a, 1);
+      glBindBuffer(GL_ARRAY_BUFFER, r.cornerVbo);
+      glEnableVertexAttribArray(3);
+      glVertexAttribPointer(3, 2, GL_FLOAT, GL_FALSE, 0, nullptr);
+    }
+  }
   glGenVertexArrays(1, &r.solidVao);
   glGenBuffers(1, &r.solidVbo);
   glGenVertexArrays(1, &r.emptyVao);
@@ -243,6 +515,7 @@ Renderer::Renderer(const RenderDef& def) : impl_(std::make_unique<Impl>()) {
   r.frame.width = def.width;
   r.frame.height = def.height;
   r.frame.rgba.assign(std::size_t(def.width) * def.height * 4, 0);
+  if (glGetError() != GL_NO_ERROR) throw std::runtime_error("OpenGL error while creating the renderer");
 }
 
 Renderer::~Renderer() {
@@ -251,88 +524,147 @@ Renderer::~Renderer() {
 
 std::string Renderer::rendererString() const { return impl_->rendererName; }
 std::vector<double> Renderer::cameraRect() const { return impl_->cam; }
+std::string Renderer::mode() const { return impl_->liquid ? "liquid" : "particles"; }
+RenderTimings Renderer::lastTimings() const { return impl_->timings; }
+bool Renderer::usedQuads() const { return impl_->quads; }
+float Renderer::maxPointSize() const { return impl_->maxPoint; }
+std::array<double, 2> Renderer::lastRange() const { return impl_->range; }
 
-const Frame& Renderer::render(const World& world) {
+const Frame& Renderer::render(const World& world, const Real* age) { return render(inputOf(world, age)); }
+
+const Frame& Renderer::render(const RenderInput& in) {
   Impl& r = *impl_;
+  if (!in.particles) throw std::invalid_argument("Renderer::render: no particles");
+  const auto tStart = Clock::now();
+  auto t = tStart;
+  r.timings = RenderTimings{};
   r.makeCurrent();
   const RenderDef& d = r.def;
-  if (r.cam.empty()) r.cam = resolveCamera(d, world);
-  if (!r.solidsBuilt) r.buildSolids(world);
+  if (r.cam.empty()) r.cam = resolveCamera(d, in);
+  if (!r.solidsBuilt) r.buildSolids(in);
+  if (in.age == nullptr && r.opt.colorBy == ColorField::Age && !r.liquid)
+    throw std::runtime_error("colour by age needs particle ages, and none were given");
 
-  const Particles& P = world.particles();
-  const Vec2d o = world.origin();
+  const Particles& P = *in.particles;
+  const std::size_t n = P.size();
+  const Vec2d o = in.origin;
   const double camW = r.cam[2] - r.cam[0], camH = r.cam[3] - r.cam[1];
   const float scale[2] = {float(2.0 / camW), float(-2.0 / camH)};
   const float offset[2] = {float((o.x() - r.cam[0]) * 2.0 / camW - 1.0), float(1.0 - (o.y() - r.cam[1]) * 2.0 / camH)};
   const double pxPerM = d.width / camW;
-  const float radiusPx = float(d.splatRadius * world.spacing() * pxPerM);
-  const float pointSize = std::min(2.0f * radiusPx, 255.0f);
+  const double spacingPx = in.spacing * pxPerM;
 
-  glBindVertexArray(r.vao);
-  glBindBuffer(GL_ARRAY_BUFFER, r.posVbo);
-  glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(P.size() * sizeof(Vec2)), P.size() ? P.x.data() : nullptr, GL_STREAM_DRAW);
-  glEnableVertexAttribArray(0);
-  glVertexAttribPointer(0, 2, GL_FLOAT, GL_FALSE, sizeof(Vec2), nullptr);
-  r.values.resize(P.size());
-  if (d.mode == "particles") {
-    float vmax = 1e-6f;
-    for (std::size_t i = 0; i < P.size(); ++i) vmax = std::max(vmax, P.v[i].norm());
-    for (std::size_t i = 0; i < P.size(); ++i) r.values[i] = P.v[i].norm() / vmax;
+  // Pack the particles in id order: position, value, weight.
+  r.sortById(P);
+  std::vector<float> weight(n);
+  for (std::size_t k = 0; k < n; ++k) weight[k] = r.fade(in, r.order[k]);
+  r.packed.resize(n * 4);
+  double lo = 0, hi = 1;
+  if (r.liquid) {
+    for (std::size_t k = 0; k < n; ++k) {
+      const std::size_t i = r.order[k];
+      r.packed[4 * k] = P.x[i].x();
+      r.packed[4 * k + 1] = P.x[i].y();
+      r.packed[4 * k + 2] = P.v[i].norm();
+      r.packed[4 * k + 3] = weight[k];
+    }
+  } else {
+    if (r.opt.range) {
+      lo = (*r.opt.range)[0];
+      hi = (*r.opt.range)[1];
+    } else if (n) {
+      lo = hi = r.valueOf(in, r.order[0]);
+      for (std::size_t k = 1; k < n; ++k) {
+        const double v = r.valueOf(in, r.order[k]);
+        lo = std::min(lo, v);
+        hi = std::max(hi, v);
+      }
+      if (r.opt.colorBy == ColorField::Speed || r.opt.colorBy == ColorField::Age) lo = 0;
+    }
+    if (!(hi > lo)) hi = lo + 1e-6 * std::max(1.0, std::fabs(lo));
+    r.range = {lo, hi};
+    const double inv = 1.0 / (hi - lo);
+    for (std::size_t k = 0; k < n; ++k) {
+      const std::size_t i = r.order[k];
+      r.packed[4 * k] = P.x[i].x();
+      r.packed[4 * k + 1] = P.x[i].y();
+      r.packed[4 * k + 2] = float((r.valueOf(in, i) - lo) * inv);
+      r.packed[4 * k + 3] = weight[k];
+    }
   }
-  glBindBuffer(GL_ARRAY_BUFFER, r.valVbo);
-  glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(r.values.size() * sizeof(float)), r.values.empty() ? nullptr : r.values.data(),
+  glBindBuffer(GL_ARRAY_BUFFER, r.particleVbo);
+  glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(r.packed.size() * sizeof(float)), n ? r.packed.data() : nullptr,
                GL_STREAM_DRAW);
-  glEnableVertexAttribArray(1);
-  glVertexAttribPointer(1, 1, GL_FLOAT, GL_FALSE, sizeof(float), nullptr);
+  if (r.liquid) r.buildAux(in, pxPerM, weight);
   glViewport(0, 0, d.width, d.height);
+  r.stageEnd(r.timings.upload, t);
 
-  if (d.mode == "liquid") {
-    // 1. Splat into the float field.
+  if (r.liquid) {
+    // 1. Splat Σw and Σw·speed into the RG32F field.
+    const float diameter = float(2.0 * d.splatRadius * spacingPx);
+    r.quads = diameter > r.maxPoint;
     glBindFramebuffer(GL_FRAMEBUFFER, r.fieldFbo);
     glClearColor(0, 0, 0, 0);
     glClear(GL_COLOR_BUFFER_BIT);
     glEnable(GL_BLEND);
     glBlendFunc(GL_ONE, GL_ONE);
-    glUseProgram(r.splatProg);
-    glUniform2fv(glGetUniformLocation(r.splatProg, "uScale"), 1, scale);
-    glUniform2fv(glGetUniformLocation(r.splatProg, "uOffset"), 1, offset);
-    glUniform1f(glGetUniformLocation(r.splatProg, "uPointSize"), pointSize);
-    glBindVertexArray(r.vao);
-    glDrawArrays(GL_POINTS, 0, GLsizei(P.size()));
+    r.setSpriteUniforms(r.splatProg, scale, offset, diameter);
+    r.drawSprites(GLsizei(n));
     glDisable(GL_BLEND);
+    r.stageEnd(r.timings.splat, t);
     // 2. Composite into the colour target.
+    const GLuint cp = r.compositeProg;
     glBindFramebuffer(GL_FRAMEBUFFER, r.colorFbo);
-    glUseProgram(r.compositeProg);
+    glUseProgram(cp);
     glActiveTexture(GL_TEXTURE0);
     glBindTexture(GL_TEXTURE_2D, r.fieldTex);
-    glUniform1i(glGetUniformLocation(r.compositeProg, "uField"), 0);
-    glUniform2f(glGetUniformLocation(r.compositeProg, "uTexel"), 1.0f / float(d.width), 1.0f / float(d.height));
-    // Bulk value of the field: Σ (1 − q²)³ over a lattice ≈ π s²/4 with s = radius in spacings.
-    const float rs = pointSize * 0.5f / float(world.spacing() * pxPerM);
+    glActiveTexture(GL_TEXTURE1);
+    glBindTexture(GL_TEXTURE_2D, r.auxTex);
+    glActiveTexture(GL_TEXTURE0);
+    glUniform1i(glGetUniformLocation(cp, "uField"), 0);
+    glUniform1i(glGetUniformLocation(cp, "uAux"), 1);
+    glUniform2f(glGetUniformLocation(cp, "uAuxScale"), float(d.width) / float(r.auxW * r.auxCell),
+                float(d.height) / float(r.auxH * r.auxCell));
+    glUniform2f(glGetUniformLocation(cp, "uTexel"), 1.0f / float(d.width), 1.0f / float(d.height));
+    // Bulk value of the field: Σ (1 − q²)³ over a square lattice ≈ π s²/4, s = sprite radius in spacings.
+    const float rs = float(diameter * 0.5 / spacingPx);
     const float bulk = std::max(1e-3f, 3.14159265f * rs * rs / 4.0f);
-    glUniform1f(glGetUniformLocation(r.compositeProg, "uInvBulk"), 1.0f / bulk);
-    glUniform3f(glGetUniformLocation(r.compositeProg, "uBackground"), float(d.background[0]), float(d.background[1]),
-                float(d.background[2]));
-    glUniform3f(glGetUniformLocation(r.compositeProg, "uWater"), float(d.water[0]), float(d.water[1]), float(d.water[2]));
+    glUniform1f(glGetUniformLocation(cp, "uInvBulk"), 1.0f / bulk);
+    const auto bg = color3(d.background), water = color3(d.water);
+    const std::array<float, 3> deep =
+        r.opt.deepWater ? color3(*r.opt.deepWater) : std::array<float, 3>{water[0] * 0.3f, water[1] * 0.3f, water[2] * 0.3f};
+    const auto foam = color3(r.opt.foam.value_or(std::array<double, 3>{0.9, 0.95, 1.0}));
+    glUniform3fv(glGetUniformLocation(cp, "uBackground"), 1, bg.data());
+    glUniform3fv(glGetUniformLocation(cp, "uWater"), 1, water.data());
+    glUniform3fv(glGetUniformLocation(cp, "uDeep"), 1, deep.data());
+    glUniform3fv(glGetUniformLocation(cp, "uFoam"), 1, foam.data());
+    const double depthScale = r.opt.depthScale > 0 ? r.opt.depthScale : 0.25 * camH;
+    glUniform1f(glGetUniformLocation(cp, "uInvDepth"), float(1.0 / depthScale));
+    const double foamLo = r.opt.foamSpeed > 0 ? r.opt.foamSpeed : 0.35 * std::sqrt(std::max(in.gravity, 1e-6) * camH);
+    glUniform2f(glGetUniformLocation(cp, "uFoamSpeed"), float(foamLo), float(2 * foamLo));
+    glUniform1f(glGetUniformLocation(cp, "uSpacingPx"), float(spacingPx));
     glBindVertexArray(r.emptyVao);
     glDrawArrays(GL_TRIANGLES, 0, 3);
+    r.stageEnd(r.timings.composite, t);
   } else {
+    const float diameter = float(std::max(3.0, spacingPx));
+    r.quads = diameter > r.maxPoint;
     glBindFramebuffer(GL_FRAMEBUFFER, r.colorFbo);
     glClearColor(float(d.background[0]), float(d.background[1]), float(d.background[2]), 1.0f);
     glClear(GL_COLOR_BUFFER_BIT);
-    glUseProgram(r.particleProg);
-    glUniform2fv(glGetUniformLocation(r.particleProg, "uScale"), 1, scale);
-    glUniform2fv(glGetUniformLocation(r.particleProg, "uOffset"), 1, offset);
-    glUniform1f(glGetUniformLocation(r.particleProg, "uPointSize"),
-                std::max(2.0f, std::min(float(world.spacing() * pxPerM), 255.0f)));
-    glBindVertexArray(r.vao);
-    glDrawArrays(GL_POINTS, 0, GLsizei(P.size()));
+    glEnable(GL_BLEND);
+    glBlendFuncSeparate(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA, GL_ZERO, GL_ONE);
+    r.setSpriteUniforms(r.discProg, scale, offset, diameter);
+    r.drawSprites(GLsizei(n));
+    glDisable(GL_BLEND);
+    r.stageEnd(r.timings.splat, t);
   }
   // 3. Solids on top.
   glUseProgram(r.solidProg);
   glUniform3f(glGetUniformLocation(r.solidProg, "uColor"), float(d.solid[0]), float(d.solid[1]), float(d.solid[2]));
   glBindVertexArray(r.solidVao);
   if (r.solidCount) glDrawArrays(GL_TRIANGLES, 0, r.solidCount);
+  r.stageEnd(r.timings.solids, t);
 
   glPixelStorei(GL_PACK_ALIGNMENT, 1);
   glReadPixels(0, 0, d.width, d.height, GL_RGBA, GL_UNSIGNED_BYTE, r.frame.rgba.data());
@@ -342,6 +674,26 @@ const Frame& Renderer::render(const World& world) {
     msg << "OpenGL error 0x" << std::hex << err << " while rendering";
     throw std::runtime_error(msg.str());
   }
+  r.stageEnd(r.timings.readback, t);
+
+  // 4. Text and colour bar on the CPU (bit-identical everywhere).
+  const int textScale = std::max(1, d.height / 270);
+  const Rgba8 textColor = toRgba8(r.opt.text.value_or(std::array<double, 3>{0.92, 0.92, 0.92}));
+  if (!r.liquid) {
+    static const char* titles[] = {"SPEED M/S", "PRESSURE PA", "DENSITY KG/M3", "AGE S"};
+    drawColorBar(r.frame, lo, hi, titles[int(r.opt.colorBy)], textScale);
+  }
+  if (r.opt.overlay) {
+    char line[128];
+    std::snprintf(line, sizeof line, "FRAME %llu  T %.3f S  %zu PARTICLES", static_cast<unsigned long long>(in.frame),
+                  in.time, n);
+    const int pad = 2 * textScale;
+    fillRect(r.frame, 0, 0, textWidth(line, textScale) + 2 * pad + 2 * textScale, textHeight(textScale) + 2 * pad + 2 * textScale,
+             Rgba8{0, 0, 0, 140});
+    drawText(r.frame, pad + textScale, pad + textScale, line, textScale, textColor);
+  }
+  r.stageEnd(r.timings.overlay, t);
+  r.timings.total = msSince(tStart);
   return r.frame;
 }
 
