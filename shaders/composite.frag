@@ -7,15 +7,16 @@
 //  - surface: shading from the field's gradient (light from above), a bright
 //    meniscus just inside the edge and a specular highlight;
 //  - foam: towards white where the kernel-weighted speed is high.
-// Rows of this target run top-down in the world (the camera flips y).
-in vec2 vUv;
+// Rows of this target run top-down in the world (the camera flips y). It is
+// drawn only over the tiles that fluid can reach (solid.vert: quads in NDC);
+// the rest of the frame keeps the background.
 out vec4 outColor;
-uniform sampler2D uField;    // RG: sum w, sum w*speed
+uniform sampler2D uBg;       // the background (RGBA8, same size)
+uniform sampler2D uField;    // RG: sum w, sum w*speed (full or half resolution, bilinear)
 uniform sampler2D uAux;      // RG: depth of water above [m], local fill 0..1 (bilinear)
 uniform vec2 uAuxScale;      // vUv -> aux texture coordinates
 uniform vec2 uTexel;         // 1 / size
 uniform float uInvBulk;      // 1 / field value inside bulk fluid
-uniform vec3 uBackground;
 uniform vec3 uWater;         // colour at the surface
 uniform vec3 uDeep;          // colour under deep water
 uniform vec3 uFoam;
@@ -23,6 +24,7 @@ uniform float uInvDepth;     // 1 / metres of water that darken by 1/e
 uniform vec2 uFoamSpeed;     // foam starts, foam full [m/s]
 uniform float uSpacingPx;    // particle spacing [px]
 void main() {
+  vec2 vUv = gl_FragCoord.xy * uTexel;
   vec2 c = texture(uField, vUv).rg;
   float f = c.r * uInvBulk;
   float fl = texture(uField, vUv - vec2(uTexel.x, 0.0)).r * uInvBulk;
@@ -32,8 +34,7 @@ void main() {
   vec2 grad = vec2(fr - fl, fa - fb) * 0.5;  // per pixel, world orientation (y up)
   float g = length(grad);
   vec2 aux = texture(uAux, vUv * uAuxScale).rg;
-  // Background: a gentle vertical gradient, lighter at the top.
-  vec3 bg = uBackground * (0.8 + 0.35 * (1.0 - vUv.y));
+  vec3 bg = texelFetch(uBg, ivec2(gl_FragCoord.xy), 0).rgb;
   float threshold = mix(0.24, 0.5, smoothstep(0.15, 0.55, aux.g));
   float cover = clamp((f - threshold) / max(g, 1e-3) + 0.5, 0.0, 1.0);
   if (cover <= 0.0) {

@@ -252,9 +252,13 @@ struct Renderer::Impl {
   bool liquid = true;
   OSMesaContext ctx = nullptr;
   unsigned char dummy[4] = {0, 0, 0, 0};
-  GLuint fieldTex = 0, fieldFbo = 0, colorTex = 0, colorFbo = 0, auxTex = 0;
-  GLuint splatProg = 0, compositeProg = 0, discProg = 0, solidProg = 0;
+  GLuint fieldTex = 0, fieldFbo = 0, colorTex = 0, colorFbo = 0, auxTex = 0, bgTex = 0, bgFbo = 0;
+  GLuint splatProg = 0, compositeProg = 0, discProg = 0, solidProg = 0, bgProg = 0;
   GLuint pointVao = 0, quadVao = 0, particleVbo = 0, cornerVbo = 0, solidVao = 0, solidVbo = 0, emptyVao = 0;
+  GLuint tileVao = 0, tileVbo = 0;
+  GLsizei tileVertices = 0;
+  std::vector<float> tiles;
+  std::vector<std::uint8_t> active, activeTmp;
   GLsizei solidCount = 0;
   bool solidsBuilt = false;
   float maxPoint = 255.0f;
@@ -265,6 +269,7 @@ struct Renderer::Impl {
   std::vector<std::uint32_t> slotOfId;
   std::vector<float> cover, aux;       // coarse grid: coverage; RG = depth above, local fill
   int auxW = 0, auxH = 0, auxCell = 0;
+  int fieldW = 0, fieldH = 0;  // the splat target: full resolution, or half when sprites are wide
   std::string rendererName;
   RenderTimings timings;
   bool quads = false;
@@ -397,11 +402,19 @@ struct Renderer::Impl {
     const double cellM = cell / pxPerM;
     const double x0 = cam[0] - in.origin.x(), y1 = cam[3] - in.origin.y();
     const float areaShare = float((spacingPx * spacingPx) / (double(cell) * double(cell)));
+    // Cloud-in-cell deposit (bilinear weights): no aliasing between the lattice and the cells.
     for (std::size_t k = 0; k < order.size(); ++k) {
       const std::size_t i = order[k];
-      const double cx = (double(P.x[i].x()) - x0) / cellM, cy = (y1 - double(P.x[i].y())) / cellM;
-      if (!(cx >= 0 && cy >= 0 && cx < w && cy < h)) continue;
-      cover[std::size_t(int(cy)) * std::size_t(w) + std::size_t(int(cx))] += areaShare * weight[k];
+      const double cx = (double(P.x[i].x()) - x0) / cellM - 0.5, cy = (y1 - double(P.x[i].y())) / cellM - 0.5;
+      if (!(cx > -1 && cy > -1 && cx < w && cy < h)) continue;
+      const int ix = int(std::floor(cx)), iy = int(std::floor(cy));
+      const float tx = float(cx - ix), ty = float(cy - iy);
+      const float m = areaShare * weight[k];
+      const float wgt[4] = {(1 - tx) * (1 - ty) * m, tx * (1 - ty) * m, (1 - tx) * ty * m, tx * ty * m};
+      for (int q = 0; q < 4; ++q) {
+        const int xx = ix + (q & 1), yy = iy + (q >> 1);
+        if (xx >= 0 && yy >= 0 && xx < w && yy < h) cover[std::size_t(yy) * std::size_t(w) + std::size_t(xx)] += wgt[q];
+      }
     }
     for (float& c : cover) c = std::min(c, 1.0f);
     aux.assign(std::size_t(w) * std::size_t(h) * 2, 0.0f);
@@ -431,13 +444,73 @@ struct Renderer::Impl {
     glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, w, h, GL_RG, GL_FLOAT, aux.data());
   }
 
-  void setSpriteUniforms(GLuint prog, const float scale[2], const float offset[2], float diameterPx) {
+  /// Quads (NDC, two triangles each) over the grid cells the splat can reach: cells with fluid,
+  /// dilated by the sprite radius plus one pixel for the gradient taps. Rows are merged into runs.
+  void buildTiles(float spriteRadiusPx) {
+    const int w = auxW, h = auxH;
+    const int reach = int(std::ceil((spriteRadiusPx + 1.0f) / float(auxCell)));
+    active.assign(std::size_t(w) * std::size_t(h), 0);
+    activeTmp.assign(active.size(), 0);
+    for (std::size_t k = 0; k < cover.size(); ++k) active[k] = cover[k] > 0.0f;
+    for (int y = 0; y < h; ++y)  // dilate along rows
+      for (int x = 0; x < w; ++x) {
+        std::uint8_t a = 0;
+        for (int dx = -reach; dx <= reach && !a; ++dx) {
+          const int xx = x + dx;
+          if (xx >= 0 && xx < w) a = active[std::size_t(y) * std::size_t(w) + std::size_t(xx)];
+        }
+        activeTmp[std::size_t(y) * std::size_t(w) + std::size_t(x)] = a;
+      }
+    for (int y = 0; y < h; ++y)  // then along columns
+      for (int x = 0; x < w; ++x) {
+        std::uint8_t a = 0;
+        for (int dy = -reach; dy <= reach && !a; ++dy) {
+          const int yy = y + dy;
+          if (yy >= 0 && yy < h) a = activeTmp[std::size_t(yy) * std::size_t(w) + std::size_t(x)];
+        }
+        active[std::size_t(y) * std::size_t(w) + std::size_t(x)] = a;
+      }
+    tiles.clear();
+    auto ndcX = [&](int px) { return float(std::min(px, def.width)) / float(def.width) * 2.0f - 1.0f; };
+    auto ndcY = [&](int py) { return float(std::min(py, def.height)) / float(def.height) * 2.0f - 1.0f; };
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w;) {
+        if (!active[std::size_t(y) * std::size_t(w) + std::size_t(x)]) {
+          ++x;
+          continue;
+        }
+        int e = x;
+        while (e < w && active[std::size_t(y) * std::size_t(w) + std::size_t(e)]) ++e;
+        const float x0 = ndcX(x * auxCell), x1 = ndcX(e * auxCell), y0 = ndcY(y * auxCell), y1 = ndcY((y + 1) * auxCell);
+        const float q[12] = {x0, y0, x1, y0, x0, y1, x0, y1, x1, y0, x1, y1};
+        tiles.insert(tiles.end(), q, q + 12);
+        x = e;
+      }
+    tileVertices = GLsizei(tiles.size() / 2);
+    glBindBuffer(GL_ARRAY_BUFFER, tileVbo);
+    glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(tiles.size() * sizeof(float)), tiles.empty() ? nullptr : tiles.data(),
+                 GL_STREAM_DRAW);
+  }
+
+  /// The background texture, drawn once with shaders/background.frag.
+  void buildBackground() {
+    bgFbo = target(GL_RGBA8, GL_RGBA, GL_UNSIGNED_BYTE, def.width, def.height, bgTex);
+    glViewport(0, 0, def.width, def.height);
+    glUseProgram(bgProg);
+    glUniform3f(glGetUniformLocation(bgProg, "uBackground"), float(def.background[0]), float(def.background[1]),
+                float(def.background[2]));
+    glUniform2f(glGetUniformLocation(bgProg, "uTexel"), 1.0f / float(def.width), 1.0f / float(def.height));
+    glBindVertexArray(emptyVao);
+    glDrawArrays(GL_TRIANGLES, 0, 3);
+  }
+
+  void setSpriteUniforms(GLuint prog, const float scale[2], const float offset[2], float diameterPx, int vw, int vh) {
     glUseProgram(prog);
     glUniform2fv(glGetUniformLocation(prog, "uScale"), 1, scale);
     glUniform2fv(glGetUniformLocation(prog, "uOffset"), 1, offset);
     glUniform1f(glGetUniformLocation(prog, "uPointSize"), std::min(diameterPx, maxPoint));
     glUniform1i(glGetUniformLocation(prog, "uQuads"), quads ? 1 : 0);
-    glUniform2f(glGetUniformLocation(prog, "uHalfNdc"), diameterPx / float(def.width), diameterPx / float(def.height));
+    glUniform2f(glGetUniformLocation(prog, "uHalfNdc"), diameterPx / float(vw), diameterPx / float(vh));
     glUniform1f(glGetUniformLocation(prog, "uRadiusPx"), 0.5f * diameterPx);
   }
 
@@ -476,12 +549,12 @@ Renderer::Renderer(const RenderDef& def, const RenderOptions& options) : impl_(s
   glGetFloatv(GL_POINT_SIZE_RANGE, range);
   r.maxPoint = std::max(1.0f, range[1]);
 
-  r.fieldFbo = target(GL_RG32F, GL_RG, GL_FLOAT, def.width, def.height, r.fieldTex);
   r.colorFbo = target(GL_RGBA8, GL_RGBA, GL_UNSIGNED_BYTE, def.width, def.height, r.colorTex);
   r.splatProg = program("splat.vert", "splat.frag");
-  r.compositeProg = program("fullscreen.vert", "composite.frag");
   r.discProg = program("splat.vert", "particles.frag");
   r.solidProg = program("solid.vert", "solid.frag");
+  r.bgProg = program("fullscreen.vert", "background.frag");
+  r.compositeProg = program("solid.vert", "composite.frag");
 
   glGenBuffers(1, &r.particleVbo);
   glGenBuffers(1, &r.cornerVbo);
@@ -511,7 +584,14 @@ Renderer::Renderer(const RenderDef& def, const RenderOptions& options) : impl_(s
   glGenVertexArrays(1, &r.solidVao);
   glGenBuffers(1, &r.solidVbo);
   glGenVertexArrays(1, &r.emptyVao);
+  glGenVertexArrays(1, &r.tileVao);
+  glGenBuffers(1, &r.tileVbo);
+  glBindVertexArray(r.tileVao);
+  glBindBuffer(GL_ARRAY_BUFFER, r.tileVbo);
+  glEnableVertexAttribArray(0);
+  glVertexAttribPointer(0, 2, GL_FLOAT, GL_FALSE, 0, nullptr);
   glEnable(GL_PROGRAM_POINT_SIZE);
+  r.buildBackground();
   r.frame.width = def.width;
   r.frame.height = def.height;
   r.frame.rgba.assign(std::size_t(def.width) * def.height * 4, 0);
@@ -595,34 +675,56 @@ const Frame& Renderer::render(const RenderInput& in) {
   glBindBuffer(GL_ARRAY_BUFFER, r.particleVbo);
   glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(r.packed.size() * sizeof(float)), n ? r.packed.data() : nullptr,
                GL_STREAM_DRAW);
-  if (r.liquid) r.buildAux(in, pxPerM, weight);
+  if (r.liquid) {
+    r.buildAux(in, pxPerM, weight);
+    r.buildTiles(float(d.splatRadius * spacingPx));
+  }
   glViewport(0, 0, d.width, d.height);
   r.stageEnd(r.timings.upload, t);
 
   if (r.liquid) {
-    // 1. Splat Σw and Σw·speed into the RG32F field.
+    // 1. Splat Σw and Σw·speed into the RG32F field; at half resolution when sprites are at
+    //    least 8 px wide (a quarter of the fragments; the composite samples it bilinearly).
     const float diameter = float(2.0 * d.splatRadius * spacingPx);
-    r.quads = diameter > r.maxPoint;
+    const int shrink = diameter >= 8.0f ? 2 : 1;
+    const int fw = (d.width + shrink - 1) / shrink, fh = (d.height + shrink - 1) / shrink;
+    if (fw != r.fieldW || fh != r.fieldH) {
+      if (r.fieldFbo) glDeleteFramebuffers(1, &r.fieldFbo);
+      r.fieldFbo = target(GL_RG32F, GL_RG, GL_FLOAT, fw, fh, r.fieldTex);
+      const GLint filter = shrink > 1 ? GL_LINEAR : GL_NEAREST;
+      glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, filter);
+      glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, filter);
+      r.fieldW = fw;
+      r.fieldH = fh;
+    }
+    const float fieldDiameter = diameter * float(fw) / float(d.width);
+    r.quads = fieldDiameter > r.maxPoint;
+    glViewport(0, 0, fw, fh);
     glBindFramebuffer(GL_FRAMEBUFFER, r.fieldFbo);
     glClearColor(0, 0, 0, 0);
     glClear(GL_COLOR_BUFFER_BIT);
     glEnable(GL_BLEND);
     glBlendFunc(GL_ONE, GL_ONE);
-    r.setSpriteUniforms(r.splatProg, scale, offset, diameter);
+    r.setSpriteUniforms(r.splatProg, scale, offset, fieldDiameter, fw, fh);
     r.drawSprites(GLsizei(n));
     glDisable(GL_BLEND);
+    glViewport(0, 0, d.width, d.height);
     r.stageEnd(r.timings.splat, t);
     // 2. Composite into the colour target.
     const GLuint cp = r.compositeProg;
+    glCopyImageSubData(r.bgTex, GL_TEXTURE_2D, 0, 0, 0, 0, r.colorTex, GL_TEXTURE_2D, 0, 0, 0, 0, d.width, d.height, 1);
     glBindFramebuffer(GL_FRAMEBUFFER, r.colorFbo);
     glUseProgram(cp);
     glActiveTexture(GL_TEXTURE0);
     glBindTexture(GL_TEXTURE_2D, r.fieldTex);
     glActiveTexture(GL_TEXTURE1);
     glBindTexture(GL_TEXTURE_2D, r.auxTex);
+    glActiveTexture(GL_TEXTURE2);
+    glBindTexture(GL_TEXTURE_2D, r.bgTex);
     glActiveTexture(GL_TEXTURE0);
     glUniform1i(glGetUniformLocation(cp, "uField"), 0);
     glUniform1i(glGetUniformLocation(cp, "uAux"), 1);
+    glUniform1i(glGetUniformLocation(cp, "uBg"), 2);
     glUniform2f(glGetUniformLocation(cp, "uAuxScale"), float(d.width) / float(r.auxW * r.auxCell),
                 float(d.height) / float(r.auxH * r.auxCell));
     glUniform2f(glGetUniformLocation(cp, "uTexel"), 1.0f / float(d.width), 1.0f / float(d.height));
@@ -630,11 +732,10 @@ const Frame& Renderer::render(const RenderInput& in) {
     const float rs = float(diameter * 0.5 / spacingPx);
     const float bulk = std::max(1e-3f, 3.14159265f * rs * rs / 4.0f);
     glUniform1f(glGetUniformLocation(cp, "uInvBulk"), 1.0f / bulk);
-    const auto bg = color3(d.background), water = color3(d.water);
+    const auto water = color3(d.water);
     const std::array<float, 3> deep =
         r.opt.deepWater ? color3(*r.opt.deepWater) : std::array<float, 3>{water[0] * 0.3f, water[1] * 0.3f, water[2] * 0.3f};
     const auto foam = color3(r.opt.foam.value_or(std::array<double, 3>{0.9, 0.95, 1.0}));
-    glUniform3fv(glGetUniformLocation(cp, "uBackground"), 1, bg.data());
     glUniform3fv(glGetUniformLocation(cp, "uWater"), 1, water.data());
     glUniform3fv(glGetUniformLocation(cp, "uDeep"), 1, deep.data());
     glUniform3fv(glGetUniformLocation(cp, "uFoam"), 1, foam.data());
@@ -643,18 +744,17 @@ const Frame& Renderer::render(const RenderInput& in) {
     const double foamLo = r.opt.foamSpeed > 0 ? r.opt.foamSpeed : 0.35 * std::sqrt(std::max(in.gravity, 1e-6) * camH);
     glUniform2f(glGetUniformLocation(cp, "uFoamSpeed"), float(foamLo), float(2 * foamLo));
     glUniform1f(glGetUniformLocation(cp, "uSpacingPx"), float(spacingPx));
-    glBindVertexArray(r.emptyVao);
-    glDrawArrays(GL_TRIANGLES, 0, 3);
+    glBindVertexArray(r.tileVao);
+    if (r.tileVertices) glDrawArrays(GL_TRIANGLES, 0, r.tileVertices);
     r.stageEnd(r.timings.composite, t);
   } else {
     const float diameter = float(std::max(3.0, spacingPx));
     r.quads = diameter > r.maxPoint;
+    glCopyImageSubData(r.bgTex, GL_TEXTURE_2D, 0, 0, 0, 0, r.colorTex, GL_TEXTURE_2D, 0, 0, 0, 0, d.width, d.height, 1);
     glBindFramebuffer(GL_FRAMEBUFFER, r.colorFbo);
-    glClearColor(float(d.background[0]), float(d.background[1]), float(d.background[2]), 1.0f);
-    glClear(GL_COLOR_BUFFER_BIT);
     glEnable(GL_BLEND);
     glBlendFuncSeparate(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA, GL_ZERO, GL_ONE);
-    r.setSpriteUniforms(r.discProg, scale, offset, diameter);
+    r.setSpriteUniforms(r.discProg, scale, offset, diameter, d.width, d.height);
     r.drawSprites(GLsizei(n));
     glDisable(GL_BLEND);
     r.stageEnd(r.timings.splat, t);
