@@ -39,13 +39,13 @@ bool parseRenderFlag(const std::vector<std::string>& args, std::size_t& i, Rende
 /// The help lines of the render flags.
 extern const char* kRenderFlagsHelp;
 /// The render options as recorded in a manifest.
-nlohmann::json renderOptionsJson(const RenderOptions& o);
+nlohmann::ordered_json renderOptionsJson(const RenderOptions& o);
 /// The render options a manifest recorded. Throws UsageError on a malformed entry.
-RenderOptions renderOptionsFromJson(const nlohmann::json& j);
+RenderOptions renderOptionsFromJson(const nlohmann::ordered_json& j);
 /// XXH64 of a file's bytes as 16 hex digits. Throws UsageError when it cannot be read.
 std::string fileHash(const std::string& path);
 /// The llvmpipe environment as recorded in a manifest (pins it first).
-nlohmann::json environmentJson();
+nlohmann::ordered_json environmentJson();
 
 /// `sph2d run`.
 int cmdRun(const std::vector<std::string>& args);

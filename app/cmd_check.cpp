@@ -16,7 +16,7 @@
 #include "sph2d/world.hpp"
 
 namespace fs = std::filesystem;
-using nlohmann::json;
+using json = nlohmann::ordered_json;
 
 namespace sph2d::cli {
 namespace {

@@ -20,7 +20,7 @@
 #include "sph2d/world.hpp"
 
 namespace fs = std::filesystem;
-using nlohmann::json;
+using json = nlohmann::ordered_json;
 
 namespace sph2d::cli {
 
@@ -29,8 +29,8 @@ const char* kRenderFlagsHelp =
     "  --color-by F    particles mode: speed (default), pressure, density or age\n"
     "  --range LO,HI   particles mode: fixed colour range (default: each frame's min..max)\n"
     "  --overlay       draw frame number, simulated time and particle count\n"
-    "  --foam-speed V  liquid: foam starts at V m/s, full at 2V (default 0.5·sqrt(g·view height))\n"
-    "  --depth-scale D liquid: D metres of water above darken the colour by 1/e (default ¼ view height)\n";
+    "  --foam-speed V  liquid: foam starts at V m/s, full at 2V (default 0.35·sqrt(g·view height))\n"
+    "  --depth-scale D liquid: D metres of water above darken the colour by 1/e (default 1)\n";
 
 namespace {
 

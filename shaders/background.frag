@@ -4,8 +4,9 @@
 // composite reads it, so both agree to the bit.
 out vec4 outColor;
 uniform vec3 uBackground;
-uniform vec2 uTexel;  // 1 / size
+uniform float uGuard;   // guard band [px] around the image
+uniform float uHeight;  // image height [px]
 void main() {
-  float v = gl_FragCoord.y * uTexel.y;  // 0 at the world's top (the camera flips y)
+  float v = (gl_FragCoord.y - uGuard) / uHeight;  // 0 at the image's top (the camera flips y)
   outColor = vec4(uBackground * (0.8 + 0.35 * (1.0 - v)), 1.0);
 }

@@ -260,9 +260,14 @@ struct Renderer::Impl {
   std::vector<float> tiles;
   std::vector<std::uint8_t> active, activeTmp;
   GLsizei solidCount = 0;
-  bool solidsBuilt = false;
   float maxPoint = 255.0f;
-  std::vector<double> cam;
+  std::vector<double> cam;  // the world rectangle of the image
+  // The targets are the image plus a guard band of `guard` pixels on each side: point sprites
+  // are culled when their centre leaves the viewport, so particles just outside the image
+  // must still fall inside the targets to draw their part of the image.
+  int guard = -1, EW = 0, EH = 0;
+  std::vector<double> ext;  // the world rectangle of the extended targets
+  double spacingSeen = -1;
   Frame frame;
   std::vector<float> packed;           // x, y, value, weight per particle, id order
   std::vector<std::uint32_t> order;    // slots in id order
@@ -288,16 +293,16 @@ struct Renderer::Impl {
   void buildSolids(const RenderInput& in) {
     // Triangles in NDC (the camera is fixed for a run).
     const Vec2d o = in.origin;
-    const double sx = 2.0 / (cam[2] - cam[0]), sy = 2.0 / (cam[3] - cam[1]);
+    const double sx = 2.0 / (ext[2] - ext[0]), sy = 2.0 / (ext[3] - ext[1]);
     auto ndc = [&](const Vec2& p) {
-      return std::array<float, 2>{float((p.x() + o.x() - cam[0]) * sx - 1.0), float(1.0 - (p.y() + o.y() - cam[1]) * sy)};
+      return std::array<float, 2>{float((p.x() + o.x() - ext[0]) * sx - 1.0), float(1.0 - (p.y() + o.y() - ext[1]) * sy)};
     };
     std::vector<float> tri;
     auto put = [&](const std::array<float, 2>& a) {
       tri.push_back(a[0]);
       tri.push_back(a[1]);
     };
-    const double pxX = 2.0 / def.width, pxY = 2.0 / def.height;
+    const double pxX = 2.0 / EW, pxY = 2.0 / EH;
     if (in.colliders)
       for (const Collider& c : *in.colliders) {
         if (c.kind == Collider::Kind::Polygon) {
@@ -339,7 +344,6 @@ struct Renderer::Impl {
                  GL_STATIC_DRAW);
     glEnableVertexAttribArray(0);
     glVertexAttribPointer(0, 2, GL_FLOAT, GL_FALSE, 0, nullptr);
-    solidsBuilt = true;
   }
 
   /// Slots in id order: a frame must not depend on how the engine stores particles.
@@ -390,7 +394,7 @@ struct Renderer::Impl {
   void buildAux(const RenderInput& in, double pxPerM, const std::vector<float>& weight) {
     const double spacingPx = in.spacing * pxPerM;
     const int cell = std::max(4, int(std::ceil(spacingPx)));
-    const int w = (def.width + cell - 1) / cell, h = (def.height + cell - 1) / cell;
+    const int w = (EW + cell - 1) / cell, h = (EH + cell - 1) / cell;
     if (w != auxW || h != auxH || cell != auxCell) {
       auxW = w;
       auxH = h;
@@ -400,7 +404,7 @@ struct Renderer::Impl {
     cover.assign(std::size_t(w) * std::size_t(h), 0.0f);
     const Particles& P = *in.particles;
     const double cellM = cell / pxPerM;
-    const double x0 = cam[0] - in.origin.x(), y1 = cam[3] - in.origin.y();
+    const double x0 = ext[0] - in.origin.x(), y1 = ext[3] - in.origin.y();
     const float areaShare = float((spacingPx * spacingPx) / (double(cell) * double(cell)));
     // Cloud-in-cell deposit (bilinear weights): no aliasing between the lattice and the cells.
     for (std::size_t k = 0; k < order.size(); ++k) {
@@ -471,8 +475,8 @@ struct Renderer::Impl {
         active[std::size_t(y) * std::size_t(w) + std::size_t(x)] = a;
       }
     tiles.clear();
-    auto ndcX = [&](int px) { return float(std::min(px, def.width)) / float(def.width) * 2.0f - 1.0f; };
-    auto ndcY = [&](int py) { return float(std::min(py, def.height)) / float(def.height) * 2.0f - 1.0f; };
+    auto ndcX = [&](int px) { return float(std::min(px, EW)) / float(EW) * 2.0f - 1.0f; };
+    auto ndcY = [&](int py) { return float(std::min(py, EH)) / float(EH) * 2.0f - 1.0f; };
     for (int y = 0; y < h; ++y)
       for (int x = 0; x < w;) {
         if (!active[std::size_t(y) * std::size_t(w) + std::size_t(x)]) {
@@ -494,14 +498,46 @@ struct Renderer::Impl {
 
   /// The background texture, drawn once with shaders/background.frag.
   void buildBackground() {
-    bgFbo = target(GL_RGBA8, GL_RGBA, GL_UNSIGNED_BYTE, def.width, def.height, bgTex);
-    glViewport(0, 0, def.width, def.height);
+    if (bgFbo) glDeleteFramebuffers(1, &bgFbo);
+    bgFbo = target(GL_RGBA8, GL_RGBA, GL_UNSIGNED_BYTE, EW, EH, bgTex);
+    glViewport(0, 0, EW, EH);
     glUseProgram(bgProg);
     glUniform3f(glGetUniformLocation(bgProg, "uBackground"), float(def.background[0]), float(def.background[1]),
                 float(def.background[2]));
-    glUniform2f(glGetUniformLocation(bgProg, "uTexel"), 1.0f / float(def.width), 1.0f / float(def.height));
+    glUniform1f(glGetUniformLocation(bgProg, "uGuard"), float(guard));
+    glUniform1f(glGetUniformLocation(bgProg, "uHeight"), float(def.height));
     glBindVertexArray(emptyVao);
     glDrawArrays(GL_TRIANGLES, 0, 3);
+  }
+
+  /// Sprite diameter [px] at full resolution for this input.
+  float spriteDiameter(double spacingPx) const {
+    return liquid ? float(2.0 * def.splatRadius * spacingPx) : float(std::max(3.0, spacingPx));
+  }
+  /// 2 when the liquid field is splatted at half resolution, else 1.
+  int fieldShrink(double spacingPx) const { return liquid && spriteDiameter(spacingPx) >= 8.0f ? 2 : 1; }
+
+  /// Sizes the guard band for the sprites of `in` and (re)creates what depends on it.
+  void ensureFrame(const RenderInput& in) {
+    if (in.spacing == spacingSeen) return;
+    spacingSeen = in.spacing;
+    const double pxPerM = def.width / (cam[2] - cam[0]);
+    const double spacingPx = in.spacing * pxPerM;
+    const float d = spriteDiameter(spacingPx);
+    const int shrink = fieldShrink(spacingPx);
+    const bool asQuads = d / float(shrink) > maxPoint;
+    const int g = asQuads ? 2 : int(std::ceil(0.5 * d)) + 2;
+    if (g == guard) return;
+    guard = g;
+    EW = def.width + 2 * g;
+    EH = def.height + 2 * g;
+    const double m = g / pxPerM;
+    ext = {cam[0] - m, cam[1] - m, cam[2] + m, cam[3] + m};
+    if (colorFbo) glDeleteFramebuffers(1, &colorFbo);
+    colorFbo = target(GL_RGBA8, GL_RGBA, GL_UNSIGNED_BYTE, EW, EH, colorTex);
+    buildBackground();
+    buildSolids(in);
+    fieldW = fieldH = 0;  // recreated at the next splat
   }
 
   void setSpriteUniforms(GLuint prog, const float scale[2], const float offset[2], float diameterPx, int vw, int vh) {
@@ -549,7 +585,6 @@ Renderer::Renderer(const RenderDef& def, const RenderOptions& options) : impl_(s
   glGetFloatv(GL_POINT_SIZE_RANGE, range);
   r.maxPoint = std::max(1.0f, range[1]);
 
-  r.colorFbo = target(GL_RGBA8, GL_RGBA, GL_UNSIGNED_BYTE, def.width, def.height, r.colorTex);
   r.splatProg = program("splat.vert", "splat.frag");
   r.discProg = program("splat.vert", "particles.frag");
   r.solidProg = program("solid.vert", "solid.frag");
@@ -591,7 +626,6 @@ Renderer::Renderer(const RenderDef& def, const RenderOptions& options) : impl_(s
   glEnableVertexAttribArray(0);
   glVertexAttribPointer(0, 2, GL_FLOAT, GL_FALSE, 0, nullptr);
   glEnable(GL_PROGRAM_POINT_SIZE);
-  r.buildBackground();
   r.frame.width = def.width;
   r.frame.height = def.height;
   r.frame.rgba.assign(std::size_t(def.width) * def.height * 4, 0);
@@ -621,7 +655,7 @@ const Frame& Renderer::render(const RenderInput& in) {
   r.makeCurrent();
   const RenderDef& d = r.def;
   if (r.cam.empty()) r.cam = resolveCamera(d, in);
-  if (!r.solidsBuilt) r.buildSolids(in);
+  r.ensureFrame(in);
   if (in.age == nullptr && r.opt.colorBy == ColorField::Age && !r.liquid)
     throw std::runtime_error("colour by age needs particle ages, and none were given");
 
@@ -629,8 +663,9 @@ const Frame& Renderer::render(const RenderInput& in) {
   const std::size_t n = P.size();
   const Vec2d o = in.origin;
   const double camW = r.cam[2] - r.cam[0], camH = r.cam[3] - r.cam[1];
-  const float scale[2] = {float(2.0 / camW), float(-2.0 / camH)};
-  const float offset[2] = {float((o.x() - r.cam[0]) * 2.0 / camW - 1.0), float(1.0 - (o.y() - r.cam[1]) * 2.0 / camH)};
+  const double extW = r.ext[2] - r.ext[0], extH = r.ext[3] - r.ext[1];
+  const float scale[2] = {float(2.0 / extW), float(-2.0 / extH)};
+  const float offset[2] = {float((o.x() - r.ext[0]) * 2.0 / extW - 1.0), float(1.0 - (o.y() - r.ext[1]) * 2.0 / extH)};
   const double pxPerM = d.width / camW;
   const double spacingPx = in.spacing * pxPerM;
 
@@ -679,15 +714,15 @@ const Frame& Renderer::render(const RenderInput& in) {
     r.buildAux(in, pxPerM, weight);
     r.buildTiles(float(d.splatRadius * spacingPx));
   }
-  glViewport(0, 0, d.width, d.height);
+  glViewport(0, 0, r.EW, r.EH);
   r.stageEnd(r.timings.upload, t);
 
   if (r.liquid) {
     // 1. Splat Σw and Σw·speed into the RG32F field; at half resolution when sprites are at
     //    least 8 px wide (a quarter of the fragments; the composite samples it bilinearly).
-    const float diameter = float(2.0 * d.splatRadius * spacingPx);
-    const int shrink = diameter >= 8.0f ? 2 : 1;
-    const int fw = (d.width + shrink - 1) / shrink, fh = (d.height + shrink - 1) / shrink;
+    const float diameter = r.spriteDiameter(spacingPx);
+    const int shrink = r.fieldShrink(spacingPx);
+    const int fw = (r.EW + shrink - 1) / shrink, fh = (r.EH + shrink - 1) / shrink;
     if (fw != r.fieldW || fh != r.fieldH) {
       if (r.fieldFbo) glDeleteFramebuffers(1, &r.fieldFbo);
       r.fieldFbo = target(GL_RG32F, GL_RG, GL_FLOAT, fw, fh, r.fieldTex);
@@ -697,7 +732,7 @@ const Frame& Renderer::render(const RenderInput& in) {
       r.fieldW = fw;
       r.fieldH = fh;
     }
-    const float fieldDiameter = diameter * float(fw) / float(d.width);
+    const float fieldDiameter = diameter * float(fw) / float(r.EW);
     r.quads = fieldDiameter > r.maxPoint;
     glViewport(0, 0, fw, fh);
     glBindFramebuffer(GL_FRAMEBUFFER, r.fieldFbo);
@@ -708,11 +743,11 @@ const Frame& Renderer::render(const RenderInput& in) {
     r.setSpriteUniforms(r.splatProg, scale, offset, fieldDiameter, fw, fh);
     r.drawSprites(GLsizei(n));
     glDisable(GL_BLEND);
-    glViewport(0, 0, d.width, d.height);
+    glViewport(0, 0, r.EW, r.EH);
     r.stageEnd(r.timings.splat, t);
     // 2. Composite into the colour target.
     const GLuint cp = r.compositeProg;
-    glCopyImageSubData(r.bgTex, GL_TEXTURE_2D, 0, 0, 0, 0, r.colorTex, GL_TEXTURE_2D, 0, 0, 0, 0, d.width, d.height, 1);
+    glCopyImageSubData(r.bgTex, GL_TEXTURE_2D, 0, 0, 0, 0, r.colorTex, GL_TEXTURE_2D, 0, 0, 0, 0, r.EW, r.EH, 1);
     glBindFramebuffer(GL_FRAMEBUFFER, r.colorFbo);
     glUseProgram(cp);
     glActiveTexture(GL_TEXTURE0);
@@ -725,9 +760,9 @@ const Frame& Renderer::render(const RenderInput& in) {
     glUniform1i(glGetUniformLocation(cp, "uField"), 0);
     glUniform1i(glGetUniformLocation(cp, "uAux"), 1);
     glUniform1i(glGetUniformLocation(cp, "uBg"), 2);
-    glUniform2f(glGetUniformLocation(cp, "uAuxScale"), float(d.width) / float(r.auxW * r.auxCell),
-                float(d.height) / float(r.auxH * r.auxCell));
-    glUniform2f(glGetUniformLocation(cp, "uTexel"), 1.0f / float(d.width), 1.0f / float(d.height));
+    glUniform2f(glGetUniformLocation(cp, "uAuxScale"), float(r.EW) / float(r.auxW * r.auxCell),
+                float(r.EH) / float(r.auxH * r.auxCell));
+    glUniform2f(glGetUniformLocation(cp, "uTexel"), 1.0f / float(r.EW), 1.0f / float(r.EH));
     // Bulk value of the field: Σ (1 − q²)³ over a square lattice ≈ π s²/4, s = sprite radius in spacings.
     const float rs = float(diameter * 0.5 / spacingPx);
     const float bulk = std::max(1e-3f, 3.14159265f * rs * rs / 4.0f);
@@ -739,7 +774,7 @@ const Frame& Renderer::render(const RenderInput& in) {
     glUniform3fv(glGetUniformLocation(cp, "uWater"), 1, water.data());
     glUniform3fv(glGetUniformLocation(cp, "uDeep"), 1, deep.data());
     glUniform3fv(glGetUniformLocation(cp, "uFoam"), 1, foam.data());
-    const double depthScale = r.opt.depthScale > 0 ? r.opt.depthScale : 0.25 * camH;
+    const double depthScale = r.opt.depthScale > 0 ? r.opt.depthScale : 1.0;
     glUniform1f(glGetUniformLocation(cp, "uInvDepth"), float(1.0 / depthScale));
     const double foamLo = r.opt.foamSpeed > 0 ? r.opt.foamSpeed : 0.35 * std::sqrt(std::max(in.gravity, 1e-6) * camH);
     glUniform2f(glGetUniformLocation(cp, "uFoamSpeed"), float(foamLo), float(2 * foamLo));
@@ -748,13 +783,13 @@ const Frame& Renderer::render(const RenderInput& in) {
     if (r.tileVertices) glDrawArrays(GL_TRIANGLES, 0, r.tileVertices);
     r.stageEnd(r.timings.composite, t);
   } else {
-    const float diameter = float(std::max(3.0, spacingPx));
+    const float diameter = r.spriteDiameter(spacingPx);
     r.quads = diameter > r.maxPoint;
-    glCopyImageSubData(r.bgTex, GL_TEXTURE_2D, 0, 0, 0, 0, r.colorTex, GL_TEXTURE_2D, 0, 0, 0, 0, d.width, d.height, 1);
+    glCopyImageSubData(r.bgTex, GL_TEXTURE_2D, 0, 0, 0, 0, r.colorTex, GL_TEXTURE_2D, 0, 0, 0, 0, r.EW, r.EH, 1);
     glBindFramebuffer(GL_FRAMEBUFFER, r.colorFbo);
     glEnable(GL_BLEND);
     glBlendFuncSeparate(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA, GL_ZERO, GL_ONE);
-    r.setSpriteUniforms(r.discProg, scale, offset, diameter, d.width, d.height);
+    r.setSpriteUniforms(r.discProg, scale, offset, diameter, r.EW, r.EH);
     r.drawSprites(GLsizei(n));
     glDisable(GL_BLEND);
     r.stageEnd(r.timings.splat, t);
@@ -767,7 +802,7 @@ const Frame& Renderer::render(const RenderInput& in) {
   r.stageEnd(r.timings.solids, t);
 
   glPixelStorei(GL_PACK_ALIGNMENT, 1);
-  glReadPixels(0, 0, d.width, d.height, GL_RGBA, GL_UNSIGNED_BYTE, r.frame.rgba.data());
+  glReadPixels(r.guard, r.guard, d.width, d.height, GL_RGBA, GL_UNSIGNED_BYTE, r.frame.rgba.data());
   const GLenum err = glGetError();
   if (err != GL_NO_ERROR) {
     std::ostringstream msg;

@@ -59,7 +59,7 @@ struct RenderOptions {
   std::optional<std::array<double, 2>> range;///< particles mode: fixed colour range (default: this frame's min..max)
   bool overlay = false;                      ///< frame number, simulated time and particle count in the frame
   double foamSpeed = 0;                      ///< liquid: speed [m/s] where foam starts (0 = 0.35·sqrt(g·view height)); full at 2×
-  double depthScale = 0;                     ///< liquid: metres of water above that darken by 1/e (0 = ¼ of the view height)
+  double depthScale = 0;                     ///< liquid: metres of water above that darken by 1/e (0 = 1 m)
   double ageFadeStart = 1.0;                 ///< a particle with an age fades from this age [s] ...
   double ageFadeEnd = 3.0;                   ///< ... to nothing at this age [s]
   std::optional<std::array<double, 3>> deepWater; ///< colour under deep water (default: water × 0.3)
