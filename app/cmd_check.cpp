@@ -2,6 +2,7 @@
 // written by `sph2d run`; on the first difference, count the differing pixels
 // against the reference PNG beside the manifest and write a diff image.
 #include <algorithm>
+#include <cstdlib>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -30,6 +31,8 @@ const char* kCheckHelp =
     "frame, counts its differing pixels and the largest channel difference against the\n"
     "reference PNG beside MANIFEST, writes DIR/frame_NNNNN.png (this run) and\n"
     "DIR/diff_NNNNN.png (differences in red over a dimmed reference), and exits 1.\n"
+    "Mesa settings the manifest recorded (GALLIUM_OVERRIDE_CPU_CAPS, ...) are used\n"
+    "unless set in this environment; a different renderer or CPU is named plainly.\n"
     "\n"
     "Options:\n"
     "  --against FILE  the manifest (required)\n"
@@ -139,6 +142,16 @@ int cmdCheck(const std::vector<std::string>& args) {
     std::printf("note: the manifest's run stopped early (%s: %s); checking the %zu frames it lists\n",
                 m["stop"].value("reason", "?").c_str(), m["stop"].value("message", "").c_str(), expected.size());
 
+  // Rerun as the manifest's run rendered: adopt the Mesa settings it recorded (e.g. a pinned
+  // GALLIUM_OVERRIDE_CPU_CAPS) unless this environment sets them itself.
+  if (m.contains("environment") && m["environment"].is_array())
+    for (const json& e : m["environment"]) {
+      const std::string name = e.value("name", ""), value = e.value("value", "");
+      if (name.empty() || value.empty() || std::getenv(name.c_str())) continue;
+      setenv(name.c_str(), value.c_str(), 0);
+      if (!quiet && e.value("source", "") == "user")
+        std::printf("note: using %s=%s as the manifest's run did\n", name.c_str(), value.c_str());
+    }
   World world(scene, WorldOptions{threads});
   world.takeWarnings();
   Renderer renderer(scene.render, opt);
