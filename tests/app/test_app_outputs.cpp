@@ -249,3 +249,18 @@ TEST_CASE("--png-level changes the file size, never the pixels; bad render flags
   CHECK(age.out.find("needs particle ages") != std::string::npos);
   CHECK(run("run " + q(kSmall) + " --range 5,1").code == 2);
 }
+
+TEST_CASE("sph2d render redraws an exported CSV frame bit-identically to the run's frame") {
+  const std::string dir = freshDir("rerender");
+  REQUIRE(run("run " + q(kSmall) + " --frames 11 --every 10 --quiet --export csv --out " + q(dir)).code == 0);
+  const Result r = run("render " + q(kSmall) + " --particles " + q(dir + "/frame_00010.csv") + " --out " +
+                       q(dir + "/again.png"));
+  INFO(r.out);
+  REQUIRE(r.code == 0);
+  CHECK(r.out.find("1250 particles of frame 10") != std::string::npos);
+  CHECK(pngHash(dir + "/again.png") == readManifest(dir)["frames"][1]["rgba_xxh64"].get<std::string>());
+  // Another mode from the same file: a different image of the same size.
+  REQUIRE(run("render " + q(kSmall) + " --particles " + q(dir + "/frame_00010.csv") + " --out " +
+              q(dir + "/discs.png") + " --mode particles --color-by density").code == 0);
+  CHECK(pngHash(dir + "/discs.png") != pngHash(dir + "/again.png"));
+}
