@@ -240,3 +240,43 @@ TEST_CASE("the overlay changes only the pixels of its box in the top-left corner
   CHECK(outside == 0);
   CHECK(inside > boxW * boxH / 2);  // the translucent box darkens every pixel it covers (but black ones)
 }
+
+TEST_CASE("100k particles render: a 2 m x 1 m lattice covers its share of a 960x540 image, both modes") {
+  // 100,352 particles at 0.0044 m (about 1.07 px at 240 px/m): sprites of 4.3 px, full-resolution field.
+  Particles P;
+  const double dx = 0.0044;
+  std::uint32_t id = 0;
+  for (int j = 0; j < 224; ++j)
+    for (int i = 0; i < 448; ++i)
+      P.push(Vec2(Real(0.5 + (i + 0.5) * dx), Real(0.5 + (j + 0.5) * dx)), Vec2(Real(i % 7), 0), id++, Real(1000));
+  REQUIRE(P.size() == 100352);
+  RenderDef def;
+  def.width = 960;
+  def.height = 540;
+  def.camera.automatic = false;
+  def.camera.min = Vec2d(0, 0);
+  def.camera.max = Vec2d(4, 2.25);
+  RenderInput in;
+  in.particles = &P;
+  in.spacing = dx;
+  const double block = (448 * dx) * (224 * dx) / (4.0 * 2.25);
+  Renderer liquid(def);
+  const double share = waterShare(liquid.render(in));
+  MESSAGE("100k liquid: water share " << share << ", block " << block);
+  CHECK(share == doctest::Approx(block).epsilon(0.03));
+  RenderOptions po;
+  po.mode = "particles";
+  Renderer discs(def, po);
+  const Frame& f = discs.render(in);
+  CHECK(discs.lastRange()[1] == doctest::Approx(6.0));
+  // Discs of 3 px on a 1.07 px lattice cover the block; count non-background pixels left of the bar.
+  std::size_t lit = 0;
+  for (int y = 0; y < f.height; ++y)
+    for (int x = 0; x < f.width * 3 / 4; ++x) {
+      const std::uint8_t* p = &f.rgba[(std::size_t(y) * std::size_t(f.width) + std::size_t(x)) * 4];
+      lit += (p[0] > 40 || p[1] > 40 || p[2] > 60);
+    }
+  const double litShare = double(lit) / (f.width * 0.75 * f.height);
+  MESSAGE("100k discs: lit share " << litShare << ", block " << block / 0.75);
+  CHECK(litShare == doctest::Approx(block / 0.75).epsilon(0.05));
+}
