@@ -82,7 +82,7 @@ TEST_CASE("the 5x7 font: glyph '0' sets 19 pixels per scale², every character o
   CHECK(formatLabel(2.5e5) == "2.50E+05");
 }
 
-TEST_CASE("liquid frames depend on particle values only, not on storage order; fresh contexts agree") {
+TEST_CASE("liquid frames depend on particle values only, not on storage order, and fresh contexts agree") {
   const SceneDef s = blockScene(160, 120, Vec2d(-0.1, -0.1), Vec2d(0.3, 0.3));
   World world(s, WorldOptions{1});
   Renderer a(s.render);
