@@ -7,6 +7,10 @@
 #include <string>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
+#include "sph2d/render/renderer.hpp"
+
 namespace sph2d {
 class World;
 }
@@ -29,8 +33,28 @@ extern std::atomic<bool> stopRequested;
 /// Makes SIGINT/SIGTERM set stopRequested instead of killing the process.
 void installStopHandler();
 
+/// Parses the render flag at args[i] (--mode, --color-by, --range, --overlay, --foam-speed,
+/// --depth-scale), advancing i past its value; false when args[i] is not a render flag.
+bool parseRenderFlag(const std::vector<std::string>& args, std::size_t& i, RenderOptions& o);
+/// The help lines of the render flags.
+extern const char* kRenderFlagsHelp;
+/// The render options as recorded in a manifest.
+nlohmann::ordered_json renderOptionsJson(const RenderOptions& o);
+/// The render options a manifest recorded. Throws UsageError on a malformed entry.
+RenderOptions renderOptionsFromJson(const nlohmann::ordered_json& j);
+/// XXH64 of a file's bytes as 16 hex digits. Throws UsageError when it cannot be read.
+std::string fileHash(const std::string& path);
+/// The llvmpipe environment as recorded in a manifest (pins it first).
+nlohmann::ordered_json environmentJson();
+
 /// `sph2d run`.
 int cmdRun(const std::vector<std::string>& args);
+/// `sph2d check`.
+int cmdCheck(const std::vector<std::string>& args);
+/// `sph2d render`.
+int cmdRender(const std::vector<std::string>& args);
+/// `sph2d bench`.
+int cmdBench(const std::vector<std::string>& args);
 /// `sph2d info`.
 int cmdInfo(const std::vector<std::string>& args);
 /// `sph2d bench step`.

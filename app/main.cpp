@@ -23,10 +23,13 @@ const char* kMainHelp =
     "Usage:\n"
     "  sph2d run SCENE.json [options]   simulate a scene and write PNG frames\n"
     "  sph2d info SCENE.json            print what a scene will simulate\n"
+    "  sph2d check SCENE.json --against MANIFEST   rerun and compare frame hashes\n"
+    "  sph2d render SCENE.json --particles FRAME.csv --out IMAGE.png   re-render exported particles\n"
     "  sph2d bench step [options]       step throughput (particle-steps per second)\n"
+    "  sph2d bench render [options]     per-stage render and PNG timings\n"
     "  sph2d --help | COMMAND --help\n"
     "\n"
-    "Exit codes: 0 ok, 1 runtime failure, 2 bad input, 3 simulation stopped by the guard, 130 interrupted.\n";
+    "Exit codes: 0 ok, 1 runtime failure (check: frames differ), 2 bad input, 3 simulation stopped by the guard, 130 interrupted.\n";
 
 }  // namespace
 
@@ -41,13 +44,13 @@ int main(int argc, char** argv) {
     args.erase(args.begin());
     if (cmd == "run") return cmdRun(args);
     if (cmd == "info") return cmdInfo(args);
+    if (cmd == "check") return cmdCheck(args);
+    if (cmd == "render") return cmdRender(args);
     if (cmd == "bench") {
-      const std::string what = args.empty() ? "" : args[0];
-      if (!args.empty()) args.erase(args.begin());
-      if (what == "step") return cmdBenchStep(args);
-      throw UsageError("unknown benchmark '" + what + "'; benchmarks: step (see sph2d bench step --help)");
+      if (!args.empty() && args[0] == "step") return cmdBenchStep(std::vector<std::string>(args.begin() + 1, args.end()));
+      return cmdBench(args);
     }
-    throw UsageError("unknown command '" + cmd + "'; commands: run, info, bench (see sph2d --help)");
+    throw UsageError("unknown command '" + cmd + "'; commands: run, info, check, render, bench (see sph2d --help)");
   } catch (const UsageError& e) {
     std::fprintf(stderr, "sph2d: %s\n", e.what());
     return 2;

@@ -1,39 +1,65 @@
 #version 330 core
-// Composite pass: threshold the splatted field into a liquid with a smooth,
-// anti-aliased edge; shade it from the field's gradient (light from above),
-// colour it by thickness, and lighten the rim.
-in vec2 vUv;
+// Composite pass (liquid mode): the splatted field becomes water.
+//  - edge: the field thresholded at half its bulk value (lower where the fluid
+//    is sparse, so lone drops stay visible), anti-aliased over one pixel;
+//  - body: light from above absorbed by the water above the pixel (depth from
+//    the CPU grid), from the surface colour towards the deep colour;
+//  - surface: shading from the field's gradient (light from above), a bright
+//    meniscus just inside the edge and a specular highlight;
+//  - foam: towards white where the kernel-weighted speed is high.
+// Rows of this target run top-down in the world (the camera flips y). It is
+// drawn only over the tiles that fluid can reach (solid.vert: quads in NDC);
+// the rest of the frame keeps the background.
 out vec4 outColor;
-uniform sampler2D uField;
-uniform vec2 uTexel;        // 1 / size
-uniform float uInvBulk;     // 1 / field value inside bulk fluid
-uniform vec3 uBackground;
-uniform vec3 uWater;
-uniform float uEdgePixels;  // width of the anti-aliased edge in field units per pixel
+uniform sampler2D uBg;       // the background (RGBA8, same size)
+uniform sampler2D uField;    // RG: sum w, sum w*speed (full or half resolution, bilinear)
+uniform sampler2D uAux;      // RG: depth of water above [m], local fill 0..1 (bilinear)
+uniform vec2 uAuxScale;      // vUv -> aux texture coordinates
+uniform vec2 uTexel;         // 1 / size
+uniform float uInvBulk;      // 1 / field value inside bulk fluid
+uniform vec3 uWater;         // colour at the surface
+uniform vec3 uDeep;          // colour under deep water
+uniform vec3 uFoam;
+uniform float uInvDepth;     // 1 / metres of water that darken by 1/e
+uniform vec2 uFoamSpeed;     // foam starts, foam full [m/s]
+uniform float uSpacingPx;    // particle spacing [px]
 void main() {
-  float f  = texture(uField, vUv).r * uInvBulk;
+  vec2 vUv = gl_FragCoord.xy * uTexel;
+  vec2 c = texture(uField, vUv).rg;
+  float f = c.r * uInvBulk;
   float fl = texture(uField, vUv - vec2(uTexel.x, 0.0)).r * uInvBulk;
   float fr = texture(uField, vUv + vec2(uTexel.x, 0.0)).r * uInvBulk;
-  float fd = texture(uField, vUv - vec2(0.0, uTexel.y)).r * uInvBulk;
-  float fu = texture(uField, vUv + vec2(0.0, uTexel.y)).r * uInvBulk;
-  // Rows run top-down in this target (the camera flips y), so +v is world down.
-  vec2 grad = vec2(fr - fl, fd - fu) * 0.5;
+  float fa = texture(uField, vUv - vec2(0.0, uTexel.y)).r * uInvBulk;  // world above
+  float fb = texture(uField, vUv + vec2(0.0, uTexel.y)).r * uInvBulk;  // world below
+  vec2 grad = vec2(fr - fl, fa - fb) * 0.5;  // per pixel, world orientation (y up)
   float g = length(grad);
-  // Anti-aliased threshold at f = 0.5: the edge spans about one pixel.
-  float w = max(g * 1.2, 1e-4);
-  float cover = smoothstep(0.5 - w, 0.5 + w, f);
-  // Background: a gentle vertical gradient.
-  vec3 bg = uBackground * (0.85 + 0.3 * (1.0 - vUv.y));
-  // Water: deeper colour where the field is thick, light from above on the surface.
-  float depth = smoothstep(0.6, 1.6, f);
-  vec3 shallow = mix(uWater, vec3(1.0), 0.35);
-  vec3 deep = uWater * 0.55;
-  vec3 water = mix(shallow, deep, depth);
-  vec3 n = normalize(vec3(-grad.x * 6.0, -grad.y * 6.0, 1.0));
-  vec3 l = normalize(vec3(-0.3, 0.8, 0.6));
-  float diffuse = 0.75 + 0.35 * dot(n, l);
-  float spec = pow(max(dot(reflect(-l, n), vec3(0.0, 0.0, 1.0)), 0.0), 24.0) * 0.6;
-  float rim = 1.0 - smoothstep(0.5, 0.8, f);
-  water = water * diffuse + vec3(spec) + vec3(0.35) * rim;
+  vec2 aux = texture(uAux, vUv * uAuxScale).rg;
+  vec3 bg = texelFetch(uBg, ivec2(gl_FragCoord.xy), 0).rgb;
+  float threshold = mix(0.24, 0.5, smoothstep(0.15, 0.55, aux.g));
+  float cover = clamp((f - threshold) / max(g, 1e-3) + 0.5, 0.0, 1.0);
+  if (cover <= 0.0) {
+    outColor = vec4(bg, 1.0);
+    return;
+  }
+  // Body: Beer-Lambert-like absorption of the light coming from above.
+  float absorb = exp(-aux.r * uInvDepth);
+  vec3 water = mix(uDeep, uWater, absorb);
+  // Surface normal from the field: it points out of the fluid (-grad), tilted by the slope.
+  float inside = smoothstep(threshold, threshold + 0.45, f);
+  vec3 n = vec3(-grad * (6.0 * (1.0 - 0.7 * inside)), 1.0);
+  n = n / sqrt(dot(n, n));
+  vec3 l = vec3(-0.35, 0.8, 0.5);
+  l = l / sqrt(dot(l, l));
+  float lambert = 1.0 + 0.55 * (dot(n, l) - l.z);
+  vec3 h = l + vec3(0.0, 0.0, 1.0);
+  h = h / sqrt(dot(h, h));
+  float spec = pow(max(dot(n, h), 0.0), 30.0) * 0.55 * (1.0 - inside);
+  float rim = (1.0 - inside) * 0.3;
+  water = water * lambert + vec3(spec) + uWater * rim;
+  // Foam: fast water, strongest at the surface and in spray.
+  float speed = c.g / max(c.r, 1e-6);
+  float foam = smoothstep(uFoamSpeed.x, uFoamSpeed.y, speed);
+  foam *= mix(1.0, 0.35, inside * smoothstep(0.4, 0.9, aux.g));
+  water = mix(water, uFoam, foam * 0.85);
   outColor = vec4(mix(bg, clamp(water, 0.0, 1.0), cover), 1.0);
 }

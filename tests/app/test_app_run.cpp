@@ -2,7 +2,6 @@
 #include <doctest/doctest.h>
 
 #include <sys/wait.h>
-#include <unistd.h>
 
 #include <cstdio>
 #include <cstdlib>
@@ -12,33 +11,12 @@
 #include <sstream>
 #include <string>
 
+#include "app_util.hpp"
 #include "sph2d/render/png_io.hpp"
 
 namespace fs = std::filesystem;
 
-namespace {
-
-struct Result {
-  int code;
-  std::string out;
-};
-
-Result run(const std::string& args) {
-  // CTest runs test cases in parallel processes: one log per process and call.
-  static int calls = 0;
-  const std::string log = std::string(SPH2D_TEST_TMP) + "/cmd_" + std::to_string(::getpid()) + "_" + std::to_string(++calls) + ".log";
-  fs::create_directories(SPH2D_TEST_TMP);
-  const std::string cmd = std::string("\"") + SPH2D_EXE + "\" " + args + " > \"" + log + "\" 2>&1";
-  const int status = std::system(cmd.c_str());
-  std::ifstream in(log);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, ss.str()};
-}
-
-std::string asset(const std::string& rel) { return std::string(SPH2D_ASSETS) + "/" + rel; }
-
-}  // namespace
+using namespace sph2d::apptest;
 
 TEST_CASE("sph2d run writes the expected number of PNG frames, of the scene's size, not blank") {
   const std::string dir = std::string(SPH2D_TEST_TMP) + "/run_small";
@@ -49,13 +27,9 @@ TEST_CASE("sph2d run writes the expected number of PNG frames, of the scene's si
   REQUIRE(r.code == 0);
   CHECK(r.out.find("sph2d: 12 frames") != std::string::npos);
   CHECK(r.out.find("state-hash: ") != std::string::npos);
-  int files = 0;
-  for (const auto& e : fs::directory_iterator(dir)) {
-    const std::string name = e.path().filename().string();
-    CHECK(name.find(".tmp") == std::string::npos);  // no temporary left behind
-    ++files;
-  }
-  CHECK(files == 12);
+  CHECK_FALSE(anyTemporary(dir));  // no temporary left behind
+  CHECK(filesEnding(dir, ".png").size() == 12);
+  CHECK(fs::exists(dir + "/manifest.json"));
   for (int f : {0, 11}) {
     char name[32];
     std::snprintf(name, sizeof name, "/frame_%05d.png", f);
@@ -80,8 +54,7 @@ TEST_CASE("sph2d run writes the expected number of PNG frames, of the scene's si
 }
 
 TEST_CASE("a scene with an unknown key exits 2 naming file, line and key") {
-  const std::string path = std::string(SPH2D_TEST_TMP) + "/typo.json";
-  fs::create_directories(SPH2D_TEST_TMP);
+  const std::string path = freshDir("typo") + "/typo.json";
   std::ofstream(path) << "{\n  \"name\": \"typo\",\n  \"fsp\": 60\n}\n";
   const Result r = run("run \"" + path + "\" --frames 1 --out \"" + std::string(SPH2D_TEST_TMP) + "/typo_out\"");
   CHECK(r.code == 2);

@@ -4,11 +4,23 @@
 #include <stdexcept>
 
 #include "sph2d/render/png_io.hpp"
+#include "sph2d/render/video.hpp"
 
 namespace sph2d {
 
-FrameWriter::FrameWriter(std::string dir, int level, std::size_t capacity)
-    : dir_(std::move(dir)), level_(level), capacity_(capacity ? capacity : 1), thread_([this] { loop(); }) {}
+FrameWriter::FrameWriter(std::string dir, int level, std::size_t capacity) {
+  opt_.dir = std::move(dir);
+  opt_.pngLevel = level;
+  opt_.capacity = capacity;
+  start();
+}
+
+FrameWriter::FrameWriter(const FrameWriterOptions& options) : opt_(options) { start(); }
+
+void FrameWriter::start() {
+  if (opt_.capacity == 0) opt_.capacity = 1;
+  thread_ = std::thread([this] { loop(); });
+}
 
 FrameWriter::~FrameWriter() {
   try {
@@ -20,14 +32,22 @@ FrameWriter::~FrameWriter() {
 std::string FrameWriter::pathOf(int index) const {
   char name[32];
   std::snprintf(name, sizeof name, "frame_%05d.png", index);
-  return dir_ + "/" + name;
+  return opt_.dir + "/" + name;
 }
 
-void FrameWriter::push(int index, int width, int height, std::vector<std::uint8_t> rgba) {
+std::string FrameWriter::exportPathOf(int index) const {
+  char name[32];
+  std::snprintf(name, sizeof name, "frame_%05d.", index);
+  return opt_.dir + "/" + name + exportExtension(opt_.exportFormat.value_or(ExportFormat::Csv));
+}
+
+void FrameWriter::push(int index, int width, int height, std::vector<std::uint8_t> rgba,
+                       std::shared_ptr<const ParticleSnapshot> particles) {
   std::unique_lock<std::mutex> lock(mutex_);
-  cv_.wait(lock, [&] { return queue_.size() < capacity_ || !error_.empty(); });
+  cv_.wait(lock, [&] { return queue_.size() < opt_.capacity || !error_.empty(); });
   if (!error_.empty()) throw std::runtime_error(error_);
-  queue_.push_back(Job{index, width, height, std::move(rgba)});
+  if (opt_.exportFormat && !particles) throw std::logic_error("FrameWriter::push: an export needs the particles");
+  queue_.push_back(Job{index, width, height, std::move(rgba), std::move(particles)});
   cv_.notify_all();
 }
 
@@ -44,9 +64,22 @@ void FrameWriter::loop() {
       if (!error_.empty()) continue;  // after an error, drop the rest
     }
     try {
-      writePngAtomic(pathOf(job.index), job.width, job.height, job.rgba.data(), level_);
-      std::lock_guard<std::mutex> lock(mutex_);
-      ++written_;
+      if (opt_.png) {
+        writePngAtomic(pathOf(job.index), job.width, job.height, job.rgba.data(), opt_.pngLevel);
+        std::lock_guard<std::mutex> lock(mutex_);
+        ++counts_.pngs;
+      }
+      if (opt_.exportFormat) {
+        writeParticlesAtomic(exportPathOf(job.index), *job.particles, *opt_.exportFormat);
+        std::lock_guard<std::mutex> lock(mutex_);
+        ++counts_.exports;
+      }
+      if (!opt_.videoPath.empty()) {
+        if (!video_) video_ = std::make_unique<VideoPipe>(opt_.videoPath, job.width, job.height, opt_.videoFps);
+        video_->write(job.rgba.data());
+        std::lock_guard<std::mutex> lock(mutex_);
+        ++counts_.videoFrames;
+      }
     } catch (const std::exception& e) {
       std::lock_guard<std::mutex> lock(mutex_);
       if (error_.empty()) error_ = e.what();
@@ -64,14 +97,26 @@ int FrameWriter::finish() {
     cv_.notify_all();
     thread_.join();
     finished_ = true;
+    if (video_) {
+      try {
+        video_->close();
+      } catch (const std::exception& e) {
+        if (error_.empty()) error_ = e.what();
+      }
+    }
   }
   if (!error_.empty()) throw std::runtime_error(error_);
-  return written_;
+  return counts_.pngs;
 }
 
 int FrameWriter::written() const {
   std::lock_guard<std::mutex> lock(mutex_);
-  return written_;
+  return counts_.pngs;
+}
+
+FrameWriterCounts FrameWriter::counts() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return counts_;
 }
 
 }  // namespace sph2d

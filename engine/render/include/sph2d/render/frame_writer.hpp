@@ -1,50 +1,93 @@
-// sph2d/render/frame_writer.hpp — PNG encoding on a background thread.
+// sph2d/render/frame_writer.hpp — frame outputs on a background thread.
+//
+// Design: the frame loop pushes each kept frame (its pixels and, for exports, a
+// particle snapshot); one writer thread does the slow parts in frame order:
+// PNG encoding (libpng, level 1 by default), the raw frame into an ffmpeg pipe,
+// the particle export (CSV or VTK). Every file is written to a temporary name
+// and renamed, so it exists whole or not at all. The queue is bounded (push()
+// blocks when `capacity` frames wait) and finish() writes everything queued,
+// so a run stopped by Ctrl-C keeps every frame it rendered. The first error
+// stops further writes and is rethrown by the next push() or by finish().
 #pragma once
 
 #include <condition_variable>
 #include <cstdint>
 #include <deque>
+#include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <thread>
 #include <vector>
 
+#include "sph2d/render/particle_export.hpp"
+
 namespace sph2d {
 
-/// Encodes frames to `dir/frame_NNNNN.png` on its own thread, in order.
-/// push() blocks when `capacity` frames wait; an encoding error is rethrown by
-/// the next push() or by finish(), and frames already written stay whole.
+class VideoPipe;
+
+/// What a FrameWriter writes.
+struct FrameWriterOptions {
+  std::string dir;                          ///< output directory (must exist)
+  bool png = true;                          ///< write frame_NNNNN.png
+  int pngLevel = 1;                         ///< zlib level 0..9 (1 = fast)
+  std::optional<ExportFormat> exportFormat; ///< also write frame_NNNNN.csv / .vtk
+  std::string videoPath;                    ///< "" = no video; else pipe frames to ffmpeg
+  double videoFps = 60;                     ///< frame rate of the video
+  std::size_t capacity = 6;                 ///< frames that may wait in the queue
+};
+
+/// Counts of what a FrameWriter wrote.
+struct FrameWriterCounts {
+  int pngs = 0;         ///< PNG files
+  int exports = 0;      ///< particle files
+  int videoFrames = 0;  ///< frames sent to ffmpeg
+};
+
+/// Writes frames to `dir/frame_NNNNN.png` (and exports, video) on its own thread, in order.
 class FrameWriter {
  public:
   /// Starts the writer thread; `dir` must exist.
   FrameWriter(std::string dir, int level = 1, std::size_t capacity = 6);
+  /// Starts the writer thread with all options; starts ffmpeg when a video is asked for
+  /// (throws std::runtime_error when it cannot).
+  explicit FrameWriter(const FrameWriterOptions& options);
   /// Finishes (writes what is queued) if finish() was not called.
   ~FrameWriter();
-  /// Queues frame `index` (RGBA8, rows top-down). Throws if an earlier write failed.
-  void push(int index, int width, int height, std::vector<std::uint8_t> rgba);
-  /// Writes what is queued and joins. Returns the number of files written; throws on error.
+  FrameWriter(const FrameWriter&) = delete;
+  FrameWriter& operator=(const FrameWriter&) = delete;
+  /// Queues frame `index` (RGBA8, rows top-down) and its particles (needed with an export).
+  /// Throws if an earlier write failed.
+  void push(int index, int width, int height, std::vector<std::uint8_t> rgba,
+            std::shared_ptr<const ParticleSnapshot> particles = nullptr);
+  /// Writes what is queued, closes the video and joins. Returns the number of PNG files written; throws on error.
   int finish();
-  /// Files written so far.
+  /// PNG files written so far.
   int written() const;
-  /// Path of frame `index`.
+  /// Everything written so far.
+  FrameWriterCounts counts() const;
+  /// Path of frame `index`'s PNG.
   std::string pathOf(int index) const;
+  /// Path of frame `index`'s particle export.
+  std::string exportPathOf(int index) const;
 
  private:
   struct Job {
     int index;
     int width, height;
     std::vector<std::uint8_t> rgba;
+    std::shared_ptr<const ParticleSnapshot> particles;
   };
   void loop();
-  std::string dir_;
-  int level_;
-  std::size_t capacity_;
+  void start();
+  FrameWriterOptions opt_;
+  std::unique_ptr<VideoPipe> video_;
   std::deque<Job> queue_;
   mutable std::mutex mutex_;
   std::condition_variable cv_;
   bool done_ = false;
   bool finished_ = false;
-  int written_ = 0;
+  FrameWriterCounts counts_;
   std::string error_;
   std::thread thread_;
 };

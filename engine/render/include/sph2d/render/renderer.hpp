@@ -1,46 +1,141 @@
 // sph2d/render/renderer.hpp — off-screen frames of a World through OSMesa.
 //
 // Passes per frame (GLSL in shaders/, embedded at build time):
-//   splat      particles → soft kernel sums in an R32F target (additive)
-//   composite  field → liquid colour with an anti-aliased edge
-//   solid      Box2D fixtures drawn with their real shapes
-// then glReadPixels into an RGBA8 buffer whose rows run top-down.
+//   liquid mode
+//     splat      particles → Σ w and Σ w·speed in one RG32F target (additive,
+//                w = (1 − q²)³ × the particle's age fade)
+//     aux        on the CPU: a coarse grid of the fluid (cells of ≥ 4 px) giving
+//                the water depth above each cell and the local fill; uploaded as
+//                a small RG32F texture, sampled bilinearly
+//     composite  field → liquid: anti-aliased edge, shading from the field's
+//                gradient (light from above), colour from the depth of water
+//                above, foam where the weighted speed is high
+//   particles mode
+//     discs      one anti-aliased disc per particle coloured by a field (speed,
+//                pressure, density, age) on a ramp, plus a colour bar with its range
+//   both
+//     solids     Box2D fixtures with their real shapes
+//     readback   glReadPixels into RGBA8, rows top-down (the camera flips y)
+//     overlay    optional text (frame, time, particle count), drawn on the CPU
+//
+// Determinism: particles are submitted in id order (additive float blending
+// depends on order), so a frame depends only on the particles' values, not on
+// how the engine stores them. The llvmpipe settings that could change pixels
+// are pinned before the first context is made (pinRenderEnvironment()).
+// Sprites wider than the driver's point-size limit (255 px on llvmpipe) are
+// drawn as instanced quads instead, so any zoom renders correctly.
 // The OSMesa context belongs to the thread that created the Renderer.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
+#include "sph2d/boundary.hpp"
+#include "sph2d/particles.hpp"
+#include "sph2d/render/image.hpp"
 #include "sph2d/scene.hpp"
 
 namespace sph2d {
 
 class World;
 
-/// An RGBA8 image, rows top-down.
-struct Frame {
-  int width = 0;
-  int height = 0;
-  std::vector<std::uint8_t> rgba;
+/// The particle quantity the particles mode colours by.
+enum class ColorField { Speed, Pressure, Density, Age };
+
+/// Parses "speed", "pressure", "density" or "age"; returns false for anything else.
+bool parseColorField(const std::string& s, ColorField& out);
+/// "speed", "pressure", "density" or "age".
+std::string colorFieldName(ColorField f);
+
+/// Render settings that the scene format does not carry (yet): they come from
+/// the command line. Unset optionals take the documented defaults.
+struct RenderOptions {
+  std::string mode;                          ///< "" = RenderDef::mode, else "liquid" or "particles"
+  ColorField colorBy = ColorField::Speed;    ///< particles mode: the field shown
+  std::optional<std::array<double, 2>> range;///< particles mode: fixed colour range (default: this frame's min..max)
+  bool overlay = false;                      ///< frame number, simulated time and particle count in the frame
+  double foamSpeed = 0;                      ///< liquid: speed [m/s] where foam starts (0 = 0.35·sqrt(g·view height)); full at 2×
+  double depthScale = 0;                     ///< liquid: metres of water above that darken by 1/e (0 = 1 m)
+  double ageFadeStart = 1.0;                 ///< a particle with an age fades from this age [s] ...
+  double ageFadeEnd = 3.0;                   ///< ... to nothing at this age [s]
+  std::optional<std::array<double, 3>> deepWater; ///< colour under deep water (default: water × 0.3)
+  std::optional<std::array<double, 3>> foam;      ///< foam colour (default: 0.9, 0.95, 1)
+  std::optional<std::array<double, 3>> text;      ///< overlay and colour-bar text (default: 0.92 grey)
+  bool profile = false;                      ///< glFinish after each stage so lastTimings() is per stage (slower)
 };
+
+/// What to draw. Particles are in the engine's local frame (add `origin` for world coordinates).
+struct RenderInput {
+  const Particles* particles = nullptr;            ///< required
+  Vec2d origin{0, 0};                              ///< local frame offset [m]
+  double spacing = 0.02;                           ///< particle spacing dx [m]
+  const std::vector<Collider>* colliders = nullptr;///< solids in the local frame (may be null)
+  const Real* age = nullptr;                       ///< optional: one age [s] per particle slot
+  double gravity = 9.81;                           ///< |g| [m/s²], scales the default foam speed
+  std::uint64_t frame = 0;                         ///< for the overlay
+  double time = 0;                                 ///< simulated time [s], for the overlay
+};
+
+/// Wall time of the stages of the last render() [ms]; per stage only with RenderOptions::profile.
+struct RenderTimings {
+  double upload = 0;     ///< CPU packing (id order, values, aux grid) and buffer uploads
+  double splat = 0;      ///< splat (liquid) or discs (particles)
+  double composite = 0;  ///< liquid composite (0 in particles mode)
+  double solids = 0;     ///< Box2D fixtures
+  double readback = 0;   ///< glReadPixels (includes the GPU work not yet finished without profile)
+  double overlay = 0;    ///< CPU text and colour bar
+  double total = 0;      ///< the whole render()
+};
+
+/// One environment variable that can affect llvmpipe, as the renderer found or set it.
+struct EnvSetting {
+  std::string name;    ///< e.g. "LP_NUM_THREADS"
+  std::string value;   ///< "" when unset
+  std::string source;  ///< "user" (set before sph2d ran), "sph2d" (pinned by pinRenderEnvironment) or "unset"
+};
+
+/// Pins, before the first OSMesa context of the process, the Mesa settings that can change
+/// pixels or make runs depend on the user's home (GALLIUM_DRIVER=llvmpipe, no shader cache),
+/// unless the user set them; returns every setting that matters, pinned or not, for the
+/// manifest. Called by the Renderer constructor; later calls only report.
+std::vector<EnvSetting> pinRenderEnvironment();
+
+/// The CPU features that llvmpipe's code generation depends on (from /proc/cpuinfo),
+/// e.g. "AMD EPYC; avx avx2 fma f16c avx512f".
+std::string cpuSummary();
 
 /// Renders frames of a World.
 class Renderer {
  public:
   /// Creates the OSMesa context and GL resources for `def`. Throws std::runtime_error.
-  explicit Renderer(const RenderDef& def);
+  explicit Renderer(const RenderDef& def, const RenderOptions& options = {});
   ~Renderer();
   Renderer(const Renderer&) = delete;
   Renderer& operator=(const Renderer&) = delete;
 
-  /// Renders the current state of `world`; the frame stays valid until the next call.
-  const Frame& render(const World& world);
+  /// Renders the current state of `world`; `age` (optional) holds one age [s] per particle
+  /// slot. The frame stays valid until the next call. Throws std::runtime_error.
+  const Frame& render(const World& world, const Real* age = nullptr);
+  /// Renders `in`; the camera is fixed by the first call. Throws std::runtime_error.
+  const Frame& render(const RenderInput& in);
   /// GL_RENDERER and GL_VERSION of the context, e.g. "llvmpipe (LLVM 15.0.6, 256 bits) / 4.5 (Core Profile) Mesa 22.3.6".
   std::string rendererString() const;
   /// The world rectangle shown (after aspect correction), min x, min y, max x, max y.
   std::vector<double> cameraRect() const;
+  /// The mode in use: "liquid" or "particles".
+  std::string mode() const;
+  /// Stage times of the last render().
+  RenderTimings lastTimings() const;
+  /// True when the last render() drew instanced quads because sprites exceeded the point-size limit.
+  bool usedQuads() const;
+  /// The driver's largest point sprite [px] (255 on llvmpipe).
+  float maxPointSize() const;
+  /// The colour range of the last particles-mode frame (lo, hi).
+  std::array<double, 2> lastRange() const;
 
   struct Impl;
 
@@ -51,5 +146,7 @@ class Renderer {
 /// The camera of `def` for `world`: its own rectangle, or the solids and fluid
 /// with a margin; widened to the image's aspect ratio.
 std::vector<double> resolveCamera(const RenderDef& def, const World& world);
+/// The camera of `def` for a RenderInput (same rules as above).
+std::vector<double> resolveCamera(const RenderDef& def, const RenderInput& in);
 
 }  // namespace sph2d

@@ -1,0 +1,57 @@
+// sph2d/render/particle_export.hpp — particles of one frame as CSV or legacy VTK.
+//
+// Design: a ParticleSnapshot is a copy, in id order and world coordinates, of
+// what an export needs (id, position, velocity, density, pressure, optional age);
+// taking it is cheap enough for the frame loop, and writing it happens on the
+// FrameWriter's thread. Files are written whole or not at all (temporary name,
+// then rename). VTK is the legacy "vtk DataFile Version 3.0" POLYDATA format
+// that ParaView and VisIt open: POINTS (double, world coordinates), one VERTEX
+// cell per particle, and POINT_DATA arrays id, velocity, density, pressure and
+// age; binary files are big-endian, as the format requires. readParticlesCsv()
+// reads our own CSV back, so frames can be re-rendered without re-simulating.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "sph2d/math.hpp"
+
+namespace sph2d {
+
+class World;
+
+/// One frame's particles, sorted by id, positions in world coordinates.
+struct ParticleSnapshot {
+  std::uint64_t frame = 0;        ///< frames stepped
+  double time = 0;                ///< simulated time [s]
+  std::vector<std::uint32_t> id;  ///< stable ids, ascending
+  std::vector<double> x, y;       ///< world position [m]
+  std::vector<float> vx, vy;      ///< velocity [m/s]
+  std::vector<float> rho, p;      ///< density [kg/m³], pressure [Pa]
+  std::vector<float> age;         ///< age [s]; empty when the particles have no age
+  /// Number of particles.
+  std::size_t size() const { return id.size(); }
+};
+
+/// Copies the particles of `world` (and `age`, one per slot, when given) in id order.
+ParticleSnapshot snapshotOf(const World& world, const Real* age = nullptr);
+
+/// File formats of particle exports.
+enum class ExportFormat { Csv, VtkBinary, VtkAscii };
+
+/// Parses "csv", "vtk" (binary) or "vtk-ascii"; false for anything else.
+bool parseExportFormat(const std::string& s, ExportFormat& out);
+/// File extension without the dot: "csv" or "vtk".
+std::string exportExtension(ExportFormat f);
+
+/// Writes `s` to `path` in format `f`, atomically. Throws std::runtime_error naming the path.
+void writeParticlesAtomic(const std::string& path, const ParticleSnapshot& s, ExportFormat f);
+
+/// Reads a CSV written by writeParticlesAtomic. Throws std::runtime_error with the line.
+ParticleSnapshot readParticlesCsv(const std::string& path);
+
+/// Writes `bytes` to `path` through a temporary file and a rename. Throws std::runtime_error.
+void writeFileAtomic(const std::string& path, const std::string& bytes);
+
+}  // namespace sph2d

@@ -1,0 +1,221 @@
+#include "sph2d/render/particle_export.hpp"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <cstdarg>
+#include <type_traits>
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <numeric>
+#include <sstream>
+#include <stdexcept>
+
+#include "sph2d/world.hpp"
+
+namespace sph2d {
+namespace {
+
+template <typename T>
+void putBigEndian(std::string& out, T v) {
+  unsigned char b[sizeof(T)];
+  std::memcpy(b, &v, sizeof(T));
+  for (std::size_t k = 0; k < sizeof(T); ++k) out.push_back(char(b[sizeof(T) - 1 - k]));  // x86 is little-endian
+}
+
+void appendf(std::string& out, const char* fmt, ...) __attribute__((format(printf, 2, 3)));
+void appendf(std::string& out, const char* fmt, ...) {
+  char buf[256];
+  va_list ap;
+  va_start(ap, fmt);
+  const int n = std::vsnprintf(buf, sizeof buf, fmt, ap);
+  va_end(ap);
+  if (n > 0) out.append(buf, std::size_t(std::min(n, int(sizeof buf) - 1)));
+}
+
+}  // namespace
+
+ParticleSnapshot snapshotOf(const World& world, const Real* age) {
+  const Particles& P = world.particles();
+  const std::size_t n = P.size();
+  std::vector<std::uint32_t> order(n);
+  std::iota(order.begin(), order.end(), 0u);
+  std::sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) { return P.id[a] < P.id[b]; });
+  ParticleSnapshot s;
+  s.frame = world.frame();
+  s.time = world.time();
+  s.id.resize(n);
+  s.x.resize(n);
+  s.y.resize(n);
+  s.vx.resize(n);
+  s.vy.resize(n);
+  s.rho.resize(n);
+  s.p.resize(n);
+  if (age) s.age.resize(n);
+  const Vec2d o = world.origin();
+  for (std::size_t k = 0; k < n; ++k) {
+    const std::size_t i = order[k];
+    s.id[k] = P.id[i];
+    s.x[k] = o.x() + double(P.x[i].x());
+    s.y[k] = o.y() + double(P.x[i].y());
+    s.vx[k] = P.v[i].x();
+    s.vy[k] = P.v[i].y();
+    s.rho[k] = P.rho[i];
+    s.p[k] = P.p[i];
+    if (age) s.age[k] = float(age[i]);
+  }
+  return s;
+}
+
+bool parseExportFormat(const std::string& s, ExportFormat& out) {
+  if (s == "csv") out = ExportFormat::Csv;
+  else if (s == "vtk") out = ExportFormat::VtkBinary;
+  else if (s == "vtk-ascii") out = ExportFormat::VtkAscii;
+  else return false;
+  return true;
+}
+
+std::string exportExtension(ExportFormat f) { return f == ExportFormat::Csv ? "csv" : "vtk"; }
+
+void writeFileAtomic(const std::string& path, const std::string& bytes) {
+  const std::string tmp = path + ".tmp" + std::to_string(::getpid());
+  FILE* f = std::fopen(tmp.c_str(), "wb");
+  if (!f) throw std::runtime_error("cannot create " + tmp + ": " + std::strerror(errno));
+  bool ok = std::fwrite(bytes.data(), 1, bytes.size(), f) == bytes.size();
+  ok = (std::fflush(f) == 0) && ok;
+  std::string why = ok ? "" : std::strerror(errno);
+  if (std::fclose(f) != 0 && ok) {
+    ok = false;
+    why = std::strerror(errno);
+  }
+  if (!ok) {
+    std::remove(tmp.c_str());
+    throw std::runtime_error("cannot write " + path + ": " + why);
+  }
+  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
+    why = std::strerror(errno);
+    std::remove(tmp.c_str());
+    throw std::runtime_error("cannot rename " + tmp + " to " + path + ": " + why);
+  }
+}
+
+void writeParticlesAtomic(const std::string& path, const ParticleSnapshot& s, ExportFormat f) {
+  const std::size_t n = s.size();
+  const bool hasAge = !s.age.empty();
+  std::string out;
+  if (f == ExportFormat::Csv) {
+    out.reserve(n * 100 + 128);
+    appendf(out, "# sph2d particles: frame %llu, time %.9g s, %zu particles, world coordinates\n",
+            static_cast<unsigned long long>(s.frame), s.time, n);
+    out += hasAge ? "id,x,y,vx,vy,density,pressure,age\n" : "id,x,y,vx,vy,density,pressure\n";
+    for (std::size_t k = 0; k < n; ++k) {
+      appendf(out, "%u,%.17g,%.17g,%.9g,%.9g,%.9g,%.9g", s.id[k], s.x[k], s.y[k], double(s.vx[k]), double(s.vy[k]),
+              double(s.rho[k]), double(s.p[k]));
+      if (hasAge) appendf(out, ",%.9g", double(s.age[k]));
+      out += '\n';
+    }
+  } else {
+    const bool bin = f == ExportFormat::VtkBinary;
+    out.reserve(n * (bin ? 48 : 120) + 512);
+    out += "# vtk DataFile Version 3.0\n";
+    appendf(out, "sph2d particles frame %llu time %.9g\n", static_cast<unsigned long long>(s.frame), s.time);
+    out += bin ? "BINARY\n" : "ASCII\n";
+    out += "DATASET POLYDATA\n";
+    appendf(out, "POINTS %zu double\n", n);
+    for (std::size_t k = 0; k < n; ++k) {
+      if (bin) {
+        putBigEndian(out, s.x[k]);
+        putBigEndian(out, s.y[k]);
+        putBigEndian(out, 0.0);
+      } else {
+        appendf(out, "%.17g %.17g 0\n", s.x[k], s.y[k]);
+      }
+    }
+    if (bin) out += '\n';
+    appendf(out, "VERTICES %zu %zu\n", n, 2 * n);
+    for (std::size_t k = 0; k < n; ++k) {
+      if (bin) {
+        putBigEndian(out, std::int32_t(1));
+        putBigEndian(out, std::int32_t(k));
+      } else {
+        appendf(out, "1 %zu\n", k);
+      }
+    }
+    if (bin) out += '\n';
+    appendf(out, "POINT_DATA %zu\n", n);
+    auto scalars = [&](const char* name, const char* type, auto get) {
+      appendf(out, "SCALARS %s %s 1\nLOOKUP_TABLE default\n", name, type);
+      for (std::size_t k = 0; k < n; ++k) {
+        const auto v = get(k);
+        if (bin) putBigEndian(out, v);
+        else if constexpr (std::is_integral_v<decltype(v)>) appendf(out, "%d\n", int(v));
+        else appendf(out, "%.9g\n", double(v));
+      }
+      if (bin) out += '\n';
+    };
+    scalars("id", "int", [&](std::size_t k) { return std::int32_t(s.id[k]); });
+    appendf(out, "VECTORS velocity float\n");
+    for (std::size_t k = 0; k < n; ++k) {
+      if (bin) {
+        putBigEndian(out, s.vx[k]);
+        putBigEndian(out, s.vy[k]);
+        putBigEndian(out, 0.0f);
+      } else {
+        appendf(out, "%.9g %.9g 0\n", double(s.vx[k]), double(s.vy[k]));
+      }
+    }
+    if (bin) out += '\n';
+    scalars("density", "float", [&](std::size_t k) { return s.rho[k]; });
+    scalars("pressure", "float", [&](std::size_t k) { return s.p[k]; });
+    if (hasAge) scalars("age", "float", [&](std::size_t k) { return s.age[k]; });
+  }
+  writeFileAtomic(path, out);
+}
+
+ParticleSnapshot readParticlesCsv(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw std::runtime_error("cannot open " + path);
+  ParticleSnapshot s;
+  std::string line;
+  int lineNo = 0;
+  bool header = false, hasAge = false;
+  while (std::getline(in, line)) {
+    ++lineNo;
+    if (line.empty()) continue;
+    if (line[0] == '#') {
+      unsigned long long fr = 0;
+      double t = 0;
+      if (std::sscanf(line.c_str(), "# sph2d particles: frame %llu, time %lf", &fr, &t) == 2) {
+        s.frame = fr;
+        s.time = t;
+      }
+      continue;
+    }
+    if (!header) {
+      if (line.rfind("id,x,y,vx,vy,density,pressure", 0) != 0)
+        throw std::runtime_error(path + ":" + std::to_string(lineNo) + ": not an sph2d particle CSV header");
+      hasAge = line.find(",age") != std::string::npos;
+      header = true;
+      continue;
+    }
+    unsigned id = 0;
+    double x = 0, y = 0, vx = 0, vy = 0, rho = 0, p = 0, age = 0;
+    const int want = hasAge ? 8 : 7;
+    if (std::sscanf(line.c_str(), "%u,%lf,%lf,%lf,%lf,%lf,%lf,%lf", &id, &x, &y, &vx, &vy, &rho, &p, &age) != want)
+      throw std::runtime_error(path + ":" + std::to_string(lineNo) + ": expected " + std::to_string(want) + " values");
+    s.id.push_back(id);
+    s.x.push_back(x);
+    s.y.push_back(y);
+    s.vx.push_back(float(vx));
+    s.vy.push_back(float(vy));
+    s.rho.push_back(float(rho));
+    s.p.push_back(float(p));
+    if (hasAge) s.age.push_back(float(age));
+  }
+  if (!header) throw std::runtime_error(path + ": empty");
+  return s;
+}
+
+}  // namespace sph2d

@@ -1,0 +1,266 @@
+// The app's outputs end to end: manifest, --every, Ctrl-C, determinism, check, exports, video.
+#include <doctest/doctest.h>
+
+#include <fcntl.h>
+#include <signal.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstring>
+#include <thread>
+
+#include <nlohmann/json.hpp>
+
+#include "app_util.hpp"
+#include "sph2d/render/particle_export.hpp"
+#include "sph2d/render/png_io.hpp"
+
+using namespace sph2d;
+using namespace sph2d::apptest;
+using nlohmann::json;
+
+namespace {
+
+const std::string kSmall = asset("scenes/tests/small_dam_break.json");
+
+json readManifest(const std::string& dir) { return json::parse(readText(dir + "/manifest.json")); }
+
+std::vector<std::string> frameHashes(const json& m) {
+  std::vector<std::string> h;
+  for (const auto& f : m.at("frames")) h.push_back(f.at("rgba_xxh64").get<std::string>());
+  return h;
+}
+
+}  // namespace
+
+TEST_CASE("--every keeps every K-th frame and the manifest lists each with hashes that match the PNG files") {
+  const std::string dir = freshDir("every");
+  const Result r = run("run " + q(kSmall) + " --frames 10 --every 3 --threads 2 --quiet --out " + q(dir));
+  INFO(r.out);
+  REQUIRE(r.code == 0);
+  const auto pngs = filesEnding(dir, ".png");
+  REQUIRE(pngs.size() == 4);
+  CHECK(pngs[0] == "frame_00000.png");
+  CHECK(pngs[3] == "frame_00009.png");
+  const json m = readManifest(dir);
+  CHECK(m.at("complete").get<bool>());
+  CHECK(m.at("stop").is_null());
+  CHECK(m.at("run").at("every").get<int>() == 3);
+  CHECK(m.at("run").at("frames").get<int>() == 10);
+  CHECK(m.at("image").at("width").get<int>() == 192);
+  CHECK(m.at("scene").at("xxh64").get<std::string>() == hex64(xxh64(readText(kSmall).data(), readText(kSmall).size())));
+  CHECK(m.at("engine_version").get<std::string>() == SPH2D_VERSION);
+  CHECK(m.at("renderer").get<std::string>().find("llvmpipe") != std::string::npos);
+  REQUIRE(m.at("frames").size() == 4);
+  for (std::size_t k = 0; k < 4; ++k) {
+    const json& f = m["frames"][k];
+    CHECK(f.at("frame").get<int>() == int(3 * k));
+    CHECK(f.at("file").get<std::string>() == pngs[k]);
+    CHECK(f.at("rgba_xxh64").get<std::string>() == pngHash(dir + "/" + pngs[k]));
+    CHECK(f.at("state_hash").get<std::string>().size() == 16);
+  }
+}
+
+TEST_CASE("SIGINT stops a run: exit 130, every PNG whole, no temporary file, the manifest says so") {
+  const std::string dir = freshDir("sigint");
+  const std::string log = dir + ".log";
+  const pid_t pid = fork();
+  REQUIRE(pid >= 0);
+  if (pid == 0) {
+    const int fd = ::open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    ::dup2(fd, 1);
+    ::dup2(fd, 2);
+    const std::string out = dir;
+    execl(SPH2D_EXE, SPH2D_EXE, "run", kSmall.c_str(), "--frames", "100000", "--threads", "1", "--out", out.c_str(),
+          "--quiet", static_cast<char*>(nullptr));
+    _exit(127);
+  }
+  // Wait for a few frames, then interrupt.
+  const auto t0 = std::chrono::steady_clock::now();
+  while (filesEnding(dir, ".png").size() < 4 && std::chrono::steady_clock::now() - t0 < std::chrono::seconds(15))
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  REQUIRE(::kill(pid, SIGINT) == 0);
+  int status = 0;
+  REQUIRE(::waitpid(pid, &status, 0) == pid);
+  const std::string out = readText(log);
+  INFO(out);
+  REQUIRE(WIFEXITED(status));
+  CHECK(WEXITSTATUS(status) == 130);
+  const auto pngs = filesEnding(dir, ".png");
+  CHECK(pngs.size() >= 4);
+  CHECK_FALSE(anyTemporary(dir));
+  CHECK(out.find("interrupted after") != std::string::npos);
+  CHECK(out.find(std::to_string(pngs.size()) + " whole PNG files kept") != std::string::npos);
+  const json m = readManifest(dir);
+  CHECK_FALSE(m.at("complete").get<bool>());
+  CHECK(m.at("stop").at("reason").get<std::string>() == "interrupted");
+  CHECK(m.at("stop").at("frames_written").get<std::size_t>() == pngs.size());
+  REQUIRE(m.at("frames").size() == pngs.size());
+  for (std::size_t k = 0; k < pngs.size(); ++k)  // every file decodes and matches its hash
+    CHECK(m["frames"][k].at("rgba_xxh64").get<std::string>() == pngHash(dir + "/" + pngs[k]));
+}
+
+TEST_CASE("frames are bit-identical across runs and across 1 and 2 simulation threads") {
+  const std::string a = freshDir("det_a"), b = freshDir("det_b"), c = freshDir("det_c");
+  const std::string args = "run " + q(kSmall) + " --frames 13 --every 4 --quiet --out ";
+  REQUIRE(run(args + q(a) + " --threads 2").code == 0);
+  REQUIRE(run(args + q(b) + " --threads 2").code == 0);
+  REQUIRE(run(args + q(c) + " --threads 1").code == 0);
+  const json ma = readManifest(a), mb = readManifest(b), mc = readManifest(c);
+  CHECK(frameHashes(ma).size() == 4);
+  CHECK(frameHashes(ma) == frameHashes(mb));
+  CHECK(frameHashes(ma) == frameHashes(mc));
+  for (std::size_t k = 0; k < 4; ++k)
+    CHECK(ma["frames"][k]["state_hash"] == mc["frames"][k]["state_hash"]);
+  // The frames move: the 4 hashes are all different.
+  auto h = frameHashes(ma);
+  std::sort(h.begin(), h.end());
+  CHECK(std::unique(h.begin(), h.end()) == h.end());
+}
+
+TEST_CASE("sph2d check: exit 0 on a match, and on a difference names the frame, counts pixels, writes a diff") {
+  const std::string dir = freshDir("check_ref"), out = freshDir("check_out");
+  REQUIRE(run("run " + q(kSmall) + " --frames 6 --every 2 --quiet --mode particles --color-by pressure --out " + q(dir))
+              .code == 0);
+  Result r = run("check " + q(kSmall) + " --against " + q(dir + "/manifest.json") + " --out " + q(out));
+  INFO(r.out);
+  CHECK(r.code == 0);
+  CHECK(r.out.find("OK, 3 frames match") != std::string::npos);
+  CHECK(r.out.find("particles mode") != std::string::npos);
+
+  // Change 7 pixels of the reference frame 4 by +5 in red, and its hash in the manifest.
+  const std::string ref = dir + "/frame_00004.png";
+  int w = 0, h = 0;
+  std::vector<std::uint8_t> rgba;
+  readPng(ref, w, h, rgba);
+  for (int k = 0; k < 7; ++k) {
+    std::uint8_t& red = rgba[(std::size_t(10 + k) * std::size_t(w) + 20) * 4];
+    red = std::uint8_t(red <= 250 ? red + 5 : red - 5);
+  }
+  writePngAtomic(ref, w, h, rgba.data(), 1);
+  json m = readManifest(dir);
+  m["frames"][2]["rgba_xxh64"] = hex64(xxh64(rgba.data(), rgba.size()));
+  std::ofstream(dir + "/manifest.json") << m.dump(1);
+  r = run("check " + q(kSmall) + " --against " + q(dir + "/manifest.json") + " --out " + q(out));
+  INFO(r.out);
+  CHECK(r.code == 1);
+  CHECK(r.out.find("frame 4 differs") != std::string::npos);
+  CHECK(r.out.find("7 of 27648 pixels differ") != std::string::npos);
+  CHECK(r.out.find("max channel difference 5 (first at x 20, y 10)") != std::string::npos);
+  CHECK(r.out.find("state hash matches") != std::string::npos);
+  CHECK(fs::exists(out + "/diff_00004.png"));
+  CHECK(fs::exists(out + "/frame_00004.png"));
+  int dw = 0, dh = 0;
+  std::vector<std::uint8_t> diff;
+  readPng(out + "/diff_00004.png", dw, dh, diff);
+  std::size_t red = 0;
+  for (std::size_t p = 0; p < diff.size(); p += 4) red += diff[p] > 150 && diff[p + 1] == 0;
+  CHECK(red == 7);
+
+  // A manifest made on another renderer is named plainly.
+  m["renderer"] = "softpipe / 3.3 (Core Profile) Mesa 0.0";
+  std::ofstream(dir + "/manifest.json") << m.dump(1);
+  r = run("check " + q(kSmall) + " --against " + q(dir + "/manifest.json") + " --out " + q(out));
+  CHECK(r.out.find("the manifest was made with \"softpipe") != std::string::npos);
+  // A missing manifest is bad input.
+  CHECK(run("check " + q(kSmall) + " --against " + q(dir + "/nope.json")).code == 2);
+}
+
+TEST_CASE("--export csv and vtk write each kept frame's particles in id order, world coordinates") {
+  const std::string dir = freshDir("export_csv"), vdir = freshDir("export_vtk"), adir = freshDir("export_vtka");
+  REQUIRE(run("run " + q(kSmall) + " --frames 5 --every 4 --quiet --export csv --out " + q(dir)).code == 0);
+  CHECK(filesEnding(dir, ".csv") == std::vector<std::string>{"frame_00000.csv", "frame_00004.csv"});
+  const ParticleSnapshot s = readParticlesCsv(dir + "/frame_00004.csv");
+  REQUIRE(s.size() == 1250);
+  CHECK(s.frame == 4);
+  CHECK(s.time == doctest::Approx(4.0 / 60.0));
+  for (std::size_t k = 0; k < s.size(); ++k) CHECK(s.id[k] == k);
+  // The column stands in 0 < x < 1, 0 < y < 2 (plus what moved in 4 frames).
+  const auto [xlo, xhi] = std::minmax_element(s.x.begin(), s.x.end());
+  CHECK(*xlo > 0.0);
+  CHECK(*xhi < 1.1);
+  CHECK(*std::max_element(s.rho.begin(), s.rho.end()) > 900.0f);
+
+  REQUIRE(run("run " + q(kSmall) + " --frames 1 --quiet --export vtk --out " + q(vdir)).code == 0);
+  REQUIRE(run("run " + q(kSmall) + " --frames 1 --quiet --export vtk-ascii --out " + q(adir)).code == 0);
+  const std::string bin = readText(vdir + "/frame_00000.vtk"), asc = readText(adir + "/frame_00000.vtk");
+  const std::size_t n = 1250;
+  for (const std::string* t : {&bin, &asc}) {
+    CHECK(t->rfind("# vtk DataFile Version 3.0\n", 0) == 0);
+    CHECK(t->find("DATASET POLYDATA\nPOINTS 1250 double\n") != std::string::npos);
+    CHECK(t->find("VERTICES 1250 2500\n") != std::string::npos);
+    CHECK(t->find("POINT_DATA 1250\nSCALARS id int 1\nLOOKUP_TABLE default\n") != std::string::npos);
+    CHECK(t->find("VECTORS velocity float\n") != std::string::npos);
+    CHECK(t->find("SCALARS density float 1\n") != std::string::npos);
+    CHECK(t->find("SCALARS pressure float 1\n") != std::string::npos);
+  }
+  CHECK(bin.find("BINARY\n") != std::string::npos);
+  CHECK(asc.find("ASCII\n") != std::string::npos);
+  // Binary payload: points 24 B, vertices 8 B, id 4 B, velocity 12 B, density 4 B, pressure 4 B per particle.
+  const std::size_t headers = bin.find("POINTS");
+  CHECK(bin.size() > n * (24 + 8 + 4 + 12 + 4 + 4) + headers);
+  CHECK(bin.size() < n * (24 + 8 + 4 + 12 + 4 + 4) + headers + 400);
+  // The first point is big-endian x of particle 0, equal to the CSV's.
+  const std::size_t p0 = bin.find("POINTS 1250 double\n") + std::strlen("POINTS 1250 double\n");
+  unsigned char be[8];
+  for (int k = 0; k < 8; ++k) be[k] = static_cast<unsigned char>(bin[p0 + 7 - std::size_t(k)]);
+  double x0 = 0;
+  std::memcpy(&x0, be, 8);
+  const ParticleSnapshot s0 = readParticlesCsv(dir + "/frame_00000.csv");
+  CHECK(x0 == s0.x[0]);
+}
+
+TEST_CASE("--video: exit 2 with a message without ffmpeg, and frames reach ffmpeg's input when present") {
+  const std::string dir = freshDir("video");
+  Result r = run("run " + q(kSmall) + " --frames 3 --quiet --video " + q(dir + "/out.mp4") + " --out " + q(dir),
+                 "PATH=" + dir + "/nothing-here");
+  INFO(r.out);
+  CHECK(r.code == 2);
+  CHECK(r.out.find("--video needs ffmpeg, which is not installed") != std::string::npos);
+  // A stand-in ffmpeg that stores its standard input in its last argument.
+  const std::string bin = freshDir("fakebin");
+  {
+    std::ofstream f(bin + "/ffmpeg");
+    f << "#!/bin/sh\nfor a in \"$@\"; do out=\"$a\"; done\ncat > \"$out\"\n";
+  }
+  ::chmod((bin + "/ffmpeg").c_str(), 0755);
+  r = run("run " + q(kSmall) + " --frames 5 --every 2 --quiet --video " + q(dir + "/out.raw") + " --out " + q(dir),
+          "PATH=" + bin + ":/usr/bin:/bin");
+  INFO(r.out);
+  CHECK(r.code == 0);
+  CHECK(r.out.find("3 frames encoded into") != std::string::npos);
+  CHECK(fs::file_size(dir + "/out.raw") == 3u * 192u * 144u * 4u);
+}
+
+TEST_CASE("--png-level changes the file size, never the pixels, and bad render flags exit 2") {
+  const std::string a = freshDir("lvl0"), b = freshDir("lvl9");
+  REQUIRE(run("run " + q(kSmall) + " --frames 1 --quiet --png-level 0 --out " + q(a)).code == 0);
+  REQUIRE(run("run " + q(kSmall) + " --frames 1 --quiet --png-level 9 --out " + q(b)).code == 0);
+  CHECK(fs::file_size(a + "/frame_00000.png") > 2 * fs::file_size(b + "/frame_00000.png"));
+  CHECK(pngHash(a + "/frame_00000.png") == pngHash(b + "/frame_00000.png"));
+  CHECK(readManifest(a)["frames"][0]["rgba_xxh64"] == readManifest(b)["frames"][0]["rgba_xxh64"]);
+  CHECK(run("run " + q(kSmall) + " --png-level 10").code == 2);
+  CHECK(run("run " + q(kSmall) + " --mode smoke").code == 2);
+  CHECK(run("run " + q(kSmall) + " --color-by vorticity").code == 2);
+  const Result age = run("run " + q(kSmall) + " --frames 1 --mode particles --color-by age --out " + q(a));
+  CHECK(age.code == 2);
+  CHECK(age.out.find("needs particle ages") != std::string::npos);
+  CHECK(run("run " + q(kSmall) + " --range 5,1").code == 2);
+}
+
+TEST_CASE("sph2d render redraws an exported CSV frame bit-identically to the run's frame") {
+  const std::string dir = freshDir("rerender");
+  REQUIRE(run("run " + q(kSmall) + " --frames 11 --every 10 --quiet --export csv --out " + q(dir)).code == 0);
+  const Result r = run("render " + q(kSmall) + " --particles " + q(dir + "/frame_00010.csv") + " --out " +
+                       q(dir + "/again.png"));
+  INFO(r.out);
+  REQUIRE(r.code == 0);
+  CHECK(r.out.find("1250 particles of frame 10") != std::string::npos);
+  CHECK(pngHash(dir + "/again.png") == readManifest(dir)["frames"][1]["rgba_xxh64"].get<std::string>());
+  // Another mode from the same file: a different image of the same size.
+  REQUIRE(run("render " + q(kSmall) + " --particles " + q(dir + "/frame_00010.csv") + " --out " +
+              q(dir + "/discs.png") + " --mode particles --color-by density").code == 0);
+  CHECK(pngHash(dir + "/discs.png") != pngHash(dir + "/again.png"));
+}

@@ -1,0 +1,282 @@
+// The renderer in process: numbers about pixels (coverage, hashes, pixel counts), not "it ran".
+#include <doctest/doctest.h>
+
+#include <algorithm>
+#include <numeric>
+#include <random>
+
+#include "sph2d/hash.hpp"
+#include "sph2d/render/image.hpp"
+#include "sph2d/render/renderer.hpp"
+#include "sph2d/scene.hpp"
+#include "sph2d/world.hpp"
+
+using namespace sph2d;
+
+namespace {
+
+/// A 0.2 m × 0.2 m block of fluid (spacing 0.02: 100 particles) on a floor, seen through `cam`.
+SceneDef blockScene(int w, int h, Vec2d camMin, Vec2d camMax) {
+  SceneDef s;
+  s.name = "block";
+  s.solver.spacing = 0.02;
+  BodyDef floor;
+  ShapeDef box;
+  box.type = ShapeDef::Type::Box;
+  box.center = Vec2d(0.1, -0.05);
+  box.halfSize = Vec2d(0.2, 0.05);
+  floor.fixtures.push_back(box);
+  s.bodies.push_back(floor);
+  FluidBlockDef b;
+  b.min = Vec2d(0, 0);
+  b.max = Vec2d(0.2, 0.2);
+  s.blocks.push_back(b);
+  s.render.width = w;
+  s.render.height = h;
+  s.render.camera.automatic = false;
+  s.render.camera.min = camMin;
+  s.render.camera.max = camMax;
+  return s;
+}
+
+/// Share of the pixels that are water: blue clearly above red.
+double waterShare(const Frame& f) {
+  std::size_t n = 0;
+  for (std::size_t p = 0; p < f.rgba.size(); p += 4)
+    if (f.rgba[p + 2] > f.rgba[p] + 60) ++n;
+  return double(n) / double(f.width * f.height);
+}
+
+std::uint64_t hashOf(const Frame& f) { return xxh64(f.rgba.data(), f.rgba.size()); }
+
+RenderInput inputOf(const World& w, const Particles& P) {
+  RenderInput in;
+  in.particles = &P;
+  in.origin = w.origin();
+  in.spacing = w.spacing();
+  in.colliders = &w.colliders();
+  return in;
+}
+
+}  // namespace
+
+TEST_CASE("the 5x7 font: glyph '0' sets 19 pixels per scale², every character of the overlay has a glyph") {
+  Frame img;
+  img.width = 20;
+  img.height = 20;
+  img.rgba.assign(20 * 20 * 4, 0);
+  drawText(img, 1, 1, "0", 1, Rgba8{255, 255, 255, 255});
+  int lit = 0;
+  for (std::size_t p = 0; p < img.rgba.size(); p += 4) lit += img.rgba[p] == 255;
+  CHECK(lit == 19);
+  img.rgba.assign(20 * 20 * 4, 0);
+  drawText(img, 0, 0, "0", 2, Rgba8{255, 255, 255, 255});
+  lit = 0;
+  for (std::size_t p = 0; p < img.rgba.size(); p += 4) lit += img.rgba[p] == 255;
+  CHECK(lit == 19 * 4);
+  for (char c : std::string("FRAME 0123456789 T . S PARTICLES SPEED M/S PRESSURE PA DENSITY KG/M3 AGE -+E"))
+    CHECK_MESSAGE(hasGlyph(c), "no glyph for '" << c << "'");
+  CHECK(textWidth("AB", 3) == (2 * 6 - 1) * 3);
+  CHECK(formatLabel(1234.0) == "1234");
+  CHECK(formatLabel(0.5) == "0.5");
+  CHECK(formatLabel(2.5e5) == "2.50E+05");
+}
+
+TEST_CASE("liquid frames depend on particle values only, not on storage order, and fresh contexts agree") {
+  const SceneDef s = blockScene(160, 120, Vec2d(-0.1, -0.1), Vec2d(0.3, 0.3));
+  World world(s, WorldOptions{1});
+  Renderer a(s.render);
+  const std::uint64_t h0 = hashOf(a.render(world));
+  // The same particles in reversed slots.
+  Particles P = world.particles();
+  Particles R;
+  for (std::size_t k = P.size(); k-- > 0;) {
+    R.push(P.x[k], P.v[k], P.id[k], P.rho[k]);
+    R.p.back() = P.p[k];
+  }
+  const std::uint64_t h1 = hashOf(a.render(inputOf(world, R)));
+  CHECK(h0 == h1);
+  Renderer b(s.render);
+  CHECK(hashOf(b.render(world)) == h0);
+  // And the water covers the block: 0.2 m × 0.2 m of a 0.4 m × 0.3 m view (aspect-widened).
+  const auto cam = a.cameraRect();
+  const double expected = 0.04 / ((cam[2] - cam[0]) * (cam[3] - cam[1]));
+  const double got = waterShare(a.render(world));
+  MESSAGE("water share " << got << ", block share " << expected);
+  CHECK(got == doctest::Approx(expected).epsilon(0.15));
+}
+
+TEST_CASE("at high zoom sprites wider than the point-size limit are drawn as quads and cover the right area") {
+  // The camera shows 0.02 m × 0.02 m around the block's lower-left corner at 200×200 px:
+  // 10000 px/m, a spacing of 200 px, liquid sprites 800 px wide (400 px in the half-resolution
+  // field, > 255). Only the particle at (0.01, 0.01) has its centre in the image.
+  const SceneDef s = blockScene(200, 200, Vec2d(-0.01, -0.01), Vec2d(0.01, 0.01));
+  World world(s, WorldOptions{1});
+  Renderer liquid(s.render);
+  REQUIRE(liquid.maxPointSize() <= 256.0f);
+  const Frame& f = liquid.render(world);
+  CHECK(liquid.usedQuads());
+  // The fluid fills x > 0, y > 0: a quarter of the view (the floor fills y < 0). At one
+  // particle per image the kernel rounds the corner outwards, hence the wider bound.
+  const double share = waterShare(f);
+  MESSAGE("high zoom: water share " << share);
+  CHECK(share > 0.20);
+  CHECK(share < 0.40);
+  // The same corner at a fifth of the zoom (guard band, points), and at a tenth.
+  const SceneDef mid = blockScene(200, 200, Vec2d(-0.05, -0.05), Vec2d(0.05, 0.05));
+  World w1(mid, WorldOptions{1});
+  Renderer r1(mid.render);
+  const double share1 = waterShare(r1.render(w1));
+  CHECK_FALSE(r1.usedQuads());
+  MESSAGE("fifth of the zoom: water share " << share1);
+  CHECK(share1 > 0.20);
+  CHECK(share1 < 0.30);
+  const SceneDef wide = blockScene(200, 200, Vec2d(-0.1, -0.1), Vec2d(0.1, 0.1));
+  World w2(wide, WorldOptions{1});
+  Renderer r2(wide.render);
+  const double share2 = waterShare(r2.render(w2));
+  CHECK_FALSE(r2.usedQuads());
+  CHECK(share2 == doctest::Approx(0.25).epsilon(0.2));
+  // Particles mode at the high zoom: discs of 80 px are points; at 16× zoom they are quads.
+  RenderOptions po;
+  po.mode = "particles";
+  const SceneDef closer = blockScene(200, 200, Vec2d(0.005, 0.005), Vec2d(0.015, 0.015));  // 20000 px/m
+  World w3(closer, WorldOptions{1});
+  Renderer discs(closer.render, po);
+  const Frame& d = discs.render(w3);
+  CHECK(discs.usedQuads());
+  // One disc of 400 px diameter centred at (0.01, 0.01) covers the view but its own corners.
+  std::size_t coloured = 0;
+  for (std::size_t p = 0; p < d.rgba.size(); p += 4)
+    if (d.rgba[p + 2] > 100 || d.rgba[p + 1] > 100 || d.rgba[p] > 100) ++coloured;
+  const double discShare = double(coloured) / (200.0 * 200.0);
+  MESSAGE("disc share " << discShare);
+  CHECK(discShare > 0.7);
+}
+
+TEST_CASE("ages fade particles: age 0 changes nothing, past the fade end the fluid vanishes") {
+  const SceneDef s = blockScene(160, 120, Vec2d(-0.1, -0.1), Vec2d(0.3, 0.3));
+  World world(s, WorldOptions{1});
+  Renderer r(s.render);
+  const std::uint64_t plain = hashOf(r.render(world));
+  const double plainShare = waterShare(r.render(world));
+  std::vector<Real> age(world.particleCount(), 0.0f);
+  CHECK(hashOf(r.render(world, age.data())) == plain);
+  std::fill(age.begin(), age.end(), 3.5f);  // default fade: 1 s .. 3 s
+  CHECK(waterShare(r.render(world, age.data())) == 0.0);
+  std::fill(age.begin(), age.end(), 2.0f);  // half faded: the field halves, the surface shrinks
+  const double half = waterShare(r.render(world, age.data()));
+  MESSAGE("water share: " << plainShare << " fresh, " << half << " half faded");
+  CHECK(half < plainShare);
+  CHECK(half > 0.0);
+  // Particles mode coloured by age: the range is 0 .. the oldest age.
+  RenderOptions po;
+  po.mode = "particles";
+  po.colorBy = ColorField::Age;
+  Renderer pr(s.render, po);
+  for (std::size_t i = 0; i < age.size(); ++i) age[i] = 0.01f * float(i % 50);
+  pr.render(world, age.data());
+  CHECK(pr.lastRange()[0] == 0.0);
+  CHECK(pr.lastRange()[1] == doctest::Approx(0.49));
+  CHECK_THROWS(pr.render(world));  // colour by age without ages
+}
+
+TEST_CASE("particles mode: the colour range is the field's min..max and the colour bar is drawn") {
+  const SceneDef s = blockScene(240, 180, Vec2d(-0.1, -0.1), Vec2d(0.3, 0.3));
+  World world(s, WorldOptions{1});
+  for (int k = 0; k < 3; ++k) world.stepFrame();
+  const Particles& P = world.particles();
+  const auto [rlo, rhi] = std::minmax_element(P.rho.begin(), P.rho.end());
+  const auto [plo, phi] = std::minmax_element(P.p.begin(), P.p.end());
+  RenderOptions po;
+  po.mode = "particles";
+  po.colorBy = ColorField::Density;
+  Renderer dr(s.render, po);
+  const Frame& f = dr.render(world);
+  CHECK(dr.lastRange()[0] == doctest::Approx(*rlo));
+  CHECK(dr.lastRange()[1] == doctest::Approx(*rhi));
+  // The bar's top row is the ramp's dark-red end, its bottom row the dark-blue end: find both
+  // in the right half of the image.
+  bool red = false, blue = false;
+  for (int y = 0; y < f.height; ++y)
+    for (int x = f.width / 2; x < f.width; ++x) {
+      const std::uint8_t* p = &f.rgba[(std::size_t(y) * std::size_t(f.width) + std::size_t(x)) * 4];
+      red = red || (p[0] == 128 && p[1] == 0 && p[2] == 0);  // colorRamp(1) = (0.5, 0, 0)
+      blue = blue || (p[0] == 0 && p[1] == 0 && p[2] == 128);  // colorRamp(0) = (0, 0, 0.5)
+    }
+  CHECK(red);
+  CHECK(blue);
+  po.colorBy = ColorField::Pressure;
+  Renderer pr(s.render, po);
+  pr.render(world);
+  CHECK(pr.lastRange()[0] == doctest::Approx(*plo));
+  CHECK(pr.lastRange()[1] == doctest::Approx(*phi));
+  po.range = std::array<double, 2>{0.0, 1000.0};
+  Renderer fixed(s.render, po);
+  fixed.render(world);
+  CHECK(fixed.lastRange()[0] == 0.0);
+  CHECK(fixed.lastRange()[1] == 1000.0);
+}
+
+TEST_CASE("the overlay changes only the pixels of its box in the top-left corner") {
+  const SceneDef s = blockScene(320, 240, Vec2d(-0.1, -0.1), Vec2d(0.3, 0.3));
+  World world(s, WorldOptions{1});
+  Renderer plain(s.render);
+  RenderOptions o;
+  o.overlay = true;
+  Renderer over(s.render, o);
+  const Frame a = plain.render(world);
+  const Frame& b = over.render(world);
+  const int scale = 1;  // 240 px high: scale max(1, 240/270)
+  const std::string line = "FRAME 0  T 0.000 S  100 PARTICLES";
+  const int boxW = textWidth(line, scale) + 6 * scale, boxH = textHeight(scale) + 6 * scale;
+  int inside = 0, outside = 0;
+  for (int y = 0; y < a.height; ++y)
+    for (int x = 0; x < a.width; ++x) {
+      const std::size_t p = (std::size_t(y) * std::size_t(a.width) + std::size_t(x)) * 4;
+      const bool diff = a.rgba[p] != b.rgba[p] || a.rgba[p + 1] != b.rgba[p + 1] || a.rgba[p + 2] != b.rgba[p + 2];
+      if (diff) (x < boxW && y < boxH ? inside : outside)++;
+    }
+  CHECK(outside == 0);
+  CHECK(inside > boxW * boxH / 2);  // the translucent box darkens every pixel it covers (but black ones)
+}
+
+TEST_CASE("100k particles render: a 2 m x 1 m lattice covers its share of a 960x540 image, both modes") {
+  // 100,352 particles at 0.0044 m (about 1.07 px at 240 px/m): sprites of 4.3 px, full-resolution field.
+  Particles P;
+  const double dx = 0.0044;
+  std::uint32_t id = 0;
+  for (int j = 0; j < 224; ++j)
+    for (int i = 0; i < 448; ++i)
+      P.push(Vec2(Real(0.5 + (i + 0.5) * dx), Real(0.5 + (j + 0.5) * dx)), Vec2(Real(i % 7), 0), id++, Real(1000));
+  REQUIRE(P.size() == 100352);
+  RenderDef def;
+  def.width = 960;
+  def.height = 540;
+  def.camera.automatic = false;
+  def.camera.min = Vec2d(0, 0);
+  def.camera.max = Vec2d(4, 2.25);
+  RenderInput in;
+  in.particles = &P;
+  in.spacing = dx;
+  const double block = (448 * dx) * (224 * dx) / (4.0 * 2.25);
+  Renderer liquid(def);
+  const double share = waterShare(liquid.render(in));
+  MESSAGE("100k liquid: water share " << share << ", block " << block);
+  CHECK(share == doctest::Approx(block).epsilon(0.03));
+  RenderOptions po;
+  po.mode = "particles";
+  Renderer discs(def, po);
+  const Frame& f = discs.render(in);
+  CHECK(discs.lastRange()[1] == doctest::Approx(6.0));
+  // Discs of 3 px on a 1.07 px lattice cover the block; count non-background pixels left of the bar.
+  std::size_t lit = 0;
+  for (int y = 0; y < f.height; ++y)
+    for (int x = 0; x < f.width * 3 / 4; ++x) {
+      const std::uint8_t* p = &f.rgba[(std::size_t(y) * std::size_t(f.width) + std::size_t(x)) * 4];
+      lit += (p[0] > 40 || p[1] > 40 || p[2] > 60);
+    }
+  const double litShare = double(lit) / (f.width * 0.75 * f.height);
+  MESSAGE("100k discs: lit share " << litShare << ", block " << block / 0.75);
+  CHECK(litShare == doctest::Approx(block / 0.75).epsilon(0.05));
+}

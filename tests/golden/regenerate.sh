@@ -1,0 +1,17 @@
+#!/usr/bin/env bash
+# Regenerates the golden manifests and frames with the app itself. Run it when a
+# change to the engine or the renderer is meant to change pixels, then look at
+# the new frames before committing them. Usage: tests/golden/regenerate.sh [build dir]
+set -euo pipefail
+# Pixels are bit-identical on CPUs with and without AVX, FMA or AVX-512 only when llvmpipe is
+# limited to SSE4.1 code; the manifests record this and `sph2d check` adopts it.
+export GALLIUM_OVERRIDE_CPU_CAPS=sse4.1
+here="$(cd "$(dirname "$0")" && pwd)"
+exe="$(cd "${1:-$here/../../build}" && pwd)/app/sph2d"
+gen() {  # gen NAME [run flags...]
+  local name=$1; shift
+  (cd "$here/$name" && rm -f frame_*.png manifest.json && "$exe" run scene.json --out . --quiet "$@")
+}
+gen liquid_dam_break --frames 9 --every 4
+gen particles_pressure --frames 7 --every 3 --color-by pressure
+gen shapes_overlay --frames 6 --every 5 --overlay
