@@ -207,7 +207,8 @@ int cmdRun(const std::vector<std::string>& args) {
     return 2;
   }
   if (a.images && a.render.colorBy == ColorField::Age && (a.render.mode == "particles" || (a.render.mode.empty() && scene.render.mode == "particles")))
-    throw UsageError("--color-by age needs particle ages, and the engine does not track them yet");
+    if (!scene.effects.lifetime)
+      throw UsageError("--color-by age needs particle ages: enable effects.lifetime in the scene");
   if (a.images) {
     std::error_code ec;
     fs::create_directories(out, ec);

@@ -370,7 +370,8 @@ struct World::Impl final : StageRunner {
     const Real vmax = maxSpeedOf(P, pool);
     const StepContext c = context(0);
     Real dt = solver->maxTimeStep(c, vmax, lastAccel);
-    for (const auto& e : effects) dt = std::min(dt, e->maxTimeStep(c));
+    for (const auto& e : effects)
+      if (e->enabled) dt = std::min(dt, e->maxTimeStep(c));
     return dt;
   }
 
@@ -639,6 +640,27 @@ void World::setUserForces(const std::vector<UserForce>& forces) {
 }
 
 void World::setEmitterEnabled(std::size_t index, bool enabled) { impl_->emitters.at(index).def.enabled = enabled; }
+
+void World::setEffectEnabled(const std::string& name, bool enabled) {
+  std::string names;
+  for (const auto& e : impl_->effects) {
+    if (name == e->name()) {
+      e->enabled = enabled;
+      return;
+    }
+    names += (names.empty() ? "" : ", ") + std::string(e->name());
+  }
+  throw std::invalid_argument("the scene does not enable the effect '" + name + "'; its effects: " +
+                              (names.empty() ? std::string("none") : names));
+}
+
+std::vector<std::string> World::effects() const {
+  std::vector<std::string> out;
+  for (const auto& e : impl_->effects) out.push_back(e->name());
+  return out;
+}
+
+std::size_t World::emitterCount() const { return impl_->emitters.size(); }
 
 std::uint64_t World::emittedCount(std::size_t index) const { return impl_->emitters.at(index).emitted; }
 

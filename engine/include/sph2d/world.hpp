@@ -162,6 +162,14 @@ class World {
   void setUserForces(const std::vector<UserForce>& forces);
   /// Enables or disables emitter `index` (scene order). Throws std::out_of_range.
   void setEmitterEnabled(std::size_t index, bool enabled);
+  /// Number of emitters of the scene.
+  std::size_t emitterCount() const;
+  /// Switches an effect the scene enables ("viscosity", "xsph", "force_fields",
+  /// "surface_tension", "user_force") on or off. Throws std::invalid_argument
+  /// naming the scene's effects when it has no such effect.
+  void setEffectEnabled(const std::string& name, bool enabled);
+  /// Names of the effects this world can run (enabled or not), in stage order.
+  std::vector<std::string> effects() const;
   /// Particles emitted so far by emitter `index`.
   std::uint64_t emittedCount(std::size_t index) const;
   /// Particles removed so far by lifetimes, sinks and the budget policy.

@@ -234,7 +234,9 @@ RenderInput inputOf(const World& world, const Real* age) {
   in.origin = world.origin();
   in.spacing = world.spacing();
   in.colliders = &world.colliders();
-  in.age = age;
+  // Ages come from the caller, or from the engine's "age" field when the scene has lifetimes.
+  const std::vector<Real>* engineAge = world.particles().find("age");
+  in.age = age ? age : (engineAge ? engineAge->data() : nullptr);
   in.gravity = world.scene().gravity.norm();
   in.frame = world.frame();
   in.time = world.time();
@@ -656,7 +658,7 @@ const Frame& Renderer::render(const RenderInput& in) {
   const RenderDef& d = r.def;
   if (r.cam.empty()) r.cam = resolveCamera(d, in);
   r.ensureFrame(in);
-  if (in.age == nullptr && r.opt.colorBy == ColorField::Age && !r.liquid)
+  if (in.age == nullptr && in.particles->size() > 0 && r.opt.colorBy == ColorField::Age && !r.liquid)
     throw std::runtime_error("colour by age needs particle ages, and none were given");
 
   const Particles& P = *in.particles;

@@ -22,6 +22,8 @@ class Effect {
   virtual const char* name() const = 0;
   /// Adds this effect's acceleration to P.a. Returns the first bad slot or kNone.
   virtual std::size_t apply(StepContext& c) = 0;
+  /// False while an input event has switched the effect off (it then runs no stage).
+  bool enabled = true;
   /// Largest stable time step this effect allows.
   virtual Real maxTimeStep(const StepContext& c) const {
     (void)c;
@@ -41,7 +43,8 @@ std::unique_ptr<Effect> makeUserForceEffect(const std::vector<UserForce>* forces
 
 /// Runs every effect as its own timed, guarded stage.
 inline void applyEffects(StepContext& c, StageRunner& run, const EffectList& effects) {
-  for (const auto& e : effects) run.checked(e->name(), [&] { return e->apply(c); });
+  for (const auto& e : effects)
+    if (e->enabled) run.checked(e->name(), [&] { return e->apply(c); });
 }
 
 }  // namespace sph2d

@@ -118,7 +118,8 @@ class Renderer {
   Renderer& operator=(const Renderer&) = delete;
 
   /// Renders the current state of `world`; `age` (optional) holds one age [s] per particle
-  /// slot. The frame stays valid until the next call. Throws std::runtime_error.
+  /// slot, by default the world's "age" field when its scene has lifetimes. The frame
+  /// stays valid until the next call. Throws std::runtime_error.
   const Frame& render(const World& world, const Real* age = nullptr);
   /// Renders `in`; the camera is fixed by the first call. Throws std::runtime_error.
   const Frame& render(const RenderInput& in);
