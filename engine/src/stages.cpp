@@ -93,10 +93,18 @@ std::size_t stageIntegrate(StepContext& c) {
   Particles& P = c.P;
   const Real dt = c.dt;
   const Real vmax2 = c.maxSpeed * c.maxSpeed;
+  // The displacement clamp: no particle moves more than half a support radius
+  // in one substep (the CFL bound the next step's time step then honours). It
+  // only acts when a force jumps within a substep (stacked particles, a new
+  // overlap), before the force limit of the next step can see it.
+  const Real vClamp = dt > 0 ? Real(0.5) * c.R / dt : std::numeric_limits<Real>::infinity();
+  const Real vClamp2 = vClamp * vClamp;
   return firstBad(c.pool, P.size(), [&](std::size_t b, std::size_t e) {
     std::size_t bad = kNone;
     for (std::size_t i = b; i < e; ++i) {
-      const Vec2 v = P.v[i] + P.a[i] * dt;
+      Vec2 v = P.v[i] + P.a[i] * dt;
+      const Real s2 = v.squaredNorm();
+      if (s2 > vClamp2 && s2 <= vmax2) v *= vClamp / std::sqrt(s2);
       P.xPrev[i] = P.x[i];
       P.v[i] = v;
       P.x[i] = P.x[i] + v * dt;

@@ -11,6 +11,9 @@
 // divided by the kernel's lattice gradient moment (0.953 for Wendland C2 at
 // R = 2.5 dx), a constant: without it a resting column's pressure is 5 % high.
 //
+// Beyond ρ = 1.1 ρ0 the equation of state continues along its tangent (stacked
+// or overlapping particles separate instead of exploding).
+//
 // Parameters (solver.*): gamma, alpha, expected_speed.
 #include <algorithm>
 #include <cmath>
@@ -53,7 +56,7 @@ class Wcsph final : public Solver {
           return m;
         },
         [](Real a, Real b2) { return std::max(a, b2); });
-    const Real cEff = c0_ * std::pow(rhoMax / c.rho0, Real(0.5) * (gamma_ - Real(1)));
+    const Real cEff = c0_ * std::pow(std::min(rhoMax / c.rho0, Real(1.1)), Real(0.5) * (gamma_ - Real(1)));
     Real dt = Real(c.def.cfl) * c.R / (cEff + vmax);
     if (amax > 0) dt = std::min(dt, Real(0.25) * std::sqrt(c.R / amax));
     return dt;
@@ -102,9 +105,18 @@ class Wcsph final : public Solver {
     Particles& P = c.P;
     const Real B = c.rho0 * c0_ * c0_ / gamma_;
     const bool clamp = c.def.clampNegativePressure;
+    // Beyond ρ = 1.1 ρ0 (never reached by a weakly compressible flow with a
+    // proper c0, but reached by stacked or overlapping particles) the Tait
+    // curve continues along its tangent, so such states separate at tens of
+    // m/s instead of exploding at thousands.
+    const Real kneeRatio = Real(1.1);
+    const Real kneeP = B * (std::pow(kneeRatio, gamma_) - Real(1));
+    const Real kneeSlope = B * gamma_ * std::pow(kneeRatio, gamma_ - Real(1)) / c.rho0;
     c.pool.parallelFor(P.size(), 4096, [&](std::size_t b, std::size_t e) {
       for (std::size_t i = b; i < e; ++i) {
-        Real p = B * (std::pow(P.rho[i] / c.rho0, gamma_) - Real(1));
+        const Real ratio = P.rho[i] / c.rho0;
+        Real p = ratio <= kneeRatio ? B * (std::pow(ratio, gamma_) - Real(1))
+                                    : kneeP + kneeSlope * (P.rho[i] - kneeRatio * c.rho0);
         if (clamp && p < 0) p = 0;
         P.p[i] = p;
         P.invRho[i] = Real(1) / P.rho[i];

@@ -1,0 +1,276 @@
+// The stability suite (docs/STABILITY.md): the cases that break SPH codes, run
+// for every solver. Each asserts numbers: no NaN or Inf, nothing outside the
+// solids' container, kinetic energy bounded by the potential energy released,
+// and the warnings or errors the engine must give.
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "sph2d/world.hpp"
+#include "test_util.hpp"
+
+using namespace sph2d;
+
+namespace {
+
+/// Every solver the suite runs.
+const std::vector<std::string>& solvers() {
+  static const std::vector<std::string> s = {"muller2003", "wcsph"};
+  return s;
+}
+
+ShapeDef box(Vec2d c, Vec2d h) {
+  ShapeDef s;
+  s.type = ShapeDef::Type::Box;
+  s.center = c;
+  s.halfSize = h;
+  return s;
+}
+
+/// A closed W × H tank [0, W] × [0, H] with `solver`.
+SceneDef tank(const std::string& solver, double W, double H, double spacing) {
+  SceneDef s;
+  s.solver.type = solver;
+  s.solver.spacing = spacing;
+  if (solver == "wcsph") s.solver.params["expected_speed"] = 6;
+  BodyDef b;
+  b.fixtures = {box({W / 2, -0.1}, {W / 2 + 0.2, 0.1}), box({W / 2, H + 0.1}, {W / 2 + 0.2, 0.1}),
+                box({-0.1, H / 2}, {0.1, H / 2 + 0.2}), box({W + 0.1, H / 2}, {0.1, H / 2 + 0.2})};
+  s.bodies.push_back(b);
+  return s;
+}
+
+std::size_t outside(const World& w, double W, double H) {
+  std::size_t n = 0;
+  for (std::size_t i = 0; i < w.particleCount(); ++i) {
+    const Vec2d p = w.worldPosition(i);
+    n += !(p.x() >= 0 && p.x() <= W && p.y() >= 0 && p.y() <= H);
+  }
+  return n;
+}
+
+double sumY(const World& w) {
+  double s = 0;
+  for (std::size_t i = 0; i < w.particleCount(); ++i) s += w.worldPosition(i).y();
+  return s;
+}
+
+}  // namespace
+
+TEST_CASE("stability: all particles created at one point separate without NaN, for every solver") {
+  for (const auto& solver : solvers()) {
+    CAPTURE(solver);
+    SceneDef s = tank(solver, 1, 1, 0.04);
+    s.gravity = Vec2d(0, 0);
+    EmitterDef e;  // 200 particles at exactly the same point, all at rest
+    e.position = Vec2d(0.5, 0.5);
+    e.rate = 200 * 60;
+    e.speed = 0;
+    e.stop = 1.0 / 60;
+    s.effects.emitters.push_back(e);
+    World w(s, WorldOptions{2});
+    for (int f = 0; f < 60; ++f) w.stepFrame();
+    REQUIRE(w.particleCount() == 200);
+    CHECK(test::allFiniteState(w));
+    CHECK(outside(w, 1, 1) == 0);
+    // They spread: the cloud is wider than a spacing.
+    double minX = 1e9, maxX = -1e9;
+    for (std::size_t i = 0; i < w.particleCount(); ++i) {
+      minX = std::min(minX, w.worldPosition(i).x());
+      maxX = std::max(maxX, w.worldPosition(i).x());
+    }
+    CHECK(maxX - minX > 0.1);
+  }
+}
+
+TEST_CASE("stability: a fluid block overlapping a static polygon at start is cut with one warning, for every solver") {
+  for (const auto& solver : solvers()) {
+    CAPTURE(solver);
+    SceneDef s = tank(solver, 2, 1.5, 0.04);
+    BodyDef poly;
+    ShapeDef tri;
+    tri.type = ShapeDef::Type::Polygon;
+    tri.vertices = {{0.5, 0.0}, {1.2, 0.0}, {0.8, 0.6}};
+    poly.fixtures.push_back(tri);
+    s.bodies.push_back(poly);
+    FluidBlockDef blk;
+    blk.min = Vec2d(0.3, 0.0);
+    blk.max = Vec2d(1.3, 0.8);
+    s.blocks.push_back(blk);
+    World w(s, WorldOptions{2});
+    const auto warnings = w.takeWarnings();
+    REQUIRE(warnings.size() == 1);
+    CHECK(warnings[0].find("inside solids") != std::string::npos);
+    for (int f = 0; f < 60; ++f) w.stepFrame();
+    CHECK(test::allFiniteState(w));
+    CHECK(outside(w, 2, 1.5) == 0);
+  }
+}
+
+TEST_CASE("stability: viscosity far beyond its explicit limit shrinks the step to the substep cap and says so") {
+  for (const auto& solver : solvers()) {
+    CAPTURE(solver);
+    SceneDef s = tank(solver, 1, 1, 0.04);
+    s.solver.viscosity = 50;  // 0.03 R²/ν ≈ 6e-6 s: far below a frame
+    s.solver.maxSubsteps = 50;
+    FluidBlockDef blk;
+    blk.min = Vec2d(0, 0);
+    blk.max = Vec2d(0.5, 0.5);
+    s.blocks.push_back(blk);
+    World w(s, WorldOptions{2});
+    for (int f = 0; f < 3; ++f) w.stepFrame();
+    const auto warnings = w.takeWarnings();
+    REQUIRE(warnings.size() == 3);  // one per frame that hit the cap
+    CHECK(warnings[0].find("max_substeps = 50") != std::string::npos);
+    CHECK(warnings[2].find("frame 2") != std::string::npos);
+    CHECK(test::allFiniteState(w));
+    CHECK(w.time() < 3.0 / 60);  // the frames ran slow instead of unstable
+  }
+}
+
+TEST_CASE("stability: stiffness far beyond its explicit limit (c = 5000 m/s) stays stable at the substep cap") {
+  for (const auto& solver : solvers()) {
+    CAPTURE(solver);
+    SceneDef s = tank(solver, 1, 1, 0.04);
+    s.solver.soundSpeed = 5000;
+    s.solver.params.erase("expected_speed");
+    s.solver.maxSubsteps = 40;
+    FluidBlockDef blk;
+    blk.min = Vec2d(0, 0);
+    blk.max = Vec2d(0.4, 0.6);
+    s.blocks.push_back(blk);
+    World w(s, WorldOptions{2});
+    for (int f = 0; f < 5; ++f) w.stepFrame();
+    CHECK_FALSE(w.takeWarnings().empty());
+    CHECK(test::allFiniteState(w));
+    CHECK(outside(w, 1, 1) == 0);
+  }
+}
+
+TEST_CASE("stability: surface tension far beyond its step limit shrinks the step, and the run stays finite") {
+  SceneDef s = tank("wcsph", 1, 1, 0.04);
+  s.gravity = Vec2d(0, 0);
+  s.effects.surfaceTension = true;
+  s.effects.tension.model = "csf";
+  s.effects.tension.sigma = 1e4;
+  s.solver.maxSubsteps = 30;
+  FluidBlockDef blk;
+  blk.min = Vec2d(0.3, 0.3);
+  blk.max = Vec2d(0.7, 0.7);
+  s.blocks.push_back(blk);
+  World w(s, WorldOptions{2});
+  for (int f = 0; f < 5; ++f) w.stepFrame();
+  CHECK_FALSE(w.takeWarnings().empty());
+  CHECK(test::allFiniteState(w));
+  CHECK(outside(w, 1, 1) == 0);
+}
+
+TEST_CASE("stability: a frame time of 1 s holds the substep cap, stays stable and says so, for every solver") {
+  for (const auto& solver : solvers()) {
+    CAPTURE(solver);
+    SceneDef s = tank(solver, 2, 1.5, 0.05);
+    s.fps = 1;
+    s.solver.maxSubsteps = 300;
+    FluidBlockDef blk;
+    blk.min = Vec2d(0, 0);
+    blk.max = Vec2d(0.5, 1.0);
+    s.blocks.push_back(blk);
+    World w(s, WorldOptions{2});
+    const double y0 = sumY(w);
+    w.stepFrame();
+    CHECK(w.lastFrameSubsteps() == 300);
+    const auto warnings = w.takeWarnings();
+    REQUIRE(warnings.size() == 1);
+    CHECK(warnings[0].find("frame 0") != std::string::npos);
+    CHECK(test::allFiniteState(w));
+    CHECK(outside(w, 2, 1.5) == 0);
+    CHECK(w.kineticEnergy() <= double(w.particleMass()) * 9.81 * (y0 - sumY(w)) + 1e-9);
+  }
+}
+
+TEST_CASE("stability: a sink that drains everything leaves an empty, working world, and a scene with zero particles runs") {
+  for (const auto& solver : solvers()) {
+    CAPTURE(solver);
+    SceneDef s = tank(solver, 1, 1, 0.04);
+    FluidBlockDef blk;
+    blk.min = Vec2d(0.2, 0.5);
+    blk.max = Vec2d(0.8, 0.9);
+    s.blocks.push_back(blk);
+    s.effects.sinks.push_back(RegionDef{Vec2d(0, 0), Vec2d(1, 0.3)});
+    World w(s, WorldOptions{2});
+    const std::size_t n0 = w.particleCount();
+    for (int f = 0; f < 150 && w.particleCount() > 0; ++f) w.stepFrame();
+    CHECK(w.particleCount() == 0);
+    CHECK(w.removedCount() == n0);
+    for (int f = 0; f < 5; ++f) w.stepFrame();  // stepping an empty world is fine
+    CHECK(w.densityStats().meanDensity == 0);
+    SceneDef empty = tank(solver, 1, 1, 0.04);
+    World e(empty, WorldOptions{1});
+    for (int f = 0; f < 5; ++f) e.stepFrame();
+    CHECK(e.particleCount() == 0);
+    CHECK(e.time() == doctest::Approx(5.0 / 60));
+  }
+}
+
+TEST_CASE("stability: a long rest, 20000 substeps of a tank at rest: energy decays and stays small, no creep, no drift (wcsph)") {
+  SceneDef s = tank("wcsph", 0.6, 0.8, 0.04);
+  FluidBlockDef blk;
+  blk.min = Vec2d(0, 0);
+  blk.max = Vec2d(0.6, 0.45);
+  s.blocks.push_back(blk);
+  World w(s, WorldOptions{2});
+  auto com = [&] {
+    Vec2d c(0, 0);
+    for (std::size_t i = 0; i < w.particleCount(); ++i) c += w.worldPosition(i);
+    return Vec2d(c / double(w.particleCount()));
+  };
+  for (int i = 0; i < 2000; ++i) w.substep();
+  const Vec2d c1 = com();
+  const double ke1 = w.kineticEnergy();
+  double keMax = 0;
+  for (int i = 2000; i < 20000; ++i) {
+    w.substep();
+    if (i % 1000 == 0) keMax = std::max(keMax, w.kineticEnergy());
+  }
+  const Vec2d c2 = com();
+  const double ke2 = w.kineticEnergy();
+  const double pe = double(w.particleMass()) * 9.81 * 0.45 / 2 * double(w.particleCount());  // potential energy scale of the column
+  MESSAGE("KE after 2000 substeps " << ke1 << ", max later " << keMax << ", final " << ke2 << " J/m (mgH/2 = " << pe
+                                    << "); COM drift " << (c2 - c1).norm() << " m");
+  REQUIRE(w.substeps() == 20000);
+  CHECK(test::allFiniteState(w));
+  CHECK(outside(w, 0.6, 0.8) == 0);
+  CHECK(ke2 < 1e-4 * pe);
+  CHECK(keMax < 1e-3 * pe);
+  CHECK((c2 - c1).norm() < 0.1 * s.solver.spacing);
+}
+
+TEST_CASE("stability: the dam break 10 km from the origin matches the one at the origin within a spacing after 1 s") {
+  for (const auto& solver : solvers()) {
+    CAPTURE(solver);
+    SceneDef s = test::scene("tests/small_dam_break.json");
+    s.solver.type = solver;
+    if (solver == "wcsph") s.solver.params["expected_speed"] = 7;
+    SceneDef far = s;
+    const Vec2d shift(10000.0, 0.0);
+    for (auto& b : far.bodies) b.position += shift;
+    for (auto& b : far.blocks) {
+      b.min += shift;
+      b.max += shift;
+    }
+    World a(s, WorldOptions{2}), b(far, WorldOptions{2});
+    CHECK(b.origin().x() > 9000);  // the far scene really runs in a shifted local frame
+    for (int f = 0; f < 60; ++f) {
+      a.stepFrame();
+      b.stepFrame();
+    }
+    double frontA = -1e9, frontB = -1e9;
+    for (std::size_t i = 0; i < a.particleCount(); ++i) frontA = std::max(frontA, a.worldPosition(i).x());
+    for (std::size_t i = 0; i < b.particleCount(); ++i) frontB = std::max(frontB, b.worldPosition(i).x() - shift.x());
+    MESSAGE(solver << ": front " << frontA << " m at the origin, " << frontB << " m at 10 km");
+    CHECK(test::allFiniteState(b));
+    CHECK(std::fabs(frontA - frontB) <= s.solver.spacing);
+  }
+}
