@@ -59,5 +59,7 @@ int cmdBench(const std::vector<std::string>& args);
 int cmdInfo(const std::vector<std::string>& args);
 /// `sph2d bench step`.
 int cmdBenchStep(const std::vector<std::string>& args);
+/// `sph2d bench accuracy`.
+int cmdBenchAccuracy(const std::vector<std::string>& args);
 
 }  // namespace sph2d::cli

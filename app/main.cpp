@@ -27,6 +27,7 @@ const char* kMainHelp =
     "  sph2d render SCENE.json --particles FRAME.csv --out IMAGE.png   re-render exported particles\n"
     "  sph2d bench step [options]       step throughput (particle-steps per second)\n"
     "  sph2d bench render [options]     per-stage render and PNG timings\n"
+    "  sph2d bench accuracy [options]   every solver against experiment and theory: error vs cost\n"
     "  sph2d --help | COMMAND --help\n"
     "\n"
     "Exit codes: 0 ok, 1 runtime failure (check: frames differ), 2 bad input, 3 simulation stopped by the guard, 130 interrupted.\n";
@@ -48,6 +49,8 @@ int main(int argc, char** argv) {
     if (cmd == "render") return cmdRender(args);
     if (cmd == "bench") {
       if (!args.empty() && args[0] == "step") return cmdBenchStep(std::vector<std::string>(args.begin() + 1, args.end()));
+      if (!args.empty() && args[0] == "accuracy")
+        return cmdBenchAccuracy(std::vector<std::string>(args.begin() + 1, args.end()));
       return cmdBench(args);
     }
     throw UsageError("unknown command '" + cmd + "'; commands: run, info, check, render, bench (see sph2d --help)");

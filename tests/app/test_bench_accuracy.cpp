@@ -1,0 +1,49 @@
+// `sph2d bench accuracy --quick`: the report's smoke test. It asserts the
+// files, the CSV's columns and that every solver produced a finite error, not
+// any timing (timings belong to the benchmark itself).
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <set>
+#include <sstream>
+
+#include "app_util.hpp"
+
+using namespace sph2d::apptest;
+
+TEST_CASE("bench accuracy --quick writes the CSV, the table and the charts, with a finite error per solver and case") {
+  const std::string dir = freshDir("accuracy_quick");
+  const Result r = run("bench accuracy --quick --out \"" + dir + "\" --assets \"" + std::string(SPH2D_ASSETS) + "\"");
+  INFO(r.out);
+  REQUIRE(r.code == 0);
+  const std::string csv = readText(dir + "/accuracy.csv");
+  std::istringstream in(csv);
+  std::string header;
+  std::getline(in, header);
+  CHECK(header == "case,solver,particles,cfl,error_name,error,mean_density_error,max_density_error,wall_s_per_sim_s,ms_per_step");
+  std::set<std::string> cases, solvers;
+  std::string line;
+  int rows = 0;
+  while (std::getline(in, line)) {
+    std::vector<std::string> f;
+    std::stringstream ls(line);
+    std::string cell;
+    while (std::getline(ls, cell, ',')) f.push_back(cell);
+    REQUIRE(f.size() == 10);
+    cases.insert(f[0]);
+    solvers.insert(f[1]);
+    const double err = std::stod(f[5]);
+    CHECK(std::isfinite(err));
+    CHECK(err >= 0);
+    if (f[0] == "dam_break") CHECK(err < 1.0);  // the surge front within one column width (RMS of Z) at the coarse resolution
+    ++rows;
+  }
+  CHECK(cases == std::set<std::string>{"dam_break", "hydrostatic"});
+  CHECK(solvers.count("muller2003") == 1);
+  CHECK(solvers.count("wcsph") == 1);
+  CHECK(rows == 2 * int(solvers.size()));
+  CHECK(readText(dir + "/accuracy.md").find("| dam_break |") != std::string::npos);
+  CHECK(std::filesystem::file_size(dir + "/dam_break.png") > 1000);
+  CHECK(std::filesystem::file_size(dir + "/hydrostatic.png") > 1000);
+}
