@@ -49,11 +49,56 @@
 // chebyshev, tensile_k, tensile_n, tensile_dq, xsph, max_dt, max_move.
 #include <algorithm>
 #include <cmath>
+#include <cstring>
+#include <type_traits>
+
+#if defined(__SSE2__) && !defined(SPH2D_NO_SIMD)
+#include <emmintrin.h>
+#endif
 
 #include "solvers/solver.hpp"
 
 namespace sph2d {
 namespace {
+
+/// Four floats operated on together: SSE2 when the compiler targets it, else four
+/// scalar operations. Every operation is IEEE single precision, correctly rounded
+/// per lane (add, mul, div, sqrt, max), so both paths give the same bits.
+struct Lane4 {
+#if defined(__SSE2__) && !defined(SPH2D_NO_SIMD)
+  __m128 v;
+  static Lane4 load(const float* p) { return {_mm_loadu_ps(p)}; }
+  static Lane4 all(float x) { return {_mm_set1_ps(x)}; }
+  void store(float* p) const { _mm_storeu_ps(p, v); }
+  friend Lane4 operator+(Lane4 a, Lane4 b) { return {_mm_add_ps(a.v, b.v)}; }
+  friend Lane4 operator-(Lane4 a, Lane4 b) { return {_mm_sub_ps(a.v, b.v)}; }
+  friend Lane4 operator*(Lane4 a, Lane4 b) { return {_mm_mul_ps(a.v, b.v)}; }
+  friend Lane4 operator/(Lane4 a, Lane4 b) { return {_mm_div_ps(a.v, b.v)}; }
+  static Lane4 sqrt(Lane4 a) { return {_mm_sqrt_ps(a.v)}; }
+  static Lane4 max(Lane4 a, Lane4 b) { return {_mm_max_ps(a.v, b.v)}; }
+#else
+  float v[4];
+  static Lane4 load(const float* p) { return {{p[0], p[1], p[2], p[3]}}; }
+  static Lane4 all(float x) { return {{x, x, x, x}}; }
+  void store(float* p) const { std::memcpy(p, v, sizeof v); }
+  template <class F>
+  static Lane4 map(Lane4 a, Lane4 b, F f) { return {{f(a.v[0], b.v[0]), f(a.v[1], b.v[1]), f(a.v[2], b.v[2]), f(a.v[3], b.v[3])}}; }
+  friend Lane4 operator+(Lane4 a, Lane4 b) { return map(a, b, [](float x, float y) { return x + y; }); }
+  friend Lane4 operator-(Lane4 a, Lane4 b) { return map(a, b, [](float x, float y) { return x - y; }); }
+  friend Lane4 operator*(Lane4 a, Lane4 b) { return map(a, b, [](float x, float y) { return x * y; }); }
+  friend Lane4 operator/(Lane4 a, Lane4 b) { return map(a, b, [](float x, float y) { return x / y; }); }
+  static Lane4 sqrt(Lane4 a) { return {{std::sqrt(a.v[0]), std::sqrt(a.v[1]), std::sqrt(a.v[2]), std::sqrt(a.v[3])}}; }
+  // _mm_max_ps(a, b) returns b when either is NaN: so does this.
+  static Lane4 max(Lane4 a, Lane4 b) { return map(a, b, [](float x, float y) { return x > y ? x : y; }); }
+#endif
+  /// ((l0 + l1) + l2) + l3, the same order on both paths.
+  float sum() const {
+    float t[4];
+    store(t);
+    return ((t[0] + t[1]) + t[2]) + t[3];
+  }
+};
+static_assert(std::is_same<Real, float>::value, "Lane4 is single precision");
 
 class Pbf final : public Solver {
  public:
@@ -237,6 +282,26 @@ class Pbf final : public Solver {
     }
   }
 
+  /// d = x_i − x_j and r² of i's neighbours into dx, dy, r2, padded to a multiple of 4
+  /// with pairs outside the support (r² = 4R², d = 0: every term vanishes). Returns the padded count.
+  static std::size_t gather(const StepContext& c, std::size_t i, Real tiny2, std::vector<Real>& dx,
+                            std::vector<Real>& dy, std::vector<Real>& r2) {
+    const std::uint32_t cnt = c.nbr.count[i];
+    const std::uint32_t* nb = c.nbr.of(i);
+    const std::size_t pad = (std::size_t(cnt) + 3) / 4 * 4;
+    if (dx.size() < pad) {
+      dx.resize(pad);
+      dy.resize(pad);
+      r2.resize(pad);
+    }
+    for (std::uint32_t k = 0; k < cnt; ++k) pairOf(c, i, nb[k], tiny2, dx[k], dy[k], r2[k]);
+    for (std::size_t k = cnt; k < pad; ++k) {
+      dx[k] = dy[k] = 0;
+      r2[k] = Real(4) * c.R * c.R;
+    }
+    return pad;
+  }
+
   /// Density of x*, the constraint and the multiplier step Δλ_i (keeping λ ≤ 0); the
   /// mean compression. Caches the spiky gradient factor per pair (∇W = gK g d) and
   /// the wall part of ∇_i C_i for correct() (same positions).
@@ -251,28 +316,30 @@ class Pbf final : public Solver {
     blockErr_.resize(c.nbr.perBlock.size());
     const std::size_t first = firstBad(c.pool, P.size(), [&](std::size_t b, std::size_t e) {
       std::vector<Real>& cache = gCache_[b / kBlock];
-      const std::size_t need = c.nbr.perBlock[b / kBlock].size();
+      const std::size_t need = c.nbr.perBlock[b / kBlock].size() + 4;  // + padding of the last particle
       if (cache.size() < need) cache.resize(need);
+      std::vector<Real> dxs, dys, r2s;
       std::size_t bad = kNone;
       double err = 0;
+      const Lane4 zero = Lane4::all(0), one = Lane4::all(1), vInvR = Lane4::all(invR);
       for (std::size_t i = b; i < e; ++i) {
-        const std::uint32_t cnt = c.nbr.count[i];
-        const std::uint32_t* nb = c.nbr.of(i);
+        const std::size_t pad = gather(c, i, tiny2, dxs, dys, r2s);
+        // Particles are visited in slot order, so the padding written past i's pairs is
+        // overwritten by i + 1's.
         Real* gc = cache.data() + c.nbr.start[i];
-        // a = 1 − r/R; W = wK a³; ∇W = gK (a²/r) d.
-        Real w = 1, gx = 0, gy = 0, g2 = 0;  // self: W(0) = wK
-        for (std::uint32_t k = 0; k < cnt; ++k) {
-          Real dx, dy, q2;
-          pairOf(c, i, nb[k], tiny2, dx, dy, q2);
-          const Real r = std::sqrt(q2);
-          const Real a = std::max(Real(0), Real(1) - r * invR);
-          const Real g = a * a / r;
-          gc[k] = g;
-          w += a * a * a;
-          gx += g * dx;
-          gy += g * dy;
-          g2 += g * g * q2;
+        // a = 1 − r/R; W = wK a³; ∇W = gK (a²/r) d; four pairs at a time.
+        Lane4 sw = zero, sx = zero, sy = zero, s2 = zero;
+        for (std::size_t k = 0; k < pad; k += 4) {
+          const Lane4 q2 = Lane4::load(&r2s[k]), r = Lane4::sqrt(q2);
+          const Lane4 a = Lane4::max(one - r * vInvR, zero);
+          const Lane4 g = a * a / r;
+          g.store(gc + k);
+          sw = sw + a * a * a;
+          sx = sx + g * Lane4::load(&dxs[k]);
+          sy = sy + g * Lane4::load(&dys[k]);
+          s2 = s2 + g * g * q2;
         }
+        const Real w = Real(1) + sw.sum(), gx = sx.sum(), gy = sy.sum(), g2 = s2.sum();  // self: W(0) = wK
         Real rho = c.mass * wK * w;
         Real gix = Vg * gx, giy = Vg * gy;
         Vec2 wall = Vec2::Zero();
