@@ -12,7 +12,8 @@
 //        Δx_i = (m/ρ0) Σ_j (Δλ_i + Δλ_j + s_corr) ∇W_ij + Δλ_i Σ_b Ψ_b ∇W_ib,
 //      each particle gathering its own Δx into a second buffer (no races), then
 //      swept out of the solids. At least `iterations`, then until the mean
-//      compression mean(max(C_i, 0)) ≤ tolerance, at most max_iterations.
+//      compression mean(max(C_i, 0)) ≤ tolerance and max(C_i) ≤ tolerance_max,
+//      at most max_iterations.
 //   4. ρ of the final x* (what the World reports), v = (x* − x)/dt, and XSPH:
 //      v_i += c Σ_j (m/ρ_j)(v_j − v_i) W_ij, gathered into a copy.
 //
@@ -40,16 +41,24 @@
 // - No warm start from the previous substep's multipliers: with a few
 //   iterations it acts as an integral controller and the column rings up
 //   (measured; the same in a linear model for any warm-start fraction > 0.5).
+// - The convergence test needs the largest compression too: a deep column that
+//   the iterations have not yet reached falls freely and piles up in its bottom
+//   layers (16 % there) while the mean over all particles is still under 1 %.
+// - Time step: min(max_dt, max_move · R / v_max, limit). The compression left
+//   after N iterations grows as dt²/N², so when max_iterations end unconverged
+//   the limit drops to 0.5–0.9 of this substep; when half of them sufficed it
+//   grows back by 1.2 per substep. max_move = 2 already gains energy in the dam
+//   break (KE > released PE).
 // - A substep shorter than 1e-3 of the previous one (the World's float remainder
 //   of a frame) only advects: projecting the residual compression over it would
 //   turn into a huge velocity.
-// - Time step: min(max_dt, max_move · R / v_max).
 //
-// Parameters (solver.*): iterations, max_iterations, tolerance, relaxation,
-// chebyshev, tensile_k, tensile_n, tensile_dq, xsph, max_dt, max_move.
+// Parameters (solver.*): iterations, max_iterations, tolerance, tolerance_max,
+// relaxation, chebyshev, tensile_k, tensile_n, tensile_dq, xsph, max_dt, max_move.
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <type_traits>
 
 #if defined(__SSE2__) && !defined(SPH2D_NO_SIMD)
@@ -106,6 +115,7 @@ class Pbf final : public Solver {
       : iterations_(int(std::lround(d.param("iterations")))),
         maxIterations_(int(std::lround(d.param("max_iterations")))),
         tolerance_(Real(d.param("tolerance"))),
+        toleranceMax_(Real(d.param("tolerance_max"))),
         relaxation_(Real(d.param("relaxation"))),
         chebyshev_(Real(d.param("chebyshev"))),
         tensileK_(Real(d.param("tensile_k"))),
@@ -133,7 +143,7 @@ class Pbf final : public Solver {
 
   Real maxTimeStep(const StepContext& c, Real vmax, Real amax) const override {
     (void)amax;
-    Real dt = maxDt_;
+    Real dt = std::min(maxDt_, dtLimit_);
     if (vmax > 0) dt = std::min(dt, maxMove_ * c.R / vmax);
     return dt;
   }
@@ -171,12 +181,22 @@ class Pbf final : public Solver {
     const int maxIt = std::max(iterations_, maxIterations_);
     const Real rho2 = chebyshev_ * chebyshev_;
     Real omega = 1;
-    for (int k = 0; k < maxIt; ++k) {
+    int used = 0;
+    for (int k = 0; k < maxIt; ++k, ++used) {
       run.checked("constraint", [&] { return constraint(c, lambda); });
-      if (k >= iterations_ && meanCompression_ <= tolerance_) break;
+      if (k >= iterations_ && converged()) break;
       // Chebyshev weights (Wang 2015): ω1 = 1, ω2 = 2/(2 − ρ²), ω_{k+1} = 4/(4 − ρ²ω_k).
       omega = k == 0 ? Real(1) : k == 1 ? Real(2) / (Real(2) - rho2) : Real(4) / (Real(4) - rho2 * omega);
       run.checked("correction", [&] { return correct(c, lambda, omega); });
+    }
+    if (tolerance_ > 0) {
+      // The compression left after N iterations grows as dt²/N²: when max_iterations
+      // did not reach the tolerance, the next substeps are shorter; when half of them
+      // sufficed, the limit grows back towards max_dt.
+      if (!converged())
+        dtLimit_ = c.dt * std::min(Real(0.9), std::max(Real(0.5), Real(0.9) * std::sqrt(std::min(tolerance_ / meanCompression_, toleranceMax_ / maxCompression_))));
+      else if (2 * used <= maxIt)
+        dtLimit_ = std::min(maxDt_, dtLimit_ * Real(1.2));
     }
     run.checked("density", [&] { return finalDensity(c, c.dt); });
     run.checked("velocity", [&] { return velocity(c); });
@@ -184,6 +204,9 @@ class Pbf final : public Solver {
   }
 
  private:
+  /// The last constraint pass met both tolerances.
+  bool converged() const { return meanCompression_ <= tolerance_ && maxCompression_ <= toleranceMax_; }
+
   /// D0 = Σ_j (m/ρ0)² |∇W|² over a full square lattice (the typical constraint denominator).
   void calibrate(const StepContext& c) {
     const double R = double(c.R), dx = double(c.dx);
@@ -314,6 +337,7 @@ class Pbf final : public Solver {
     const Real tiny2 = Real(1e-12) * c.R * c.R;
     gCache_.resize(c.nbr.perBlock.size());
     blockErr_.resize(c.nbr.perBlock.size());
+    blockMax_.resize(c.nbr.perBlock.size());
     const std::size_t first = firstBad(c.pool, P.size(), [&](std::size_t b, std::size_t e) {
       std::vector<Real>& cache = gCache_[b / kBlock];
       const std::size_t need = c.nbr.perBlock[b / kBlock].size() + 4;  // + padding of the last particle
@@ -321,6 +345,7 @@ class Pbf final : public Solver {
       std::vector<Real> dxs, dys, r2s;
       std::size_t bad = kNone;
       double err = 0;
+      Real worst = 0;
       const Lane4 zero = Lane4::all(0), one = Lane4::all(1), vInvR = Lane4::all(invR);
       for (std::size_t i = b; i < e; ++i) {
         const std::size_t pad = gather(c, i, tiny2, dxs, dys, r2s);
@@ -373,14 +398,21 @@ class Pbf final : public Solver {
         dLambda_[i] = lNew - lOld;
         P.rho[i] = rho;
         err += double(std::max(Real(0), C));
+        worst = std::max(worst, C);
         if (bad == kNone && !std::isfinite(lNew)) bad = i;
       }
       blockErr_[b / kBlock] = err;
+      blockMax_[b / kBlock] = worst;
       return bad;
     });
     double sum = 0;
-    for (double v : blockErr_) sum += v;  // in block order: the same for any thread count
+    Real mx = 0;
+    for (std::size_t k = 0; k < blockErr_.size(); ++k) {  // in block order: the same for any thread count
+      sum += blockErr_[k];
+      mx = std::max(mx, blockMax_[k]);
+    }
     meanCompression_ = Real(sum / double(P.size()));
+    maxCompression_ = mx;
     return first;
   }
 
@@ -539,14 +571,17 @@ class Pbf final : public Solver {
   }
 
   int iterations_, maxIterations_;
-  Real tolerance_, relaxation_, chebyshev_, tensileK_;
+  Real tolerance_, toleranceMax_, relaxation_, chebyshev_, tensileK_;
   int tensileN_;
   Real tensileDq_, xsph_, maxDt_, maxMove_;
+
   Real d0_ = 0, eps_ = 0, invWdq_ = 0, sCorrScale_ = 0;
-  Real dtPrev_ = 0, meanCompression_ = 0;
+  Real dtPrev_ = 0, meanCompression_ = 0, maxCompression_ = 0;
+  Real dtLimit_ = std::numeric_limits<Real>::infinity();  ///< shortened while the iterations do not converge
   std::vector<Real> dLambda_, lOld_;
   std::vector<Vec2> wallGrad_;             ///< the boundary part of ∇_i C_i
   std::vector<double> blockErr_;           ///< compression per block (fixed-order sum)
+  std::vector<Real> blockMax_;             ///< largest compression per block
   std::vector<std::vector<Real>> gCache_;  ///< per pair, laid out like NeighbourLists
   std::vector<std::vector<std::uint32_t>> bBlock_;
   std::vector<std::uint32_t> bStart_, bCount_;

@@ -32,6 +32,7 @@ const std::vector<Entry>& entries() {
        {{"iterations", 4, 1, 1000, "Jacobi iterations of the density constraint per substep, at least (integer)"},
         {"max_iterations", 100, 1, 1000, "iterations per substep, at most (integer)"},
         {"tolerance", 0.01, 0, 1, "after `iterations`, stop once the mean compression mean(max(ρ/ρ0 − 1, 0)) ≤ this (0: exactly `iterations`)"},
+        {"tolerance_max", 0.05, 0, 10, "… and the largest compression max(ρ/ρ0 − 1) ≤ this"},
         {"relaxation", 0.5, 0, 100, "ε of the constraint denominator, in units of D0 (the denominator on a full rest lattice)"},
         {"chebyshev", 0.9, 0, 0.99, "Chebyshev acceleration of the Jacobi iterations: spectral radius estimate ρ (0: plain Jacobi)"},
         {"tensile_k", 0, 0, 1, "s_corr strength k, in multipliers of a unit density error per iteration (0: off)"},
