@@ -46,9 +46,9 @@
 //   layers (16 % there) while the mean over all particles is still under 1 %.
 // - Time step: min(max_dt, max_move · R / v_max, limit). The compression left
 //   after N iterations grows as dt²/N², so when max_iterations end unconverged
-//   the limit drops to 0.5–0.9 of this substep; when half of them sufficed it
-//   grows back by 1.2 per substep. max_move = 2 already gains energy in the dam
-//   break (KE > released PE).
+//   the limit drops to 0.5–0.9 of this substep (not below max_dt/32); when half
+//   of them sufficed it grows back by 1.2 per substep. max_move = 2 already gains
+//   energy in the dam break (KE > released PE).
 // - A substep shorter than 1e-3 of the previous one (the World's float remainder
 //   of a frame) only advects: projecting the residual compression over it would
 //   turn into a huge velocity.
@@ -91,7 +91,9 @@ struct Lane4 {
   static Lane4 all(float x) { return {{x, x, x, x}}; }
   void store(float* p) const { std::memcpy(p, v, sizeof v); }
   template <class F>
-  static Lane4 map(Lane4 a, Lane4 b, F f) { return {{f(a.v[0], b.v[0]), f(a.v[1], b.v[1]), f(a.v[2], b.v[2]), f(a.v[3], b.v[3])}}; }
+  static Lane4 map(Lane4 a, Lane4 b, F f) {
+    return {{f(a.v[0], b.v[0]), f(a.v[1], b.v[1]), f(a.v[2], b.v[2]), f(a.v[3], b.v[3])}};
+  }
   friend Lane4 operator+(Lane4 a, Lane4 b) { return map(a, b, [](float x, float y) { return x + y; }); }
   friend Lane4 operator-(Lane4 a, Lane4 b) { return map(a, b, [](float x, float y) { return x - y; }); }
   friend Lane4 operator*(Lane4 a, Lane4 b) { return map(a, b, [](float x, float y) { return x * y; }); }
@@ -193,10 +195,13 @@ class Pbf final : public Solver {
       // The compression left after N iterations grows as dt²/N²: when max_iterations
       // did not reach the tolerance, the next substeps are shorter; when half of them
       // sufficed, the limit grows back towards max_dt.
-      if (!converged())
-        dtLimit_ = c.dt * std::min(Real(0.9), std::max(Real(0.5), Real(0.9) * std::sqrt(std::min(tolerance_ / meanCompression_, toleranceMax_ / maxCompression_))));
-      else if (2 * used <= maxIt)
+      if (!converged()) {
+        const Real ratio = std::min(tolerance_ / meanCompression_, toleranceMax_ / maxCompression_);
+        dtLimit_ = c.dt * std::min(Real(0.9), std::max(Real(0.5), Real(0.9) * std::sqrt(ratio)));
+        dtLimit_ = std::max(dtLimit_, maxDt_ / Real(32));  // a jam it cannot resolve must not stall the run
+      } else if (2 * used <= maxIt) {
         dtLimit_ = std::min(maxDt_, dtLimit_ * Real(1.2));
+      }
     }
     run.checked("density", [&] { return finalDensity(c, c.dt); });
     run.checked("velocity", [&] { return velocity(c); });
