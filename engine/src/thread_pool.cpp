@@ -51,7 +51,7 @@ void ThreadPool::workerLoop() {
     while (epoch_.load(std::memory_order_acquire) == seen) {
       SPH2D_PAUSE();
       if (++spins % 256 == 0 &&
-          std::chrono::steady_clock::now() - start > std::chrono::microseconds(300)) {
+          std::chrono::steady_clock::now() - start > std::chrono::microseconds(100)) {
         std::unique_lock<std::mutex> lock(mutex_);
         wake_.wait(lock, [&] { return epoch_.load(std::memory_order_acquire) != seen; });
         break;

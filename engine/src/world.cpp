@@ -391,7 +391,8 @@ struct World::Impl final : StageRunner {
     double remaining = frameDt;
     int n = 0;
     const int cap = scene.solver.maxSubsteps;
-    while (remaining > 1e-9 * frameDt) {
+    // A leftover below a millionth of the frame (float rounding of dt) is not a substep.
+    while (remaining > 1e-6 * frameDt) {
       if (n == cap) {
         std::ostringstream o;
         o << "frame " << frames << ": substep cap solver.max_substeps = " << cap << " reached; simulated "
@@ -474,6 +475,21 @@ void World::init() {
   w.rebuildBoundary();
   // Fluid blocks on a square lattice; particles inside solids are dropped.
   for (const FluidBlockDef& b : scene.blocks) w.fillBlock(b, true);
+  // An effect whose explicit step limit is below the smallest substep the
+  // solver can take cannot be followed: refuse the scene, naming the limit.
+  {
+    const StepContext lc = w.context(0);
+    const double minDt = w.solver->minTimeStep(lc);
+    for (const auto& e : w.effects) {
+      const double lim = double(e->maxTimeStep(lc));
+      if (lim < minDt) {
+        std::ostringstream o;
+        o << "the " << e->name() << " effect needs substeps of at most " << lim << " s, but the " << w.solver->name()
+          << " solver cannot go below " << minDt << " s; lower " << e->limitKey() << " or use wcsph or muller2003";
+        throw SceneError(scene.path.empty() ? "scene" : scene.path, 0, 0, e->limitKey(), o.str());
+      }
+    }
+  }
   // First density/pressure so that the initial state is complete for readers.
   StepContext c = w.context(0);
   w.solver->prepare(c);

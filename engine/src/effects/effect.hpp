@@ -22,6 +22,8 @@ class Effect {
   virtual const char* name() const = 0;
   /// Adds this effect's acceleration to P.a. Returns the first bad slot or kNone.
   virtual std::size_t apply(StepContext& c) = 0;
+  /// The scene key whose value sets this effect's time-step limit (for error messages).
+  virtual const char* limitKey() const { return name(); }
   /// False while an input event has switched the effect off (it then runs no stage).
   bool enabled = true;
   /// Largest stable time step this effect allows.

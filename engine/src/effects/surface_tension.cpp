@@ -25,6 +25,7 @@ class SurfaceTension final : public Effect {
  public:
   explicit SurfaceTension(const SurfaceTensionDef& d) : def_(d) {}
   const char* name() const override { return "surface_tension"; }
+  const char* limitKey() const override { return "effects.surface_tension.sigma"; }
 
   Real maxTimeStep(const StepContext& c) const override {
     if (def_.model != "csf" || !(def_.sigma > 0)) return std::numeric_limits<Real>::infinity();

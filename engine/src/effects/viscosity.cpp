@@ -14,6 +14,7 @@ class LaplacianViscosity final : public Effect {
  public:
   explicit LaplacianViscosity(double nu) : nu_(Real(nu)) {}
   const char* name() const override { return "viscosity"; }
+  const char* limitKey() const override { return "solver.viscosity"; }
 
   Real maxTimeStep(const StepContext& c) const override { return Real(0.03) * c.R * c.R / nu_; }
 

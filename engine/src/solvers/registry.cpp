@@ -9,6 +9,7 @@ namespace sph2d {
 
 std::unique_ptr<Solver> makeMuller2003(const SolverDef& def);
 std::unique_ptr<Solver> makeWcsph(const SolverDef& def);
+std::unique_ptr<Solver> makePbf(const SolverDef& def);
 
 namespace {
 
@@ -26,6 +27,20 @@ const std::vector<Entry>& entries() {
        {{"gamma", 7, 1, 10, "Tait exponent γ in p = B((ρ/ρ0)^γ − 1), B = ρ0c²/γ"},
         {"alpha", 0.05, 0, 2, "Monaghan artificial viscosity α (Π = −α c h μ/ρ̄ for approaching pairs)"},
         {"expected_speed", 0, 0, 1e4, "when > 0, the sound speed is 10 × this (m/s) instead of sound_speed"}}},
+      {"pbf",
+       &makePbf,
+       {{"iterations", 4, 1, 1000, "Jacobi iterations of the density constraint per substep, at least (integer)"},
+        {"max_iterations", 100, 1, 1000, "iterations per substep, at most (integer); unconverged: shorter substeps"},
+        {"tolerance", 0.01, 0, 1, "stop once mean(max(ρ/ρ0 − 1, 0)) ≤ this … (0: exactly `iterations`)"},
+        {"tolerance_max", 0.05, 0.001, 10, "… and the largest compression max(ρ/ρ0 − 1) ≤ this"},
+        {"relaxation", 0.5, 0, 100, "ε of the constraint denominator, in units of its value on a full rest lattice"},
+        {"chebyshev", 0.9, 0, 0.99, "Chebyshev acceleration: spectral radius estimate ρ (0: plain Jacobi)"},
+        {"tensile_k", 0, 0, 1, "s_corr strength k, in multipliers of a unit density error (0: off)"},
+        {"tensile_n", 4, 1, 8, "s_corr exponent n (integer)"},
+        {"tensile_dq", 0.2, 0.01, 0.9, "s_corr reference distance Δq, in units of the support R"},
+        {"xsph", 0.01, 0, 1, "XSPH velocity smoothing c"},
+        {"max_dt", 1.0 / 60.0, 1e-5, 0.1, "largest substep (s)"},
+        {"max_move", 1, 0.05, 10, "dt ≤ max_move · R / v_max: largest move per substep, in support radii"}}},
   };
   return e;
 }

@@ -28,6 +28,13 @@ class Solver {
   virtual double densityKernel(double r, double R) const = 0;
   /// Density and pressure of the current positions (for a complete initial state).
   virtual void prepare(StepContext& c) = 0;
+  /// Smallest substep the scheme can take [s] (0: any). A position-based solver
+  /// turns its corrections into velocities by dividing by dt, so it cannot follow
+  /// an effect's explicit limit below this; the World then refuses the scene.
+  virtual double minTimeStep(const StepContext& c) const {
+    (void)c;
+    return 0;
+  }
   /// Largest stable substep for the current state, given the largest speed and acceleration.
   virtual Real maxTimeStep(const StepContext& c, Real vmax, Real amax) const = 0;
   /// One substep (grid → … → integrate).
