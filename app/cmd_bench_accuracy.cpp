@@ -41,7 +41,7 @@ const char* kHelp =
     "and two CFL numbers, and writes DIR/accuracy.csv, DIR/accuracy.md and\n"
     "DIR/<case>.png (default DIR: out/accuracy). --quick runs one small resolution and one\n"
     "CFL number per solver (a smoke test of a minute or two). --assets: the assets folder\n"
-    "(default: ./assets).\n";
+    "(default: ./assets). --levels K runs only the K coarsest resolutions (1..3).\n";
 
 struct Run {
   std::string caseName, solver;
@@ -254,7 +254,7 @@ void chart(const std::vector<Run>& runs, const std::string& caseName, const std:
 int cmdBenchAccuracy(const std::vector<std::string>& args) {
   std::string out = "out/accuracy", assets = "assets";
   bool quick = false;
-  int threads = 0;
+  int threads = 0, levels = 3;
   std::vector<std::string> solvers;
   for (std::size_t i = 0; i < args.size(); ++i) {
     const std::string& a = args[i];
@@ -269,6 +269,7 @@ int cmdBenchAccuracy(const std::vector<std::string>& args) {
     else if (a == "--assets") assets = value();
     else if (a == "--quick") quick = true;
     else if (a == "--threads") threads = parseInt(a, value(), 1, 256);
+    else if (a == "--levels") levels = parseInt(a, value(), 1, 3);
     else if (a == "--solvers") {
       std::stringstream ss(value());
       std::string item;
@@ -295,8 +296,12 @@ int cmdBenchAccuracy(const std::vector<std::string>& args) {
   fs::create_directories(out, ec);
   if (ec) throw UsageError("cannot create " + out + ": " + ec.message());
 
-  const std::vector<double> damSpacings = quick ? std::vector<double>{0.04} : std::vector<double>{0.02, 0.01, 0.005};
-  const std::vector<double> hydroSpacings = quick ? std::vector<double>{0.05} : std::vector<double>{0.05, 0.025, 0.0125};
+  std::vector<double> damSpacings = quick ? std::vector<double>{0.04} : std::vector<double>{0.02, 0.01, 0.005};
+  std::vector<double> hydroSpacings = quick ? std::vector<double>{0.05} : std::vector<double>{0.05, 0.025, 0.0125};
+  if (!quick) {
+    damSpacings.resize(std::size_t(levels));
+    hydroSpacings.resize(std::size_t(levels));
+  }
   const std::vector<double> cflScales = quick ? std::vector<double>{1.0} : std::vector<double>{1.0, 2.0};
   std::vector<Run> runs;
   std::printf("%-12s %-11s %9s %6s %-26s %10s %10s %10s %12s %10s\n", "case", "solver", "particles", "cfl", "error_name",
