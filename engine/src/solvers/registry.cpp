@@ -9,6 +9,7 @@ namespace sph2d {
 
 std::unique_ptr<Solver> makeMuller2003(const SolverDef& def);
 std::unique_ptr<Solver> makeWcsph(const SolverDef& def);
+std::unique_ptr<Solver> makeDfsph(const SolverDef& def);
 
 namespace {
 
@@ -26,6 +27,15 @@ const std::vector<Entry>& entries() {
        {{"gamma", 7, 1, 10, "Tait exponent γ in p = B((ρ/ρ0)^γ − 1), B = ρ0c²/γ"},
         {"alpha", 0.05, 0, 2, "Monaghan artificial viscosity α (Π = −α c h μ/ρ̄ for approaching pairs)"},
         {"expected_speed", 0, 0, 1e4, "when > 0, the sound speed is 10 × this (m/s) instead of sound_speed"}}},
+      {"dfsph",
+       &makeDfsph,
+       {{"tolerance", 0.001, 1e-6, 0.1, "largest mean predicted compression max(ρ* − ρ0, 0)/ρ0 the pressure solve accepts"},
+        {"divergence_tolerance", 0.01, 1e-6, 100,
+         "largest mean max(Dρ/Dt, 0)/ρ0 (per second) the divergence-free solve accepts"},
+        {"max_iterations", 100, 1, 10000, "iterations per solve at most (each solve separately)"},
+        {"min_iterations", 2, 0, 10000, "iterations per solve at least"},
+        {"relaxation", 0.6, 0.05, 1, "Jacobi relaxation ω of both solves (κ increments are ω times the diagonal estimate)"},
+        {"divergence_solve", 1, 0, 1, "1: run the divergence-free solve each substep; 0: constant-density solve only"}}},
   };
   return e;
 }
