@@ -107,14 +107,23 @@ TEST_CASE("dfsph: a resting tank settles incompressible and calm") {
   const SceneDef s = dfsphScene("tests/resting_column.json");
   World w(s, WorldOptions{1});  // thread counts are the hash test's business
   const double H = 0.6, g = 9.81;
-  for (int f = 0; f < 120; ++f) w.stepFrame();  // 2 s
+  double vSum = 0, vMax = 0, errMax = 0;
+  for (int f = 0; f < 120; ++f) {  // 2 s; the second second is measured
+    w.stepFrame();
+    if (f < 60) continue;
+    const double v = meanSpeed(w.particles());
+    vSum += v;
+    vMax = std::max(vMax, v);
+    errMax = std::max(errMax, w.densityStats().meanError);
+  }
   REQUIRE(test::allFiniteState(w));
   const DensityStats d = w.densityStats();
-  const double v = meanSpeed(w.particles());
-  MESSAGE("mean compression " << d.meanError << ", max " << d.maxError << ", mean density " << d.meanDensity
-                              << "; mean speed " << v << " m/s (sqrt(gH) = " << std::sqrt(g * H) << ")");
-  CHECK(d.meanError <= 0.002);
-  CHECK(v < 0.02);  // measured 0.005–0.01 m/s between 1 and 2 s
+  MESSAGE("at 2 s: mean compression " << d.meanError << ", max " << d.maxError << ", mean density " << d.meanDensity);
+  MESSAGE("1–2 s: mean compression ≤ " << errMax << "; mean speed " << vSum / 60 << " m/s on average, ≤ " << vMax
+                                       << " (sqrt(gH) = " << std::sqrt(g * H) << " m/s)");
+  CHECK(errMax <= 0.002);
+  CHECK(vSum / 60 < 0.03);  // measured 0.011 m/s (plain Jacobi, chebyshev_rho = 0: 0.007)
+  CHECK(vMax < 0.06);       // measured 0.022 m/s
   CHECK(outside(w, 0, 0, 0.6, 1.3) == 0);
 }
 

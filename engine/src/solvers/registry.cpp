@@ -29,12 +29,15 @@ const std::vector<Entry>& entries() {
         {"expected_speed", 0, 0, 1e4, "when > 0, the sound speed is 10 × this (m/s) instead of sound_speed"}}},
       {"dfsph",
        &makeDfsph,
-       {{"tolerance", 0.001, 1e-6, 0.1, "largest mean predicted compression max(ρ* − ρ0, 0)/ρ0 the pressure solve accepts"},
+       {{"tolerance", 0.001, 1e-6, 0.1,
+         "largest mean predicted density error |ρ* − ρ0|/ρ0 the pressure solve accepts (compression only where κ = 0)"},
         {"divergence_tolerance", 0.01, 1e-6, 100,
-         "largest mean max(Dρ/Dt, 0)/ρ0 (per second) the divergence-free solve accepts"},
+         "largest mean |Dρ/Dt|/ρ0 per second the divergence-free solve accepts (compression only where κ_v = 0)"},
         {"max_iterations", 100, 1, 10000, "iterations per solve at most (each solve separately)"},
         {"min_iterations", 2, 0, 10000, "iterations per solve at least"},
         {"relaxation", 0.6, 0.05, 1, "Jacobi relaxation ω of both solves (κ increments are ω times the diagonal estimate)"},
+        {"chebyshev_rho", 0.98, 0, 0.999,
+         "Chebyshev acceleration of both solves (Wang 2015) with this spectral radius estimate; 0: plain relaxed Jacobi"},
         {"divergence_solve", 1, 0, 1, "1: run the divergence-free solve each substep; 0: constant-density solve only"}}},
   };
   return e;
