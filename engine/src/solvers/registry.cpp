@@ -38,6 +38,7 @@ const std::vector<Entry>& entries() {
         {"relaxation", 0.6, 0.05, 1, "Jacobi relaxation ω of both solves (κ increments are ω times the diagonal estimate)"},
         {"chebyshev_rho", 0.98, 0, 0.999,
          "Chebyshev acceleration of both solves (Wang 2015) with this spectral radius estimate; 0: plain relaxed Jacobi"},
+        {"velocity_cfl", 0.4, 0.01, 1, "dt ≤ velocity_cfl·R/v_max (dfsph does not read solver.cfl, the CFL number on c + v_max)"},
         {"divergence_solve", 1, 0, 1, "1: run the divergence-free solve each substep; 0: constant-density solve only"}}},
   };
   return e;
