@@ -59,19 +59,18 @@
 // block order: the same bits for any thread count.
 //
 // Time step: dt ≤ velocity_cfl·R/v_max (velocity only; solver.cfl, the other
-// solvers' CFL number on c + v_max, is not read) and dt ≤ 0.1·sqrt(R/a) with
-// a = max(a_max, |g|), a the non-pressure acceleration (gravity + effects).
-// velocity_cfl defaults to 0.4: on the dam break (10k particles) it takes
-// 11 substeps a frame instead of 15 at 0.25, for 25 % less work, and the
-// mean density error stays below 0.02 %.
-// The second limit sets the step of a fluid at rest: at 0.25·sqrt(R/g) (the
-// other solvers' force limit) the first, cold-started steps of the resting
-// column did not converge within 100 iterations and at ν ≤ 0.001 m²/s the
-// column blew up; at 0.1·sqrt(R/g) it rests at ν = 0. A substep shorter than
-// 1 % of the solver's own limit (the World's float rounding remainder of a
-// frame, ~1e-10 s) runs without the solves: the density solve would correct
-// the existing compression at a speed ∝ 1/dt and leave κ ∝ 1/dt for the next
-// warm start (it blew up the resting column).
+// solvers' CFL number on c + v_max, is not read), the other solvers' force
+// limit 0.25·sqrt(R/a_max) with a the non-pressure acceleration (gravity +
+// effects), and dt ≤ 0.1·sqrt(R/|g|), which sets the step of a fluid at rest:
+// at 0.25·sqrt(R/g) the first, cold-started steps of the resting column did
+// not converge within 100 iterations and at ν ≤ 0.001 m²/s it blew up; at
+// 0.1·sqrt(R/g) it rests at ν = 0. velocity_cfl defaults to 0.4: on the dam
+// break (10k particles) that is 10 substeps a frame instead of 15 at 0.25,
+// and the mean density error stays below 0.02 %.
+// A substep shorter than 1 % of the solver's own limit (the World's float
+// rounding remainder of a frame, ~1e-10 s) runs without the solves: the
+// density solve would correct the existing compression at a speed ∝ 1/dt
+// and leave κ ∝ 1/dt for the next warm start (it blew up the resting column).
 //
 // Parameters (solver.*): tolerance, divergence_tolerance, max_iterations,
 // min_iterations, relaxation, chebyshev_rho, velocity_cfl, divergence_solve. stats()
@@ -111,8 +110,9 @@ class Dfsph final : public Solver {
 
   Real maxTimeStep(const StepContext& c, Real vmax, Real amax) const override {
     Real dt = cfl_ * c.R / std::max(vmax, Real(1e-6) * c.R);
-    const Real a = std::max(amax, c.gravity.norm());
-    if (a > 0) dt = std::min(dt, Real(0.1) * std::sqrt(c.R / a));
+    const Real g = c.gravity.norm();
+    if (g > 0) dt = std::min(dt, Real(0.1) * std::sqrt(c.R / g));
+    if (amax > 0) dt = std::min(dt, Real(0.25) * std::sqrt(c.R / amax));
     lastLimit_ = dt;
     return dt;
   }
