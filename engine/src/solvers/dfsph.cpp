@@ -85,6 +85,7 @@ namespace {
 
 class Dfsph final : public Solver {
  public:
+  /// Reads the solver.* keys listed above (the registry fills their defaults).
   explicit Dfsph(const SolverDef& d)
       : tol_(d.param("tolerance")),
         divTol_(d.param("divergence_tolerance")),
@@ -95,11 +96,14 @@ class Dfsph final : public Solver {
         cheb_(Real(d.param("chebyshev_rho"))),
         cfl_(Real(d.param("velocity_cfl"))) {}
 
+  /// "dfsph".
   const char* name() const override { return "dfsph"; }
-  // Incompressible: a column at rest has ρ0 at every depth.
+  /// 0: incompressible, a column at rest has ρ0 at every depth.
   double hydrostaticFactor() const override { return 0; }
+  /// Wendland C2.
   double densityKernel(double r, double R) const override { return WendlandC2<double>(R).value(r); }
 
+  /// Creates the κ fields; density, α and gradients of the initial positions.
   void prepare(StepContext& c) override {
     c.P.field("dfsph.kappa");
     c.P.field("dfsph.kappa_v");
@@ -108,6 +112,7 @@ class Dfsph final : public Solver {
     densityAndFactor(c, WendlandC2<Real>(c.R));
   }
 
+  /// velocity_cfl·R/v_max, 0.1·sqrt(R/|g|) and 0.25·sqrt(R/a_max), whichever is least.
   Real maxTimeStep(const StepContext& c, Real vmax, Real amax) const override {
     Real dt = cfl_ * c.R / std::max(vmax, Real(1e-6) * c.R);
     const Real g = c.gravity.norm();
@@ -117,6 +122,7 @@ class Dfsph final : public Solver {
     return dt;
   }
 
+  /// grid → neighbours → density → divergence solve → gravity, effects → pressure solve → x += dt v.
   void substep(StepContext& c, StageRunner& run, const EffectList& effects) override {
     const WendlandC2<Real> W(c.R);
     const int every = c.def.reorderInterval;
@@ -148,6 +154,7 @@ class Dfsph final : public Solver {
     run.checked("integrate", [&] { return integrate(c); });
   }
 
+  /// Iterations and residuals of the last substep that ran the solves.
   SolverStats stats() const override { return stats_; }
 
  private:
@@ -432,6 +439,7 @@ class Dfsph final : public Solver {
 
 }  // namespace
 
+/// The dfsph solver for a scene's solver definition (registry.cpp).
 std::unique_ptr<Solver> makeDfsph(const SolverDef& def) { return std::make_unique<Dfsph>(def); }
 
 }  // namespace sph2d
