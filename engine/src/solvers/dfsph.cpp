@@ -158,7 +158,7 @@ class Dfsph final : public Solver {
   SolverStats stats() const override { return stats_; }
 
  private:
-  /// ρ, 1/ρ, α, the per-neighbour m∇W_ij and the per-particle wall gradient Σ_b ρ0Ψ_b∇W_ib.
+  /// ρ, 1/ρ, α, the per-neighbour (slot, m∇W_ij) and per particle Σ_j m∇W_ij + Σ_b ρ0Ψ_b∇W_ib.
   std::size_t densityAndFactor(StepContext& c, const WendlandC2<Real>& W) {
     Particles& P = c.P;
     const std::size_t n = P.size();
@@ -246,7 +246,7 @@ class Dfsph final : public Solver {
     std::vector<Real>& kappa = *P.find(divergence ? "dfsph.kappa_v" : "dfsph.kappa");
     const Real dt = c.dt;
     const double limit =
-        divergence ? divTol_ * double(c.rho0) : tol_ * double(c.rho0);  // on the mean of max(source, 0)
+        divergence ? divTol_ * double(c.rho0) : tol_ * double(c.rho0);  // on the mean residual
     double err = 0;
     run.run(divergence ? "divergence_solve" : "pressure_solve", [&] {
       // Stored κ_v is κ_v·dt of the previous substep (an impulse); κ is p/ρ.
@@ -311,7 +311,7 @@ class Dfsph final : public Solver {
   }
 
   /// Pass A: the source of every particle, its κ increment (dk_, and dk_/ρ in q_)
-  /// and the sum of max(ρ* − ρ0, 0) (or max(Dρ/Dt, 0)) in block order.
+  /// and the sum of the complementarity residuals, combined in block order.
   double sourcePass(StepContext& c, const std::vector<Real>& kappa, bool divergence) {
     Particles& P = c.P;
     const NeighbourLists& L = c.nbr;
@@ -355,7 +355,8 @@ class Dfsph final : public Solver {
         [](double a, double b) { return a + b; });
   }
 
-  /// Pass B: v_i −= dt [Σ_j (q_i + q_j) m∇W_ij + q_i Σ_b ρ0Ψ_b∇W_ib]; κ_i += dk_i.
+  /// Pass B: v_i −= dt [Σ_j (q_i + q_j) m∇W_ij + q_i Σ_b ρ0Ψ_b∇W_ib]; κ_i += dk_i
+  /// (w ≠ 1: the Chebyshev step from the previous iterate).
   void correctPass(StepContext& c, std::vector<Real>& kappa, Real w = 1) {
     Particles& P = c.P;
     const NeighbourLists& L = c.nbr;
