@@ -84,7 +84,12 @@ void ThreadPool::parallelFor(std::size_t n, std::size_t block,
   }
   wake_.notify_all();
   runBlocks();
-  while (busy_.load(std::memory_order_acquire) != 0) SPH2D_PAUSE();
+  // Wait for the workers: spin briefly, then yield the core (on a busy machine
+  // the worker may be descheduled, and spinning would only delay it).
+  for (unsigned spins = 0; busy_.load(std::memory_order_acquire) != 0; ++spins) {
+    if (spins < 2048) SPH2D_PAUSE();
+    else std::this_thread::yield();
+  }
   fn_ = nullptr;
   if (error_) {
     std::exception_ptr e = error_;

@@ -10,6 +10,7 @@ namespace sph2d {
 std::unique_ptr<Solver> makeMuller2003(const SolverDef& def);
 std::unique_ptr<Solver> makeWcsph(const SolverDef& def);
 std::unique_ptr<Solver> makePbf(const SolverDef& def);
+std::unique_ptr<Solver> makeDfsph(const SolverDef& def);
 
 namespace {
 
@@ -41,6 +42,19 @@ const std::vector<Entry>& entries() {
         {"xsph", 0.01, 0, 1, "XSPH velocity smoothing c"},
         {"max_dt", 1.0 / 60.0, 1e-5, 0.1, "largest substep (s)"},
         {"max_move", 1, 0.05, 10, "dt ≤ max_move · R / v_max: largest move per substep, in support radii"}}},
+      {"dfsph",
+       &makeDfsph,
+       {{"tolerance", 0.001, 1e-6, 0.1,
+         "largest mean predicted density error |ρ* − ρ0|/ρ0 the pressure solve accepts (compression only where κ = 0)"},
+        {"divergence_tolerance", 0.01, 1e-6, 100,
+         "largest mean |Dρ/Dt|/ρ0 per second the divergence-free solve accepts (compression only where κ_v = 0)"},
+        {"max_iterations", 100, 1, 10000, "iterations per solve at most (each solve separately)"},
+        {"min_iterations", 2, 0, 10000, "iterations per solve at least"},
+        {"relaxation", 0.6, 0.05, 1, "Jacobi relaxation ω of both solves (κ increments are ω times the diagonal estimate)"},
+        {"chebyshev_rho", 0.98, 0, 0.999,
+         "Chebyshev acceleration of both solves (Wang 2015) with this spectral radius estimate; 0: plain relaxed Jacobi"},
+        {"velocity_cfl", 0.4, 0.01, 1, "dt ≤ velocity_cfl·R/v_max (dfsph does not read solver.cfl, the CFL number on c + v_max)"},
+        {"divergence_solve", 1, 0, 1, "1: run the divergence-free solve each substep; 0: constant-density solve only"}}},
   };
   return e;
 }

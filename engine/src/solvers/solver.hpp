@@ -14,6 +14,14 @@
 
 namespace sph2d {
 
+/// What an iterative solver did in its last substep (all zero for explicit solvers).
+struct SolverStats {
+  int pressureIterations = 0;     ///< constant-density (pressure) solve iterations
+  int divergenceIterations = 0;   ///< divergence-free solve iterations (0 when disabled)
+  double densityError = 0;        ///< mean predicted density error /ρ0 after the pressure solve (solver-defined residual)
+  double divergenceError = 0;     ///< mean |Dρ/Dt|/ρ0 [1/s] after the divergence solve (solver-defined residual)
+};
+
 class Solver {
  public:
   virtual ~Solver() = default;
@@ -39,6 +47,8 @@ class Solver {
   virtual Real maxTimeStep(const StepContext& c, Real vmax, Real amax) const = 0;
   /// One substep (grid → … → integrate).
   virtual void substep(StepContext& c, StageRunner& run, const EffectList& effects) = 0;
+  /// Iterations and residuals of the last substep (explicit solvers: all zero).
+  virtual SolverStats stats() const { return {}; }
 };
 
 /// One solver-specific scene key (under "solver").

@@ -1,0 +1,211 @@
+// The dfsph solver (Bender & Koschier 2015/2017): a resting tank settles, the
+// implicit solves reach their tolerances within the iteration cap, the dam
+// break stays sane, and the state is bit-identical for 1, 2 and 3 threads.
+#include <doctest/doctest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+#include "solvers/solver.hpp"
+#include "sph2d/world.hpp"
+#include "test_util.hpp"
+
+using namespace sph2d;
+
+namespace {
+
+/// A test scene with the solver switched to dfsph (its parameters at their defaults).
+SceneDef dfsphScene(const std::string& rel) {
+  SceneDef s = test::scene(rel);
+  s.solver.type = "dfsph";
+  s.solver.params.clear();
+  for (const SolverParam& p : solverParams("dfsph")) s.solver.params[p.key] = p.def;
+  return s;
+}
+
+/// Particles outside the rectangle [x0, x1] × [y0, y1] (world frame).
+std::size_t outside(const World& w, double x0, double y0, double x1, double y1) {
+  std::size_t n = 0;
+  for (std::size_t i = 0; i < w.particleCount(); ++i) {
+    const Vec2d p = w.worldPosition(i);
+    if (!(p.x() >= x0 && p.x() <= x1 && p.y() >= y0 && p.y() <= y1)) ++n;
+  }
+  return n;
+}
+
+double meanSpeed(const Particles& P) {
+  double s = 0;
+  for (std::size_t i = 0; i < P.size(); ++i) s += double(P.v[i].norm());
+  return P.size() ? s / double(P.size()) : 0;
+}
+
+/// The World's substep loop around the scene's solver, so that a test can read
+/// Solver::stats() (World does not expose its solver). The particles, mass,
+/// support and boundary samples come from a World built from the same scene.
+struct SolverHarness final : StageRunner {
+  SceneDef scene;
+  ThreadPool pool;
+  Particles P;
+  Grid grid;
+  NeighbourLists nbr;
+  BoundarySet boundary;
+  Scratch scratch;
+  std::unique_ptr<Solver> solver;
+  EffectList effects;
+  Real R = 0, dx = 0, mass = 0, lastAccel = 0;
+  std::uint64_t steps = 0;
+
+  SolverHarness(const SceneDef& s, int threads) : scene(s), pool(threads) {
+    World w(s, WorldOptions{1});
+    scene = w.scene();
+    P = w.particles();
+    R = w.support();
+    dx = w.spacing();
+    mass = w.particleMass();
+    boundary.collect(w.box2d(), w.origin());
+    boundary.sample(dx, R, pool);
+    boundary.buildBins(Real(4) * R);
+    solver = makeSolver(scene.solver);
+    effects = makeEffects(scene);
+    StepContext c = context(0);
+    solver->prepare(c);
+  }
+  StepContext context(Real dt) {
+    StepContext c{P, grid, nbr, boundary, pool, scratch, scene.solver};
+    c.R = R;
+    c.dx = dx;
+    c.dt = dt;
+    c.mass = mass;
+    c.rho0 = Real(scene.solver.restDensity);
+    c.gravity = Vec2(Real(scene.gravity.x()), Real(scene.gravity.y()));
+    c.clearance = Real(0.25) * dx;
+    c.maxSpeed = Real(scene.solver.maxSpeed);
+    c.step = steps;
+    return c;
+  }
+  void run(const char*, const std::function<void()>& f) override { f(); }
+  void checked(const char* name, const std::function<std::size_t()>& f) override {
+    if (f() != kNone) throw std::runtime_error(std::string("bad value after ") + name);
+  }
+  /// One substep of the largest stable length (as World::substep()).
+  void substep() {
+    const StepContext c0 = context(0);
+    Real dt = solver->maxTimeStep(c0, maxSpeedOf(P, pool), lastAccel);
+    for (const auto& e : effects) dt = std::min(dt, e->maxTimeStep(c0));
+    StepContext c = context(dt);
+    solver->substep(c, *this, effects);
+    lastAccel = maxAccelOf(P, pool);
+    stageCollide(c);
+    ++steps;
+  }
+};
+
+}  // namespace
+
+TEST_CASE("dfsph: a resting tank settles incompressible and calm") {
+  const SceneDef s = dfsphScene("tests/resting_column.json");
+  World w(s, WorldOptions{1});  // thread counts are the hash test's business
+  const double H = 0.6, g = 9.81;
+  double vSum = 0, vMax = 0, errMax = 0;
+  for (int f = 0; f < 120; ++f) {  // 2 s; the second second is measured
+    w.stepFrame();
+    if (f < 60) continue;
+    const double v = meanSpeed(w.particles());
+    vSum += v;
+    vMax = std::max(vMax, v);
+    errMax = std::max(errMax, w.densityStats().meanError);
+  }
+  REQUIRE(test::allFiniteState(w));
+  const DensityStats d = w.densityStats();
+  MESSAGE("at 2 s: mean compression " << d.meanError << ", max " << d.maxError << ", mean density " << d.meanDensity);
+  MESSAGE("1–2 s: mean compression ≤ " << errMax << "; mean speed " << vSum / 60 << " m/s on average, ≤ " << vMax
+                                       << " (sqrt(gH) = " << std::sqrt(g * H) << " m/s)");
+  CHECK(errMax <= 0.002);
+  CHECK(vSum / 60 < 0.03);  // measured 0.012 m/s
+  CHECK(vMax < 0.06);       // measured 0.015 m/s
+  CHECK(outside(w, 0, 0, 0.6, 1.3) == 0);
+}
+
+TEST_CASE("dfsph: both implicit solves reach their tolerances within the iteration cap on the resting tank") {
+  const SceneDef s = dfsphScene("tests/resting_column.json");
+  SolverHarness h(s, 1);
+  const double tol = s.solver.param("tolerance"), divTol = s.solver.param("divergence_tolerance");
+  const int cap = int(s.solver.param("max_iterations"));
+  for (int k = 0; k < 200; ++k) h.substep();  // about 1.4 s: past the start-up transient
+  int worstP = 0, worstD = 0;
+  double worstErr = 0, worstDivErr = 0;
+  for (int k = 0; k < 100; ++k) {
+    h.substep();
+    const SolverStats st = h.solver->stats();
+    worstP = std::max(worstP, st.pressureIterations);
+    worstD = std::max(worstD, st.divergenceIterations);
+    worstErr = std::max(worstErr, st.densityError);
+    worstDivErr = std::max(worstDivErr, st.divergenceError);
+  }
+  MESSAGE("over 100 substeps: pressure iterations ≤ " << worstP << ", density error ≤ " << worstErr
+                                                      << "; divergence iterations ≤ " << worstD
+                                                      << ", divergence error ≤ " << worstDivErr << " /s");
+  CHECK(worstP < cap);
+  CHECK(worstD < cap);
+  CHECK(worstErr <= tol);
+  CHECK(worstDivErr <= divTol);
+  CHECK(worstP >= 2);  // min_iterations
+}
+
+TEST_CASE("dfsph: the small dam break runs 1 s: no NaN, nothing escapes, the front moves right, energy bounded") {
+  const SceneDef s = dfsphScene("tests/small_dam_break.json");
+  World w(s, WorldOptions{1});
+  double front0 = -1e300, sumY0 = 0;
+  for (std::size_t i = 0; i < w.particleCount(); ++i) {
+    front0 = std::max(front0, w.worldPosition(i).x());
+    sumY0 += w.worldPosition(i).y();
+  }
+  const std::size_t n0 = w.particleCount();
+  for (int f = 0; f < 60; ++f) w.stepFrame();
+  CHECK(w.time() == doctest::Approx(1.0).epsilon(1e-6));
+  REQUIRE(test::allFiniteState(w));
+  CHECK(w.particleCount() == n0);
+  CHECK(outside(w, 0, 0, 4, 3) == 0);
+  double front = -1e300, sumY = 0;
+  for (std::size_t i = 0; i < w.particleCount(); ++i) {
+    front = std::max(front, w.worldPosition(i).x());
+    sumY += w.worldPosition(i).y();
+  }
+  MESSAGE("front moved from " << front0 << " to " << front << " m");
+  CHECK(front > front0 + 1.5);
+  const double released = double(w.particleMass()) * 9.81 * (sumY0 - sumY);
+  MESSAGE("kinetic " << w.kineticEnergy() << " J/m, potential released " << released << " J/m, mean compression "
+                     << w.densityStats().meanError);
+  CHECK(released > 0);
+  CHECK(w.kineticEnergy() <= released);
+}
+
+TEST_CASE("dfsph: the state hash is bit-identical for 1, 2 and 3 threads") {
+  const SceneDef s = dfsphScene("tests/small_dam_break.json");
+  std::uint64_t h[3];
+  const int threads[3] = {1, 2, 3};
+  for (int k = 0; k < 3; ++k) {
+    World w(s, WorldOptions{threads[k]});
+    for (int f = 0; f < 10; ++f) w.stepFrame();  // the collapse: ~60 substeps, every solve iterating
+    h[k] = w.stateHash();
+  }
+  CHECK(h[0] == h[1]);
+  CHECK(h[0] == h[2]);
+}
+
+TEST_CASE("dfsph: scene keys are read, defaulted and range-checked") {
+  const std::string base =
+      R"({"solver": {"type": "dfsph", "spacing": 0.05, "tolerance": 0.0005, "max_iterations": 50)";
+  const SceneDef s = parseScene(base + R"(}, "fluid": [{"min": [0, 0], "max": [1, 1]}]})", "inline.json");
+  CHECK(s.solver.param("tolerance") == doctest::Approx(0.0005));
+  CHECK(s.solver.param("max_iterations") == 50);
+  CHECK(s.solver.param("divergence_tolerance") == doctest::Approx(0.01));
+  CHECK(s.solver.param("min_iterations") == 2);
+  CHECK(s.solver.param("divergence_solve") == 1);
+  CHECK(s.solver.param("relaxation") == doctest::Approx(0.6));
+  CHECK(s.solver.param("chebyshev_rho") == doctest::Approx(0.98));
+  CHECK(s.solver.param("velocity_cfl") == doctest::Approx(0.4));
+  CHECK_THROWS(parseScene(base + R"(, "relaxation": 1.5}})", "inline.json"));
+  CHECK_THROWS(parseScene(R"({"solver": {"type": "wcsph", "tolerance": 0.001}})", "inline.json"));
+}
