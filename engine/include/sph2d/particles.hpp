@@ -7,6 +7,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <deque>
 #include <string>
 #include <utility>
 #include <vector>
@@ -28,9 +29,10 @@ struct Particles {
   std::vector<std::uint32_t> id;  ///< stable identifier
 
   /// Optional per-particle scalar fields, created only by the solver or effect
-  /// that needs them (e.g. "age", "dfsph.alpha"), in creation order. Reordering
-  /// permutes them with the rest; push() gives new particles 0.
-  std::vector<std::pair<std::string, std::vector<Real>>> extra;
+  /// that needs them (e.g. "age", "dfsph.kappa"), in creation order. Reordering
+  /// permutes them with the rest; push() gives new particles 0. A deque: creating
+  /// a field never moves the others, so references from field() stay valid.
+  std::deque<std::pair<std::string, std::vector<Real>>> extra;
 
   /// Number of particles.
   std::size_t size() const { return x.size(); }
