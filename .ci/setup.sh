@@ -1,6 +1,8 @@
 # Sourced by ./demo.sh and ./test.sh: install what a fresh Debian 12 machine
 # lacks (apt-get, sudo when not root) and build the Release tree in build/.
-SPH2D_PACKAGES="g++ cmake make pkg-config libbox2d-dev libosmesa6-dev libpng-dev libeigen3-dev doctest-dev nlohmann-json3-dev"
+# clang-14 + libclang-rt-14-dev: libFuzzer for the scene-loader fuzz smoke test
+# that ./test.sh runs through CTest (docs/STABILITY.md).
+SPH2D_PACKAGES="g++ cmake make pkg-config libbox2d-dev libosmesa6-dev libpng-dev libeigen3-dev doctest-dev nlohmann-json3-dev clang-14 libclang-rt-14-dev"
 
 sph2d_install() {
   local missing=() p sudo=""

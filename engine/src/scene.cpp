@@ -1,9 +1,20 @@
 // Scene loading: JSON text → SceneDef, with every key checked against what is
 // allowed. Errors name file, line, column, key path and the allowed values.
+//
+// Besides types and ranges, the loader refuses what Box2D 2.4.1 would assert
+// on (Debian builds it with assertions on: a bad polygon or chain would abort
+// the process), what would exhaust memory (particles and boundary samples
+// beyond max_particles) and what can only be a mistake (a fluid block holding
+// no particle, a degenerate camera, an absurd number of frames).
 #include "sph2d/scene.hpp"
 
+#include <algorithm>
+#include <cerrno>
 #include <cmath>
+#include <cstring>
+#include <filesystem>
 #include <fstream>
+#include <limits>
 #include <sstream>
 
 #include "json_reader.hpp"
@@ -29,6 +40,14 @@ namespace {
 
 using nlohmann::json;
 
+// Limits the loader enforces (documented in docs/SCENES.md).
+constexpr double kMaxCoordinate = 1e7;         ///< |x|, |y| of every [x, y] [m]: floats stay exact to ~1 m
+constexpr double kLinearSlop = 0.005;          ///< Box2D 2.4.1's b2_linearSlop [m]
+constexpr double kMaxFrames = 1e6;             ///< duration × fps
+constexpr double kMinCameraSize = 1e-3;        ///< camera width and height [m]
+constexpr std::size_t kMaxSceneBytes = 64u << 20;  ///< scene file size
+constexpr std::size_t kMinSampleBudget = 4000000;  ///< boundary samples allowed even when max_particles is lower
+
 std::string typeName(const json& j) {
   switch (j.type()) {
     case json::value_t::null: return "null";
@@ -43,6 +62,12 @@ std::string typeName(const json& j) {
   }
 }
 
+/// Like typeName, with the length of an array ("an array of 3 elements").
+std::string describe(const json& j) {
+  if (!j.is_array()) return typeName(j);
+  return "an array of " + std::to_string(j.size()) + (j.size() == 1 ? " element" : " elements");
+}
+
 std::string join(const std::vector<std::string>& v) {
   std::string s;
   for (std::size_t i = 0; i < v.size(); ++i) s += (i ? ", " : "") + v[i];
@@ -50,9 +75,40 @@ std::string join(const std::vector<std::string>& v) {
 }
 
 std::string fmt(double v) {
+  if (v == std::floor(v) && std::fabs(v) < 1e15) return std::to_string(static_cast<long long>(v));
   std::ostringstream o;
   o << v;
   return o.str();
+}
+
+/// A user's key as it may appear in a message: control characters escaped.
+std::string printable(const std::string& s) {
+  std::string o;
+  for (const char c : s) {
+    const unsigned char u = static_cast<unsigned char>(c);
+    if (u < 0x20 || u == 0x7F) {
+      char buf[8];
+      std::snprintf(buf, sizeof buf, "\\x%02X", unsigned(u));
+      o += buf;
+    } else {
+      o += c;
+    }
+  }
+  return o;
+}
+
+/// Edit distance with transpositions (optimal string alignment), for "did you mean".
+std::size_t editDistance(const std::string& a, const std::string& b) {
+  if (a.size() > 64 || b.size() > 64) return 99;
+  std::vector<std::vector<std::size_t>> d(a.size() + 1, std::vector<std::size_t>(b.size() + 1));
+  for (std::size_t i = 0; i <= a.size(); ++i) d[i][0] = i;
+  for (std::size_t j = 0; j <= b.size(); ++j) d[0][j] = j;
+  for (std::size_t i = 1; i <= a.size(); ++i)
+    for (std::size_t j = 1; j <= b.size(); ++j) {
+      d[i][j] = std::min({d[i - 1][j] + 1, d[i][j - 1] + 1, d[i - 1][j - 1] + (a[i - 1] == b[j - 1] ? 0 : 1)});
+      if (i > 1 && j > 1 && a[i - 1] == b[j - 2] && a[i - 2] == b[j - 1]) d[i][j] = std::min(d[i][j], d[i - 2][j - 2] + 1);
+    }
+  return d[a.size()][b.size()];
 }
 
 /// Typed, position-aware access to one JSON object of the scene.
@@ -76,13 +132,26 @@ class Reader {
   static std::string sub(const std::string& path, const std::string& key) { return path.empty() ? key : path + "." + key; }
 
   void requireObject(const json& j, const std::string& path) const {
-    if (!j.is_object()) fail(path, "expected an object, got " + typeName(j));
+    if (!j.is_object())
+      fail(path, path.empty() ? "a scene is a JSON object ({ ... }) at the top level, got " + describe(j)
+                              : "expected an object, got " + describe(j));
   }
   void checkKeys(const json& obj, const std::string& path, const std::vector<std::string>& allowed) const {
     for (auto it = obj.begin(); it != obj.end(); ++it) {
       bool ok = false;
       for (const auto& a : allowed) ok = ok || a == it.key();
-      if (!ok) fail(sub(path, it.key()), "unknown key '" + it.key() + "'; allowed keys: " + join(allowed));
+      if (ok) continue;
+      const std::string key = printable(it.key());
+      std::string hint;
+      std::size_t best = 3;
+      for (const auto& a : allowed) {
+        const std::size_t d = editDistance(it.key(), a);
+        if (d < best && d <= 1 + a.size() / 4) {
+          best = d;
+          hint = " (did you mean '" + a + "'?)";
+        }
+      }
+      fail(sub(path, key), "unknown key '" + key + "'" + hint + "; allowed keys: " + join(allowed));
     }
   }
   double number(const json& obj, const std::string& path, const std::string& key, double def, double lo, double hi,
@@ -90,26 +159,38 @@ class Reader {
     if (!obj.contains(key)) return def;
     const json& j = obj.at(key);
     const std::string p = sub(path, key);
-    if (!j.is_number()) fail(p, "expected a number, got " + typeName(j));
+    if (!j.is_number()) fail(p, "expected a number, got " + describe(j));
     const double v = j.get<double>();
     const bool below = loOpen ? !(v > lo) : !(v >= lo);
     if (!std::isfinite(v) || below || v > hi)
       fail(p, "value " + fmt(v) + " is out of range; allowed: " + (loOpen ? "> " : ">= ") + fmt(lo) + " and <= " + fmt(hi));
     return v;
   }
-  int integer(const json& obj, const std::string& path, const std::string& key, int def, int lo, int hi) const {
+  /// An integer in [lo, hi]; a number with an integral value (1e3, 960.0) counts as one.
+  long long integer64(const json& obj, const std::string& path, const std::string& key, long long def, long long lo,
+                      long long hi) const {
     if (!obj.contains(key)) return def;
     const json& j = obj.at(key);
     const std::string p = sub(path, key);
-    if (!j.is_number_integer()) fail(p, "expected an integer, got " + typeName(j));
-    const long long v = j.get<long long>();
-    if (v < lo || v > hi) fail(p, "value " + std::to_string(v) + " is out of range; allowed: " + std::to_string(lo) + " to " + std::to_string(hi));
-    return static_cast<int>(v);
+    const std::string range = "an integer from " + std::to_string(lo) + " to " + std::to_string(hi);
+    if (!j.is_number()) fail(p, "expected " + range + ", got " + describe(j));
+    if (j.is_number_integer()) {
+      const long long v = j.get<long long>();
+      if (v < lo || v > hi) fail(p, "value " + std::to_string(v) + " is out of range; allowed: " + range);
+      return v;
+    }
+    const double d = j.get<double>();
+    if (!(d == std::floor(d))) fail(p, "expected " + range + ", got " + fmt(d));
+    if (!(d >= double(lo) && d <= double(hi))) fail(p, "value " + fmt(d) + " is out of range; allowed: " + range);
+    return static_cast<long long>(d);
+  }
+  int integer(const json& obj, const std::string& path, const std::string& key, int def, int lo, int hi) const {
+    return static_cast<int>(integer64(obj, path, key, def, lo, hi));
   }
   bool boolean(const json& obj, const std::string& path, const std::string& key, bool def) const {
     if (!obj.contains(key)) return def;
     const json& j = obj.at(key);
-    if (!j.is_boolean()) fail(sub(path, key), "expected true or false, got " + typeName(j));
+    if (!j.is_boolean()) fail(sub(path, key), "expected true or false, got " + describe(j));
     return j.get<bool>();
   }
   std::string string(const json& obj, const std::string& path, const std::string& key, const std::string& def,
@@ -117,18 +198,21 @@ class Reader {
     if (!obj.contains(key)) return def;
     const json& j = obj.at(key);
     const std::string p = sub(path, key);
-    if (!j.is_string()) fail(p, "expected a string, got " + typeName(j));
+    if (!j.is_string()) fail(p, "expected a string, got " + describe(j));
     const std::string v = j.get<std::string>();
     if (allowed.empty()) return v;
     for (const auto& a : allowed)
       if (a == v) return v;
-    fail(p, "'" + v + "' is not allowed; allowed values: " + join(allowed));
+    fail(p, "'" + printable(v) + "' is not allowed; allowed values: " + join(allowed));
   }
   Vec2d vec2(const json& j, const std::string& p) const {
-    if (!j.is_array() || j.size() != 2 || !j[0].is_number() || !j[1].is_number())
-      fail(p, "expected [x, y] (two numbers), got " + (j.is_array() ? "an array of " + std::to_string(j.size()) : typeName(j)));
+    if (!j.is_array() || j.size() != 2) fail(p, "expected [x, y] (two numbers), got " + describe(j));
+    for (std::size_t k = 0; k < 2; ++k)
+      if (!j[k].is_number()) fail(p, "expected [x, y] (two numbers), got " + typeName(j[k]) + " at [" + std::to_string(k) + "]");
     const Vec2d v(j[0].get<double>(), j[1].get<double>());
     if (!std::isfinite(v.x()) || !std::isfinite(v.y())) fail(p, "coordinates must be finite");
+    if (std::fabs(v.x()) > kMaxCoordinate || std::fabs(v.y()) > kMaxCoordinate)
+      fail(p, "[" + fmt(v.x()) + ", " + fmt(v.y()) + "] is out of range; each component must be within +-" + fmt(kMaxCoordinate));
     return v;
   }
   Vec2d vec2(const json& obj, const std::string& path, const std::string& key, const Vec2d& def) const {
@@ -144,12 +228,12 @@ class Reader {
     if (!obj.contains(key)) return def;
     const json& j = obj.at(key);
     const std::string p = sub(path, key);
-    if (!j.is_array() || j.size() != 3) fail(p, "expected [r, g, b] with components in 0..1");
+    if (!j.is_array() || j.size() != 3) fail(p, "expected [r, g, b] with components in 0..1, got " + describe(j));
     std::array<double, 3> c{};
-    for (int k = 0; k < 3; ++k) {
-      if (!j[k].is_number()) fail(p, "expected [r, g, b] with components in 0..1");
+    for (std::size_t k = 0; k < 3; ++k) {
+      if (!j[k].is_number()) fail(p, "expected [r, g, b] with components in 0..1, got " + typeName(j[k]) + " at [" + std::to_string(k) + "]");
       c[k] = j[k].get<double>();
-      if (!(c[k] >= 0 && c[k] <= 1)) fail(p, "colour components must be in 0..1");
+      if (!(c[k] >= 0 && c[k] <= 1)) fail(p, "colour components must be in 0..1, got " + fmt(c[k]) + " at [" + std::to_string(k) + "]");
     }
     return c;
   }
@@ -157,7 +241,7 @@ class Reader {
     const std::string p = sub(path, key);
     if (!obj.contains(key)) fail(p, "missing; expected an array of [x, y] points");
     const json& j = obj.at(key);
-    if (!j.is_array()) fail(p, "expected an array of [x, y] points, got " + typeName(j));
+    if (!j.is_array()) fail(p, "expected an array of [x, y] points, got " + describe(j));
     std::vector<Vec2d> out;
     for (std::size_t i = 0; i < j.size(); ++i) out.push_back(vec2(j[i], p + "[" + std::to_string(i) + "]"));
     return out;
@@ -170,21 +254,102 @@ class Reader {
 
 double cross(const Vec2d& a, const Vec2d& b) { return a.x() * b.y() - a.y() * b.x(); }
 
+// ---- What Box2D 2.4.1 sees: the vertices as floats. --------------------------
+
+struct F2 {
+  float x, y;
+};
+F2 toF(const Vec2d& v) { return {static_cast<float>(v.x()), static_cast<float>(v.y())}; }
+float distSqF(F2 a, F2 b) {
+  const float dx = a.x - b.x, dy = a.y - b.y;
+  return dx * dx + dy * dy;
+}
+float crossF(F2 a, F2 b) { return a.x * b.y - a.y * b.x; }
+
+/// True when two vertices are closer than Box2D's linear slop, in double or
+/// as Box2D's float check (b2ChainShape asserts distance² > slop²).
+bool closerThanSlop(const Vec2d& a, const Vec2d& b) {
+  const float slop = static_cast<float>(kLinearSlop);
+  return (a - b).norm() < kLinearSlop || !(distSqF(toF(a), toF(b)) > slop * slop);
+}
+
+/// Replays b2PolygonShape::Set (welding, gift-wrapping hull, edge lengths,
+/// centroid area) in float; returns what Box2D would assert on, or "".
+std::string box2dPolygonProblem(const std::vector<Vec2d>& vertices) {
+  const float epsilon = std::numeric_limits<float>::epsilon();
+  const float halfSlop = 0.5f * static_cast<float>(kLinearSlop);
+  std::vector<F2> ps;
+  for (const Vec2d& v : vertices) {
+    const F2 f = toF(v);
+    bool unique = true;
+    for (const F2& q : ps) unique = unique && !(distSqF(f, q) < halfSlop * halfSlop);
+    if (unique) ps.push_back(f);
+  }
+  const std::size_t n = ps.size();
+  if (n < 3) return "Box2D welds vertices closer than 0.0025 m and would keep fewer than 3";
+  std::size_t i0 = 0;
+  for (std::size_t i = 1; i < n; ++i)
+    if (ps[i].x > ps[i0].x || (ps[i].x == ps[i0].x && ps[i].y < ps[i0].y)) i0 = i;
+  std::vector<std::size_t> hull;
+  std::size_t ih = i0;
+  for (;;) {
+    if (hull.size() >= 8) return "Box2D cannot build the convex hull of these vertices";
+    hull.push_back(ih);
+    std::size_t ie = 0;
+    for (std::size_t j = 1; j < n; ++j) {
+      if (ie == ih) {
+        ie = j;
+        continue;
+      }
+      const F2 a = ps[hull.back()];
+      const F2 r{ps[ie].x - a.x, ps[ie].y - a.y}, v{ps[j].x - a.x, ps[j].y - a.y};
+      const float c = crossF(r, v);
+      if (c < 0.0f) ie = j;
+      if (c == 0.0f && v.x * v.x + v.y * v.y > r.x * r.x + r.y * r.y) ie = j;
+    }
+    ih = ie;
+    if (ie == i0) break;
+  }
+  const std::size_t m = hull.size();
+  if (m < 3) return "the vertices are (almost) collinear: Box2D's convex hull has fewer than 3 vertices";
+  std::vector<F2> h;
+  for (std::size_t k : hull) h.push_back(ps[k]);
+  for (std::size_t i = 0; i < m; ++i)
+    if (!(distSqF(h[(i + 1) % m], h[i]) > epsilon * epsilon)) return "Box2D's convex hull has an edge of zero length";
+  float area = 0;
+  const F2 s = h[0];
+  for (std::size_t i = 0; i < m; ++i) {
+    const F2 e1{h[i].x - s.x, h[i].y - s.y};
+    const F2 p3 = h[(i + 1) % m];
+    const F2 e2{p3.x - s.x, p3.y - s.y};
+    area += 0.5f * crossF(e1, e2);
+  }
+  // Box2D asserts area > FLT_EPSILON; keep a margin for rounding.
+  if (!(area > 16 * epsilon))
+    return "the polygon is too thin: its area in Box2D's float arithmetic is " + fmt(area) + " m^2, Box2D needs more than " +
+           fmt(16 * epsilon) + " m^2";
+  return "";
+}
+
+// ---- Fixtures -----------------------------------------------------------------
+
 ShapeDef readFixture(const Reader& r, const json& j, const std::string& path) {
   r.requireObject(j, path);
   ShapeDef s;
   if (!j.contains("shape")) r.fail(Reader::sub(path, "shape"), "missing; allowed values: box, polygon, circle, edge, chain");
   const std::string shape = r.string(j, path, "shape", "", {"box", "polygon", "circle", "edge", "chain"});
   std::vector<std::string> keys = {"shape", "friction", "restitution"};
-  s.friction = r.number(j, path, "friction", s.friction, 0, 10);
-  s.restitution = r.number(j, path, "restitution", s.restitution, 0, 1);
   if (shape == "box") {
     s.type = ShapeDef::Type::Box;
     keys.insert(keys.end(), {"center", "half_size", "angle"});
     r.checkKeys(j, path, keys);
     s.center = r.vec2(j, path, "center", s.center);
     s.halfSize = r.requiredVec2(j, path, "half_size");
-    if (!(s.halfSize.x() > 0 && s.halfSize.y() > 0)) r.fail(Reader::sub(path, "half_size"), "both half sizes must be > 0");
+    if (!(s.halfSize.x() > 0 && s.halfSize.y() > 0))
+      r.fail(Reader::sub(path, "half_size"), "both half sizes must be > 0, got [" + fmt(s.halfSize.x()) + ", " + fmt(s.halfSize.y()) + "]");
+    if (!(s.halfSize.x() >= kLinearSlop / 2 && s.halfSize.y() >= kLinearSlop / 2))
+      r.fail(Reader::sub(path, "half_size"), "both half sizes must be >= 0.0025 (a box at least 0.005 m across, Box2D's linear slop), got [" +
+                                                fmt(s.halfSize.x()) + ", " + fmt(s.halfSize.y()) + "]");
     s.angle = r.number(j, path, "angle", 0, -1e3, 1e3);
   } else if (shape == "polygon") {
     s.type = ShapeDef::Type::Polygon;
@@ -192,23 +357,37 @@ ShapeDef readFixture(const Reader& r, const json& j, const std::string& path) {
     r.checkKeys(j, path, keys);
     s.vertices = r.points(j, path, "vertices");
     const std::string p = Reader::sub(path, "vertices");
-    if (s.vertices.size() < 3 || s.vertices.size() > 8) r.fail(p, "a polygon needs 3 to 8 vertices (Box2D 2.4.1), got " + std::to_string(s.vertices.size()));
-    double area = 0;
-    int sign = 0;
     const std::size_t n = s.vertices.size();
+    if (n < 3 || n > 8) r.fail(p, "a polygon needs 3 to 8 vertices (Box2D 2.4.1), got " + std::to_string(n));
+    for (std::size_t a = 0; a < n; ++a)
+      for (std::size_t b = a + 1; b < n; ++b)
+        if (closerThanSlop(s.vertices[a], s.vertices[b]))
+          r.fail(p, "vertices [" + std::to_string(a) + "] and [" + std::to_string(b) +
+                        "] are closer than 0.005 m (Box2D's linear slop)");
+    // Convex: every turn has the same sign (straight turns aside) and the
+    // turns add up to one full revolution (a star polygon turns twice).
+    double area = 0, turning = 0;
+    int sign = 0;
     for (std::size_t i = 0; i < n; ++i) {
       const Vec2d& a = s.vertices[i];
       const Vec2d& b = s.vertices[(i + 1) % n];
       const Vec2d& c = s.vertices[(i + 2) % n];
       area += cross(a, b);
-      const double turn = cross(b - a, c - b);
-      const int sg = turn > 1e-12 ? 1 : (turn < -1e-12 ? -1 : 0);
+      const Vec2d u = b - a, v = c - b;
+      const double turn = cross(u, v) / (u.norm() * v.norm());
+      turning += std::atan2(cross(u, v), u.dot(v));
+      const int sg = turn > 1e-9 ? 1 : (turn < -1e-9 ? -1 : 0);
+      if (sg == 0 && u.dot(v) < 0)
+        r.fail(p, "the polygon must be convex: its outline doubles back at vertex [" + std::to_string((i + 1) % n) + "]");
       if (sg != 0) {
         if (sign != 0 && sg != sign) r.fail(p, "the polygon must be convex (split a concave shape into several fixtures)");
         sign = sg;
       }
     }
+    if (std::fabs(turning) > 3 * 3.14159265358979) r.fail(p, "the polygon must be convex: its edges cross (the outline winds around more than once)");
     if (std::fabs(area) < 1e-10) r.fail(p, "the polygon has no area");
+    const std::string problem = box2dPolygonProblem(s.vertices);
+    if (!problem.empty()) r.fail(p, problem);
   } else if (shape == "circle") {
     s.type = ShapeDef::Type::Circle;
     keys.insert(keys.end(), {"center", "radius"});
@@ -216,13 +395,16 @@ ShapeDef readFixture(const Reader& r, const json& j, const std::string& path) {
     s.center = r.vec2(j, path, "center", s.center);
     if (!j.contains("radius")) r.fail(Reader::sub(path, "radius"), "missing; expected a number > 0");
     s.radius = r.number(j, path, "radius", 0, 0, 1e6, true);
+    if (s.radius < kLinearSlop / 2)
+      r.fail(Reader::sub(path, "radius"), "value " + fmt(s.radius) + " is too small; a circle is at least 0.005 m across (radius >= 0.0025, Box2D's linear slop)");
   } else if (shape == "edge") {
     s.type = ShapeDef::Type::Edge;
     keys.insert(keys.end(), {"vertices"});
     r.checkKeys(j, path, keys);
     s.vertices = r.points(j, path, "vertices");
-    if (s.vertices.size() != 2) r.fail(Reader::sub(path, "vertices"), "an edge needs exactly 2 vertices");
-    if ((s.vertices[0] - s.vertices[1]).norm() < 1e-6) r.fail(Reader::sub(path, "vertices"), "the edge has zero length");
+    if (s.vertices.size() != 2) r.fail(Reader::sub(path, "vertices"), "an edge needs exactly 2 vertices, got " + std::to_string(s.vertices.size()));
+    if (closerThanSlop(s.vertices[0], s.vertices[1]))
+      r.fail(Reader::sub(path, "vertices"), "the edge is shorter than 0.005 m (Box2D's linear slop)");
   } else {
     s.type = ShapeDef::Type::Chain;
     keys.insert(keys.end(), {"vertices", "loop"});
@@ -230,11 +412,19 @@ ShapeDef readFixture(const Reader& r, const json& j, const std::string& path) {
     s.vertices = r.points(j, path, "vertices");
     s.loop = r.boolean(j, path, "loop", false);
     const std::size_t need = s.loop ? 3 : 2;
-    if (s.vertices.size() < need) r.fail(Reader::sub(path, "vertices"), std::string("a ") + (s.loop ? "looped" : "open") + " chain needs at least " + std::to_string(need) + " vertices");
+    if (s.vertices.size() < need)
+      r.fail(Reader::sub(path, "vertices"), std::string("a ") + (s.loop ? "looped" : "open") + " chain needs at least " + std::to_string(need) +
+                                               " vertices, got " + std::to_string(s.vertices.size()));
     for (std::size_t i = 1; i < s.vertices.size(); ++i)
-      if ((s.vertices[i] - s.vertices[i - 1]).norm() < 0.005)  // b2_linearSlop
-        r.fail(Reader::sub(path, "vertices[" + std::to_string(i) + "]"), "chain vertices closer than 0.005 m (Box2D's linear slop)");
+      if (closerThanSlop(s.vertices[i], s.vertices[i - 1]))
+        r.fail(Reader::sub(path, "vertices[" + std::to_string(i) + "]"),
+               "chain vertices [" + std::to_string(i - 1) + "] and [" + std::to_string(i) + "] are closer than 0.005 m (Box2D's linear slop)");
+    if (s.loop && closerThanSlop(s.vertices.back(), s.vertices.front()))
+      r.fail(Reader::sub(path, "vertices[" + std::to_string(s.vertices.size() - 1) + "]"),
+             "the last vertex of a looped chain is closer than 0.005 m to the first (the loop closes itself: do not repeat the first vertex)");
   }
+  s.friction = r.number(j, path, "friction", s.friction, 0, 10);
+  s.restitution = r.number(j, path, "restitution", s.restitution, 0, 1);
   return s;
 }
 
@@ -261,7 +451,7 @@ void readEffects(const Reader& r, const nlohmann::json& j, SceneDef& s) {
   }
   if (j.contains("force_fields")) {
     const auto& a = j.at("force_fields");
-    if (!a.is_array()) r.fail("effects.force_fields", "expected an array of force fields, got " + typeName(a));
+    if (!a.is_array()) r.fail("effects.force_fields", "expected an array of force fields, got " + describe(a));
     for (std::size_t k = 0; k < a.size(); ++k) {
       const std::string q = "effects.force_fields[" + std::to_string(k) + "]";
       r.requireObject(a[k], q);
@@ -297,7 +487,7 @@ void readEffects(const Reader& r, const nlohmann::json& j, SceneDef& s) {
   }
   if (j.contains("sinks")) {
     const auto& a = j.at("sinks");
-    if (!a.is_array()) r.fail("effects.sinks", "expected an array of regions {min, max}, got " + typeName(a));
+    if (!a.is_array()) r.fail("effects.sinks", "expected an array of regions {min, max}, got " + describe(a));
     for (std::size_t k = 0; k < a.size(); ++k) {
       const std::string q = "effects.sinks[" + std::to_string(k) + "]";
       r.requireObject(a[k], q);
@@ -307,7 +497,7 @@ void readEffects(const Reader& r, const nlohmann::json& j, SceneDef& s) {
   }
   if (j.contains("emitters")) {
     const auto& a = j.at("emitters");
-    if (!a.is_array()) r.fail("effects.emitters", "expected an array of emitters, got " + typeName(a));
+    if (!a.is_array()) r.fail("effects.emitters", "expected an array of emitters, got " + describe(a));
     for (std::size_t k = 0; k < a.size(); ++k) {
       const std::string q = "effects.emitters[" + std::to_string(k) + "]";
       r.requireObject(a[k], q);
@@ -325,7 +515,7 @@ void readEffects(const Reader& r, const nlohmann::json& j, SceneDef& s) {
       m.start = r.number(a[k], q, "start", m.start, 0, 1e9);
       m.stop = r.number(a[k], q, "stop", m.stop, 0, 1e30);
       if (m.stop < m.start) r.fail(Reader::sub(q, "stop"), "stop must not be before start");
-      m.seed = std::uint64_t(r.number(a[k], q, "seed", double(m.seed), 0, 9007199254740992.0));
+      m.seed = static_cast<std::uint64_t>(r.integer64(a[k], q, "seed", static_cast<long long>(m.seed), 0, 9007199254740992LL));
       m.enabled = r.boolean(a[k], q, "enabled", m.enabled);
       e.emitters.push_back(m);
     }
@@ -335,24 +525,145 @@ void readEffects(const Reader& r, const nlohmann::json& j, SceneDef& s) {
     const std::string q = "effects.budget";
     r.requireObject(b, q);
     r.checkKeys(b, q, {"max_particles", "policy"});
-    e.budget = std::size_t(r.number(b, q, "max_particles", 0, 1, 1e8));
+    e.budget = static_cast<std::size_t>(r.integer64(b, q, "max_particles", 0, 1, 100000000));
     e.budgetPolicy = r.string(b, q, "policy", "stop_emitting", {"stop_emitting", "recycle_oldest"}) == "recycle_oldest"
                          ? BudgetPolicy::RecycleOldest
                          : BudgetPolicy::StopEmitting;
   }
 }
 
+// ---- Whole-scene checks -----------------------------------------------------------
+
+/// Particles along x and y in a block (as doubles: no overflow for any input).
+std::pair<double, double> blockLattice(const FluidBlockDef& b, double dx) {
+  return {std::floor((b.max.x() - b.min.x()) / dx + 1e-9), std::floor((b.max.y() - b.min.y()) / dx + 1e-9)};
+}
+
+/// An upper estimate of the boundary samples the World will lay in the solids
+/// (layers of ceil(R/dx) rows under every face, both sides of segments).
+double estimateBoundarySamples(const SceneDef& s) {
+  const double dx = s.solver.spacing;
+  const double layers = std::max(1.0, std::ceil(s.solver.supportRatio - 1e-9));
+  const auto along = [&](double len) { return std::max(1.0, std::round(len / dx)); };
+  double total = 0;
+  for (const BodyDef& b : s.bodies)
+    for (const ShapeDef& f : b.fixtures) {
+      switch (f.type) {
+        case ShapeDef::Type::Box:
+          total += layers * 2 * (along(2 * f.halfSize.x()) + along(2 * f.halfSize.y()));
+          break;
+        case ShapeDef::Type::Polygon:
+          for (std::size_t i = 0; i < f.vertices.size(); ++i)
+            total += layers * along((f.vertices[(i + 1) % f.vertices.size()] - f.vertices[i]).norm());
+          break;
+        case ShapeDef::Type::Circle:
+          total += layers * std::max(3.0, std::round(2 * 3.14159265358979 * f.radius / dx));
+          break;
+        case ShapeDef::Type::Edge:
+        case ShapeDef::Type::Chain:
+          for (std::size_t i = 0; i + 1 < f.vertices.size(); ++i) total += 2 * layers * along((f.vertices[i + 1] - f.vertices[i]).norm());
+          if (f.loop) total += 2 * layers * along((f.vertices.front() - f.vertices.back()).norm());
+          break;
+      }
+    }
+  return total;
+}
+
+Vec2d rotate(const Vec2d& v, double angle) {
+  const double c = std::cos(angle), s = std::sin(angle);
+  return Vec2d(c * v.x() - s * v.y(), s * v.x() + c * v.y());
+}
+
+/// How deep p lies inside the solid fixture f of body b (world coordinates;
+/// <= 0 outside; edges and chains have no inside).
+double depthInside(const BodyDef& b, const ShapeDef& f, const Vec2d& p) {
+  const Vec2d q = rotate(p - b.position, -b.angle);  // body coordinates
+  switch (f.type) {
+    case ShapeDef::Type::Box: {
+      const Vec2d l = rotate(q - f.center, -f.angle);
+      return std::min(f.halfSize.x() - std::fabs(l.x()), f.halfSize.y() - std::fabs(l.y()));
+    }
+    case ShapeDef::Type::Circle:
+      return f.radius - (q - f.center).norm();
+    case ShapeDef::Type::Polygon: {
+      const std::size_t n = f.vertices.size();
+      double area = 0;
+      for (std::size_t i = 0; i < n; ++i) area += cross(f.vertices[i], f.vertices[(i + 1) % n]);
+      const double orient = area > 0 ? 1 : -1;
+      double depth = std::numeric_limits<double>::infinity();
+      for (std::size_t i = 0; i < n; ++i) {
+        const Vec2d e = f.vertices[(i + 1) % n] - f.vertices[i];
+        depth = std::min(depth, orient * cross(e, q - f.vertices[i]) / e.norm());
+      }
+      return depth;
+    }
+    default:
+      return 0;
+  }
+}
+
+const char* shapeName(ShapeDef::Type t) {
+  switch (t) {
+    case ShapeDef::Type::Box: return "a box";
+    case ShapeDef::Type::Polygon: return "a polygon";
+    case ShapeDef::Type::Circle: return "a circle";
+    case ShapeDef::Type::Edge: return "an edge";
+    case ShapeDef::Type::Chain: return "a chain";
+  }
+  return "a solid";
+}
+
+/// A block none of whose particles could exist: thinner than one spacing, or
+/// with every lattice point inside one solid fixture.
+void checkBlock(const Reader& r, const SceneDef& s, const FluidBlockDef& blk, const std::string& p) {
+  const double dx = s.solver.spacing;
+  const auto [nx, ny] = blockLattice(blk, dx);
+  if (nx < 1 || ny < 1)
+    r.fail(Reader::sub(p, "max"), "the block is " + fmt(blk.max.x() - blk.min.x()) + " m x " + fmt(blk.max.y() - blk.min.y()) +
+                                      " m, less than one particle spacing (" + fmt(dx) + " m) " + (nx < 1 ? "wide" : "high") +
+                                      ": it would hold no particle");
+  // The lattice spans x in [min + dx/2, min + (nx - 1/2) dx]; the rows, compressed
+  // downwards at most, y in [min, min + (ny - 1/2) dx]. A convex solid holding
+  // the four corners holds every particle.
+  const double x0 = blk.min.x() + 0.5 * dx, x1 = blk.min.x() + (nx - 0.5) * dx;
+  const double y0 = blk.min.y(), y1 = blk.min.y() + (ny - 0.5) * dx;
+  const double margin = 0.01 * dx + 1e-6 * std::max({1.0, std::fabs(x0), std::fabs(x1), std::fabs(y0), std::fabs(y1)});
+  for (std::size_t bi = 0; bi < s.bodies.size(); ++bi)
+    for (std::size_t fi = 0; fi < s.bodies[bi].fixtures.size(); ++fi) {
+      const BodyDef& b = s.bodies[bi];
+      const ShapeDef& f = b.fixtures[fi];
+      bool all = true;
+      for (const Vec2d& c : {Vec2d(x0, y0), Vec2d(x1, y0), Vec2d(x0, y1), Vec2d(x1, y1)}) all = all && depthInside(b, f, c) > margin;
+      if (all)
+        r.fail(p, "the block lies entirely inside boundaries[" + std::to_string(bi) + "].fixtures[" + std::to_string(fi) + "] (" +
+                      shapeName(f.type) + "): every particle would be dropped");
+    }
+}
+
+/// A scene name becomes the output directory out/<name>: one plain path component.
+void checkName(const Reader& r, const std::string& name) {
+  std::string why;
+  if (name.empty()) why = "the name is empty";
+  else if (name.size() > 200) why = "the name is longer than 200 bytes";
+  else if (name == "." || name == "..") why = "'" + name + "' is not a directory name";
+  else if (name.find_first_of("/\\") != std::string::npos) why = "the name contains a slash";
+  else
+    for (const char c : name)
+      if (static_cast<unsigned char>(c) < 0x20 || c == 0x7F) why = "the name contains a control character";
+  if (!why.empty())
+    r.fail("name", why + "; the name names the output directory out/<name>: use letters, digits, '_', '-' or '.'");
+}
+
 }  // namespace
 
 std::size_t countBlockParticles(const SceneDef& scene) {
-  std::size_t n = 0;
-  const double dx = scene.solver.spacing;
+  double n = 0;
   for (const auto& b : scene.blocks) {
-    const double nx = std::floor((b.max.x() - b.min.x()) / dx + 1e-9);
-    const double ny = std::floor((b.max.y() - b.min.y()) / dx + 1e-9);
-    if (nx > 0 && ny > 0) n += static_cast<std::size_t>(nx) * static_cast<std::size_t>(ny);
+    const auto [nx, ny] = blockLattice(b, scene.solver.spacing);
+    if (nx > 0 && ny > 0) n += nx * ny;
   }
-  return n;
+  const double most = double(std::numeric_limits<std::size_t>::max() / 2);
+  return !(n < most) ? std::numeric_limits<std::size_t>::max() / 2 : static_cast<std::size_t>(n);
 }
 
 SceneDef parseScene(const std::string& text, const std::string& file) {
@@ -364,10 +675,15 @@ SceneDef parseScene(const std::string& text, const std::string& file) {
   SceneDef s;
   s.path = file;
   s.name = r.string(root, "", "name", s.name, {});
+  checkName(r, s.name);
   s.gravity = r.vec2(root, "", "gravity", s.gravity);
   s.fps = r.number(root, "", "fps", s.fps, 1, 1000);
   s.duration = r.number(root, "", "duration", s.duration, 0, 1e5);
-  s.maxParticles = static_cast<std::size_t>(r.number(root, "", "max_particles", double(s.maxParticles), 0, 1e8));
+  if (s.duration * s.fps > kMaxFrames)
+    r.fail(root.contains("duration") ? "duration" : "fps",
+           "duration x fps = " + fmt(s.duration) + " s x " + fmt(s.fps) + " = " + fmt(s.duration * s.fps) + " frames, more than " +
+               fmt(kMaxFrames) + "; shorten the duration (sph2d run --frames N renders fewer frames)");
+  s.maxParticles = static_cast<std::size_t>(r.integer64(root, "", "max_particles", static_cast<long long>(s.maxParticles), 0, 100000000));
 
   if (root.contains("solver")) {
     const json& j = root.at("solver");
@@ -397,7 +713,7 @@ SceneDef parseScene(const std::string& text, const std::string& file) {
 
   if (root.contains("boundaries")) {
     const json& arr = root.at("boundaries");
-    if (!arr.is_array()) r.fail("boundaries", "expected an array of static bodies, got " + typeName(arr));
+    if (!arr.is_array()) r.fail("boundaries", "expected an array of static bodies, got " + describe(arr));
     for (std::size_t b = 0; b < arr.size(); ++b) {
       const std::string p = "boundaries[" + std::to_string(b) + "]";
       const json& j = arr[b];
@@ -408,7 +724,7 @@ SceneDef parseScene(const std::string& text, const std::string& file) {
       body.angle = r.number(j, p, "angle", 0, -1e3, 1e3);
       if (!j.contains("fixtures")) r.fail(Reader::sub(p, "fixtures"), "missing; expected an array of fixtures");
       const json& fx = j.at("fixtures");
-      if (!fx.is_array()) r.fail(Reader::sub(p, "fixtures"), "expected an array of fixtures, got " + typeName(fx));
+      if (!fx.is_array()) r.fail(Reader::sub(p, "fixtures"), "expected an array of fixtures, got " + describe(fx));
       for (std::size_t f = 0; f < fx.size(); ++f)
         body.fixtures.push_back(readFixture(r, fx[f], p + ".fixtures[" + std::to_string(f) + "]"));
       s.bodies.push_back(body);
@@ -417,7 +733,7 @@ SceneDef parseScene(const std::string& text, const std::string& file) {
 
   if (root.contains("fluid")) {
     const json& arr = root.at("fluid");
-    if (!arr.is_array()) r.fail("fluid", "expected an array of blocks, got " + typeName(arr));
+    if (!arr.is_array()) r.fail("fluid", "expected an array of blocks, got " + describe(arr));
     for (std::size_t b = 0; b < arr.size(); ++b) {
       const std::string p = "fluid[" + std::to_string(b) + "]";
       const json& j = arr[b];
@@ -429,6 +745,7 @@ SceneDef parseScene(const std::string& text, const std::string& file) {
       blk.velocity = r.vec2(j, p, "velocity", blk.velocity);
       if (!(blk.max.x() > blk.min.x() && blk.max.y() > blk.min.y()))
         r.fail(Reader::sub(p, "max"), "max must be greater than min in x and in y");
+      checkBlock(r, s, blk, p);
       s.blocks.push_back(blk);
     }
   }
@@ -458,23 +775,47 @@ SceneDef parseScene(const std::string& text, const std::string& file) {
       d.camera.automatic = false;
       if (!(d.camera.max.x() > d.camera.min.x() && d.camera.max.y() > d.camera.min.y()))
         r.fail(Reader::sub(pc, "max"), "max must be greater than min in x and in y");
+      const Vec2d size = d.camera.max - d.camera.min;
+      if (size.x() < kMinCameraSize || size.y() < kMinCameraSize)
+        r.fail(Reader::sub(pc, "max"), "the camera shows " + fmt(size.x()) + " m x " + fmt(size.y()) +
+                                           " m; it must be at least 0.001 m wide and high");
     }
   }
 
   const std::size_t n = countBlockParticles(s);
   if (n > s.maxParticles)
-    r.fail("solver.spacing", "spacing " + fmt(s.solver.spacing) + " fills the fluid blocks with " + std::to_string(n) +
+    r.fail("solver.spacing", "spacing " + fmt(s.solver.spacing) + " fills the fluid blocks with " +
+                                 (n >= std::numeric_limits<std::size_t>::max() / 2 ? std::string("too many") : std::to_string(n)) +
                                  " particles, more than max_particles = " + std::to_string(s.maxParticles) +
                                  "; use a larger spacing or raise max_particles");
+  const double samples = estimateBoundarySamples(s);
+  const std::size_t sampleBudget = std::max<std::size_t>(s.maxParticles, kMinSampleBudget);
+  if (samples > double(sampleBudget))
+    r.fail("solver.spacing", "spacing " + fmt(s.solver.spacing) + " lines the solids with about " + fmt(samples) +
+                                 " boundary samples, more than max(max_particles, " + std::to_string(kMinSampleBudget) +
+                                 ") = " + std::to_string(sampleBudget) +
+                                 "; use a larger spacing or smaller solids");
   return s;
 }
 
 SceneDef loadScene(const std::string& path) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) throw SceneError(path, 0, 0, "", "is a directory, not a scene file");
+  errno = 0;
   std::ifstream in(path, std::ios::binary);
-  if (!in) throw SceneError(path, 0, 0, "", "cannot open the scene file");
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return parseScene(ss.str(), path);
+  if (!in) {
+    const int err = errno;
+    throw SceneError(path, 0, 0, "", std::string("cannot open the scene file") + (err ? std::string(": ") + std::strerror(err) : ""));
+  }
+  std::string text;
+  char buf[65536];
+  while (in.read(buf, sizeof buf) || in.gcount() > 0) {
+    text.append(buf, static_cast<std::size_t>(in.gcount()));
+    if (text.size() > kMaxSceneBytes)
+      throw SceneError(path, 0, 0, "", "the file is larger than " + std::to_string(kMaxSceneBytes >> 20) + " MiB; is it a scene file?");
+  }
+  if (in.bad()) throw SceneError(path, 0, 0, "", "cannot read the scene file");
+  return parseScene(text, path);
 }
 
 }  // namespace sph2d

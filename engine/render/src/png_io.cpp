@@ -4,9 +4,11 @@
 #include <zlib.h>
 #include <unistd.h>
 
+#include <atomic>
 #include <cerrno>
 #include <csetjmp>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <stdexcept>
 
@@ -73,6 +75,19 @@ bool readRaw(FILE* f, int* width, int* height, std::uint8_t** out, char* err, st
   return true;
 }
 
+/// Test hook: with SPH2D_TEST_FAIL_WRITE_AFTER=N in the environment, the
+/// first N writes of the process succeed and every later one fails as a full
+/// disk would (after its temporary file was written). Tests use it to check
+/// that a failing writer stops the run, names the file and leaves whole PNGs.
+bool injectedWriteFailure() {
+  static const long long failAfter = [] {
+    const char* e = std::getenv("SPH2D_TEST_FAIL_WRITE_AFTER");
+    return e && *e ? std::atoll(e) : -1LL;
+  }();
+  static std::atomic<long long> writes{0};
+  return failAfter >= 0 && writes.fetch_add(1) >= failAfter;
+}
+
 }  // namespace
 
 void writePngAtomic(const std::string& path, int width, int height, const std::uint8_t* rgba, int level) {
@@ -83,6 +98,10 @@ void writePngAtomic(const std::string& path, int width, int height, const std::u
   bool ok = writeRaw(f, width, height, rgba, level, err, sizeof err);
   if (std::fflush(f) != 0 || std::ferror(f)) {
     if (ok) std::snprintf(err, sizeof err, "%s", std::strerror(errno));
+    ok = false;
+  }
+  if (ok && injectedWriteFailure()) {
+    std::snprintf(err, sizeof err, "%s (injected by SPH2D_TEST_FAIL_WRITE_AFTER)", std::strerror(ENOSPC));
     ok = false;
   }
   if (std::fclose(f) != 0 && ok) {

@@ -35,12 +35,17 @@ class SurfaceTension final : public Effect {
 
   std::size_t apply(StepContext& c) override {
     Particles& P = c.P;
-    std::vector<Real>& nx = P.field("surface_tension.nx");
-    std::vector<Real>& ny = P.field("surface_tension.ny");
-    const Vec2* X = P.x.data();
     const bool csf = def_.model == "csf";
+    // Create every field before taking references: creating one may grow
+    // P.extra and move the others (a dangling reference, found by ASan).
+    P.field("surface_tension.nx");
+    P.field("surface_tension.ny");
+    if (csf) P.field("surface_tension.laplacian");
+    std::vector<Real>& nx = *P.find("surface_tension.nx");
+    std::vector<Real>& ny = *P.find("surface_tension.ny");
+    const Vec2* X = P.x.data();
     // Pass 1: normals (and, for CSF, the colour-field Laplacian into a scratch field).
-    std::vector<Real>* lap = csf ? &P.field("surface_tension.laplacian") : nullptr;
+    std::vector<Real>* lap = csf ? P.find("surface_tension.laplacian") : nullptr;
     const Poly6<Real> W6(c.R);
     const WendlandC2<Real> WW(c.R);
     c.pool.parallelFor(P.size(), kBlock, [&](std::size_t b, std::size_t e) {

@@ -1,0 +1,66 @@
+// libFuzzer target for the scene loader (built by -DSPH2D_FUZZ=ON with clang;
+// run it with tests/fuzz/run.sh, see docs/STABILITY.md).
+//
+// Every input must either load or throw SceneError with a message and a sane
+// position; anything else (another exception, a crash, a leak, undefined
+// behaviour, a hang) is a finding. A scene that loads and is small enough is
+// also built into a World and stepped once, so that what the loader lets
+// through is known to be acceptable to Box2D (whose assertions abort) and to
+// the engine.
+#include <cstddef>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <string>
+
+#include "sph2d/scene.hpp"
+#include "sph2d/world.hpp"
+
+namespace {
+
+[[noreturn]] void finding(const char* what, const std::string& detail) {
+  std::fprintf(stderr, "fuzz_scene: %s: %s\n", what, detail.c_str());
+  std::abort();
+}
+
+/// Work a World would do for this scene, in boundary segments of one spacing.
+double worldCost(const sph2d::SceneDef& s) {
+  double len = 0, vertices = 0;
+  for (const auto& b : s.bodies)
+    for (const auto& f : b.fixtures) {
+      vertices += double(f.vertices.size()) + 1;
+      len += 4 * (f.halfSize.x() + f.halfSize.y()) + 6.3 * f.radius;
+      for (std::size_t i = 0; i + 1 < f.vertices.size(); ++i) len += (f.vertices[i + 1] - f.vertices[i]).norm();
+      if (!f.vertices.empty()) len += (f.vertices.front() - f.vertices.back()).norm();
+    }
+  return vertices * 50 + len / s.solver.spacing;
+}
+
+}  // namespace
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  const std::string text(reinterpret_cast<const char*>(data), size);
+  sph2d::SceneDef scene;
+  try {
+    scene = sph2d::parseScene(text, "fuzz.json");
+  } catch (const sph2d::SceneError& e) {
+    if (e.message.empty()) finding("SceneError without a message", e.what());
+    if (e.file != "fuzz.json") finding("SceneError names another file", e.what());
+    if (e.line < 0 || e.column < 0 || (e.line == 0) != (e.column == 0)) finding("SceneError with a bad position", e.what());
+    if (std::string(e.what()).rfind("fuzz.json", 0) != 0) finding("what() does not start with the file", e.what());
+    return 0;
+  }
+  // What the loader promises about an accepted scene.
+  if (!(scene.solver.spacing > 0) || !(scene.fps >= 1 && scene.fps <= 1000) || !(scene.duration * scene.fps <= 1e6))
+    finding("accepted scene out of range", text);
+  const std::size_t particles = sph2d::countBlockParticles(scene);
+  if (particles > scene.maxParticles) finding("accepted scene over max_particles", text);
+  if (particles > 2000 || worldCost(scene) > 20000 || scene.effects.emitters.size() > 4) return 0;
+  try {
+    sph2d::World world(scene, sph2d::WorldOptions{1});
+    world.substep();
+  } catch (const sph2d::SimulationError&) {
+    // The guard stopping a wild scene is a correct outcome.
+  }
+  return 0;
+}
