@@ -691,7 +691,13 @@ SceneDef parseScene(const std::string& text, const std::string& file) {
     r.requireObject(j, p);
     SolverDef& d = s.solver;
     d.type = r.string(j, p, "type", d.type, solverNames());
-    std::vector<std::string> keys = {"type", "spacing", "support_ratio", "rest_density", "sound_speed", "viscosity", "cfl",
+    // A preset instead of a solver, chosen from docs/ACCURACY.md's measurements.
+    if (j.contains("quality")) {
+      if (j.contains("type")) r.fail(Reader::sub(p, "quality"), "give either solver.type or solver.quality, not both");
+      const std::string q = r.string(j, p, "quality", "balanced", {"game", "balanced", "accurate"});
+      d.type = q == "game" ? "pbf" : q == "accurate" ? "dfsph" : "wcsph";
+    }
+    std::vector<std::string> keys = {"type", "quality", "spacing", "support_ratio", "rest_density", "sound_speed", "viscosity", "cfl",
                                      "max_substeps", "clamp_negative_pressure", "reorder_interval", "max_speed"};
     for (const SolverParam& sp : solverParams(d.type)) keys.push_back(sp.key);
     r.checkKeys(j, p, keys);

@@ -89,3 +89,21 @@ TEST_CASE("a missing scene file names the file") {
     CHECK(e.message.find("cannot open") != std::string::npos);
   }
 }
+
+TEST_CASE("solver.quality presets pick a solver, and cannot be combined with solver.type") {
+  CHECK(parseScene("{\"solver\": {\"quality\": \"game\"}}", "q.json").solver.type == "pbf");
+  CHECK(parseScene("{\"solver\": {\"quality\": \"balanced\"}}", "q.json").solver.type == "wcsph");
+  CHECK(parseScene("{\"solver\": {\"quality\": \"accurate\"}}", "q.json").solver.type == "dfsph");
+  try {
+    parseScene("{\"solver\": {\"quality\": \"game\", \"type\": \"wcsph\"}}", "q.json");
+    FAIL("expected SceneError");
+  } catch (const SceneError& e) {
+    CHECK(e.key == "solver.quality");
+  }
+  try {
+    parseScene("{\"solver\": {\"quality\": \"ultra\"}}", "q.json");
+    FAIL("expected SceneError");
+  } catch (const SceneError& e) {
+    CHECK(e.message.find("game, balanced, accurate") != std::string::npos);
+  }
+}
