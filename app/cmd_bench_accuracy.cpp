@@ -41,7 +41,9 @@ const char* kHelp =
     "and two CFL numbers, and writes DIR/accuracy.csv, DIR/accuracy.md and\n"
     "DIR/<case>.png (default DIR: out/accuracy). --quick runs one small resolution and one\n"
     "CFL number per solver (a smoke test of a minute or two). --assets: the assets folder\n"
-    "(default: ./assets). --levels K runs only the K coarsest resolutions (1..3).\n";
+    "(default: ./assets). --levels K runs only the K coarsest resolutions (1..3).\n"
+    "--from-csv A.csv[,B.csv...] runs nothing: it redraws accuracy.csv, accuracy.md and the\n"
+    "charts in DIR from earlier runs' CSV files.\n";
 
 struct Run {
   std::string caseName, solver;
@@ -255,7 +257,7 @@ int cmdBenchAccuracy(const std::vector<std::string>& args) {
   std::string out = "out/accuracy", assets = "assets";
   bool quick = false;
   int threads = 0, levels = 3;
-  std::vector<std::string> solvers;
+  std::vector<std::string> solvers, fromCsv;
   for (std::size_t i = 0; i < args.size(); ++i) {
     const std::string& a = args[i];
     auto value = [&]() -> std::string {
@@ -270,11 +272,44 @@ int cmdBenchAccuracy(const std::vector<std::string>& args) {
     else if (a == "--quick") quick = true;
     else if (a == "--threads") threads = parseInt(a, value(), 1, 256);
     else if (a == "--levels") levels = parseInt(a, value(), 1, 3);
+    else if (a == "--from-csv") {
+      std::stringstream ss(value());
+      std::string item;
+      while (std::getline(ss, item, ',')) fromCsv.push_back(item);
+    }
     else if (a == "--solvers") {
       std::stringstream ss(value());
       std::string item;
       while (std::getline(ss, item, ',')) solvers.push_back(item);
     } else throw UsageError("unknown option '" + a + "' (see sph2d bench accuracy --help)");
+  }
+  std::vector<Run> runs;
+  if (!fromCsv.empty()) {
+    for (const std::string& path : fromCsv) {
+      std::ifstream in(path);
+      if (!in) throw UsageError("cannot open " + path);
+      std::string line;
+      std::getline(in, line);  // header
+      while (std::getline(in, line)) {
+        std::vector<std::string> f;
+        std::stringstream ls(line);
+        std::string cell;
+        while (std::getline(ls, cell, ',')) f.push_back(cell);
+        if (f.size() != 10) throw UsageError(path + ": expected 10 columns in '" + line + "'");
+        Run r;
+        r.caseName = f[0];
+        r.solver = f[1];
+        r.particles = std::size_t(std::stoull(f[2]));
+        r.cfl = std::stod(f[3]);
+        r.errorName = f[4];
+        r.error = std::stod(f[5]);
+        r.meanDensityError = std::stod(f[6]);
+        r.maxDensityError = std::stod(f[7]);
+        r.wallPerSim = std::stod(f[8]);
+        r.msPerStep = std::stod(f[9]);
+        runs.push_back(r);
+      }
+    }
   }
   SceneDef dam = loadScene(assets + "/scenes/validation/dam_break.json");
   SceneDef hydro = loadScene(assets + "/scenes/validation/hydrostatic_tank.json");
@@ -303,7 +338,7 @@ int cmdBenchAccuracy(const std::vector<std::string>& args) {
     hydroSpacings.resize(std::size_t(levels));
   }
   const std::vector<double> cflScales = quick ? std::vector<double>{1.0} : std::vector<double>{1.0, 2.0};
-  std::vector<Run> runs;
+  if (!fromCsv.empty()) known.clear();  // redraw only
   std::printf("%-12s %-11s %9s %6s %-26s %10s %10s %10s %12s %10s\n", "case", "solver", "particles", "cfl", "error_name",
               "error", "mean_rho", "max_rho", "wall/sim_s", "ms/step");
   auto report = [&](const Run& r) {
