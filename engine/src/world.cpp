@@ -599,6 +599,7 @@ double World::time() const { return impl_->time; }
 std::uint64_t World::frame() const { return impl_->frames; }
 std::uint64_t World::substeps() const { return impl_->steps; }
 int World::lastFrameSubsteps() const { return impl_->lastSubsteps; }
+double World::stableTimeStep() const { return double(impl_->stableDt()); }
 Real World::particleMass() const { return impl_->mass; }
 Real World::support() const { return impl_->R; }
 Real World::spacing() const { return impl_->dx; }

@@ -105,6 +105,8 @@ class World {
   std::uint64_t frame() const;
   /// Substeps taken.
   std::uint64_t substeps() const;
+  /// The substep length [s] the limits (CFL, force, effects) allow in the current state.
+  double stableTimeStep() const;
   /// Substeps of the last frame.
   int lastFrameSubsteps() const;
   /// Particle mass [kg] (all particles share it).
