@@ -576,7 +576,8 @@ int cmdRun(const std::vector<std::string>& args) {
   std::printf("sph2d: worst density error %.3f %% (the largest per-frame mean compression, at frame %lld); "
               "largest single-particle compression %.3f %% (frame %lld)\n",
               100 * worstMean, (long long)worstMeanFrame, 100 * worstMax, (long long)worstMaxFrame);
-  std::printf("sph2d: %d events applied, %d warnings%s%s\n", applied, warningCount,
+  std::printf("sph2d: %d event%s applied, %d warning%s%s%s\n", applied, applied == 1 ? "" : "s", warningCount,
+              warningCount == 1 ? "" : "s",
               record.is_open() ? "; events recorded in " : "", record.is_open() ? a.record.c_str() : "");
   if (a.realtime)
     std::printf("sph2d: realtime at %.4g fps: %llu frames dropped (stepped but not rendered, to keep up), %llu frames late "

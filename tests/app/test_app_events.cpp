@@ -86,7 +86,7 @@ TEST_CASE("a run fed live events through a pipe is recorded, and replaying the r
     prev = e.at("frame").get<long long>();
   }
   CHECK(json::parse(recorded[0]).at("type") == "drop");
-  CHECK(a.out.find(std::to_string(recorded.size()) + " events applied") != std::string::npos);
+  CHECK(a.out.find(std::to_string(recorded.size()) + " events applied, 1 warning;") != std::string::npos);
 
   const Result b = run("run " + q(kSmall) + " --frames 20 --threads 1 --input " + q(rec) + " --out " + q(replay) +
                        " --state-hash --quiet");
@@ -121,7 +121,7 @@ TEST_CASE("the timeline applies each event at its frame, before that frame is re
   r = run("run " + q(gravity) + common + q(outG));
   INFO(r.out);
   REQUIRE(r.code == 0);
-  CHECK(r.out.find("1 events applied") != std::string::npos);
+  CHECK(r.out.find("1 event applied, 0 warnings") != std::string::npos);
   r = run("run " + q(drop) + common + q(outD));
   REQUIRE(r.code == 0);
   const auto p = column(readManifest(plain), "state_hash"), g = column(readManifest(outG), "state_hash"),
