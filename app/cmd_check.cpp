@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "cli.hpp"
+#include "events.hpp"
 #include "sph2d/hash.hpp"
 #include "sph2d/render/png_io.hpp"
 #include "sph2d/render/renderer.hpp"
@@ -31,6 +32,8 @@ const char* kCheckHelp =
     "frame, counts its differing pixels and the largest channel difference against the\n"
     "reference PNG beside MANIFEST, writes DIR/frame_NNNNN.png (this run) and\n"
     "DIR/diff_NNNNN.png (differences in red over a dimmed reference), and exits 1.\n"
+    "The events the manifest lists (the run's timeline, --input files and live input)\n"
+    "are applied at their frames, so runs driven by input check like any other.\n"
     "Mesa settings the manifest recorded (GALLIUM_OVERRIDE_CPU_CAPS, ...) are used\n"
     "unless set in this environment; a different renderer or CPU is named plainly.\n"
     "\n"
@@ -152,6 +155,22 @@ int cmdCheck(const std::vector<std::string>& args) {
       if (!quiet && e.value("source", "") == "user")
         std::printf("note: using %s=%s as the manifest's run did\n", name.c_str(), value.c_str());
     }
+  // The events the manifest's run applied, at their frames (a manifest without an event list:
+  // the scene's own timeline).
+  std::map<std::int64_t, std::vector<EventDef>> events;
+  if (m.contains("events") && m["events"].is_array()) {
+    for (std::size_t k = 0; k < m["events"].size(); ++k) {
+      try {
+        const EventDef e = parseEvent(m["events"][k].dump(), manifestPath + " events[" + std::to_string(k) + "]", 1, scene);
+        events[eventFrame(e, scene.fps)].push_back(e);
+      } catch (const SceneError& e) {
+        throw UsageError(std::string("the manifest's event is malformed: ") + e.what());
+      }
+    }
+  } else {
+    for (const EventDef& e : scene.events) events[eventFrame(e, scene.fps)].push_back(e);
+  }
+  EventApplier applier;
   World world(scene, WorldOptions{threads});
   world.takeWarnings();
   Renderer renderer(scene.render, opt);
@@ -180,6 +199,11 @@ int cmdCheck(const std::vector<std::string>& args) {
   try {
     for (int f = 0; f <= last && f < frames; ++f) {
       if (f > 0) world.stepFrame();
+      if (events.count(f))
+        for (const EventDef& e : events[f]) {
+          const std::string err = applier.apply(world, e);
+          if (!err.empty()) std::printf("note: frame %d: %s not applied: %s\n", f, describeEvent(e).c_str(), err.c_str());
+        }
       world.takeWarnings();
       if (f % every != 0 || !expected.count(f)) continue;
       const json& e = expected[f];

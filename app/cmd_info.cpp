@@ -1,8 +1,10 @@
 // `sph2d info`: what a scene will simulate, without running it.
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 
 #include "cli.hpp"
+#include "events.hpp"
 #include "sph2d/scene.hpp"
 #include "sph2d/world.hpp"
 
@@ -12,7 +14,13 @@ namespace {
 const char* kInfoHelp =
     "Usage: sph2d info SCENE.json [--threads T]\n"
     "\n"
-    "Prints the scene's particles, solver, boundaries, frames and memory without running it.\n";
+    "Prints what SCENE will simulate, without running it: particles, solver, effects\n"
+    "and stages, emitters, boundaries, frames and the substeps per frame the initial\n"
+    "state needs, the timeline's events, memory and the image.\n"
+    "\n"
+    "Options:\n"
+    "  --threads T     job-system threads (default: all cores)\n"
+    "  --help          this text\n";
 
 }  // namespace
 
@@ -41,17 +49,51 @@ int cmdInfo(const std::vector<std::string>& args) {
   for (const auto& m : w.takeWarnings()) std::printf("warning: %s\n", m.c_str());
   std::size_t fixtures = 0;
   for (const auto& b : s.bodies) fixtures += b.fixtures.size();
+  auto list = [](const std::vector<std::string>& v) {
+    std::string out;
+    for (const auto& x : v) out += (out.empty() ? "" : ", ") + x;
+    return out.empty() ? std::string("none") : out;
+  };
   std::printf("scene        %s (%s)\n", s.name.c_str(), path.c_str());
   std::printf("particles    %zu (spacing %.4g m, support %.4g m, mass %.4g kg)\n", w.particleCount(), w.spacing(),
               w.support(), w.particleMass());
   std::printf("solver       %s, c = %.4g m/s, viscosity %.4g m^2/s, cfl %.3g, max %d substeps/frame\n",
               s.solver.type.c_str(), s.solver.soundSpeed, s.solver.viscosity, s.solver.cfl, s.solver.maxSubsteps);
+  if (!s.solver.params.empty()) {
+    std::string params;
+    for (const auto& p : s.solver.params) {
+      char buf[96];
+      std::snprintf(buf, sizeof buf, "%s%s %.4g", params.empty() ? "" : ", ", p.first.c_str(), p.second);
+      params += buf;
+    }
+    std::printf("             %s parameters: %s\n", s.solver.type.c_str(), params.c_str());
+  }
+  std::printf("effects      %s\n", list(w.effects()).c_str());
+  if (w.emitterCount()) {
+    double rate = 0;
+    for (const auto& e : s.effects.emitters) rate += e.rate;
+    std::printf("emitters     %zu, %.4g particles/s in all; budget %zu (%s)\n", w.emitterCount(), rate,
+                s.effects.budget ? s.effects.budget : s.maxParticles,
+                s.effects.budgetPolicy == BudgetPolicy::RecycleOldest ? "recycle_oldest" : "stop_emitting");
+  }
   std::printf("boundaries   %zu static bodies, %zu fixtures, %zu colliders, %zu boundary samples\n", s.bodies.size(),
               fixtures, w.colliders().size(), w.boundarySamples().size());
-  const double dtRest = s.solver.cfl * w.support() / s.solver.soundSpeed;
-  std::printf("frames       %d at %.4g fps (%.4g s); about %.0f substeps per frame at rest\n",
-              int(std::lround(s.duration * s.fps)), s.fps, s.duration, std::ceil(1.0 / s.fps / dtRest));
-  std::printf("memory       %.1f MB of particle arrays\n", double(w.particles().bytes()) / 1e6);
+  const double dt = w.stableTimeStep();
+  const int substeps = std::min(s.solver.maxSubsteps, int(std::ceil(1.0 / s.fps / dt - 1e-9)));
+  std::printf("frames       %d at %.4g fps (%.4g s); %d substeps per frame in the initial state (substep %.3g ms, "
+              "at most %d; more once the fluid moves: the CFL limit shrinks with speed)\n",
+              int(std::lround(s.duration * s.fps)), s.fps, s.duration, substeps, 1e3 * dt, s.solver.maxSubsteps);
+  std::printf("events       %zu in the timeline\n", s.events.size());
+  for (const EventDef& e : s.events)
+    std::printf("             frame %lld: %s\n", (long long)eventFrame(e, s.fps), describeEvent(e).c_str());
+  const double mb = double(w.memoryBytes()) / 1e6;
+  std::printf("memory       %.1f MB (particle arrays %.1f MB; grid, neighbour lists, boundary samples)", mb,
+              double(w.particles().bytes()) / 1e6);
+  if (w.emitterCount() && w.particleCount() > 0) {
+    const std::size_t budget = s.effects.budget ? s.effects.budget : s.maxParticles;
+    std::printf("; about %.1f MB at the budget of %zu particles", mb / double(w.particleCount()) * double(budget), budget);
+  }
+  std::printf("\n");
   std::printf("image        %dx%d, %s mode\n", s.render.width, s.render.height, s.render.mode.c_str());
   return 0;
 }

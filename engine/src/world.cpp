@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstring>
+#include <functional>
 #include <sstream>
 
 #include "effects/effect.hpp"
@@ -169,7 +170,9 @@ struct World::Impl final : StageRunner {
   /// ρ = ρ0(1 + f g z) with the solver's factor f (2/c² for muller2003, whose
   /// symmetric force recovers ∇p/2; 1/c0² for wcsph). Started uncompressed, a
   /// column would ring in its acoustic mode with a speed amplitude of about g·H/c.
-  std::size_t fillBlock(const FluidBlockDef& b, bool hydrostaticStart) {
+  /// `keep` (optional) selects lattice points by world position (addDrop's disc).
+  std::size_t fillBlock(const FluidBlockDef& b, bool hydrostaticStart,
+                        const std::function<bool(const Vec2d&)>& keep = nullptr) {
     const SolverDef& sd = scene.solver;
     const double hydroFactor = solver->hydrostaticFactor();
     const bool hydrostatic = hydrostaticStart && hydroFactor > 0 && scene.gravity.x() == 0 && scene.gravity.y() < 0;
@@ -191,6 +194,7 @@ struct World::Impl final : StageRunner {
     for (long j = 0; j < ny; ++j)
       for (long i = 0; i < nx; ++i) {
         const Vec2d pw(b.min.x() + (double(i) + 0.5) * sd.spacing, rowY[std::size_t(j)]);
+        if (keep && !keep(pw)) continue;
         const Vec2 p = Vec2(Real(pw.x() - origin.x()), Real(pw.y() - origin.y()));
         if (boundary.insideDepth(p) > 0) {
           dlo = dropped ? dlo.cwiseMin(pw) : pw;
@@ -527,6 +531,27 @@ void World::setGravity(const Vec2d& g) { impl_->scene.gravity = g; }
 
 std::size_t World::addBlock(const FluidBlockDef& block) { return impl_->fillBlock(block, false); }
 
+std::size_t World::addDrop(const Vec2d& center, double radius, const Vec2d& velocity) {
+  // A square patch of 2k × 2k lattice points centred on `center` (k spacings each
+  // side covers the radius); the extra half spacing makes the count exact in floats.
+  const double dx = impl_->scene.solver.spacing;
+  const double half = std::ceil(radius / dx - 1e-9) * dx;
+  FluidBlockDef b;
+  b.min = center - Vec2d(half, half);
+  b.max = center + Vec2d(half + 0.5 * dx, half + 0.5 * dx);
+  b.velocity = velocity;
+  return impl_->fillBlock(b, false, [&](const Vec2d& p) { return (p - center).squaredNorm() <= radius * radius; });
+}
+
+void World::moveEmitter(std::size_t index, const Vec2d& position, const Vec2d& direction) {
+  EmitterDef& d = impl_->emitters.at(index).def;
+  if (!(direction.norm() > 0)) throw std::invalid_argument("moveEmitter: the direction must not be zero");
+  d.position = position;
+  d.direction = direction.normalized();
+}
+
+const EmitterDef& World::emitter(std::size_t index) const { return impl_->emitters.at(index).def; }
+
 std::size_t World::removeParticlesInBox(const Vec2d& lo, const Vec2d& hi) {
   Impl& w = *impl_;
   const RegionDef r{lo, hi};
@@ -590,6 +615,7 @@ double World::time() const { return impl_->time; }
 std::uint64_t World::frame() const { return impl_->frames; }
 std::uint64_t World::substeps() const { return impl_->steps; }
 int World::lastFrameSubsteps() const { return impl_->lastSubsteps; }
+double World::stableTimeStep() const { return double(impl_->stableDt()); }
 Real World::particleMass() const { return impl_->mass; }
 Real World::support() const { return impl_->R; }
 Real World::spacing() const { return impl_->dx; }

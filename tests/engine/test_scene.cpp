@@ -41,7 +41,7 @@ TEST_CASE("an unknown key names file, line, column, the key path and the allowed
   CHECK(e.line == 4);
   CHECK(e.column == 5);
   CHECK(e.key == "solver.spacng");
-  CHECK(std::string(e.what()).find("allowed keys: type, spacing") != std::string::npos);
+  CHECK(std::string(e.what()).find("allowed keys: type, quality, spacing") != std::string::npos);
   CHECK(std::string(e.what()).rfind("bad.json:4:5: key 'solver.spacng'", 0) == 0);
 }
 

@@ -105,6 +105,8 @@ class World {
   std::uint64_t frame() const;
   /// Substeps taken.
   std::uint64_t substeps() const;
+  /// The substep length [s] the limits (CFL, force, effects) allow in the current state.
+  double stableTimeStep() const;
   /// Substeps of the last frame.
   int lastFrameSubsteps() const;
   /// Particle mass [kg] (all particles share it).
@@ -138,6 +140,10 @@ class World {
   /// Adds a block of fluid on the lattice of the scene's spacing (particles
   /// inside solids are skipped). Returns the number of particles added.
   std::size_t addBlock(const FluidBlockDef& block);
+  /// Adds a drop of fluid: the lattice points of a block around `center` that lie
+  /// within `radius` (world coordinates), moving at `velocity`; points inside
+  /// solids are skipped. Returns the number of particles added.
+  std::size_t addDrop(const Vec2d& center, double radius, const Vec2d& velocity = Vec2d(0, 0));
   /// Removes the particles inside the box [lo, hi] (world coordinates). Returns how many.
   std::size_t removeParticlesInBox(const Vec2d& lo, const Vec2d& hi);
   /// Slots of the particles within `radius` of `center` (world coordinates), in slot order.
@@ -162,6 +168,12 @@ class World {
   void setUserForces(const std::vector<UserForce>& forces);
   /// Enables or disables emitter `index` (scene order). Throws std::out_of_range.
   void setEmitterEnabled(std::size_t index, bool enabled);
+  /// Moves emitter `index` to `position` shooting along `direction` (normalised here)
+  /// from the next substep on; its timing, seed and count continue. Throws
+  /// std::out_of_range for a bad index, std::invalid_argument for a zero direction.
+  void moveEmitter(std::size_t index, const Vec2d& position, const Vec2d& direction);
+  /// The current settings of emitter `index` (position, direction, enabled...). Throws std::out_of_range.
+  const EmitterDef& emitter(std::size_t index) const;
   /// Number of emitters of the scene.
   std::size_t emitterCount() const;
   /// Switches an effect the scene enables ("viscosity", "xsph", "force_fields",

@@ -1,0 +1,237 @@
+// The game loop end to end: input events from live standard input, files and the
+// scene's timeline, applied at frame boundaries; records that replay bit for bit;
+// bad lines skipped with their line number; real-time pacing; the frame clock.
+#include <doctest/doctest.h>
+
+#include <chrono>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "app_util.hpp"
+#include "frame_clock.hpp"
+
+using namespace sph2d;
+using namespace sph2d::apptest;
+using nlohmann::json;
+
+namespace {
+
+const std::string kSmall = asset("scenes/tests/small_dam_break.json");
+
+json readManifest(const std::string& dir) { return json::parse(readText(dir + "/manifest.json")); }
+
+std::vector<std::string> column(const json& m, const char* key) {
+  std::vector<std::string> h;
+  for (const auto& f : m.at("frames")) h.push_back(f.at(key).get<std::string>());
+  return h;
+}
+
+/// The value after "state-hash: " in a run's output.
+std::string stateHashOf(const std::string& out) {
+  const auto at = out.rfind("state-hash: ");
+  return at == std::string::npos ? "" : out.substr(at + 12, 16);
+}
+
+std::vector<std::string> lines(const std::string& text) {
+  std::vector<std::string> out;
+  std::istringstream in(text);
+  std::string l;
+  while (std::getline(in, l))
+    if (!l.empty()) out.push_back(l);
+  return out;
+}
+
+/// small_dam_break.json with an `events` key added.
+std::string sceneWithEvents(const std::string& name, const std::string& events) {
+  std::string text = readText(kSmall);
+  const auto end = text.rfind('}');
+  text = text.substr(0, end) + ",\n  \"events\": " + events + "\n}\n";
+  const std::string path = freshDir(name) + "/scene.json";
+  std::ofstream(path) << text;
+  return path;
+}
+
+}  // namespace
+
+TEST_CASE("a run fed live events through a pipe is recorded, and replaying the record gives the same hashes") {
+  const std::string dir = freshDir("live_record"), replay = freshDir("live_replay");
+  const std::string rec = dir + "/run.jsonl";
+  // Lines arrive while the run goes: a drop, a gravity change, a bad line, a push, then a
+  // pause that holds the loop until the resume 0.3 s later, an effect switch and a release.
+  // When each line lands depends on the machine; the record says, and the replay must agree.
+  const std::string feed =
+      "(printf '%s\\n' '{\"type\": \"drop\", \"center\": [2, 2], \"radius\": 0.15}' "
+      "'{\"type\": \"gravity\", \"gravity\": [3, -9]}' 'not json' "
+      "'{\"type\": \"force\", \"point\": [1, 0.5], \"radius\": 0.4, \"strength\": -20}'; sleep 0.3; "
+      "printf '%s\\n' '{\"type\": \"pause\"}'; sleep 0.3; "
+      "printf '%s\\n' '{\"type\": \"resume\"}' '{\"type\": \"effect\", \"name\": \"user_force\", \"enabled\": false}' "
+      "'{\"type\": \"release\"}') | ";
+  const Result a = run("run " + q(kSmall) + " --frames 20 --threads 2 --input - --record " + q(rec) + " --out " + q(dir) +
+                           " --state-hash",
+                       feed);
+  INFO(a.out);
+  REQUIRE(a.code == 0);
+  CHECK(a.out.find("warning: stdin:3:1: invalid JSON") != std::string::npos);
+  const auto recorded = lines(readText(rec));
+  MESSAGE(recorded.size() << " events recorded:\n" << readText(rec));
+  REQUIRE(recorded.size() >= 3);  // the first three valid lines arrive before the run starts stepping
+  long long prev = -1;
+  for (const std::string& l : recorded) {
+    const json e = json::parse(l);
+    CHECK(e.at("source").get<std::string>() == "live");
+    CHECK(e.at("frame").get<long long>() >= prev);  // applied in order, at frame boundaries
+    prev = e.at("frame").get<long long>();
+  }
+  CHECK(json::parse(recorded[0]).at("type") == "drop");
+  CHECK(a.out.find(std::to_string(recorded.size()) + " events applied, 1 warning;") != std::string::npos);
+
+  const Result b = run("run " + q(kSmall) + " --frames 20 --threads 1 --input " + q(rec) + " --out " + q(replay) +
+                       " --state-hash --quiet");
+  INFO(b.out);
+  REQUIRE(b.code == 0);
+  CHECK(b.out.find(std::to_string(recorded.size()) + " events applied") != std::string::npos);
+  CHECK(stateHashOf(a.out).size() == 16);
+  CHECK(stateHashOf(a.out) == stateHashOf(b.out));
+  const json ma = readManifest(dir), mb = readManifest(replay);
+  CHECK(column(ma, "state_hash") == column(mb, "state_hash"));
+  CHECK(column(ma, "rgba_xxh64") == column(mb, "rgba_xxh64"));
+  CHECK(column(ma, "rgba_xxh64").size() == 20);
+  CHECK(ma.at("events") == mb.at("events"));
+  // sph2d check applies the events the manifest lists.
+  const Result c = run("check " + q(kSmall) + " --against " + q(dir + "/manifest.json") + " --threads 2 --out " +
+                       q(dir + "/check"));
+  INFO(c.out);
+  CHECK(c.code == 0);
+  CHECK(c.out.find("OK, 20 frames match") != std::string::npos);
+}
+
+TEST_CASE("the timeline applies each event at its frame, before that frame is rendered") {
+  // 60 fps: t = 0.25 s is frame 15. Gravity changes the state only from the step after it;
+  // a drop is part of the frame it is applied at.
+  const std::string plain = freshDir("timeline_plain");
+  const std::string gravity = sceneWithEvents("timeline_gravity", R"([ { "t": 0.25, "type": "gravity", "gravity": [4, -9.81] } ])");
+  const std::string drop = sceneWithEvents("timeline_drop", R"([ { "frame": 10, "type": "drop", "center": [3, 2], "radius": 0.2 } ])");
+  const std::string outG = fs::path(gravity).parent_path().string() + "/out", outD = fs::path(drop).parent_path().string() + "/out";
+  const std::string common = " --frames 20 --threads 2 --quiet --out ";
+  Result r = run("run " + q(kSmall) + common + q(plain));
+  REQUIRE(r.code == 0);
+  r = run("run " + q(gravity) + common + q(outG));
+  INFO(r.out);
+  REQUIRE(r.code == 0);
+  CHECK(r.out.find("1 event applied, 0 warnings") != std::string::npos);
+  r = run("run " + q(drop) + common + q(outD));
+  REQUIRE(r.code == 0);
+  const auto p = column(readManifest(plain), "state_hash"), g = column(readManifest(outG), "state_hash"),
+             d = column(readManifest(outD), "state_hash");
+  REQUIRE(p.size() == 20);
+  REQUIRE(g.size() == 20);
+  REQUIRE(d.size() == 20);
+  for (int f = 0; f < 20; ++f) {
+    CAPTURE(f);
+    if (f <= 15) CHECK(g[f] == p[f]);  // through frame 15: gravity has not acted yet
+    else CHECK(g[f] != p[f]);
+    if (f < 10) CHECK(d[f] == p[f]);
+    else CHECK(d[f] != p[f]);  // the drop is in frame 10 already
+  }
+  const json m = readManifest(outG);
+  REQUIRE(m.at("events").size() == 1);
+  CHECK(m.at("events")[0].at("frame").get<int>() == 15);
+  CHECK(m.at("events")[0].at("source").get<std::string>() == "scene");
+}
+
+TEST_CASE("a bad event line is reported with its line number and skipped, and the run finishes") {
+  const std::string dir = freshDir("bad_line");
+  const std::string events = dir + "/events.jsonl";
+  std::ofstream(events) << "{\"frame\": 2, \"type\": \"drop\", \"center\": [2, 2], \"radius\": 0.1}\n"
+                        << "{\"frame\": 3, \"type\": \"gravity\", \"gravity\": [1, -9.81]\n"  // unterminated
+                        << "\n"
+                        << "{\"frame\": 4, \"type\": \"drop\", \"center\": [2, 2], \"radius\": -1}\n"
+                        << "{\"frame\": 5, \"type\": \"effect\", \"name\": \"xsph\", \"enabled\": true}\n"
+                        << "{\"frame\": 6, \"type\": \"force\", \"point\": [1, 1], \"strength\": 20}\n";
+  const Result r = run("run " + q(kSmall) + " --frames 8 --threads 2 --no-images --input " + q(events));
+  INFO(r.out);
+  CHECK(r.code == 0);
+  CHECK(r.out.find("warning: " + events + ":2:") != std::string::npos);
+  CHECK(r.out.find("invalid JSON") != std::string::npos);
+  CHECK(r.out.find("warning: " + events + ":4:") != std::string::npos);
+  CHECK(r.out.find("key 'radius': value -1 is out of range") != std::string::npos);
+  CHECK(r.out.find("warning: " + events + ":5:") != std::string::npos);
+  CHECK(r.out.find("'xsph' is not allowed; allowed values: viscosity, user_force (line skipped)") != std::string::npos);
+  CHECK(r.out.find("2 events from") != std::string::npos);
+  CHECK(r.out.find("sph2d: 8 frames") != std::string::npos);
+  CHECK(r.out.find("2 events applied, 3 warnings") != std::string::npos);
+  CHECK(r.out.find("worst density error") != std::string::npos);
+}
+
+TEST_CASE("bad input sources and timeline events exit 2 with a message") {
+  Result r = run("run " + q(kSmall) + " --frames 2 --no-images --input /nonexistent/events.jsonl");
+  CHECK(r.code == 2);
+  CHECK(r.out.find("cannot read the events file /nonexistent/events.jsonl") != std::string::npos);
+  r = run("run " + q(kSmall) + " --frames 2 --no-images --input - --input -");
+  CHECK(r.code == 2);
+  CHECK(r.out.find("--input - may be given once") != std::string::npos);
+  r = run("run " + q(kSmall) + " --frames 2 --no-images --record /nonexistent/dir/run.jsonl");
+  CHECK(r.code == 2);
+  const std::string bad = sceneWithEvents("timeline_bad", R"([ { "t": 1, "type": "emitter", "index": 0, "enabled": true } ])");
+  r = run("run " + q(bad) + " --frames 2 --no-images");
+  CHECK(r.code == 2);
+  CHECK(r.out.find(bad + ":17:25: key 'events[0].type': the scene has no emitters") != std::string::npos);
+  r = run("run --help");
+  CHECK(r.code == 0);
+  for (const char* flag : {"--realtime", "--catch-up N", "--input FILE", "--input -", "--record FILE", "Exit codes:"})
+    CHECK(r.out.find(flag) != std::string::npos);
+}
+
+TEST_CASE("--realtime keeps pace with the wall clock and reports dropped and late frames") {
+  // A tiny scene steps far faster than real time: 31 frames at 60 fps must take at least 0.5 s.
+  const std::string path = freshDir("realtime") + "/tiny.json";
+  std::ofstream(path) << R"({ "name": "tiny", "fps": 60, "solver": { "spacing": 0.05 },
+    "boundaries": [ { "fixtures": [ { "shape": "box", "center": [0.5, -0.1], "half_size": [0.7, 0.1] } ] } ],
+    "fluid": [ { "min": [0, 0], "max": [0.3, 0.3] } ] })";
+  const auto t0 = std::chrono::steady_clock::now();
+  Result r = run("run " + q(path) + " --frames 31 --threads 1 --no-images --realtime --state-hash");
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  INFO(r.out);
+  REQUIRE(r.code == 0);
+  MESSAGE("31 frames at 60 fps in real time took " << wall << " s");
+  CHECK(wall >= 0.5);
+  CHECK(r.out.find("sph2d: realtime at 60 fps: ") != std::string::npos);
+  CHECK(r.out.find("frames late (the simulation fell") != std::string::npos);
+  // Pacing changes when frames are computed, never what they are.
+  const Result h = run("run " + q(path) + " --frames 31 --threads 1 --no-images --state-hash");
+  CHECK(stateHashOf(h.out) == stateHashOf(r.out));
+}
+
+TEST_CASE("the frame clock steps whole frames, waits when ahead and forgets the backlog beyond its catch-up") {
+  using sph2d::cli::FrameClock;
+  FrameClock c(0.1, true, 4);
+  c.resync(10.0);
+  c.tick(10.05);
+  CHECK_FALSE(c.due());
+  CHECK(c.untilDue() == doctest::Approx(0.05));
+  c.tick(10.1);
+  CHECK(c.due());
+  c.consume();
+  CHECK_FALSE(c.due());
+  c.tick(11.0);  // 0.9 s late: 9 frames due
+  int steps = 0;
+  while (c.due() && steps < c.maxStepsPerRender()) {
+    c.consume();
+    ++steps;
+  }
+  CHECK(steps == 4);
+  CHECK(c.dropBacklog() == 5);
+  CHECK(c.late() == 5);
+  CHECK(c.behindSeconds() == doctest::Approx(0.5));
+  CHECK_FALSE(c.due());
+  FrameClock h(0.1, false, 4);  // headless: one frame per tick, never a wait
+  h.resync(0);
+  h.tick(0);
+  CHECK(h.due());
+  h.consume();
+  CHECK_FALSE(h.due());
+  CHECK(h.untilDue() == 0);
+}
