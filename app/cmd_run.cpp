@@ -579,6 +579,9 @@ int cmdRun(const std::vector<std::string>& args) {
   std::printf("sph2d: %d event%s applied, %d warning%s%s%s\n", applied, applied == 1 ? "" : "s", warningCount,
               warningCount == 1 ? "" : "s",
               record.is_open() ? "; events recorded in " : "", record.is_open() ? a.record.c_str() : "");
+  if (schedule.pending() && status == 0)
+    std::printf("sph2d: %zu event%s never applied: stamped after the last frame (%d)\n", schedule.pending(),
+                schedule.pending() == 1 ? " was" : "s were", frames - 1);
   if (a.realtime)
     std::printf("sph2d: realtime at %.4g fps: %llu frames dropped (stepped but not rendered, to keep up), %llu frames late "
                 "(the simulation fell %.3f s behind the wall clock)\n",

@@ -150,7 +150,8 @@ TEST_CASE("a bad event line is reported with its line number and skipped, and th
                         << "\n"
                         << "{\"frame\": 4, \"type\": \"drop\", \"center\": [2, 2], \"radius\": -1}\n"
                         << "{\"frame\": 5, \"type\": \"effect\", \"name\": \"xsph\", \"enabled\": true}\n"
-                        << "{\"frame\": 6, \"type\": \"force\", \"point\": [1, 1], \"strength\": 20}\n";
+                        << "{\"frame\": 6, \"type\": \"force\", \"point\": [1, 1], \"strength\": 20}\n"
+                        << "{\"t\": 10, \"type\": \"release\"}\n";  // after the run's last frame
   const Result r = run("run " + q(kSmall) + " --frames 8 --threads 2 --no-images --input " + q(events));
   INFO(r.out);
   CHECK(r.code == 0);
@@ -160,9 +161,10 @@ TEST_CASE("a bad event line is reported with its line number and skipped, and th
   CHECK(r.out.find("key 'radius': value -1 is out of range") != std::string::npos);
   CHECK(r.out.find("warning: " + events + ":5:") != std::string::npos);
   CHECK(r.out.find("'xsph' is not allowed; allowed values: viscosity, user_force (line skipped)") != std::string::npos);
-  CHECK(r.out.find("2 events from") != std::string::npos);
+  CHECK(r.out.find("3 events from") != std::string::npos);
   CHECK(r.out.find("sph2d: 8 frames") != std::string::npos);
   CHECK(r.out.find("2 events applied, 3 warnings") != std::string::npos);
+  CHECK(r.out.find("1 event was never applied: stamped after the last frame (7)") != std::string::npos);
   CHECK(r.out.find("worst density error") != std::string::npos);
 }
 
