@@ -56,7 +56,7 @@ struct UserForce {
 /// Density error of the fluid, relative to ρ0.
 struct DensityStats {
   double meanError = 0;  ///< mean of max(ρ − ρ0, 0)/ρ0 over particles (compression)
-  double maxError = 0;   ///< max of |ρ − ρ0|/ρ0 over particles with a full neighbourhood
+  double maxError = 0;   ///< max of max(ρ − ρ0, 0)/ρ0 over particles (the most compressed particle)
   double meanDensity = 0;
 };
 
