@@ -51,6 +51,28 @@ class Solver {
   virtual SolverStats stats() const { return {}; }
 };
 
+/// True when this substep reorders particle storage along the grid.
+inline bool reorderThisStep(const StepContext& c) {
+  const int every = c.def.reorderInterval;
+  return every > 0 && c.step % std::uint64_t(every) == 0;
+}
+
+/// The substep of the equation-of-state solvers (muller2003, wcsph):
+/// grid → neighbours → density → pressure → pressure_force → effects → integrate.
+/// density(c) and pressureForce(c) return the first bad slot; pressure(c) returns nothing.
+template <class Density, class Pressure, class Force>
+void explicitSubstep(StepContext& c, StageRunner& run, const EffectList& effects, Density density, Pressure pressure,
+                     Force pressureForce) {
+  const bool reorder = reorderThisStep(c);
+  run.run("grid", [&] { stageGrid(c, reorder); });
+  run.run("neighbours", [&] { stageNeighbours(c); });
+  run.checked("density", [&] { return density(c); });
+  run.run("pressure", [&] { pressure(c); });
+  run.checked("pressure_force", [&] { return pressureForce(c); });
+  applyEffects(c, run, effects);
+  run.checked("integrate", [&] { return stageIntegrate(c); });
+}
+
 /// One solver-specific scene key (under "solver").
 struct SolverParam {
   std::string key;   ///< scene key

@@ -64,15 +64,9 @@ class Wcsph final : public Solver {
 
   void substep(StepContext& c, StageRunner& run, const EffectList& effects) override {
     const WendlandC2<Real> W(c.R);
-    const int every = c.def.reorderInterval;
-    const bool reorder = every > 0 && c.step % std::uint64_t(every) == 0;
-    run.run("grid", [&] { stageGrid(c, reorder); });
-    run.run("neighbours", [&] { stageNeighbours(c); });
-    run.checked("density", [&] { return density(c, W); });
-    run.run("pressure", [&] { pressure(c); });
-    run.checked("pressure_force", [&] { return pressureForce(c, W); });
-    applyEffects(c, run, effects);
-    run.checked("integrate", [&] { return stageIntegrate(c); });
+    explicitSubstep(
+        c, run, effects, [&](StepContext& cc) { return density(cc, W); }, [&](StepContext& cc) { pressure(cc); },
+        [&](StepContext& cc) { return pressureForce(cc, W); });
   }
 
  private:
