@@ -146,10 +146,8 @@ class Muller2003 final : public Solver {
   double densityKernel(double r, double R) const override { return Poly6<double>(R).value(r); }
 
   void prepare(StepContext& c) override {
-    stageGrid(c, false);
-    stageNeighbours(c);
-    density(c, Poly6<Real>(c.R));
-    pressure(c);
+    const Poly6<Real> W(c.R);
+    explicitPrepare(c, [&](StepContext& cc) { density(cc, W); }, [&](StepContext& cc) { pressure(cc); });
   }
 
   Real maxTimeStep(const StepContext& c, Real vmax, Real amax) const override {

@@ -73,6 +73,16 @@ void explicitSubstep(StepContext& c, StageRunner& run, const EffectList& effects
   run.checked("integrate", [&] { return stageIntegrate(c); });
 }
 
+/// The complete initial state of the equation-of-state solvers: grid,
+/// neighbours, density and pressure of the current positions.
+template <class Density, class Pressure>
+void explicitPrepare(StepContext& c, Density density, Pressure pressure) {
+  stageGrid(c, false);
+  stageNeighbours(c);
+  density(c);
+  pressure(c);
+}
+
 /// One solver-specific scene key (under "solver").
 struct SolverParam {
   std::string key;   ///< scene key

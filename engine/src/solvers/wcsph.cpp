@@ -37,10 +37,8 @@ class Wcsph final : public Solver {
   double densityKernel(double r, double R) const override { return WendlandC2<double>(R).value(r); }
 
   void prepare(StepContext& c) override {
-    stageGrid(c, false);
-    stageNeighbours(c);
-    density(c, WendlandC2<Real>(c.R));
-    pressure(c);
+    const WendlandC2<Real> W(c.R);
+    explicitPrepare(c, [&](StepContext& cc) { density(cc, W); }, [&](StepContext& cc) { pressure(cc); });
   }
 
   Real maxTimeStep(const StepContext& c, Real vmax, Real amax) const override {
