@@ -5,7 +5,8 @@
 
 namespace sph2d {
 
-void Grid::build(const Vec2* x, std::size_t n, Real support, ThreadPool& pool, int cellsPerSupport) {
+void Grid::build(const Vec2* x, std::size_t n, Real support, ThreadPool& pool, int cellsPerSupport,
+                 const PeriodicBox* periodic) {
   reach = std::max(1, cellsPerSupport);
   const Real minCell = support / Real(reach);
   struct Box {
@@ -48,12 +49,37 @@ void Grid::build(const Vec2* x, std::size_t n, Real support, ThreadPool& pool, i
     ny = static_cast<int>(std::floor(ey * invCell)) + 1;
   }
   invCell = Real(1) / cell;
+  invCellY = invCell;
+  wrapX = periodic && periodic->x;
+  wrapY = periodic && periodic->y;
+  if (wrapX || wrapY) {
+    // A periodic axis: the period in a whole number of cells of at least
+    // minCell (the loader guarantees a period of at least 3 R, so at least
+    // 2·reach + 1 cells and no cell is visited twice by one query).
+    const Real c = cell;
+    if (wrapX) {
+      nx = std::max(2 * reach + 1, static_cast<int>(std::floor(periodic->lx / c)));
+      lo.x() = periodic->lo.x();
+      cell = periodic->lx / Real(nx);
+      invCell = Real(nx) / periodic->lx;
+    }
+    if (wrapY) {
+      ny = std::max(2 * reach + 1, static_cast<int>(std::floor(periodic->ly / c)));
+      lo.y() = periodic->lo.y();
+      invCellY = Real(ny) / periodic->ly;
+    } else {
+      // y keeps cells of the original size c over the bounding box.
+      invCellY = Real(1) / c;
+      if (n == 0) ny = 1;
+    }
+  }
   const std::size_t cells = std::size_t(nx) * std::size_t(ny);
 
   cellOf.resize(n);
   pool.parallelFor(n, 4096, [&](std::size_t b, std::size_t e) {
     for (std::size_t i = b; i < e; ++i)
-      cellOf[i] = std::uint32_t(coord(x[i].y(), lo.y(), ny)) * std::uint32_t(nx) + std::uint32_t(coord(x[i].x(), lo.x(), nx));
+      cellOf[i] = std::uint32_t(coord(x[i].y(), lo.y(), invCellY, ny)) * std::uint32_t(nx) +
+                  std::uint32_t(coord(x[i].x(), lo.x(), invCell, nx));
   });
   // Stable counting sort (serial: it is a few ms at a million particles).
   cellStart.assign(cells + 1, 0);

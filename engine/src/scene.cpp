@@ -440,8 +440,16 @@ RegionDef readRegion(const Reader& r, const nlohmann::json& j, const std::string
 void readEffects(const Reader& r, const nlohmann::json& j, SceneDef& s) {
   const std::string p = "effects";
   r.requireObject(j, p);
-  r.checkKeys(j, p, {"xsph", "force_fields", "surface_tension", "lifetime", "sinks", "emitters", "budget"});
+  r.checkKeys(j, p, {"xsph", "shifting", "force_fields", "surface_tension", "lifetime", "sinks", "emitters", "budget"});
   EffectsDef& e = s.effects;
+  if (j.contains("shifting")) {
+    const auto& x = j.at("shifting");
+    const std::string q = "effects.shifting";
+    r.requireObject(x, q);
+    r.checkKeys(x, q, {"strength"});
+    e.shifting = true;
+    e.shiftingStrength = r.number(x, q, "strength", e.shiftingStrength, 0, 100);
+  }
   if (j.contains("xsph")) {
     const auto& x = j.at("xsph");
     const std::string q = "effects.xsph";
@@ -875,7 +883,7 @@ SceneDef parseScene(const std::string& text, const std::string& file) {
   const Reader r(doc, file);
   const json& root = doc.root;
   r.requireObject(root, "");
-  r.checkKeys(root, "", {"name", "gravity", "fps", "duration", "max_particles", "solver", "boundaries", "fluid", "effects", "render", "events"});
+  r.checkKeys(root, "", {"name", "gravity", "fps", "duration", "max_particles", "solver", "boundaries", "fluid", "periodic", "effects", "render", "events"});
   SceneDef s;
   s.path = file;
   s.name = r.string(root, "", "name", s.name, {});
@@ -901,7 +909,7 @@ SceneDef parseScene(const std::string& text, const std::string& file) {
       const std::string q = r.string(j, p, "quality", "balanced", {"game", "balanced", "accurate"});
       d.type = q == "game" ? "pbf" : q == "accurate" ? "dfsph" : "wcsph";
     }
-    std::vector<std::string> keys = {"type", "quality", "spacing", "support_ratio", "rest_density", "sound_speed", "viscosity", "cfl",
+    std::vector<std::string> keys = {"type", "quality", "spacing", "support_ratio", "rest_density", "sound_speed", "viscosity", "no_slip", "cfl",
                                      "max_substeps", "clamp_negative_pressure", "reorder_interval", "max_speed"};
     for (const SolverParam& sp : solverParams(d.type)) keys.push_back(sp.key);
     r.checkKeys(j, p, keys);
@@ -911,6 +919,7 @@ SceneDef parseScene(const std::string& text, const std::string& file) {
     d.restDensity = r.number(j, p, "rest_density", d.restDensity, 0, 1e5, true);
     d.soundSpeed = r.number(j, p, "sound_speed", d.soundSpeed, 0, 1e4, true);
     d.viscosity = r.number(j, p, "viscosity", d.viscosity, 0, 100);
+    d.noSlip = r.boolean(j, p, "no_slip", d.noSlip);
     d.cfl = r.number(j, p, "cfl", d.cfl, 0, 1, true);
     d.maxSubsteps = r.integer(j, p, "max_substeps", d.maxSubsteps, 1, 100000);
     d.clampNegativePressure = r.boolean(j, p, "clamp_negative_pressure", d.clampNegativePressure);
@@ -948,15 +957,50 @@ SceneDef parseScene(const std::string& text, const std::string& file) {
       const std::string p = "fluid[" + std::to_string(b) + "]";
       const json& j = arr[b];
       r.requireObject(j, p);
-      r.checkKeys(j, p, {"min", "max", "velocity"});
+      r.checkKeys(j, p, {"min", "max", "velocity", "velocity_field"});
       FluidBlockDef blk;
       blk.min = r.requiredVec2(j, p, "min");
       blk.max = r.requiredVec2(j, p, "max");
       blk.velocity = r.vec2(j, p, "velocity", blk.velocity);
+      if (j.contains("velocity_field")) {
+        const json& f = j.at("velocity_field");
+        const std::string pf = Reader::sub(p, "velocity_field");
+        r.requireObject(f, pf);
+        r.checkKeys(f, pf, {"type", "amplitude", "wavelength", "origin"});
+        if (!f.contains("type")) r.fail(Reader::sub(pf, "type"), "missing; allowed values: taylor_green");
+        r.string(f, pf, "type", "", {"taylor_green"});
+        blk.field.type = VelocityFieldDef::Type::TaylorGreen;
+        blk.field.amplitude = r.number(f, pf, "amplitude", blk.field.amplitude, -1e3, 1e3);
+        blk.field.wavelength = r.number(f, pf, "wavelength", blk.field.wavelength, 0, 1e4, true);
+        blk.field.origin = r.vec2(f, pf, "origin", blk.field.origin);
+      }
       if (!(blk.max.x() > blk.min.x() && blk.max.y() > blk.min.y()))
         r.fail(Reader::sub(p, "max"), "max must be greater than min in x and in y");
       checkBlock(r, s, blk, p);
       s.blocks.push_back(blk);
+    }
+  }
+
+  if (root.contains("periodic")) {
+    const json& j = root.at("periodic");
+    const std::string p = "periodic";
+    r.requireObject(j, p);
+    r.checkKeys(j, p, {"x", "y"});
+    if (j.empty()) r.fail(p, "give \"x\": [min, max] and/or \"y\": [min, max], the periodic range of each wrapping axis");
+    const double R = s.solver.supportRatio * s.solver.spacing;
+    for (int axis = 0; axis < 2; ++axis) {
+      const std::string key = axis == 0 ? "x" : "y";
+      if (!j.contains(key)) continue;
+      const Vec2d range = r.vec2(j, p, key, Vec2d(0, 0));
+      const std::string pk = Reader::sub(p, key);
+      // The neighbour grid needs five cells of R/2 across the period, and one
+      // particle must not meet two images of another: a period of at least 3R.
+      if (!(range.y() - range.x() >= 3 * R))
+        r.fail(pk, "the period [" + fmt(range.x()) + ", " + fmt(range.y()) + "] is " + fmt(range.y() - range.x()) +
+                       " m long; it must be at least 3 support radii (3 x " + fmt(R) + " m) long, min < max");
+      (axis == 0 ? s.periodic.x : s.periodic.y) = true;
+      s.periodic.min[axis] = range.x();
+      s.periodic.max[axis] = range.y();
     }
   }
 

@@ -35,9 +35,22 @@ Vec2 tieBreakDirection(std::uint32_t idi, std::uint32_t idj) {
   return idi < idj ? d : Vec2(-d);
 }
 
+void stageWrap(StepContext& c) {
+  if (!c.periodic.any()) return;
+  Particles& P = c.P;
+  const PeriodicBox& box = c.periodic;
+  c.pool.parallelFor(P.size(), 4096, [&](std::size_t b, std::size_t e) {
+    for (std::size_t i = b; i < e; ++i) {
+      const Vec2 s = box.wrap(P.x[i]);
+      P.xPrev[i] += s;
+    }
+  });
+}
+
 void stageGrid(StepContext& c, bool reorder) {
   Particles& P = c.P;
-  c.grid.build(P.x.data(), P.size(), c.R, c.pool, 2);
+  if (c.periodic.any()) stageWrap(c);
+  c.grid.build(P.x.data(), P.size(), c.R, c.pool, 2, c.periodic.any() ? &c.periodic : nullptr);
   if (!reorder) return;
   const std::vector<std::uint32_t>& order = c.grid.sorted;
   Scratch& s = c.scratch;
@@ -65,6 +78,7 @@ void stageNeighbours(StepContext& c) {
   L.start.resize(n);
   L.count.resize(n);
   const Real R2 = c.R * c.R;
+  const PeriodicBox per = c.periodic;
   c.pool.parallelFor(n, kBlock, [&](std::size_t b, std::size_t e) {
     std::vector<std::uint32_t>& out = L.perBlock[b / kBlock];
     std::size_t used = 0;
@@ -78,7 +92,8 @@ void stageNeighbours(StepContext& c) {
         const Vec2* X = P.x.data();
         for (std::uint32_t k = kb; k < ke; ++k) {
           const std::uint32_t j = sorted[k];
-          const Real dx = xi.x() - X[j].x(), dy = xi.y() - X[j].y();
+          Real dx = xi.x() - X[j].x(), dy = xi.y() - X[j].y();
+          per.nearest(dx, dy);
           const Real r2 = dx * dx + dy * dy;
           dst[used] = j;  // written always, kept only when inside: no branch
           used += std::size_t((r2 < R2) & (j != i));

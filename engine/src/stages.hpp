@@ -71,6 +71,7 @@ struct StepContext {
   std::uint64_t step = 0;       ///< substep counter
   double time = 0;              ///< simulated time at the start of the substep
   Vec2d origin{0, 0};           ///< local frame offset (world = local + origin)
+  PeriodicBox periodic{};       ///< periodic axes: every pair difference takes the nearest image
 };
 
 /// Runs named stages: times them and turns a bad slot into a SimulationError.
@@ -89,7 +90,11 @@ std::size_t firstBad(ThreadPool& pool, std::size_t n, const std::function<std::s
 Vec2 tieBreakDirection(std::uint32_t idi, std::uint32_t idj);
 
 /// Neighbour grid (counting sort, cells of R/2) and, when `reorder`, every particle array permuted into cell order.
+/// In a periodic scene it first wraps every position into the box (stageWrap).
 void stageGrid(StepContext& c, bool reorder);
+/// Moves particles that left the periodic box to their image inside it (x and
+/// xPrev shift together, so the swept collision sees the true move). Reads and writes x, xPrev.
+void stageWrap(StepContext& c);
 /// Neighbour lists: the grid's candidates within R, compacted without branches. Reads x, grid; writes nbr.
 void stageNeighbours(StepContext& c);
 /// Σ_b Ψ_b W(x − x_b) over the boundary samples visible from x (a volume fraction; times ρ0 for density).
@@ -115,6 +120,24 @@ double latticeGradientMoment(const Kernel& W, double dx, double volume) {
     for (int i = -n; i <= n; ++i) {
       const double x = i * dx, y = j * dx, r = std::sqrt(x * x + y * y);
       if (r > 0) m -= volume * x * x * double(W.derivative(decltype(W.R)(r))) / r;  // W' < 0
+    }
+  return m;
+}
+
+/// The second moment ¼ Σ_j V r² L(r) of a Laplacian kernel L over a square
+/// lattice of spacing dx (V = dx²), the centre excluded: the factor by which
+/// Σ_j V (A_j − A_i) L(r_ij) gives ∇²A for a smooth field (1 when exact). The
+/// 2D Laplacian of Müller's viscosity kernel has an R³/r³ term whose continuous
+/// moment diverges, so the discrete one depends on R/dx (0.834 at R = 2.5 dx):
+/// the viscosity effect divides by it.
+template <class Laplacian>
+double latticeLaplacianMoment(const Laplacian& L, double R, double dx) {
+  const int n = int(std::ceil(R / dx)) + 1;
+  double m = 0;
+  for (int j = -n; j <= n; ++j)
+    for (int i = -n; i <= n; ++i) {
+      const double r = std::sqrt(double(i * i + j * j)) * dx;
+      if (r > 0 && r < R) m += 0.25 * dx * dx * r * r * L(r);
     }
   return m;
 }

@@ -98,6 +98,7 @@ struct World::Impl final : StageRunner {
   std::unique_ptr<Solver> solver;
   EffectList effects;
   Real dx = 0, R = 0, mass = 0;
+  PeriodicBox periodic;  ///< the scene's periodic box in the local frame
   double time = 0;
   std::uint64_t frames = 0, steps = 0;
   int lastSubsteps = 0;
@@ -135,6 +136,7 @@ struct World::Impl final : StageRunner {
     c.step = steps;
     c.time = time;
     c.origin = origin;
+    c.periodic = periodic;
     return c;
   }
 
@@ -202,7 +204,13 @@ struct World::Impl final : StageRunner {
           ++dropped;
           continue;
         }
-        P.push(p, Vec2(Real(b.velocity.x()), Real(b.velocity.y())), nextId++, rho0);
+        Vec2d vel = b.velocity;
+        if (b.field.type == VelocityFieldDef::Type::TaylorGreen) {
+          const double k = 2 * 3.14159265358979323846 / b.field.wavelength, U = b.field.amplitude;
+          const Vec2d q = pw - b.field.origin;
+          vel += Vec2d(-U * std::cos(k * q.x()) * std::sin(k * q.y()), U * std::sin(k * q.x()) * std::cos(k * q.y()));
+        }
+        P.push(p, Vec2(Real(vel.x()), Real(vel.y())), nextId++, rho0);
         ++added;
       }
     if (dropped) {
@@ -385,6 +393,7 @@ struct World::Impl final : StageRunner {
     solver->substep(c, *this, effects);
     lastAccel = maxAccelOf(P, pool);
     run("collide", [&] { stageCollide(c); });
+    if (periodic.any()) run("wrap", [&] { stageWrap(c); });
     if (scene.effects.lifetime) run("lifetimes", [&] { lifetimes(dt); });
     if (!scene.effects.sinks.empty()) run("sinks", [&] { sinks(); });
     time += double(dt);
@@ -476,6 +485,22 @@ void World::init() {
   // Mass so that a full square lattice at spacing dx has exactly ρ0.
   w.mass = Real(sd.restDensity / latticeSum(*w.solver, double(w.R), sd.spacing));
 
+  if (scene.periodic.any()) {
+    const PeriodicDef& pd = scene.periodic;
+    for (int axis = 0; axis < 2; ++axis) {
+      if (!(axis == 0 ? pd.x : pd.y)) continue;
+      const double L = pd.max[axis] - pd.min[axis];
+      if (!(L >= 3 * double(w.R)))
+        throw SceneError(scene.path.empty() ? "scene" : scene.path, 0, 0, axis == 0 ? "periodic.x" : "periodic.y",
+                         "the period is " + std::to_string(L) + " m; it must be at least 3 support radii (" +
+                             std::to_string(3 * double(w.R)) + " m)");
+    }
+    w.periodic.x = pd.x;
+    w.periodic.y = pd.y;
+    w.periodic.lo = Vec2(Real(pd.min.x() - w.origin.x()), Real(pd.min.y() - w.origin.y()));
+    w.periodic.lx = pd.x ? Real(pd.max.x() - pd.min.x()) : Real(0);
+    w.periodic.ly = pd.y ? Real(pd.max.y() - pd.min.y()) : Real(0);
+  }
   w.rebuildBoundary();
   // Fluid blocks on a square lattice; particles inside solids are dropped.
   for (const FluidBlockDef& b : scene.blocks) w.fillBlock(b, true);

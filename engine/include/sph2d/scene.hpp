@@ -47,11 +47,35 @@ struct BodyDef {
   std::vector<ShapeDef> fixtures;
 };
 
+/// An initial velocity field added to a block's uniform velocity.
+struct VelocityFieldDef {
+  /// None, or the Taylor–Green vortex u = −U cos(kx) sin(ky), v = U sin(kx) cos(ky),
+  /// k = 2π / wavelength (x, y measured from the field's origin).
+  enum class Type { None, TaylorGreen };
+  Type type = Type::None;
+  double amplitude = 1;          ///< U [m/s]
+  double wavelength = 1;         ///< L [m]
+  Vec2d origin{0, 0};            ///< where x = y = 0 [m]
+};
+
 /// A rectangle of fluid filled on a square lattice.
 struct FluidBlockDef {
   Vec2d min{0, 0};               ///< lower-left corner [m]
   Vec2d max{1, 1};               ///< upper-right corner [m]
   Vec2d velocity{0, 0};          ///< initial velocity [m/s]
+  VelocityFieldDef field;        ///< initial velocity field added to `velocity`
+};
+
+/// Periodic boundaries: an axis with `x` (or `y`) set wraps at [min, max) —
+/// a particle leaving one side enters at the other, and pairs interact
+/// across the seam by the nearest image. Solids crossing a periodic seam
+/// must extend at least one support radius beyond it (docs/SCENES.md).
+struct PeriodicDef {
+  bool x = false, y = false;
+  Vec2d min{0, 0};               ///< lower corner of the periodic box (used per periodic axis)
+  Vec2d max{0, 0};               ///< upper corner
+  /// True when some axis wraps.
+  bool any() const { return x || y; }
 };
 
 /// Pressure solver and its numerical parameters.
@@ -62,6 +86,7 @@ struct SolverDef {
   double restDensity = 1000;        ///< ρ0 [kg/m³]
   double soundSpeed = 25;           ///< c: p = c²(ρ − ρ0) (stiffness K = c²) [m/s]
   double viscosity = 0.01;          ///< kinematic viscosity ν [m²/s] (muller2003 heats up below ~0.005)
+  bool noSlip = false;              ///< viscosity also acts between the fluid and the walls (no-slip walls)
   double cfl = 0.25;                ///< dt ≤ cfl · R / (c + v_max)
   int maxSubsteps = 400;            ///< cap per frame; beyond it the frame advances less time
   bool clampNegativePressure = true;///< p = max(p, 0): no tension at the free surface
@@ -143,6 +168,8 @@ enum class BudgetPolicy {
 struct EffectsDef {
   bool xsph = false;
   double xsphC = 0.05;                      ///< XSPH velocity smoothing factor
+  bool shifting = false;                    ///< particle shifting (Lind et al. 2012)
+  double shiftingStrength = 2;              ///< A in D = A h v_max dt
   std::vector<ForceFieldDef> forceFields;
   bool surfaceTension = false;
   SurfaceTensionDef tension;
@@ -200,6 +227,7 @@ struct SceneDef {
   SolverDef solver;
   std::vector<BodyDef> bodies;
   std::vector<FluidBlockDef> blocks;
+  PeriodicDef periodic;             ///< periodic axes (none by default)
   double fps = 60;                  ///< frames per simulated second
   double duration = 4;              ///< simulated seconds the app renders
   std::size_t maxParticles = 4000000;///< refuse scenes with more particles than this

@@ -55,7 +55,7 @@ class SurfaceTension final : public Effect {
         const std::uint32_t* nb = c.nbr.of(i);
         for (std::uint32_t q = 0; q < c.nbr.count[i]; ++q) {
           const std::uint32_t j = nb[q];
-          const Vec2 d = X[i] - X[j];
+          const Vec2 d = c.periodic.delta(X[i], X[j]);
           const Real r = d.norm();
           const Real vj = c.mass / P.rho[j];
           if (csf) {
@@ -87,7 +87,7 @@ class SurfaceTension final : public Effect {
           const std::uint32_t* nb = c.nbr.of(i);
           for (std::uint32_t q = 0; q < c.nbr.count[i]; ++q) {
             const std::uint32_t j = nb[q];
-            const Vec2 d = X[i] - X[j];
+            const Vec2 d = c.periodic.delta(X[i], X[j]);
             const Real r = d.norm();
             const Real K = Real(2) * c.rho0 / (P.rho[i] + P.rho[j]);
             Vec2 f = Vec2(nx[j] - nx[i], ny[j] - ny[i]) * gamma;  // curvature: −γ (n_i − n_j)

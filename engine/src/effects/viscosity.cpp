@@ -1,8 +1,16 @@
 // Viscosity, the Laplacian form of Müller, Charypar & Gross 2003 (seed 002,
 // eq. 14): a_i += (μ/ρ_i) Σ_j m (v_j − v_i)/ρ_j ∇²W_visc(r_ij), with the 2D
 // Laplacian of the viscosity kernel (kernels.hpp: 5(R−r)(R³+R²r+Rr²+9r³)/(3πR⁵r³),
-// not the 3D c·(R − r)), r clamped to 0.05 R. μ = ν·ρ0.
+// not the 3D c·(R − r)), r clamped to 0.05 R. μ = ν·ρ0. The sum is divided by
+// the Laplacian's lattice moment (stages.hpp: 0.834 at R = 2.5 dx), so that a
+// shear flow feels ν and not 0.83 ν (measured on start-up Poiseuille flow).
 // Time-step limit: dt ≤ 0.03 R²/ν (explicit diffusion).
+//
+// With solver.no_slip, the walls' boundary samples take part as fluid at rest
+// (v_b = 0, density ρ0, volume Ψ_b): a_i += ν ρ0/ρ_i Σ_b Ψ_b (0 − v_i) ∇²W_ib,
+// the no-slip wall of Morris, Fox & Zhu 1997 with the wall velocity in place
+// of their mirrored one. Without it (the default) walls are free-slip and only
+// the collision stage's Coulomb friction acts on the fluid at the wall.
 #include <cmath>
 
 #include "effects/effect.hpp"
@@ -12,7 +20,7 @@ namespace {
 
 class LaplacianViscosity final : public Effect {
  public:
-  explicit LaplacianViscosity(double nu) : nu_(Real(nu)) {}
+  LaplacianViscosity(double nu, bool noSlip) : nu_(Real(nu)), noSlip_(noSlip) {}
   const char* name() const override { return "viscosity"; }
   const char* limitKey() const override { return "solver.viscosity"; }
 
@@ -24,10 +32,26 @@ class LaplacianViscosity final : public Effect {
     const Real R = c.R, R2 = R * R, R3 = R2 * R;
     const Real rMin = W.rMin, invRMin = Real(1) / W.rMin;
     const Real lapK = Real(5) / (Real(3) * kPi<Real> * R2 * R3);
-    const Real muMass = nu_ * c.rho0 * c.mass;
+    if (c.R != momentR_ || c.dx != momentDx_) {
+      const double Rd = double(c.R);
+      const double lk = 5.0 / (3.0 * 3.14159265358979323846 * Rd * Rd * Rd * Rd * Rd);
+      const double m = latticeLaplacianMoment(
+          [&](double r) {
+            const double q = std::max(r, 0.05 * Rd);
+            return lk * (Rd - q) * (Rd * Rd * Rd + Rd * Rd * q + Rd * q * q + 9 * q * q * q) / (q * q * q);
+          },
+          Rd, double(c.dx));
+      scale_ = Real(1.0 / m);
+      momentR_ = c.R;
+      momentDx_ = c.dx;
+    }
+    const Real nuS = nu_ * scale_;
+    const Real muMass = nuS * c.rho0 * c.mass;
     const Vec2* X = P.x.data();
     const Vec2* V = P.v.data();
     const Real* IR = P.invRho.data();
+    const BoundarySet& B = c.boundary;
+    const bool walls = noSlip_ && !B.samples.empty();
     return firstBad(c.pool, P.size(), [&](std::size_t b, std::size_t e) {
       std::size_t bad = kNone;
       for (std::size_t i = b; i < e; ++i) {
@@ -37,7 +61,8 @@ class LaplacianViscosity final : public Effect {
         const std::uint32_t cnt = c.nbr.count[i];
         for (std::uint32_t k = 0; k < cnt; ++k) {
           const std::uint32_t j = nb[k];
-          const Real dx = xix - X[j].x(), dy = xiy - X[j].y();
+          Real dx = xix - X[j].x(), dy = xiy - X[j].y();
+          c.periodic.nearest(dx, dy);
           const Real r2 = dx * dx + dy * dy;
           // The same clamped Laplacian as ViscosityKernel::laplacian, one division per pair.
           const Real q = r2 > rMin * rMin ? std::sqrt(r2) : rMin;
@@ -46,7 +71,20 @@ class LaplacianViscosity final : public Effect {
           fx += (V[j].x() - vix) * w;
           fy += (V[j].y() - viy) * w;
         }
-        const Vec2 acc = Vec2(fx, fy) * (muMass * IR[i]);
+        Vec2 acc = Vec2(fx, fy) * (muMass * IR[i]);
+        if (walls) {
+          const Vec2 xi = X[i];
+          Real sum = 0;  // Σ_b Ψ_b ∇²W_ib
+          B.sampleGrid.forCandidates(xi, [&](std::uint32_t s) {
+            const Vec2 d = xi - B.samples[s];
+            const Real r2 = d.squaredNorm();
+            if (r2 >= R2 || !B.visible(s, xi)) return;
+            const Real q = r2 > rMin * rMin ? std::sqrt(r2) : rMin;
+            const Real iq = Real(1) / q;
+            sum += B.volume[s] * lapK * (R - q) * (R3 + R2 * q + R * q * q + Real(9) * q * q * q) * iq * iq * iq;
+          });
+          acc -= Vec2(vix, viy) * (Real(2) * nuS * c.rho0 * IR[i] * sum);
+        }
         P.a[i] += acc;
         if (!allFinite(acc) && bad == kNone) bad = i;
       }
@@ -56,10 +94,14 @@ class LaplacianViscosity final : public Effect {
 
  private:
   Real nu_;
+  bool noSlip_;
+  Real scale_ = 1, momentR_ = -1, momentDx_ = -1;  ///< 1 / lattice moment, for (R, dx)
 };
 
 }  // namespace
 
-std::unique_ptr<Effect> makeLaplacianViscosity(double nu) { return std::make_unique<LaplacianViscosity>(nu); }
+std::unique_ptr<Effect> makeLaplacianViscosity(double nu, bool noSlip) {
+  return std::make_unique<LaplacianViscosity>(nu, noSlip);
+}
 
 }  // namespace sph2d

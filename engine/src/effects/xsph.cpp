@@ -28,7 +28,7 @@ class Xsph final : public Effect {
         const std::uint32_t* nb = c.nbr.of(i);
         for (std::uint32_t q = 0; q < c.nbr.count[i]; ++q) {
           const std::uint32_t j = nb[q];
-          const Real w = W.value((X[i] - X[j]).norm()) / (P.rho[i] + P.rho[j]);
+          const Real w = W.value(c.periodic.delta(X[i], X[j]).norm()) / (P.rho[i] + P.rho[j]);
           sx += (V[j].x() - V[i].x()) * w;
           sy += (V[j].y() - V[i].y()) * w;
         }

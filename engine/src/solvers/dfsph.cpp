@@ -47,6 +47,13 @@
 // complementarity one: |s_i| where κ_i > 0, max(s_i, 0) where κ_i = 0; its
 // mean must be ≤ tolerance·ρ0 (divergence: ≤ divergence_tolerance·ρ0 per
 // second), after at least min_iterations and at most max_iterations.
+// With solver.clamp_negative_pressure = false (a flow with no free surface)
+// κ takes either sign and every |s_i| counts. When, in addition, both axes
+// are periodic and there are no walls, a constant κ is (nearly) in the null
+// space of the solve, and the mean of the summation-density error is not a
+// compression: each pass A then removes the mean of the source first (one
+// extra reduction), or κ drifts without bound (measured: a Taylor–Green
+// vortex's pressure reached −7e33 Pa).
 // Warm start: each solve starts from its previous substep's κ (particle
 // fields "dfsph.kappa" [m²/s², = p/ρ] and "dfsph.kappa_v" [m²/s, κ_v·dt],
 // permuted with the particles on reorder), applied once before iterating.
@@ -77,6 +84,7 @@
 // reports the last solved substep's iterations and residuals.
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "solvers/solver.hpp"
 
@@ -94,7 +102,9 @@ class Dfsph final : public Solver {
         divSolve_(d.param("divergence_solve") != 0),
         omega_(Real(d.param("relaxation"))),
         cheb_(Real(d.param("chebyshev_rho"))),
-        cfl_(Real(d.param("velocity_cfl"))) {}
+        cfl_(Real(d.param("velocity_cfl"))),
+        unilateral_(d.clampNegativePressure),
+        kMin_(d.clampNegativePressure ? Real(0) : -std::numeric_limits<Real>::infinity()) {}
 
   /// "dfsph".
   const char* name() const override { return "dfsph"; }
@@ -129,6 +139,7 @@ class Dfsph final : public Solver {
     const bool reorder = every > 0 && c.step % std::uint64_t(every) == 0;
     c.P.field("dfsph.kappa");
     c.P.field("dfsph.kappa_v");
+    closed_ = !unilateral_ && c.periodic.x && c.periodic.y && c.boundary.samples.empty();
     run.run("grid", [&] { stageGrid(c, reorder); });
     run.run("neighbours", [&] { stageNeighbours(c); });
     run.checked("density", [&] { return densityAndFactor(c, W); });
@@ -192,6 +203,7 @@ class Dfsph final : public Solver {
         for (std::uint32_t k = 0; k < cnt; ++k) {
           const std::uint32_t j = nb[k];
           Real dx = xix - X[j].x(), dy = xiy - X[j].y();
+          c.periodic.nearest(dx, dy);
           Real r2 = dx * dx + dy * dy;
           const Real q = std::sqrt(r2) * W.invR;
           const Real a = Real(1) - q;
@@ -256,7 +268,7 @@ class Dfsph final : public Solver {
         kPrev_.resize(n);
       }
       warmStart(c, kappa, scale);
-      err = sourcePass(c, kappa, divergence) / double(std::max<std::size_t>(n, 1));
+      err = sourceMean(c, kappa, divergence);
     });
     int it = 0;
     if (cheb_ > 0) {
@@ -275,7 +287,7 @@ class Dfsph final : public Solver {
         w = 1;
       run.run(divergence ? "divergence_iteration" : "pressure_iteration", [&] {
         correctPass(c, kappa, w);
-        err = sourcePass(c, kappa, divergence) / double(std::max<std::size_t>(n, 1));
+        err = sourceMean(c, kappa, divergence);
       });
       ++it;
       // Safeguard: a residual that grows restarts the acceleration (plain steps first).
@@ -312,18 +324,32 @@ class Dfsph final : public Solver {
 
   /// Pass A: the source of every particle, its κ increment (dk_, and dk_/ρ in q_)
   /// and the sum of the complementarity residuals, combined in block order.
-  double sourcePass(StepContext& c, const std::vector<Real>& kappa, bool divergence) {
+  struct Sums {
+    double err = 0, src = 0;
+  };
+  /// The mean residual of pass A; in a closed domain (closed_) the source's
+  /// mean is first found by a pass with no shift, then removed.
+  double sourceMean(StepContext& c, const std::vector<Real>& kappa, bool divergence) {
+    const double n = double(std::max<std::size_t>(c.P.size(), 1));
+    Real shift = 0;
+    if (closed_) shift = Real(sourcePass(c, kappa, divergence, 0).src / n);
+    return sourcePass(c, kappa, divergence, shift).err / n;
+  }
+
+  Sums sourcePass(StepContext& c, const std::vector<Real>& kappa, bool divergence, Real shift) {
     Particles& P = c.P;
     const NeighbourLists& L = c.nbr;
     const Vec2* V = P.v.data();
     const Real* K = kappa.data();
     const Real dt = c.dt, invDt = Real(1) / dt, rho0 = c.rho0;
     const Real wInvDt = omega_ * invDt, wInvDt2 = wInvDt * invDt;
+    const bool unilateral = unilateral_;
+    const Real kMin = kMin_;
     return c.pool.reduce(
-        P.size(), kBlock, 0.0,
+        P.size(), kBlock, Sums{},
         [&](std::size_t b, std::size_t e) {
           const std::vector<Pair>& G = pairs_[b / kBlock];
-          double errSum = 0;
+          double errSum = 0, srcSum = 0;
           for (std::size_t i = b; i < e; ++i) {
             const std::uint32_t cnt = L.count[i];
             const Pair* Gi = G.data() + L.start[i];
@@ -337,22 +363,23 @@ class Dfsph final : public Solver {
             const Real div = (gradSum_[i].x() * V[i].x() + gradSum_[i].y() * V[i].y()) - (sx + sy);
             Real src, dk;
             if (divergence) {
-              src = div;
+              src = div - shift;
               dk = src * alpha_[i] * wInvDt;
             } else {
-              src = P.rho[i] + dt * div - rho0;
+              src = P.rho[i] + dt * div - rho0 - shift;
               dk = src * alpha_[i] * wInvDt2;
             }
             // Complementarity residual: where κ_i > 0 the constraint is active and
             // any deviation counts; where κ_i = 0 only compression does.
-            errSum += double(K[i] > 0 ? std::fabs(src) : std::max(src, Real(0)));
-            dk = std::max(dk, -K[i]);  // κ stays ≥ 0: no tension at the free surface
+            errSum += double(K[i] > 0 || !unilateral ? std::fabs(src) : std::max(src, Real(0)));
+            dk = std::max(dk, kMin - K[i]);  // κ stays ≥ 0: no tension at the free surface
             dk_[i] = dk;
             q_[i] = dk * P.invRho[i];
+            srcSum += double(src);
           }
-          return errSum;
+          return Sums{errSum, srcSum};
         },
-        [](double a, double b) { return a + b; });
+        [](Sums a, Sums b) { return Sums{a.err + b.err, a.src + b.src}; });
   }
 
   /// Pass B: v_i −= dt [Σ_j (q_i + q_j) m∇W_ij + q_i Σ_b ρ0Ψ_b∇W_ib]; κ_i += dk_i
@@ -363,6 +390,7 @@ class Dfsph final : public Solver {
     Vec2* V = P.v.data();
     const Real* Q = q_.data();
     const Real dt = c.dt;
+    const Real kMin = kMin_;
     c.pool.parallelFor(P.size(), kBlock, [&](std::size_t b, std::size_t e) {
       const std::vector<Pair>& G = pairs_[b / kBlock];
       for (std::size_t i = b; i < e; ++i) {
@@ -379,12 +407,12 @@ class Dfsph final : public Solver {
         ax += gradSum_[i].x() * qi;
         ay += gradSum_[i].y() * qi;
         const Vec2 vJ(V[i].x() - dt * ax, V[i].y() - dt * ay);
-        const Real kJ = std::max(kappa[i] + dk_[i], Real(0));
+        const Real kJ = std::max(kappa[i] + dk_[i], kMin);
         if (cheb_ > 0) {  // x_{k+1} = w (x_Jacobi − x_{k−1}) + x_{k−1}; κ clamped again
           const Vec2 vOld = V[i];
           const Real kOld = kappa[i];
           V[i] = w == 1 ? vJ : Vec2((vJ - vPrev_[i]) * w + vPrev_[i]);
-          kappa[i] = w == 1 ? kJ : std::max((kJ - kPrev_[i]) * w + kPrev_[i], Real(0));
+          kappa[i] = w == 1 ? kJ : std::max((kJ - kPrev_[i]) * w + kPrev_[i], kMin);
           vPrev_[i] = vOld;
           kPrev_[i] = kOld;
         } else {
@@ -436,6 +464,9 @@ class Dfsph final : public Solver {
   std::vector<Real> q_;                  ///< dk_/ρ
   SolverStats stats_;
   mutable Real lastLimit_ = 0;  ///< the last maxTimeStep() result (a substep far shorter is a remainder)
+  bool closed_ = false;  ///< set per substep: no wall, no free surface (both axes periodic, κ of either sign)
+  bool unilateral_;  ///< solver.clamp_negative_pressure: κ ≥ 0 (a free surface); false: κ of either sign
+  Real kMin_;        ///< 0, or −∞ without the clamp
 };
 
 }  // namespace

@@ -33,7 +33,8 @@ std::size_t density(StepContext& c, const Poly6<Real>& W) {
       const Vec2* X = P.x.data();
       for (std::uint32_t k = 0; k < cnt; ++k) {
         const Vec2 xj = X[nb[k]];
-        const Real dx = xi.x() - xj.x(), dy = xi.y() - xj.y();
+        Real dx = xi.x() - xj.x(), dy = xi.y() - xj.y();
+        c.periodic.nearest(dx, dy);
         sum += W.valueR2(dx * dx + dy * dy);
       }
       Real rho = c.mass * sum;
@@ -93,6 +94,7 @@ std::size_t pressureForce(StepContext& c, const Spiky<Real>& spiky) {
       for (std::uint32_t k = 0; k < cnt; ++k) {
         const std::uint32_t j = nb[k];
         Real dx = xix - X[j].x(), dy = xiy - X[j].y();
+        c.periodic.nearest(dx, dy);
         Real r2 = dx * dx + dy * dy;
         if (r2 < tiny2) {  // coincident pair: a fixed, antisymmetric direction
           const Vec2 t = tieBreakDirection(idi, ID[j]) * (Real(1e-6) * R);

@@ -306,6 +306,7 @@ class Pbf final : public Solver {
     const Vec2* X = c.P.x.data();
     dx = X[i].x() - X[j].x();
     dy = X[i].y() - X[j].y();
+    c.periodic.nearest(dx, dy);
     r2 = dx * dx + dy * dy;
     if (r2 < tiny2) {
       const Vec2 t = tieBreakDirection(c.P.id[i], c.P.id[j]) * std::sqrt(tiny2);
@@ -514,7 +515,8 @@ class Pbf final : public Solver {
         const Real xix = X[i].x(), xiy = X[i].y();
         Real w = 1;
         for (std::uint32_t k = 0; k < cnt; ++k) {
-          const Real dx = xix - X[nb[k]].x(), dy = xiy - X[nb[k]].y();
+          Real dx = xix - X[nb[k]].x(), dy = xiy - X[nb[k]].y();
+          c.periodic.nearest(dx, dy);
           const Real a = std::max(Real(0), Real(1) - std::sqrt(dx * dx + dy * dy) * invR);
           wc[k] = a * a * a;
           w += wc[k];

@@ -81,7 +81,8 @@ class Wcsph final : public Solver {
         const std::uint32_t cnt = c.nbr.count[i];
         Real sum = self;
         for (std::uint32_t k = 0; k < cnt; ++k) {
-          const Real dx = xi.x() - X[nb[k]].x(), dy = xi.y() - X[nb[k]].y();
+          Real dx = xi.x() - X[nb[k]].x(), dy = xi.y() - X[nb[k]].y();
+          c.periodic.nearest(dx, dy);
           sum += W.value(std::sqrt(dx * dx + dy * dy));
         }
         Real rho = c.mass * sum;
@@ -145,6 +146,7 @@ class Wcsph final : public Solver {
         for (std::uint32_t k = 0; k < cnt; ++k) {
           const std::uint32_t j = nb[k];
           Real dx = xix - X[j].x(), dy = xiy - X[j].y();
+          c.periodic.nearest(dx, dy);
           Real r2 = dx * dx + dy * dy;
           if (r2 < tiny2) {
             const Vec2 t = tieBreakDirection(ID[i], ID[j]) * (Real(1e-6) * R);
