@@ -11,6 +11,12 @@
 //                pressure profile against ρ0 g (H − y), as a share of ρ0 g H.
 //   dam_break    1 m × 2 m column, 4 m × 3 m tank: RMS of the surge front Z = x/a
 //                against Martin & Moyce 1952 (Table 2) at the table's T = t·sqrt(2g/a).
+//   taylor_green periodic unit box, Re = 100: RMS of |u|max/U against exp(−8π²t/Re)
+//                (assets/reference/taylor_green_decay.csv) over 1 s (app/validation.hpp).
+//   poiseuille   start-up flow between plates, periodic in x: RMS of u/u_c against
+//                Morris, Fox & Zhu's series (channel_flow_transient.csv), τ ≤ 0.5.
+// The CFL number varied is each solver's own: solver.cfl (muller2003, wcsph),
+// solver.velocity_cfl (dfsph), solver.max_move (pbf).
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -23,6 +29,7 @@
 #include <vector>
 
 #include "cli.hpp"
+#include "validation.hpp"
 #include "sph2d/render/image.hpp"
 #include "sph2d/render/png_io.hpp"
 #include "sph2d/scene.hpp"
@@ -53,10 +60,15 @@ struct Run {
   double error = 0, meanDensityError = 0, maxDensityError = 0, wallPerSim = 0, msPerStep = 0;
 };
 
-double cflFor(const std::string& solver, double scale) {
-  // Each solver's own default, and a multiple of it.
-  const double base = solver == "dfsph" || solver == "pbf" ? 0.4 : 0.25;
-  return base * scale;
+/// Sets `solver` and its own CFL-type number to `scale` × its default; returns the number.
+double setSolver(SceneDef& s, const std::string& solver, double scale) {
+  if (s.solver.type != solver) {
+    s.solver.type = solver;
+    s.solver.params.clear();  // the World fills the new solver's defaults
+  }
+  if (solver == "dfsph") return s.solver.params["velocity_cfl"] = 0.4 * scale;
+  if (solver == "pbf") return s.solver.params["max_move"] = 1.0 * scale;
+  return s.solver.cfl = 0.25 * scale;
 }
 
 /// Martin & Moyce 1952: (T, Z) rows.
@@ -313,6 +325,10 @@ int cmdBenchAccuracy(const std::vector<std::string>& args) {
   }
   SceneDef dam = loadScene(assets + "/scenes/validation/dam_break.json");
   SceneDef hydro = loadScene(assets + "/scenes/validation/hydrostatic_tank.json");
+  SceneDef tg = loadScene(assets + "/scenes/validation/taylor_green.json");
+  SceneDef channel = loadScene(assets + "/scenes/validation/poiseuille.json");
+  const auto tgTable = validation::readReferenceCsv(assets + "/reference/taylor_green_decay.csv");
+  const auto channelTable = validation::readReferenceCsv(assets + "/reference/channel_flow_transient.csv");
   const auto table = readSurgeTable(assets + "/reference/martin_moyce_1952_surge_front.csv");
   if (solvers.empty()) solvers = {"muller2003", "wcsph", "dfsph", "pbf"};
   std::vector<std::string> known;
@@ -333,9 +349,13 @@ int cmdBenchAccuracy(const std::vector<std::string>& args) {
 
   std::vector<double> damSpacings = quick ? std::vector<double>{0.04} : std::vector<double>{0.02, 0.01, 0.005};
   std::vector<double> hydroSpacings = quick ? std::vector<double>{0.05} : std::vector<double>{0.05, 0.025, 0.0125};
+  std::vector<double> tgSpacings = quick ? std::vector<double>{0.04} : std::vector<double>{0.04, 0.02, 0.01};
+  std::vector<double> channelSpacings = quick ? std::vector<double>{0.1} : std::vector<double>{0.1, 0.05, 0.025};
   if (!quick) {
     damSpacings.resize(std::size_t(levels));
     hydroSpacings.resize(std::size_t(levels));
+    tgSpacings.resize(std::size_t(levels));
+    channelSpacings.resize(std::size_t(levels));
   }
   const std::vector<double> cflScales = quick ? std::vector<double>{1.0} : std::vector<double>{1.0, 2.0};
   if (!fromCsv.empty()) known.clear();  // redraw only
@@ -352,35 +372,87 @@ int cmdBenchAccuracy(const std::vector<std::string>& args) {
     for (double cs : cflScales) {
       for (double dx : hydroSpacings) {
         SceneDef s = hydro;
-        s.solver.type = solver;
+        const double cfl = setSolver(s, solver, cs);
         s.solver.spacing = dx;
-        s.solver.cfl = cflFor(solver, cs);
         s.solver.maxSubsteps = 100000;
         if (solver == "muller2003") s.solver.viscosity = 0.01;
         try {
           Run r = runHydrostatic(s, threads);
           r.solver = solver;
-          r.cfl = s.solver.cfl;
+          r.cfl = cfl;
           report(r);
         } catch (const SimulationError& e) {
-          std::printf("hydrostatic  %-11s dx %.4f cfl %.3f: unstable (%s)\n", solver.c_str(), dx, s.solver.cfl, e.what());
+          std::printf("hydrostatic  %-11s dx %.4f cfl %.3f: unstable (%s)\n", solver.c_str(), dx, cfl, e.what());
         }
       }
       for (double dx : damSpacings) {
         SceneDef s = dam;
-        s.solver.type = solver;
+        const double cfl = setSolver(s, solver, cs);
         s.solver.spacing = dx;
-        s.solver.cfl = cflFor(solver, cs);
         s.solver.maxSubsteps = 100000;
         s.maxParticles = 1000000;
         if (solver == "muller2003") s.solver.viscosity = 0.01;
         try {
           Run r = runDamBreak(s, table, threads);
           r.solver = solver;
-          r.cfl = s.solver.cfl;
+          r.cfl = cfl;
           report(r);
         } catch (const SimulationError& e) {
-          std::printf("dam_break    %-11s dx %.4f cfl %.3f: unstable (%s)\n", solver.c_str(), dx, s.solver.cfl, e.what());
+          std::printf("dam_break    %-11s dx %.4f cfl %.3f: unstable (%s)\n", solver.c_str(), dx, cfl, e.what());
+        }
+      }
+      for (double dx : tgSpacings) {
+        SceneDef s = tg;
+        const double cfl = setSolver(s, solver, cs);
+        s.solver.spacing = dx;
+        s.solver.maxSubsteps = 100000;
+        try {
+          const auto t0 = std::chrono::steady_clock::now();
+          const auto v = validation::runTaylorGreen(s, s.duration, tgTable, threads);
+          const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+          Run r;
+          r.caseName = "taylor_green";
+          r.errorName = "umax_ratio_rms";
+          r.error = v.umaxRms;
+          r.particles = countBlockParticles(s);
+          r.meanDensityError = v.meanDensityError;
+          r.maxDensityError = v.maxDensityError;
+          r.wallPerSim = wall / v.simSeconds;
+          r.msPerStep = 1e3 * wall / double(std::max<std::uint64_t>(1, v.substeps));
+          r.solver = solver;
+          r.cfl = cfl;
+          report(r);
+        } catch (const SimulationError& e) {
+          std::printf("taylor_green %-11s dx %.4f cfl %.3f: unstable (%s)\n", solver.c_str(), dx, cfl, e.what());
+        }
+      }
+      for (double dx : channelSpacings) {
+        SceneDef s = channel;
+        const double cfl = setSolver(s, solver, cs);
+        s.solver.spacing = dx;
+        // The period must hold 3 support radii: 8 spacings at the coarse level (the plates reach 1 m beyond).
+        const double period = std::max(s.periodic.max.x() - s.periodic.min.x(), 8 * dx);
+        s.periodic.max.x() = s.periodic.min.x() + period;
+        s.blocks[0].max.x() = s.blocks[0].min.x() + period;
+        s.solver.maxSubsteps = 100000;
+        try {
+          const auto t0 = std::chrono::steady_clock::now();
+          const auto v = validation::runPoiseuille(s, 0.0, 1.0, channelTable, threads);
+          const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+          Run r;
+          r.caseName = "poiseuille";
+          r.errorName = "u_rms_vs_series";
+          r.error = v.rmsError;
+          r.particles = countBlockParticles(s);
+          r.meanDensityError = v.meanDensityError;
+          r.maxDensityError = v.maxDensityError;
+          r.wallPerSim = wall / v.simSeconds;
+          r.msPerStep = 1e3 * wall / double(std::max<std::uint64_t>(1, v.substeps));
+          r.solver = solver;
+          r.cfl = cfl;
+          report(r);
+        } catch (const SimulationError& e) {
+          std::printf("poiseuille   %-11s dx %.4f cfl %.3f: unstable (%s)\n", solver.c_str(), dx, cfl, e.what());
         }
       }
     }
@@ -408,8 +480,10 @@ int cmdBenchAccuracy(const std::vector<std::string>& args) {
   fs::rename(out + "/accuracy.md.tmp", out + "/accuracy.md");
   chart(runs, "dam_break", out + "/dam_break.png");
   chart(runs, "hydrostatic", out + "/hydrostatic.png");
-  std::printf("bench accuracy: %zu runs; wrote %s/accuracy.csv, accuracy.md, dam_break.png, hydrostatic.png\n", runs.size(),
-              out.c_str());
+  chart(runs, "taylor_green", out + "/taylor_green.png");
+  chart(runs, "poiseuille", out + "/poiseuille.png");
+  std::printf("bench accuracy: %zu runs; wrote %s/accuracy.csv, accuracy.md, dam_break.png, hydrostatic.png, taylor_green.png, "
+              "poiseuille.png\n", runs.size(), out.c_str());
   return runs.empty() ? 1 : 0;
 }
 

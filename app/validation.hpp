@@ -21,6 +21,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdint>
 #include <fstream>
 #include <map>
 #include <sstream>
@@ -59,6 +60,8 @@ struct TaylorGreenResult {
   double umaxRms = 0;       ///< RMS of (|u|max/U − exp(bt)) at the reference table's times
   double amplitudeRms = 0;  ///< RMS of (A/U − exp(bt)) at the same times
   double simSeconds = 0;
+  std::uint64_t substeps = 0;
+  double meanDensityError = 0, maxDensityError = 0;  ///< of DensityStats::meanError over the frames
   std::vector<double> t, amplitude, umax;  ///< per frame (t = 0 included)
 };
 
@@ -99,8 +102,12 @@ inline TaylorGreenResult runTaylorGreen(const SceneDef& s, double seconds, const
   for (int fr = 0; fr < frames; ++fr) {
     w.stepFrame();
     sample();
+    const DensityStats d = w.densityStats();
+    r.meanDensityError += d.meanError / frames;
+    r.maxDensityError = std::max(r.maxDensityError, d.meanError);
   }
   r.simSeconds = w.time();
+  r.substeps = w.substeps();
   // Least-squares slope of ln A(t).
   double st = 0, sy = 0, stt = 0, sty = 0, n = 0;
   for (std::size_t i = 0; i < r.t.size(); ++i) {
@@ -140,6 +147,8 @@ struct PoiseuilleResult {
   double steadyError = 0;  ///< the same over the last τ of the table (τ = 0.5: within 1 % of steady)
   double rmsError = 0;     ///< RMS over all the table's points
   double simSeconds = 0;
+  std::uint64_t substeps = 0;
+  double meanDensityError = 0, maxDensityError = 0;  ///< of DensityStats::meanError at the table's times
   /// (τ, y/H, measured u/u_c, reference u/u_c) for each interior point of the table.
   std::vector<std::array<double, 4>> points;
 };
@@ -174,6 +183,9 @@ inline PoiseuilleResult runPoiseuille(const SceneDef& s, double y0, double heigh
       }
     }
     const double u = n > 0 ? sum / n / uc : 0;
+    const DensityStats d = w.densityStats();
+    r.meanDensityError += d.meanError;
+    r.maxDensityError = std::max(r.maxDensityError, d.meanError);
     r.points.push_back({tau, eta, u, ref});
     const double err = std::fabs(u - ref);
     r.worstError = std::max(r.worstError, err);
@@ -181,7 +193,9 @@ inline PoiseuilleResult runPoiseuille(const SceneDef& s, double y0, double heigh
     sq += err * err;
   }
   r.rmsError = r.points.empty() ? 0 : std::sqrt(sq / double(r.points.size()));
+  if (!r.points.empty()) r.meanDensityError /= double(r.points.size());
   r.simSeconds = w.time();
+  r.substeps = w.substeps();
   return r;
 }
 
