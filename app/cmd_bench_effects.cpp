@@ -5,10 +5,13 @@
 // rounds (the order rotates each round), so that a shared machine's load
 // falls on every configuration alike. Prints, per configuration, the median
 // over rounds of the milliseconds per substep, of the ratio to "none" in the
-// same round, and of the effect's own stages. A benchmark, not a test: compare
-// the figures as ratios within one run. The cost of the effect machinery
+// same round, and of the effect's own stages (--clock cpu: process CPU time
+// instead of the wall clock). A benchmark, not a test: compare the figures as
+// ratios within one run. The cost of the effect machinery
 // itself (a scene without effects against a build without effect modules) is
 // measured by benchmarks/effects_overhead.sh.
+#include <time.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -31,7 +34,8 @@ namespace {
 
 const char* kHelp =
     "Usage: sph2d bench effects [--scene S] [--particles N] [--threads T] [--steps K] [--warmup W]\n"
-    "                           [--rounds R] [--effects A,B,...] [--solver NAME] [--csv FILE]\n"
+    "                           [--rounds R] [--effects A,B,...] [--solver NAME] [--clock wall|cpu]\n"
+    "                           [--csv FILE]\n"
     "\n"
     "Runs scene S (default assets/scenes/dam_break.json) resampled to about N particles\n"
     "(default 20000) once per configuration: none (gravity and pressure only: viscosity 0,\n"
@@ -44,9 +48,12 @@ const char* kHelp =
     "round, R rounds (default 5), the configurations interleaved in an order that rotates\n"
     "each round. Prints the medians over rounds of ms per substep, of the ratio to none in\n"
     "the same round and of the effect's own stages (ms per substep and share of the step),\n"
-    "and the substep length the configuration allows at the end. --effects runs only the\n"
-    "listed configurations (none is always run); --solver replaces the scene's solver type;\n"
-    "--threads T (default 1). --csv FILE also writes the table as CSV.\n";
+    "the best round, and the substep length the configuration allows at the end. --effects\n"
+    "runs only the listed configurations (none is always run); --solver replaces the scene's\n"
+    "solver type; --threads T (default 1). --clock cpu times substeps with the process's CPU\n"
+    "time instead of the wall clock (default wall): on a shared machine it leaves out the\n"
+    "time other processes hold the core (with more than one thread it includes the workers'\n"
+    "brief spinning). --csv FILE also writes the table as CSV.\n";
 
 struct Config {
   std::string name;
@@ -58,7 +65,7 @@ struct Config {
 struct Row {
   Config cfg;
   std::unique_ptr<World> world;
-  std::vector<double> ms, ratio, effectMs;
+  std::vector<double> ms, ratio, effectMs, share;
 };
 
 double median(std::vector<double> v) {
@@ -66,6 +73,18 @@ double median(std::vector<double> v) {
   std::sort(v.begin(), v.end());
   const std::size_t n = v.size();
   return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+/// Seconds of the process's CPU time (all threads).
+double cpuSeconds() {
+  timespec t{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+  return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
+}
+
+/// Seconds of the steady wall clock.
+double wallSeconds() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
 }
 
 std::vector<std::string> splitList(const std::string& s) {
@@ -80,7 +99,7 @@ std::vector<std::string> splitList(const std::string& s) {
 }  // namespace
 
 int cmdBenchEffects(const std::vector<std::string>& args) {
-  std::string scenePath = "assets/scenes/dam_break.json", csvPath, solver;
+  std::string scenePath = "assets/scenes/dam_break.json", csvPath, solver, clock = "wall";
   int particles = 20000, threads = 1, steps = 50, warmup = 50, rounds = 5;
   std::vector<std::string> only;
   for (std::size_t i = 0; i < args.size(); ++i) {
@@ -101,6 +120,10 @@ int cmdBenchEffects(const std::vector<std::string>& args) {
     else if (a == "--effects") only = splitList(value());
     else if (a == "--solver") solver = value();
     else if (a == "--csv") csvPath = value();
+    else if (a == "--clock") {
+      clock = value();
+      if (clock != "wall" && clock != "cpu") throw UsageError("--clock expects wall or cpu, got '" + clock + "'");
+    }
     else throw UsageError("unknown option '" + a + "' (see sph2d bench effects --help)");
   }
 
@@ -198,9 +221,10 @@ int cmdBenchEffects(const std::vector<std::string>& args) {
     rows.push_back(std::move(r));
   }
   const std::size_t np = rows.front().world->particleCount();
-  std::printf("bench effects: %s resampled to %zu particles (spacing %.5g m), %s, %d thread%s; %d rounds of %d substeps after %d warm-up\n",
+  std::printf("bench effects: %s resampled to %zu particles (spacing %.5g m), %s, %d thread%s; %d rounds of %d substeps after %d warm-up; %s clock\n",
               scenePath.c_str(), np, base.solver.spacing, rows.front().world->scene().solver.type.c_str(), threads,
-              threads == 1 ? "" : "s", rounds, steps, warmup);
+              threads == 1 ? "" : "s", rounds, steps, warmup, clock == "cpu" ? "CPU-time" : "wall");
+  double (*const now)() = clock == "cpu" ? &cpuSeconds : &wallSeconds;
   std::fflush(stdout);
   for (Row& r : rows)
     for (int i = 0; i < warmup; ++i) r.world->substep();
@@ -210,14 +234,15 @@ int cmdBenchEffects(const std::vector<std::string>& args) {
       const std::size_t idx = (k + std::size_t(round)) % rows.size();
       Row& r = rows[idx];
       r.world->resetTimings();
-      const auto t0 = std::chrono::steady_clock::now();
+      const double t0 = now(), w0 = wallSeconds();
       for (int i = 0; i < steps; ++i) r.world->substep();
-      const double sec = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+      const double sec = now() - t0, wallSec = wallSeconds() - w0;
       msThisRound[idx] = 1e3 * sec / steps;
       double effectSec = 0;
       for (const StageTiming& t : r.world->timings())
         if (std::find(r.cfg.stages.begin(), r.cfg.stages.end(), t.name) != r.cfg.stages.end()) effectSec += t.seconds;
       r.effectMs.push_back(1e3 * effectSec / steps);
+      r.share.push_back(effectSec / wallSec);  // both wall: the stage timers use the wall clock
     }
     for (std::size_t k = 0; k < rows.size(); ++k) {
       rows[k].ms.push_back(msThisRound[k]);
@@ -225,19 +250,23 @@ int cmdBenchEffects(const std::vector<std::string>& args) {
     }
   }
 
-  std::printf("%-12s %10s %9s %12s %7s %11s\n", "effect", "ms/substep", "vs none", "effect ms", "share", "substep ms");
+  std::printf("%-12s %10s %9s %9s %12s %7s %11s\n", "effect", "ms/substep", "best", "vs none", "effect ms", "share",
+              "substep ms");
   std::ostringstream csv;
-  csv << "effect,particles,threads,rounds,steps_per_round,ms_per_step,ratio_to_none,effect_ms_per_step,effect_share,substep_s\n";
+  csv << "effect,particles,threads,rounds,steps_per_round,clock,ms_per_step,ms_per_step_best,ratio_to_none,"
+         "effect_ms_per_step,effect_share,substep_s\n";
   for (const Row& r : rows) {
-    const double ms = median(r.ms), ratio = median(r.ratio), eff = median(r.effectMs);
-    const double share = ms > 0 ? eff / ms : 0;
+    const double ms = median(r.ms), best = *std::min_element(r.ms.begin(), r.ms.end());
+    const double ratio = median(r.ratio), eff = median(r.effectMs), share = median(r.share);
     const double dt = r.world->stableTimeStep();
-    std::printf("%-12s %10.3f %9.3f %12.3f %6.1f%% %11.3f\n", r.cfg.name.c_str(), ms, ratio, eff, 100 * share, 1e3 * dt);
-    csv << r.cfg.name << ',' << np << ',' << threads << ',' << rounds << ',' << steps << ',' << ms << ',' << ratio << ','
-        << eff << ',' << share << ',' << dt << '\n';
+    std::printf("%-12s %10.3f %9.3f %9.3f %12.3f %6.1f%% %11.3f\n", r.cfg.name.c_str(), ms, best, ratio, eff, 100 * share,
+                1e3 * dt);
+    csv << r.cfg.name << ',' << np << ',' << threads << ',' << rounds << ',' << steps << ',' << clock << ',' << ms << ','
+        << best << ',' << ratio << ',' << eff << ',' << share << ',' << dt << '\n';
   }
-  std::printf("(medians over rounds; 'vs none' is the ratio to none within each round; 'effect ms' is the time of the\n"
-              " effect's own stages; 'substep ms' is the longest stable substep at the end: viscosity limits it)\n");
+  std::printf("(ms/substep and 'vs none' are medians over rounds, 'vs none' taken within each round; 'best' is the\n"
+              " fastest round; 'effect ms' is the wall time of the effect's own stages per substep, 'share' its part of\n"
+              " the round's wall time; 'substep ms' is the longest stable substep at the end: viscosity limits it)\n");
   if (!csvPath.empty()) {
     const std::filesystem::path out(csvPath);
     if (out.has_parent_path()) std::filesystem::create_directories(out.parent_path());
