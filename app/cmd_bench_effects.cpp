@@ -127,6 +127,14 @@ int cmdBenchEffects(const std::vector<std::string>& args) {
     else throw UsageError("unknown option '" + a + "' (see sph2d bench effects --help)");
   }
 
+  const std::vector<std::string> known = {"none", "none_again", "viscosity", "xsph",       "force_field", "csf",
+                                          "akinci", "lifetime",  "sink",      "user_force", "all"};
+  for (const std::string& name : only)
+    if (std::find(known.begin(), known.end(), name) == known.end())
+      throw UsageError("--effects: unknown configuration '" + name +
+                       "'; configurations: none, none_again, viscosity, xsph, force_field, csf, akinci, lifetime, sink, "
+                       "user_force, all");
+
   SceneDef base = loadScene(scenePath);
   const std::size_t n0 = countBlockParticles(base);
   if (n0 == 0) throw UsageError("scene " + scenePath + " has no fluid to resample");
@@ -198,10 +206,6 @@ int cmdBenchEffects(const std::vector<std::string>& args) {
        },
        true},
   };
-  for (const std::string& name : only)
-    if (std::none_of(configs.begin(), configs.end(), [&](const Config& c) { return c.name == name; }))
-      throw UsageError("--effects: unknown configuration '" + name +
-                       "'; configurations: none, none_again, viscosity, xsph, force_field, csf, akinci, lifetime, sink, user_force, all");
 
   std::vector<Row> rows;
   for (const Config& cfg : configs) {
