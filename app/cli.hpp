@@ -61,5 +61,7 @@ int cmdInfo(const std::vector<std::string>& args);
 int cmdBenchStep(const std::vector<std::string>& args);
 /// `sph2d bench accuracy`.
 int cmdBenchAccuracy(const std::vector<std::string>& args);
+/// `sph2d bench effects`.
+int cmdBenchEffects(const std::vector<std::string>& args);
 
 }  // namespace sph2d::cli

@@ -50,7 +50,7 @@ int cmdBench(const std::vector<std::string>& args) {
     std::fputs(kRenderFlagsHelp, stdout);
     return args.empty() ? 2 : 0;
   }
-  if (args[0] != "render") throw UsageError("unknown benchmark '" + args[0] + "'; benchmarks: step, render, accuracy (see sph2d bench step|render|accuracy --help)");
+  if (args[0] != "render") throw UsageError("unknown benchmark '" + args[0] + "'; benchmarks: step, render, accuracy, effects (see sph2d bench step|render|accuracy|effects --help)");
   int particles = 20000, width = 960, height = 540, frames = 30, level = 1;
   std::string save;
   RenderOptions opt;

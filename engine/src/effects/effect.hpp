@@ -43,10 +43,17 @@ EffectList makeEffects(const SceneDef& scene);
 /// The effect that applies the current user forces (created when the first is set).
 std::unique_ptr<Effect> makeUserForceEffect(const std::vector<UserForce>* forces);
 
-/// Runs every effect as its own timed, guarded stage.
+/// Runs every effect as its own timed, guarded stage (nothing at all in a build
+/// with SPH2D_NO_EFFECT_MODULES, the baseline of benchmarks/effects_overhead.sh).
 inline void applyEffects(StepContext& c, StageRunner& run, const EffectList& effects) {
+#ifdef SPH2D_NO_EFFECT_MODULES
+  (void)c;
+  (void)run;
+  (void)effects;
+#else
   for (const auto& e : effects)
     if (e->enabled) run.checked(e->name(), [&] { return e->apply(c); });
+#endif
 }
 
 }  // namespace sph2d
