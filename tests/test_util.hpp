@@ -2,6 +2,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include "sph2d/scene.hpp"
 #include "sph2d/world.hpp"
@@ -22,4 +23,20 @@ inline bool allFiniteState(const World& w) {
   return true;
 }
 
+/// Every pressure solver, in the registry's order (a test checks it matches
+/// engine/src/solvers/registry.cpp, so a new solver cannot be left out).
+inline const std::vector<std::string>& solvers() {
+  static const std::vector<std::string> s = {"muller2003", "wcsph", "pbf", "dfsph"};
+  return s;
+}
+
 }  // namespace sph2d::test
+
+/// One doctest TEST_CASE per solver of sph2d::test::solvers(), named "NAME (solver)",
+/// each calling FN(solver) with the solver's name (a std::string): CTest runs, times
+/// and reports every solver on its own, and a failure names the solver.
+#define TEST_CASE_EVERY_SOLVER(NAME, FN)                        \
+  TEST_CASE(NAME " (muller2003)") { FN(std::string("muller2003")); } \
+  TEST_CASE(NAME " (wcsph)") { FN(std::string("wcsph")); }           \
+  TEST_CASE(NAME " (pbf)") { FN(std::string("pbf")); }               \
+  TEST_CASE(NAME " (dfsph)") { FN(std::string("dfsph")); }

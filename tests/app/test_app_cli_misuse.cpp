@@ -158,7 +158,9 @@ TEST_CASE("cli misuse: a full disk (a 200 KiB tmpfs) exits 1 naming the file, ea
   CHECK(r.code == 1);
   CHECK(r.out.find("cannot write " + mnt + "/frame_") != std::string::npos);
   CHECK(r.out.find("No space left on device") != std::string::npos);
-  const std::vector<std::string> names = listDir(copy);
+  std::vector<std::string> names = listDir(copy);
+  // The manifest is written when the run stops, if the disk still has room for it.
+  names.erase(std::remove(names.begin(), names.end(), std::string("manifest.json")), names.end());
   MESSAGE(names.size() << " whole frames fit in 200 KiB");
   CHECK(names.size() >= 3);
   CHECK(names.size() < 200);

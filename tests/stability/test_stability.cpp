@@ -8,18 +8,13 @@
 #include <string>
 #include <vector>
 
+#include "solvers/solver.hpp"
 #include "sph2d/world.hpp"
 #include "test_util.hpp"
 
 using namespace sph2d;
 
 namespace {
-
-/// Every solver the suite runs.
-const std::vector<std::string>& solvers() {
-  static const std::vector<std::string> s = {"muller2003", "wcsph", "pbf", "dfsph"};
-  return s;
-}
 
 ShapeDef box(Vec2d c, Vec2d h) {
   ShapeDef s;
@@ -59,8 +54,12 @@ double sumY(const World& w) {
 
 }  // namespace
 
+TEST_CASE("stability: the suite runs every registered solver") {
+  CHECK(test::solvers() == solverNames());  // TEST_CASE_EVERY_SOLVER (tests/test_util.hpp) lists the same names
+}
+
 TEST_CASE("stability: all particles created at one point separate without NaN, for every solver") {
-  for (const auto& solver : solvers()) {
+  for (const auto& solver : test::solvers()) {
     CAPTURE(solver);
     SceneDef s = tank(solver, 1, 1, 0.04);
     s.gravity = Vec2d(0, 0);
@@ -75,8 +74,13 @@ TEST_CASE("stability: all particles created at one point separate without NaN, f
     REQUIRE(w.particleCount() == 200);
     CHECK(test::allFiniteState(w));
     CHECK(outside(w, 1, 1) == 0);
-    // They spread: the cloud is wider than a spacing. dfsph is the exception:
-    // its Wendland gradient vanishes at r = 0, so a stack stays (finite) where it is.
+    // They spread: the cloud is wider than a spacing. dfsph is the exception: the
+    // emitter's ±0.1 dx offsets leave the 200 particles on an 8 mm line, 70 ρ0 dense,
+    // each neighbouring all 199 others. Its constant-density solve, a Jacobi iteration
+    // scaled by the diagonal, then overshoots by about the neighbour count, and the
+    // κ ≥ 0 clamp takes each overshoot back: a 2-cycle that ends where it began, so the
+    // clump stays (finite) where it is. Damping the step by ρ0/ρ (as pbf does)
+    // converges, but the first frame-long substep then throws particles at 800 m/s.
     double minX = 1e9, maxX = -1e9;
     for (std::size_t i = 0; i < w.particleCount(); ++i) {
       minX = std::min(minX, w.worldPosition(i).x());
@@ -88,8 +92,53 @@ TEST_CASE("stability: all particles created at one point separate without NaN, f
   }
 }
 
+namespace {
+
+/// The smallest distance between two particles.
+double minPairDistance(const World& w) {
+  double m = 1e300;
+  for (std::size_t i = 0; i < w.particleCount(); ++i)
+    for (std::size_t j = i + 1; j < w.particleCount(); ++j) m = std::min(m, (w.worldPosition(i) - w.worldPosition(j)).norm());
+  return m;
+}
+
+/// Zero gravity, fluid at rest, and a second block added on top of it (twice the
+/// density where they overlap; where the lattices meet, particles coincide): within
+/// 1 s the compression is gone (the most compressed particle under 5 %), nothing
+/// escapes. (Coincident pairs need not part: once the fluid has spread into the empty
+/// tank its pressure is 0, and a pair at rest on top of each other stays so.)
+void overlapSeparates(const std::string& solver) {
+  SceneDef s = tank(solver, 1, 1, 0.04);
+  s.gravity = Vec2d(0, 0);
+  FluidBlockDef blk;
+  blk.min = Vec2d(0.3, 0.3);
+  blk.max = Vec2d(0.7, 0.7);
+  s.blocks.push_back(blk);
+  World w(s, WorldOptions{2});
+  FluidBlockDef top;
+  top.min = Vec2d(0.42, 0.42);
+  top.max = Vec2d(0.58, 0.58);
+  const std::size_t added = w.addBlock(top);
+  const double d0 = minPairDistance(w);
+  for (int f = 0; f < 60; ++f) w.stepFrame();
+  const DensityStats d = w.densityStats();
+  const double d1 = minPairDistance(w);
+  MESSAGE(solver << ": " << added << " particles added; closest pair " << d0 / s.solver.spacing << " dx at the start, "
+                 << d1 / s.solver.spacing << " dx after 1 s; most compressed particle " << 100 * d.maxError
+                 << " % (mean " << 100 * d.meanError << " %), KE " << w.kineticEnergy() << " J/m");
+  REQUIRE(added > 0);
+  CHECK(d0 < 1e-6);  // it really starts with coincident particles
+  CHECK(test::allFiniteState(w));
+  CHECK(outside(w, 1, 1) == 0);
+  CHECK(d.maxError < 0.05);
+}
+
+}  // namespace
+
+TEST_CASE_EVERY_SOLVER("stability: fluid added on top of fluid at rest in zero gravity separates", overlapSeparates)
+
 TEST_CASE("stability: a fluid block overlapping a static polygon at start is cut with one warning, for every solver") {
-  for (const auto& solver : solvers()) {
+  for (const auto& solver : test::solvers()) {
     CAPTURE(solver);
     SceneDef s = tank(solver, 2, 1.5, 0.04);
     BodyDef poly;
@@ -113,7 +162,7 @@ TEST_CASE("stability: a fluid block overlapping a static polygon at start is cut
 }
 
 TEST_CASE("stability: viscosity far beyond its explicit limit shrinks the step to the substep cap and says so, or is refused") {
-  for (const auto& solver : solvers()) {
+  for (const auto& solver : test::solvers()) {
     CAPTURE(solver);
     SceneDef s = tank(solver, 1, 1, 0.04);
     s.solver.viscosity = 50;  // 0.03 R²/ν ≈ 6e-6 s: far below a frame
@@ -144,7 +193,7 @@ TEST_CASE("stability: viscosity far beyond its explicit limit shrinks the step t
 }
 
 TEST_CASE("stability: stiffness far beyond its explicit limit (c = 5000 m/s) stays stable at the substep cap") {
-  for (const auto& solver : solvers()) {
+  for (const auto& solver : test::solvers()) {
     if (solver == "pbf" || solver == "dfsph") continue;  // no sound speed: incompressible by projection or solve
     CAPTURE(solver);
     SceneDef s = tank(solver, 1, 1, 0.04);
@@ -182,7 +231,7 @@ TEST_CASE("stability: surface tension far beyond its step limit shrinks the step
 }
 
 TEST_CASE("stability: a frame time of 1 s holds the substep cap, stays stable and says so, for every solver") {
-  for (const auto& solver : solvers()) {
+  for (const auto& solver : test::solvers()) {
     CAPTURE(solver);
     SceneDef s = tank(solver, 2, 1.5, 0.05);
     s.fps = 1;
@@ -209,7 +258,7 @@ TEST_CASE("stability: a frame time of 1 s holds the substep cap, stays stable an
 }
 
 TEST_CASE("stability: a sink that drains everything leaves an empty, working world, and a scene with zero particles runs") {
-  for (const auto& solver : solvers()) {
+  for (const auto& solver : test::solvers()) {
     CAPTURE(solver);
     SceneDef s = tank(solver, 1, 1, 0.04);
     FluidBlockDef blk;
@@ -232,8 +281,31 @@ TEST_CASE("stability: a sink that drains everything leaves an empty, working wor
   }
 }
 
-TEST_CASE("stability: a long rest, 20000 substeps of a tank at rest: energy decays and stays small, no creep, no drift (wcsph)") {
-  SceneDef s = tank("wcsph", 0.6, 0.8, 0.04);
+namespace {
+
+/// The mean compression each solver promises for water at rest (docs/SCENES.md), for a
+/// column H deep. dfsph: its solve's tolerance, 0.1 %, twice (the solve bounds a linear
+/// prediction of the density; tests/engine/test_solver_dfsph.cpp uses the same);
+/// pbf: its tolerance, 1 %, twice (measured after the last correction, as
+/// tests/engine/test_solver_pbf.cpp); wcsph: 1 % (c0 ≥ 10 v_max); muller2003: its
+/// equilibrium compression at the floor, 2gH/c² (p = c²(ρ − ρ0) and ∇p/2).
+double restBand(const SceneDef& s, double H) {
+  const std::string& t = s.solver.type;
+  if (t == "dfsph") return 2 * 0.001;
+  if (t == "pbf") return 2 * 0.01;
+  if (t == "wcsph") return 0.01;
+  return 2 * 9.81 * H / (s.solver.soundSpeed * s.solver.soundSpeed);
+}
+
+/// A 0.6 m × 0.8 m tank with 0.45 m of water at rest (dx = 0.04), `substeps` substeps.
+void longRest(const std::string& solver, int substeps) {
+  SceneDef s = tank(solver, 0.6, 0.8, 0.04);
+  // muller2003 needs ν ≳ 0.005 m²/s at dx = 0.02 to keep a column calm (docs/SCENES.md:
+  // its density and gradient kernels differ, so its pressure force is not conservative);
+  // viscous damping goes as ν/R², so at dx = 0.04 that is ν ≳ 0.02. Measured here (with
+  // its single-term walls): at ν = 0.01 its kinetic energy stays between 0.08 and
+  // 0.55 J/m, at 0.02 between 0.01 and 0.09.
+  if (solver == "muller2003") s.solver.viscosity = 0.02;
   FluidBlockDef blk;
   blk.min = Vec2d(0, 0);
   blk.max = Vec2d(0.6, 0.45);
@@ -244,30 +316,47 @@ TEST_CASE("stability: a long rest, 20000 substeps of a tank at rest: energy deca
     for (std::size_t i = 0; i < w.particleCount(); ++i) c += w.worldPosition(i);
     return Vec2d(c / double(w.particleCount()));
   };
-  for (int i = 0; i < 2000; ++i) w.substep();
+  const int settle = substeps / 10;
+  for (int i = 0; i < settle; ++i) w.substep();
   const Vec2d c1 = com();
-  const double ke1 = w.kineticEnergy();
-  double keMax = 0;
-  for (int i = 2000; i < 20000; ++i) {
+  const double ke1 = w.kineticEnergy(), t1 = w.time();
+  double keMax = 0, errMax = 0;
+  for (int i = settle; i < substeps; ++i) {
     w.substep();
-    if (i % 1000 == 0) keMax = std::max(keMax, w.kineticEnergy());
+    if (i % 500 == 0) {
+      keMax = std::max(keMax, w.kineticEnergy());
+      errMax = std::max(errMax, w.densityStats().meanError);
+    }
   }
   const Vec2d c2 = com();
   const double ke2 = w.kineticEnergy();
   const double pe = double(w.particleMass()) * 9.81 * 0.45 / 2 * double(w.particleCount());  // potential energy scale of the column
-  MESSAGE("KE after 2000 substeps " << ke1 << ", max later " << keMax << ", final " << ke2 << " J/m (mgH/2 = " << pe
-                                    << "); COM drift " << (c2 - c1).norm() << " m");
-  REQUIRE(w.substeps() == 20000);
+  MESSAGE(solver << ": " << w.time() << " s simulated; KE after " << settle << " substeps (" << t1 << " s) " << ke1
+                 << ", max later " << keMax << ", final " << ke2 << " J/m (mgH/2 = " << pe << "); COM drift "
+                 << (c2 - c1).norm() << " m; mean compression at most " << 100 * errMax << " %, final "
+                 << 100 * w.densityStats().meanError << " % (band " << 100 * restBand(s, 0.45) << " %), max "
+                 << 100 * w.densityStats().maxError << " %");
+  REQUIRE(w.substeps() == std::uint64_t(substeps));
   CHECK(test::allFiniteState(w));
   CHECK(outside(w, 0.6, 0.8) == 0);
-  CHECK(ke2 < ke1);           // it decays (slowly: wcsph's α = 0.05 damps sloshing weakly)
+  // It decays — or it already sits below the energy of a 1 cm/s mean speed,
+  // where pbf (1e-9 J/m) and dfsph (its solve tolerance, ~0.006 J/m) wander.
+  const double floor = 0.5 * double(w.particleMass()) * double(w.particleCount()) * 0.01 * 0.01;
+  CHECK(ke2 < std::max(ke1, floor));
   CHECK(ke2 < 5e-4 * pe);     // and stays small: under 0.05 % of the column's potential energy
   CHECK(keMax < 1e-3 * pe);
   CHECK((c2 - c1).norm() < 0.1 * s.solver.spacing);
+  CHECK(errMax <= restBand(s, 0.45));  // the density within the solver's stated band throughout
 }
 
+void longRest20000(const std::string& solver) { longRest(solver, 20000); }
+
+}  // namespace
+
+TEST_CASE_EVERY_SOLVER("stability: a long rest, 20000 substeps of a tank at rest: energy decays and stays small, no creep, no drift", longRest20000)
+
 TEST_CASE("stability: the dam break 10 km from the origin matches the one at the origin within a spacing after 1 s") {
-  for (const auto& solver : solvers()) {
+  for (const auto& solver : test::solvers()) {
     CAPTURE(solver);
     SceneDef s = test::scene("tests/small_dam_break.json");
     s.solver.type = solver;

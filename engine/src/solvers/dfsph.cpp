@@ -74,10 +74,14 @@
 // 0.1·sqrt(R/g) it rests at ν = 0. velocity_cfl defaults to 0.4: on the dam
 // break (10k particles) that is 10 substeps a frame instead of 15 at 0.25,
 // and the mean density error stays below 0.02 %.
-// A substep shorter than 1 % of the solver's own limit (the World's float
-// rounding remainder of a frame, ~1e-10 s) runs without the solves: the
-// density solve would correct the existing compression at a speed ∝ 1/dt
-// and leave κ ∝ 1/dt for the next warm start (it blew up the resting column).
+// A substep shorter than 1 % of the solver's own limit and of the last solved
+// substep (the World's float rounding remainder of a frame, ~1e-10 s) runs
+// without the solves: the density solve would correct the existing
+// compression at a speed ∝ 1/dt and leave κ ∝ 1/dt for the next warm start
+// (it blew up the resting column). The limit alone is not enough: without
+// gravity and at rest it is velocity_cfl·R/(1e-6 R), 4·10⁵ s, so every
+// frame-long substep looked like a remainder: fluid added on top of fluid at
+// rest in zero gravity (the stability suite) stayed twice as dense for good.
 //
 // Parameters (solver.*): tolerance, divergence_tolerance, max_iterations,
 // min_iterations, relaxation, chebyshev_rho, velocity_cfl, divergence_solve. stats()
@@ -147,8 +151,11 @@ class Dfsph final : public Solver {
     // frame, ~1e-10 s) would correct the existing compression at a speed
     // ∝ 1/dt and leave κ ∝ 1/dt for the next warm start: it runs without the
     // solves (nothing moves in that time anyway).
-    const bool solves = c.dt >= Real(0.01) * lastLimit_;
-    if (solves) stats_ = SolverStats{};  // else the last solved substep's stats stay
+    const bool solves = c.dt >= Real(0.01) * std::min(lastLimit_, lastSolvedDt_);
+    if (solves) {
+      stats_ = SolverStats{};  // else the last solved substep's stats stay
+      lastSolvedDt_ = c.dt;
+    }
     if (divSolve_ && solves) solve(c, run, true);
     run.run("gravity", [&] {
       c.pool.parallelFor(c.P.size(), 4096, [&](std::size_t b, std::size_t e) {
@@ -464,6 +471,7 @@ class Dfsph final : public Solver {
   std::vector<Real> q_;                  ///< dk_/ρ
   SolverStats stats_;
   mutable Real lastLimit_ = 0;  ///< the last maxTimeStep() result (a substep far shorter is a remainder)
+  Real lastSolvedDt_ = 0;       ///< the last substep that ran the solves (0: none yet; a substep far shorter is a remainder)
   bool closed_ = false;  ///< set per substep: no wall, no free surface (both axes periodic, κ of either sign)
   bool unilateral_;  ///< solver.clamp_negative_pressure: κ ≥ 0 (a free surface); false: κ of either sign
   Real kMin_;        ///< 0, or −∞ without the clamp
