@@ -401,30 +401,42 @@ int cmdBenchAccuracy(const std::vector<std::string>& args) {
           std::printf("dam_break    %-11s dx %.4f cfl %.3f: unstable (%s)\n", solver.c_str(), dx, cfl, e.what());
         }
       }
-      for (double dx : tgSpacings) {
-        SceneDef s = tg;
-        const double cfl = setSolver(s, solver, cs);
-        s.solver.spacing = dx;
-        s.solver.maxSubsteps = 100000;
+      // The analytic cases: `run` returns (error, mean and max density error, simulated s, substeps).
+      auto analytic = [&](const char* caseName, const char* errorName, const SceneDef& s, double cfl, auto run) {
         try {
           const auto t0 = std::chrono::steady_clock::now();
-          const auto v = validation::runTaylorGreen(s, s.duration, tgTable, threads);
+          const auto v = run(s);
           const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
           Run r;
-          r.caseName = "taylor_green";
-          r.errorName = "umax_ratio_rms";
-          r.error = v.umaxRms;
+          r.caseName = caseName;
+          r.errorName = errorName;
+          r.error = v.error;
           r.particles = countBlockParticles(s);
           r.meanDensityError = v.meanDensityError;
           r.maxDensityError = v.maxDensityError;
           r.wallPerSim = wall / v.simSeconds;
           r.msPerStep = 1e3 * wall / double(std::max<std::uint64_t>(1, v.substeps));
-          r.solver = solver;
+          r.solver = s.solver.type;
           r.cfl = cfl;
           report(r);
         } catch (const SimulationError& e) {
-          std::printf("taylor_green %-11s dx %.4f cfl %.3f: unstable (%s)\n", solver.c_str(), dx, cfl, e.what());
+          std::printf("%-12s %-11s dx %.4f cfl %.3f: unstable (%s)\n", caseName, s.solver.type.c_str(), s.solver.spacing, cfl,
+                      e.what());
         }
+      };
+      struct Measured {
+        double error, meanDensityError, maxDensityError, simSeconds;
+        std::uint64_t substeps;
+      };
+      for (double dx : tgSpacings) {
+        SceneDef s = tg;
+        const double cfl = setSolver(s, solver, cs);
+        s.solver.spacing = dx;
+        s.solver.maxSubsteps = 100000;
+        analytic("taylor_green", "umax_ratio_rms", s, cfl, [&](const SceneDef& sc) {
+          const auto v = validation::runTaylorGreen(sc, sc.duration, tgTable, threads);
+          return Measured{v.umaxRms, v.meanDensityError, v.maxDensityError, v.simSeconds, v.substeps};
+        });
       }
       for (double dx : channelSpacings) {
         SceneDef s = channel;
@@ -435,25 +447,10 @@ int cmdBenchAccuracy(const std::vector<std::string>& args) {
         s.periodic.max.x() = s.periodic.min.x() + period;
         s.blocks[0].max.x() = s.blocks[0].min.x() + period;
         s.solver.maxSubsteps = 100000;
-        try {
-          const auto t0 = std::chrono::steady_clock::now();
-          const auto v = validation::runPoiseuille(s, 0.0, 1.0, channelTable, threads);
-          const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-          Run r;
-          r.caseName = "poiseuille";
-          r.errorName = "u_rms_vs_series";
-          r.error = v.rmsError;
-          r.particles = countBlockParticles(s);
-          r.meanDensityError = v.meanDensityError;
-          r.maxDensityError = v.maxDensityError;
-          r.wallPerSim = wall / v.simSeconds;
-          r.msPerStep = 1e3 * wall / double(std::max<std::uint64_t>(1, v.substeps));
-          r.solver = solver;
-          r.cfl = cfl;
-          report(r);
-        } catch (const SimulationError& e) {
-          std::printf("poiseuille   %-11s dx %.4f cfl %.3f: unstable (%s)\n", solver.c_str(), dx, cfl, e.what());
-        }
+        analytic("poiseuille", "u_rms_vs_series", s, cfl, [&](const SceneDef& sc) {
+          const auto v = validation::runPoiseuille(sc, 0.0, 1.0, channelTable, threads);
+          return Measured{v.rmsError, v.meanDensityError, v.maxDensityError, v.simSeconds, v.substeps};
+        });
       }
     }
 
