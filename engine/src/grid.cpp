@@ -36,9 +36,12 @@ void Grid::build(const Vec2* x, std::size_t n, Real support, ThreadPool& pool, i
     lo = Vec2(box.x0, box.y0);
     const double ex = double(box.x1) - double(box.x0), ey = double(box.y1) - double(box.y0);
     const double maxCells = std::max<double>(16.0 * double(n), 4096.0);
+    const bool px = periodic && periodic->x, py = periodic && periodic->y;
     double c = minCell;
     for (;;) {
-      const double cx = std::floor(ex / c) + 1, cy = std::floor(ey / c) + 1;
+      // A periodic axis spans its whole period (however few particles it holds).
+      const double cx = px ? std::floor(double(periodic->lx) / c) : std::floor(ex / c) + 1;
+      const double cy = py ? std::floor(double(periodic->ly) / c) : std::floor(ey / c) + 1;
       if (cx * cy <= maxCells) break;
       c *= std::sqrt(cx * cy / maxCells) * 1.01;
     }
@@ -50,8 +53,8 @@ void Grid::build(const Vec2* x, std::size_t n, Real support, ThreadPool& pool, i
   }
   invCell = Real(1) / cell;
   invCellY = invCell;
-  wrapX = periodic && periodic->x;
-  wrapY = periodic && periodic->y;
+  wrapX = n > 0 && periodic && periodic->x;  // an empty grid has nothing to wrap
+  wrapY = n > 0 && periodic && periodic->y;
   if (wrapX || wrapY) {
     // A periodic axis: the period in a whole number of cells of at least
     // minCell (the loader guarantees a period of at least 3 R, so at least

@@ -173,3 +173,22 @@ TEST_CASE("Taylor-Green vortex at Re = 5 (dfsph, bilateral pressure in a closed 
   CHECK(r.rateError < 0.10);
   CHECK(r.amplitude.back() == doctest::Approx(std::exp(r.analyticRate * r.simSeconds)).epsilon(0.1));
 }
+
+TEST_CASE("periodic grid: a period far longer than the fluid keeps the cell count bounded") {
+  ThreadPool pool(1);
+  PeriodicBox box;
+  box.x = true;
+  box.lo = Vec2(0, 0);
+  box.lx = 1.0e5f;  // 100 km period, 10 particles
+  std::vector<Vec2> x;
+  for (int i = 0; i < 10; ++i) x.push_back(Vec2(0.01f * float(i), 0.5f));
+  Grid g;
+  g.build(x.data(), x.size(), 0.025f, pool, 2, &box);
+  CHECK(double(g.nx) * double(g.ny) <= 4096.0 * 1.05);
+  std::size_t found = 0;
+  g.forCandidates(x[0], [&](std::uint32_t j) { found += box.delta(x[0], x[j]).squaredNorm() < 0.025f * 0.025f; });
+  CHECK(found == 3);  // itself and the two within 0.025 m
+  Grid empty;
+  empty.build(x.data(), 0, 0.025f, pool, 2, &box);
+  CHECK(empty.nx * empty.ny == 1);
+}
