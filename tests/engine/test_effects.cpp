@@ -293,6 +293,8 @@ void runEffectAlone(int k) {
     s.effects.tension.model = "akinci";
   }
   if (k == 4) s.effects.forceFields.push_back(ForceFieldDef{Vec2d(3.0, 0.0), true, RegionDef{}});
+  if (k == 5) s.effects.shifting = true;
+  if (k != 0) s.solver.viscosity = 0;  // the effect alone
   World w(s, WorldOptions{2});
   for (int f = 0; f < 120; ++f) w.stepFrame();
   CHECK(w.time() == doctest::Approx(2.0));
@@ -306,3 +308,4 @@ TEST_CASE("xsph alone runs 2 s with no NaN and nothing leaving the box") { runEf
 TEST_CASE("csf surface tension alone runs 2 s with no NaN and nothing leaving the box") { runEffectAlone(2); }
 TEST_CASE("akinci surface tension alone runs 2 s with no NaN and nothing leaving the box") { runEffectAlone(3); }
 TEST_CASE("a force field alone runs 2 s with no NaN and nothing leaving the box") { runEffectAlone(4); }
+TEST_CASE("particle shifting alone runs 2 s with no NaN and nothing leaving the box") { runEffectAlone(5); }

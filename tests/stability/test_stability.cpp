@@ -212,23 +212,41 @@ TEST_CASE("stability: stiffness far beyond its explicit limit (c = 5000 m/s) sta
   }
 }
 
-TEST_CASE("stability: surface tension far beyond its step limit shrinks the step, and the run stays finite") {
-  SceneDef s = tank("wcsph", 1, 1, 0.04);
+namespace {
+void surfaceTensionBeyondLimit(const std::string& solver) {
+  SceneDef s = tank(solver, 1, 1, 0.04);
   s.gravity = Vec2d(0, 0);
   s.effects.surfaceTension = true;
   s.effects.tension.model = "csf";
-  s.effects.tension.sigma = 1e4;
+  // Brackbill's limit sqrt(ρ0 h³/(2πσ)) with h = R/2 = 0.05 m: 0.45 ms, 37 substeps a frame
+  // (more than the cap of 30) and below pbf's smallest substep (max_dt/32 = 0.52 ms).
+  s.effects.tension.sigma = 1e5;
   s.solver.maxSubsteps = 30;
   FluidBlockDef blk;
   blk.min = Vec2d(0.3, 0.3);
   blk.max = Vec2d(0.7, 0.7);
   s.blocks.push_back(blk);
+  if (solver == "pbf") {  // pbf's smallest substep (max_dt/32) is above the limit: refused, naming the key
+    try {
+      World w(s, WorldOptions{2});
+      FAIL("pbf accepted a surface-tension step limit it cannot follow");
+    } catch (const SceneError& e) {
+      CHECK(e.key == "effects.surface_tension.sigma");
+      CHECK(std::string(e.what()).find("surface_tension") != std::string::npos);
+    }
+    return;
+  }
   World w(s, WorldOptions{2});
   for (int f = 0; f < 5; ++f) w.stepFrame();
+  CHECK(w.lastFrameSubsteps() == 30);  // the cap, not a longer substep
   CHECK_FALSE(w.takeWarnings().empty());
   CHECK(test::allFiniteState(w));
   CHECK(outside(w, 1, 1) == 0);
 }
+}  // namespace
+
+TEST_CASE_EVERY_SOLVER("stability: surface tension far beyond its step limit shrinks the step and stays finite, or is refused",
+                       surfaceTensionBeyondLimit)
 
 TEST_CASE("stability: a frame time of 1 s holds the substep cap, stays stable and says so, for every solver") {
   for (const auto& solver : test::solvers()) {
