@@ -203,7 +203,7 @@ TEST_CASE("dfsph: scene keys are read, defaulted and range-checked") {
   CHECK(s.solver.param("divergence_tolerance") == doctest::Approx(0.01));
   CHECK(s.solver.param("min_iterations") == 2);
   CHECK(s.solver.param("divergence_solve") == 1);
-  CHECK(s.solver.param("relaxation") == doctest::Approx(0.6));
+  CHECK(s.solver.param("relaxation") == doctest::Approx(0.5));
   CHECK(s.solver.param("chebyshev_rho") == doctest::Approx(0.98));
   CHECK(s.solver.param("velocity_cfl") == doctest::Approx(0.4));
   CHECK_THROWS(parseScene(base + R"(, "relaxation": 1.5}})", "inline.json"));

@@ -50,7 +50,7 @@ const std::vector<Entry>& entries() {
          "largest mean |Dρ/Dt|/ρ0 per second the divergence-free solve accepts (compression only where κ_v = 0)"},
         {"max_iterations", 100, 1, 10000, "iterations per solve at most (each solve separately)"},
         {"min_iterations", 2, 0, 10000, "iterations per solve at least"},
-        {"relaxation", 0.6, 0.05, 1, "Jacobi relaxation ω of both solves (κ increments are ω times the diagonal estimate)"},
+        {"relaxation", 0.5, 0.05, 1, "Jacobi relaxation ω of both solves (κ increments are ω times the diagonal estimate)"},
         {"chebyshev_rho", 0.98, 0, 0.999,
          "Chebyshev acceleration of both solves (Wang 2015) with this spectral radius estimate; 0: plain relaxed Jacobi"},
         {"velocity_cfl", 0.4, 0.01, 1, "dt ≤ velocity_cfl·R/v_max (dfsph does not read solver.cfl, the CFL number on c + v_max)"},
