@@ -30,6 +30,15 @@ int parseInt(const std::string& flag, const std::string& v, int lo, int hi) {
   return int(x);
 }
 
+std::vector<std::string> splitList(const std::string& s) {
+  std::vector<std::string> out;
+  std::stringstream ss(s);
+  std::string item;
+  while (std::getline(ss, item, ','))
+    if (!item.empty()) out.push_back(item);
+  return out;
+}
+
 std::vector<int> parseIntList(const std::string& flag, const std::string& v, int lo, int hi) {
   std::vector<int> out;
   std::stringstream ss(v);

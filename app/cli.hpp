@@ -26,6 +26,8 @@ struct UsageError : std::runtime_error {
 int parseInt(const std::string& flag, const std::string& v, int lo, int hi);
 /// Parses a comma-separated list of integers in [lo, hi].
 std::vector<int> parseIntList(const std::string& flag, const std::string& v, int lo, int hi);
+/// Splits a comma-separated list (empty items dropped).
+std::vector<std::string> splitList(const std::string& s);
 /// Prints each stage's calls, seconds, ms per call and share.
 void printProfile(const World& w);
 /// Set by SIGINT/SIGTERM once installStopHandler() ran.

@@ -71,24 +71,8 @@ double setSolver(SceneDef& s, const std::string& solver, double scale) {
   return s.solver.cfl = 0.25 * scale;
 }
 
-/// Martin & Moyce 1952: (T, Z) rows.
-std::vector<std::pair<double, double>> readSurgeTable(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw std::runtime_error("cannot open " + path);
-  std::vector<std::pair<double, double>> rows;
-  std::string line;
-  while (std::getline(in, line)) {
-    if (line.empty() || line[0] == '#' || line[0] == 'T') continue;
-    std::stringstream ss(line);
-    double T = 0, Z = 0;
-    char comma = 0;
-    if (ss >> T >> comma >> Z) rows.emplace_back(T, Z);
-  }
-  if (rows.empty()) throw std::runtime_error("no rows in " + path);
-  return rows;
-}
-
-Run runDamBreak(SceneDef s, const std::vector<std::pair<double, double>>& table, int threads) {
+/// `table`: Martin & Moyce 1952's (T, Z) rows.
+Run runDamBreak(SceneDef s, const std::vector<std::vector<double>>& table, int threads) {
   Run r;
   World w(s, WorldOptions{threads});
   w.takeWarnings();
@@ -115,13 +99,13 @@ Run runDamBreak(SceneDef s, const std::vector<std::pair<double, double>>& table,
   double se = 0;
   int n = 0;
   for (const auto& row : table) {
-    const double t = row.first / std::sqrt(2 * g / a);
+    const double t = row[0] / std::sqrt(2 * g / a);
     if (t > times.back()) continue;
     std::size_t k = 1;
     while (k + 1 < times.size() && times[k] < t) ++k;
     const double u = (t - times[k - 1]) / (times[k] - times[k - 1]);
     const double x = fronts[k - 1] + u * (fronts[k] - fronts[k - 1]);
-    se += (x / a - row.second) * (x / a - row.second);
+    se += (x / a - row[1]) * (x / a - row[1]);
     ++n;
   }
   r.caseName = "dam_break";
@@ -284,16 +268,9 @@ int cmdBenchAccuracy(const std::vector<std::string>& args) {
     else if (a == "--quick") quick = true;
     else if (a == "--threads") threads = parseInt(a, value(), 1, 256);
     else if (a == "--levels") levels = parseInt(a, value(), 1, 3);
-    else if (a == "--from-csv") {
-      std::stringstream ss(value());
-      std::string item;
-      while (std::getline(ss, item, ',')) fromCsv.push_back(item);
-    }
-    else if (a == "--solvers") {
-      std::stringstream ss(value());
-      std::string item;
-      while (std::getline(ss, item, ',')) solvers.push_back(item);
-    } else throw UsageError("unknown option '" + a + "' (see sph2d bench accuracy --help)");
+    else if (a == "--from-csv") fromCsv = splitList(value());
+    else if (a == "--solvers") solvers = splitList(value());
+    else throw UsageError("unknown option '" + a + "' (see sph2d bench accuracy --help)");
   }
   std::vector<Run> runs;
   if (!fromCsv.empty()) {
@@ -329,7 +306,7 @@ int cmdBenchAccuracy(const std::vector<std::string>& args) {
   SceneDef channel = loadScene(assets + "/scenes/validation/poiseuille.json");
   const auto tgTable = validation::readReferenceCsv(assets + "/reference/taylor_green_decay.csv");
   const auto channelTable = validation::readReferenceCsv(assets + "/reference/channel_flow_transient.csv");
-  const auto table = readSurgeTable(assets + "/reference/martin_moyce_1952_surge_front.csv");
+  const auto table = validation::readReferenceCsv(assets + "/reference/martin_moyce_1952_surge_front.csv");
   if (solvers.empty()) solvers = {"muller2003", "wcsph", "dfsph", "pbf"};
   std::vector<std::string> known;
   {
