@@ -41,16 +41,21 @@ namespace sph2d::cli {
 namespace {
 
 const char* kHelp =
-    "Usage: sph2d bench accuracy [--out DIR] [--quick] [--solvers A,B] [--threads T] [--assets DIR]\n"
+    "Usage: sph2d bench accuracy [--out DIR] [--quick] [--solvers A,B] [--cases A,B] [--threads T] [--assets DIR]\n"
     "\n"
     "Runs every solver over the validation cases (hydrostatic tank, dam break against\n"
-    "Martin & Moyce 1952) at three resolutions (dam break about 5k, 20k and 80k particles)\n"
+    "Martin & Moyce 1952, Taylor-Green vortex, start-up Poiseuille flow) at three\n"
+    "resolutions (dam break about 5k, 20k and 80k particles)\n"
     "and two CFL numbers, and writes DIR/accuracy.csv, DIR/accuracy.md and\n"
     "DIR/<case>.png (default DIR: out/accuracy). --quick runs one small resolution and one\n"
     "CFL number per solver (a smoke test of a minute or two). --assets: the assets folder\n"
     "(default: ./assets). --levels K runs only the K coarsest resolutions (1..3).\n"
     "--from-csv A.csv[,B.csv...] runs nothing: it redraws accuracy.csv, accuracy.md and the\n"
-    "charts in DIR from earlier runs' CSV files.\n";
+    "charts in DIR from earlier runs' CSV files. --cases hydrostatic,dam_break,taylor_green,\n"
+    "poiseuille runs only those cases (default: all four).\n";
+
+/// The validation cases, in the order they run.
+const char* const kCases[] = {"hydrostatic", "dam_break", "taylor_green", "poiseuille"};
 
 struct Run {
   std::string caseName, solver;
@@ -253,7 +258,7 @@ int cmdBenchAccuracy(const std::vector<std::string>& args) {
   std::string out = "out/accuracy", assets = "assets";
   bool quick = false;
   int threads = 0, levels = 3;
-  std::vector<std::string> solvers, fromCsv;
+  std::vector<std::string> solvers, fromCsv, cases(std::begin(kCases), std::end(kCases));
   for (std::size_t i = 0; i < args.size(); ++i) {
     const std::string& a = args[i];
     auto value = [&]() -> std::string {
@@ -270,6 +275,12 @@ int cmdBenchAccuracy(const std::vector<std::string>& args) {
     else if (a == "--levels") levels = parseInt(a, value(), 1, 3);
     else if (a == "--from-csv") fromCsv = splitList(value());
     else if (a == "--solvers") solvers = splitList(value());
+    else if (a == "--cases") {
+      cases = splitList(value());
+      for (const std::string& k : cases)
+        if (std::find(std::begin(kCases), std::end(kCases), k) == std::end(kCases))
+          throw UsageError("--cases: unknown case '" + k + "' (allowed: hydrostatic, dam_break, taylor_green, poiseuille)");
+    }
     else throw UsageError("unknown option '" + a + "' (see sph2d bench accuracy --help)");
   }
   std::vector<Run> runs;
@@ -334,6 +345,11 @@ int cmdBenchAccuracy(const std::vector<std::string>& args) {
     tgSpacings.resize(std::size_t(levels));
     channelSpacings.resize(std::size_t(levels));
   }
+  auto want = [&](const char* k) { return std::find(cases.begin(), cases.end(), k) != cases.end(); };
+  if (!want("hydrostatic")) hydroSpacings.clear();
+  if (!want("dam_break")) damSpacings.clear();
+  if (!want("taylor_green")) tgSpacings.clear();
+  if (!want("poiseuille")) channelSpacings.clear();
   const std::vector<double> cflScales = quick ? std::vector<double>{1.0} : std::vector<double>{1.0, 2.0};
   if (!fromCsv.empty()) known.clear();  // redraw only
   std::printf("%-12s %-11s %9s %6s %-26s %10s %10s %10s %12s %10s\n", "case", "solver", "particles", "cfl", "error_name",
