@@ -19,7 +19,7 @@ struct SolverStats {
   int pressureIterations = 0;     ///< constant-density (pressure) solve iterations
   int divergenceIterations = 0;   ///< divergence-free solve iterations (0 when disabled)
   double densityError = 0;        ///< mean predicted density error /ρ0 after the pressure solve (solver-defined residual)
-  double divergenceError = 0;     ///< mean |Dρ/Dt|/ρ0 [1/s] after the divergence solve (solver-defined residual)
+  double divergenceError = 0;     ///< mean |Dρ/Dt|·dt/ρ0 after the divergence solve (solver-defined residual)
 };
 
 class Solver {
