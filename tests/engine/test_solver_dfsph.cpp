@@ -127,6 +127,51 @@ TEST_CASE("dfsph: a resting tank settles incompressible and calm") {
   CHECK(outside(w, 0, 0, 0.6, 1.3) == 0);
 }
 
+TEST_CASE("dfsph: the 2 m x 1 m tank at dx = 12.5 mm (12,800 particles) rests: no eruption, floor pressure near rho0 g H") {
+  // Before the hydrostatic time-step limit (dt ≤ 0.35·R/sqrt(|g| D), dfsph.cpp's
+  // header) the floor rows oscillated in alternation with a growing amplitude
+  // from the first substep, were crushed at the collision clearance (single
+  // particles 50 % compressed, mean 1.2 % at t = 0.08 s) and the tank erupted
+  // at t ≈ 0.09 s (speeds of 10 m/s).
+  SceneDef s = dfsphScene("validation/hydrostatic_tank.json");
+  s.solver.spacing = 0.0125;
+  World w(s, WorldOptions{2});
+  const double rho0 = 1000, g = 9.81, H = 1.0, dx = s.solver.spacing;
+  const double tol = s.solver.param("tolerance");
+  double vMax = 0, meanErrSum = 0, meanErrMax = 0, maxErrMax = 0, pSum = 0;
+  int pCount = 0;
+  for (int f = 0; f < 30; ++f) {  // 0.5 s
+    REQUIRE_NOTHROW(w.stepFrame());
+    const Particles& P = w.particles();
+    for (std::size_t i = 0; i < w.particleCount(); ++i) vMax = std::max(vMax, double(P.v[i].norm()));
+    const DensityStats d = w.densityStats();
+    meanErrSum += d.meanError;
+    meanErrMax = std::max(meanErrMax, d.meanError);
+    maxErrMax = std::max(maxErrMax, d.maxError);
+    if (f < 15) continue;
+    for (std::size_t i = 0; i < w.particleCount(); ++i) {  // the floor rows, away from the side walls
+      const Vec2d q = w.worldPosition(i);
+      if (std::fabs(q.x() - 1.0) < 0.5 && q.y() < 1.5 * dx) {
+        pSum += P.p[i];
+        ++pCount;
+      }
+    }
+  }
+  REQUIRE(test::allFiniteState(w));
+  REQUIRE(pCount > 0);
+  const double pFloor = pSum / pCount / (rho0 * g * H);
+  MESSAGE("0–0.5 s: max speed " << vMax << " m/s, mean compression " << meanErrSum / 30 << " on average, ≤ " << meanErrMax
+                                << ", max ≤ " << maxErrMax
+                                << "; floor rows' pressure (0.25–0.5 s) " << pFloor << " rho0 g H");
+  CHECK(vMax < 1.5);                // measured 0.84 m/s (sqrt(gH) = 3.1 m/s); before: 10 m/s at t = 0.08 s
+  CHECK(meanErrSum / 30 <= tol);    // the pressure solve's tolerance (0.1 %); measured 0.05 %
+  CHECK(meanErrMax <= 2 * tol);     // as the resting-column test; measured 0.08 %; before: 1.2 %
+  CHECK(maxErrMax <= 0.1);          // measured 3.5 %; before: 50 %
+  CHECK(pFloor > 0.8);              // measured 1.08 (the wall row reads above ρ0 g H, see dfsph.cpp)
+  CHECK(pFloor < 1.5);
+  CHECK(outside(w, 0, 0, 2, 1.2) == 0);
+}
+
 TEST_CASE("dfsph: both implicit solves reach their tolerances within the iteration cap on the resting tank") {
   const SceneDef s = dfsphScene("tests/resting_column.json");
   SolverHarness h(s, 1);

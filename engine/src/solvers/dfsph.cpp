@@ -83,6 +83,44 @@
 // 0.1·sqrt(R/g) it rests at ν = 0. velocity_cfl defaults to 0.4: on the dam
 // break (10k particles) that is 10 substeps a frame instead of 15 at 0.25,
 // and the mean density error stays below 0.02 %.
+// And dt ≤ 0.35·R/sqrt(|g| D), D the greatest depth of a particle below
+// the highest particle of its column (strips of width R across gravity, as
+// the hydrostatic warm start): the stiffness of the hydrostatic pressure
+// itself. The solves make ρ* = ρ0 for the positions of this substep; how the
+// pressure force changes as the particles move (∇W under a pressure
+// κ ≈ |g| D, a stiffness ~ κ/R²) is explicit, a wave of speed ~ sqrt(κ), and
+// at rest the other limits do not see it: at dt = 0.1·sqrt(R/g),
+// dt·sqrt(gD)/R = 0.1·sqrt(D/R), which grows with the depth in supports.
+// Measured on the 2 m × 1 m tank at dx = 12.5 mm (12,800 particles, ν = 0,
+// R = 31 mm, D = 1 m): at dt = 0.1·sqrt(R/g) (5.6 ms: 0.57 R/sqrt(κ_max),
+// κ_max ≈ 1.2 g·1 m) the rows near the floor move in alternation (even rows
+// down, odd rows up: a mode the SPH divergence does not see in the bulk, so
+// neither solve damps it), the pattern flips sign every substep and its
+// amplitude doubles (floor row v_y +0.012, −0.024, +0.11, −0.14 m/s over the
+// first four substeps, with the symmetric wall term; with the single term
+// the warm start's first kick, −1.4 m/s, hides it), the floor rows are
+// crushed at the collision clearance (single particles 50 % compressed) and
+// the tank erupts at t ≈ 0.09 s. Halving that step (0.05·sqrt(R/g)) rests;
+// so does 0.5 R/sqrt(κ_max) for 0.5 s. The coarse tank (dx = 25 mm) ran at
+// 0.40 R/sqrt(κ_max) under the old limits and held. Not the cause (each
+// still erupted within 0.1–0.3 s at the old step): 500–2,000 iterations, a
+// tenfold tighter tolerance, chebyshev_rho = 0, the symmetric wall term
+// 2δκ_i/ρ_i (with α's wall part to match), no divergence solve, no or a
+// halved warm start of κ_v, ν ≤ 0.003 m²/s (ν = 0.01 held, through its own,
+// smaller, viscous step limit). A first version of the limit on the largest
+// κ instead of the depth let a jammed particle's κ spike shorten the step,
+// and a shorter step makes the density solve push harder (the wedge test
+// gained 4× its potential energy): the depth is geometric and has no such
+// feedback. With the limit (0.35 ≈ 0.38 R/sqrt(κ_max) at rest) the fine
+// tank runs 5 substeps a frame instead of 3 and rests like the coarse one
+// (measured with a driver, not the bench: 1.5 s, no blow-up, kinetic energy
+// falling from 8.6 to 4.1 J, max speed ≤ 0.46 m/s after 0.25 s, mean density
+// error 0.04 %, floor rows at 1.08–1.18 ρ0 g H). The coarse tank still runs
+// 3 substeps a frame (the same bits). The dam break (a 2 m column; the
+// limit binds until it has collapsed) takes 294 substeps instead of 258 at
+// dx = 0.02 m and 541 instead of 493 at 0.01 m (20k particles, 9.4 wall s
+// per simulated s on 2 threads), its mean density error unchanged (0.07 %,
+// 0.05 %).
 // A substep shorter than 1 % of the solver's own limit and of the last solved
 // substep (the World's float rounding remainder of a frame, ~1e-10 s) runs
 // without the solves: the density solve would correct the existing
@@ -147,6 +185,18 @@ class Dfsph final : public Solver {
     Particles& P = c.P;
     const Real g = c.gravity.norm();
     if (!(g > 0) || P.size() == 0) return;
+    depths(c, [&](std::size_t i, Real depth) {
+      kappa[i] = g * (depth + Real(0.5) * c.dx);
+      P.p[i] = kappa[i] * P.rho[i];
+    });
+  }
+
+  /// Calls f(i, depth) for every particle with its depth below the highest
+  /// particle of the same column (strips of width R across gravity). Needs |g| > 0.
+  template <class F>
+  void depths(const StepContext& c, F f) const {
+    const Particles& P = c.P;
+    const Real g = c.gravity.norm();
     const Vec2 up = -c.gravity / g, across(up.y(), -up.x());
     Real sMin = std::numeric_limits<Real>::infinity(), sMax = -sMin;
     for (std::size_t i = 0; i < P.size(); ++i) {
@@ -163,18 +213,21 @@ class Dfsph final : public Solver {
       Real& t = top[strip(P.x[i])];
       t = std::max(t, up.dot(P.x[i]));
     }
-    for (std::size_t i = 0; i < P.size(); ++i) {
-      kappa[i] = g * (top[strip(P.x[i])] - up.dot(P.x[i]) + Real(0.5) * c.dx);
-      P.p[i] = kappa[i] * P.rho[i];
-    }
+    for (std::size_t i = 0; i < P.size(); ++i) f(i, top[strip(P.x[i])] - up.dot(P.x[i]));
   }
 
-  /// velocity_cfl·R/v_max, 0.1·sqrt(R/|g|) and 0.25·sqrt(R/a_max), whichever is least.
+  /// velocity_cfl·R/v_max, 0.1·sqrt(R/|g|), 0.25·sqrt(R/a_max) and 0.35·R/sqrt(|g| D), whichever is least.
   Real maxTimeStep(const StepContext& c, Real vmax, Real amax) const override {
     Real dt = cfl_ * c.R / std::max(vmax, Real(1e-6) * c.R);
     const Real g = c.gravity.norm();
     if (g > 0) dt = std::min(dt, Real(0.1) * std::sqrt(c.R / g));
     if (amax > 0) dt = std::min(dt, Real(0.25) * std::sqrt(c.R / amax));
+    // The hydrostatic pressure's own stiffness: dt ≤ 0.35·R/sqrt(|g| D) (see the header).
+    if (g > 0 && c.P.size() > 0) {
+      Real dMax = 0;
+      depths(c, [&](std::size_t, Real depth) { dMax = std::max(dMax, depth); });
+      if (dMax > 0) dt = std::min(dt, kPressureCfl * c.R / std::sqrt(g * dMax));
+    }
     lastLimit_ = dt;
     return dt;
   }
@@ -500,6 +553,7 @@ class Dfsph final : public Solver {
   Real cheb_;                            ///< Chebyshev ρ (0: plain relaxed Jacobi)
   Real cfl_;                             ///< dt ≤ cfl_·R/v_max
   static constexpr int kChebDelay = 5;   ///< plain iterations before the acceleration starts
+  static constexpr Real kPressureCfl = Real(0.35);  ///< dt ≤ kPressureCfl·R/sqrt(|g| D), D the greatest depth
   std::vector<Vec2> vPrev_;              ///< velocity before the last iteration (Chebyshev)
   std::vector<Real> kPrev_;              ///< κ before the last iteration (Chebyshev)
   /// One neighbour entry of an iteration: the neighbour's slot and m∇W_ij.
