@@ -277,6 +277,7 @@ int cmdBenchAccuracy(const std::vector<std::string>& args) {
     else if (a == "--solvers") solvers = splitList(value());
     else if (a == "--cases") {
       cases = splitList(value());
+      if (cases.empty()) throw UsageError("--cases needs at least one case (hydrostatic, dam_break, taylor_green, poiseuille)");
       for (const std::string& k : cases)
         if (std::find(std::begin(kCases), std::end(kCases), k) == std::end(kCases))
           throw UsageError("--cases: unknown case '" + k + "' (allowed: hydrostatic, dam_break, taylor_green, poiseuille)");

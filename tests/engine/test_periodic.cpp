@@ -163,6 +163,8 @@ static void taylorGreenRe100(const std::string& solver) {
                  << "; mean density error " << r.meanDensityError);
   CHECK(r.analyticRate == doctest::Approx(-8 * 3.14159265358979 * 3.14159265358979 / 100));
   CHECK(r.rateError < 0.10);
+  // dfsph measured 1.8 %: a looser divergence solve (0.1 ρ0/s) gave 7 %, which this catches.
+  if (solver == "dfsph") CHECK(r.rateError < 0.05);
   CHECK(r.umaxRms < 0.06);
   CHECK(r.amplitudeRms < 0.06);
   // The flow keeps its shape: the mode carries the kinetic energy (noise would not decay as the mode).

@@ -9,7 +9,8 @@
 // gradient of the particle concentration C_i = Σ_j V_j W_ij (Fick's law):
 //   δx_i = −D ∇C_i,  ∇C_i = Σ_j V_j ∇W_ij + Σ_b Ψ_b ∇W_ib,  D = A h v_max dt,
 // with h = R/2, A = effects.shifting.strength (Lind: 1 to 6), the largest
-// speed v_max, Wendland C2 gradients, V_j = m/ρ_j, and δx capped at 0.1 dx.
+// speed v_max, Wendland C2 gradients, V_j = m/ρ_j, and δx capped at 0.1 dx
+// per pass.
 // One pass of explicit diffusion is stable for D below about 0.1 R²
 // (measured: at dfsph's long substeps D = 0.4 A R² in one pass blew up within
 // 6 substeps). A larger D is applied as k = ⌈D / 0.1 R²⌉ passes of D/k, each
@@ -23,7 +24,10 @@
 // surface ∇C points into the fluid; there (C_i below 0.95 of a full lattice's)
 // only the component along the surface is kept (Lind's surface treatment).
 // Velocities are not interpolated to the new positions (the shift is a small
-// fraction of the spacing per substep).
+// fraction of the spacing per pass; at most 8 passes a substep, 0.8 dx in
+// all). Later passes keep the substep's neighbour lists: pairs that moved
+// out of the support are skipped, pairs that moved into it are not seen
+// (only near a pair that was already closer than R + 0.8 dx).
 //
 // The stage runs after the forces, before integration: it reads x, ρ and
 // the neighbour lists, and writes x (through a scratch copy: a gather).
@@ -86,6 +90,7 @@ class ParticleShifting final : public Effect {
           Real dx = xi.x() - X[j].x(), dy = xi.y() - X[j].y();
           per.nearest(dx, dy);
           const Real r = std::sqrt(dx * dx + dy * dy);
+          if (r >= c.R) continue;  // a later pass: the pair has left the support since the lists were built
           const Real q = r * W.invR, a = Real(1) - q;
           const Real V = c.mass * IR[j];
           const Real g = V * gradK * a * a * a;
