@@ -221,7 +221,8 @@ class Dfsph final : public Solver {
       sMax = std::max(sMax, s);
     }
     const std::size_t strips = std::min<std::size_t>(std::size_t((sMax - sMin) / c.R) + 1, 1u << 20);
-    std::vector<Real> top(strips, -std::numeric_limits<Real>::infinity());
+    std::vector<Real>& top = topScratch_;  // reused: maxTimeStep runs this every substep
+    top.assign(strips, -std::numeric_limits<Real>::infinity());
     auto strip = [&](const Vec2& x) {
       return std::min(strips - 1, std::size_t(std::max(Real(0), (across.dot(x) - sMin) / c.R)));
     };
@@ -585,6 +586,7 @@ class Dfsph final : public Solver {
   std::vector<Real> q_;                  ///< dk_/ρ
   SolverStats stats_;
   mutable Real lastLimit_ = 0;  ///< the last maxTimeStep() result (a substep far shorter is a remainder)
+  mutable std::vector<Real> topScratch_;  ///< depths(): the highest particle per strip
   Real lastSolvedDt_ = 0;       ///< the last substep that ran the solves (0: none yet; a substep far shorter is a remainder)
   bool closed_ = false;  ///< set per substep: no wall, no free surface (both axes periodic, κ of either sign)
   bool unilateral_;  ///< solver.clamp_negative_pressure: κ ≥ 0 (a free surface); false: κ of either sign
