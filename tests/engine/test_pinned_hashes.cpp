@@ -1,0 +1,71 @@
+// Pinned state hashes (Box2D v3's test_determinism with its EXPECTED_HASH): every
+// solver on standard scenes, checked for 1, 2 and 3 threads against a hash fixed
+// in this file. A change that moves bits on purpose updates the table in a commit
+// of its own that says why; a change that should not (a refactoring, a new stage
+// elsewhere) must leave it alone. The hashes are of ids, positions and velocities
+// (World::stateHash) after whole frames, so they pin the substep split too.
+#include <doctest/doctest.h>
+
+#include <cinttypes>
+#include <cstdio>
+#include <string>
+
+#include "sph2d/world.hpp"
+#include "test_util.hpp"
+
+using namespace sph2d;
+
+namespace {
+
+struct Pinned {
+  const char* scene;    ///< under assets/scenes/
+  const char* solver;   ///< solver type, overriding the scene's
+  int frames;           ///< frames stepped
+  bool userForce;       ///< a push at frame 10 (the user_force stage)
+  std::uint64_t hash;   ///< expected World::stateHash()
+};
+
+// To regenerate after a change that moves bits on purpose: run the test, copy
+// the "actual" values it prints, and say why in the commit message.
+const Pinned kPinned[] = {
+    {"tests/small_dam_break.json", "muller2003", 30, false, 0x6bee05716112ca6cULL},
+    {"tests/small_dam_break.json", "wcsph", 30, false, 0xc3041c6c74ac89c6ULL},
+    {"tests/small_dam_break.json", "pbf", 30, false, 0xe582cf9cd167fcc4ULL},
+    {"tests/small_dam_break.json", "dfsph", 30, false, 0xfcb9157e0470c2aeULL},
+    {"tests/every_stage.json", "muller2003", 20, true, 0x1071278408b8c4e6ULL},
+    {"tests/every_stage.json", "wcsph", 20, true, 0x49c5f12b2a3f39a3ULL},
+    {"tests/every_stage.json", "pbf", 20, true, 0xfb2b872bae751b69ULL},
+    {"tests/every_stage.json", "dfsph", 20, true, 0x4c9ce60c3c249f06ULL},
+    {"validation/poiseuille.json", "wcsph", 20, false, 0x13969a633f398ab4ULL},
+    {"validation/poiseuille.json", "dfsph", 20, false, 0xa667c8585c914fd9ULL},
+};
+
+std::uint64_t run(const Pinned& p, int threads) {
+  SceneDef s = test::scene(p.scene);
+  if (s.solver.type != p.solver) {
+    s.solver.type = p.solver;
+    s.solver.params.clear();  // the World fills the new solver's own defaults
+  }
+  World w(s, WorldOptions{threads});
+  for (int f = 0; f < p.frames; ++f) {
+    if (p.userForce && f == 10) w.setUserForces({UserForce{Vec2d(0.5, 0.4), 0.4, -30}});
+    w.stepFrame();
+  }
+  return w.stateHash();
+}
+
+}  // namespace
+
+TEST_CASE("pinned state hashes: every solver on the standard scenes, for 1, 2 and 3 threads") {
+  for (const Pinned& p : kPinned) {
+    for (int threads = 1; threads <= 3; ++threads) {
+      const std::uint64_t h = run(p, threads);
+      char line[160];
+      std::snprintf(line, sizeof line, "%s, %s, %d frames, %d threads: actual 0x%016" PRIx64 "ULL", p.scene, p.solver,
+                    p.frames, threads, h);
+      INFO(line);
+      if (h != p.hash) MESSAGE(line);
+      CHECK(h == p.hash);
+    }
+  }
+}
