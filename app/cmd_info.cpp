@@ -69,6 +69,11 @@ int cmdInfo(const std::vector<std::string>& args) {
     std::printf("             %s parameters: %s\n", s.solver.type.c_str(), params.c_str());
   }
   std::printf("effects      %s\n", list(w.effects()).c_str());
+  {
+    std::string st;
+    for (const std::string& n : w.stages()) st += (st.empty() ? "" : " > ") + n;
+    std::printf("stages       %s\n", st.c_str());  // one substep, in order (World::stages())
+  }
   if (w.emitterCount()) {
     double rate = 0;
     for (const auto& e : s.effects.emitters) rate += e.rate;

@@ -1,5 +1,5 @@
-// The stages every solver shares: grid, neighbour lists, integration,
-// collision, and the deterministic reductions.
+// The stages every solver shares: grid, neighbour lists (fluid and boundary),
+// integration, collision, the periodic wrap, and the deterministic reductions.
 #include "stages.hpp"
 
 #include <algorithm>
@@ -10,13 +10,18 @@ namespace sph2d {
 namespace {
 
 template <class T>
-void permute(std::vector<T>& field, const std::vector<std::uint32_t>& order, std::vector<T>& scratch, ThreadPool& pool) {
+void permuteField(std::vector<T>& field, const std::vector<std::uint32_t>& order, std::vector<T>& scratch,
+                  ThreadPool& pool) {
   scratch.resize(field.size());
-  pool.parallelFor(field.size(), 4096, [&](std::size_t b, std::size_t e) {
+  pool.parallelFor(field.size(), kStreamBlock, [&](std::size_t b, std::size_t e) {
     for (std::size_t k = b; k < e; ++k) scratch[k] = field[order[k]];
   });
   field.swap(scratch);
 }
+
+std::vector<Vec2>& scratchFor(Scratch& s, const std::vector<Vec2>&) { return s.v; }
+std::vector<Real>& scratchFor(Scratch& s, const std::vector<Real>&) { return s.r; }
+std::vector<std::uint32_t>& scratchFor(Scratch& s, const std::vector<std::uint32_t>&) { return s.u; }
 
 }  // namespace
 
@@ -35,11 +40,20 @@ Vec2 tieBreakDirection(std::uint32_t idi, std::uint32_t idj) {
   return idi < idj ? d : Vec2(-d);
 }
 
+bool reorderThisStep(const StepContext& c) {
+  const int every = c.def.reorderInterval;
+  return every > 0 && c.step % std::uint64_t(every) == 0;
+}
+
+void permuteParticles(Particles& P, const std::vector<std::uint32_t>& order, Scratch& s, ThreadPool& pool) {
+  P.forEachField([&](const char*, auto& field) { permuteField(field, order, scratchFor(s, field), pool); });
+}
+
 void stageWrap(StepContext& c) {
   if (!c.periodic.any()) return;
   Particles& P = c.P;
   const PeriodicBox& box = c.periodic;
-  c.pool.parallelFor(P.size(), 4096, [&](std::size_t b, std::size_t e) {
+  c.pool.parallelFor(P.size(), kStreamBlock, [&](std::size_t b, std::size_t e) {
     for (std::size_t i = b; i < e; ++i) {
       const Vec2 s = box.wrap(P.x[i]);
       P.xPrev[i] += s;
@@ -53,34 +67,32 @@ void stageGrid(StepContext& c, bool reorder) {
   c.grid.build(P.x.data(), P.size(), c.R, c.pool, 2, c.periodic.any() ? &c.periodic : nullptr);
   if (!reorder) return;
   const std::vector<std::uint32_t>& order = c.grid.sorted;
-  Scratch& s = c.scratch;
-  permute(P.x, order, s.v, c.pool);
-  permute(P.v, order, s.v, c.pool);
-  permute(P.a, order, s.v, c.pool);
-  permute(P.xPrev, order, s.v, c.pool);
-  permute(P.rho, order, s.r, c.pool);
-  permute(P.p, order, s.r, c.pool);
-  permute(P.invRho, order, s.r, c.pool);
-  permute(P.pOverRho, order, s.r, c.pool);
-  for (auto& f : P.extra) permute(f.second, order, s.r, c.pool);
-  permute(P.id, order, s.u, c.pool);
+  permuteParticles(P, order, c.scratch, c.pool);
   // After the permutation slot k is the k-th particle in cell order.
-  permute(c.grid.cellOf, order, s.u, c.pool);
+  permuteField(c.grid.cellOf, order, c.scratch.u, c.pool);
   for (std::size_t k = 0; k < c.grid.sorted.size(); ++k) c.grid.sorted[k] = std::uint32_t(k);
 }
 
 void stageNeighbours(StepContext& c) {
   Particles& P = c.P;
   const Grid& g = c.grid;
+  const BoundarySet& B = c.boundary;
   NeighbourLists& L = c.nbr;
   const std::size_t n = P.size();
-  L.perBlock.resize((n + kBlock - 1) / kBlock);
+  const std::size_t blocks = (n + kBlock - 1) / kBlock;
+  L.perBlock.resize(blocks);
   L.start.resize(n);
   L.count.resize(n);
+  L.boundaryPerBlock.resize(blocks);
+  L.boundaryStart.resize(n);
+  L.boundaryCount.resize(n);
   const Real R2 = c.R * c.R;
   const PeriodicBox per = c.periodic;
+  const bool walls = !B.samples.empty();
   c.pool.parallelFor(n, kBlock, [&](std::size_t b, std::size_t e) {
     std::vector<std::uint32_t>& out = L.perBlock[b / kBlock];
+    std::vector<std::uint32_t>& bout = L.boundaryPerBlock[b / kBlock];
+    bout.clear();
     std::size_t used = 0;
     for (std::size_t i = b; i < e; ++i) {
       const Vec2 xi = P.x[i];
@@ -100,6 +112,12 @@ void stageNeighbours(StepContext& c) {
         }
       });
       L.count[i] = std::uint32_t(used - L.start[i]);
+      L.boundaryStart[i] = std::uint32_t(bout.size());
+      if (walls)
+        B.sampleGrid.forCandidates(xi, [&](std::uint32_t s) {
+          if ((xi - B.samples[s]).squaredNorm() < R2 && B.visible(s, xi)) bout.push_back(s);
+        });
+      L.boundaryCount[i] = std::uint32_t(bout.size() - L.boundaryStart[i]);
     }
   });
 }
@@ -108,11 +126,11 @@ std::size_t stageIntegrate(StepContext& c) {
   Particles& P = c.P;
   const Real dt = c.dt;
   const Real vmax2 = c.maxSpeed * c.maxSpeed;
-  // The displacement clamp: no particle moves more than half a support radius
-  // in one substep (the CFL bound the next step's time step then honours). It
+  // The displacement clamp: no particle moves more than kMaxMove·R in one
+  // substep (the CFL bound the next step's time step then honours). It
   // only acts when a force jumps within a substep (stacked particles, a new
   // overlap), before the force limit of the next step can see it.
-  const Real vClamp = dt > 0 ? Real(0.5) * c.R / dt : std::numeric_limits<Real>::infinity();
+  const Real vClamp = dt > 0 ? kMaxMove * c.R / dt : std::numeric_limits<Real>::infinity();
   const Real vClamp2 = vClamp * vClamp;
   return firstBad(c.pool, P.size(), [&](std::size_t b, std::size_t e) {
     std::size_t bad = kNone;
@@ -129,6 +147,22 @@ std::size_t stageIntegrate(StepContext& c) {
   });
 }
 
+std::size_t stageDrift(StepContext& c) {
+  Particles& P = c.P;
+  const Real dt = c.dt, vmax2 = c.maxSpeed * c.maxSpeed;
+  return firstBad(c.pool, P.size(), [&](std::size_t b, std::size_t e) {
+    std::size_t bad = kNone;
+    for (std::size_t i = b; i < e; ++i) {
+      P.a[i] = c.gravity;
+      P.xPrev[i] = P.x[i];
+      P.v[i] += c.gravity * dt;
+      P.x[i] += P.v[i] * dt;
+      if (bad == kNone && (!allFinite(P.x[i]) || P.v[i].squaredNorm() > vmax2)) bad = i;
+    }
+    return bad;
+  });
+}
+
 void stageCollide(StepContext& c) {
   Particles& P = c.P;
   if (c.boundary.colliders.empty()) return;
@@ -139,7 +173,7 @@ void stageCollide(StepContext& c) {
 
 Real maxSpeedOf(const Particles& P, ThreadPool& pool) {
   const Real m2 = pool.reduce(
-      P.size(), 4096, Real(0),
+      P.size(), kStreamBlock, Real(0),
       [&](std::size_t b, std::size_t e) {
         Real m = 0;
         for (std::size_t i = b; i < e; ++i) m = std::max(m, P.v[i].squaredNorm());
@@ -151,7 +185,7 @@ Real maxSpeedOf(const Particles& P, ThreadPool& pool) {
 
 Real maxAccelOf(const Particles& P, ThreadPool& pool) {
   const Real m2 = pool.reduce(
-      P.size(), 4096, Real(0),
+      P.size(), kStreamBlock, Real(0),
       [&](std::size_t b, std::size_t e) {
         Real m = 0;
         for (std::size_t i = b; i < e; ++i) m = std::max(m, P.a[i].squaredNorm());

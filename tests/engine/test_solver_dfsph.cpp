@@ -7,7 +7,7 @@
 #include <cmath>
 #include <stdexcept>
 
-#include "solvers/solver.hpp"
+#include "solvers/solver.hpp"  // solverParams
 #include "sph2d/world.hpp"
 #include "test_util.hpp"
 
@@ -39,67 +39,6 @@ double meanSpeed(const Particles& P) {
   for (std::size_t i = 0; i < P.size(); ++i) s += double(P.v[i].norm());
   return P.size() ? s / double(P.size()) : 0;
 }
-
-/// The World's substep loop around the scene's solver, so that a test can read
-/// Solver::stats() (World does not expose its solver). The particles, mass,
-/// support and boundary samples come from a World built from the same scene.
-struct SolverHarness final : StageRunner {
-  SceneDef scene;
-  ThreadPool pool;
-  Particles P;
-  Grid grid;
-  NeighbourLists nbr;
-  BoundarySet boundary;
-  Scratch scratch;
-  std::unique_ptr<Solver> solver;
-  EffectList effects;
-  Real R = 0, dx = 0, mass = 0, lastAccel = 0;
-  std::uint64_t steps = 0;
-
-  SolverHarness(const SceneDef& s, int threads) : scene(s), pool(threads) {
-    World w(s, WorldOptions{1});
-    scene = w.scene();
-    P = w.particles();
-    R = w.support();
-    dx = w.spacing();
-    mass = w.particleMass();
-    boundary.collect(w.box2d(), w.origin());
-    boundary.sample(dx, R, pool);
-    boundary.buildBins(Real(4) * R);
-    solver = makeSolver(scene.solver);
-    effects = makeEffects(scene);
-    StepContext c = context(0);
-    solver->prepare(c);
-  }
-  StepContext context(Real dt) {
-    StepContext c{P, grid, nbr, boundary, pool, scratch, scene.solver};
-    c.R = R;
-    c.dx = dx;
-    c.dt = dt;
-    c.mass = mass;
-    c.rho0 = Real(scene.solver.restDensity);
-    c.gravity = Vec2(Real(scene.gravity.x()), Real(scene.gravity.y()));
-    c.clearance = Real(0.25) * dx;
-    c.maxSpeed = Real(scene.solver.maxSpeed);
-    c.step = steps;
-    return c;
-  }
-  void run(const char*, const std::function<void()>& f) override { f(); }
-  void checked(const char* name, const std::function<std::size_t()>& f) override {
-    if (f() != kNone) throw std::runtime_error(std::string("bad value after ") + name);
-  }
-  /// One substep of the largest stable length (as World::substep()).
-  void substep() {
-    const StepContext c0 = context(0);
-    Real dt = solver->maxTimeStep(c0, maxSpeedOf(P, pool), lastAccel);
-    for (const auto& e : effects) dt = std::min(dt, e->maxTimeStep(c0));
-    StepContext c = context(dt);
-    solver->substep(c, *this, effects);
-    lastAccel = maxAccelOf(P, pool);
-    stageCollide(c);
-    ++steps;
-  }
-};
 
 }  // namespace
 
@@ -174,15 +113,15 @@ TEST_CASE("dfsph: the 2 m x 1 m tank at dx = 12.5 mm (12,800 particles) rests: n
 
 TEST_CASE("dfsph: both implicit solves reach their tolerances within the iteration cap on the resting tank") {
   const SceneDef s = dfsphScene("tests/resting_column.json");
-  SolverHarness h(s, 1);
+  World w(s, WorldOptions{1});
   const double tol = s.solver.param("tolerance"), divTol = s.solver.param("divergence_tolerance");
   const int cap = int(s.solver.param("max_iterations"));
-  for (int k = 0; k < 200; ++k) h.substep();  // about 1.4 s: past the start-up transient
+  for (int k = 0; k < 200; ++k) w.substep();  // about 1.4 s: past the start-up transient
   int worstP = 0, worstD = 0;
   double worstErr = 0, worstDivErr = 0;
   for (int k = 0; k < 100; ++k) {
-    h.substep();
-    const SolverStats st = h.solver->stats();
+    w.substep();
+    const SolverStats st = w.solverStats();
     worstP = std::max(worstP, st.pressureIterations);
     worstD = std::max(worstD, st.divergenceIterations);
     worstErr = std::max(worstErr, st.densityError);

@@ -54,7 +54,28 @@ struct Particles {
     extra.emplace_back(name, std::vector<Real>(size(), init));
     return extra.back().second;
   }
-  /// Appends one particle at rest-density with zero pressure.
+  /// Calls f(name, field) for every per-particle array: the fixed ones, then
+  /// the optional ones in creation order. The one list of fields: storage,
+  /// removal, reordering and memory accounting all go through it.
+  template <class F>
+  void forEachField(F&& f) {
+    f("x", x);
+    f("v", v);
+    f("a", a);
+    f("xPrev", xPrev);
+    f("rho", rho);
+    f("p", p);
+    f("invRho", invRho);
+    f("pOverRho", pOverRho);
+    f("id", id);
+    for (auto& e : extra) f(e.first.c_str(), e.second);
+  }
+  /// Const variant of forEachField().
+  template <class F>
+  void forEachField(F&& f) const {
+    const_cast<Particles*>(this)->forEachField([&](const char* name, const auto& field) { f(name, field); });
+  }
+  /// Appends one particle at rest-density with zero pressure (optional fields 0).
   void push(const Vec2& pos, const Vec2& vel, std::uint32_t pid, Real rho0) {
     x.push_back(pos);
     v.push_back(vel);
@@ -67,12 +88,24 @@ struct Particles {
     id.push_back(pid);
     for (auto& f : extra) f.second.push_back(0);
   }
+  /// Removes the particles whose flag in `remove` is non-zero, keeping the
+  /// order of the rest (serial: deterministic). Returns how many were removed.
+  std::size_t compact(const std::vector<unsigned char>& remove) {
+    const std::size_t n = size();
+    std::size_t out = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+      if (remove[i]) continue;
+      if (out != i)
+        forEachField([&](const char*, auto& field) { field[out] = field[i]; });
+      ++out;
+    }
+    forEachField([&](const char*, auto& field) { field.resize(out); });
+    return n - out;
+  }
   /// Bytes held by the particle arrays (capacity, not size).
   std::size_t bytes() const {
-    std::size_t b = (x.capacity() + v.capacity() + a.capacity() + xPrev.capacity()) * sizeof(Vec2) +
-                    (rho.capacity() + p.capacity() + invRho.capacity() + pOverRho.capacity()) * sizeof(Real) +
-                    id.capacity() * sizeof(std::uint32_t);
-    for (const auto& f : extra) b += f.second.capacity() * sizeof(Real);
+    std::size_t b = 0;
+    forEachField([&](const char*, const auto& field) { b += field.capacity() * sizeof(field[0]); });
     return b;
   }
 };

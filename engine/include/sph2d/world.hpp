@@ -4,8 +4,9 @@
 //
 // A World owns its particles, its job system and (unless a game attaches its
 // own) a b2World of static bodies. One stepFrame() advances 1/fps seconds in
-// CFL-limited substeps; each substep runs the stages listed in
-// docs/ARCHITECTURE.md.
+// substeps as long as the solver's and the effects' limits allow; each
+// substep runs one list of stages built with the World (stages(); the list of
+// a scene is in docs/ARCHITECTURE.md and printed by `sph2d info`).
 #pragma once
 
 #include <cstdint>
@@ -51,6 +52,14 @@ struct UserForce {
   Vec2d point{0, 0};   ///< world coordinates [m]
   double radius = 0.5; ///< reach [m]
   double strength = 0; ///< acceleration at the centre [m/s²]; > 0 pulls towards the point, < 0 pushes away
+};
+
+/// What an iterative pressure solver did in its last substep (all zero for explicit solvers).
+struct SolverStats {
+  int pressureIterations = 0;     ///< constant-density (pressure) solve iterations
+  int divergenceIterations = 0;   ///< divergence-free solve iterations (0 when disabled)
+  double densityError = 0;        ///< mean predicted density error /ρ0 after the pressure solve (solver-defined residual)
+  double divergenceError = 0;     ///< mean |Dρ/Dt|·dt/ρ0 after the divergence solve (solver-defined residual)
 };
 
 /// Density error of the fluid, relative to ρ0.
@@ -124,7 +133,9 @@ class World {
   DensityStats densityStats() const;
   /// Kinetic energy ½ Σ m |v|² [J per metre of depth].
   double kineticEnergy() const;
-  /// Per-stage wall time and calls since construction (or the last resetTimings()).
+  /// Iterations and residuals of the pressure solver in the last substep (explicit solvers: all zero).
+  SolverStats solverStats() const;
+  /// Per-stage wall time and calls since construction (or the last resetTimings()), by stage name in list order.
   std::vector<StageTiming> timings() const;
   /// Zeroes the stage timings.
   void resetTimings();
@@ -189,7 +200,10 @@ class World {
   /// Names of the per-particle fields this world allocates (the fixed ones
   /// and the optional ones its solver and effects created).
   std::vector<std::string> particleFields() const;
-  /// Names of the stages a substep runs, in order (solver stages, effects, particle system).
+  /// Names of the stages a substep runs, in order: the list built with the World
+  /// (the solver's stages with the enabled effects where the solver puts them,
+  /// then collision and the particle system), rebuilt when a user force is first
+  /// set or an effect is switched.
   std::vector<std::string> stages() const;
 
   struct Impl;

@@ -1,9 +1,18 @@
-// effects/effect.hpp (internal) — an effect: a force the scene asks for.
+// effects/effect.hpp (internal) — an effect: physics a scene asks for beyond
+// the pressure solver (viscosity, XSPH, force fields, surface tension,
+// particle shifting, user forces).
 //
-// A scene's step runs only the effects the scene enables; an absent effect
-// has no object, allocates no particle field and runs no stage. Each effect
-// adds its acceleration to P.a after the solver's pressure force (or where
-// the solver calls applyEffects), and may limit the time step.
+// A scene's step runs only the effects the scene enables: an absent effect
+// has no object, allocates no particle field and runs no stage. Each enabled
+// effect is one stage of the substep's list, placed where the solver's
+// effects marker is (after its pressure force for explicit solvers, before
+// the pressure solve for the implicit ones). Most effects add an acceleration
+// to P.a; particle shifting moves positions instead. An effect may limit the
+// time step.
+//
+// A new effect: its own file in this folder with a
+// `std::unique_ptr<Effect> NAMEEffect(const SceneDef&)` (nullptr when the
+// scene does not enable it), and one line in effects.def.
 #pragma once
 
 #include <limits>
@@ -20,7 +29,7 @@ class Effect {
   virtual ~Effect() = default;
   /// Stage name shown by --profile.
   virtual const char* name() const = 0;
-  /// Adds this effect's acceleration to P.a. Returns the first bad slot or kNone.
+  /// Runs the effect (adds to P.a, or moves x). Returns the first bad slot or kNone.
   virtual std::size_t apply(StepContext& c) = 0;
   /// The scene key whose value sets this effect's time-step limit (for error messages).
   virtual const char* limitKey() const { return name(); }
@@ -35,25 +44,11 @@ class Effect {
 
 using EffectList = std::vector<std::unique_ptr<Effect>>;
 
-/// The effects a scene enables, in a fixed order: viscosity, xsph, force
-/// fields, surface tension. (The particle system — emitters, lifetimes,
-/// sinks — runs in the World's emit and lifetime stages.)
+/// The effects a scene enables, in the order of effects.def. Throws
+/// std::invalid_argument in a build without effect modules when the scene asks for one.
 EffectList makeEffects(const SceneDef& scene);
 
 /// The effect that applies the current user forces (created when the first is set).
 std::unique_ptr<Effect> makeUserForceEffect(const std::vector<UserForce>* forces);
-
-/// Runs every effect as its own timed, guarded stage (nothing at all in a build
-/// with SPH2D_NO_EFFECT_MODULES, the baseline of benchmarks/effects_overhead.sh).
-inline void applyEffects(StepContext& c, StageRunner& run, const EffectList& effects) {
-#ifdef SPH2D_NO_EFFECT_MODULES
-  (void)c;
-  (void)run;
-  (void)effects;
-#else
-  for (const auto& e : effects)
-    if (e->enabled) run.checked(e->name(), [&] { return e->apply(c); });
-#endif
-}
 
 }  // namespace sph2d

@@ -60,8 +60,10 @@ class UserForces final : public Effect {
 
 }  // namespace
 
-std::unique_ptr<Effect> makeForceFields(const std::vector<ForceFieldDef>& fields) {
-  return std::make_unique<ForceFields>(fields);
+/// The force fields of effects.force_fields, when there are any.
+std::unique_ptr<Effect> forceFieldsEffect(const SceneDef& scene) {
+  if (scene.effects.forceFields.empty()) return nullptr;
+  return std::make_unique<ForceFields>(scene.effects.forceFields);
 }
 
 std::unique_ptr<Effect> makeUserForceEffect(const std::vector<UserForce>* forces) {

@@ -1,4 +1,4 @@
-// Which effects a scene's step runs, in a fixed order.
+// The effect registry: builds a scene's effect list from effects.def.
 #include <stdexcept>
 
 #include "effects/effect.hpp"
@@ -32,21 +32,17 @@ std::unique_ptr<Effect> makeUserForceEffect(const std::vector<UserForce>*) { noM
 
 #else
 
-std::unique_ptr<Effect> makeLaplacianViscosity(double nu, bool noSlip);
-std::unique_ptr<Effect> makeXsph(double c);
-std::unique_ptr<Effect> makeForceFields(const std::vector<ForceFieldDef>& fields);
-std::unique_ptr<Effect> makeSurfaceTension(const SurfaceTensionDef& def);
-std::unique_ptr<Effect> makeParticleShifting(double strength);
+#define SPH2D_EFFECT(name) std::unique_ptr<Effect> name##Effect(const SceneDef& scene);
+#include "effects/effects.def"
+#undef SPH2D_EFFECT
 
-/// The scene's effects in the fixed order viscosity, xsph, force fields, surface tension, shifting.
 EffectList makeEffects(const SceneDef& scene) {
   EffectList out;
-  const EffectsDef& e = scene.effects;
-  if (scene.solver.viscosity > 0) out.push_back(makeLaplacianViscosity(scene.solver.viscosity, scene.solver.noSlip));
-  if (e.xsph) out.push_back(makeXsph(e.xsphC));
-  if (!e.forceFields.empty()) out.push_back(makeForceFields(e.forceFields));
-  if (e.surfaceTension) out.push_back(makeSurfaceTension(e.tension));
-  if (e.shifting) out.push_back(makeParticleShifting(e.shiftingStrength));
+  std::unique_ptr<Effect> e;
+#define SPH2D_EFFECT(name) \
+  if ((e = name##Effect(scene))) out.push_back(std::move(e));
+#include "effects/effects.def"
+#undef SPH2D_EFFECT
   return out;
 }
 

@@ -136,6 +136,10 @@ class ParticleShifting final : public Effect {
 
 }  // namespace
 
-std::unique_ptr<Effect> makeParticleShifting(double strength) { return std::make_unique<ParticleShifting>(strength); }
+/// Particle shifting when the scene enables effects.shifting.
+std::unique_ptr<Effect> shiftingEffect(const SceneDef& scene) {
+  if (!scene.effects.shifting) return nullptr;
+  return std::make_unique<ParticleShifting>(scene.effects.shiftingStrength);
+}
 
 }  // namespace sph2d

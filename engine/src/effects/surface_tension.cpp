@@ -235,7 +235,10 @@ class SurfaceTension final : public Effect {
 
 }  // namespace
 
-/// The surface-tension effect of a scene (model csf or akinci).
-std::unique_ptr<Effect> makeSurfaceTension(const SurfaceTensionDef& def) { return std::make_unique<SurfaceTension>(def); }
+/// The surface-tension effect (model csf or akinci) when the scene enables effects.surface_tension.
+std::unique_ptr<Effect> surfaceTensionEffect(const SceneDef& scene) {
+  if (!scene.effects.surfaceTension) return nullptr;
+  return std::make_unique<SurfaceTension>(scene.effects.tension);
+}
 
 }  // namespace sph2d

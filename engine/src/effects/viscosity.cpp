@@ -2,7 +2,7 @@
 // eq. 14): a_i += (μ/ρ_i) Σ_j m (v_j − v_i)/ρ_j ∇²W_visc(r_ij), with the 2D
 // Laplacian of the viscosity kernel (kernels.hpp: 5(R−r)(R³+R²r+Rr²+9r³)/(3πR⁵r³),
 // not the 3D c·(R − r)), r clamped to 0.05 R. μ = ν·ρ0. The sum is divided by
-// the Laplacian's lattice moment (stages.hpp: 0.834 at R = 2.5 dx), so that a
+// the Laplacian's lattice moment (kernels.hpp: 0.834 at R = 2.5 dx), so that a
 // shear flow feels ν and not 0.83 ν (measured on start-up Poiseuille flow).
 // Time-step limit: dt ≤ 0.03 R²/ν (explicit diffusion).
 //
@@ -75,14 +75,14 @@ class LaplacianViscosity final : public Effect {
         if (walls) {
           const Vec2 xi = X[i];
           Real sum = 0;  // Σ_b Ψ_b ∇²W_ib
-          B.sampleGrid.forCandidates(xi, [&](std::uint32_t s) {
-            const Vec2 d = xi - B.samples[s];
-            const Real r2 = d.squaredNorm();
-            if (r2 >= R2 || !B.visible(s, xi)) return;
+          const std::uint32_t* bl = c.nbr.boundaryOf(i);
+          for (std::uint32_t k = 0; k < c.nbr.boundaryCount[i]; ++k) {
+            const std::uint32_t s = bl[k];
+            const Real r2 = (xi - B.samples[s]).squaredNorm();
             const Real q = r2 > rMin * rMin ? std::sqrt(r2) : rMin;
             const Real iq = Real(1) / q;
             sum += B.volume[s] * lapK * (R - q) * (R3 + R2 * q + R * q * q + Real(9) * q * q * q) * iq * iq * iq;
-          });
+          }
           acc -= Vec2(vix, viy) * (Real(2) * nuS * c.rho0 * IR[i] * sum);
         }
         P.a[i] += acc;
@@ -100,8 +100,10 @@ class LaplacianViscosity final : public Effect {
 
 }  // namespace
 
-std::unique_ptr<Effect> makeLaplacianViscosity(double nu, bool noSlip) {
-  return std::make_unique<LaplacianViscosity>(nu, noSlip);
+/// The viscosity effect when solver.viscosity > 0 (with the walls when solver.no_slip).
+std::unique_ptr<Effect> viscosityEffect(const SceneDef& scene) {
+  if (!(scene.solver.viscosity > 0)) return nullptr;
+  return std::make_unique<LaplacianViscosity>(scene.solver.viscosity, scene.solver.noSlip);
 }
 
 }  // namespace sph2d

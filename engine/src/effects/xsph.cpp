@@ -46,6 +46,10 @@ class Xsph final : public Effect {
 
 }  // namespace
 
-std::unique_ptr<Effect> makeXsph(double c) { return std::make_unique<Xsph>(c); }
+/// XSPH when the scene enables effects.xsph.
+std::unique_ptr<Effect> xsphEffect(const SceneDef& scene) {
+  if (!scene.effects.xsph) return nullptr;
+  return std::make_unique<Xsph>(scene.effects.xsphC);
+}
 
 }  // namespace sph2d

@@ -1,26 +1,23 @@
 // solvers/solver.hpp (internal) — the pressure solver interface.
 //
-// A solver owns one substep from the neighbour grid to the integration:
-// it computes density and pressure its own way, adds its pressure
-// acceleration, calls the scene's effects where its scheme puts external
-// forces, and integrates. The World then runs the shared collision stage.
-// One file per solver in this folder; registry.cpp maps scene names to them.
+// A solver contributes the part of the substep from the neighbour search to
+// the integration as an ordered list of stages (stage_list.hpp), with a marker
+// where the scene's effects run; an iterative solve is one stage. It reports
+// the largest substep it can take; the World owns the split of a frame into
+// substeps, runs the stages, and follows them with the collision and the
+// particle system. Each solver lives in its own folder with its parameters
+// (name, default, range, one line of doc); registry.cpp lists them.
 #pragma once
 
 #include <memory>
+#include <string>
+#include <vector>
 
-#include "effects/effect.hpp"
+#include "sph2d/world.hpp"
+#include "stage_list.hpp"
 #include "stages.hpp"
 
 namespace sph2d {
-
-/// What an iterative solver did in its last substep (all zero for explicit solvers).
-struct SolverStats {
-  int pressureIterations = 0;     ///< constant-density (pressure) solve iterations
-  int divergenceIterations = 0;   ///< divergence-free solve iterations (0 when disabled)
-  double densityError = 0;        ///< mean predicted density error /ρ0 after the pressure solve (solver-defined residual)
-  double divergenceError = 0;     ///< mean |Dρ/Dt|·dt/ρ0 after the divergence solve (solver-defined residual)
-};
 
 class Solver {
  public:
@@ -43,45 +40,22 @@ class Solver {
     (void)c;
     return 0;
   }
-  /// Largest stable substep for the current state, given the largest speed and acceleration.
+  /// Largest stable substep for the current state, given the largest speed and
+  /// acceleration. Pure: asking does not change the solver.
   virtual Real maxTimeStep(const StepContext& c, Real vmax, Real amax) const = 0;
-  /// One substep (grid → … → integrate).
-  virtual void substep(StepContext& c, StageRunner& run, const EffectList& effects) = 0;
+  /// The stages of one substep in order, with Stage::effects() where the
+  /// scene's effects run. `effects`: whether any effect will run (a solver may
+  /// then need neighbours of the current positions first). The stages may
+  /// keep pointers to the solver; the World rebuilds the list when effects change.
+  virtual std::vector<Stage> stages(bool effects) = 0;
   /// Iterations and residuals of the last substep (explicit solvers: all zero).
   virtual SolverStats stats() const { return {}; }
 };
 
-/// True when this substep reorders particle storage along the grid.
-inline bool reorderThisStep(const StepContext& c) {
-  const int every = c.def.reorderInterval;
-  return every > 0 && c.step % std::uint64_t(every) == 0;
-}
-
-/// The substep of the equation-of-state solvers (muller2003, wcsph):
-/// grid → neighbours → density → pressure → pressure_force → effects → integrate.
-/// density(c) and pressureForce(c) return the first bad slot; pressure(c) returns nothing.
-template <class Density, class Pressure, class Force>
-void explicitSubstep(StepContext& c, StageRunner& run, const EffectList& effects, Density density, Pressure pressure,
-                     Force pressureForce) {
-  const bool reorder = reorderThisStep(c);
-  run.run("grid", [&] { stageGrid(c, reorder); });
-  run.run("neighbours", [&] { stageNeighbours(c); });
-  run.checked("density", [&] { return density(c); });
-  run.run("pressure", [&] { pressure(c); });
-  run.checked("pressure_force", [&] { return pressureForce(c); });
-  applyEffects(c, run, effects);
-  run.checked("integrate", [&] { return stageIntegrate(c); });
-}
-
-/// The complete initial state of the equation-of-state solvers: grid,
-/// neighbours, density and pressure of the current positions.
-template <class Density, class Pressure>
-void explicitPrepare(StepContext& c, Density density, Pressure pressure) {
-  stageGrid(c, false);
-  stageNeighbours(c);
-  density(c);
-  pressure(c);
-}
+/// The stages of the equation-of-state solvers (muller2003, wcsph): grid →
+/// neighbours → density → pressure → pressure_force → effects → integrate.
+/// density and pressureForce return the first bad slot; pressure returns nothing.
+std::vector<Stage> explicitStages(Stage::Fn density, std::function<void(StepContext&)> pressure, Stage::Fn pressureForce);
 
 /// One solver-specific scene key (under "solver").
 struct SolverParam {
@@ -89,6 +63,13 @@ struct SolverParam {
   double def;        ///< default
   double lo, hi;     ///< allowed range (inclusive)
   std::string doc;   ///< one line for docs/SCENES.md and errors
+};
+
+/// A solver's registration: its scene name, its parameters and how to make it.
+struct SolverInfo {
+  const char* name;                                      ///< solver.type
+  std::vector<SolverParam> params;                       ///< its solver.* keys
+  std::unique_ptr<Solver> (*make)(const SolverDef& def); ///< builds it (params filled)
 };
 
 /// The solver a scene names. Throws std::invalid_argument for an unknown name.
@@ -99,5 +80,9 @@ const std::vector<std::string>& solverNames();
 
 /// The extra keys solver `type` accepts (empty for an unknown type).
 const std::vector<SolverParam>& solverParams(const std::string& type);
+
+/// Fills every parameter of `def`'s solver that `def` leaves out with its default
+/// (a scene built in code need not name them).
+void fillSolverDefaults(SolverDef& def);
 
 }  // namespace sph2d

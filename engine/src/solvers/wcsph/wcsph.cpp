@@ -46,8 +46,10 @@ class Wcsph final : public Solver {
   double densityKernel(double r, double R) const override { return WendlandC2<double>(R).value(r); }
 
   void prepare(StepContext& c) override {
-    const WendlandC2<Real> W(c.R);
-    explicitPrepare(c, [&](StepContext& cc) { density(cc, W); }, [&](StepContext& cc) { pressure(cc); });
+    stageGrid(c, false);
+    stageNeighbours(c);
+    density(c, WendlandC2<Real>(c.R));
+    pressure(c);
   }
 
   Real maxTimeStep(const StepContext& c, Real vmax, Real amax) const override {
@@ -65,15 +67,15 @@ class Wcsph final : public Solver {
         [](Real a, Real b2) { return std::max(a, b2); });
     const Real cEff = c0_ * std::pow(std::min(rhoMax / c.rho0, Real(1.1)), Real(0.5) * (gamma_ - Real(1)));
     Real dt = Real(c.def.cfl) * c.R / (cEff + vmax);
-    if (amax > 0) dt = std::min(dt, Real(0.25) * std::sqrt(c.R / amax));
+    if (amax > 0) dt = std::min(dt, kForceCfl * std::sqrt(c.R / amax));
     return dt;
   }
 
-  void substep(StepContext& c, StageRunner& run, const EffectList& effects) override {
-    const WendlandC2<Real> W(c.R);
-    explicitSubstep(
-        c, run, effects, [&](StepContext& cc) { return density(cc, W); }, [&](StepContext& cc) { pressure(cc); },
-        [&](StepContext& cc) { return pressureForce(cc, W); });
+  /// grid → neighbours → density → pressure (Tait) → pressure_force (+ artificial viscosity) → effects → integrate.
+  std::vector<Stage> stages(bool) override {
+    return explicitStages([this](StepContext& c) { return density(c, WendlandC2<Real>(c.R)); },
+                          [this](StepContext& c) { pressure(c); },
+                          [this](StepContext& c) { return pressureForce(c, WendlandC2<Real>(c.R)); });
   }
 
  private:
@@ -95,7 +97,13 @@ class Wcsph final : public Solver {
           sum += W.value(std::sqrt(dx * dx + dy * dy));
         }
         Real rho = c.mass * sum;
-        if (walls) rho += c.rho0 * boundaryVolumeSum(c.boundary, W, xi);
+        if (walls) {
+          Real s = 0;
+          const std::uint32_t* bl = c.nbr.boundaryOf(i);
+          for (std::uint32_t k = 0; k < c.nbr.boundaryCount[i]; ++k)
+            s += c.boundary.volume[bl[k]] * W.value(std::sqrt((xi - c.boundary.samples[bl[k]]).squaredNorm()));
+          rho += c.rho0 * s;
+        }
         P.rho[i] = rho;
         if (!std::isfinite(rho) && bad == kNone) bad = i;
       }
@@ -131,10 +139,9 @@ class Wcsph final : public Solver {
     Particles& P = c.P;
     const BoundarySet& B = c.boundary;
     const bool walls = !B.samples.empty();
-    const Real R = c.R, R2 = R * R, h = Real(0.5) * R;
-    const Real tiny2 = Real(1e-12) * R2;
+    const Real R = c.R, h = Real(0.5) * R;
     // ∇W = gradK (1 − q)³ d, with the pressure term renormalised by the lattice
-    // gradient moment (stages.hpp) so a hydrostatic column gets ρ g per metre.
+    // gradient moment (kernels.hpp) so a hydrostatic column gets ρ g per metre.
     const Real gradK = Real(-20) * W.s * W.invR * W.invR;
     const Real pScale = Real(1.0 / latticeGradientMoment(WendlandC2<double>(double(c.R)), double(c.dx), double(c.mass / c.rho0)));
     const Real avK = alpha_ * c0_;  // Π = −α c μ / ρ̄ with μ = h v·x / (r² + 0.01h²)
@@ -143,26 +150,18 @@ class Wcsph final : public Solver {
     const Vec2* V = P.v.data();
     const Real* IR = P.invRho.data();
     const Real* POR2 = P.pOverRho.data();
-    const std::uint32_t* ID = P.id.data();
     return firstBad(c.pool, P.size(), [&](std::size_t b, std::size_t e) {
       std::size_t bad = kNone;
       for (std::size_t i = b; i < e; ++i) {
-        const Real xix = X[i].x(), xiy = X[i].y(), vix = V[i].x(), viy = V[i].y();
+        const Real vix = V[i].x(), viy = V[i].y();
         const Real pri = POR2[i], iri = IR[i];
         Real ax = 0, ay = 0;
         const std::uint32_t* nb = c.nbr.of(i);
         const std::uint32_t cnt = c.nbr.count[i];
         for (std::uint32_t k = 0; k < cnt; ++k) {
           const std::uint32_t j = nb[k];
-          Real dx = xix - X[j].x(), dy = xiy - X[j].y();
-          c.periodic.nearest(dx, dy);
-          Real r2 = dx * dx + dy * dy;
-          if (r2 < tiny2) {
-            const Vec2 t = tieBreakDirection(ID[i], ID[j]) * (Real(1e-6) * R);
-            dx = t.x();
-            dy = t.y();
-            r2 = dx * dx + dy * dy;
-          }
+          Real dx, dy, r2;
+          pairDelta(c, i, j, dx, dy, r2);
           const Real q = std::sqrt(r2) * W.invR;
           const Real a = Real(1) - q;
           const Real g = gradK * a * a * a;  // ∇W = g·d
@@ -181,10 +180,11 @@ class Wcsph final : public Solver {
         if (walls) {
           const Real pi = P.p[i], rhoi = P.rho[i];
           Vec2 gb = Vec2::Zero(), gv = Vec2::Zero();
-          B.sampleGrid.forCandidates(X[i], [&](std::uint32_t s) {
+          const std::uint32_t* bl = c.nbr.boundaryOf(i);
+          for (std::uint32_t k = 0; k < c.nbr.boundaryCount[i]; ++k) {
+            const std::uint32_t s = bl[k];
             const Vec2 d = X[i] - B.samples[s];
             const Real rr = d.squaredNorm();
-            if (rr >= R2 || !B.visible(s, X[i])) return;
             const Real q = std::sqrt(rr) * W.invR;
             const Real a = Real(1) - q;
             const Real gw = gradK * a * a * a * B.volume[s];
@@ -194,7 +194,7 @@ class Wcsph final : public Solver {
             // Artificial viscosity against the sample (frozen fluid at rest) when approaching it.
             const Real vdotx = vix * d.x() + viy * d.y();
             if (vdotx < 0) gv += d * (gw * (h * vdotx / (rr + eta2)));
-          });
+          }
           acc -= gb * (c.rho0 * pScale);
           acc += gv * (c.rho0 * avK * Real(2) / (rhoi + c.rho0));
         }
@@ -211,6 +211,13 @@ class Wcsph final : public Solver {
 
 }  // namespace
 
-std::unique_ptr<Solver> makeWcsph(const SolverDef& def) { return std::make_unique<Wcsph>(def); }
+/// wcsph's registration (solvers.def) and its parameters.
+SolverInfo wcsphSolver() {
+  return {"wcsph",
+          {{"gamma", 7, 1, 10, "Tait exponent γ in p = B((ρ/ρ0)^γ − 1), B = ρ0c²/γ"},
+           {"alpha", 0.05, 0, 2, "Monaghan artificial viscosity α (Π = −α c h μ/ρ̄ for approaching pairs)"},
+           {"expected_speed", 0, 0, 1e4, "when > 0, the sound speed is 10 × this (m/s) instead of sound_speed"}},
+          [](const SolverDef& d) -> std::unique_ptr<Solver> { return std::make_unique<Wcsph>(d); }};
+}
 
 }  // namespace sph2d

@@ -238,7 +238,7 @@ class Dfsph final : public Solver {
     Real dt = cfl_ * c.R / std::max(vmax, Real(1e-6) * c.R);
     const Real g = c.gravity.norm();
     if (g > 0) dt = std::min(dt, Real(0.1) * std::sqrt(c.R / g));
-    if (amax > 0) dt = std::min(dt, Real(0.25) * std::sqrt(c.R / amax));
+    if (amax > 0) dt = std::min(dt, kForceCfl * std::sqrt(c.R / amax));
     // The hydrostatic pressure's own stiffness: dt ≤ 0.35·R/sqrt(|g| D) (see the header).
     const Real gh = hydrostaticGravity(c).norm();
     if (gh > 0 && c.P.size() > 0) {
@@ -246,47 +246,40 @@ class Dfsph final : public Solver {
       depths(c, [&](std::size_t, Real depth) { dMax = std::max(dMax, depth); });
       if (dMax > 0) dt = std::min(dt, kPressureCfl * c.R / std::sqrt(gh * dMax));
     }
-    lastLimit_ = dt;
     return dt;
   }
 
-  /// grid → neighbours → density → divergence solve → gravity, effects → pressure solve → x += dt v.
-  void substep(StepContext& c, StageRunner& run, const EffectList& effects) override {
-    const WendlandC2<Real> W(c.R);
-    const int every = c.def.reorderInterval;
-    const bool reorder = every > 0 && c.step % std::uint64_t(every) == 0;
-    c.P.field("dfsph.kappa");
-    c.P.field("dfsph.kappa_v");
-    closed_ = !unilateral_ && c.periodic.x && c.periodic.y && c.boundary.samples.empty();
-    run.run("grid", [&] { stageGrid(c, reorder); });
-    run.run("neighbours", [&] { stageNeighbours(c); });
-    run.checked("density", [&] { return densityAndFactor(c, W); });
-    // A substep far shorter than the limit (the float rounding remainder of a
-    // frame, ~1e-10 s) would correct the existing compression at a speed
-    // ∝ 1/dt and leave κ ∝ 1/dt for the next warm start: it runs without the
-    // solves (nothing moves in that time anyway).
-    const bool solves = c.dt >= Real(0.01) * std::min(lastLimit_, lastSolvedDt_);
-    if (solves) {
-      stats_ = SolverStats{};  // else the last solved substep's stats stay
-      lastSolvedDt_ = c.dt;
-    }
-    if (divSolve_ && solves) solve(c, run, true);
-    run.run("gravity", [&] {
-      c.pool.parallelFor(c.P.size(), 4096, [&](std::size_t b, std::size_t e) {
+  /// grid → neighbours → density (and α) → divergence_solve → gravity → effects →
+  /// predict_velocity → pressure_solve → integrate.
+  std::vector<Stage> stages(bool) override {
+    std::vector<Stage> s;
+    s.push_back(plainStage("grid", [](StepContext& c) { stageGrid(c, reorderThisStep(c)); }));
+    s.push_back(plainStage("neighbours", [](StepContext& c) { stageNeighbours(c); }));
+    s.push_back(Stage{"density", [this](StepContext& c) {
+                        c.P.field("dfsph.kappa");
+                        c.P.field("dfsph.kappa_v");
+                        closed_ = !unilateral_ && c.periodic.x && c.periodic.y && c.boundary.samples.empty();
+                        stats_ = SolverStats{};
+                        return densityAndFactor(c, WendlandC2<Real>(c.R));
+                      }});
+    if (divSolve_) s.push_back(plainStage("divergence_solve", [this](StepContext& c) { solve(c, true); }));
+    s.push_back(plainStage("gravity", [](StepContext& c) {
+      c.pool.parallelFor(c.P.size(), kStreamBlock, [&](std::size_t b, std::size_t e) {
         for (std::size_t i = b; i < e; ++i) c.P.a[i] = c.gravity;
       });
-    });
-    applyEffects(c, run, effects);
-    run.run("predict_velocity", [&] {
-      c.pool.parallelFor(c.P.size(), 4096, [&](std::size_t b, std::size_t e) {
+    }));
+    s.push_back(Stage::effects());
+    s.push_back(plainStage("predict_velocity", [](StepContext& c) {
+      c.pool.parallelFor(c.P.size(), kStreamBlock, [&](std::size_t b, std::size_t e) {
         for (std::size_t i = b; i < e; ++i) c.P.v[i] += c.P.a[i] * c.dt;
       });
-    });
-    if (solves) solve(c, run, false);
-    run.checked("integrate", [&] { return integrate(c); });
+    }));
+    s.push_back(plainStage("pressure_solve", [this](StepContext& c) { solve(c, false); }));
+    s.push_back(Stage{"integrate", [this](StepContext& c) { return integrate(c); }});
+    return s;
   }
 
-  /// Iterations and residuals of the last substep that ran the solves.
+  /// Iterations and residuals of the last substep.
   SolverStats stats() const override { return stats_; }
 
  private:
@@ -347,15 +340,15 @@ class Dfsph final : public Solver {
         if (walls) {
           Real vol = 0;
           const Vec2 xi = X[i];
-          B.sampleGrid.forCandidates(xi, [&](std::uint32_t s) {
+          const std::uint32_t* bl = L.boundaryOf(i);
+          for (std::uint32_t k = 0; k < L.boundaryCount[i]; ++k) {
+            const std::uint32_t s = bl[k];
             const Vec2 d = xi - B.samples[s];
-            const Real rr = d.squaredNorm();
-            if (rr >= R2 || !B.visible(s, xi)) return;
-            const Real q = std::sqrt(rr) * W.invR;
+            const Real q = std::sqrt(d.squaredNorm()) * W.invR;
             const Real a = Real(1) - q;
             vol += B.volume[s] * (W.s * a * a * a * a * (Real(4) * q + Real(1)));
             gb += d * (gradK * a * a * a * B.volume[s]);
-          });
+          }
           rho += c.rho0 * vol;
           gb *= c.rho0;
         }
@@ -373,7 +366,7 @@ class Dfsph final : public Solver {
 
   /// One solve: warm start, then iterations of (B, A) until the mean error is small.
   /// divergence: the divergence-free solve (source Dρ/Dt), else the constant-density solve.
-  void solve(StepContext& c, StageRunner& run, bool divergence) {
+  void solve(StepContext& c, bool divergence) {
     Particles& P = c.P;
     const std::size_t n = P.size();
     std::vector<Real>& kappa = *P.find(divergence ? "dfsph.kappa_v" : "dfsph.kappa");
@@ -381,7 +374,7 @@ class Dfsph final : public Solver {
     const double limit =
         divergence ? divTol_ * double(c.rho0) / double(dt) : tol_ * double(c.rho0);  // on the mean residual
     double err = 0;
-    run.run(divergence ? "divergence_solve" : "pressure_solve", [&] {
+    {
       // Stored κ_v is κ_v·dt of the previous substep (an impulse); κ is p/ρ.
       const Real scale = divergence ? Real(1) / dt : Real(1);
       if (cheb_ > 0) {
@@ -390,7 +383,7 @@ class Dfsph final : public Solver {
       }
       warmStart(c, kappa, scale);
       err = sourceMean(c, kappa, divergence);
-    });
+    }
     int it = 0;
     if (cheb_ > 0) {
       vPrev_.assign(P.v.begin(), P.v.end());
@@ -406,10 +399,8 @@ class Dfsph final : public Solver {
         w = it == chebStart ? Real(2) / (Real(2) - cheb_ * cheb_) : Real(4) / (Real(4) - cheb_ * cheb_ * w);
       else
         w = 1;
-      run.run(divergence ? "divergence_iteration" : "pressure_iteration", [&] {
-        correctPass(c, kappa, w);
-        err = sourceMean(c, kappa, divergence);
-      });
+      correctPass(c, kappa, w);
+      err = sourceMean(c, kappa, divergence);
       ++it;
       // Safeguard: a residual that grows restarts the acceleration (plain steps first).
       if (cheb_ > 0 && it > chebStart && err > lastErr) chebStart = it + kChebDelay;
@@ -585,9 +576,7 @@ class Dfsph final : public Solver {
   std::vector<Real> dk_;                 ///< this iteration's κ increment
   std::vector<Real> q_;                  ///< dk_/ρ
   SolverStats stats_;
-  mutable Real lastLimit_ = 0;  ///< the last maxTimeStep() result (a substep far shorter is a remainder)
-  mutable std::vector<Real> topScratch_;  ///< depths(): the highest particle per strip
-  Real lastSolvedDt_ = 0;       ///< the last substep that ran the solves (0: none yet; a substep far shorter is a remainder)
+  mutable std::vector<Real> topScratch_;  ///< depths(): the highest particle per strip (reused: maxTimeStep runs it every substep)
   bool closed_ = false;  ///< set per substep: no wall, no free surface (both axes periodic, κ of either sign)
   bool unilateral_;  ///< solver.clamp_negative_pressure: κ ≥ 0 (a free surface); false: κ of either sign
   Real kMin_;        ///< 0, or −∞ without the clamp
@@ -595,7 +584,21 @@ class Dfsph final : public Solver {
 
 }  // namespace
 
-/// The dfsph solver for a scene's solver definition (registry.cpp).
-std::unique_ptr<Solver> makeDfsph(const SolverDef& def) { return std::make_unique<Dfsph>(def); }
+/// dfsph's registration (solvers.def) and its parameters.
+SolverInfo dfsphSolver() {
+  return {"dfsph",
+          {{"tolerance", 0.001, 1e-6, 0.1,
+            "largest mean predicted density error |ρ* − ρ0|/ρ0 the pressure solve accepts (compression only where κ = 0)"},
+           {"divergence_tolerance", 1e-4, 1e-8, 1,
+            "largest mean |Dρ/Dt|·dt/ρ0 (the density change one substep's divergence error makes) the divergence-free solve accepts (compression only where κ_v = 0)"},
+           {"max_iterations", 100, 1, 10000, "iterations per solve at most (each solve separately)"},
+           {"min_iterations", 2, 0, 10000, "iterations per solve at least"},
+           {"relaxation", 0.5, 0.05, 1, "Jacobi relaxation ω of both solves (κ increments are ω times the diagonal estimate)"},
+           {"chebyshev_rho", 0.98, 0, 0.999,
+            "Chebyshev acceleration of both solves (Wang 2015) with this spectral radius estimate; 0: plain relaxed Jacobi"},
+           {"velocity_cfl", 0.4, 0.01, 1, "dt ≤ velocity_cfl·R/v_max (dfsph does not read solver.cfl, the CFL number on c + v_max)"},
+           {"divergence_solve", 1, 0, 1, "1: run the divergence-free solve each substep; 0: constant-density solve only"}},
+          [](const SolverDef& d) -> std::unique_ptr<Solver> { return std::make_unique<Dfsph>(d); }};
+}
 
 }  // namespace sph2d

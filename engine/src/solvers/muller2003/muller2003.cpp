@@ -41,9 +41,9 @@ std::size_t density(StepContext& c, const Poly6<Real>& W) {
       Real rho = c.mass * sum;
       if (hasBoundary) {
         Real bs = 0;
-        B.sampleGrid.forCandidates(xi, [&](std::uint32_t k) {
-          if (B.visible(k, xi)) bs += B.volume[k] * W.valueR2((xi - B.samples[k]).squaredNorm());
-        });
+        const std::uint32_t* bl = L.boundaryOf(i);
+        for (std::uint32_t k = 0; k < L.boundaryCount[i]; ++k)
+          bs += B.volume[bl[k]] * W.valueR2((xi - B.samples[bl[k]]).squaredNorm());
         rho += c.rho0 * bs;
       }
       P.rho[i] = rho;
@@ -72,37 +72,25 @@ std::size_t pressureForce(StepContext& c, const Spiky<Real>& spiky) {
   Particles& P = c.P;
   const BoundarySet& B = c.boundary;
   const bool hasBoundary = !B.samples.empty();
-  const Real R = spiky.R, R2 = R * R;
-  const Real tiny2 = Real(1e-12) * R2;
+  const Real R = spiky.R;
   const Real spikyK = Real(-3) * spiky.c;  // dW/dr = −3c(R − r)²
   const Real halfMass = Real(0.5) * c.mass;
-  const Vec2* X = P.x.data();
   const Real* IR = P.invRho.data();
   const Real* POR = P.pOverRho.data();
-  const std::uint32_t* ID = P.id.data();
   return firstBad(c.pool, P.size(), [&](std::size_t b, std::size_t e) {
     std::size_t bad = kNone;
     for (std::size_t i = b; i < e; ++i) {
       const Vec2 xi = P.x[i];
       const Real pi = P.p[i];
-      const std::uint32_t idi = P.id[i];
       // Σ m (p_i + p_j)/(2 ρ_j) ∇W (force density, Müller eq. 10), accumulated
       // in scalars from raw arrays so the loop keeps everything in registers.
       Real fpx = 0, fpy = 0;
-      const Real xix = xi.x(), xiy = xi.y();
       const std::uint32_t* nb = c.nbr.of(i);
       const std::uint32_t cnt = c.nbr.count[i];
       for (std::uint32_t k = 0; k < cnt; ++k) {
         const std::uint32_t j = nb[k];
-        Real dx = xix - X[j].x(), dy = xiy - X[j].y();
-        c.periodic.nearest(dx, dy);
-        Real r2 = dx * dx + dy * dy;
-        if (r2 < tiny2) {  // coincident pair: a fixed, antisymmetric direction
-          const Vec2 t = tieBreakDirection(idi, ID[j]) * (Real(1e-6) * R);
-          dx = t.x();
-          dy = t.y();
-          r2 = dx * dx + dy * dy;
-        }
+        Real dx, dy, r2;
+        pairDelta(c, i, j, dx, dy, r2);  // coincident pairs: a fixed, antisymmetric direction
         // One square root and one division per pair.
         const Real invr = Real(1) / std::sqrt(r2);
         const Real r = r2 * invr;
@@ -130,12 +118,11 @@ std::size_t pressureForce(StepContext& c, const Spiky<Real>& spiky) {
         // pressure, so the wall row sits more compressed (the resting column's
         // most compressed particle: about 4 % instead of 2–3.5 %).
         Vec2 gb = Vec2::Zero();
-        B.sampleGrid.forCandidates(xi, [&](std::uint32_t k) {
-          const Vec2 d = xi - B.samples[k];
-          const Real r2 = d.squaredNorm();
-          if (r2 >= R2 || !B.visible(k, xi)) return;
-          gb += spiky.gradient(d, std::sqrt(r2)) * B.volume[k];
-        });
+        const std::uint32_t* bl = c.nbr.boundaryOf(i);
+        for (std::uint32_t k = 0; k < c.nbr.boundaryCount[i]; ++k) {
+          const Vec2 d = xi - B.samples[bl[k]];
+          gb += spiky.gradient(d, std::sqrt(d.squaredNorm())) * B.volume[bl[k]];
+        }
         acc -= gb * (Real(0.5) * pi * invRhoi);
       }
       acc += c.gravity;
@@ -156,22 +143,23 @@ class Muller2003 final : public Solver {
   double densityKernel(double r, double R) const override { return Poly6<double>(R).value(r); }
 
   void prepare(StepContext& c) override {
-    const Poly6<Real> W(c.R);
-    explicitPrepare(c, [&](StepContext& cc) { density(cc, W); }, [&](StepContext& cc) { pressure(cc); });
+    stageGrid(c, false);
+    stageNeighbours(c);
+    density(c, Poly6<Real>(c.R));
+    pressure(c);
   }
 
+  /// The CFL limit cfl·R/(c + v_max) and the force limit.
   Real maxTimeStep(const StepContext& c, Real vmax, Real amax) const override {
     Real dt = Real(c.def.cfl) * c.R / (Real(c.def.soundSpeed) + vmax);
-    if (amax > 0) dt = std::min(dt, Real(0.25) * std::sqrt(c.R / amax));
+    if (amax > 0) dt = std::min(dt, kForceCfl * std::sqrt(c.R / amax));
     return dt;
   }
 
-  void substep(StepContext& c, StageRunner& run, const EffectList& effects) override {
-    const Poly6<Real> W(c.R);
-    const Spiky<Real> S(c.R);
-    explicitSubstep(
-        c, run, effects, [&](StepContext& cc) { return density(cc, W); }, [&](StepContext& cc) { pressure(cc); },
-        [&](StepContext& cc) { return pressureForce(cc, S); });
+  /// grid → neighbours → density (poly6) → pressure → pressure_force (spiky) → effects → integrate.
+  std::vector<Stage> stages(bool) override {
+    return explicitStages([](StepContext& c) { return density(c, Poly6<Real>(c.R)); }, pressure,
+                          [](StepContext& c) { return pressureForce(c, Spiky<Real>(c.R)); });
   }
 
  private:
@@ -180,6 +168,9 @@ class Muller2003 final : public Solver {
 
 }  // namespace
 
-std::unique_ptr<Solver> makeMuller2003(const SolverDef& def) { return std::make_unique<Muller2003>(def); }
+/// muller2003's registration (solvers.def): no parameters of its own (solver.sound_speed is its stiffness).
+SolverInfo muller2003Solver() {
+  return {"muller2003", {}, [](const SolverDef& d) -> std::unique_ptr<Solver> { return std::make_unique<Muller2003>(d); }};
+}
 
 }  // namespace sph2d

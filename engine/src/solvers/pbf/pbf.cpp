@@ -49,9 +49,6 @@
 //   the limit drops to 0.5–0.9 of this substep (not below max_dt/32); when half
 //   of them sufficed it grows back by 1.2 per substep. max_move = 2 already gains
 //   energy in the dam break (KE > released PE).
-// - A substep shorter than 1e-3 of the previous one (the World's float remainder
-//   of a frame) only advects: projecting the residual compression over it would
-//   turn into a huge velocity.
 //
 // Parameters (solver.*): iterations, max_iterations, tolerance, tolerance_max,
 // relaxation, chebyshev, tensile_k, tensile_n, tensile_dq, xsph, max_dt, max_move.
@@ -139,7 +136,6 @@ class Pbf final : public Solver {
     if (c.P.size() == 0) return;
     stageGrid(c, false);
     stageNeighbours(c);
-    boundaryLists(c);
     finalDensity(c, Real(0));
   }
 
@@ -155,33 +151,41 @@ class Pbf final : public Solver {
     return dt;
   }
 
-  void substep(StepContext& c, StageRunner& run, const EffectList& effects) override {
-    if (c.P.size() == 0) return;
-    if (!(d0_ > 0)) calibrate(c);
-    std::vector<Real>& lambda = c.P.field("pbf.lambda");
-    if (dtPrev_ > 0 && c.dt < Real(1e-3) * dtPrev_) {
-      run.checked("predict", [&] { return advect(c); });
-      return;
+  /// Correction passes and the mean compression after them, of the last substep.
+  SolverStats stats() const override { return stats_; }
+
+  /// [grid → neighbours, when effects run] → external → effects → predict →
+  /// predicted_grid → predicted_neighbours → density_solve → density → velocity.
+  std::vector<Stage> stages(bool effects) override {
+    std::vector<Stage> s;
+    if (effects) {  // the effects read neighbours of the current positions
+      s.push_back(plainStage("grid", [](StepContext& c) { stageGrid(c, false); }));
+      s.push_back(plainStage("neighbours", [](StepContext& c) { stageNeighbours(c); }));
     }
-    const int every = c.def.reorderInterval;
-    const bool reorder = every > 0 && c.step % std::uint64_t(every) == 0;
-    if (!effects.empty()) {
-      // The effects read neighbours of the current positions.
-      run.run("grid", [&] { stageGrid(c, false); });
-      run.run("neighbours", [&] { stageNeighbours(c); });
-    }
-    run.run("external", [&] {
+    s.push_back(plainStage("external", [](StepContext& c) {
       Particles& P = c.P;
-      c.pool.parallelFor(P.size(), 4096, [&](std::size_t b, std::size_t e) {
+      c.pool.parallelFor(P.size(), kStreamBlock, [&](std::size_t b, std::size_t e) {
         for (std::size_t i = b; i < e; ++i) P.a[i] = c.gravity;
       });
-    });
-    applyEffects(c, run, effects);
-    run.checked("predict", [&] { return predict(c, lambda); });
-    run.run("grid", [&] { stageGrid(c, reorder); });
-    run.run("neighbours", [&] { stageNeighbours(c); });
-    run.run("boundary_neighbours", [&] { boundaryLists(c); });
+    }));
+    s.push_back(Stage::effects());
+    s.push_back(Stage{"predict", [this](StepContext& c) { return predict(c, c.P.field("pbf.lambda")); }});
+    s.push_back(plainStage("predicted_grid", [](StepContext& c) { stageGrid(c, reorderThisStep(c)); }));
+    s.push_back(plainStage("predicted_neighbours", [](StepContext& c) { stageNeighbours(c); }));
+    s.push_back(Stage{"density_solve", [this](StepContext& c) { return solve(c); }});
+    s.push_back(Stage{"density", [this](StepContext& c) { return finalDensity(c, c.dt); }});
+    s.push_back(Stage{"velocity", [this](StepContext& c) { return velocity(c); }});
+    return s;
+  }
+
+ private:
+  /// Jacobi iterations of the density constraints on the predicted positions
+  /// (Chebyshev-accelerated) until the tolerances; then the step-limit controller.
+  std::size_t solve(StepContext& c) {
     const std::size_t n = c.P.size();
+    if (n == 0) return kNone;
+    if (!(d0_ > 0)) calibrate(c);
+    std::vector<Real>& lambda = c.P.field("pbf.lambda");
     dLambda_.resize(n);
     lOld_.resize(n);
     wallGrad_.resize(n);
@@ -190,12 +194,16 @@ class Pbf final : public Solver {
     Real omega = 1;
     int used = 0;
     for (int k = 0; k < maxIt; ++k, ++used) {
-      run.checked("constraint", [&] { return constraint(c, lambda); });
+      const std::size_t bad = constraint(c, lambda);
+      if (bad != kNone) return bad;
       if (k >= iterations_ && converged()) break;
       // Chebyshev weights (Wang 2015): ω1 = 1, ω2 = 2/(2 − ρ²), ω_{k+1} = 4/(4 − ρ²ω_k).
       omega = k == 0 ? Real(1) : k == 1 ? Real(2) / (Real(2) - rho2) : Real(4) / (Real(4) - rho2 * omega);
-      run.checked("correction", [&] { return correct(c, lambda, omega); });
+      const std::size_t badC = correct(c, lambda, omega);
+      if (badC != kNone) return badC;
     }
+    stats_.pressureIterations = used;  // corrections applied
+    stats_.densityError = double(meanCompression_);
     if (tolerance_ > 0) {
       // The compression left after N iterations grows as dt²/N²: when max_iterations
       // did not reach the tolerance, the next substeps are shorter; when half of them
@@ -208,12 +216,9 @@ class Pbf final : public Solver {
         dtLimit_ = std::min(maxDt_, dtLimit_ * Real(1.2));
       }
     }
-    run.checked("density", [&] { return finalDensity(c, c.dt); });
-    run.checked("velocity", [&] { return velocity(c); });
-    dtPrev_ = c.dt;
+    return kNone;
   }
 
- private:
   /// The last constraint pass met both tolerances.
   bool converged() const { return meanCompression_ <= tolerance_ && maxCompression_ <= toleranceMax_; }
 
@@ -235,48 +240,6 @@ class Pbf final : public Solver {
     // s_corr = −k (W(r)/W(Δq))^n, in multipliers: 1/D0 corrects a density error of 1.
     invWdq_ = Real(1.0 / W.value(double(tensileDq_) * R));
     sCorrScale_ = Real(-double(tensileK_) / double(d0_));
-  }
-
-  /// Neighbouring boundary samples (visible, within R of x*), per block like NeighbourLists.
-  void boundaryLists(StepContext& c) {
-    const Particles& P = c.P;
-    const BoundarySet& B = c.boundary;
-    const std::size_t n = P.size();
-    bStart_.resize(n);
-    bCount_.resize(n);
-    bBlock_.resize((n + kBlock - 1) / kBlock);
-    const Real R2 = c.R * c.R;
-    const bool any = !B.samples.empty();
-    c.pool.parallelFor(n, kBlock, [&](std::size_t b, std::size_t e) {
-      std::vector<std::uint32_t>& out = bBlock_[b / kBlock];
-      out.clear();
-      for (std::size_t i = b; i < e; ++i) {
-        const Vec2 xi = P.x[i];
-        bStart_[i] = std::uint32_t(out.size());
-        if (any)
-          B.sampleGrid.forCandidates(xi, [&](std::uint32_t s) {
-            if ((xi - B.samples[s]).squaredNorm() < R2 && B.visible(s, xi)) out.push_back(s);
-          });
-        bCount_[i] = std::uint32_t(out.size() - bStart_[i]);
-      }
-    });
-  }
-
-  /// A sliver of a substep: xPrev = x; v += dt g; x += dt v (no projection, no effects).
-  std::size_t advect(StepContext& c) {
-    Particles& P = c.P;
-    const Real dt = c.dt, vmax2 = c.maxSpeed * c.maxSpeed;
-    return firstBad(c.pool, P.size(), [&](std::size_t b, std::size_t e) {
-      std::size_t bad = kNone;
-      for (std::size_t i = b; i < e; ++i) {
-        P.a[i] = c.gravity;
-        P.xPrev[i] = P.x[i];
-        P.v[i] += c.gravity * dt;
-        P.x[i] += P.v[i] * dt;
-        if (bad == kNone && (!allFinite(P.x[i]) || P.v[i].squaredNorm() > vmax2)) bad = i;
-      }
-      return bad;
-    });
   }
 
   /// xPrev = x; v += dt a; x += dt v, swept out of the solids; λ = 0.
@@ -379,9 +342,9 @@ class Pbf final : public Solver {
         Real rho = c.mass * wK * w;
         Real gix = Vg * gx, giy = Vg * gy;
         Vec2 wall = Vec2::Zero();
-        const std::uint32_t bc = bCount_[i];
+        const std::uint32_t bc = c.nbr.boundaryCount[i];
         if (bc) {
-          const std::uint32_t* bl = bBlock_[i / kBlock].data() + bStart_[i];
+          const std::uint32_t* bl = c.nbr.boundaryOf(i);
           const Vec2 xi = P.x[i];
           Real bw = 0, bx = 0, by = 0;
           for (std::uint32_t k = 0; k < bc; ++k) {
@@ -478,7 +441,7 @@ class Pbf final : public Solver {
           lambda[i] = lk + li;
         }
         lOld_[i] = lk;
-        if (bCount_[i]) {
+        if (c.nbr.boundaryCount[i]) {
           Vec2 vd = Vec2::Zero();
           c.boundary.resolve(x, vd, x0, c.clearance);
         }
@@ -522,9 +485,9 @@ class Pbf final : public Solver {
           w += wc[k];
         }
         Real rho = c.mass * wK * w;
-        const std::uint32_t bc = bCount_[i];
+        const std::uint32_t bc = c.nbr.boundaryCount[i];
         if (bc) {
-          const std::uint32_t* bl = bBlock_[i / kBlock].data() + bStart_[i];
+          const std::uint32_t* bl = c.nbr.boundaryOf(i);
           Real bw = 0;
           for (std::uint32_t k = 0; k < bc; ++k) {
             const std::uint32_t s = bl[k];
@@ -588,20 +551,35 @@ class Pbf final : public Solver {
   Real tensileDq_, xsph_, maxDt_, maxMove_;
 
   Real d0_ = 0, eps_ = 0, invWdq_ = 0, sCorrScale_ = 0;
-  Real dtPrev_ = 0, meanCompression_ = 0, maxCompression_ = 0;
+  Real meanCompression_ = 0, maxCompression_ = 0;
+  SolverStats stats_;
   Real dtLimit_ = std::numeric_limits<Real>::infinity();  ///< shortened while the iterations do not converge
   std::vector<Real> dLambda_, lOld_;
   std::vector<Vec2> wallGrad_;             ///< the boundary part of ∇_i C_i
   std::vector<double> blockErr_;           ///< compression per block (fixed-order sum)
   std::vector<Real> blockMax_;             ///< largest compression per block
   std::vector<std::vector<Real>> gCache_;  ///< per pair, laid out like NeighbourLists
-  std::vector<std::vector<std::uint32_t>> bBlock_;
-  std::vector<std::uint32_t> bStart_, bCount_;
   std::vector<Vec2> xNew_, vNew_, xOld_;
 };
 
 }  // namespace
 
-std::unique_ptr<Solver> makePbf(const SolverDef& def) { return std::make_unique<Pbf>(def); }
+/// pbf's registration (solvers.def) and its parameters.
+SolverInfo pbfSolver() {
+  return {"pbf",
+          {{"iterations", 4, 1, 1000, "Jacobi iterations of the density constraint per substep, at least (integer)"},
+           {"max_iterations", 100, 1, 1000, "iterations per substep, at most (integer); unconverged: shorter substeps"},
+           {"tolerance", 0.01, 0, 1, "stop once mean(max(ρ/ρ0 − 1, 0)) ≤ this … (0: exactly `iterations`)"},
+           {"tolerance_max", 0.05, 0.001, 10, "… and the largest compression max(ρ/ρ0 − 1) ≤ this"},
+           {"relaxation", 0.5, 0, 100, "ε of the constraint denominator, in units of its value on a full rest lattice"},
+           {"chebyshev", 0.9, 0, 0.99, "Chebyshev acceleration: spectral radius estimate ρ (0: plain Jacobi)"},
+           {"tensile_k", 0, 0, 1, "s_corr strength k, in multipliers of a unit density error (0: off)"},
+           {"tensile_n", 4, 1, 8, "s_corr exponent n (integer)"},
+           {"tensile_dq", 0.2, 0.01, 0.9, "s_corr reference distance Δq, in units of the support R"},
+           {"xsph", 0.01, 0, 1, "XSPH velocity smoothing c"},
+           {"max_dt", 1.0 / 60.0, 1e-5, 0.1, "largest substep (s)"},
+           {"max_move", 1, 0.05, 10, "dt ≤ max_move · R / v_max: largest move per substep, in support radii"}},
+          [](const SolverDef& d) -> std::unique_ptr<Solver> { return std::make_unique<Pbf>(d); }};
+}
 
 }  // namespace sph2d

@@ -1,0 +1,57 @@
+// constants.hpp (internal) — the engine's tuning constants in one place, each
+// with the reason for its value (Box2D's constants.h). Solver-specific
+// constants that a scene may change are solver parameters instead
+// (solvers/<name>/: each solver declares its own).
+#pragma once
+
+#include <cstddef>
+
+#include "sph2d/math.hpp"
+
+namespace sph2d {
+
+/// Particles per job block of a pass over neighbours: large enough that a
+/// block's neighbour lists fill whole cache lines, small enough for 2–8
+/// threads to share 10k particles evenly. Block boundaries never depend on
+/// the thread count (the determinism of every reduction rests on that).
+constexpr std::size_t kBlock = 256;
+
+/// Particles per job block of a streaming pass (no neighbours: integrate,
+/// gravity, reductions): a pass of a few ns per particle needs large blocks
+/// or the job system's overhead dominates.
+constexpr std::size_t kStreamBlock = 4096;
+
+/// A pair closer than sqrt(kCoincident2)·R is coincident: its direction is
+/// undefined (0/0), so it gets a fixed antisymmetric one (pairDelta).
+constexpr Real kCoincident2 = Real(1e-12);
+
+/// The length of that fixed direction, in R: short enough not to change a
+/// kernel value, long enough to give a finite gradient direction.
+constexpr Real kTieBreakLength = Real(1e-6);
+
+/// The force limit of explicit schemes, dt ≤ kForceCfl·sqrt(R/a_max)
+/// (Monaghan 1992's force condition; 0.25 is the usual safety factor).
+constexpr Real kForceCfl = Real(0.25);
+
+/// Particles are kept kClearance·dx clear of solid surfaces: the layer of
+/// boundary samples starts dx/2 inside, so a particle at the clearance still
+/// sees a full neighbourhood, and a resting particle does not touch the surface.
+constexpr Real kClearance = Real(0.25);
+
+/// Integration moves no particle more than kMaxMove·R in one substep: a force
+/// that jumps within a substep (a new overlap) cannot fling a particle across
+/// the neighbour search radius before the next step's limits see it.
+constexpr Real kMaxMove = Real(0.5);
+
+/// A step() shorter than this fraction of the last substep only drifts (no
+/// solver stage): a solver that divides by dt (the density solves of pbf and
+/// dfsph) would turn the compression the last substep left into a huge
+/// velocity. (A fraction of the stable limit would not do: in zero gravity at
+/// rest that limit is ~1e5 s, and every frame would be a sliver.)
+constexpr double kMinStepOfLast = 1e-2;
+
+/// What is left of a frame after its substeps, below this fraction of the
+/// frame, is float rounding of the substep lengths and is dropped.
+constexpr double kFrameLeftover = 1e-6;
+
+}  // namespace sph2d

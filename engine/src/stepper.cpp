@@ -1,0 +1,139 @@
+// The World's stepper: the substep as one explicit list of stages, the
+// time-step policy and the guard.
+//
+// The list is built once from the solver's stages (solvers/solver.hpp), the
+// scene's enabled effects at the solver's effects marker, and the World's own
+// stages around them: emit first; then, after the solver, the largest
+// acceleration (for the next substep's force limit), the swept collision with
+// the Box2D solids, the periodic wrap, lifetimes and sinks. A stage exists
+// only when the scene needs it. The list is rebuilt when a user force is
+// first set or an effect is switched on or off.
+//
+// The time-step policy is the World's alone: the solver and the enabled
+// effects report their limits; a frame is split into equal substeps no longer
+// than the least of them, at most solver.max_substeps a frame (beyond that the
+// frame advances less time and a warning names it); what remains of a frame
+// below kFrameLeftover of it is float rounding and is dropped. A step()
+// shorter than kMinStepOfLast of the last substep (a caller stepping "up to
+// time t") is a drift: the particles move with their velocity under gravity,
+// collide, and the particle system runs, but no solver stage: the density
+// solves divide by dt, and a sliver would turn the compression the last
+// substep left into a huge velocity. The drift is a second, short stage list.
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include "world_impl.hpp"
+
+namespace sph2d {
+
+StepContext World::Impl::context(Real dt) {
+  StepContext c{P, grid, nbr, boundary, pool, scratch, scene.solver};
+  c.R = R;
+  c.dx = dx;
+  c.dt = dt;
+  c.mass = mass;
+  c.rho0 = Real(scene.solver.restDensity);
+  c.gravity = Vec2(Real(scene.gravity.x()), Real(scene.gravity.y()));
+  c.clearance = kClearance * dx;
+  c.maxSpeed = Real(scene.solver.maxSpeed);
+  c.step = steps;
+  c.time = time;
+  c.origin = origin;
+  c.periodic = periodic;
+  return c;
+}
+
+void World::Impl::buildStages() {
+  stages.clear();
+  if (!emitters.empty()) stages.add(plainStage("emit", [this](StepContext& c) { emit(c.dt); }));
+  bool anyEffect = false;
+  for (const auto& e : effects) anyEffect = anyEffect || e->enabled;
+  bool marker = false;
+  for (Stage& s : solver->stages(anyEffect)) {
+    if (!s.effectsMarker) {
+      stages.add(std::move(s));
+      continue;
+    }
+    marker = true;
+    for (const auto& e : effects) {
+      if (!e->enabled) continue;
+      Effect* fx = e.get();
+      stages.add(Stage{fx->name(), [fx](StepContext& c) { return fx->apply(c); }});
+    }
+  }
+  if (!marker)
+    throw std::logic_error(std::string("solver ") + solver->name() + " has no effects marker in its stages");
+  stages.add(plainStage("max_acceleration", [this](StepContext& c) { lastAccel = maxAccelOf(c.P, c.pool); }));
+  addParticleSystemStages(stages);
+
+  drift.clear();
+  if (!emitters.empty()) drift.add(plainStage("emit", [this](StepContext& c) { emit(c.dt); }));
+  drift.add(Stage{"drift", [](StepContext& c) { return stageDrift(c); }});
+  addParticleSystemStages(drift);
+}
+
+void World::Impl::addParticleSystemStages(StageList& list) {
+  list.add(plainStage("collide", [](StepContext& c) { stageCollide(c); }));
+  if (periodic.any()) list.add(plainStage("wrap", [](StepContext& c) { stageWrap(c); }));
+  if (scene.effects.lifetime) list.add(plainStage("lifetimes", [this](StepContext& c) { lifetimes(c.dt); }));
+  if (!scene.effects.sinks.empty()) list.add(plainStage("sinks", [this](StepContext&) { sinks(); }));
+}
+
+Real World::Impl::stableDt() {
+  const Real vmax = maxSpeedOf(P, pool);
+  const StepContext c = context(0);
+  Real dt = solver->maxTimeStep(c, vmax, lastAccel);
+  for (const auto& e : effects)
+    if (e->enabled) dt = std::min(dt, e->maxTimeStep(c));
+  return dt;
+}
+
+void World::Impl::fail(const std::string& stage, std::size_t slot) {
+  std::ostringstream o;
+  o.precision(9);
+  const Vec2d w = Vec2d(P.x[slot].x(), P.x[slot].y()) + origin;
+  o << "simulation stopped: non-finite or runaway value after stage '" << stage << "' at substep " << steps
+    << " (t = " << time << " s): particle id " << P.id[slot] << " position (" << w.x() << ", " << w.y()
+    << ") velocity (" << P.v[slot].x() << ", " << P.v[slot].y() << ") density " << P.rho[slot] << " pressure "
+    << P.p[slot] << " (speed limit solver.max_speed = " << scene.solver.maxSpeed << " m/s)";
+  throw SimulationError(o.str(), stage, P.id[slot], steps, time);
+}
+
+void World::Impl::substep(Real dt, bool driftOnly) {
+  StepContext c = context(dt);
+  (driftOnly ? drift : stages).run(c, [this](const std::string& stage, std::size_t slot) { fail(stage, slot); });
+  time += double(dt);
+  ++steps;
+}
+
+void World::Impl::advance(double frameDt) {
+  double remaining = frameDt;
+  if (remaining < kMinStepOfLast * lastDt) {  // a sliver: drift only (see the top of this file)
+    substep(Real(remaining), true);
+    lastSubsteps = 1;
+    return;
+  }
+  const double total = remaining;
+  int n = 0;
+  const int cap = scene.solver.maxSubsteps;
+  while (remaining > kFrameLeftover * total) {
+    if (n == cap) {
+      std::ostringstream o;
+      o << "frame " << frames << ": substep cap solver.max_substeps = " << cap << " reached; simulated "
+        << (total - remaining) << " s of " << total << " s (the frame runs slow instead of unstable)";
+      warnings.push_back(o.str());
+      break;
+    }
+    const Real limit = stableDt();
+    const double k = std::ceil(remaining / double(limit) - 1e-9);
+    const double dt = k <= 1 ? remaining : remaining / k;
+    substep(Real(dt));
+    lastDt = double(Real(dt));
+    remaining -= double(Real(dt));
+    ++n;
+  }
+  lastSubsteps = n;
+}
+
+}  // namespace sph2d
