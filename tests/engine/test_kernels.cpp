@@ -120,3 +120,22 @@ TEST_CASE("viscosity kernel Laplacian is the 2D form, not c(R - r)") {
   CHECK(k.laplacian(r) == doctest::Approx(expected));
   CHECK(k.laplacian(r) != doctest::Approx(40 / kPi<double> * (1 - r)));
 }
+
+TEST_CASE("the pair-loop forms equal the kernels: Wendland's valueQ and gradientScale, the viscosity Laplacian of r²") {
+  const WendlandC2<float> w(0.025f);
+  const ViscosityKernel<float> v(0.025f);
+  for (float r = 0.0f; r < 0.025f; r += 0.0005f) {
+    CAPTURE(r);
+    const float q = r * w.invR;
+    CHECK(w.valueQ(q) == w.value(r));  // the same expression: the same bits
+    const WendlandC2<float>::V d(0.6f * r, -0.8f * r);
+    const float a = 1.0f - q;
+    const WendlandC2<float>::V g = d * (w.gradientScale * a * a * a);
+    const WendlandC2<float>::V ref = w.gradient(d, r);
+    CHECK(g.x() == doctest::Approx(ref.x()).epsilon(1e-5));
+    CHECK(g.y() == doctest::Approx(ref.y()).epsilon(1e-5));
+    CHECK(v.laplacianR2(r * r) == doctest::Approx(v.laplacian(r)).epsilon(1e-5));
+  }
+  CHECK(v.laplacianR2(0.025f * 0.025f) == 0.0f);
+  CHECK(std::isfinite(v.laplacianR2(0.0f)));  // clamped at rMin
+}

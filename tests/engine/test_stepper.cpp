@@ -38,7 +38,7 @@ TEST_CASE("the stage list exists from construction: the solver's stages, the eff
   for (const std::string& name : expected) CHECK(callsOf(w, name) == w.substeps());
 }
 
-TEST_CASE("switching an effect or adding a user force rebuilds the list; a switched-off effect runs no stage") {
+TEST_CASE("switching an effect or adding a user force rebuilds the list, and a switched-off effect runs no stage") {
   SceneDef s = test::scene("tests/resting_column.json");
   s.effects.xsph = true;
   World w(s, WorldOptions{1});
@@ -88,4 +88,4 @@ void sliverOnlyDrifts(const std::string& solver) {
 
 }  // namespace
 
-TEST_CASE_EVERY_SOLVER("a sliver of a step only drifts: no solver stage runs and nothing is kicked", sliverOnlyDrifts)
+TEST_CASE_EVERY_SOLVER("a sliver of a step only drifts (no solver stage runs, nothing is kicked)", sliverOnlyDrifts)

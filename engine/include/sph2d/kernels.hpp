@@ -130,6 +130,16 @@ struct ViscosityKernel {
   }
   /// ∇W (zero vector at r = 0).
   V gradient(const V& d, T r) const { return radialGradient<T>(d, r, derivative(r)); }
+  /// The same Laplacian for r² (pair loops): one square root and one division,
+  /// r clamped to rMin; equal to laplacian(√r²) to rounding.
+  T laplacianR2(T r2) const {
+    if (r2 >= R * R) return T(0);
+    const T R2 = R * R, R3 = R2 * R;
+    const T lapK = T(5) / (T(3) * kPi<T> * R2 * R3);
+    const T q = r2 > rMin * rMin ? std::sqrt(r2) : rMin;
+    const T iq = T(1) / q;
+    return lapK * (R - q) * (R3 + R2 * q + R * q * q + T(9) * q * q * q) * iq * iq * iq;
+  }
   /// The exact 2D Laplacian, r clamped to rMin.
   T laplacian(T r) const {
     if (r >= R) return T(0);
@@ -185,12 +195,19 @@ struct WendlandC2 {
   static constexpr bool hasLaplacian = true;
   static constexpr const char* name = "wendland_c2";
   T R, invR, s;
+  /// −20σ/R²: ∇W = gradientScale·(1 − q)³·d (the pair loops multiply by (1 − q)³ themselves).
+  T gradientScale;
   /// Builds the kernel with support radius `support`.
-  explicit WendlandC2(T support) : R(support), invR(T(1) / support), s(T(7) / (kPi<T> * support * support)) {}
+  explicit WendlandC2(T support)
+      : R(support), invR(T(1) / support), s(T(7) / (kPi<T> * support * support)), gradientScale(T(-20) * s * invR * invR) {}
   /// W(r).
   T value(T r) const {
     const T q = r * invR;
     if (q >= T(1)) return T(0);
+    return valueQ(q);
+  }
+  /// W at q = r/R < 1 (no range check; pair loops that know q < 1 call this).
+  T valueQ(T q) const {
     const T a = T(1) - q;
     return s * a * a * a * a * (T(4) * q + T(1));
   }

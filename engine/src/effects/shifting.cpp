@@ -69,7 +69,7 @@ class ParticleShifting final : public Effect {
     Particles& P = c.P;
     const WendlandC2<Real> W(c.R);
     const Real R2 = c.R * c.R;
-    const Real gradK = Real(-20) * W.s * W.invR * W.invR;  // ∇W = gradK (1 − q)³ d
+    const Real gradK = W.gradientScale;  // ∇W = gradK (1 − q)³ d
     const Real cap = Real(0.1) * c.dx, cap2 = cap * cap;
     // C of a full lattice (the mass makes Σ m W = ρ0 there, so Σ V W = 1).
     const Real surfaceC = Real(0.95);
@@ -99,16 +99,18 @@ class ParticleShifting final : public Effect {
           C += V * W.value(r);
         }
         if (walls) {
-          B.sampleGrid.forCandidates(xi, [&](std::uint32_t s) {
+          const std::uint32_t* bl = c.nbr.boundaryOf(i);
+          for (std::uint32_t k = 0; k < c.nbr.boundaryCount[i]; ++k) {
+            const std::uint32_t s = bl[k];
             const Vec2 d = xi - B.samples[s];
             const Real r2 = d.squaredNorm();
-            if (r2 >= R2 || !B.visible(s, xi)) return;
+            if (r2 >= R2) continue;  // a later pass: the sample has left the support since the lists were built
             const Real r = std::sqrt(r2), a = Real(1) - r * W.invR;
             const Real g = B.volume[s] * gradK * a * a * a;
             gx += g * d.x();
             gy += g * d.y();
             C += B.volume[s] * W.value(r);
-          });
+          }
         }
         Vec2 s(-D * gx, -D * gy);
         if (C < surfaceC) {  // near a free surface: keep only the tangential part

@@ -29,18 +29,9 @@ class LaplacianViscosity final : public Effect {
   std::size_t apply(StepContext& c) override {
     Particles& P = c.P;
     const ViscosityKernel<Real> W(c.R);
-    const Real R = c.R, R2 = R * R, R3 = R2 * R;
-    const Real rMin = W.rMin, invRMin = Real(1) / W.rMin;
-    const Real lapK = Real(5) / (Real(3) * kPi<Real> * R2 * R3);
     if (c.R != momentR_ || c.dx != momentDx_) {
-      const double Rd = double(c.R);
-      const double lk = 5.0 / (3.0 * 3.14159265358979323846 * Rd * Rd * Rd * Rd * Rd);
-      const double m = latticeLaplacianMoment(
-          [&](double r) {
-            const double q = std::max(r, 0.05 * Rd);
-            return lk * (Rd - q) * (Rd * Rd * Rd + Rd * Rd * q + Rd * q * q + 9 * q * q * q) / (q * q * q);
-          },
-          Rd, double(c.dx));
+      const ViscosityKernel<double> Wd(double(c.R));
+      const double m = latticeLaplacianMoment([&](double r) { return Wd.laplacian(r); }, Wd.R, double(c.dx));
       scale_ = Real(1.0 / m);
       momentR_ = c.R;
       momentDx_ = c.dx;
@@ -64,10 +55,7 @@ class LaplacianViscosity final : public Effect {
           Real dx = xix - X[j].x(), dy = xiy - X[j].y();
           c.periodic.nearest(dx, dy);
           const Real r2 = dx * dx + dy * dy;
-          // The same clamped Laplacian as ViscosityKernel::laplacian, one division per pair.
-          const Real q = r2 > rMin * rMin ? std::sqrt(r2) : rMin;
-          const Real iq = r2 > rMin * rMin ? Real(1) / q : invRMin;
-          const Real w = lapK * (R - q) * (R3 + R2 * q + R * q * q + Real(9) * q * q * q) * iq * iq * iq * IR[j];
+          const Real w = W.laplacianR2(r2) * IR[j];
           fx += (V[j].x() - vix) * w;
           fy += (V[j].y() - viy) * w;
         }
@@ -78,10 +66,7 @@ class LaplacianViscosity final : public Effect {
           const std::uint32_t* bl = c.nbr.boundaryOf(i);
           for (std::uint32_t k = 0; k < c.nbr.boundaryCount[i]; ++k) {
             const std::uint32_t s = bl[k];
-            const Real r2 = (xi - B.samples[s]).squaredNorm();
-            const Real q = r2 > rMin * rMin ? std::sqrt(r2) : rMin;
-            const Real iq = Real(1) / q;
-            sum += B.volume[s] * lapK * (R - q) * (R3 + R2 * q + R * q * q + Real(9) * q * q * q) * iq * iq * iq;
+            sum += B.volume[s] * W.laplacianR2((xi - B.samples[s]).squaredNorm());
           }
           acc -= Vec2(vix, viy) * (Real(2) * nuS * c.rho0 * IR[i] * sum);
         }

@@ -295,39 +295,30 @@ class Dfsph final : public Solver {
     alpha_.resize(n);
     dk_.resize(n);
     q_.resize(n);
-    const Real R = c.R, R2 = R * R, tiny2 = Real(1e-12) * R2;
-    const Real gradK = Real(-20) * W.s * W.invR * W.invR;  // ∇W = gradK (1 − q)³ d
+    const Real R = c.R;
+    const Real gradK = W.gradientScale;  // ∇W = gradK (1 − q)³ d
     const Real mGradK = c.mass * gradK;
     const Real self = W.value(0);
     // Below this the factor's denominator means no neighbours at all (a full
     // neighbourhood gives about (ρ0/R)²).
     const Real eps = Real(1e-6) * (c.rho0 / R) * (c.rho0 / R);
     const Vec2* X = P.x.data();
-    const std::uint32_t* ID = P.id.data();
     return firstBad(c.pool, n, [&](std::size_t b, std::size_t e) {
       std::size_t bad = kNone;
       std::vector<Pair>& G = pairs_[b / kBlock];
       G.resize(L.perBlock[b / kBlock].size());
       for (std::size_t i = b; i < e; ++i) {
-        const Real xix = X[i].x(), xiy = X[i].y();
         const std::uint32_t* nb = L.of(i);
         const std::uint32_t cnt = L.count[i];
         Pair* Gi = G.data() + L.start[i];
         Real sum = self, gx = 0, gy = 0, sq = 0;
         for (std::uint32_t k = 0; k < cnt; ++k) {
           const std::uint32_t j = nb[k];
-          Real dx = xix - X[j].x(), dy = xiy - X[j].y();
-          c.periodic.nearest(dx, dy);
-          Real r2 = dx * dx + dy * dy;
+          Real dx, dy, r2;
+          pairDelta(c, i, j, dx, dy, r2);  // coincident pairs: a fixed, antisymmetric direction
           const Real q = std::sqrt(r2) * W.invR;
           const Real a = Real(1) - q;
-          sum += W.s * a * a * a * a * (Real(4) * q + Real(1));
-          if (r2 < tiny2) {  // coincident pair: a fixed, antisymmetric direction
-            const Vec2 t = tieBreakDirection(ID[i], ID[j]) * (Real(1e-6) * R);
-            dx = t.x();
-            dy = t.y();
-            r2 = dx * dx + dy * dy;
-          }
+          sum += W.valueQ(q);
           const Real g = mGradK * a * a * a;  // m∇W_ij = g·d
           const Real gxk = g * dx, gyk = g * dy;
           Gi[k] = Pair{j, gxk, gyk};
@@ -346,7 +337,7 @@ class Dfsph final : public Solver {
             const Vec2 d = xi - B.samples[s];
             const Real q = std::sqrt(d.squaredNorm()) * W.invR;
             const Real a = Real(1) - q;
-            vol += B.volume[s] * (W.s * a * a * a * a * (Real(4) * q + Real(1)));
+            vol += B.volume[s] * W.valueQ(q);
             gb += d * (gradK * a * a * a * B.volume[s]);
           }
           rho += c.rho0 * vol;

@@ -264,24 +264,9 @@ class Pbf final : public Solver {
     });
   }
 
-  /// d = x_i − x_j and r² of one pair; a fixed direction of length √tiny2 for coincident particles.
-  static void pairOf(const StepContext& c, std::size_t i, std::uint32_t j, Real tiny2, Real& dx, Real& dy, Real& r2) {
-    const Vec2* X = c.P.x.data();
-    dx = X[i].x() - X[j].x();
-    dy = X[i].y() - X[j].y();
-    c.periodic.nearest(dx, dy);
-    r2 = dx * dx + dy * dy;
-    if (r2 < tiny2) {
-      const Vec2 t = tieBreakDirection(c.P.id[i], c.P.id[j]) * std::sqrt(tiny2);
-      dx = t.x();
-      dy = t.y();
-      r2 = dx * dx + dy * dy;
-    }
-  }
-
   /// d = x_i − x_j and r² of i's neighbours into dx, dy, r2, padded to a multiple of 4
   /// with pairs outside the support (r² = 4R², d = 0: every term vanishes). Returns the padded count.
-  static std::size_t gather(const StepContext& c, std::size_t i, Real tiny2, std::vector<Real>& dx,
+  static std::size_t gather(const StepContext& c, std::size_t i, std::vector<Real>& dx,
                             std::vector<Real>& dy, std::vector<Real>& r2) {
     const std::uint32_t cnt = c.nbr.count[i];
     const std::uint32_t* nb = c.nbr.of(i);
@@ -291,7 +276,7 @@ class Pbf final : public Solver {
       dy.resize(pad);
       r2.resize(pad);
     }
-    for (std::uint32_t k = 0; k < cnt; ++k) pairOf(c, i, nb[k], tiny2, dx[k], dy[k], r2[k]);
+    for (std::uint32_t k = 0; k < cnt; ++k) pairDelta(c, i, nb[k], dx[k], dy[k], r2[k]);
     for (std::size_t k = cnt; k < pad; ++k) {
       dx[k] = dy[k] = 0;
       r2[k] = Real(4) * c.R * c.R;
@@ -322,7 +307,7 @@ class Pbf final : public Solver {
       Real worst = 0;
       const Lane4 zero = Lane4::all(0), one = Lane4::all(1), vInvR = Lane4::all(invR);
       for (std::size_t i = b; i < e; ++i) {
-        const std::size_t pad = gather(c, i, tiny2, dxs, dys, r2s);
+        const std::size_t pad = gather(c, i, dxs, dys, r2s);
         // Particles are visited in slot order, so the padding written past i's pairs is
         // overwritten by i + 1's.
         Real* gc = cache.data() + c.nbr.start[i];
@@ -398,7 +383,6 @@ class Pbf final : public Solver {
     const Spiky<Real> S(c.R);
     const Real invR = Real(1) / c.R, wK = S.c * c.R * c.R * c.R, gK = Real(-3) * S.c * c.R * c.R;
     const Real Vg = c.mass / c.rho0 * gK;
-    const Real tiny2 = Real(1e-12) * c.R * c.R;
     const bool tensile = sCorrScale_ != 0;
     const Real wRatio = wK * invWdq_;
     const int sn = tensileN_;
@@ -417,7 +401,7 @@ class Pbf final : public Solver {
         for (std::uint32_t k = 0; k < cnt; ++k) {
           const std::uint32_t j = nb[k];
           Real dx, dy, q2;
-          pairOf(c, i, j, tiny2, dx, dy, q2);
+          pairDelta(c, i, j, dx, dy, q2);
           Real f = li + L[j];
           if (tensile) {
             const Real a = std::max(Real(0), Real(1) - std::sqrt(q2) * invR);

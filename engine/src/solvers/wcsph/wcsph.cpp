@@ -142,7 +142,7 @@ class Wcsph final : public Solver {
     const Real R = c.R, h = Real(0.5) * R;
     // ∇W = gradK (1 − q)³ d, with the pressure term renormalised by the lattice
     // gradient moment (kernels.hpp) so a hydrostatic column gets ρ g per metre.
-    const Real gradK = Real(-20) * W.s * W.invR * W.invR;
+    const Real gradK = W.gradientScale;
     const Real pScale = Real(1.0 / latticeGradientMoment(WendlandC2<double>(double(c.R)), double(c.dx), double(c.mass / c.rho0)));
     const Real avK = alpha_ * c0_;  // Π = −α c μ / ρ̄ with μ = h v·x / (r² + 0.01h²)
     const Real eta2 = Real(0.01) * h * h;
