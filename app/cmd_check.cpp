@@ -10,7 +10,9 @@
 #include <sstream>
 
 #include "cli.hpp"
+#include "commands.hpp"
 #include "events.hpp"
+#include "manifest.hpp"
 #include "sph2d/hash.hpp"
 #include "sph2d/render/png_io.hpp"
 #include "sph2d/render/renderer.hpp"

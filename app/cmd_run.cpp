@@ -17,8 +17,10 @@
 #include <thread>
 
 #include "cli.hpp"
+#include "commands.hpp"
 #include "events.hpp"
 #include "frame_clock.hpp"
+#include "manifest.hpp"
 #include "sph2d/hash.hpp"
 #include "sph2d/render/frame_writer.hpp"
 #include "sph2d/render/particle_export.hpp"
@@ -31,14 +33,6 @@ namespace fs = std::filesystem;
 using json = nlohmann::ordered_json;
 
 namespace sph2d::cli {
-
-const char* kRenderFlagsHelp =
-    "  --mode M        liquid (default: the scene's) or particles\n"
-    "  --color-by F    particles mode: speed (default), pressure, density or age\n"
-    "  --range LO,HI   particles mode: fixed colour range (default: each frame's min..max)\n"
-    "  --overlay       draw frame number, simulated time and particle count\n"
-    "  --foam-speed V  liquid: foam starts at V m/s, full at 2V (default 0.35·sqrt(g·view height))\n"
-    "  --depth-scale D liquid: D metres of water above darken the colour by 1/e (default 1)\n";
 
 namespace {
 
@@ -134,13 +128,6 @@ RunArgs parseRun(const std::vector<std::string>& a) {
   return r;
 }
 
-double parseNumber(const std::string& flag, const std::string& v) {
-  char* end = nullptr;
-  const double x = std::strtod(v.c_str(), &end);
-  if (v.empty() || *end || !std::isfinite(x)) throw UsageError(flag + " expects a number, got '" + v + "'");
-  return x;
-}
-
 std::string frameName(int f) {
   char name[32];
   std::snprintf(name, sizeof name, "frame_%05d.png", f);
@@ -148,83 +135,6 @@ std::string frameName(int f) {
 }
 
 }  // namespace
-
-bool parseRenderFlag(const std::vector<std::string>& a, std::size_t& i, RenderOptions& o) {
-  const std::string& s = a[i];
-  auto value = [&]() -> std::string {
-    if (i + 1 >= a.size()) throw UsageError(s + " needs a value");
-    return a[++i];
-  };
-  if (s == "--mode") {
-    o.mode = value();
-    if (o.mode != "liquid" && o.mode != "particles")
-      throw UsageError("--mode expects liquid or particles, got '" + o.mode + "'");
-  } else if (s == "--color-by") {
-    const std::string v = value();
-    if (!parseColorField(v, o.colorBy))
-      throw UsageError("--color-by expects speed, pressure, density or age, got '" + v + "'");
-  } else if (s == "--range") {
-    const std::string v = value();
-    const auto c = v.find(',');
-    if (c == std::string::npos) throw UsageError("--range expects LO,HI, got '" + v + "'");
-    const double lo = parseNumber(s, v.substr(0, c)), hi = parseNumber(s, v.substr(c + 1));
-    if (!(hi > lo)) throw UsageError("--range needs HI > LO, got '" + v + "'");
-    o.range = std::array<double, 2>{lo, hi};
-  } else if (s == "--overlay") {
-    o.overlay = true;
-  } else if (s == "--foam-speed") {
-    o.foamSpeed = parseNumber(s, value());
-    if (!(o.foamSpeed > 0)) throw UsageError("--foam-speed must be > 0");
-  } else if (s == "--depth-scale") {
-    o.depthScale = parseNumber(s, value());
-    if (!(o.depthScale > 0)) throw UsageError("--depth-scale must be > 0");
-  } else {
-    return false;
-  }
-  return true;
-}
-
-json renderOptionsJson(const RenderOptions& o) {
-  json j;
-  j["mode"] = o.mode;
-  j["color_by"] = colorFieldName(o.colorBy);
-  j["range"] = o.range ? json::array({(*o.range)[0], (*o.range)[1]}) : json(nullptr);
-  j["overlay"] = o.overlay;
-  j["foam_speed"] = o.foamSpeed;
-  j["depth_scale"] = o.depthScale;
-  return j;
-}
-
-RenderOptions renderOptionsFromJson(const json& j) {
-  RenderOptions o;
-  try {
-    o.mode = j.at("mode").get<std::string>();
-    if (!parseColorField(j.at("color_by").get<std::string>(), o.colorBy)) throw UsageError("bad color_by");
-    if (!j.at("range").is_null()) o.range = std::array<double, 2>{j.at("range").at(0).get<double>(), j.at("range").at(1).get<double>()};
-    o.overlay = j.at("overlay").get<bool>();
-    o.foamSpeed = j.at("foam_speed").get<double>();
-    o.depthScale = j.at("depth_scale").get<double>();
-  } catch (const json::exception& e) {
-    throw UsageError(std::string("the manifest's render options are malformed: ") + e.what());
-  }
-  return o;
-}
-
-std::string fileHash(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw UsageError("cannot read " + path);
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  const std::string bytes = ss.str();
-  return hex64(xxh64(bytes.data(), bytes.size()));
-}
-
-json environmentJson() {
-  json env = json::array();
-  for (const EnvSetting& e : pinRenderEnvironment())
-    env.push_back({{"name", e.name}, {"value", e.value}, {"source", e.source}});
-  return env;
-}
 
 int cmdRun(const std::vector<std::string>& args) {
   for (const auto& s : args)
