@@ -8,8 +8,6 @@
 #include <cstdlib>
 #include <sstream>
 
-#include "sph2d/world.hpp"
-
 namespace sph2d::cli {
 
 std::atomic<bool> stopRequested{false};
@@ -55,15 +53,6 @@ std::vector<int> parseIntList(const std::string& flag, const std::string& v, int
   while (std::getline(ss, item, ',')) out.push_back(parseInt(flag, item, lo, hi));
   if (out.empty()) throw UsageError(flag + " expects a comma-separated list of integers");
   return out;
-}
-
-void printProfile(const World& w) {
-  double total = 0;
-  for (const auto& t : w.timings()) total += t.seconds;
-  std::printf("%-16s %10s %10s %8s %7s\n", "stage", "calls", "seconds", "ms/call", "share");
-  for (const auto& t : w.timings())
-    std::printf("%-16s %10llu %10.3f %8.4f %6.1f%%\n", t.name.c_str(), (unsigned long long)t.calls, t.seconds,
-                t.calls ? 1e3 * t.seconds / double(t.calls) : 0.0, total > 0 ? 100.0 * t.seconds / total : 0.0);
 }
 
 const char* kRenderFlagsHelp =

@@ -1,6 +1,5 @@
 // app/cli.hpp — command-line helpers the sph2d commands share: usage errors, number
-// and list flags, the render flags, the stage profile table and the stop flag set by
-// SIGINT/SIGTERM.
+// and list flags, the render flags, and the stop flag set by SIGINT/SIGTERM.
 // (The commands themselves are declared in commands.hpp.)
 #pragma once
 
@@ -10,10 +9,6 @@
 #include <vector>
 
 #include "sph2d/render/renderer.hpp"
-
-namespace sph2d {
-class World;
-}
 
 namespace sph2d::cli {
 
@@ -30,8 +25,6 @@ double parseNumber(const std::string& flag, const std::string& v);
 std::vector<int> parseIntList(const std::string& flag, const std::string& v, int lo, int hi);
 /// Splits a comma-separated list (empty items dropped).
 std::vector<std::string> splitList(const std::string& s);
-/// Prints each stage's calls, seconds, ms per call and share.
-void printProfile(const World& w);
 /// Set by SIGINT/SIGTERM once installStopHandler() ran.
 extern std::atomic<bool> stopRequested;
 /// Makes SIGINT/SIGTERM set stopRequested instead of killing the process.

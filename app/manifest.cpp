@@ -1,15 +1,23 @@
 // app/manifest.cpp — writing and reading manifest.json; see manifest.hpp.
 #include "manifest.hpp"
 
+#include <cstdio>
 #include <fstream>
 #include <sstream>
 
 #include "cli.hpp"
 #include "sph2d/hash.hpp"
+#include "sph2d/render/particle_export.hpp"
 
 namespace sph2d::cli {
 
 using json = nlohmann::ordered_json;
+
+std::string frameFileName(std::int64_t frame) {
+  char name[32];
+  std::snprintf(name, sizeof name, "frame_%05d.png", int(frame));
+  return name;
+}
 
 std::string fileHash(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
@@ -52,5 +60,46 @@ RenderOptions renderOptionsFromJson(const json& j) {
   }
   return o;
 }
+
+RunManifest::RunManifest(const RunArgs& a, const SceneDef& scene, const Renderer& renderer, int frames, int threads) {
+  std::string exportName = "none";
+  if (a.exportFormat) exportName = exportExtension(*a.exportFormat) + (*a.exportFormat == ExportFormat::VtkAscii ? "-ascii" : "");
+  j_["format"] = "sph2d-frames";
+  j_["format_version"] = 1;
+  j_["engine_version"] = SPH2D_VERSION;
+  j_["scene"] = {{"path", a.scene}, {"name", scene.name}, {"xxh64", fileHash(a.scene)}};
+  j_["renderer"] = renderer.rendererString();
+  j_["cpu"] = cpuSummary();
+  j_["environment"] = environmentJson();
+  j_["image"] = {{"width", scene.render.width}, {"height", scene.render.height}, {"format", "png"},
+                 {"png_level", a.pngLevel}, {"mode", renderer.mode()}};
+  j_["render"] = renderOptionsJson(a.render);
+  j_["run"] = {{"frames", frames}, {"every", a.every}, {"threads", threads}, {"fps", scene.fps}, {"export", exportName},
+               {"video", a.video}, {"realtime", a.realtime}, {"inputs", a.inputs}};
+  j_["frames"] = json::array();
+  j_["events"] = json::array();
+}
+
+void RunManifest::addFrame(std::int64_t frame, double time, std::uint64_t pixels, std::uint64_t state) {
+  j_["frames"].push_back({{"frame", frame},
+                          {"time", time},
+                          {"file", frameFileName(frame)},
+                          {"rgba_xxh64", hex64(pixels)},
+                          {"state_hash", hex64(state)}});
+}
+
+void RunManifest::addEvent(const std::string& line) { j_["events"].push_back(json::parse(line)); }
+
+void RunManifest::finish(int written, int status, const std::string& reason, const std::string& message,
+                         std::int64_t simulated) {
+  json& list = j_["frames"];
+  while (int(list.size()) > written) list.erase(list.size() - 1);
+  j_["complete"] = status == 0;
+  j_["stop"] = status == 0 ? json(nullptr)
+                           : json{{"reason", reason}, {"message", message}, {"frames_simulated", simulated},
+                                  {"frames_written", written}};
+}
+
+void RunManifest::write(const std::string& dir) const { writeFileAtomic(dir + "/manifest.json", j_.dump(1) + "\n"); }
 
 }  // namespace sph2d::cli

@@ -6,17 +6,24 @@
 // run's settings, and per kept frame its number, simulated time, PNG file, the
 // XXH64 of its RGBA pixels and the World's state hash; then every applied event
 // stamped with its frame, and whether the run completed (else why it stopped).
-// This file holds the pieces of it both commands use.
+// Design: the run fills it as frames are rendered and events applied and writes it
+// once at the end, whole or not at all (writeFileAtomic), listing only the frames
+// whose PNG exists. Keys keep their insertion order, so equal runs give equal bytes.
 #pragma once
 
+#include <cstdint>
 #include <string>
 
 #include <nlohmann/json.hpp>
 
+#include "run_args.hpp"
 #include "sph2d/render/renderer.hpp"
+#include "sph2d/scene.hpp"
 
 namespace sph2d::cli {
 
+/// "frame_NNNNN.png", the file name of frame `frame`.
+std::string frameFileName(std::int64_t frame);
 /// XXH64 of a file's bytes as 16 hex digits. Throws UsageError when it cannot be read.
 std::string fileHash(const std::string& path);
 /// The llvmpipe environment as recorded in a manifest (pins it first).
@@ -25,5 +32,25 @@ nlohmann::ordered_json environmentJson();
 nlohmann::ordered_json renderOptionsJson(const RenderOptions& o);
 /// The render options a manifest recorded. Throws UsageError on a malformed entry.
 RenderOptions renderOptionsFromJson(const nlohmann::ordered_json& j);
+
+/// The manifest of one `sph2d run`, filled while it runs.
+class RunManifest {
+ public:
+  /// The header of a run of `scene` with options `a`, `frames` frames on `threads`
+  /// threads, rendered by `renderer`.
+  RunManifest(const RunArgs& a, const SceneDef& scene, const Renderer& renderer, int frames, int threads);
+  /// Lists kept frame `frame`: simulated time, pixel hash, state hash.
+  void addFrame(std::int64_t frame, double time, std::uint64_t pixels, std::uint64_t state);
+  /// Lists an applied event (a recordLine()).
+  void addEvent(const std::string& line);
+  /// Keeps the first `written` frames (those whose PNG exists) and says how the run ended:
+  /// complete when `status` is 0, else `reason` ("interrupted", "guard", "error") and `message`.
+  void finish(int written, int status, const std::string& reason, const std::string& message, std::int64_t simulated);
+  /// Writes DIR/manifest.json whole or not at all. Throws std::runtime_error.
+  void write(const std::string& dir) const;
+
+ private:
+  nlohmann::ordered_json j_;
+};
 
 }  // namespace sph2d::cli
