@@ -1,6 +1,7 @@
 // app/manifest.cpp — writing and reading manifest.json; see manifest.hpp.
 #include "manifest.hpp"
 
+#include <algorithm>
 #include <cstdio>
 #include <fstream>
 #include <sstream>
@@ -101,5 +102,32 @@ void RunManifest::finish(int written, int status, const std::string& reason, con
 }
 
 void RunManifest::write(const std::string& dir) const { writeFileAtomic(dir + "/manifest.json", j_.dump(1) + "\n"); }
+
+ManifestView readManifest(const std::string& path) {
+  ManifestView v;
+  json& m = v.json;
+  {
+    std::ifstream in(path);
+    if (!in) throw UsageError("cannot read the manifest " + path);
+    try {
+      in >> m;
+    } catch (const json::exception& e) {
+      throw UsageError(path + " is not valid JSON: " + e.what());
+    }
+  }
+  try {
+    if (m.at("format").get<std::string>() != "sph2d-frames") throw UsageError(path + " is not an sph2d frames manifest");
+    v.frames = m.at("run").at("frames").get<int>();
+    v.every = std::max(1, m.at("run").at("every").get<int>());
+    v.renderer = m.at("renderer").get<std::string>();
+    v.cpu = m.value("cpu", "");
+    v.sceneHash = m.at("scene").at("xxh64").get<std::string>();
+    v.render = renderOptionsFromJson(m.at("render"));
+    for (const json& f : m.at("frames")) v.expected[f.at("frame").get<int>()] = f;
+  } catch (const json::exception& e) {
+    throw UsageError(path + " lacks a field `sph2d check` needs: " + e.what());
+  }
+  return v;
+}
 
 }  // namespace sph2d::cli

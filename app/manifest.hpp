@@ -12,6 +12,7 @@
 #pragma once
 
 #include <cstdint>
+#include <map>
 #include <string>
 
 #include <nlohmann/json.hpp>
@@ -52,5 +53,19 @@ class RunManifest {
  private:
   nlohmann::ordered_json j_;
 };
+
+/// A manifest as `sph2d check` reads it.
+struct ManifestView {
+  nlohmann::ordered_json json;                     ///< the whole manifest
+  int frames = 0;                                  ///< run.frames
+  int every = 1;                                   ///< run.every (at least 1)
+  std::map<int, nlohmann::ordered_json> expected;  ///< the listed frames by number
+  std::string renderer, cpu, sceneHash;            ///< what it was made with
+  RenderOptions render;                            ///< the render options of the run
+};
+
+/// Reads a manifest for `sph2d check`. Throws UsageError when it cannot be read, is not
+/// JSON, is not an sph2d frames manifest or lacks a field check needs.
+ManifestView readManifest(const std::string& path);
 
 }  // namespace sph2d::cli
