@@ -7,9 +7,9 @@
 #include <cstdlib>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <map>
-#include <sstream>
+#include <string>
+#include <utility>
 
 #include "cli.hpp"
 #include "commands.hpp"
