@@ -1,12 +1,12 @@
+// app/cli.cpp — command-line helpers shared by the sph2d commands; see cli.hpp.
 #include "cli.hpp"
 
 #include <cerrno>
+#include <cmath>
 #include <csignal>
 #include <cstdio>
 #include <cstdlib>
 #include <sstream>
-
-#include "sph2d/world.hpp"
 
 namespace sph2d::cli {
 
@@ -30,6 +30,13 @@ int parseInt(const std::string& flag, const std::string& v, int lo, int hi) {
   return int(x);
 }
 
+double parseNumber(const std::string& flag, const std::string& v) {
+  char* end = nullptr;
+  const double x = std::strtod(v.c_str(), &end);
+  if (v.empty() || *end || !std::isfinite(x)) throw UsageError(flag + " expects a number, got '" + v + "'");
+  return x;
+}
+
 std::vector<std::string> splitList(const std::string& s) {
   std::vector<std::string> out;
   std::stringstream ss(s);
@@ -48,13 +55,47 @@ std::vector<int> parseIntList(const std::string& flag, const std::string& v, int
   return out;
 }
 
-void printProfile(const World& w) {
-  double total = 0;
-  for (const auto& t : w.timings()) total += t.seconds;
-  std::printf("%-16s %10s %10s %8s %7s\n", "stage", "calls", "seconds", "ms/call", "share");
-  for (const auto& t : w.timings())
-    std::printf("%-16s %10llu %10.3f %8.4f %6.1f%%\n", t.name.c_str(), (unsigned long long)t.calls, t.seconds,
-                t.calls ? 1e3 * t.seconds / double(t.calls) : 0.0, total > 0 ? 100.0 * t.seconds / total : 0.0);
+const char* kRenderFlagsHelp =
+    "  --mode M        liquid (default: the scene's) or particles\n"
+    "  --color-by F    particles mode: speed (default), pressure, density or age\n"
+    "  --range LO,HI   particles mode: fixed colour range (default: each frame's min..max)\n"
+    "  --overlay       draw frame number, simulated time and particle count\n"
+    "  --foam-speed V  liquid: foam starts at V m/s, full at 2V (default 0.35·sqrt(g·view height))\n"
+    "  --depth-scale D liquid: D metres of water above darken the colour by 1/e (default 1)\n";
+
+bool parseRenderFlag(const std::vector<std::string>& a, std::size_t& i, RenderOptions& o) {
+  const std::string& s = a[i];
+  auto value = [&]() -> std::string {
+    if (i + 1 >= a.size()) throw UsageError(s + " needs a value");
+    return a[++i];
+  };
+  if (s == "--mode") {
+    o.mode = value();
+    if (o.mode != "liquid" && o.mode != "particles")
+      throw UsageError("--mode expects liquid or particles, got '" + o.mode + "'");
+  } else if (s == "--color-by") {
+    const std::string v = value();
+    if (!parseColorField(v, o.colorBy))
+      throw UsageError("--color-by expects speed, pressure, density or age, got '" + v + "'");
+  } else if (s == "--range") {
+    const std::string v = value();
+    const auto c = v.find(',');
+    if (c == std::string::npos) throw UsageError("--range expects LO,HI, got '" + v + "'");
+    const double lo = parseNumber(s, v.substr(0, c)), hi = parseNumber(s, v.substr(c + 1));
+    if (!(hi > lo)) throw UsageError("--range needs HI > LO, got '" + v + "'");
+    o.range = std::array<double, 2>{lo, hi};
+  } else if (s == "--overlay") {
+    o.overlay = true;
+  } else if (s == "--foam-speed") {
+    o.foamSpeed = parseNumber(s, value());
+    if (!(o.foamSpeed > 0)) throw UsageError("--foam-speed must be > 0");
+  } else if (s == "--depth-scale") {
+    o.depthScale = parseNumber(s, value());
+    if (!(o.depthScale > 0)) throw UsageError("--depth-scale must be > 0");
+  } else {
+    return false;
+  }
+  return true;
 }
 
 }  // namespace sph2d::cli

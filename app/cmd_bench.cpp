@@ -9,6 +9,7 @@
 #include <filesystem>
 
 #include "cli.hpp"
+#include "commands.hpp"
 #include "sph2d/hash.hpp"
 #include "sph2d/render/png_io.hpp"
 #include "sph2d/render/renderer.hpp"

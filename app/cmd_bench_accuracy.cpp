@@ -29,6 +29,7 @@
 #include <vector>
 
 #include "cli.hpp"
+#include "commands.hpp"
 #include "validation.hpp"
 #include "sph2d/render/image.hpp"
 #include "sph2d/render/png_io.hpp"

@@ -26,6 +26,7 @@
 #include <vector>
 
 #include "cli.hpp"
+#include "commands.hpp"
 #include "sph2d/scene.hpp"
 #include "sph2d/world.hpp"
 

@@ -9,6 +9,7 @@
 #include <string>
 
 #include "cli.hpp"
+#include "commands.hpp"
 #include "sph2d/scene.hpp"
 #include "sph2d/world.hpp"
 

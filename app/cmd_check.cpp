@@ -1,16 +1,21 @@
 // `sph2d check`: rerun a scene and compare every frame's pixel hash with a manifest
 // written by `sph2d run`; on the first difference, count the differing pixels
-// against the reference PNG beside the manifest and write a diff image.
+// against the reference PNG beside the manifest and write a diff image. The rerun
+// is run's own GameLoop (headless), fed the events the manifest lists at their
+// frames, so a run driven by input checks like any other.
 #include <algorithm>
 #include <cstdlib>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <map>
-#include <sstream>
+#include <string>
+#include <utility>
 
 #include "cli.hpp"
-#include "events.hpp"
+#include "commands.hpp"
+#include "event_intake.hpp"
+#include "game_loop.hpp"
+#include "manifest.hpp"
 #include "sph2d/hash.hpp"
 #include "sph2d/render/png_io.hpp"
 #include "sph2d/render/renderer.hpp"
@@ -75,6 +80,99 @@ PixelDiff diffImages(const Frame& got, const std::vector<std::uint8_t>& ref, Fra
   return d;
 }
 
+/// Compares each kept frame of the rerun with the manifest; stops at the first difference
+/// after writing this run's frame and a diff image.
+class FrameCheck : public LoopObserver {
+ public:
+  FrameCheck(const ManifestView& m, const std::string& out, const fs::path& refDir)
+      : m_(m), out_(out), refDir_(refDir) {}
+
+  void warn(const std::string&) override {}
+  void note(const std::string&) override {}
+  void applied(const TimedEvent&, std::int64_t) override {}
+  void notApplied(const TimedEvent& t, std::int64_t frame, const std::string& why) override {
+    std::printf("note: frame %d: %s not applied: %s\n", int(frame), describeEvent(t.event).c_str(), why.c_str());
+  }
+  bool keeps(std::int64_t frame) override { return frame % m_.every == 0 && m_.expected.count(int(frame)); }
+  bool frame(const World& world, std::int64_t frame, const Frame& fr) override {
+    const int f = int(frame);
+    const json& e = m_.expected.at(f);
+    const std::string got = hex64(xxh64(fr.rgba.data(), fr.rgba.size()));
+    const std::string want = e.value("rgba_xxh64", "");
+    ++compared;
+    if (got == want) return true;
+    failed = true;
+    const std::string state = hex64(world.stateHash()), wantState = e.value("state_hash", "");
+    std::printf("check: frame %d differs: RGBA XXH64 %s here, %s in the manifest\n", f, got.c_str(), want.c_str());
+    std::printf("check: state hash %s\n", state == wantState
+                                             ? "matches: the simulation agrees, the rendering differs"
+                                             : ("differs too (" + state + " vs " + wantState + "): the simulation changed").c_str());
+    std::error_code ec;
+    fs::create_directories(out_, ec);
+    const std::string name = frameFileName(f);
+    const std::string mine = out_ + "/" + name;
+    writePngAtomic(mine, fr.width, fr.height, fr.rgba.data(), 1);
+    const std::string refPath = (refDir_ / e.value("file", name)).string();
+    int rw = 0, rh = 0;
+    std::vector<std::uint8_t> ref;
+    try {
+      readPng(refPath, rw, rh, ref);
+    } catch (const std::exception& ex) {
+      std::printf("check: no readable reference image (%s); cannot count pixels. This run's frame: %s\n", ex.what(),
+                  mine.c_str());
+      return false;
+    }
+    if (rw != fr.width || rh != fr.height) {
+      std::printf("check: the reference %s is %dx%d, this run renders %dx%d. This run's frame: %s\n", refPath.c_str(), rw,
+                  rh, fr.width, fr.height, mine.c_str());
+      return false;
+    }
+    if (hex64(xxh64(ref.data(), ref.size())) != want)
+      std::printf("note: the reference %s does not match its own manifest hash either\n", refPath.c_str());
+    Frame diff;
+    const PixelDiff d = diffImages(fr, ref, diff);
+    char diffName[64];
+    std::snprintf(diffName, sizeof diffName, "diff_%05d.png", f);
+    const std::string diffPath = out_ + "/" + diffName;
+    writePngAtomic(diffPath, diff.width, diff.height, diff.rgba.data(), 1);
+    std::printf("check: frame %d: %zu of %d pixels differ (%.4f %%), max channel difference %d (first at x %d, y %d)\n", f,
+                d.differing, fr.width * fr.height, 100.0 * double(d.differing) / double(fr.width * fr.height), d.maxDiff,
+                d.firstX, d.firstY);
+    std::printf("check: wrote %s (this run) and %s (differing pixels in red)\n", mine.c_str(), diffPath.c_str());
+    std::printf("check: FAILED at frame %d (%d frames matched before it)\n", f, compared - 1);
+    return false;
+  }
+
+  int compared = 0;     ///< frames rendered and compared
+  bool failed = false;  ///< a frame differed
+
+ private:
+  const ManifestView& m_;
+  std::string out_;
+  fs::path refDir_;
+};
+
+/// The events the manifest's run applied, at their frames (a manifest without an event
+/// list: the scene's own timeline).
+void addManifestEvents(EventIntake& input, const json& m, const std::string& manifestPath, const SceneDef& scene) {
+  if (!m.contains("events") || !m["events"].is_array()) {
+    input.addScene();
+    return;
+  }
+  for (std::size_t k = 0; k < m["events"].size(); ++k) {
+    const std::string where = manifestPath + " events[" + std::to_string(k) + "]";
+    try {
+      TimedEvent t;
+      t.event = parseEvent(m["events"][k].dump(), where, 1, scene);
+      t.frame = eventFrame(t.event, scene.fps);
+      t.where = where;
+      input.add(std::move(t));
+    } catch (const SceneError& e) {
+      throw UsageError(std::string("the manifest's event is malformed: ") + e.what());
+    }
+  }
+}
+
 }  // namespace
 
 int cmdCheck(const std::vector<std::string>& args) {
@@ -102,33 +200,9 @@ int cmdCheck(const std::vector<std::string>& args) {
   if (scenePath.empty()) throw UsageError("missing the scene file (see sph2d check --help)");
   if (manifestPath.empty()) throw UsageError("missing --against MANIFEST (see sph2d check --help)");
 
-  json m;
-  {
-    std::ifstream in(manifestPath);
-    if (!in) throw UsageError("cannot read the manifest " + manifestPath);
-    try {
-      in >> m;
-    } catch (const json::exception& e) {
-      throw UsageError(manifestPath + " is not valid JSON: " + e.what());
-    }
-  }
-  int frames = 0, every = 1;
-  std::map<int, json> expected;
-  std::string expRenderer, expCpu, expSceneHash;
-  RenderOptions opt;
-  try {
-    if (m.at("format").get<std::string>() != "sph2d-frames") throw UsageError(manifestPath + " is not an sph2d frames manifest");
-    frames = m.at("run").at("frames").get<int>();
-    every = std::max(1, m.at("run").at("every").get<int>());
-    expRenderer = m.at("renderer").get<std::string>();
-    expCpu = m.value("cpu", "");
-    expSceneHash = m.at("scene").at("xxh64").get<std::string>();
-    opt = renderOptionsFromJson(m.at("render"));
-    for (const json& f : m.at("frames")) expected[f.at("frame").get<int>()] = f;
-  } catch (const json::exception& e) {
-    throw UsageError(manifestPath + " lacks a field `sph2d check` needs: " + e.what());
-  }
-  if (expected.empty()) {
+  const ManifestView mv = readManifest(manifestPath);
+  const json& m = mv.json;
+  if (mv.expected.empty()) {
     std::printf("check: %s lists no frames; nothing to compare\n", manifestPath.c_str());
     return 1;
   }
@@ -137,13 +211,13 @@ int cmdCheck(const std::vector<std::string>& args) {
   const fs::path refDir = fs::path(manifestPath).parent_path();
 
   const std::string sceneHash = fileHash(scenePath);
-  if (sceneHash != expSceneHash)
+  if (sceneHash != mv.sceneHash)
     std::printf("note: %s has XXH64 %s but the manifest was made from a file with %s: the scene changed, "
                 "frames will likely differ\n",
-                scenePath.c_str(), sceneHash.c_str(), expSceneHash.c_str());
+                scenePath.c_str(), sceneHash.c_str(), mv.sceneHash.c_str());
   if (m.value("complete", true) == false && m.contains("stop") && m["stop"].is_object())
     std::printf("note: the manifest's run stopped early (%s: %s); checking the %zu frames it lists\n",
-                m["stop"].value("reason", "?").c_str(), m["stop"].value("message", "").c_str(), expected.size());
+                m["stop"].value("reason", "?").c_str(), m["stop"].value("message", "").c_str(), mv.expected.size());
 
   // Rerun as the manifest's run rendered: adopt the Mesa settings it recorded (e.g. a pinned
   // GALLIUM_OVERRIDE_CPU_CAPS) unless this environment sets them itself.
@@ -155,33 +229,19 @@ int cmdCheck(const std::vector<std::string>& args) {
       if (!quiet && e.value("source", "") == "user")
         std::printf("note: using %s=%s as the manifest's run did\n", name.c_str(), value.c_str());
     }
-  // The events the manifest's run applied, at their frames (a manifest without an event list:
-  // the scene's own timeline).
-  std::map<std::int64_t, std::vector<EventDef>> events;
-  if (m.contains("events") && m["events"].is_array()) {
-    for (std::size_t k = 0; k < m["events"].size(); ++k) {
-      try {
-        const EventDef e = parseEvent(m["events"][k].dump(), manifestPath + " events[" + std::to_string(k) + "]", 1, scene);
-        events[eventFrame(e, scene.fps)].push_back(e);
-      } catch (const SceneError& e) {
-        throw UsageError(std::string("the manifest's event is malformed: ") + e.what());
-      }
-    }
-  } else {
-    for (const EventDef& e : scene.events) events[eventFrame(e, scene.fps)].push_back(e);
-  }
-  EventApplier applier;
+  EventIntake input(scene, [](const std::string&) {});
+  addManifestEvents(input, m, manifestPath, scene);
   World world(scene, WorldOptions{threads});
   world.takeWarnings();
-  Renderer renderer(scene.render, opt);
+  Renderer renderer(scene.render, mv.render);
   const std::string here = renderer.rendererString();
-  if (here != expRenderer)
+  if (here != mv.renderer)
     std::printf("note: this machine's renderer is \"%s\" but the manifest was made with \"%s\"; "
                 "pixels may differ for that reason alone\n",
-                here.c_str(), expRenderer.c_str());
+                here.c_str(), mv.renderer.c_str());
   const std::string cpu = cpuSummary();
-  if (!expCpu.empty() && cpu != expCpu)
-    std::printf("note: this CPU is \"%s\"; the manifest's was \"%s\"\n", cpu.c_str(), expCpu.c_str());
+  if (!mv.cpu.empty() && cpu != mv.cpu)
+    std::printf("note: this CPU is \"%s\"; the manifest's was \"%s\"\n", cpu.c_str(), mv.cpu.c_str());
   if (m.contains("environment") && m["environment"].is_array()) {
     std::map<std::string, std::string> now;
     for (const EnvSetting& e : pinRenderEnvironment()) now[e.name] = e.value;
@@ -192,78 +252,28 @@ int cmdCheck(const std::vector<std::string>& args) {
                     value.c_str());
     }
   }
-  if (!quiet) std::printf("check: rerunning %s, %d frames, comparing %zu\n", scenePath.c_str(), frames, expected.size());
+  if (!quiet) std::printf("check: rerunning %s, %d frames, comparing %zu\n", scenePath.c_str(), mv.frames, mv.expected.size());
 
-  const int last = expected.rbegin()->first;
-  int compared = 0;
+  // The rerun: run's loop, headless, up to the last listed frame.
+  FrameCheck check(mv, out, refDir);
+  LoopSettings settings;
+  settings.frames = std::min(mv.frames, mv.expected.rbegin()->first + 1);
+  settings.fps = scene.fps;
+  GameLoop loop(world, input, check, &renderer, settings);
   try {
-    for (int f = 0; f <= last && f < frames; ++f) {
-      if (f > 0) world.stepFrame();
-      if (events.count(f))
-        for (const EventDef& e : events[f]) {
-          const std::string err = applier.apply(world, e);
-          if (!err.empty()) std::printf("note: frame %d: %s not applied: %s\n", f, describeEvent(e).c_str(), err.c_str());
-        }
-      world.takeWarnings();
-      if (f % every != 0 || !expected.count(f)) continue;
-      const json& e = expected[f];
-      const Frame& fr = renderer.render(world);
-      const std::string got = hex64(xxh64(fr.rgba.data(), fr.rgba.size()));
-      const std::string state = hex64(world.stateHash());
-      const std::string want = e.value("rgba_xxh64", ""), wantState = e.value("state_hash", "");
-      ++compared;
-      if (got == want) continue;
-
-      std::printf("check: frame %d differs: RGBA XXH64 %s here, %s in the manifest\n", f, got.c_str(), want.c_str());
-      std::printf("check: state hash %s\n", state == wantState
-                                               ? "matches: the simulation agrees, the rendering differs"
-                                               : ("differs too (" + state + " vs " + wantState + "): the simulation changed").c_str());
-      std::error_code ec;
-      fs::create_directories(out, ec);
-      char name[64];
-      std::snprintf(name, sizeof name, "frame_%05d.png", f);
-      const std::string mine = out + "/" + name;
-      writePngAtomic(mine, fr.width, fr.height, fr.rgba.data(), 1);
-      const std::string refPath = (refDir / e.value("file", std::string(name))).string();
-      int rw = 0, rh = 0;
-      std::vector<std::uint8_t> ref;
-      try {
-        readPng(refPath, rw, rh, ref);
-      } catch (const std::exception& ex) {
-        std::printf("check: no readable reference image (%s); cannot count pixels. This run's frame: %s\n", ex.what(),
-                    mine.c_str());
-        return 1;
-      }
-      if (rw != fr.width || rh != fr.height) {
-        std::printf("check: the reference %s is %dx%d, this run renders %dx%d. This run's frame: %s\n", refPath.c_str(),
-                    rw, rh, fr.width, fr.height, mine.c_str());
-        return 1;
-      }
-      if (hex64(xxh64(ref.data(), ref.size())) != want)
-        std::printf("note: the reference %s does not match its own manifest hash either\n", refPath.c_str());
-      Frame diff;
-      const PixelDiff d = diffImages(fr, ref, diff);
-      std::snprintf(name, sizeof name, "diff_%05d.png", f);
-      const std::string diffPath = out + "/" + name;
-      writePngAtomic(diffPath, diff.width, diff.height, diff.rgba.data(), 1);
-      std::printf("check: frame %d: %zu of %d pixels differ (%.4f %%), max channel difference %d (first at x %d, y %d)\n",
-                  f, d.differing, fr.width * fr.height, 100.0 * double(d.differing) / double(fr.width * fr.height),
-                  d.maxDiff, d.firstX, d.firstY);
-      std::printf("check: wrote %s (this run) and %s (differing pixels in red)\n", mine.c_str(), diffPath.c_str());
-      std::printf("check: FAILED at frame %d (%d frames matched before it)\n", f, compared - 1);
-      return 1;
-    }
+    loop.run();
   } catch (const SimulationError& e) {
     std::printf("check: the simulation stopped: %s\n", e.what());
     const bool expectedStop = m.contains("stop") && m["stop"].is_object() && m["stop"].value("reason", "") == "guard";
-    std::printf("check: %s after %d matching frames\n", expectedStop ? "as in the manifest's run" : "FAILED", compared);
-    return expectedStop && compared == int(expected.size()) ? 0 : 1;
+    std::printf("check: %s after %d matching frames\n", expectedStop ? "as in the manifest's run" : "FAILED", check.compared);
+    return expectedStop && check.compared == int(mv.expected.size()) ? 0 : 1;
   }
-  if (compared != int(expected.size())) {
-    std::printf("check: FAILED: compared %d frames, the manifest lists %zu\n", compared, expected.size());
+  if (check.failed) return 1;
+  if (check.compared != int(mv.expected.size())) {
+    std::printf("check: FAILED: compared %d frames, the manifest lists %zu\n", check.compared, mv.expected.size());
     return 1;
   }
-  std::printf("check: OK, %d frames match (%dx%d, %s mode, renderer %s)\n", compared, scene.render.width,
+  std::printf("check: OK, %d frames match (%dx%d, %s mode, renderer %s)\n", check.compared, scene.render.width,
               scene.render.height, renderer.mode().c_str(), here.c_str());
   return 0;
 }

@@ -4,6 +4,7 @@
 #include <cstdio>
 
 #include "cli.hpp"
+#include "commands.hpp"
 #include "events.hpp"
 #include "sph2d/scene.hpp"
 #include "sph2d/world.hpp"

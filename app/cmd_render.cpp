@@ -4,6 +4,7 @@
 #include <cstdio>
 
 #include "cli.hpp"
+#include "commands.hpp"
 #include "sph2d/render/particle_export.hpp"
 #include "sph2d/render/png_io.hpp"
 #include "sph2d/render/renderer.hpp"

@@ -3,12 +3,13 @@
 // Exit codes: 0 success; 1 a runtime failure (output, OpenGL); 2 bad input
 // (command line or scene file); 3 the simulation guard stopped the run;
 // 130 interrupted (SIGINT/SIGTERM) — frames already written stay whole.
-// Each command lives in its own cmd_*.cpp; cli.hpp lists them.
+// Each command lives in its own cmd_*.cpp; commands.hpp lists them.
 #include <cstdio>
 #include <string>
 #include <vector>
 
 #include "cli.hpp"
+#include "commands.hpp"
 #include "sph2d/scene.hpp"
 #include "sph2d/world.hpp"
 

@@ -1,5 +1,7 @@
 // app_util.hpp — helpers of the app tests: run the sph2d executable, read files,
 // hash decoded PNGs. Each run logs to its own file, so CTest may run tests in parallel.
+// Result, q and asset come from app_runner.hpp: one definition each in the test binary
+// (two different inline q's broke the quoting of whichever test got the other one).
 #pragma once
 
 #include <sys/wait.h>
@@ -15,18 +17,13 @@
 #include <string>
 #include <vector>
 
+#include "app_runner.hpp"
 #include "sph2d/hash.hpp"
 #include "sph2d/render/png_io.hpp"
 
 namespace sph2d::apptest {
 
 namespace fs = std::filesystem;
-
-/// Exit code and combined stdout + stderr of one sph2d run.
-struct Result {
-  int code;
-  std::string out;
-};
 
 /// A fresh, empty directory under the test build's tmp folder.
 inline std::string freshDir(const std::string& name) {
@@ -56,12 +53,6 @@ inline Result run(const std::string& args, const std::string& envPrefix = "") {
   fs::remove(log);
   return r;
 }
-
-/// Absolute path of a file under assets/.
-inline std::string asset(const std::string& rel) { return std::string(SPH2D_ASSETS) + "/" + rel; }
-
-/// Quotes a path for the shell.
-inline std::string q(const std::string& s) { return "\"" + s + "\""; }
 
 /// XXH64 (hex) of a PNG's decoded RGBA pixels, as the manifest records them.
 inline std::string pngHash(const std::string& path) {

@@ -1,0 +1,93 @@
+// app/event_intake.cpp — the events of a run (timeline, files, live standard input)
+// and the --record file; see event_intake.hpp.
+#include "event_intake.hpp"
+
+#include <stdexcept>
+#include <utility>
+
+#include "cli.hpp"
+
+namespace sph2d::cli {
+
+EventIntake::EventIntake(const SceneDef& scene, WarnFn warn) : scene_(scene), warn_(std::move(warn)) {}
+
+void EventIntake::addScene() { schedule_.addScene(scene_); }
+
+std::size_t EventIntake::addFile(const std::string& path) {
+  try {
+    return schedule_.addFile(path, scene_, warn_);
+  } catch (const std::runtime_error& e) {
+    throw UsageError(e.what());
+  }
+}
+
+void EventIntake::add(TimedEvent e) { schedule_.add(std::move(e)); }
+
+void EventIntake::openLive(int fd) { live_ = std::make_unique<LiveInput>(fd); }
+
+void EventIntake::closeLive() { live_.reset(); }
+
+bool EventIntake::liveOpen() const { return live_ && live_->open(); }
+
+std::vector<TimedEvent> EventIntake::takeScheduled(std::int64_t frame) { return schedule_.take(frame); }
+
+void EventIntake::pollLive() {
+  if (!live_) return;
+  for (auto& [lineNo, text] : live_->take()) {
+    if (text.find_first_not_of(" \t\r") == std::string::npos) continue;
+    try {
+      TimedEvent t;
+      t.event = parseEvent(text, "stdin", lineNo, scene_, EventStamp::Optional);
+      t.event.source = "live";
+      t.frame = eventFrame(t.event, scene_.fps);
+      t.where = "stdin:" + std::to_string(lineNo);
+      liveQueue_.push_back(std::move(t));
+    } catch (const SceneError& e) {
+      warn_(std::string(e.what()) + " (line skipped)");
+    }
+  }
+}
+
+std::vector<TimedEvent> EventIntake::takeLive(std::int64_t frame) {
+  pollLive();
+  std::vector<TimedEvent> now, queued;
+  queued.swap(liveQueue_);
+  for (TimedEvent& t : queued) {
+    if (t.frame > frame) schedule_.add(std::move(t));
+    else now.push_back(std::move(t));
+  }
+  return now;
+}
+
+std::vector<TimedEvent> EventIntake::takeLivePauses(std::int64_t frame) {
+  pollLive();
+  std::vector<TimedEvent> now, keep;
+  for (TimedEvent& t : liveQueue_) {
+    const auto type = t.event.type;
+    if ((type == EventDef::Type::Resume || type == EventDef::Type::Pause) && t.frame <= frame) now.push_back(std::move(t));
+    else keep.push_back(std::move(t));
+  }
+  liveQueue_.swap(keep);
+  return now;
+}
+
+std::string recordLine(const EventDef& e, std::int64_t frame) {
+  EventDef stamped = e;
+  stamped.frame = frame;
+  stamped.t = -1;
+  return eventToJson(stamped);
+}
+
+EventRecord::EventRecord(const std::string& path) : path_(path) {
+  if (path.empty()) return;
+  out_.open(path, std::ios::trunc);
+  if (!out_) throw UsageError("cannot write the record file '" + path + "'");
+}
+
+void EventRecord::write(const std::string& line) {
+  if (!out_.is_open()) return;
+  out_ << line << '\n';
+  out_.flush();
+}
+
+}  // namespace sph2d::cli

@@ -1,0 +1,88 @@
+// app/event_intake.hpp — where a run's events come from and where they are recorded.
+//
+//   scene timeline ─┐
+//   --input FILE ───┴─> EventSchedule (by frame) ─> takeScheduled(f) ─┐
+//   --input - ─────────> LiveInput ─> parsed here ─> takeLive(f) ─────┴─> GameLoop
+//   applied events ────> EventRecord (--record FILE), recordLine() also for the manifest
+//
+// Design: the intake only collects and orders events; the game loop applies them
+// at frame boundaries. Live lines are parsed on the loop's thread when the loop
+// asks for them, so a bad line is reported (and skipped) between frames; a live
+// event stamped for a later frame joins the schedule. Events of one frame come in
+// the order: the timeline's, the events files' (command-line and line order), live.
+#pragma once
+
+#include <cstdint>
+#include <fstream>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "events.hpp"
+#include "sph2d/scene.hpp"
+
+namespace sph2d::cli {
+
+/// The events of a run: the schedule known in advance and live standard input.
+class EventIntake {
+ public:
+  /// Events for `scene` (which must outlive the intake); `warn` reports skipped lines.
+  EventIntake(const SceneDef& scene, WarnFn warn);
+  /// Adds the scene's timeline (source "scene").
+  void addScene();
+  /// Adds the events of an events file (see EventSchedule::addFile) and returns how many.
+  /// Throws UsageError when the file cannot be read.
+  std::size_t addFile(const std::string& path);
+  /// Adds one event at its frame (e.g. an event a manifest lists).
+  void add(TimedEvent e);
+  /// Starts reading live events from `fd` (`--input -`).
+  void openLive(int fd);
+  /// Stops reading live events (joins the reader thread).
+  void closeLive();
+  /// True while live input is open or has lines not taken yet.
+  bool liveOpen() const;
+  /// Removes and returns the scheduled events due at or before `frame`, in order.
+  std::vector<TimedEvent> takeScheduled(std::int64_t frame);
+  /// Reads the live lines that arrived, and removes and returns the live events due at
+  /// `frame` (unstamped, or stamped for it or before); later ones join the schedule.
+  std::vector<TimedEvent> takeLive(std::int64_t frame);
+  /// While paused at `frame`: reads the live lines that arrived, and removes and returns
+  /// the live pause and resume events due at `frame`; other live events wait.
+  std::vector<TimedEvent> takeLivePauses(std::int64_t frame);
+  /// Scheduled events not taken yet.
+  std::size_t pending() const { return schedule_.pending(); }
+  /// Events files' lines skipped because a record took them from the scene's timeline.
+  std::size_t skippedSceneEvents() const { return schedule_.skippedSceneEvents(); }
+
+ private:
+  void pollLive();
+  const SceneDef& scene_;
+  WarnFn warn_;
+  EventSchedule schedule_;
+  std::unique_ptr<LiveInput> live_;
+  std::vector<TimedEvent> liveQueue_;  ///< parsed live events not taken yet
+};
+
+/// The line --record writes and the manifest lists for event `e` applied at `frame`:
+/// the event stamped with that frame (eventToJson, read back bit for bit).
+std::string recordLine(const EventDef& e, std::int64_t frame);
+
+/// The --record file: every applied event, one line each, flushed as it is applied.
+class EventRecord {
+ public:
+  /// Opens (truncates) `path`; an empty path records nothing. Throws UsageError when
+  /// the file cannot be written.
+  explicit EventRecord(const std::string& path);
+  /// True when recording.
+  bool open() const { return out_.is_open(); }
+  /// The file's path ("" when not recording).
+  const std::string& path() const { return path_; }
+  /// Appends one line (recordLine) and flushes it; nothing when not recording.
+  void write(const std::string& line);
+
+ private:
+  std::string path_;
+  std::ofstream out_;
+};
+
+}  // namespace sph2d::cli

@@ -1,0 +1,148 @@
+// app/game_loop.cpp — the fixed-step game loop of `sph2d run` and `sph2d check`;
+// see game_loop.hpp for the order of things at a frame boundary.
+#include "game_loop.hpp"
+
+#include <algorithm>
+#include <thread>
+#include <utility>
+
+namespace sph2d::cli {
+
+GameLoop::GameLoop(World& world, EventIntake& input, LoopObserver& observer, Renderer* renderer, LoopSettings settings)
+    : world_(world),
+      input_(input),
+      observer_(observer),
+      renderer_(renderer),
+      settings_(settings),
+      clock_(1.0 / settings.fps, settings.realtime, settings.catchUp),
+      start_(std::chrono::steady_clock::now()) {
+  status_.frames = settings.frames;
+}
+
+double GameLoop::wallNow() const {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+}
+
+bool GameLoop::stopRequested() const { return settings_.stop && settings_.stop->load(); }
+
+LoopEnd GameLoop::run() {
+  if (settings_.frames < 1) return LoopEnd::Finished;
+  std::int64_t& f = status_.frame;
+  f = 0;
+  applyDue(0);
+  if (!finishBoundary(false)) return LoopEnd::Ended;
+  if (settings_.frames == 1) observer_.progress(world_, status_, true);
+  clock_.resync(wallNow());
+  // One more step is due now (the clock says so; headless: always) and may be taken
+  // in this render iteration.
+  int steps = 0;
+  auto stepDue = [&] {
+    return clock_.due() && steps < clock_.maxStepsPerRender() && f + 1 < settings_.frames && !applier_.paused();
+  };
+  while (f + 1 < settings_.frames) {
+    if (stopRequested()) return LoopEnd::Interrupted;
+    if (applier_.paused()) {
+      holdPause();
+      clock_.resync(wallNow());
+      continue;
+    }
+    clock_.tick(wallNow());
+    if (!clock_.due()) {
+      // Ahead of the wall clock: sleep (in short slices, so Ctrl-C stays prompt).
+      std::this_thread::sleep_for(std::chrono::duration<double>(std::min(clock_.untilDue(), 0.02)));
+      continue;
+    }
+    steps = 0;
+    while (stepDue()) {
+      const auto s0 = std::chrono::steady_clock::now();
+      world_.stepFrame();
+      status_.simSeconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - s0).count();
+      ++f;
+      ++steps;
+      clock_.consume();
+      for (const auto& w : world_.takeWarnings()) observer_.warn(w);
+      applyDue(f);
+      // Render the last frame of this iteration; a kept frame that another step follows
+      // at once (the loop is behind the wall clock) is dropped.
+      if (!finishBoundary(stepDue())) return LoopEnd::Ended;
+    }
+    if (settings_.realtime && steps == clock_.maxStepsPerRender()) clock_.dropBacklog();
+    status_.late = clock_.late();
+    status_.behindSeconds = clock_.behindSeconds();
+    status_.paused = applier_.paused();
+    observer_.progress(world_, status_, f + 1 == settings_.frames);
+  }
+  return LoopEnd::Finished;
+}
+
+void GameLoop::applyOne(const TimedEvent& t, std::int64_t frame) {
+  const std::string err = applier_.apply(world_, t.event);
+  if (!err.empty()) {
+    observer_.notApplied(t, frame, err);
+    return;
+  }
+  ++status_.applied;
+  observer_.applied(t, frame);
+  for (const auto& w : world_.takeWarnings()) observer_.warn(w);
+}
+
+void GameLoop::applyDue(std::int64_t frame) {
+  for (const TimedEvent& t : input_.takeScheduled(frame)) applyOne(t, frame);
+  for (const TimedEvent& t : input_.takeLive(frame)) applyOne(t, frame);
+  status_.paused = applier_.paused();
+}
+
+bool GameLoop::finishBoundary(bool drop) {
+  const std::int64_t f = status_.frame;
+  observer_.boundary(world_, f);
+  status_.done = f + 1;
+  if (!renderer_ || !observer_.keeps(f)) return true;
+  if (drop) {
+    ++status_.dropped;
+    return true;
+  }
+  const auto r0 = std::chrono::steady_clock::now();
+  const Frame& image = renderer_->render(world_);
+  status_.renderSeconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - r0).count();
+  return observer_.frame(world_, f, image);
+}
+
+// Paused at boundary f (already rendered): waits for a resume, or the pause's own seconds
+// (real time only). Live pause/resume take effect at once; other live events wait for the
+// next frame.
+void GameLoop::holdPause() {
+  const std::int64_t f = status_.frame;
+  const double start = wallNow();
+  const double seconds = applier_.pauseSeconds();
+  if (seconds > 0 && !settings_.realtime) {  // headless: a timed pause takes no time
+    applier_.endPause();
+    return;
+  }
+  if (seconds <= 0 && !input_.liveOpen()) {
+    observer_.warn("pause at frame " + std::to_string(f) + ": no live input (--input -) can resume it; ignored");
+    applier_.endPause();
+    return;
+  }
+  observer_.note("paused at frame " + std::to_string(f) +
+                 (seconds > 0 ? " for " + std::to_string(seconds) + " s" : ": waiting for {\"type\": \"resume\"}"));
+  while (applier_.paused() && !stopRequested()) {
+    for (const TimedEvent& t : input_.takeLivePauses(f)) applyOne(t, f);
+    if (!applier_.paused()) break;
+    if (seconds > 0 && wallNow() - start >= seconds) {
+      applier_.endPause();
+      break;
+    }
+    if (seconds <= 0 && !input_.liveOpen()) {
+      observer_.warn("standard input closed while paused at frame " + std::to_string(f) + "; resuming");
+      applier_.endPause();
+      break;
+    }
+    status_.paused = true;
+    observer_.progress(world_, status_, false);
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  status_.paused = applier_.paused();
+  if (!applier_.paused()) observer_.note("resumed at frame " + std::to_string(f));
+}
+
+}  // namespace sph2d::cli

@@ -1,0 +1,133 @@
+// app/manifest.cpp — writing and reading manifest.json; see manifest.hpp.
+#include "manifest.hpp"
+
+#include <algorithm>
+#include <cstdio>
+#include <fstream>
+#include <sstream>
+
+#include "cli.hpp"
+#include "sph2d/hash.hpp"
+#include "sph2d/render/particle_export.hpp"
+
+namespace sph2d::cli {
+
+using json = nlohmann::ordered_json;
+
+std::string frameFileName(std::int64_t frame) {
+  char name[32];
+  std::snprintf(name, sizeof name, "frame_%05d.png", int(frame));
+  return name;
+}
+
+std::string fileHash(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw UsageError("cannot read " + path);
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  const std::string bytes = ss.str();
+  return hex64(xxh64(bytes.data(), bytes.size()));
+}
+
+json environmentJson() {
+  json env = json::array();
+  for (const EnvSetting& e : pinRenderEnvironment())
+    env.push_back({{"name", e.name}, {"value", e.value}, {"source", e.source}});
+  return env;
+}
+
+json renderOptionsJson(const RenderOptions& o) {
+  json j;
+  j["mode"] = o.mode;
+  j["color_by"] = colorFieldName(o.colorBy);
+  j["range"] = o.range ? json::array({(*o.range)[0], (*o.range)[1]}) : json(nullptr);
+  j["overlay"] = o.overlay;
+  j["foam_speed"] = o.foamSpeed;
+  j["depth_scale"] = o.depthScale;
+  return j;
+}
+
+RenderOptions renderOptionsFromJson(const json& j) {
+  RenderOptions o;
+  try {
+    o.mode = j.at("mode").get<std::string>();
+    if (!parseColorField(j.at("color_by").get<std::string>(), o.colorBy)) throw UsageError("bad color_by");
+    if (!j.at("range").is_null()) o.range = std::array<double, 2>{j.at("range").at(0).get<double>(), j.at("range").at(1).get<double>()};
+    o.overlay = j.at("overlay").get<bool>();
+    o.foamSpeed = j.at("foam_speed").get<double>();
+    o.depthScale = j.at("depth_scale").get<double>();
+  } catch (const json::exception& e) {
+    throw UsageError(std::string("the manifest's render options are malformed: ") + e.what());
+  }
+  return o;
+}
+
+RunManifest::RunManifest(const RunArgs& a, const SceneDef& scene, const Renderer& renderer, int frames, int threads) {
+  std::string exportName = "none";
+  if (a.exportFormat) exportName = exportExtension(*a.exportFormat) + (*a.exportFormat == ExportFormat::VtkAscii ? "-ascii" : "");
+  j_["format"] = "sph2d-frames";
+  j_["format_version"] = 1;
+  j_["engine_version"] = SPH2D_VERSION;
+  j_["scene"] = {{"path", a.scene}, {"name", scene.name}, {"xxh64", fileHash(a.scene)}};
+  j_["renderer"] = renderer.rendererString();
+  j_["cpu"] = cpuSummary();
+  j_["environment"] = environmentJson();
+  j_["image"] = {{"width", scene.render.width}, {"height", scene.render.height}, {"format", "png"},
+                 {"png_level", a.pngLevel}, {"mode", renderer.mode()}};
+  j_["render"] = renderOptionsJson(a.render);
+  j_["run"] = {{"frames", frames}, {"every", a.every}, {"threads", threads}, {"fps", scene.fps}, {"export", exportName},
+               {"video", a.video}, {"realtime", a.realtime}, {"inputs", a.inputs}};
+  j_["frames"] = json::array();
+  j_["events"] = json::array();
+}
+
+void RunManifest::addFrame(std::int64_t frame, double time, std::uint64_t pixels, std::uint64_t state) {
+  j_["frames"].push_back({{"frame", frame},
+                          {"time", time},
+                          {"file", frameFileName(frame)},
+                          {"rgba_xxh64", hex64(pixels)},
+                          {"state_hash", hex64(state)}});
+}
+
+void RunManifest::addEvent(const std::string& line) { j_["events"].push_back(json::parse(line)); }
+
+void RunManifest::finish(int written, int status, const std::string& reason, const std::string& message,
+                         std::int64_t simulated) {
+  json& list = j_["frames"];
+  while (int(list.size()) > written) list.erase(list.size() - 1);
+  j_["complete"] = status == 0;
+  j_["stop"] = status == 0 ? json(nullptr)
+                           : json{{"reason", reason}, {"message", message}, {"frames_simulated", simulated},
+                                  {"frames_written", written}};
+}
+
+void RunManifest::write(const std::string& dir) const { writeFileAtomic(dir + "/manifest.json", j_.dump(1) + "\n"); }
+
+ManifestView readManifest(const std::string& path) {
+  ManifestView v;
+  json& m = v.json;
+  {
+    std::ifstream in(path);
+    if (!in) throw UsageError("cannot read the manifest " + path);
+    try {
+      in >> m;
+    } catch (const json::exception& e) {
+      throw UsageError(path + " is not valid JSON: " + e.what());
+    }
+  }
+  try {
+    if (m.at("format").get<std::string>() != "sph2d-frames") throw UsageError(path + " is not an sph2d frames manifest");
+    v.frames = m.at("run").at("frames").get<int>();
+    v.every = std::max(1, m.at("run").at("every").get<int>());
+    v.renderer = m.at("renderer").get<std::string>();
+    v.cpu = m.value("cpu", "");
+    v.sceneHash = m.at("scene").at("xxh64").get<std::string>();
+    v.render = renderOptionsFromJson(m.at("render"));
+    for (const json& f : m.at("frames")) v.expected[f.at("frame").get<int>()] = f;
+  } catch (const json::exception& e) {
+    throw UsageError(path + " lacks a field `sph2d check` needs: " + e.what());
+  }
+  return v;
+}
+
+}  // namespace sph2d::cli

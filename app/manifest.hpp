@@ -1,0 +1,71 @@
+// app/manifest.hpp — manifest.json: what `sph2d run` writes beside its frames and
+// `sph2d check` reads back.
+//
+// A manifest names the scene (path, name, XXH64 of the file), the engine version,
+// the renderer, the CPU and the Mesa settings, the image, the render options, the
+// run's settings, and per kept frame its number, simulated time, PNG file, the
+// XXH64 of its RGBA pixels and the World's state hash; then every applied event
+// stamped with its frame, and whether the run completed (else why it stopped).
+// Design: the run fills it as frames are rendered and events applied and writes it
+// once at the end, whole or not at all (writeFileAtomic), listing only the frames
+// whose PNG exists. Keys keep their insertion order, so equal runs give equal bytes.
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "run_args.hpp"
+#include "sph2d/render/renderer.hpp"
+#include "sph2d/scene.hpp"
+
+namespace sph2d::cli {
+
+/// "frame_NNNNN.png", the file name of frame `frame`.
+std::string frameFileName(std::int64_t frame);
+/// XXH64 of a file's bytes as 16 hex digits. Throws UsageError when it cannot be read.
+std::string fileHash(const std::string& path);
+/// The llvmpipe environment as recorded in a manifest (pins it first).
+nlohmann::ordered_json environmentJson();
+/// The render options as recorded in a manifest.
+nlohmann::ordered_json renderOptionsJson(const RenderOptions& o);
+/// The render options a manifest recorded. Throws UsageError on a malformed entry.
+RenderOptions renderOptionsFromJson(const nlohmann::ordered_json& j);
+
+/// The manifest of one `sph2d run`, filled while it runs.
+class RunManifest {
+ public:
+  /// The header of a run of `scene` with options `a`, `frames` frames on `threads`
+  /// threads, rendered by `renderer`.
+  RunManifest(const RunArgs& a, const SceneDef& scene, const Renderer& renderer, int frames, int threads);
+  /// Lists kept frame `frame`: simulated time, pixel hash, state hash.
+  void addFrame(std::int64_t frame, double time, std::uint64_t pixels, std::uint64_t state);
+  /// Lists an applied event (a recordLine()).
+  void addEvent(const std::string& line);
+  /// Keeps the first `written` frames (those whose PNG exists) and says how the run ended:
+  /// complete when `status` is 0, else `reason` ("interrupted", "guard", "error") and `message`.
+  void finish(int written, int status, const std::string& reason, const std::string& message, std::int64_t simulated);
+  /// Writes DIR/manifest.json whole or not at all. Throws std::runtime_error.
+  void write(const std::string& dir) const;
+
+ private:
+  nlohmann::ordered_json j_;
+};
+
+/// A manifest as `sph2d check` reads it.
+struct ManifestView {
+  nlohmann::ordered_json json;                     ///< the whole manifest
+  int frames = 0;                                  ///< run.frames
+  int every = 1;                                   ///< run.every (at least 1)
+  std::map<int, nlohmann::ordered_json> expected;  ///< the listed frames by number
+  std::string renderer, cpu, sceneHash;            ///< what it was made with
+  RenderOptions render;                            ///< the render options of the run
+};
+
+/// Reads a manifest for `sph2d check`. Throws UsageError when it cannot be read, is not
+/// JSON, is not an sph2d frames manifest or lacks a field check needs.
+ManifestView readManifest(const std::string& path);
+
+}  // namespace sph2d::cli
