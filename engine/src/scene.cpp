@@ -6,7 +6,8 @@
 // on (Debian builds it with assertions on: a bad polygon or chain would abort
 // the process), what would exhaust memory (particles and boundary samples
 // beyond max_particles) and what can only be a mistake (a fluid block holding
-// no particle, a degenerate camera, an absurd number of frames).
+// no particle, a degenerate camera, an absurd number of frames): the checks
+// of scene_checks.hpp.
 #include "sph2d/scene.hpp"
 
 #include <algorithm>
@@ -20,6 +21,7 @@
 
 #include "effects/effect.hpp"
 #include "json_reader.hpp"
+#include "scene_checks.hpp"
 #include "scene_reader.hpp"
 #include "solvers/solver.hpp"
 
@@ -28,91 +30,7 @@ namespace {
 
 using nlohmann::json;
 
-// Limits the loader enforces (documented in docs/SCENES.md).
-constexpr double kLinearSlop = 0.005;          ///< Box2D 2.4.1's b2_linearSlop [m]
-constexpr double kMaxFrames = 1e6;             ///< duration × fps
-constexpr double kMinCameraSize = 1e-3;        ///< camera width and height [m]
 constexpr std::size_t kMaxSceneBytes = 64u << 20;  ///< scene file size
-constexpr std::size_t kMinSampleBudget = 4000000;  ///< boundary samples allowed even when max_particles is lower
-
-double cross(const Vec2d& a, const Vec2d& b) { return a.x() * b.y() - a.y() * b.x(); }
-
-// ---- What Box2D 2.4.1 sees: the vertices as floats. --------------------------
-
-struct F2 {
-  float x, y;
-};
-F2 toF(const Vec2d& v) { return {static_cast<float>(v.x()), static_cast<float>(v.y())}; }
-float distSqF(F2 a, F2 b) {
-  const float dx = a.x - b.x, dy = a.y - b.y;
-  return dx * dx + dy * dy;
-}
-float crossF(F2 a, F2 b) { return a.x * b.y - a.y * b.x; }
-
-/// True when two vertices are closer than Box2D's linear slop, in double or
-/// as Box2D's float check (b2ChainShape asserts distance² > slop²).
-bool closerThanSlop(const Vec2d& a, const Vec2d& b) {
-  const float slop = static_cast<float>(kLinearSlop);
-  return (a - b).norm() < kLinearSlop || !(distSqF(toF(a), toF(b)) > slop * slop);
-}
-
-/// Replays b2PolygonShape::Set (welding, gift-wrapping hull, edge lengths,
-/// centroid area) in float; returns what Box2D would assert on, or "".
-std::string box2dPolygonProblem(const std::vector<Vec2d>& vertices) {
-  const float epsilon = std::numeric_limits<float>::epsilon();
-  const float halfSlop = 0.5f * static_cast<float>(kLinearSlop);
-  std::vector<F2> ps;
-  for (const Vec2d& v : vertices) {
-    const F2 f = toF(v);
-    bool unique = true;
-    for (const F2& q : ps) unique = unique && !(distSqF(f, q) < halfSlop * halfSlop);
-    if (unique) ps.push_back(f);
-  }
-  const std::size_t n = ps.size();
-  if (n < 3) return "Box2D welds vertices closer than 0.0025 m and would keep fewer than 3";
-  std::size_t i0 = 0;
-  for (std::size_t i = 1; i < n; ++i)
-    if (ps[i].x > ps[i0].x || (ps[i].x == ps[i0].x && ps[i].y < ps[i0].y)) i0 = i;
-  std::vector<std::size_t> hull;
-  std::size_t ih = i0;
-  for (;;) {
-    if (hull.size() >= 8) return "Box2D cannot build the convex hull of these vertices";
-    hull.push_back(ih);
-    std::size_t ie = 0;
-    for (std::size_t j = 1; j < n; ++j) {
-      if (ie == ih) {
-        ie = j;
-        continue;
-      }
-      const F2 a = ps[hull.back()];
-      const F2 r{ps[ie].x - a.x, ps[ie].y - a.y}, v{ps[j].x - a.x, ps[j].y - a.y};
-      const float c = crossF(r, v);
-      if (c < 0.0f) ie = j;
-      if (c == 0.0f && v.x * v.x + v.y * v.y > r.x * r.x + r.y * r.y) ie = j;
-    }
-    ih = ie;
-    if (ie == i0) break;
-  }
-  const std::size_t m = hull.size();
-  if (m < 3) return "the vertices are (almost) collinear: Box2D's convex hull has fewer than 3 vertices";
-  std::vector<F2> h;
-  for (std::size_t k : hull) h.push_back(ps[k]);
-  for (std::size_t i = 0; i < m; ++i)
-    if (!(distSqF(h[(i + 1) % m], h[i]) > epsilon * epsilon)) return "Box2D's convex hull has an edge of zero length";
-  float area = 0;
-  const F2 s = h[0];
-  for (std::size_t i = 0; i < m; ++i) {
-    const F2 e1{h[i].x - s.x, h[i].y - s.y};
-    const F2 p3 = h[(i + 1) % m];
-    const F2 e2{p3.x - s.x, p3.y - s.y};
-    area += 0.5f * crossF(e1, e2);
-  }
-  // Box2D asserts area > FLT_EPSILON; keep a margin for rounding.
-  if (!(area > 16 * epsilon))
-    return "the polygon is too thin: its area in Box2D's float arithmetic is " + fmt(area) + " m^2, Box2D needs more than " +
-           fmt(16 * epsilon) + " m^2";
-  return "";
-}
 
 // ---- Fixtures -----------------------------------------------------------------
 
@@ -128,49 +46,14 @@ ShapeDef readFixture(const Reader& r, const json& j, const std::string& path) {
     r.checkKeys(j, path, keys);
     s.center = r.vec2(j, path, "center", s.center);
     s.halfSize = r.requiredVec2(j, path, "half_size");
-    if (!(s.halfSize.x() > 0 && s.halfSize.y() > 0))
-      r.fail(Reader::sub(path, "half_size"), "both half sizes must be > 0, got [" + fmt(s.halfSize.x()) + ", " + fmt(s.halfSize.y()) + "]");
-    if (!(s.halfSize.x() >= kLinearSlop / 2 && s.halfSize.y() >= kLinearSlop / 2))
-      r.fail(Reader::sub(path, "half_size"), "both half sizes must be >= 0.0025 (a box at least 0.005 m across, Box2D's linear slop), got [" +
-                                                fmt(s.halfSize.x()) + ", " + fmt(s.halfSize.y()) + "]");
+    checkBoxHalfSize(r, s.halfSize, path);
     s.angle = r.number(j, path, "angle", 0, -1e3, 1e3);
   } else if (shape == "polygon") {
     s.type = ShapeDef::Type::Polygon;
     keys.insert(keys.end(), {"vertices"});
     r.checkKeys(j, path, keys);
     s.vertices = r.points(j, path, "vertices");
-    const std::string p = Reader::sub(path, "vertices");
-    const std::size_t n = s.vertices.size();
-    if (n < 3 || n > 8) r.fail(p, "a polygon needs 3 to 8 vertices (Box2D 2.4.1), got " + std::to_string(n));
-    for (std::size_t a = 0; a < n; ++a)
-      for (std::size_t b = a + 1; b < n; ++b)
-        if (closerThanSlop(s.vertices[a], s.vertices[b]))
-          r.fail(p, "vertices [" + std::to_string(a) + "] and [" + std::to_string(b) +
-                        "] are closer than 0.005 m (Box2D's linear slop)");
-    // Convex: every turn has the same sign (straight turns aside) and the
-    // turns add up to one full revolution (a star polygon turns twice).
-    double area = 0, turning = 0;
-    int sign = 0;
-    for (std::size_t i = 0; i < n; ++i) {
-      const Vec2d& a = s.vertices[i];
-      const Vec2d& b = s.vertices[(i + 1) % n];
-      const Vec2d& c = s.vertices[(i + 2) % n];
-      area += cross(a, b);
-      const Vec2d u = b - a, v = c - b;
-      const double turn = cross(u, v) / (u.norm() * v.norm());
-      turning += std::atan2(cross(u, v), u.dot(v));
-      const int sg = turn > 1e-9 ? 1 : (turn < -1e-9 ? -1 : 0);
-      if (sg == 0 && u.dot(v) < 0)
-        r.fail(p, "the polygon must be convex: its outline doubles back at vertex [" + std::to_string((i + 1) % n) + "]");
-      if (sg != 0) {
-        if (sign != 0 && sg != sign) r.fail(p, "the polygon must be convex (split a concave shape into several fixtures)");
-        sign = sg;
-      }
-    }
-    if (std::fabs(turning) > 3 * 3.14159265358979) r.fail(p, "the polygon must be convex: its edges cross (the outline winds around more than once)");
-    if (std::fabs(area) < 1e-10) r.fail(p, "the polygon has no area");
-    const std::string problem = box2dPolygonProblem(s.vertices);
-    if (!problem.empty()) r.fail(p, problem);
+    checkPolygon(r, s.vertices, Reader::sub(path, "vertices"));
   } else if (shape == "circle") {
     s.type = ShapeDef::Type::Circle;
     keys.insert(keys.end(), {"center", "radius"});
@@ -178,33 +61,20 @@ ShapeDef readFixture(const Reader& r, const json& j, const std::string& path) {
     s.center = r.vec2(j, path, "center", s.center);
     if (!j.contains("radius")) r.fail(Reader::sub(path, "radius"), "missing; expected a number > 0");
     s.radius = r.number(j, path, "radius", 0, 0, 1e6, true);
-    if (s.radius < kLinearSlop / 2)
-      r.fail(Reader::sub(path, "radius"), "value " + fmt(s.radius) + " is too small; a circle is at least 0.005 m across (radius >= 0.0025, Box2D's linear slop)");
+    checkCircleRadius(r, s.radius, path);
   } else if (shape == "edge") {
     s.type = ShapeDef::Type::Edge;
     keys.insert(keys.end(), {"vertices"});
     r.checkKeys(j, path, keys);
     s.vertices = r.points(j, path, "vertices");
-    if (s.vertices.size() != 2) r.fail(Reader::sub(path, "vertices"), "an edge needs exactly 2 vertices, got " + std::to_string(s.vertices.size()));
-    if (closerThanSlop(s.vertices[0], s.vertices[1]))
-      r.fail(Reader::sub(path, "vertices"), "the edge is shorter than 0.005 m (Box2D's linear slop)");
+    checkEdge(r, s.vertices, Reader::sub(path, "vertices"));
   } else {
     s.type = ShapeDef::Type::Chain;
     keys.insert(keys.end(), {"vertices", "loop"});
     r.checkKeys(j, path, keys);
     s.vertices = r.points(j, path, "vertices");
     s.loop = r.boolean(j, path, "loop", false);
-    const std::size_t need = s.loop ? 3 : 2;
-    if (s.vertices.size() < need)
-      r.fail(Reader::sub(path, "vertices"), std::string("a ") + (s.loop ? "looped" : "open") + " chain needs at least " + std::to_string(need) +
-                                               " vertices, got " + std::to_string(s.vertices.size()));
-    for (std::size_t i = 1; i < s.vertices.size(); ++i)
-      if (closerThanSlop(s.vertices[i], s.vertices[i - 1]))
-        r.fail(Reader::sub(path, "vertices[" + std::to_string(i) + "]"),
-               "chain vertices [" + std::to_string(i - 1) + "] and [" + std::to_string(i) + "] are closer than 0.005 m (Box2D's linear slop)");
-    if (s.loop && closerThanSlop(s.vertices.back(), s.vertices.front()))
-      r.fail(Reader::sub(path, "vertices[" + std::to_string(s.vertices.size() - 1) + "]"),
-             "the last vertex of a looped chain is closer than 0.005 m to the first (the loop closes itself: do not repeat the first vertex)");
+    checkChain(r, s.vertices, s.loop, Reader::sub(path, "vertices"));
   }
   s.friction = r.number(j, path, "friction", s.friction, 0, 10);
   s.restitution = r.number(j, path, "restitution", s.restitution, 0, 1);
@@ -215,7 +85,7 @@ RegionDef readRegion(const Reader& r, const nlohmann::json& j, const std::string
   RegionDef g;
   g.min = r.requiredVec2(j, path, "min");
   g.max = r.requiredVec2(j, path, "max");
-  if (!(g.max.x() > g.min.x() && g.max.y() > g.min.y())) r.fail(Reader::sub(path, "max"), "max must be greater than min in x and in y");
+  checkMaxAboveMin(r, g.min, g.max, path);
   return g;
 }
 
@@ -323,128 +193,6 @@ void readEffects(const Reader& r, const nlohmann::json& j, SceneDef& s) {
   }
 }
 
-// ---- Whole-scene checks -----------------------------------------------------------
-
-/// Particles along x and y in a block (as doubles: no overflow for any input).
-std::pair<double, double> blockLattice(const FluidBlockDef& b, double dx) {
-  return {std::floor((b.max.x() - b.min.x()) / dx + 1e-9), std::floor((b.max.y() - b.min.y()) / dx + 1e-9)};
-}
-
-/// An upper estimate of the boundary samples the World will lay in the solids
-/// (layers of ceil(R/dx) rows under every face, both sides of segments).
-double estimateBoundarySamples(const SceneDef& s) {
-  const double dx = s.solver.spacing;
-  const double layers = std::max(1.0, std::ceil(s.solver.supportRatio - 1e-9));
-  const auto along = [&](double len) { return std::max(1.0, std::round(len / dx)); };
-  double total = 0;
-  for (const BodyDef& b : s.bodies)
-    for (const ShapeDef& f : b.fixtures) {
-      switch (f.type) {
-        case ShapeDef::Type::Box:
-          total += layers * 2 * (along(2 * f.halfSize.x()) + along(2 * f.halfSize.y()));
-          break;
-        case ShapeDef::Type::Polygon:
-          for (std::size_t i = 0; i < f.vertices.size(); ++i)
-            total += layers * along((f.vertices[(i + 1) % f.vertices.size()] - f.vertices[i]).norm());
-          break;
-        case ShapeDef::Type::Circle:
-          total += layers * std::max(3.0, std::round(2 * 3.14159265358979 * f.radius / dx));
-          break;
-        case ShapeDef::Type::Edge:
-        case ShapeDef::Type::Chain:
-          for (std::size_t i = 0; i + 1 < f.vertices.size(); ++i) total += 2 * layers * along((f.vertices[i + 1] - f.vertices[i]).norm());
-          if (f.loop) total += 2 * layers * along((f.vertices.front() - f.vertices.back()).norm());
-          break;
-      }
-    }
-  return total;
-}
-
-Vec2d rotate(const Vec2d& v, double angle) {
-  const double c = std::cos(angle), s = std::sin(angle);
-  return Vec2d(c * v.x() - s * v.y(), s * v.x() + c * v.y());
-}
-
-/// How deep p lies inside the solid fixture f of body b (world coordinates;
-/// <= 0 outside; edges and chains have no inside).
-double depthInside(const BodyDef& b, const ShapeDef& f, const Vec2d& p) {
-  const Vec2d q = rotate(p - b.position, -b.angle);  // body coordinates
-  switch (f.type) {
-    case ShapeDef::Type::Box: {
-      const Vec2d l = rotate(q - f.center, -f.angle);
-      return std::min(f.halfSize.x() - std::fabs(l.x()), f.halfSize.y() - std::fabs(l.y()));
-    }
-    case ShapeDef::Type::Circle:
-      return f.radius - (q - f.center).norm();
-    case ShapeDef::Type::Polygon: {
-      const std::size_t n = f.vertices.size();
-      double area = 0;
-      for (std::size_t i = 0; i < n; ++i) area += cross(f.vertices[i], f.vertices[(i + 1) % n]);
-      const double orient = area > 0 ? 1 : -1;
-      double depth = std::numeric_limits<double>::infinity();
-      for (std::size_t i = 0; i < n; ++i) {
-        const Vec2d e = f.vertices[(i + 1) % n] - f.vertices[i];
-        depth = std::min(depth, orient * cross(e, q - f.vertices[i]) / e.norm());
-      }
-      return depth;
-    }
-    default:
-      return 0;
-  }
-}
-
-const char* shapeName(ShapeDef::Type t) {
-  switch (t) {
-    case ShapeDef::Type::Box: return "a box";
-    case ShapeDef::Type::Polygon: return "a polygon";
-    case ShapeDef::Type::Circle: return "a circle";
-    case ShapeDef::Type::Edge: return "an edge";
-    case ShapeDef::Type::Chain: return "a chain";
-  }
-  return "a solid";
-}
-
-/// A block none of whose particles could exist: thinner than one spacing, or
-/// with every lattice point inside one solid fixture.
-void checkBlock(const Reader& r, const SceneDef& s, const FluidBlockDef& blk, const std::string& p) {
-  const double dx = s.solver.spacing;
-  const auto [nx, ny] = blockLattice(blk, dx);
-  if (nx < 1 || ny < 1)
-    r.fail(Reader::sub(p, "max"), "the block is " + fmt(blk.max.x() - blk.min.x()) + " m x " + fmt(blk.max.y() - blk.min.y()) +
-                                      " m, less than one particle spacing (" + fmt(dx) + " m) " + (nx < 1 ? "wide" : "high") +
-                                      ": it would hold no particle");
-  // The lattice spans x in [min + dx/2, min + (nx - 1/2) dx]; the rows, compressed
-  // downwards at most, y in [min, min + (ny - 1/2) dx]. A convex solid holding
-  // the four corners holds every particle.
-  const double x0 = blk.min.x() + 0.5 * dx, x1 = blk.min.x() + (nx - 0.5) * dx;
-  const double y0 = blk.min.y(), y1 = blk.min.y() + (ny - 0.5) * dx;
-  const double margin = 0.01 * dx + 1e-6 * std::max({1.0, std::fabs(x0), std::fabs(x1), std::fabs(y0), std::fabs(y1)});
-  for (std::size_t bi = 0; bi < s.bodies.size(); ++bi)
-    for (std::size_t fi = 0; fi < s.bodies[bi].fixtures.size(); ++fi) {
-      const BodyDef& b = s.bodies[bi];
-      const ShapeDef& f = b.fixtures[fi];
-      bool all = true;
-      for (const Vec2d& c : {Vec2d(x0, y0), Vec2d(x1, y0), Vec2d(x0, y1), Vec2d(x1, y1)}) all = all && depthInside(b, f, c) > margin;
-      if (all)
-        r.fail(p, "the block lies entirely inside boundaries[" + std::to_string(bi) + "].fixtures[" + std::to_string(fi) + "] (" +
-                      shapeName(f.type) + "): every particle would be dropped");
-    }
-}
-
-/// A scene name becomes the output directory out/<name>: one plain path component.
-void checkName(const Reader& r, const std::string& name) {
-  std::string why;
-  if (name.empty()) why = "the name is empty";
-  else if (name.size() > 200) why = "the name is longer than 200 bytes";
-  else if (name == "." || name == "..") why = "'" + name + "' is not a directory name";
-  else if (name.find_first_of("/\\") != std::string::npos) why = "the name contains a slash";
-  else
-    for (const char c : name)
-      if (static_cast<unsigned char>(c) < 0x20 || c == 0x7F) why = "the name contains a control character";
-  if (!why.empty())
-    r.fail("name", why + "; the name names the output directory out/<name>: use letters, digits, '_', '-' or '.'");
-}
-
 /// The one place where an event's fields are read and checked: the scene's
 /// `events` entries and every line of events files and live input come here.
 EventDef readEvent(const Reader& r, const nlohmann::json& j, const std::string& path, const SceneDef& scene,
@@ -503,8 +251,7 @@ EventDef readEvent(const Reader& r, const nlohmann::json& j, const std::string& 
       e.block.min = r.requiredVec2(j, path, "min");
       e.block.max = r.requiredVec2(j, path, "max");
       e.block.velocity = r.vec2(j, path, "velocity", e.block.velocity);
-      if (!(e.block.max.x() > e.block.min.x() && e.block.max.y() > e.block.min.y()))
-        r.fail(Reader::sub(path, "max"), "max must be greater than min in x and in y");
+      checkMaxAboveMin(r, e.block.min, e.block.max, path);
       break;
     case T::Drop:
       e.point = r.requiredVec2(j, path, "center");
@@ -650,16 +397,6 @@ std::string eventToJson(const EventDef& e) {
 }
 
 
-std::size_t countBlockParticles(const SceneDef& scene) {
-  double n = 0;
-  for (const auto& b : scene.blocks) {
-    const auto [nx, ny] = blockLattice(b, scene.solver.spacing);
-    if (nx > 0 && ny > 0) n += nx * ny;
-  }
-  const double most = double(std::numeric_limits<std::size_t>::max() / 2);
-  return !(n < most) ? std::numeric_limits<std::size_t>::max() / 2 : static_cast<std::size_t>(n);
-}
-
 SceneDef parseScene(const std::string& text, const std::string& file) {
   const JsonDoc doc = parseJsonWithPositions(text, file);
   const Reader r(doc, file);
@@ -673,10 +410,7 @@ SceneDef parseScene(const std::string& text, const std::string& file) {
   s.gravity = r.vec2(root, "", "gravity", s.gravity);
   s.fps = r.number(root, "", "fps", s.fps, 1, 1000);
   s.duration = r.number(root, "", "duration", s.duration, 0, 1e5);
-  if (s.duration * s.fps > kMaxFrames)
-    r.fail(root.contains("duration") ? "duration" : "fps",
-           "duration x fps = " + fmt(s.duration) + " s x " + fmt(s.fps) + " = " + fmt(s.duration * s.fps) + " frames, more than " +
-               fmt(kMaxFrames) + "; shorten the duration (sph2d run --frames N renders fewer frames)");
+  checkFrameCount(r, s.duration, s.fps, root.contains("duration") ? "duration" : "fps");
   s.maxParticles = static_cast<std::size_t>(r.integer64(root, "", "max_particles", static_cast<long long>(s.maxParticles), 0, 100000000));
 
   if (root.contains("solver")) {
@@ -756,8 +490,7 @@ SceneDef parseScene(const std::string& text, const std::string& file) {
         blk.field.wavelength = r.number(f, pf, "wavelength", blk.field.wavelength, 0, 1e4, true);
         blk.field.origin = r.vec2(f, pf, "origin", blk.field.origin);
       }
-      if (!(blk.max.x() > blk.min.x() && blk.max.y() > blk.min.y()))
-        r.fail(Reader::sub(p, "max"), "max must be greater than min in x and in y");
+      checkMaxAboveMin(r, blk.min, blk.max, p);
       checkBlock(r, s, blk, p);
       s.blocks.push_back(blk);
     }
@@ -774,12 +507,7 @@ SceneDef parseScene(const std::string& text, const std::string& file) {
       const std::string key = axis == 0 ? "x" : "y";
       if (!j.contains(key)) continue;
       const Vec2d range = r.vec2(j, p, key, Vec2d(0, 0));
-      const std::string pk = Reader::sub(p, key);
-      // The neighbour grid needs five cells of R/2 across the period, and one
-      // particle must not meet two images of another: a period of at least 3R.
-      if (!(range.y() - range.x() >= 3 * R))
-        r.fail(pk, "the period [" + fmt(range.x()) + ", " + fmt(range.y()) + "] is " + fmt(range.y() - range.x()) +
-                       " m long; it must be at least 3 support radii (3 x " + fmt(R) + " m) long, min < max");
+      checkPeriod(r, range, R, Reader::sub(p, key));
       (axis == 0 ? s.periodic.x : s.periodic.y) = true;
       s.periodic.min[axis] = range.x();
       s.periodic.max[axis] = range.y();
@@ -809,12 +537,7 @@ SceneDef parseScene(const std::string& text, const std::string& file) {
       d.camera.min = r.requiredVec2(c, pc, "min");
       d.camera.max = r.requiredVec2(c, pc, "max");
       d.camera.automatic = false;
-      if (!(d.camera.max.x() > d.camera.min.x() && d.camera.max.y() > d.camera.min.y()))
-        r.fail(Reader::sub(pc, "max"), "max must be greater than min in x and in y");
-      const Vec2d size = d.camera.max - d.camera.min;
-      if (size.x() < kMinCameraSize || size.y() < kMinCameraSize)
-        r.fail(Reader::sub(pc, "max"), "the camera shows " + fmt(size.x()) + " m x " + fmt(size.y()) +
-                                           " m; it must be at least 0.001 m wide and high");
+      checkCamera(r, d.camera, pc);
     }
   }
 
@@ -826,19 +549,7 @@ SceneDef parseScene(const std::string& text, const std::string& file) {
       s.events.push_back(readEvent(r, arr[k], "events[" + std::to_string(k) + "]", s, EventStamp::Required, false));
   }
 
-  const std::size_t n = countBlockParticles(s);
-  if (n > s.maxParticles)
-    r.fail("solver.spacing", "spacing " + fmt(s.solver.spacing) + " fills the fluid blocks with " +
-                                 (n >= std::numeric_limits<std::size_t>::max() / 2 ? std::string("too many") : std::to_string(n)) +
-                                 " particles, more than max_particles = " + std::to_string(s.maxParticles) +
-                                 "; use a larger spacing or raise max_particles");
-  const double samples = estimateBoundarySamples(s);
-  const std::size_t sampleBudget = std::max<std::size_t>(s.maxParticles, kMinSampleBudget);
-  if (samples > double(sampleBudget))
-    r.fail("solver.spacing", "spacing " + fmt(s.solver.spacing) + " lines the solids with about " + fmt(samples) +
-                                 " boundary samples, more than max(max_particles, " + std::to_string(kMinSampleBudget) +
-                                 ") = " + std::to_string(sampleBudget) +
-                                 "; use a larger spacing or smaller solids");
+  checkParticleBudget(r, s);
   return s;
 }
 
