@@ -1,5 +1,5 @@
 // The scene's section readers (scene_sections.hpp), all but `events`
-// (scene.cpp, with the event reader). Each reads its keys in a fixed order and calls the checks of
+// (events.cpp). Each reads its keys in a fixed order and calls the checks of
 // scene_checks.hpp as soon as the values they look at are read, so a file with
 // several mistakes always reports the same first one.
 #include "scene_sections.hpp"

@@ -40,7 +40,7 @@ void readEffects(const Reader& r, const nlohmann::json& root, SceneDef& s);
 void readRender(const Reader& r, const nlohmann::json& root, SceneDef& s);
 
 /// `events`: the timeline, each entry read as parseEvent reads one event (a stamp
-/// required, no "source"). Defined in scene.cpp, with the event reader it uses.
+/// required, no "source"). Defined in events.cpp, with the event reader it uses.
 void readEvents(const Reader& r, const nlohmann::json& root, SceneDef& s);
 
 }  // namespace sph2d
