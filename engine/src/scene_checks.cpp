@@ -257,7 +257,7 @@ void checkEdge(const Reader& r, const std::vector<Vec2d>& vertices, const std::s
 void checkChain(const Reader& r, const std::vector<Vec2d>& vertices, bool loop, const std::string& p) {
   const std::size_t need = loop ? 3 : 2;
   if (vertices.size() < need)
-    r.fail(p, std::string("a ") + (loop ? "looped" : "open") + " chain needs at least " + std::to_string(need) +
+    r.fail(p, std::string(loop ? "a looped" : "an open") + " chain needs at least " + std::to_string(need) +
                   " vertices, got " + std::to_string(vertices.size()));
   for (std::size_t i = 1; i < vertices.size(); ++i)
     if (closerThanSlop(vertices[i], vertices[i - 1]))

@@ -67,6 +67,7 @@ TEST_CASE("checkEdge and checkChain refuse too few vertices and segments shorter
   CHECK(failure([](const Reader& r) { checkEdge(r, {{0, 0}, {0.004, 0}}, "e"); }) == "the edge is shorter than 0.005 m (Box2D's linear slop)");
   CHECK(failure([](const Reader& r) { checkEdge(r, {{0, 0}}, "e"); }) == "an edge needs exactly 2 vertices, got 1");
   CHECK(failure([](const Reader& r) { checkChain(r, {{0, 0}, {1, 0}}, false, "c"); }) == "");
+  CHECK(failure([](const Reader& r) { checkChain(r, {{0, 0}}, false, "c"); }) == "an open chain needs at least 2 vertices, got 1");
   CHECK(failure([](const Reader& r) { checkChain(r, {{0, 0}, {1, 0}}, true, "c"); }) == "a looped chain needs at least 3 vertices, got 2");
   std::string key;
   CHECK(failure([](const Reader& r) { checkChain(r, {{0, 0}, {1, 0}, {1.003, 0}, {2, 1}}, false, "c"); }, &key) ==
