@@ -6,6 +6,7 @@
 #include <cmath>
 #include <string>
 
+#include "sph2d/events.hpp"
 #include "sph2d/scene.hpp"
 #include "sph2d/world.hpp"
 #include "test_util.hpp"
