@@ -275,6 +275,9 @@ struct Renderer::Impl {
   std::vector<std::uint32_t> order;    // slots in id order
   std::vector<std::uint32_t> slotOfId;
   std::vector<float> cover, aux;       // coarse grid: coverage; RG = depth above, local fill
+  std::vector<float> carry, above;     // one row each: depth carried down, blurred along the row
+  std::vector<std::uint8_t> solidMask; // coarse grid: 1 where a cell's centre lies in a solid
+  bool solidMaskStale = true;
   int auxW = 0, auxH = 0, auxCell = 0;
   int fieldW = 0, fieldH = 0;  // the splat target: full resolution, or half when sprites are wide
   std::string rendererName;
@@ -392,6 +395,40 @@ struct Renderer::Impl {
     return 0.0;
   }
 
+  /// Marks the coarse grid's cells whose centre lies inside a collider (segments: within half a
+  /// cell of it). The colliders are static, so this runs when the grid or the camera changes.
+  void buildSolidMask(const RenderInput& in, double pxPerM) {
+    const double cellM = auxCell / pxPerM;
+    const double x0 = ext[0] - in.origin.x(), y1 = ext[3] - in.origin.y();
+    solidMask.assign(std::size_t(auxW) * std::size_t(auxH), 0);
+    solidMaskStale = false;
+    if (!in.colliders) return;
+    for (const Collider& c : *in.colliders) {
+      const double pad = c.kind == Collider::Kind::Segment ? 0.5 * cellM : 0.0;
+      // Cells whose centre can lie in the collider's bounding box (grid rows run top-down).
+      const int ix0 = std::max(0, int(std::floor((c.lo.x() - pad - x0) / cellM - 0.5)));
+      const int ix1 = std::min(auxW - 1, int(std::ceil((c.hi.x() + pad - x0) / cellM - 0.5)));
+      const int iy0 = std::max(0, int(std::floor((y1 - c.hi.y() - pad) / cellM - 0.5)));
+      const int iy1 = std::min(auxH - 1, int(std::ceil((y1 - c.lo.y() + pad) / cellM - 0.5)));
+      for (int iy = iy0; iy <= iy1; ++iy)
+        for (int ix = ix0; ix <= ix1; ++ix) {
+          const Vec2d p(x0 + (ix + 0.5) * cellM, y1 - (iy + 0.5) * cellM);
+          bool inside = true;
+          if (c.kind == Collider::Kind::Polygon) {
+            for (std::size_t k = 0; k < c.vertices.size() && inside; ++k)
+              inside = c.normals[k].cast<double>().dot(p - c.vertices[k].cast<double>()) <= 0.0;
+          } else if (c.kind == Collider::Kind::Circle) {
+            inside = (p - c.center.cast<double>()).squaredNorm() <= double(c.radius) * double(c.radius);
+          } else {
+            const Vec2d a = c.vertices[0].cast<double>(), b = c.vertices[1].cast<double>(), ab = b - a;
+            const double t = ab.squaredNorm() > 0 ? std::clamp((p - a).dot(ab) / ab.squaredNorm(), 0.0, 1.0) : 0.0;
+            inside = (p - (a + t * ab)).norm() <= pad;
+          }
+          if (inside) solidMask[std::size_t(iy) * std::size_t(auxW) + std::size_t(ix)] = 1;
+        }
+    }
+  }
+
   /// The coarse grid: coverage per cell, then depth of water above and local fill.
   void buildAux(const RenderInput& in, double pxPerM, const std::vector<float>& weight) {
     const double spacingPx = in.spacing * pxPerM;
@@ -402,6 +439,7 @@ struct Renderer::Impl {
       auxH = h;
       auxCell = cell;
       makeTexture(auxTex, GL_RG32F, GL_RG, GL_FLOAT, w, h, GL_LINEAR);
+      solidMaskStale = true;
     }
     cover.assign(std::size_t(w) * std::size_t(h), 0.0f);
     const Particles& P = *in.particles;
@@ -423,14 +461,36 @@ struct Renderer::Impl {
       }
     }
     for (float& c : cover) c = std::min(c, 1.0f);
+    if (solidMaskStale) buildSolidMask(in, pxPerM);
     aux.assign(std::size_t(w) * std::size_t(h) * 2, 0.0f);
-    for (int x = 0; x < w; ++x) {
-      float above = 0;
-      for (int y = 0; y < h; ++y) {
-        const float c = cover[std::size_t(y) * std::size_t(w) + std::size_t(x)];
-        aux[(std::size_t(y) * std::size_t(w) + std::size_t(x)) * 2] = float((above + 0.5f * c) * cellM);
-        above += c;
+    // Depth of water above, with the light scattered sideways as it goes down: row by row from
+    // the top, the depth carried into a row is the row above's, blurred along the row by a
+    // binomial kernel [1 4 6 4 1]/16 (variance one cell² per row) over the cells that are not
+    // solid. A step in depth between neighbouring columns (under a bump, at the foot of a
+    // splash) thus widens like a diffusion, about sqrt(rows below the step) cells, instead of
+    // running down as a vertical seam; solids neither pass light nor lend their depth of zero
+    // to the water beside them (a wall would otherwise light the water along it).
+    carry.assign(std::size_t(w), 0.0f);
+    above.assign(std::size_t(w), 0.0f);
+    static const float kBlur[5] = {1.0f / 16, 4.0f / 16, 6.0f / 16, 4.0f / 16, 1.0f / 16};
+    for (int y = 0; y < h; ++y) {
+      const std::size_t row = std::size_t(y) * std::size_t(w);
+      for (int x = 0; x < w; ++x) {
+        const float c = cover[row + std::size_t(x)];
+        aux[(row + std::size_t(x)) * 2] = float((carry[std::size_t(x)] + 0.5f * c) * cellM);
+        carry[std::size_t(x)] += c;
       }
+      for (int x = 0; x < w; ++x) {
+        float s = 0, n = 0;
+        for (int d = -2; d <= 2; ++d) {
+          const int xx = x + d;
+          if (xx < 0 || xx >= w || solidMask[row + std::size_t(xx)]) continue;
+          s += kBlur[d + 2] * carry[std::size_t(xx)];
+          n += kBlur[d + 2];
+        }
+        above[std::size_t(x)] = n > 0 ? s / n : carry[std::size_t(x)];
+      }
+      carry.swap(above);
     }
     for (int y = 0; y < h; ++y)
       for (int x = 0; x < w; ++x) {
@@ -539,6 +599,7 @@ struct Renderer::Impl {
     colorFbo = target(GL_RGBA8, GL_RGBA, GL_UNSIGNED_BYTE, EW, EH, colorTex);
     buildBackground();
     buildSolids(in);
+    solidMaskStale = true;
     fieldW = fieldH = 0;  // recreated at the next splat
   }
 

@@ -5,8 +5,10 @@
 //     splat      particles → Σ w and Σ w·speed in one RG32F target (additive,
 //                w = (1 − q²)³ × the particle's age fade)
 //     aux        on the CPU: a coarse grid of the fluid (cells of ≥ 4 px) giving
-//                the water depth above each cell and the local fill; uploaded as
-//                a small RG32F texture, sampled bilinearly
+//                the water depth above each cell (carried down row by row and
+//                blurred along each row, so light scatters sideways and no
+//                vertical seams appear) and the local fill; uploaded as a small
+//                RG32F texture, sampled bilinearly
 //     composite  field → liquid: anti-aliased edge, shading from the field's
 //                gradient (light from above), colour from the depth of water
 //                above, foam where the weighted speed is high
