@@ -82,69 +82,90 @@ void DepthGrid::build(const RenderInput& in, const std::vector<double>& ext, dou
   // splash) thus widens like a diffusion, about sqrt(rows below the step) cells, instead of
   // running down as a vertical seam; solids neither pass light nor lend their depth of zero
   // to the water beside them (a wall would otherwise light the water along it).
-  carry_.assign(std::size_t(w), 0.0f);
-  above_.assign(std::size_t(w), 0.0f);
+  // The row buffers carry two cells of zero-weight padding on each side: the kernel's taps
+  // need no bounds checks, and a masked tap adds exactly +0 to both sums.
+  carry_.assign(std::size_t(w) + 4, 0.0f);
+  above_.assign(std::size_t(w) + 4, 0.0f);
+  open_.assign(std::size_t(w) + 4, 0.0f);
   static const float kBlur[5] = {1.0f / 16, 4.0f / 16, 6.0f / 16, 4.0f / 16, 1.0f / 16};
+  float* carry = carry_.data() + 2;
+  float* above = above_.data() + 2;
+  float* open = open_.data() + 2;  // 1 where the cell is not solid, 0 where it is and outside
   for (int y = 0; y < h; ++y) {
     const std::size_t row = std::size_t(y) * std::size_t(w);
     for (int x = 0; x < w; ++x) {
       const float c = cover_[row + std::size_t(x)];
-      aux_[(row + std::size_t(x)) * 2] = float((carry_[std::size_t(x)] + 0.5f * c) * cellM);
-      carry_[std::size_t(x)] += c;
+      aux_[(row + std::size_t(x)) * 2] = float((carry[x] + 0.5f * c) * cellM);
+      carry[x] += c;
+      open[x] = solid_[row + std::size_t(x)] ? 0.0f : 1.0f;
     }
     for (int x = 0; x < w; ++x) {
       float s = 0, n = 0;
       for (int d = -2; d <= 2; ++d) {
-        const int xx = x + d;
-        if (xx < 0 || xx >= w || solid_[row + std::size_t(xx)]) continue;
-        s += kBlur[d + 2] * carry_[std::size_t(xx)];
-        n += kBlur[d + 2];
+        const float k = kBlur[d + 2] * open[x + d];
+        s += k * carry[x + d];
+        n += k;
       }
-      above_[std::size_t(x)] = n > 0 ? s / n : carry_[std::size_t(x)];
+      above[x] = n > 0 ? s / n : carry[x];
     }
-    carry_.swap(above_);
+    std::swap(carry, above);
   }
-  // Local fill: the 3×3 mean of the coverage.
+  // Local fill: the 3×3 mean of the coverage (inside without bounds checks, same order).
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x) {
       float s = 0;
       int n = 0;
-      for (int dy = -1; dy <= 1; ++dy)
-        for (int dx = -1; dx <= 1; ++dx) {
-          const int xx = x + dx, yy = y + dy;
-          if (xx < 0 || yy < 0 || xx >= w || yy >= h) continue;
-          s += cover_[std::size_t(yy) * std::size_t(w) + std::size_t(xx)];
-          ++n;
+      if (y > 0 && x > 0 && y + 1 < h && x + 1 < w) {
+        for (int dy = -1; dy <= 1; ++dy) {
+          const float* c = &cover_[std::size_t(y + dy) * std::size_t(w) + std::size_t(x - 1)];
+          s += c[0];
+          s += c[1];
+          s += c[2];
         }
+        n = 9;
+      } else {
+        for (int dy = -1; dy <= 1; ++dy)
+          for (int dx = -1; dx <= 1; ++dx) {
+            const int xx = x + dx, yy = y + dy;
+            if (xx < 0 || yy < 0 || xx >= w || yy >= h) continue;
+            s += cover_[std::size_t(yy) * std::size_t(w) + std::size_t(xx)];
+            ++n;
+          }
+      }
       aux_[(std::size_t(y) * std::size_t(w) + std::size_t(x)) * 2 + 1] = s / float(n);
     }
 }
 
-void DepthGrid::tiles(float spriteRadiusPx, int EW, int EH, std::vector<float>& out) {
+std::pair<int, int> DepthGrid::tiles(float spriteRadiusPx, int EW, int EH, std::vector<float>& out) {
   const int w = w_, h = h_;
   const int reach = int(std::ceil((spriteRadiusPx + 1.0f) / float(cell_)));
+  // Dilation by `reach` cells along rows, then along columns, with running counts of the
+  // active cells in the window.
   active_.assign(std::size_t(w) * std::size_t(h), 0);
   activeTmp_.assign(active_.size(), 0);
   for (std::size_t k = 0; k < cover_.size(); ++k) active_[k] = cover_[k] > 0.0f;
-  for (int y = 0; y < h; ++y)  // dilate along rows
+  for (int y = 0; y < h; ++y) {
+    const std::uint8_t* a = &active_[std::size_t(y) * std::size_t(w)];
+    std::uint8_t* o = &activeTmp_[std::size_t(y) * std::size_t(w)];
+    int count = 0;
+    for (int x = 0; x < std::min(reach, w); ++x) count += a[x];
     for (int x = 0; x < w; ++x) {
-      std::uint8_t a = 0;
-      for (int dx = -reach; dx <= reach && !a; ++dx) {
-        const int xx = x + dx;
-        if (xx >= 0 && xx < w) a = active_[std::size_t(y) * std::size_t(w) + std::size_t(xx)];
-      }
-      activeTmp_[std::size_t(y) * std::size_t(w) + std::size_t(x)] = a;
+      if (x + reach < w) count += a[x + reach];
+      if (x - reach - 1 >= 0) count -= a[x - reach - 1];
+      o[x] = count > 0;
     }
-  for (int y = 0; y < h; ++y)  // then along columns
-    for (int x = 0; x < w; ++x) {
-      std::uint8_t a = 0;
-      for (int dy = -reach; dy <= reach && !a; ++dy) {
-        const int yy = y + dy;
-        if (yy >= 0 && yy < h) a = activeTmp_[std::size_t(yy) * std::size_t(w) + std::size_t(x)];
-      }
-      active_[std::size_t(y) * std::size_t(w) + std::size_t(x)] = a;
+  }
+  for (int x = 0; x < w; ++x) {
+    int count = 0;
+    for (int y = 0; y < std::min(reach, h); ++y) count += activeTmp_[std::size_t(y) * std::size_t(w) + std::size_t(x)];
+    for (int y = 0; y < h; ++y) {
+      if (y + reach < h) count += activeTmp_[std::size_t(y + reach) * std::size_t(w) + std::size_t(x)];
+      if (y - reach - 1 >= 0) count -= activeTmp_[std::size_t(y - reach - 1) * std::size_t(w) + std::size_t(x)];
+      active_[std::size_t(y) * std::size_t(w) + std::size_t(x)] = count > 0;
     }
+  }
   out.clear();
+  int rowFirst = h, rowLast = -1;
   auto ndcX = [&](int px) { return float(std::min(px, EW)) / float(EW) * 2.0f - 1.0f; };
   auto ndcY = [&](int py) { return float(std::min(py, EH)) / float(EH) * 2.0f - 1.0f; };
   for (int y = 0; y < h; ++y)
@@ -158,8 +179,12 @@ void DepthGrid::tiles(float spriteRadiusPx, int EW, int EH, std::vector<float>& 
       const float x0 = ndcX(x * cell_), x1 = ndcX(e * cell_), y0 = ndcY(y * cell_), y1 = ndcY((y + 1) * cell_);
       const float q[12] = {x0, y0, x1, y0, x0, y1, x0, y1, x1, y0, x1, y1};
       out.insert(out.end(), q, q + 12);
+      rowFirst = std::min(rowFirst, y);
+      rowLast = std::max(rowLast, y);
       x = e;
     }
+  if (rowLast < 0) return {0, 0};
+  return {std::min(rowFirst * cell_, EH), std::min((rowLast + 1) * cell_, EH)};
 }
 
 }  // namespace sph2d

@@ -12,6 +12,7 @@
 #pragma once
 
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #include "sph2d/render/renderer.hpp"
@@ -32,7 +33,8 @@ class DepthGrid {
              const std::vector<std::uint32_t>& order, const std::vector<float>& weight);
   /// Two triangles (NDC of targets EW × EH) per run of cells in a row that the splat can reach:
   /// cells with water, dilated by `spriteRadiusPx` plus one pixel for the gradient taps.
-  void tiles(float spriteRadiusPx, int EW, int EH, std::vector<float>& out);
+  /// Returns the target rows [first, last) the tiles cover (first = last: none).
+  std::pair<int, int> tiles(float spriteRadiusPx, int EW, int EH, std::vector<float>& out);
 
   int width() const { return w_; }    ///< cells per row
   int height() const { return h_; }   ///< rows
@@ -47,6 +49,7 @@ class DepthGrid {
   bool solidsStale_ = true;
   std::vector<float> cover_, aux_;         // coverage per cell; RG = depth above, local fill
   std::vector<float> carry_, above_;       // one row each: depth carried down, blurred along the row
+  std::vector<float> open_;                // one row: 1 where the cell is not solid
   std::vector<std::uint8_t> solid_;        // 1 where a cell's centre lies in a solid
   std::vector<std::uint8_t> active_, activeTmp_;
 };
