@@ -114,6 +114,22 @@ TEST_CASE("liquid frames depend on particle values only, not on storage order, a
   CHECK(got == doctest::Approx(expected).epsilon(0.15));
 }
 
+TEST_CASE("a liquid frame does not depend on the frames before it (the background comes back where water was)") {
+  const SceneDef s = blockScene(160, 120, Vec2d(-0.1, -0.1), Vec2d(0.3, 0.3));
+  World world(s, WorldOptions{1});
+  // The same block lifted by 0.08 m: its rows of the image are others.
+  Particles up = world.particles();
+  for (auto& x : up.x) x.y() += 0.08f;
+  Renderer seq(s.render);
+  const std::uint64_t first = hashOf(seq.render(world));
+  const std::uint64_t lifted = hashOf(seq.render(inputOf(world, up)));
+  const std::uint64_t again = hashOf(seq.render(world));
+  Renderer fresh(s.render);
+  CHECK(hashOf(fresh.render(inputOf(world, up))) == lifted);
+  CHECK(again == first);
+  CHECK(lifted != first);
+}
+
 TEST_CASE("at high zoom the liquid covers the right area, and discs wider than the point-size limit are drawn as quads") {
   // The camera shows 0.02 m × 0.02 m around the block's lower-left corner at 200×200 px:
   // 10000 px/m, a spacing of 200 px, liquid sprites 800 px wide (400 px in the half-resolution

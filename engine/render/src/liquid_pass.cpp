@@ -25,7 +25,6 @@ std::array<float, 3> color3(const std::array<double, 3>& c) { return {float(c[0]
 class LiquidPass final : public RenderPass {
  public:
   LiquidPass(const RenderDef& def, const RenderOptions& opt) : def_(def), opt_(opt) {
-    compositeProg_ = gl::program("solid.vert", "composite.frag");
     glGenVertexArrays(1, &tileVao_);
     glGenBuffers(1, &tileVbo_);
     glBindVertexArray(tileVao_);
@@ -41,6 +40,7 @@ class LiquidPass final : public RenderPass {
   void targetsChanged() override {
     field_.resize(0, 0);  // resized with its texture at the next splat
     grid_.solidsChanged();
+    drawnRows_ = {0, 1 << 30};  // a new colour target: the whole background at the next frame
   }
 
   void prepare(const PassFrame& f) override {
@@ -61,7 +61,7 @@ class LiquidPass final : public RenderPass {
     glBindTexture(GL_TEXTURE_2D, auxTex_);
     glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
     glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, grid_.width(), grid_.height(), GL_RG, GL_FLOAT, grid_.aux().data());
-    grid_.tiles(float(def_.splatRadius * f.spacingPx), EW, EH, tiles_);
+    tileRows_ = grid_.tiles(float(def_.splatRadius * f.spacingPx), EW, EH, tiles_);
     tileVertices_ = GLsizei(tiles_.size() / 2);
     glBindBuffer(GL_ARRAY_BUFFER, tileVbo_);
     glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(tiles_.size() * sizeof(float)), tiles_.empty() ? nullptr : tiles_.data(),
@@ -76,6 +76,13 @@ class LiquidPass final : public RenderPass {
   }
 
  private:
+  /// The composite program for a field at half (`half`) or full resolution, compiled at first use.
+  GLuint compositeProgram(bool half) {
+    GLuint& p = half ? compositeHalfProg_ : compositeProg_;
+    if (!p) p = gl::program("solid.vert", "composite.frag", half ? "#define HALF_FIELD 1\n" : "");
+    return p;
+  }
+
   /// Σw and Σw·speed into the RG32F field (field_splat.hpp) and up to its texture; at half
   /// resolution when sprites are at least 8 px wide (the composite samples it bilinearly).
   void splat(const PassFrame& f) {
@@ -100,8 +107,12 @@ class LiquidPass final : public RenderPass {
   /// The field becomes water over the tiles the fluid can reach (shaders/composite.frag).
   void composite(const PassFrame& f) {
     const int EW = f.geo.EW, EH = f.geo.EH;
-    const GLuint cp = compositeProg_;
-    f.color.startFrame();
+    const GLuint cp = compositeProgram(field_.width() < EW);
+    // The colour target still holds the last frame: background and solids, and water over the
+    // rows its tiles covered. Only those rows go back to the background; the tiles of this
+    // frame write every pixel they cover.
+    f.color.startFrameRows(drawnRows_.first, std::min(drawnRows_.second, EH));
+    drawnRows_ = tileRows_;
     glUseProgram(cp);
     glActiveTexture(GL_TEXTURE0);
     glBindTexture(GL_TEXTURE_2D, fieldTex_);
@@ -141,9 +152,11 @@ class LiquidPass final : public RenderPass {
 
   RenderDef def_;
   RenderOptions opt_;
-  GLuint compositeProg_ = 0;
+  GLuint compositeProg_ = 0, compositeHalfProg_ = 0;  // field at full, half resolution
   GLuint fieldTex_ = 0, auxTex_ = 0, tileVao_ = 0, tileVbo_ = 0;
   GLsizei tileVertices_ = 0;
+  std::pair<int, int> tileRows_{0, 0};              // target rows this frame's tiles cover
+  std::pair<int, int> drawnRows_{0, 1 << 30};       // rows of the colour target that are not background
   std::vector<float> packed_, tiles_;  // particles (x, y, speed, weight) in id order; tile quads
   FieldSplat field_;                   // full resolution, or half when sprites are wide
   DepthGrid grid_;

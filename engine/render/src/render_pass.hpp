@@ -45,8 +45,12 @@ struct ColorTarget {
   GLuint background = 0;  ///< the background texture, same size
   int EW = 0, EH = 0;
   /// Starts the frame: copies the background into the colour target and binds it.
-  void startFrame() const {
-    glCopyImageSubData(background, GL_TEXTURE_2D, 0, 0, 0, 0, tex, GL_TEXTURE_2D, 0, 0, 0, 0, EW, EH, 1);
+  void startFrame() const { startFrameRows(0, EH); }
+  /// Starts the frame when only rows [y0, y1) (window rows, from the world's top) differ from
+  /// the background and solids: copies the background over those rows and binds the target.
+  void startFrameRows(int y0, int y1) const {
+    if (y1 > y0)
+      glCopyImageSubData(background, GL_TEXTURE_2D, 0, 0, y0, 0, tex, GL_TEXTURE_2D, 0, 0, y0, 0, EW, y1 - y0, 1);
     glBindFramebuffer(GL_FRAMEBUFFER, fbo);
   }
 };
