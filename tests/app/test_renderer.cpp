@@ -461,6 +461,24 @@ TEST_CASE("PNG level 1 (sph2d's own encoder): pixels survive, the zlib stream ch
   Frame skewed = image(640, 64);
   for (std::size_t p = 0; p < skewed.rgba.size(); ++p) skewed.rgba[p] = rng() % 200 ? 0 : std::uint8_t(rng());
   roundTrip(skewed, "skewed");
+  // No byte equal to the one before it after filtering: 128 rows of 256 literals fill exactly one
+  // block of 32768 symbols, and the stream ends with an empty last block.
+  Frame literals = image(85, 128);
+  int before = -1;
+  for (int y = 0; y < literals.height; ++y) {
+    std::vector<int> f(3 * 85 + 1, 1);  // the filtered row: SUB (1), then the differences
+    for (std::size_t i = 1; i < f.size(); ++i)
+      do f[i] = int(rng() & 255);
+      while (f[i] == f[i - 1] || (i + 1 == f.size() && f[i] == 1));
+    REQUIRE(f[0] != before);
+    before = f.back();
+    for (int x = 0; x < 85; ++x)
+      for (int c = 0; c < 3; ++c) {
+        std::uint8_t* px = &literals.rgba[(std::size_t(y) * 85 + std::size_t(x)) * 4];
+        px[c] = std::uint8_t((x ? px[c - 4] : 0) + f[std::size_t(1 + 3 * x + c)]);
+      }
+  }
+  roundTrip(literals, "one full block");
   // A rendered frame: within 10 % of libpng's size with the same filter and run-length matching.
   const SceneDef s = blockScene(480, 270, Vec2d(-0.1, -0.1), Vec2d(0.3, 0.3));
   World world(s, WorldOptions{1});

@@ -25,8 +25,8 @@ class FieldSplat {
   /// (y·sy + oy + 1) h/2), with (sx, sy, ox, oy) the targets' local → NDC transform; the
   /// sprites are `diameterPx` wide in field pixels.
   void splat(const std::vector<float>& packed, const float scale[2], const float offset[2], float diameterPx);
-  int width() const { return w_; }
-  int height() const { return h_; }
+  int width() const { return w_; }   ///< field width [px]
+  int height() const { return h_; }  ///< field height [px]
   /// R = Σ w, G = Σ w·speed per pixel, rows from the world's top.
   const std::vector<float>& data() const { return field_; }
   /// The rows [dirtyBegin, dirtyEnd) that changed in the last splat() (cleared or written;

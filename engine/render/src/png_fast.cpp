@@ -48,28 +48,35 @@ struct LengthTable {
 };
 const LengthTable kLengths;
 
-/// Writes bits least significant first, 32 at a time.
+/// Writes bits least significant first, 32 at a time, at the end of a byte vector.
 struct BitWriter {
-  std::uint8_t* p;
+  std::vector<std::uint8_t>& v;
+  std::size_t pos;  // bytes written
   std::uint64_t buf = 0;
   int n = 0;
+  /// Makes room for `bytes` more bytes (and the 4-byte steps of put()).
+  void reserve(std::size_t bytes) {
+    if (v.size() < pos + bytes + 8) v.resize(std::max(pos + bytes + 8, v.size() * 3 / 2));
+  }
   void put(std::uint32_t bits, int len) {  // len <= 32
     buf |= std::uint64_t(bits) << n;
     n += len;
     if (n >= 32) {
+      std::uint8_t* p = v.data() + pos;
       p[0] = std::uint8_t(buf);
       p[1] = std::uint8_t(buf >> 8);
       p[2] = std::uint8_t(buf >> 16);
       p[3] = std::uint8_t(buf >> 24);
-      p += 4;
+      pos += 4;
       buf >>= 32;
       n -= 32;
     }
   }
   /// Pads with zero bits to a byte boundary and writes what is left.
   void flush() {
+    reserve(8);
     while (n > 0) {
-      *p++ = std::uint8_t(buf);
+      v[pos++] = std::uint8_t(buf);
       buf >>= 8;
       n -= 8;
     }
@@ -221,6 +228,9 @@ void writeBlock(BitWriter& out, const Token* tokens, std::size_t n, bool final) 
   int hclen = 19;
   while (hclen > 4 && !cl.len[std::size_t(kCodeLenOrder[std::size_t(hclen - 1)])]) --hclen;
 
+  // At most: the header (3 + 14 bits, 19 × 3 bits, 316 code lengths of 7 + 7 bits: < 600 bytes)
+  // and 35 bits per token (a literal takes 15, a run 15 + 5 + 15), and the end of the block.
+  out.reserve(600 + (35 * n + 15) / 8 + 8);
   out.put(final ? 1 : 0, 1);
   out.put(2, 2);  // dynamic Huffman codes
   out.put(std::uint32_t(hlit - 257), 5);
@@ -319,68 +329,7 @@ std::uint32_t adler32Fast(std::uint32_t adler, const std::uint8_t* data, std::si
 
 void encodePngFast(int width, int height, const std::uint8_t* rgba, std::vector<std::uint8_t>& out) {
   const std::size_t w = std::size_t(width), h = std::size_t(height), stride = 3 * w + 1;
-  // The filtered rows: filter type 1 (SUB), then each byte minus the same channel one pixel left.
-  thread_local std::vector<std::uint8_t> raw;
-  thread_local std::vector<Token> tokens;
-  thread_local std::vector<std::uint8_t> z;
-  raw.resize(stride * h);
-  for (std::size_t y = 0; y < h; ++y) {
-    const std::uint8_t* s = rgba + y * w * 4;
-    std::uint8_t* d = raw.data() + y * stride;
-    d[0] = 1;
-    if (w == 0) continue;
-    d[1] = s[0];
-    d[2] = s[1];
-    d[3] = s[2];
-    for (std::size_t x = 1; x < w; ++x) {  // no value carried from pixel to pixel
-      d[1 + 3 * x] = std::uint8_t(s[4 * x] - s[4 * x - 4]);
-      d[2 + 3 * x] = std::uint8_t(s[4 * x + 1] - s[4 * x - 3]);
-      d[3 + 3 * x] = std::uint8_t(s[4 * x + 2] - s[4 * x - 2]);
-    }
-  }
-  // Runs of the previous byte (distance 1), at least 3 long, as zlib's Z_RLE finds them.
-  const std::uint8_t* p = raw.data();
-  const std::size_t n = raw.size();
-  tokens.resize(n + 1);
-  std::size_t nt = 0;
-  for (std::size_t i = 0; i < n;) {
-    if (i > 0 && p[i] == p[i - 1]) {
-      const std::uint8_t v = p[i - 1];
-      const std::size_t end = std::min(n, i + 258);
-      std::size_t e = i + 1;
-      // Eight bytes at a time while they all equal v, then byte by byte.
-      const std::uint64_t v8 = 0x0101010101010101ull * v;
-      for (std::uint64_t word; e + 8 <= end; e += 8) {
-        std::memcpy(&word, p + e, 8);
-        if (word != v8) break;
-      }
-      while (e < end && p[e] == v) ++e;
-      if (e - i >= 3) {
-        tokens[nt++] = Token(256 + (e - i));
-        i = e;
-        continue;
-      }
-    }
-    tokens[nt++] = p[i++];
-  }
-  // Worst case: 15 bits per input byte (a literal each; a run of 3 or more bytes takes at most
-  // 35 bits), plus the block headers (at most 600 bytes each) and the bit writer's 4-byte steps.
-  z.resize(2 + 2 * n + (nt / kBlockSymbols + 1) * 700 + 16);
-  z[0] = 0x78;  // deflate, 32 KB window
-  z[1] = 0x01;  // no dictionary, check bits ((0x78 << 8) | 0x01 is a multiple of 31)
-  BitWriter bw{z.data() + 2};
-  for (std::size_t k = 0; k < nt || k == 0; k += kBlockSymbols)  // one block at least
-    writeBlock(bw, tokens.data() + k, std::min(kBlockSymbols, nt - k), k + kBlockSymbols >= nt);
-  bw.flush();
-  std::size_t zn = std::size_t(bw.p - z.data());
-  const std::uint32_t adler = adler32Fast(1, raw.data(), raw.size());
-  z[zn++] = std::uint8_t(adler >> 24);
-  z[zn++] = std::uint8_t(adler >> 16);
-  z[zn++] = std::uint8_t(adler >> 8);
-  z[zn++] = std::uint8_t(adler);
-
   out.clear();
-  out.reserve(zn + 64);
   static const std::uint8_t kSignature[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
   out.insert(out.end(), kSignature, kSignature + 8);
   std::uint8_t ihdr[13];
@@ -394,7 +343,74 @@ void encodePngFast(int width, int height, const std::uint8_t* rgba, std::vector<
   ihdr[11] = 0;  // adaptive filtering (each row names its filter)
   ihdr[12] = 0;  // not interlaced
   putChunk(out, "IHDR", ihdr, 13);
-  putChunk(out, "IDAT", z.data(), zn);
+  // The IDAT chunk is written in place: its length is filled in at the end.
+  const std::size_t idat = out.size();
+  out.insert(out.end(), {0, 0, 0, 0, 'I', 'D', 'A', 'T', 0x78, 0x01});  // zlib: deflate, 32 KB window; check bits
+  BitWriter bw{out, out.size()};
+
+  // Row by row: the SUB filter (each byte minus the same channel one pixel left), the row's
+  // share of the Adler-32, then its tokens — runs of the previous byte (distance 1), at least
+  // 3 long, as zlib's Z_RLE finds them — written out a block at a time.
+  thread_local std::vector<std::uint8_t> row;
+  thread_local std::vector<Token> tokens;
+  row.resize(stride);
+  tokens.resize(kBlockSymbols);
+  std::size_t nt = 0;
+  std::uint32_t adler = 1;
+  int prev = -1;  // the byte before the row (none before the first)
+  for (std::size_t y = 0; y < h; ++y) {
+    const std::uint8_t* src = rgba + y * w * 4;
+    std::uint8_t* d = row.data();
+    d[0] = 1;
+    if (w > 0) {
+      d[1] = src[0];
+      d[2] = src[1];
+      d[3] = src[2];
+    }
+    for (std::size_t x = 1; x < w; ++x) {  // no value carried from pixel to pixel
+      d[1 + 3 * x] = std::uint8_t(src[4 * x] - src[4 * x - 4]);
+      d[2 + 3 * x] = std::uint8_t(src[4 * x + 1] - src[4 * x - 3]);
+      d[3 + 3 * x] = std::uint8_t(src[4 * x + 2] - src[4 * x - 2]);
+    }
+    adler = adler32Fast(adler, d, stride);
+    for (std::size_t i = 0; i < stride;) {
+      const int before = i > 0 ? d[i - 1] : prev;
+      if (d[i] == before) {
+        const std::uint8_t v = d[i];
+        const std::size_t end = std::min(stride, i + 258);
+        std::size_t e = i + 1;
+        // Eight bytes at a time while they all equal v, then byte by byte.
+        const std::uint64_t v8 = 0x0101010101010101ull * v;
+        for (std::uint64_t word; e + 8 <= end; e += 8) {
+          std::memcpy(&word, d + e, 8);
+          if (word != v8) break;
+        }
+        while (e < end && d[e] == v) ++e;
+        if (e - i >= 3) {
+          tokens[nt++] = Token(256 + (e - i));
+          i = e;
+          if (nt == kBlockSymbols) {
+            writeBlock(bw, tokens.data(), nt, false);
+            nt = 0;
+          }
+          continue;
+        }
+      }
+      tokens[nt++] = d[i++];
+      if (nt == kBlockSymbols) {
+        writeBlock(bw, tokens.data(), nt, false);
+        nt = 0;
+      }
+    }
+    prev = d[stride - 1];
+  }
+  writeBlock(bw, tokens.data(), nt, true);  // the last block (possibly empty: just its end)
+  bw.flush();
+  out.resize(bw.pos);
+  for (int k = 3; k >= 0; --k) out.push_back(std::uint8_t(adler >> (8 * k)));
+  const std::uint32_t len = std::uint32_t(out.size() - idat - 8);
+  for (int k = 0; k < 4; ++k) out[idat + std::size_t(k)] = std::uint8_t(len >> (24 - 8 * k));
+  putU32(out, std::uint32_t(crc32(crc32(0L, nullptr, 0), out.data() + idat + 4, uInt(4 + len))));
   putChunk(out, "IEND", nullptr, 0);
 }
 

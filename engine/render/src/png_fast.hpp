@@ -5,9 +5,10 @@
 // smooth water. Each row gets PNG's SUB filter (left neighbour), which turns flat areas into
 // runs of zeros; the filtered stream is then deflated (RFC 1951) the way zlib's Z_RLE strategy
 // does it — only matches at distance 1 (runs of one byte value, 3..258 long), everything else
-// literals — but without zlib's general machinery: one pass finds the runs, blocks of up to
-// 32768 symbols get their own dynamic Huffman codes (limited to 15 bits by halving the counts
-// until they fit), and a 64-bit bit buffer writes them. The zlib wrapper's Adler-32 is
+// literals — but without zlib's general machinery: row by row, one pass filters, one finds the
+// runs, blocks of up to 32768 symbols get their own dynamic Huffman codes (limited to 15 bits by
+// halving the counts until they fit), and a 64-bit bit buffer writes them straight into the
+// IDAT chunk (memory: one row, one block of symbols and the file). The zlib wrapper's Adler-32 is
 // computed 16 bytes at a time with SSE2 (psadbw, pmaddwd). Output is a plain,
 // standard PNG (IHDR, one IDAT, IEND); every decoder reads it. Deterministic: the bytes depend
 // only on the pixels.
