@@ -1,6 +1,4 @@
 #version 330 core
-#extension GL_ARB_texture_gather : enable
-#extension GL_ARB_gpu_shader5 : enable
 // Composite pass (liquid mode): the splatted field becomes water.
 //  - edge: the field thresholded at half its bulk value (lower where the fluid
 //    is sparse, so lone drops stay visible), anti-aliased over one pixel;
@@ -13,14 +11,11 @@
 // Rows of this target run top-down in the world (the camera flips y). It is
 // drawn only over the tiles that fluid can reach (solid.vert: quads in NDC);
 // the rest of the frame keeps the background.
-// HALF_FIELD (defined by the renderer when the field has half the resolution):
-// the field and its gradient come from two gathers of the four texels around the
-// pixel, bilinear interpolation and its exact derivative, instead of five
-// filtered samples (central differences); llvmpipe spends most of this pass in
-// texture sampling. Without gathers (or at full resolution) the five samples.
 out vec4 outColor;
 uniform sampler2D uBg;       // the background (RGBA8, same size)
-uniform sampler2D uField;    // RG: sum w, sum w*speed (full or half resolution, bilinear)
+uniform sampler2D uField;    // RGBA: sum w, sum w*speed, its gradient per field pixel
+                             // (x right, y up); full or half resolution, bilinear
+uniform vec2 uGradScale;     // field pixels per target pixel
 uniform sampler2D uAux;      // RG: depth of water above [m], local fill 0..1 (bilinear)
 uniform vec2 uAuxScale;      // vUv -> aux texture coordinates
 uniform vec2 uTexel;         // 1 / size
@@ -33,25 +28,10 @@ uniform vec2 uFoamSpeed;     // foam starts, foam full [m/s]
 uniform float uSpacingPx;    // particle spacing [px]
 void main() {
   vec2 vUv = gl_FragCoord.xy * uTexel;
-#if defined(HALF_FIELD) && defined(GL_ARB_texture_gather) && defined(GL_ARB_gpu_shader5)
-  vec2 size = vec2(textureSize(uField, 0));
-  vec2 w = fract(vUv * size - 0.5);
-  vec4 r = textureGather(uField, vUv, 0);  // texels (x0, y1), (x1, y1), (x1, y0), (x0, y0)
-  vec4 s = textureGather(uField, vUv, 1);
-  float r0 = mix(r.w, r.z, w.x), r1 = mix(r.x, r.y, w.x);
-  vec2 c = vec2(mix(r0, r1, w.y), mix(mix(s.w, s.z, w.x), mix(s.x, s.y, w.x), w.y));
+  vec4 t = texture(uField, vUv);  // one filtered sample: the gradient comes with the field
+  vec2 c = t.rg;
   float f = c.r * uInvBulk;
-  // d/dx and d/dy of the interpolation, per target pixel; world orientation (y up).
-  vec2 grad = vec2(mix(r.z - r.w, r.y - r.x, w.y), r0 - r1) * size * uTexel * uInvBulk;
-#else
-  vec2 c = texture(uField, vUv).rg;
-  float f = c.r * uInvBulk;
-  float fl = texture(uField, vUv - vec2(uTexel.x, 0.0)).r * uInvBulk;
-  float fr = texture(uField, vUv + vec2(uTexel.x, 0.0)).r * uInvBulk;
-  float fa = texture(uField, vUv - vec2(0.0, uTexel.y)).r * uInvBulk;  // world above
-  float fb = texture(uField, vUv + vec2(0.0, uTexel.y)).r * uInvBulk;  // world below
-  vec2 grad = vec2(fr - fl, fa - fb) * 0.5;  // per pixel, world orientation (y up)
-#endif
+  vec2 grad = t.ba * uGradScale * uInvBulk;  // per pixel, world orientation (y up)
   float g = length(grad);
   vec2 aux = texture(uAux, vUv * uAuxScale).rg;
   vec3 bg = texelFetch(uBg, ivec2(gl_FragCoord.xy), 0).rgb;

@@ -10,17 +10,18 @@ namespace sph2d {
 void FieldSplat::resize(int w, int h) {
   w_ = w;
   h_ = h;
-  field_.assign(std::size_t(w) * std::size_t(h) * 2, 0.0f);
+  field_.assign(std::size_t(w) * std::size_t(h) * 4, 0.0f);
   rowBegin_ = rowEnd_ = 0;
   fresh_ = true;
 }
 
 void FieldSplat::splat(const std::vector<float>& packed, const float scale[2], const float offset[2],
                        float diameterPx) {
-  // Clear what the last splat wrote.
+  const std::size_t w = std::size_t(w_);
+  // Clear what the last splat left.
   if (rowEnd_ > rowBegin_)
-    std::memset(field_.data() + std::size_t(rowBegin_) * std::size_t(w_) * 2, 0,
-                std::size_t(rowEnd_ - rowBegin_) * std::size_t(w_) * 2 * sizeof(float));
+    std::memset(field_.data() + std::size_t(rowBegin_) * w * 4, 0,
+                std::size_t(rowEnd_ - rowBegin_) * w * 4 * sizeof(float));
   int lo = h_, hi = 0;
   const double r = 0.5 * double(diameterPx);
   const float inv = float(1.0 / r);
@@ -40,17 +41,28 @@ void FieldSplat::splat(const std::vector<float>& packed, const float scale[2], c
     for (int y = y0; y <= y1; ++y) {
       const float dy = float((y + 0.5 - cy) * inv);
       const float dy2 = dy * dy;
-      float* row = field_.data() + (std::size_t(y) * std::size_t(w_) + std::size_t(x0)) * 2;
+      float* row = field_.data() + (std::size_t(y) * w + std::size_t(x0)) * 4;
       for (int i = 0; i <= x1 - x0; ++i) {
         const float dx = fx0 + float(i) * inv;
         const float a = std::max(0.0f, 1.0f - (dx * dx + dy2));  // 0 outside the disc: adds nothing
-        const float w = a * a * a * weight;
-        row[2 * i] += w;
-        row[2 * i + 1] += w * speed;
+        const float wk = a * a * a * weight;
+        row[4 * i] += wk;
+        row[4 * i + 1] += wk * speed;
       }
     }
   }
-  const int begin = std::min(lo, hi), end = hi;
+  // The gradient, on the rows written and one row beyond on each side.
+  const int begin = lo < hi ? std::max(0, lo - 1) : 0, end = lo < hi ? std::min(h_, hi + 1) : 0;
+  for (int y = begin; y < end; ++y) {
+    const float* above = field_.data() + std::size_t(std::max(y - 1, 0)) * w * 4;
+    const float* below = field_.data() + std::size_t(std::min(y + 1, h_ - 1)) * w * 4;
+    float* row = field_.data() + std::size_t(y) * w * 4;
+    for (std::size_t x = 0; x < w; ++x) row[4 * x + 3] = (above[4 * x] - below[4 * x]) * 0.5f;
+    if (w < 2) continue;
+    for (std::size_t x = 1; x + 1 < w; ++x) row[4 * x + 2] = (row[4 * x + 4] - row[4 * x - 4]) * 0.5f;
+    row[2] = (row[4] - row[0]) * 0.5f;
+    row[4 * (w - 1) + 2] = (row[4 * (w - 1)] - row[4 * (w - 2)]) * 0.5f;
+  }
   // Changed rows: those written now and those cleared (written last time); all after resize().
   if (fresh_) {
     dirtyBegin_ = 0;

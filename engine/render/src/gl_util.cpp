@@ -14,12 +14,8 @@ const std::map<std::string, std::string>& embeddedShaders();
 namespace gl {
 namespace {
 
-GLuint compile(GLenum type, const std::string& name, const std::string& defines = "") {
-  std::string src = shaderSource(name);
-  if (!defines.empty()) {
-    const std::size_t eol = src.find('\n');
-    src.insert(eol == std::string::npos ? src.size() : eol + 1, defines);
-  }
+GLuint compile(GLenum type, const std::string& name) {
+  const std::string src = shaderSource(name);
   GLuint s = glCreateShader(type);
   const char* p = src.c_str();
   glShaderSource(s, 1, &p, nullptr);
@@ -51,9 +47,9 @@ std::string shaderSource(const std::string& name) {
   return it->second;
 }
 
-GLuint program(const std::string& vs, const std::string& fs, const std::string& fsDefines) {
+GLuint program(const std::string& vs, const std::string& fs) {
   GLuint p = glCreateProgram();
-  GLuint a = compile(GL_VERTEX_SHADER, vs), b = compile(GL_FRAGMENT_SHADER, fs, fsDefines);
+  GLuint a = compile(GL_VERTEX_SHADER, vs), b = compile(GL_FRAGMENT_SHADER, fs);
   glAttachShader(p, a);
   glAttachShader(p, b);
   glLinkProgram(p);

@@ -3,8 +3,9 @@
 // Design: a blobby (metaball) density field, after Blinn, "A Generalization of Algebraic Surface
 // Drawing" (1982), cut at an iso-level and shaded in screen space:
 //  1. splat: on the CPU (field_splat.hpp), each particle adds w = (1 − q²)³ × its age fade, and
-//     w·|v|, into an RG32F field; when sprites are at least 8 px wide the field has half the
-//     image's resolution (a quarter of the pixels) and the composite reads it bilinearly;
+//     w·|v|, into an RGBA32F field that also carries the gradient of Σw; when sprites are at
+//     least 8 px wide the field has half the image's resolution (a quarter of the pixels) and
+//     the composite reads it bilinearly;
 //  2. depth grid: on the CPU, the depth of water above and the local fill (depth_grid.hpp),
 //     uploaded as a small RG32F texture, and the tiles of the image the fluid can reach;
 //  3. composite: over those tiles only, the field becomes water (shaders/composite.frag:
@@ -25,6 +26,7 @@ std::array<float, 3> color3(const std::array<double, 3>& c) { return {float(c[0]
 class LiquidPass final : public RenderPass {
  public:
   LiquidPass(const RenderDef& def, const RenderOptions& opt) : def_(def), opt_(opt) {
+    compositeProg_ = gl::program("solid.vert", "composite.frag");
     glGenVertexArrays(1, &tileVao_);
     glGenBuffers(1, &tileVbo_);
     glBindVertexArray(tileVao_);
@@ -76,15 +78,9 @@ class LiquidPass final : public RenderPass {
   }
 
  private:
-  /// The composite program for a field at half (`half`) or full resolution, compiled at first use.
-  GLuint compositeProgram(bool half) {
-    GLuint& p = half ? compositeHalfProg_ : compositeProg_;
-    if (!p) p = gl::program("solid.vert", "composite.frag", half ? "#define HALF_FIELD 1\n" : "");
-    return p;
-  }
-
-  /// Σw and Σw·speed into the RG32F field (field_splat.hpp) and up to its texture; at half
-  /// resolution when sprites are at least 8 px wide (the composite samples it bilinearly).
+  /// Σw, Σw·speed and the gradient into the RGBA32F field (field_splat.hpp) and up to its
+  /// texture; at half resolution when sprites are at least 8 px wide (the composite samples it
+  /// bilinearly).
   void splat(const PassFrame& f) {
     const int EW = f.geo.EW, EH = f.geo.EH;
     const float diameter = spriteDiameter(f.spacingPx);
@@ -92,22 +88,22 @@ class LiquidPass final : public RenderPass {
     const int fw = (EW + shrink - 1) / shrink, fh = (EH + shrink - 1) / shrink;
     if (fw != field_.width() || fh != field_.height()) {
       field_.resize(fw, fh);
-      gl::makeTexture(fieldTex_, GL_RG32F, GL_RG, GL_FLOAT, fw, fh, shrink > 1 ? GL_LINEAR : GL_NEAREST);
+      gl::makeTexture(fieldTex_, GL_RGBA32F, GL_RGBA, GL_FLOAT, fw, fh, shrink > 1 ? GL_LINEAR : GL_NEAREST);
     }
     field_.splat(packed_, f.scale, f.offset, diameter * float(fw) / float(EW));
     const int y0 = field_.dirtyBegin(), y1 = field_.dirtyEnd();
     if (y1 > y0) {
       glBindTexture(GL_TEXTURE_2D, fieldTex_);
       glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
-      glTexSubImage2D(GL_TEXTURE_2D, 0, 0, y0, fw, y1 - y0, GL_RG, GL_FLOAT,
-                      field_.data().data() + std::size_t(y0) * std::size_t(fw) * 2);
+      glTexSubImage2D(GL_TEXTURE_2D, 0, 0, y0, fw, y1 - y0, GL_RGBA, GL_FLOAT,
+                      field_.data().data() + std::size_t(y0) * std::size_t(fw) * 4);
     }
   }
 
   /// The field becomes water over the tiles the fluid can reach (shaders/composite.frag).
   void composite(const PassFrame& f) {
     const int EW = f.geo.EW, EH = f.geo.EH;
-    const GLuint cp = compositeProgram(field_.width() < EW);
+    const GLuint cp = compositeProg_;
     // The colour target still holds the last frame: background and solids, and water over the
     // rows its tiles covered. Only those rows go back to the background; the tiles of this
     // frame write every pixel they cover.
@@ -127,6 +123,8 @@ class LiquidPass final : public RenderPass {
     glUniform2f(gl::uniform(cp, "uAuxScale"), float(EW) / float(grid_.width() * grid_.cell()),
                 float(EH) / float(grid_.height() * grid_.cell()));
     glUniform2f(gl::uniform(cp, "uTexel"), 1.0f / float(EW), 1.0f / float(EH));
+    // The field's gradient is per field pixel: per target pixel it scales by field px per target px.
+    glUniform2f(gl::uniform(cp, "uGradScale"), float(field_.width()) / float(EW), float(field_.height()) / float(EH));
     // Bulk value of the field: Σ (1 − q²)³ over a square lattice ≈ π s²/4, s = sprite radius in spacings.
     const float diameter = spriteDiameter(f.spacingPx);
     const float rs = float(diameter * 0.5 / f.spacingPx);
@@ -152,7 +150,7 @@ class LiquidPass final : public RenderPass {
 
   RenderDef def_;
   RenderOptions opt_;
-  GLuint compositeProg_ = 0, compositeHalfProg_ = 0;  // field at full, half resolution
+  GLuint compositeProg_ = 0;
   GLuint fieldTex_ = 0, auxTex_ = 0, tileVao_ = 0, tileVbo_ = 0;
   GLsizei tileVertices_ = 0;
   std::pair<int, int> tileRows_{0, 0};              // target rows this frame's tiles cover
