@@ -70,6 +70,8 @@ class LiquidPass final : public RenderPass {
                  GL_STREAM_DRAW);
   }
 
+  std::pair<int, int> changedRows() const override { return changedRows_; }
+
   void draw(const PassFrame& f, StageTimer& timer, RenderTimings& timings) override {
     splat(f);
     timer.end(timings.splat);
@@ -108,6 +110,12 @@ class LiquidPass final : public RenderPass {
     // rows its tiles covered. Only those rows go back to the background; the tiles of this
     // frame write every pixel they cover.
     f.color.startFrameRows(drawnRows_.first, std::min(drawnRows_.second, EH));
+    changedRows_ = drawnRows_;
+    if (tileRows_.first < tileRows_.second) {
+      changedRows_.first = changedRows_.first < changedRows_.second ? std::min(changedRows_.first, tileRows_.first)
+                                                                    : tileRows_.first;
+      changedRows_.second = std::max(changedRows_.second, tileRows_.second);
+    }
     drawnRows_ = tileRows_;
     glUseProgram(cp);
     glActiveTexture(GL_TEXTURE0);
@@ -155,6 +163,7 @@ class LiquidPass final : public RenderPass {
   GLsizei tileVertices_ = 0;
   std::pair<int, int> tileRows_{0, 0};              // target rows this frame's tiles cover
   std::pair<int, int> drawnRows_{0, 1 << 30};       // rows of the colour target that are not background
+  std::pair<int, int> changedRows_{0, 1 << 30};     // rows the last composite restored or drew
   std::vector<float> packed_, tiles_;  // particles (x, y, speed, weight) in id order; tile quads
   FieldSplat field_;                   // full resolution, or half when sprites are wide
   DepthGrid grid_;

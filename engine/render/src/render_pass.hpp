@@ -13,6 +13,7 @@
 #include <chrono>
 #include <cstdint>
 #include <memory>
+#include <utility>
 #include <vector>
 
 #include "camera.hpp"
@@ -84,6 +85,10 @@ class RenderPass {
   virtual void prepare(const PassFrame& f) = 0;
   /// Draws into the colour target, starting it from the background; ends its own stages.
   virtual void draw(const PassFrame& f, StageTimer& timer, RenderTimings& timings) = 0;
+  /// The rows [first, last) of the colour target that the last draw() changed (copied back from
+  /// the background or drawn over); elsewhere the target still holds the last frame's pixels,
+  /// solids included. Default: every row.
+  virtual std::pair<int, int> changedRows() const { return {0, 1 << 30}; }
   /// CPU drawing into the read-back frame (the colour bar); `textScale` is the font scale.
   virtual void annotate(Frame& /*frame*/, int /*textScale*/) const {}
   /// True when the last draw() used instanced quads instead of points.

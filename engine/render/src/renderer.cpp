@@ -172,7 +172,8 @@ const Frame& Renderer::render(const RenderInput& in) {
   timer.end(r.timings.upload);
 
   r.pass->draw(f, timer, r.timings);
-  r.scenery.drawSolids(d);  // solids on top
+  const auto rows = r.pass->changedRows();  // solids on top, where the pass may have drawn over them
+  r.scenery.drawSolids(d, rows.first, rows.second);
   timer.end(r.timings.solids);
 
   glPixelStorei(GL_PACK_ALIGNMENT, 1);

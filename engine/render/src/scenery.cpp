@@ -1,6 +1,7 @@
 // scenery.cpp — the background texture and the solid triangles (see scenery.hpp).
 #include "scenery.hpp"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 
@@ -89,11 +90,17 @@ void Scenery::buildSolids(const FrameGeometry& geo, const RenderInput& in) {
   glVertexAttribPointer(0, 2, GL_FLOAT, GL_FALSE, 0, nullptr);
 }
 
-void Scenery::drawSolids(const RenderDef& def) const {
+void Scenery::drawSolids(const RenderDef& def, int rowFirst, int rowLast) const {
+  if (!solidCount_ || rowLast <= rowFirst) return;
   glUseProgram(solidProg_);
   glUniform3f(gl::uniform(solidProg_, "uColor"), float(def.solid[0]), float(def.solid[1]), float(def.solid[2]));
   glBindVertexArray(solidVao_);
-  if (solidCount_) glDrawArrays(GL_TRIANGLES, 0, solidCount_);
+  GLint vp[4] = {0, 0, 0, 0};
+  glGetIntegerv(GL_VIEWPORT, vp);
+  glEnable(GL_SCISSOR_TEST);
+  glScissor(0, rowFirst, vp[2], std::min(rowLast, vp[3]) - rowFirst);
+  glDrawArrays(GL_TRIANGLES, 0, solidCount_);
+  glDisable(GL_SCISSOR_TEST);
 }
 
 }  // namespace sph2d

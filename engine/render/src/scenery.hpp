@@ -22,8 +22,9 @@ class Scenery {
   void build(const RenderDef& def, const FrameGeometry& geo, const RenderInput& in);
   /// The background texture (RGBA8, the targets' size).
   GLuint background() const { return bgTex_; }
-  /// Draws the solids in `def.solid`'s colour into the bound framebuffer.
-  void drawSolids(const RenderDef& def) const;
+  /// Draws the solids in `def.solid`'s colour into the bound framebuffer, over the target rows
+  /// [rowFirst, rowLast) only (the rest still shows them from an earlier frame).
+  void drawSolids(const RenderDef& def, int rowFirst, int rowLast) const;
 
  private:
   void buildBackground(const RenderDef& def, const FrameGeometry& geo);
