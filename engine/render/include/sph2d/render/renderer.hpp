@@ -2,8 +2,9 @@
 //
 // Passes per frame (GLSL in shaders/, embedded at build time):
 //   liquid mode
-//     splat      on the CPU, particles → Σ w and Σ w·speed in one RG32F field
-//                (w = (1 − q²)³ × the particle's age fade), uploaded as a texture
+//     splat      on the CPU, particles → Σ w, Σ w·speed and the gradient of Σ w
+//                in one RGBA32F field (w = (1 − q²)³ × the particle's age fade),
+//                uploaded as a texture
 //     aux        on the CPU: a coarse grid of the fluid (cells of ≥ 4 px) giving
 //                the water depth above each cell (carried down row by row and
 //                blurred along each row, so light scatters sideways and no
