@@ -13,9 +13,7 @@
 // the rest of the frame keeps the background.
 out vec4 outColor;
 uniform sampler2D uBg;       // the background (RGBA8, same size)
-uniform sampler2D uField;    // RGBA: sum w, sum w*speed, its gradient per field pixel
-                             // (x right, y up); full or half resolution, bilinear
-uniform vec2 uGradScale;     // field pixels per target pixel
+uniform sampler2D uField;    // RG: sum w, sum w*speed (full or half resolution, bilinear)
 uniform sampler2D uAux;      // RG: depth of water above [m], local fill 0..1 (bilinear)
 uniform vec2 uAuxScale;      // vUv -> aux texture coordinates
 uniform vec2 uTexel;         // 1 / size
@@ -28,10 +26,13 @@ uniform vec2 uFoamSpeed;     // foam starts, foam full [m/s]
 uniform float uSpacingPx;    // particle spacing [px]
 void main() {
   vec2 vUv = gl_FragCoord.xy * uTexel;
-  vec4 t = texture(uField, vUv);  // one filtered sample: the gradient comes with the field
-  vec2 c = t.rg;
+  vec2 c = texture(uField, vUv).rg;
   float f = c.r * uInvBulk;
-  vec2 grad = t.ba * uGradScale * uInvBulk;  // per pixel, world orientation (y up)
+  float fl = texture(uField, vUv - vec2(uTexel.x, 0.0)).r * uInvBulk;
+  float fr = texture(uField, vUv + vec2(uTexel.x, 0.0)).r * uInvBulk;
+  float fa = texture(uField, vUv - vec2(0.0, uTexel.y)).r * uInvBulk;  // world above
+  float fb = texture(uField, vUv + vec2(0.0, uTexel.y)).r * uInvBulk;  // world below
+  vec2 grad = vec2(fr - fl, fa - fb) * 0.5;  // per pixel, world orientation (y up)
   float g = length(grad);
   vec2 aux = texture(uAux, vUv * uAuxScale).rg;
   vec3 bg = texelFetch(uBg, ivec2(gl_FragCoord.xy), 0).rgb;

@@ -1,6 +1,5 @@
 #version 330 core
-// Sprite vertex shader of the discs (particles mode); the liquid's splat runs on the CPU
-// (engine/render/src/field_splat.cpp) with the same geometry.
+// Sprite vertex shader of the splat pass (liquid) and the discs (particles mode).
 // Points: one vertex per particle, gl_PointSize = diameter. Quads: when the
 // diameter exceeds the driver's point-size limit, four corners per instance.
 layout(location = 0) in vec2 aPos;     // particle position, engine local frame [m]

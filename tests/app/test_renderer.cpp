@@ -130,17 +130,16 @@ TEST_CASE("a liquid frame does not depend on the frames before it (the backgroun
   CHECK(lifted != first);
 }
 
-TEST_CASE("at high zoom the liquid covers the right area, and discs wider than the point-size limit are drawn as quads") {
+TEST_CASE("at high zoom sprites wider than the point-size limit are drawn as quads and cover the right area") {
   // The camera shows 0.02 m × 0.02 m around the block's lower-left corner at 200×200 px:
   // 10000 px/m, a spacing of 200 px, liquid sprites 800 px wide (400 px in the half-resolution
-  // field, wider than any point sprite; the liquid's splat runs on the CPU, which has no size
-  // limit). Only the particle at (0.01, 0.01) has its centre in the image.
+  // field, > 255). Only the particle at (0.01, 0.01) has its centre in the image.
   const SceneDef s = blockScene(200, 200, Vec2d(-0.01, -0.01), Vec2d(0.01, 0.01));
   World world(s, WorldOptions{1});
   Renderer liquid(s.render);
   REQUIRE(liquid.maxPointSize() <= 256.0f);
   const Frame& f = liquid.render(world);
-  CHECK_FALSE(liquid.usedQuads());  // no GL sprites in the liquid mode
+  CHECK(liquid.usedQuads());
   // The fluid fills x > 0, y > 0: a quarter of the view (the floor fills y < 0). At one
   // particle per image the kernel rounds the corner outwards, hence the wider bound.
   const double share = waterShare(f);

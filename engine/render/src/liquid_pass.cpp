@@ -2,10 +2,10 @@
 //
 // Design: a blobby (metaball) density field, after Blinn, "A Generalization of Algebraic Surface
 // Drawing" (1982), cut at an iso-level and shaded in screen space:
-//  1. splat: on the CPU (field_splat.hpp), each particle adds w = (1 − q²)³ × its age fade, and
-//     w·|v|, into an RGBA32F field that also carries the gradient of Σw; when sprites are at
-//     least 8 px wide the field has half the image's resolution (a quarter of the pixels) and
-//     the composite reads it bilinearly;
+//  1. splat: each particle is a point sprite (shaders/splat.*) adding w = (1 − q²)³ × its age
+//     fade, and w·|v|, into an RG32F target with additive blending; when sprites are at least
+//     8 px wide the target has half the image's resolution (a quarter of the fragments) and the
+//     composite reads it bilinearly;
 //  2. depth grid: on the CPU, the depth of water above and the local fill (depth_grid.hpp),
 //     uploaded as a small RG32F texture, and the tiles of the image the fluid can reach;
 //  3. composite: over those tiles only, the field becomes water (shaders/composite.frag:
@@ -15,7 +15,6 @@
 #include <cmath>
 
 #include "depth_grid.hpp"
-#include "field_splat.hpp"
 #include "render_pass.hpp"
 
 namespace sph2d {
@@ -25,7 +24,9 @@ std::array<float, 3> color3(const std::array<double, 3>& c) { return {float(c[0]
 
 class LiquidPass final : public RenderPass {
  public:
-  LiquidPass(const RenderDef& def, const RenderOptions& opt) : def_(def), opt_(opt) {
+  LiquidPass(const RenderDef& def, const RenderOptions& opt, SpriteBatch& sprites)
+      : def_(def), opt_(opt), sprites_(sprites) {
+    splatProg_ = gl::program("splat.vert", "splat.frag");
     compositeProg_ = gl::program("solid.vert", "composite.frag");
     glGenVertexArrays(1, &tileVao_);
     glGenBuffers(1, &tileVbo_);
@@ -40,7 +41,7 @@ class LiquidPass final : public RenderPass {
   int spriteShrink(double spacingPx) const override { return spriteDiameter(spacingPx) >= 8.0f ? 2 : 1; }
 
   void targetsChanged() override {
-    field_.resize(0, 0);  // resized with its texture at the next splat
+    fieldW_ = fieldH_ = 0;  // recreated at the next splat
     grid_.solidsChanged();
     drawnRows_ = {0, 1 << 30};  // a new colour target: the whole background at the next frame
   }
@@ -56,6 +57,7 @@ class LiquidPass final : public RenderPass {
       packed_[4 * k + 2] = P.v[i].norm();
       packed_[4 * k + 3] = f.weight[k];
     }
+    sprites_.upload(packed_);
     const int EW = f.geo.EW, EH = f.geo.EH;
     if (grid_.resize(EW, EH, f.spacingPx))
       gl::makeTexture(auxTex_, GL_RG32F, GL_RG, GL_FLOAT, grid_.width(), grid_.height(), GL_LINEAR);
@@ -80,26 +82,34 @@ class LiquidPass final : public RenderPass {
   }
 
  private:
-  /// Σw, Σw·speed and the gradient into the RGBA32F field (field_splat.hpp) and up to its
-  /// texture; at half resolution when sprites are at least 8 px wide (the composite samples it
-  /// bilinearly).
+  /// Σw and Σw·speed into the RG32F field (shaders/splat.*); at half resolution when sprites
+  /// are at least 8 px wide (a quarter of the fragments; the composite samples it bilinearly).
   void splat(const PassFrame& f) {
     const int EW = f.geo.EW, EH = f.geo.EH;
     const float diameter = spriteDiameter(f.spacingPx);
     const int shrink = spriteShrink(f.spacingPx);
     const int fw = (EW + shrink - 1) / shrink, fh = (EH + shrink - 1) / shrink;
-    if (fw != field_.width() || fh != field_.height()) {
-      field_.resize(fw, fh);
-      gl::makeTexture(fieldTex_, GL_RGBA32F, GL_RGBA, GL_FLOAT, fw, fh, shrink > 1 ? GL_LINEAR : GL_NEAREST);
+    if (fw != fieldW_ || fh != fieldH_) {
+      if (fieldFbo_) glDeleteFramebuffers(1, &fieldFbo_);
+      fieldFbo_ = gl::target(GL_RG32F, GL_RG, GL_FLOAT, fw, fh, fieldTex_);
+      const GLint filter = shrink > 1 ? GL_LINEAR : GL_NEAREST;
+      glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, filter);
+      glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, filter);
+      fieldW_ = fw;
+      fieldH_ = fh;
     }
-    field_.splat(packed_, f.scale, f.offset, diameter * float(fw) / float(EW));
-    const int y0 = field_.dirtyBegin(), y1 = field_.dirtyEnd();
-    if (y1 > y0) {
-      glBindTexture(GL_TEXTURE_2D, fieldTex_);
-      glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
-      glTexSubImage2D(GL_TEXTURE_2D, 0, 0, y0, fw, y1 - y0, GL_RGBA, GL_FLOAT,
-                      field_.data().data() + std::size_t(y0) * std::size_t(fw) * 4);
-    }
+    const float fieldDiameter = diameter * float(fw) / float(EW);
+    quads_ = fieldDiameter > sprites_.maxPoint();
+    glViewport(0, 0, fw, fh);
+    glBindFramebuffer(GL_FRAMEBUFFER, fieldFbo_);
+    glClearColor(0, 0, 0, 0);
+    glClear(GL_COLOR_BUFFER_BIT);
+    glEnable(GL_BLEND);
+    glBlendFunc(GL_ONE, GL_ONE);
+    sprites_.setUniforms(splatProg_, f.scale, f.offset, fieldDiameter, fw, fh, quads_);
+    sprites_.draw(GLsizei(f.order.size()), quads_);
+    glDisable(GL_BLEND);
+    glViewport(0, 0, EW, EH);
   }
 
   /// The field becomes water over the tiles the fluid can reach (shaders/composite.frag).
@@ -131,8 +141,6 @@ class LiquidPass final : public RenderPass {
     glUniform2f(gl::uniform(cp, "uAuxScale"), float(EW) / float(grid_.width() * grid_.cell()),
                 float(EH) / float(grid_.height() * grid_.cell()));
     glUniform2f(gl::uniform(cp, "uTexel"), 1.0f / float(EW), 1.0f / float(EH));
-    // The field's gradient is per field pixel: per target pixel it scales by field px per target px.
-    glUniform2f(gl::uniform(cp, "uGradScale"), float(field_.width()) / float(EW), float(field_.height()) / float(EH));
     // Bulk value of the field: Σ (1 − q²)³ over a square lattice ≈ π s²/4, s = sprite radius in spacings.
     const float diameter = spriteDiameter(f.spacingPx);
     const float rs = float(diameter * 0.5 / f.spacingPx);
@@ -158,21 +166,22 @@ class LiquidPass final : public RenderPass {
 
   RenderDef def_;
   RenderOptions opt_;
-  GLuint compositeProg_ = 0;
-  GLuint fieldTex_ = 0, auxTex_ = 0, tileVao_ = 0, tileVbo_ = 0;
+  SpriteBatch& sprites_;
+  GLuint splatProg_ = 0, compositeProg_ = 0;
+  GLuint fieldTex_ = 0, fieldFbo_ = 0, auxTex_ = 0, tileVao_ = 0, tileVbo_ = 0;
+  int fieldW_ = 0, fieldH_ = 0;  // the splat target: full resolution, or half when sprites are wide
   GLsizei tileVertices_ = 0;
   std::pair<int, int> tileRows_{0, 0};              // target rows this frame's tiles cover
   std::pair<int, int> drawnRows_{0, 1 << 30};       // rows of the colour target that are not background
   std::pair<int, int> changedRows_{0, 1 << 30};     // rows the last composite restored or drew
   std::vector<float> packed_, tiles_;  // particles (x, y, speed, weight) in id order; tile quads
-  FieldSplat field_;                   // full resolution, or half when sprites are wide
   DepthGrid grid_;
 };
 
 }  // namespace
 
-std::unique_ptr<RenderPass> makeLiquidPass(const RenderDef& def, const RenderOptions& opt) {
-  return std::make_unique<LiquidPass>(def, opt);
+std::unique_ptr<RenderPass> makeLiquidPass(const RenderDef& def, const RenderOptions& opt, SpriteBatch& sprites) {
+  return std::make_unique<LiquidPass>(def, opt, sprites);
 }
 
 }  // namespace sph2d

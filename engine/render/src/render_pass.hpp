@@ -100,8 +100,8 @@ class RenderPass {
   bool quads_ = false;
 };
 
-/// The liquid mode's pass (liquid_pass.cpp).
-std::unique_ptr<RenderPass> makeLiquidPass(const RenderDef& def, const RenderOptions& opt);
+/// The liquid mode's pass (liquid_pass.cpp); `sprites` must outlive it.
+std::unique_ptr<RenderPass> makeLiquidPass(const RenderDef& def, const RenderOptions& opt, SpriteBatch& sprites);
 /// The particles mode's pass (particles_pass.cpp); `sprites` must outlive it.
 std::unique_ptr<RenderPass> makeParticlesPass(const RenderDef& def, const RenderOptions& opt, SpriteBatch& sprites);
 

@@ -124,7 +124,7 @@ Renderer::Renderer(const RenderDef& def, const RenderOptions& options) : impl_(s
   r.rendererName = std::string(ren ? ren : "?") + " / " + (ver ? ver : "?");
   r.sprites.init();
   r.scenery.init();
-  r.pass = mode == "liquid" ? makeLiquidPass(def, options) : makeParticlesPass(def, options, r.sprites);
+  r.pass = mode == "liquid" ? makeLiquidPass(def, options, r.sprites) : makeParticlesPass(def, options, r.sprites);
   r.frame.width = def.width;
   r.frame.height = def.height;
   r.frame.rgba.assign(std::size_t(def.width) * def.height * 4, 0);

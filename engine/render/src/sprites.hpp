@@ -1,7 +1,6 @@
 // sprites.hpp — particles on their way to the GPU: in id order, one vertex (x, y, value, weight)
 // each, drawn as point sprites or, when wider than the driver's point-size limit, as instanced
-// quads (splat.vert + particles.frag: the particles mode's discs; the liquid splats its field on
-// the CPU, field_splat.hpp, but takes its particles in the same id order).
+// quads (splat.vert serves both the liquid's splat and the particles mode's discs).
 //
 // Design: additive float blending depends on the order of the additions, so particles are
 // always submitted in id order, not in the engine's storage order (which the neighbour grid

@@ -2,9 +2,8 @@
 //
 // Passes per frame (GLSL in shaders/, embedded at build time):
 //   liquid mode
-//     splat      on the CPU, particles → Σ w, Σ w·speed and the gradient of Σ w
-//                in one RGBA32F field (w = (1 − q²)³ × the particle's age fade),
-//                uploaded as a texture
+//     splat      particles → Σ w and Σ w·speed in one RG32F target (point
+//                sprites, additive, w = (1 − q²)³ × the particle's age fade)
 //     aux        on the CPU: a coarse grid of the fluid (cells of ≥ 4 px) giving
 //                the water depth above each cell (carried down row by row and
 //                blurred along each row, so light scatters sideways and no
@@ -25,9 +24,8 @@
 // depends on order), so a frame depends only on the particles' values, not on
 // how the engine stores them. The llvmpipe settings that could change pixels
 // are pinned before the first context is made (pinRenderEnvironment()).
-// Discs wider than the driver's point-size limit (255 px on llvmpipe) are
-// drawn as instanced quads instead, so any zoom renders correctly (the
-// liquid's CPU splat has no size limit).
+// Sprites wider than the driver's point-size limit (255 px on llvmpipe) are
+// drawn as instanced quads instead, so any zoom renders correctly.
 // The OSMesa context belongs to the thread that created the Renderer.
 #pragma once
 
@@ -88,7 +86,7 @@ struct RenderInput {
 /// Wall time of the stages of the last render() [ms]; per stage only with RenderOptions::profile.
 struct RenderTimings {
   double upload = 0;     ///< CPU packing (id order, values, aux grid) and buffer uploads
-  double splat = 0;      ///< splat on the CPU and its upload (liquid) or discs (particles)
+  double splat = 0;      ///< splat (liquid) or discs (particles)
   double composite = 0;  ///< liquid composite (0 in particles mode)
   double solids = 0;     ///< Box2D fixtures
   double readback = 0;   ///< glReadPixels (includes the GPU work not yet finished without profile)
@@ -119,8 +117,7 @@ class Renderer {
   std::string mode() const;
   /// Stage times of the last render().
   RenderTimings lastTimings() const;
-  /// True when the last render() drew instanced quads because discs exceeded the point-size
-  /// limit (particles mode; the liquid's splat runs on the CPU and never does).
+  /// True when the last render() drew instanced quads because sprites exceeded the point-size limit.
   bool usedQuads() const;
   /// The driver's largest point sprite [px] (255 on llvmpipe).
   float maxPointSize() const;
