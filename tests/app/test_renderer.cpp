@@ -1,20 +1,11 @@
 // The renderer in process: numbers about pixels (coverage, hashes, pixel counts), not "it ran".
 #include <doctest/doctest.h>
 
-#include <unistd.h>
-#include <zlib.h>
-
 #include <algorithm>
-#include <cstdio>
-#include <filesystem>
-#include <fstream>
-#include <iterator>
-#include <numeric>
-#include <random>
+#include <cstdlib>
 
 #include "sph2d/hash.hpp"
 #include "sph2d/render/image.hpp"
-#include "sph2d/render/png_io.hpp"
 #include "sph2d/render/renderer.hpp"
 #include "sph2d/scene.hpp"
 #include "sph2d/world.hpp"
@@ -383,110 +374,4 @@ TEST_CASE("liquid depth shading has no vertical seams under a bump and does not 
   const int nearWall = int(at(px(0.0) + 6, yDeep)[2]), awayFromWall = int(at(px(0.0) + 40, yDeep)[2]);
   MESSAGE("blue 6 px from the wall " << nearWall << ", 40 px from it " << awayFromWall);
   CHECK(std::abs(nearWall - awayFromWall) <= 2);
-}
-
-namespace {
-
-/// The concatenated IDAT payload of a PNG file (a zlib stream); checks every chunk's CRC.
-std::vector<std::uint8_t> idatOf(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  const std::vector<std::uint8_t> b((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  std::vector<std::uint8_t> idat;
-  auto u32 = [&](std::size_t at) {
-    return std::uint32_t(b[at]) << 24 | std::uint32_t(b[at + 1]) << 16 | std::uint32_t(b[at + 2]) << 8 | b[at + 3];
-  };
-  REQUIRE(b.size() > 8);
-  for (std::size_t at = 8; at + 12 <= b.size();) {
-    const std::uint32_t n = u32(at);
-    REQUIRE(at + 12 + n <= b.size());
-    CHECK(crc32(0L, b.data() + at + 4, uInt(4 + n)) == u32(at + 8 + n));
-    if (std::equal(b.begin() + long(at) + 4, b.begin() + long(at) + 8, "IDAT")) idat.insert(idat.end(), b.begin() + long(at) + 8, b.begin() + long(at) + 8 + n);
-    at += 12 + n;
-  }
-  return idat;
-}
-
-}  // namespace
-
-TEST_CASE("PNG level 1 (sph2d's own encoder): pixels survive, the zlib stream checks, the size is libpng's") {
-  const std::string dir = (std::filesystem::temp_directory_path() / ("sph2d-png-test-" + std::to_string(::getpid()))).string();
-  std::filesystem::create_directories(dir);
-  std::mt19937 rng(7);
-  auto roundTrip = [&](const Frame& f, const char* what) {
-    const std::string path = dir + "/f.png";
-    writePngAtomic(path, f.width, f.height, f.rgba.data(), 1);
-    int w = 0, h = 0;
-    std::vector<std::uint8_t> back;
-    readPng(path, w, h, back);
-    CHECK_MESSAGE(w == f.width, what);
-    CHECK_MESSAGE(h == f.height, what);
-    // Alpha is not stored (RGB); everything else must come back.
-    std::vector<std::uint8_t> want = f.rgba;
-    for (std::size_t k = 3; k < want.size(); k += 4) want[k] = 255;
-    CHECK_MESSAGE(back == want, what);
-    // zlib's own inflate checks the stream and its Adler-32.
-    const std::vector<std::uint8_t> z = idatOf(path);
-    std::vector<std::uint8_t> raw(std::size_t(f.height) * (3 * std::size_t(f.width) + 1) + 1);
-    uLongf rawLen = uLongf(raw.size());
-    CHECK_MESSAGE(uncompress(raw.data(), &rawLen, z.data(), uLong(z.size())) == Z_OK, what);
-    CHECK_MESSAGE(rawLen == raw.size() - 1, what);
-    return std::filesystem::file_size(path);
-  };
-  auto image = [](int w, int h) {
-    Frame f;
-    f.width = w;
-    f.height = h;
-    f.rgba.assign(std::size_t(w) * std::size_t(h) * 4, 0);
-    return f;
-  };
-  Frame noise = image(333, 77);  // no runs: literals only, every byte value
-  for (auto& b : noise.rgba) b = std::uint8_t(rng());
-  roundTrip(noise, "noise");
-  Frame flat = image(1000, 20);  // runs far longer than deflate's 258
-  std::fill(flat.rgba.begin(), flat.rgba.end(), std::uint8_t(7));
-  roundTrip(flat, "flat");
-  Frame bands = image(257, 9);  // runs of every length 1..40 between changes
-  for (std::size_t p = 0, run = 1, left = 1; p < bands.rgba.size(); ++p) {
-    if (--left == 0) {
-      run = run % 40 + 1;
-      left = run;
-    }
-    bands.rgba[p] = std::uint8_t(run * 6);
-  }
-  roundTrip(bands, "bands");
-  roundTrip(image(1, 1), "1x1");
-  // One dominant byte value: with this generator's numbers the Huffman code first comes out
-  // longer than deflate's 15 bits and must be rebuilt with halved counts (measured).
-  Frame skewed = image(640, 64);
-  for (std::size_t p = 0; p < skewed.rgba.size(); ++p) skewed.rgba[p] = rng() % 200 ? 0 : std::uint8_t(rng());
-  roundTrip(skewed, "skewed");
-  // No byte equal to the one before it after filtering: 128 rows of 256 literals fill exactly one
-  // block of 32768 symbols, and the stream ends with an empty last block.
-  Frame literals = image(85, 128);
-  int before = -1;
-  for (int y = 0; y < literals.height; ++y) {
-    std::vector<int> f(3 * 85 + 1, 1);  // the filtered row: SUB (1), then the differences
-    for (std::size_t i = 1; i < f.size(); ++i)
-      do f[i] = int(rng() & 255);
-      while (f[i] == f[i - 1] || (i + 1 == f.size() && f[i] == 1));
-    REQUIRE(f[0] != before);
-    before = f.back();
-    for (int x = 0; x < 85; ++x)
-      for (int c = 0; c < 3; ++c) {
-        std::uint8_t* px = &literals.rgba[(std::size_t(y) * 85 + std::size_t(x)) * 4];
-        px[c] = std::uint8_t((x ? px[c - 4] : 0) + f[std::size_t(1 + 3 * x + c)]);
-      }
-  }
-  roundTrip(literals, "one full block");
-  // A rendered frame: within 10 % of libpng's size with the same filter and run-length matching.
-  const SceneDef s = blockScene(480, 270, Vec2d(-0.1, -0.1), Vec2d(0.3, 0.3));
-  World world(s, WorldOptions{1});
-  Renderer r(s.render);
-  const Frame frame = r.render(world);
-  const auto ours = roundTrip(frame, "rendered frame");
-  writePngAtomic(dir + "/libpng.png", frame.width, frame.height, frame.rgba.data(), 2);
-  const auto theirs = std::filesystem::file_size(dir + "/libpng.png");
-  MESSAGE("rendered frame: " << ours << " bytes at level 1, " << theirs << " bytes with libpng at level 2");
-  CHECK(double(ours) < 1.1 * double(theirs));
-  std::filesystem::remove_all(dir);
 }
