@@ -1,5 +1,6 @@
 // `sph2d bench render`: per-stage milliseconds of the renderer and the PNG encoder
 // on a synthetic dam-break tank. A benchmark, not a test.
+#include <time.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -29,7 +30,9 @@ const char* kBenchHelp =
     "best milliseconds of each stage: upload (CPU packing, depth grid), splat,\n"
     "composite, solids, readback, overlay, PNG encode (level L, default 1) and hash.\n"
     "Stages are timed with glFinish between them; the 'render, no sync' row is the\n"
-    "same frame without those fences, as `sph2d run` renders it. --save writes the frame.\n"
+    "same frame without those fences, as `sph2d run` renders it. The CPU rows are the\n"
+    "process's CPU time (every thread: llvmpipe's too) per frame, which other processes\n"
+    "on a shared machine disturb less than wall time. --save writes the frame.\n"
     "\n"
     "Render flags:\n";
 
@@ -42,6 +45,13 @@ struct Stat {
   }
   double best() const { return v.empty() ? 0 : *std::min_element(v.begin(), v.end()); }
 };
+
+/// CPU time of the whole process (all threads) [ms].
+double processCpuMs() {
+  timespec t{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+  return double(t.tv_sec) * 1e3 + double(t.tv_nsec) * 1e-6;
+}
 
 }  // namespace
 
@@ -126,7 +136,7 @@ int cmdBench(const std::vector<std::string>& args) {
   Renderer profiled(scene.render, opt);
   std::printf("bench render: %zu particles, %dx%d, %s mode, %d frames, PNG level %d\nrenderer: %s\n", P.size(), width,
               height, profiled.mode().c_str(), frames, level, profiled.rendererString().c_str());
-  Stat upload, splat, composite, solids, readback, overlay, png, hash, total, nosync, pngBytes;
+  Stat upload, splat, composite, solids, readback, overlay, png, hash, total, nosync, pngBytes, cpuRender, cpuPng;
   {
     const Frame& first = profiled.render(in);  // warm-up: shader compilation, first-use costs
     if (!save.empty()) writePngAtomic(save, first.width, first.height, first.rgba.data(), level);
@@ -147,7 +157,9 @@ int cmdBench(const std::vector<std::string>& args) {
     hash.v.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
     const std::string path = tmp + "/frame.png";
     t0 = std::chrono::steady_clock::now();
+    const double c0 = processCpuMs();
     writePngAtomic(path, fr.width, fr.height, fr.rgba.data(), level);
+    cpuPng.v.push_back(processCpuMs() - c0);
     png.v.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
     pngBytes.v.push_back(double(fs::file_size(path)));
   }
@@ -156,7 +168,9 @@ int cmdBench(const std::vector<std::string>& args) {
     Renderer plain(scene.render, opt);
     plain.render(in);
     for (int k = 0; k < frames; ++k) {
+      const double c0 = processCpuMs();
       plain.render(in);
+      cpuRender.v.push_back(processCpuMs() - c0);
       nosync.v.push_back(plain.lastTimings().total);
     }
   }
@@ -176,6 +190,11 @@ int cmdBench(const std::vector<std::string>& args) {
   Stat sum;
   for (std::size_t k = 0; k < nosync.v.size(); ++k) sum.v.push_back(nosync.v[k] + png.v[k]);
   row("render + PNG", sum);
+  Stat cpuSum;
+  for (std::size_t k = 0; k < cpuRender.v.size(); ++k) cpuSum.v.push_back(cpuRender.v[k] + cpuPng.v[k]);
+  row("CPU: render, no sync", cpuRender);
+  row("CPU: PNG encode", cpuPng);
+  row("CPU: render + PNG", cpuSum);
   std::printf("PNG size %.0f KB; sprites as %s\n", pngBytes.mean() / 1024.0, profiled.usedQuads() ? "instanced quads" : "points");
   return 0;
 }

@@ -3,7 +3,8 @@
 //  - edge: the field thresholded at half its bulk value (lower where the fluid
 //    is sparse, so lone drops stay visible), anti-aliased over one pixel;
 //  - body: light from above absorbed by the water above the pixel (depth from
-//    the CPU grid), from the surface colour towards the deep colour;
+//    the CPU grid, scattered sideways on its way down), from the surface colour
+//    towards the deep colour;
 //  - surface: shading from the field's gradient (light from above), a bright
 //    meniscus just inside the edge and a specular highlight;
 //  - foam: towards white where the kernel-weighted speed is high.

@@ -2,8 +2,7 @@
 #include <doctest/doctest.h>
 
 #include <algorithm>
-#include <numeric>
-#include <random>
+#include <cstdlib>
 
 #include "sph2d/hash.hpp"
 #include "sph2d/render/image.hpp"
@@ -104,6 +103,22 @@ TEST_CASE("liquid frames depend on particle values only, not on storage order, a
   const double got = waterShare(a.render(world));
   MESSAGE("water share " << got << ", block share " << expected);
   CHECK(got == doctest::Approx(expected).epsilon(0.15));
+}
+
+TEST_CASE("a liquid frame does not depend on the frames before it (the background comes back where water was)") {
+  const SceneDef s = blockScene(160, 120, Vec2d(-0.1, -0.1), Vec2d(0.3, 0.3));
+  World world(s, WorldOptions{1});
+  // The same block lifted by 0.08 m: its rows of the image are others.
+  Particles up = world.particles();
+  for (auto& x : up.x) x.y() += 0.08f;
+  Renderer seq(s.render);
+  const std::uint64_t first = hashOf(seq.render(world));
+  const std::uint64_t lifted = hashOf(seq.render(inputOf(world, up)));
+  const std::uint64_t again = hashOf(seq.render(world));
+  Renderer fresh(s.render);
+  CHECK(hashOf(fresh.render(inputOf(world, up))) == lifted);
+  CHECK(again == first);
+  CHECK(lifted != first);
 }
 
 TEST_CASE("at high zoom sprites wider than the point-size limit are drawn as quads and cover the right area") {
@@ -279,4 +294,84 @@ TEST_CASE("100k particles render: a 2 m x 1 m lattice covers its share of a 960x
   const double litShare = double(lit) / (f.width * 0.75 * f.height);
   MESSAGE("100k discs: lit share " << litShare << ", block " << block / 0.75);
   CHECK(litShare == doctest::Approx(block / 0.75).epsilon(0.05));
+}
+
+namespace {
+
+/// A pool 0.6 m deep from a wall at x = 0 to beyond the view's right edge, with a block 0.3 m
+/// high and 0.2 m wide standing on its surface at x = 0.8 .. 1.0 (a bump), as a square lattice
+/// at rest, seen at 240 px/m (spacing 3 px, like the dam break).
+struct BumpPool {
+  Particles P;
+  std::vector<Collider> walls;
+  RenderDef def;
+  RenderInput in;
+  static constexpr double dx = 0.0125;
+  BumpPool() {
+    std::uint32_t id = 0;
+    auto fill = [&](double x0, double x1, double y0, double y1) {
+      for (double y = y0 + dx / 2; y < y1; y += dx)
+        for (double x = x0 + dx / 2; x < x1; x += dx) P.push(Vec2(Real(x), Real(y)), Vec2(0, 0), id++, Real(1000));
+    };
+    fill(0.0, 2.5, 0.0, 0.6);
+    fill(0.8, 1.0, 0.6, 0.9);
+    Collider wall;  // x −0.1 .. 0, y −0.1 .. 1.2, counter-clockwise
+    wall.vertices = {Vec2(-0.1f, -0.1f), Vec2(0.0f, -0.1f), Vec2(0.0f, 1.2f), Vec2(-0.1f, 1.2f)};
+    wall.normals = {Vec2(0, -1), Vec2(1, 0), Vec2(0, 1), Vec2(-1, 0)};
+    wall.lo = Vec2(-0.1f, -0.1f);
+    wall.hi = Vec2(0.0f, 1.2f);
+    walls.push_back(wall);
+    def.width = 480;
+    def.height = 270;
+    def.camera.automatic = false;
+    def.camera.min = Vec2d(-0.2, -0.1);
+    def.camera.max = Vec2d(1.8, 1.025);
+    in.particles = &P;
+    in.spacing = dx;
+    in.colliders = &walls;
+  }
+};
+
+}  // namespace
+
+TEST_CASE("liquid depth shading has no vertical seams under a bump and does not light the water along a wall") {
+  BumpPool pool;
+  Renderer r(pool.def);
+  const Frame& f = r.render(pool.in);
+  const auto cam = r.cameraRect();
+  const double pxPerM = f.width / (cam[2] - cam[0]);
+  auto px = [&](double x) { return int(std::floor((x - cam[0]) * pxPerM)); };
+  auto py = [&](double y) { return int(std::floor((cam[3] - y) * pxPerM)); };
+  auto at = [&](int x, int y) { return &f.rgba[(std::size_t(y) * std::size_t(f.width) + std::size_t(x)) * 4]; };
+  // Rows 0.12 m to 0.45 m below the pool's surface (29 px or more from any edge of the water),
+  // from 12 px right of the wall to the image's right edge (the pool goes on beyond it). The
+  // old shading (each column's own depth, no sideways spread) stepped by 8 levels between two
+  // pixels under the bump's sides; now the largest step is 2.
+  int worst = 0, worstX = 0, worstY = 0;
+  for (double depth = 0.12; depth <= 0.45; depth += 0.03) {
+    const int y = py(0.6 - depth);
+    for (int x = px(0.0) + 12; x + 1 < f.width; ++x)
+      for (int c = 0; c < 3; ++c) {
+        const int d = std::abs(int(at(x + 1, y)[c]) - int(at(x, y)[c]));
+        if (d > worst) {
+          worst = d;
+          worstX = x;
+          worstY = y;
+        }
+      }
+  }
+  MESSAGE("largest step between neighbouring pixels inside the water: " << worst << " levels at x " << worstX
+                                                                          << ", y " << worstY);
+  CHECK(worst <= 3);
+  // The shading is still there: deeper water is darker, and so is the water under the bump.
+  const int yDeep = py(0.15), yShallow = py(0.55), xFar = px(1.6), xBump = px(0.9);
+  MESSAGE("blue: shallow " << int(at(xFar, yShallow)[2]) << ", deep " << int(at(xFar, yDeep)[2])
+                           << ", deep under the bump " << int(at(xBump, yDeep)[2]));
+  CHECK(int(at(xFar, yShallow)[2]) - int(at(xFar, yDeep)[2]) >= 20);
+  CHECK(int(at(xFar, yDeep)[2]) - int(at(xBump, yDeep)[2]) >= 8);
+  // The wall neither passes light nor lends its own depth (none) to the water beside it: deep
+  // down, the water 6 px from the wall (past the rim the fluid's edge draws there) is as dark as 40 px from it.
+  const int nearWall = int(at(px(0.0) + 6, yDeep)[2]), awayFromWall = int(at(px(0.0) + 40, yDeep)[2]);
+  MESSAGE("blue 6 px from the wall " << nearWall << ", 40 px from it " << awayFromWall);
+  CHECK(std::abs(nearWall - awayFromWall) <= 2);
 }

@@ -1,3 +1,5 @@
+// png_io.cpp — PNG files through libpng: encoded in memory with the settings of their level,
+// written to a temporary name and renamed.
 #include "sph2d/render/png_io.hpp"
 
 #include <png.h>
@@ -17,7 +19,25 @@ namespace {
 
 // libpng reports errors by longjmp; these helpers keep C++ objects out of the
 // functions that call setjmp.
-bool writeRaw(FILE* f, int width, int height, const std::uint8_t* rgba, int level, char* err, std::size_t errLen) {
+
+/// libpng's write callback: appends to the std::vector<std::uint8_t> behind the io pointer.
+void appendBytes(png_structp png, png_bytep data, png_size_t n) {
+  auto* out = static_cast<std::vector<std::uint8_t>*>(png_get_io_ptr(png));
+  bool ok = true;
+  try {
+    out->insert(out->end(), data, data + n);
+  } catch (...) {
+    ok = false;
+  }
+  if (!ok) png_error(png, "out of memory");
+}
+
+void flushNothing(png_structp) {}
+
+/// Encodes with `s` into `out`; `rows` points at each row libpng is given (RGBA, or packed RGB
+/// with Input::PackedRgb).
+bool encodeRaw(std::vector<std::uint8_t>* out, int width, int height, png_bytepp rows, const PngSettings& s,
+               char* err, std::size_t errLen) {
   png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, nullptr, nullptr, nullptr);
   if (!png) {
     std::snprintf(err, errLen, "png_create_write_struct failed");
@@ -29,18 +49,24 @@ bool writeRaw(FILE* f, int width, int height, const std::uint8_t* rgba, int leve
     std::snprintf(err, errLen, "libpng could not encode the image");
     return false;
   }
-  png_init_io(png, f);
-  png_set_compression_level(png, level);
-  // Fast levels: the SUB filter and run-length matching, which on our frames (flat
-  // background, smooth water) is as fast as plain level 1 and about 10 % smaller.
-  if (level <= 2) png_set_compression_strategy(png, Z_RLE);
-  png_set_filter(png, 0, level <= 2 ? PNG_FILTER_SUB : PNG_ALL_FILTERS);
-  png_set_IHDR(png, info, png_uint_32(width), png_uint_32(height), 8, PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE,
+  png_set_write_fn(png, out, appendBytes, flushNothing);
+  png_set_compression_level(png, s.level);
+  png_set_compression_strategy(png, s.strategy);
+  png_set_compression_mem_level(png, s.memLevel);
+  png_set_compression_window_bits(png, s.windowBits);
+  png_set_compression_buffer_size(png, png_size_t(s.bufferSize));
+  png_set_filter(png, 0, s.filters);
+  const bool rgba = s.input == PngSettings::Input::Rgba;
+  const int colorType = rgba ? PNG_COLOR_TYPE_RGB_ALPHA : PNG_COLOR_TYPE_RGB;
+  png_set_IHDR(png, info, png_uint_32(width), png_uint_32(height), 8, colorType, PNG_INTERLACE_NONE,
                PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
   png_write_info(png, info);
-  png_set_filler(png, 0, PNG_FILLER_AFTER);  // input rows are RGBA; drop A
-  for (int y = 0; y < height; ++y)
-    png_write_row(png, const_cast<png_bytep>(rgba + std::size_t(y) * std::size_t(width) * 4));
+  if (s.input == PngSettings::Input::Filler) png_set_filler(png, 0, PNG_FILLER_AFTER);  // rows are RGBA; drop A
+  if (s.wholeImage) {
+    png_write_image(png, rows);
+  } else {
+    for (int y = 0; y < height; ++y) png_write_row(png, rows[y]);
+  }
   png_write_end(png, nullptr);
   png_destroy_write_struct(&png, &info);
   return true;
@@ -90,12 +116,62 @@ bool injectedWriteFailure() {
 
 }  // namespace
 
+PngSettings pngSettings(int level) {
+  PngSettings s;
+  s.level = level;
+  if (level == 0) {  // stored: no filter, no compression
+    s.strategy = Z_DEFAULT_STRATEGY;
+    s.filters = PNG_FILTER_NONE;
+  } else if (level == 2) {  // the SUB filter and run-length matching: smaller files than level 1
+    s.strategy = Z_RLE;
+    s.filters = PNG_FILTER_SUB;
+  } else if (level >= 3) {  // zlib's level, libpng choosing each row's filter
+    s.strategy = Z_DEFAULT_STRATEGY;
+    s.filters = PNG_ALL_FILTERS;
+  } else {  // 1: the fastest measured on the dam break's frames (docs/RENDERING.md "PNG settings")
+    s.strategy = Z_DEFAULT_STRATEGY;
+    s.filters = PNG_FILTER_NONE;
+  }
+  return s;
+}
+
+void encodePng(int width, int height, const std::uint8_t* rgba, const PngSettings& settings,
+               std::vector<std::uint8_t>& out) {
+  if (width <= 0 || height <= 0) throw std::runtime_error("encodePng: empty image");
+  const std::size_t w = std::size_t(width), h = std::size_t(height);
+  thread_local std::vector<std::uint8_t> packed;
+  thread_local std::vector<png_bytep> rows;
+  rows.resize(h);
+  if (settings.input == PngSettings::Input::PackedRgb) {
+    packed.resize(w * h * 3);
+    // Four bytes copied per pixel, the fourth overwritten by the next pixel (one spare byte).
+    packed.resize(w * h * 3 + 1);
+    for (std::size_t p = 0; p < w * h; ++p) std::memcpy(&packed[3 * p], &rgba[4 * p], 4);
+    for (std::size_t y = 0; y < h; ++y) rows[y] = packed.data() + y * w * 3;
+  } else {
+    for (std::size_t y = 0; y < h; ++y) rows[y] = const_cast<png_bytep>(rgba + y * w * 4);
+  }
+  out.clear();
+  char err[256] = {0};
+  if (!encodeRaw(&out, width, height, rows.data(), settings, err, sizeof err)) throw std::runtime_error(err);
+}
+
 void writePngAtomic(const std::string& path, int width, int height, const std::uint8_t* rgba, int level) {
+  thread_local std::vector<std::uint8_t> bytes;
+  try {
+    encodePng(width, height, rgba, pngSettings(level), bytes);
+  } catch (const std::exception& e) {
+    throw std::runtime_error("cannot write " + path + ": " + e.what());
+  }
   const std::string tmp = path + ".tmp" + std::to_string(::getpid());
   FILE* f = std::fopen(tmp.c_str(), "wb");
   if (!f) throw std::runtime_error("cannot create " + tmp + ": " + std::strerror(errno));
   char err[256] = {0};
-  bool ok = writeRaw(f, width, height, rgba, level, err, sizeof err);
+  bool ok = true;
+  if (std::fwrite(bytes.data(), 1, bytes.size(), f) != bytes.size()) {
+    std::snprintf(err, sizeof err, "%s", std::strerror(errno));
+    ok = false;
+  }
   if (std::fflush(f) != 0 || std::ferror(f)) {
     if (ok) std::snprintf(err, sizeof err, "%s", std::strerror(errno));
     ok = false;

@@ -2,11 +2,13 @@
 //
 // Passes per frame (GLSL in shaders/, embedded at build time):
 //   liquid mode
-//     splat      particles → Σ w and Σ w·speed in one RG32F target (additive,
-//                w = (1 − q²)³ × the particle's age fade)
+//     splat      particles → Σ w and Σ w·speed in one RG32F target (point
+//                sprites, additive, w = (1 − q²)³ × the particle's age fade)
 //     aux        on the CPU: a coarse grid of the fluid (cells of ≥ 4 px) giving
-//                the water depth above each cell and the local fill; uploaded as
-//                a small RG32F texture, sampled bilinearly
+//                the water depth above each cell (carried down row by row and
+//                blurred along each row, so light scatters sideways and no
+//                vertical seams appear) and the local fill; uploaded as a small
+//                RG32F texture, sampled bilinearly
 //     composite  field → liquid: anti-aliased edge, shading from the field's
 //                gradient (light from above), colour from the depth of water
 //                above, foam where the weighted speed is high
@@ -37,6 +39,7 @@
 #include "sph2d/boundary.hpp"
 #include "sph2d/particles.hpp"
 #include "sph2d/render/image.hpp"
+#include "sph2d/render/render_env.hpp"  // EnvSetting, pinRenderEnvironment(), cpuSummary()
 #include "sph2d/scene.hpp"
 
 namespace sph2d {
@@ -90,23 +93,6 @@ struct RenderTimings {
   double overlay = 0;    ///< CPU text and colour bar
   double total = 0;      ///< the whole render()
 };
-
-/// One environment variable that can affect llvmpipe, as the renderer found or set it.
-struct EnvSetting {
-  std::string name;    ///< e.g. "LP_NUM_THREADS"
-  std::string value;   ///< "" when unset
-  std::string source;  ///< "user" (set before sph2d ran), "sph2d" (pinned by pinRenderEnvironment) or "unset"
-};
-
-/// Pins, before the first OSMesa context of the process, the Mesa settings that can change
-/// pixels or make runs depend on the user's home (GALLIUM_DRIVER=llvmpipe, no shader cache),
-/// unless the user set them; returns every setting that matters, pinned or not, for the
-/// manifest. Called by the Renderer constructor; later calls only report.
-std::vector<EnvSetting> pinRenderEnvironment();
-
-/// The CPU features that llvmpipe's code generation depends on (from /proc/cpuinfo),
-/// e.g. "AMD EPYC; avx avx2 fma f16c avx512f".
-std::string cpuSummary();
 
 /// Renders frames of a World.
 class Renderer {

@@ -1,0 +1,190 @@
+// depth_grid.cpp — the liquid's coarse CPU grid (see depth_grid.hpp for the design).
+#include "depth_grid.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace sph2d {
+
+bool DepthGrid::resize(int EW, int EH, double spacingPx) {
+  const int cell = std::max(4, int(std::ceil(spacingPx)));
+  const int w = (EW + cell - 1) / cell, h = (EH + cell - 1) / cell;
+  if (w == w_ && h == h_ && cell == cell_) return false;
+  w_ = w;
+  h_ = h;
+  cell_ = cell;
+  solidsStale_ = true;
+  return true;
+}
+
+void DepthGrid::buildSolidMask(const RenderInput& in, double x0, double y1, double cellM) {
+  // Cells whose centre lies inside a collider (segments: within half a cell of it). The
+  // colliders are static, so this runs when the grid or the camera changes.
+  solid_.assign(std::size_t(w_) * std::size_t(h_), 0);
+  solidsStale_ = false;
+  if (!in.colliders) return;
+  for (const Collider& c : *in.colliders) {
+    const double pad = c.kind == Collider::Kind::Segment ? 0.5 * cellM : 0.0;
+    // Cells whose centre can lie in the collider's bounding box (grid rows run top-down).
+    const int ix0 = std::max(0, int(std::floor((c.lo.x() - pad - x0) / cellM - 0.5)));
+    const int ix1 = std::min(w_ - 1, int(std::ceil((c.hi.x() + pad - x0) / cellM - 0.5)));
+    const int iy0 = std::max(0, int(std::floor((y1 - c.hi.y() - pad) / cellM - 0.5)));
+    const int iy1 = std::min(h_ - 1, int(std::ceil((y1 - c.lo.y() + pad) / cellM - 0.5)));
+    for (int iy = iy0; iy <= iy1; ++iy)
+      for (int ix = ix0; ix <= ix1; ++ix) {
+        const Vec2d p(x0 + (ix + 0.5) * cellM, y1 - (iy + 0.5) * cellM);
+        bool inside = true;
+        if (c.kind == Collider::Kind::Polygon) {
+          for (std::size_t k = 0; k < c.vertices.size() && inside; ++k)
+            inside = c.normals[k].cast<double>().dot(p - c.vertices[k].cast<double>()) <= 0.0;
+        } else if (c.kind == Collider::Kind::Circle) {
+          inside = (p - c.center.cast<double>()).squaredNorm() <= double(c.radius) * double(c.radius);
+        } else {
+          const Vec2d a = c.vertices[0].cast<double>(), b = c.vertices[1].cast<double>(), ab = b - a;
+          const double t = ab.squaredNorm() > 0 ? std::clamp((p - a).dot(ab) / ab.squaredNorm(), 0.0, 1.0) : 0.0;
+          inside = (p - (a + t * ab)).norm() <= pad;
+        }
+        if (inside) solid_[std::size_t(iy) * std::size_t(w_) + std::size_t(ix)] = 1;
+      }
+  }
+}
+
+void DepthGrid::build(const RenderInput& in, const std::vector<double>& ext, double pxPerM,
+                      const std::vector<std::uint32_t>& order, const std::vector<float>& weight) {
+  const double spacingPx = in.spacing * pxPerM;
+  const int w = w_, h = h_, cell = cell_;
+  cover_.assign(std::size_t(w) * std::size_t(h), 0.0f);
+  const Particles& P = *in.particles;
+  const double cellM = cell / pxPerM;
+  const double x0 = ext[0] - in.origin.x(), y1 = ext[3] - in.origin.y();
+  const float areaShare = float((spacingPx * spacingPx) / (double(cell) * double(cell)));
+  // Cloud-in-cell deposit (bilinear weights): no aliasing between the lattice and the cells.
+  for (std::size_t k = 0; k < order.size(); ++k) {
+    const std::size_t i = order[k];
+    const double cx = (double(P.x[i].x()) - x0) / cellM - 0.5, cy = (y1 - double(P.x[i].y())) / cellM - 0.5;
+    if (!(cx > -1 && cy > -1 && cx < w && cy < h)) continue;
+    const int ix = int(std::floor(cx)), iy = int(std::floor(cy));
+    const float tx = float(cx - ix), ty = float(cy - iy);
+    const float m = areaShare * weight[k];
+    const float wgt[4] = {(1 - tx) * (1 - ty) * m, tx * (1 - ty) * m, (1 - tx) * ty * m, tx * ty * m};
+    for (int q = 0; q < 4; ++q) {
+      const int xx = ix + (q & 1), yy = iy + (q >> 1);
+      if (xx >= 0 && yy >= 0 && xx < w && yy < h) cover_[std::size_t(yy) * std::size_t(w) + std::size_t(xx)] += wgt[q];
+    }
+  }
+  for (float& c : cover_) c = std::min(c, 1.0f);
+  if (solidsStale_) buildSolidMask(in, x0, y1, cellM);
+  aux_.assign(std::size_t(w) * std::size_t(h) * 2, 0.0f);
+  // Depth of water above, with the light scattered sideways as it goes down: row by row from
+  // the top, the depth carried into a row is the row above's, blurred along the row by a
+  // binomial kernel [1 4 6 4 1]/16 (variance one cell² per row) over the cells that are not
+  // solid. A step in depth between neighbouring columns (under a bump, at the foot of a
+  // splash) thus widens like a diffusion, about sqrt(rows below the step) cells, instead of
+  // running down as a vertical seam; solids neither pass light nor lend their depth of zero
+  // to the water beside them (a wall would otherwise light the water along it).
+  // The row buffers carry two cells of zero-weight padding on each side: the kernel's taps
+  // need no bounds checks, and a masked tap adds exactly +0 to both sums.
+  carry_.assign(std::size_t(w) + 4, 0.0f);
+  above_.assign(std::size_t(w) + 4, 0.0f);
+  open_.assign(std::size_t(w) + 4, 0.0f);
+  static const float kBlur[5] = {1.0f / 16, 4.0f / 16, 6.0f / 16, 4.0f / 16, 1.0f / 16};
+  float* carry = carry_.data() + 2;
+  float* above = above_.data() + 2;
+  float* open = open_.data() + 2;  // 1 where the cell is not solid, 0 where it is and outside
+  for (int y = 0; y < h; ++y) {
+    const std::size_t row = std::size_t(y) * std::size_t(w);
+    for (int x = 0; x < w; ++x) {
+      const float c = cover_[row + std::size_t(x)];
+      aux_[(row + std::size_t(x)) * 2] = float((carry[x] + 0.5f * c) * cellM);
+      carry[x] += c;
+      open[x] = solid_[row + std::size_t(x)] ? 0.0f : 1.0f;
+    }
+    for (int x = 0; x < w; ++x) {
+      float s = 0, n = 0;
+      for (int d = -2; d <= 2; ++d) {
+        const float k = kBlur[d + 2] * open[x + d];
+        s += k * carry[x + d];
+        n += k;
+      }
+      above[x] = n > 0 ? s / n : carry[x];
+    }
+    std::swap(carry, above);
+  }
+  // Local fill: the 3×3 mean of the coverage (inside without bounds checks, same order).
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      float s = 0;
+      int n = 0;
+      if (y > 0 && x > 0 && y + 1 < h && x + 1 < w) {
+        for (int dy = -1; dy <= 1; ++dy) {
+          const float* c = &cover_[std::size_t(y + dy) * std::size_t(w) + std::size_t(x - 1)];
+          s += c[0];
+          s += c[1];
+          s += c[2];
+        }
+        n = 9;
+      } else {
+        for (int dy = -1; dy <= 1; ++dy)
+          for (int dx = -1; dx <= 1; ++dx) {
+            const int xx = x + dx, yy = y + dy;
+            if (xx < 0 || yy < 0 || xx >= w || yy >= h) continue;
+            s += cover_[std::size_t(yy) * std::size_t(w) + std::size_t(xx)];
+            ++n;
+          }
+      }
+      aux_[(std::size_t(y) * std::size_t(w) + std::size_t(x)) * 2 + 1] = s / float(n);
+    }
+}
+
+std::pair<int, int> DepthGrid::tiles(float spriteRadiusPx, int EW, int EH, std::vector<float>& out) {
+  const int w = w_, h = h_;
+  const int reach = int(std::ceil((spriteRadiusPx + 1.0f) / float(cell_)));
+  // Dilation by `reach` cells along rows, then along columns, with running counts of the
+  // active cells in the window.
+  active_.assign(std::size_t(w) * std::size_t(h), 0);
+  activeTmp_.assign(active_.size(), 0);
+  for (std::size_t k = 0; k < cover_.size(); ++k) active_[k] = cover_[k] > 0.0f;
+  for (int y = 0; y < h; ++y) {
+    const std::uint8_t* a = &active_[std::size_t(y) * std::size_t(w)];
+    std::uint8_t* o = &activeTmp_[std::size_t(y) * std::size_t(w)];
+    int count = 0;
+    for (int x = 0; x < std::min(reach, w); ++x) count += a[x];
+    for (int x = 0; x < w; ++x) {
+      if (x + reach < w) count += a[x + reach];
+      if (x - reach - 1 >= 0) count -= a[x - reach - 1];
+      o[x] = count > 0;
+    }
+  }
+  for (int x = 0; x < w; ++x) {
+    int count = 0;
+    for (int y = 0; y < std::min(reach, h); ++y) count += activeTmp_[std::size_t(y) * std::size_t(w) + std::size_t(x)];
+    for (int y = 0; y < h; ++y) {
+      if (y + reach < h) count += activeTmp_[std::size_t(y + reach) * std::size_t(w) + std::size_t(x)];
+      if (y - reach - 1 >= 0) count -= activeTmp_[std::size_t(y - reach - 1) * std::size_t(w) + std::size_t(x)];
+      active_[std::size_t(y) * std::size_t(w) + std::size_t(x)] = count > 0;
+    }
+  }
+  out.clear();
+  int rowFirst = h, rowLast = -1;
+  auto ndcX = [&](int px) { return float(std::min(px, EW)) / float(EW) * 2.0f - 1.0f; };
+  auto ndcY = [&](int py) { return float(std::min(py, EH)) / float(EH) * 2.0f - 1.0f; };
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w;) {
+      if (!active_[std::size_t(y) * std::size_t(w) + std::size_t(x)]) {
+        ++x;
+        continue;
+      }
+      int e = x;
+      while (e < w && active_[std::size_t(y) * std::size_t(w) + std::size_t(e)]) ++e;
+      const float x0 = ndcX(x * cell_), x1 = ndcX(e * cell_), y0 = ndcY(y * cell_), y1 = ndcY((y + 1) * cell_);
+      const float q[12] = {x0, y0, x1, y0, x0, y1, x0, y1, x1, y0, x1, y1};
+      out.insert(out.end(), q, q + 12);
+      rowFirst = std::min(rowFirst, y);
+      rowLast = std::max(rowLast, y);
+      x = e;
+    }
+  if (rowLast < 0) return {0, 0};
+  return {std::min(rowFirst * cell_, EH), std::min((rowLast + 1) * cell_, EH)};
+}
+
+}  // namespace sph2d

@@ -1,0 +1,187 @@
+// liquid_pass.cpp — the liquid mode: particles → a smooth field → water.
+//
+// Design: a blobby (metaball) density field, after Blinn, "A Generalization of Algebraic Surface
+// Drawing" (1982), cut at an iso-level and shaded in screen space:
+//  1. splat: each particle is a point sprite (shaders/splat.*) adding w = (1 − q²)³ × its age
+//     fade, and w·|v|, into an RG32F target with additive blending; when sprites are at least
+//     8 px wide the target has half the image's resolution (a quarter of the fragments) and the
+//     composite reads it bilinearly;
+//  2. depth grid: on the CPU, the depth of water above and the local fill (depth_grid.hpp),
+//     uploaded as a small RG32F texture, and the tiles of the image the fluid can reach;
+//  3. composite: over those tiles only, the field becomes water (shaders/composite.frag:
+//     thresholded edge, depth colour, shading from the field's gradient, foam); elsewhere the
+//     frame keeps its background.
+#include <algorithm>
+#include <cmath>
+
+#include "depth_grid.hpp"
+#include "render_pass.hpp"
+
+namespace sph2d {
+namespace {
+
+std::array<float, 3> color3(const std::array<double, 3>& c) { return {float(c[0]), float(c[1]), float(c[2])}; }
+
+class LiquidPass final : public RenderPass {
+ public:
+  LiquidPass(const RenderDef& def, const RenderOptions& opt, SpriteBatch& sprites)
+      : def_(def), opt_(opt), sprites_(sprites) {
+    splatProg_ = gl::program("splat.vert", "splat.frag");
+    compositeProg_ = gl::program("solid.vert", "composite.frag");
+    glGenVertexArrays(1, &tileVao_);
+    glGenBuffers(1, &tileVbo_);
+    glBindVertexArray(tileVao_);
+    glBindBuffer(GL_ARRAY_BUFFER, tileVbo_);
+    glEnableVertexAttribArray(0);
+    glVertexAttribPointer(0, 2, GL_FLOAT, GL_FALSE, 0, nullptr);
+  }
+
+  const char* mode() const override { return "liquid"; }
+  float spriteDiameter(double spacingPx) const override { return float(2.0 * def_.splatRadius * spacingPx); }
+  int spriteShrink(double spacingPx) const override { return spriteDiameter(spacingPx) >= 8.0f ? 2 : 1; }
+
+  void targetsChanged() override {
+    fieldW_ = fieldH_ = 0;  // recreated at the next splat
+    grid_.solidsChanged();
+    drawnRows_ = {0, 1 << 30};  // a new colour target: the whole background at the next frame
+  }
+
+  void prepare(const PassFrame& f) override {
+    const Particles& P = *f.in.particles;
+    const std::size_t n = f.order.size();
+    packed_.resize(n * 4);
+    for (std::size_t k = 0; k < n; ++k) {
+      const std::size_t i = f.order[k];
+      packed_[4 * k] = P.x[i].x();
+      packed_[4 * k + 1] = P.x[i].y();
+      packed_[4 * k + 2] = P.v[i].norm();
+      packed_[4 * k + 3] = f.weight[k];
+    }
+    sprites_.upload(packed_);
+    const int EW = f.geo.EW, EH = f.geo.EH;
+    if (grid_.resize(EW, EH, f.spacingPx))
+      gl::makeTexture(auxTex_, GL_RG32F, GL_RG, GL_FLOAT, grid_.width(), grid_.height(), GL_LINEAR);
+    grid_.build(f.in, f.geo.ext, f.pxPerM, f.order, f.weight);
+    glBindTexture(GL_TEXTURE_2D, auxTex_);
+    glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+    glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, grid_.width(), grid_.height(), GL_RG, GL_FLOAT, grid_.aux().data());
+    tileRows_ = grid_.tiles(float(def_.splatRadius * f.spacingPx), EW, EH, tiles_);
+    tileVertices_ = GLsizei(tiles_.size() / 2);
+    glBindBuffer(GL_ARRAY_BUFFER, tileVbo_);
+    glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(tiles_.size() * sizeof(float)), tiles_.empty() ? nullptr : tiles_.data(),
+                 GL_STREAM_DRAW);
+  }
+
+  std::pair<int, int> changedRows() const override { return changedRows_; }
+
+  void draw(const PassFrame& f, StageTimer& timer, RenderTimings& timings) override {
+    splat(f);
+    timer.end(timings.splat);
+    composite(f);
+    timer.end(timings.composite);
+  }
+
+ private:
+  /// Σw and Σw·speed into the RG32F field (shaders/splat.*); at half resolution when sprites
+  /// are at least 8 px wide (a quarter of the fragments; the composite samples it bilinearly).
+  void splat(const PassFrame& f) {
+    const int EW = f.geo.EW, EH = f.geo.EH;
+    const float diameter = spriteDiameter(f.spacingPx);
+    const int shrink = spriteShrink(f.spacingPx);
+    const int fw = (EW + shrink - 1) / shrink, fh = (EH + shrink - 1) / shrink;
+    if (fw != fieldW_ || fh != fieldH_) {
+      if (fieldFbo_) glDeleteFramebuffers(1, &fieldFbo_);
+      fieldFbo_ = gl::target(GL_RG32F, GL_RG, GL_FLOAT, fw, fh, fieldTex_);
+      const GLint filter = shrink > 1 ? GL_LINEAR : GL_NEAREST;
+      glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, filter);
+      glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, filter);
+      fieldW_ = fw;
+      fieldH_ = fh;
+    }
+    const float fieldDiameter = diameter * float(fw) / float(EW);
+    quads_ = fieldDiameter > sprites_.maxPoint();
+    glViewport(0, 0, fw, fh);
+    glBindFramebuffer(GL_FRAMEBUFFER, fieldFbo_);
+    glClearColor(0, 0, 0, 0);
+    glClear(GL_COLOR_BUFFER_BIT);
+    glEnable(GL_BLEND);
+    glBlendFunc(GL_ONE, GL_ONE);
+    sprites_.setUniforms(splatProg_, f.scale, f.offset, fieldDiameter, fw, fh, quads_);
+    sprites_.draw(GLsizei(f.order.size()), quads_);
+    glDisable(GL_BLEND);
+    glViewport(0, 0, EW, EH);
+  }
+
+  /// The field becomes water over the tiles the fluid can reach (shaders/composite.frag).
+  void composite(const PassFrame& f) {
+    const int EW = f.geo.EW, EH = f.geo.EH;
+    const GLuint cp = compositeProg_;
+    // The colour target still holds the last frame: background and solids, and water over the
+    // rows its tiles covered. Only those rows go back to the background; the tiles of this
+    // frame write every pixel they cover.
+    f.color.startFrameRows(drawnRows_.first, std::min(drawnRows_.second, EH));
+    changedRows_ = drawnRows_;
+    if (tileRows_.first < tileRows_.second) {
+      changedRows_.first = changedRows_.first < changedRows_.second ? std::min(changedRows_.first, tileRows_.first)
+                                                                    : tileRows_.first;
+      changedRows_.second = std::max(changedRows_.second, tileRows_.second);
+    }
+    drawnRows_ = tileRows_;
+    glUseProgram(cp);
+    glActiveTexture(GL_TEXTURE0);
+    glBindTexture(GL_TEXTURE_2D, fieldTex_);
+    glActiveTexture(GL_TEXTURE1);
+    glBindTexture(GL_TEXTURE_2D, auxTex_);
+    glActiveTexture(GL_TEXTURE2);
+    glBindTexture(GL_TEXTURE_2D, f.color.background);
+    glActiveTexture(GL_TEXTURE0);
+    glUniform1i(gl::uniform(cp, "uField"), 0);
+    glUniform1i(gl::uniform(cp, "uAux"), 1);
+    glUniform1i(gl::uniform(cp, "uBg"), 2);
+    glUniform2f(gl::uniform(cp, "uAuxScale"), float(EW) / float(grid_.width() * grid_.cell()),
+                float(EH) / float(grid_.height() * grid_.cell()));
+    glUniform2f(gl::uniform(cp, "uTexel"), 1.0f / float(EW), 1.0f / float(EH));
+    // Bulk value of the field: Σ (1 − q²)³ over a square lattice ≈ π s²/4, s = sprite radius in spacings.
+    const float diameter = spriteDiameter(f.spacingPx);
+    const float rs = float(diameter * 0.5 / f.spacingPx);
+    const float bulk = std::max(1e-3f, 3.14159265f * rs * rs / 4.0f);
+    glUniform1f(gl::uniform(cp, "uInvBulk"), 1.0f / bulk);
+    const auto water = color3(def_.water);
+    const std::array<float, 3> deep = opt_.deepWater
+                                          ? color3(*opt_.deepWater)
+                                          : std::array<float, 3>{water[0] * 0.3f, water[1] * 0.3f, water[2] * 0.3f};
+    const auto foam = color3(opt_.foam.value_or(std::array<double, 3>{0.9, 0.95, 1.0}));
+    glUniform3fv(gl::uniform(cp, "uWater"), 1, water.data());
+    glUniform3fv(gl::uniform(cp, "uDeep"), 1, deep.data());
+    glUniform3fv(gl::uniform(cp, "uFoam"), 1, foam.data());
+    const double depthScale = opt_.depthScale > 0 ? opt_.depthScale : 1.0;
+    glUniform1f(gl::uniform(cp, "uInvDepth"), float(1.0 / depthScale));
+    const double camH = f.geo.cam[3] - f.geo.cam[1];
+    const double foamLo = opt_.foamSpeed > 0 ? opt_.foamSpeed : 0.35 * std::sqrt(std::max(f.in.gravity, 1e-6) * camH);
+    glUniform2f(gl::uniform(cp, "uFoamSpeed"), float(foamLo), float(2 * foamLo));
+    glUniform1f(gl::uniform(cp, "uSpacingPx"), float(f.spacingPx));
+    glBindVertexArray(tileVao_);
+    if (tileVertices_) glDrawArrays(GL_TRIANGLES, 0, tileVertices_);
+  }
+
+  RenderDef def_;
+  RenderOptions opt_;
+  SpriteBatch& sprites_;
+  GLuint splatProg_ = 0, compositeProg_ = 0;
+  GLuint fieldTex_ = 0, fieldFbo_ = 0, auxTex_ = 0, tileVao_ = 0, tileVbo_ = 0;
+  int fieldW_ = 0, fieldH_ = 0;  // the splat target: full resolution, or half when sprites are wide
+  GLsizei tileVertices_ = 0;
+  std::pair<int, int> tileRows_{0, 0};              // target rows this frame's tiles cover
+  std::pair<int, int> drawnRows_{0, 1 << 30};       // rows of the colour target that are not background
+  std::pair<int, int> changedRows_{0, 1 << 30};     // rows the last composite restored or drew
+  std::vector<float> packed_, tiles_;  // particles (x, y, speed, weight) in id order; tile quads
+  DepthGrid grid_;
+};
+
+}  // namespace
+
+std::unique_ptr<RenderPass> makeLiquidPass(const RenderDef& def, const RenderOptions& opt, SpriteBatch& sprites) {
+  return std::make_unique<LiquidPass>(def, opt, sprites);
+}
+
+}  // namespace sph2d

@@ -1,0 +1,106 @@
+// scenery.cpp — the background texture and the solid triangles (see scenery.hpp).
+#include "scenery.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+
+namespace sph2d {
+
+void Scenery::init() {
+  solidProg_ = gl::program("solid.vert", "solid.frag");
+  bgProg_ = gl::program("fullscreen.vert", "background.frag");
+  glGenVertexArrays(1, &solidVao_);
+  glGenBuffers(1, &solidVbo_);
+  glGenVertexArrays(1, &emptyVao_);
+}
+
+void Scenery::build(const RenderDef& def, const FrameGeometry& geo, const RenderInput& in) {
+  buildBackground(def, geo);
+  buildSolids(geo, in);
+}
+
+void Scenery::buildBackground(const RenderDef& def, const FrameGeometry& geo) {
+  if (bgFbo_) glDeleteFramebuffers(1, &bgFbo_);
+  bgFbo_ = gl::target(GL_RGBA8, GL_RGBA, GL_UNSIGNED_BYTE, geo.EW, geo.EH, bgTex_);
+  glViewport(0, 0, geo.EW, geo.EH);
+  glUseProgram(bgProg_);
+  glUniform3f(gl::uniform(bgProg_, "uBackground"), float(def.background[0]), float(def.background[1]),
+              float(def.background[2]));
+  glUniform1f(gl::uniform(bgProg_, "uGuard"), float(geo.guard));
+  glUniform1f(gl::uniform(bgProg_, "uHeight"), float(def.height));
+  glBindVertexArray(emptyVao_);
+  glDrawArrays(GL_TRIANGLES, 0, 3);
+}
+
+void Scenery::buildSolids(const FrameGeometry& geo, const RenderInput& in) {
+  // Triangles in NDC (the camera is fixed for a run).
+  const std::vector<double>& ext = geo.ext;
+  const Vec2d o = in.origin;
+  const double sx = 2.0 / (ext[2] - ext[0]), sy = 2.0 / (ext[3] - ext[1]);
+  auto ndc = [&](const Vec2& p) {
+    return std::array<float, 2>{float((p.x() + o.x() - ext[0]) * sx - 1.0), float(1.0 - (p.y() + o.y() - ext[1]) * sy)};
+  };
+  std::vector<float> tri;
+  auto put = [&](const std::array<float, 2>& a) {
+    tri.push_back(a[0]);
+    tri.push_back(a[1]);
+  };
+  const double pxX = 2.0 / geo.EW, pxY = 2.0 / geo.EH;
+  if (in.colliders)
+    for (const Collider& c : *in.colliders) {
+      if (c.kind == Collider::Kind::Polygon) {
+        for (std::size_t k = 1; k + 1 < c.vertices.size(); ++k) {
+          put(ndc(c.vertices[0]));
+          put(ndc(c.vertices[k]));
+          put(ndc(c.vertices[k + 1]));
+        }
+      } else if (c.kind == Collider::Kind::Circle) {
+        const int n = 64;
+        for (int k = 0; k < n; ++k) {
+          const Real a0 = 2 * kPi<Real> * Real(k) / n, a1 = 2 * kPi<Real> * Real(k + 1) / n;
+          put(ndc(c.center));
+          put(ndc(c.center + c.radius * Vec2(std::cos(a0), std::sin(a0))));
+          put(ndc(c.center + c.radius * Vec2(std::cos(a1), std::sin(a1))));
+        }
+      } else {
+        // A zero-thickness segment drawn 3 px wide.
+        const auto a = ndc(c.vertices[0]), b = ndc(c.vertices[1]);
+        const double dxp = (b[0] - a[0]) / pxX, dyp = (b[1] - a[1]) / pxY;
+        const double len = std::sqrt(dxp * dxp + dyp * dyp);
+        if (len <= 0) continue;
+        const double nxp = -dyp / len * 1.5, nyp = dxp / len * 1.5;
+        const float ox = float(nxp * pxX), oy = float(nyp * pxY);
+        const std::array<float, 2> p0{a[0] + ox, a[1] + oy}, p1{a[0] - ox, a[1] - oy}, p2{b[0] + ox, b[1] + oy},
+            p3{b[0] - ox, b[1] - oy};
+        put(p0);
+        put(p1);
+        put(p2);
+        put(p2);
+        put(p1);
+        put(p3);
+      }
+    }
+  solidCount_ = GLsizei(tri.size() / 2);
+  glBindVertexArray(solidVao_);
+  glBindBuffer(GL_ARRAY_BUFFER, solidVbo_);
+  glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(tri.size() * sizeof(float)), tri.empty() ? nullptr : tri.data(),
+               GL_STATIC_DRAW);
+  glEnableVertexAttribArray(0);
+  glVertexAttribPointer(0, 2, GL_FLOAT, GL_FALSE, 0, nullptr);
+}
+
+void Scenery::drawSolids(const RenderDef& def, int rowFirst, int rowLast) const {
+  if (!solidCount_ || rowLast <= rowFirst) return;
+  glUseProgram(solidProg_);
+  glUniform3f(gl::uniform(solidProg_, "uColor"), float(def.solid[0]), float(def.solid[1]), float(def.solid[2]));
+  glBindVertexArray(solidVao_);
+  GLint vp[4] = {0, 0, 0, 0};
+  glGetIntegerv(GL_VIEWPORT, vp);
+  glEnable(GL_SCISSOR_TEST);
+  glScissor(0, rowFirst, vp[2], std::min(rowLast, vp[3]) - rowFirst);
+  glDrawArrays(GL_TRIANGLES, 0, solidCount_);
+  glDisable(GL_SCISSOR_TEST);
+}
+
+}  // namespace sph2d

@@ -1,0 +1,37 @@
+// scenery.hpp — what does not move during a run: the background and the solids.
+//
+// Design: the background (shaders/background.frag, a vertical gradient) is drawn once per
+// target size into a texture; each frame starts as a copy of it, and the liquid composite reads
+// it, so both agree to the bit. The solids are the World's colliders as triangles in the
+// targets' NDC, built once per camera: polygons as fans, circles as 64-gons, segments (edges,
+// chain links, zero thickness) as 3 px wide quads. Both are rebuilt when the guard band changes.
+#pragma once
+
+#include "camera.hpp"
+#include "gl_util.hpp"
+#include "sph2d/render/renderer.hpp"
+
+namespace sph2d {
+
+/// The background texture and the solid triangles of a renderer.
+class Scenery {
+ public:
+  /// Compiles the programs and creates the buffers in the current context.
+  void init();
+  /// (Re)draws the background for targets of `geo` and rebuilds the solids of `in` (local frame).
+  void build(const RenderDef& def, const FrameGeometry& geo, const RenderInput& in);
+  /// The background texture (RGBA8, the targets' size).
+  GLuint background() const { return bgTex_; }
+  /// Draws the solids in `def.solid`'s colour into the bound framebuffer, over the target rows
+  /// [rowFirst, rowLast) only (the rest still shows them from an earlier frame).
+  void drawSolids(const RenderDef& def, int rowFirst, int rowLast) const;
+
+ private:
+  void buildBackground(const RenderDef& def, const FrameGeometry& geo);
+  void buildSolids(const FrameGeometry& geo, const RenderInput& in);
+
+  GLuint bgProg_ = 0, solidProg_ = 0, emptyVao_ = 0, solidVao_ = 0, solidVbo_ = 0, bgTex_ = 0, bgFbo_ = 0;
+  GLsizei solidCount_ = 0;
+};
+
+}  // namespace sph2d
