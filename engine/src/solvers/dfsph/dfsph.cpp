@@ -135,6 +135,36 @@
 // frame-long substep looked like a remainder: fluid added on top of fluid at
 // rest in zero gravity (the stability suite) stayed twice as dense for good.
 //
+// Stacked and coincident particles (200 particles created at one point, the
+// stability suite). Wendland's |∇W| = |gradK|(1 − q)³ r vanishes as r → 0:
+// a stacked pair adds to ρ but hardly to ∇ρ, so its α is huge, and the
+// linear density prediction asks for velocities of hundreds of m/s (pairDelta's
+// tie-break direction gives a coincident pair a direction of length 1e-6 R:
+// a direction, but no magnitude). In a clump where every particle neighbours
+// every other one the Jacobi operator also exceeds its diagonal by about the
+// neighbour count: each iteration overshoots, κ ≥ 0 takes it back, and the
+// solve is a 2-cycle that ends where it began (measured: velocities 0 and
+// 146 m/s in turn, 100 iterations a substep, the clump 70 ρ0 dense for good).
+// Three measures, none of which acts on fluid near its rest density and
+// spacing (pairs closer than 0.625 dx, compression beyond 10 %):
+//   1. the solves' gradient keeps the peak magnitude of |∇W| (at q = 1/4,
+//      r = 0.625 dx) for closer pairs, along d (Thomas & Couchman 1992's
+//      modified gradient), so a stacked pair has a direction and a magnitude;
+//   2. beyond 1.1 ρ0 a particle's Jacobi step is scaled by 1.1 ρ0/ρ_i (as
+//      pbf's ρ0/ρ_i: the operator's largest eigenvalue grows with compression;
+//      below 1.1 ρ0 the relaxation ω = 0.5 leaves a margin of 1.6);
+//   3. the constant-density solve removes compression that is already there
+//      at most at a pushout speed of 3 m/s (ρ0·2·3 m/s·dt/dx a substep, Box2D
+//      v3's contact pushout): at 70 ρ0 the linearised prediction is far off,
+//      and the whole error in one frame-long substep flung particles at
+//      800 m/s. Ordinary compression (a few %) stays far below that cap.
+// Without 2 the solve stays a 2-cycle (with 1 and 3 too); without 3 the
+// first substeps fling particles past the guard's 500 m/s; without 1 a
+// stacked pair still can (with 2 and 3 alone, one run of four stopped at
+// 670 m/s: a pair 2 neighbours strong, α 10⁴ times the bulk's). Together the
+// clump spreads across the tank within 1 s (peak speeds 6–24 m/s for 50–200
+// particles, three seeds each).
+//
 // Parameters (solver.*): tolerance, divergence_tolerance, max_iterations,
 // min_iterations, relaxation, chebyshev_rho, velocity_cfl, divergence_solve. stats()
 // reports the last solved substep's iterations and residuals.
@@ -298,6 +328,8 @@ class Dfsph final : public Solver {
     const Real R = c.R;
     const Real gradK = W.gradientScale;  // ∇W = gradK (1 − q)³ d
     const Real mGradK = c.mass * gradK;
+    const Real aFlat = Real(1) - kFlatQ;
+    const Real mGradFlat = mGradK * aFlat * aFlat * aFlat * (kFlatQ * R);  // m|∇W| at q = 1/4, times r/|d|
     const Real self = W.value(0);
     // Below this the factor's denominator means no neighbours at all (a full
     // neighbourhood gives about (ρ0/R)²).
@@ -316,10 +348,13 @@ class Dfsph final : public Solver {
           const std::uint32_t j = nb[k];
           Real dx, dy, r2;
           pairDelta(c, i, j, dx, dy, r2);  // coincident pairs: a fixed, antisymmetric direction
-          const Real q = std::sqrt(r2) * W.invR;
+          const Real r = std::sqrt(r2);
+          const Real q = r * W.invR;
           const Real a = Real(1) - q;
           sum += W.valueQ(q);
-          const Real g = mGradK * a * a * a;  // m∇W_ij = g·d
+          // m∇W_ij = g·d; below q = 1/4, where |∇W| peaks, the solves' gradient keeps
+          // its peak magnitude along d (stacked and coincident pairs: see the header).
+          const Real g = q < kFlatQ ? mGradFlat / r : mGradK * a * a * a;
           const Real gxk = g * dx, gyk = g * dy;
           Gi[k] = Pair{j, gxk, gyk};
           gx += gxk;
@@ -448,6 +483,8 @@ class Dfsph final : public Solver {
     const Real wInvDt = omega_ * invDt, wInvDt2 = wInvDt * invDt;
     const bool unilateral = unilateral_;
     const Real kMin = kMin_;
+    const Real kneeRho = kKneeDensity * rho0;
+    const Real pushout = rho0 * Real(2) * kPushoutSpeed * dt / c.dx;  // [kg/m³] per substep
     return c.pool.reduce(
         P.size(), kBlock, Sums{},
         [&](std::size_t b, std::size_t e) {
@@ -470,8 +507,13 @@ class Dfsph final : public Solver {
               dk = src * alpha_[i] * wInvDt;
             } else {
               src = P.rho[i] + dt * div - rho0 - shift;
+              // Compression already there is removed at most at the pushout rate.
+              const Real excess = P.rho[i] - rho0 - pushout;
+              if (excess > 0) src -= excess;
               dk = src * alpha_[i] * wInvDt2;
             }
+            // Beyond the knee density the Jacobi step shrinks as ρ_knee/ρ_i.
+            if (P.rho[i] > kneeRho) dk *= kneeRho * P.invRho[i];
             // Complementarity residual: where κ_i > 0 the constraint is active and
             // any deviation counts; where κ_i = 0 only compression does.
             errSum += double(K[i] > 0 || !unilateral ? std::fabs(src) : std::max(src, Real(0)));
@@ -554,6 +596,9 @@ class Dfsph final : public Solver {
   Real cfl_;                             ///< dt ≤ cfl_·R/v_max
   static constexpr int kChebDelay = 5;   ///< plain iterations before the acceleration starts
   static constexpr Real kPressureCfl = Real(0.35);  ///< dt ≤ kPressureCfl·R/sqrt(|g| D), D the greatest depth
+  static constexpr Real kFlatQ = Real(0.25);        ///< below q = r/R = 1/4 the solves' |∇W| keeps its peak value
+  static constexpr Real kKneeDensity = Real(1.1);   ///< beyond ρ = 1.1 ρ0 the Jacobi step shrinks as 1.1 ρ0/ρ
+  static constexpr Real kPushoutSpeed = Real(3);    ///< [m/s] existing compression is removed at most this fast
   std::vector<Vec2> vPrev_;              ///< velocity before the last iteration (Chebyshev)
   std::vector<Real> kPrev_;              ///< κ before the last iteration (Chebyshev)
   /// One neighbour entry of an iteration: the neighbour's slot and m∇W_ij.
