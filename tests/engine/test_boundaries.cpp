@@ -10,36 +10,15 @@
 #include <cmath>
 
 #include "sph2d/world.hpp"
-#include "test_util.hpp"
+#include "support/fixture.hpp"
 
 using namespace sph2d;
+using test::arena;
+using test::boxShape;
+using test::pointsShape;
+using test::potentialEnergy;
 
 namespace {
-
-ShapeDef boxShape(Vec2d center, Vec2d half, double angle = 0) {
-  ShapeDef s;
-  s.type = ShapeDef::Type::Box;
-  s.center = center;
-  s.halfSize = half;
-  s.angle = angle;
-  return s;
-}
-
-ShapeDef pointsShape(ShapeDef::Type t, std::vector<Vec2d> v, bool loop = false) {
-  ShapeDef s;
-  s.type = t;
-  s.vertices = std::move(v);
-  s.loop = loop;
-  return s;
-}
-
-/// A closed 4 m × 4 m arena [0, 4]², walls 0.2 m thick.
-BodyDef arena() {
-  BodyDef b;
-  b.fixtures = {boxShape({2, -0.2}, {2.4, 0.2}), boxShape({2, 4.2}, {2.4, 0.2}), boxShape({-0.2, 2}, {0.2, 2.4}),
-                boxShape({4.2, 2}, {0.2, 2.4})};
-  return b;
-}
 
 /// `solver` (default wcsph) with the settings these scenes need: they fall up to 3 m
 /// (v ≈ 7.7 m/s), and a weakly compressible fluid needs c0 ≥ 10 v_max (at c0 = 25 m/s
@@ -60,13 +39,6 @@ SceneDef baseScene(double spacing, const std::string& solver = "wcsph") {
   if (solver == "muller2003") s.solver.soundSpeed = 80;
   s.gravity = Vec2d(0, -9.81);
   return s;
-}
-
-/// Σ m g y over the particles [J per metre of depth] (the potential energy).
-double potentialEnergy(const World& w, double g) {
-  double s = 0;
-  for (std::size_t i = 0; i < w.particleCount(); ++i) s += w.worldPosition(i).y();
-  return double(w.particleMass()) * g * s;
 }
 
 }  // namespace

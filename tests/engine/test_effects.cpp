@@ -7,7 +7,7 @@
 #include <set>
 
 #include "sph2d/world.hpp"
-#include "test_util.hpp"
+#include "support/fixture.hpp"
 
 using namespace sph2d;
 
@@ -15,39 +15,11 @@ namespace {
 
 bool has(const std::vector<std::string>& v, const std::string& s) { return std::find(v.begin(), v.end(), s) != v.end(); }
 
-/// A closed box 2 m × 2 m (four boxes), no fluid.
+/// The closed tank [0, 2]² (wcsph, no viscosity), no fluid.
 SceneDef box(double spacing = 0.04) {
-  SceneDef s;
-  s.solver.type = "wcsph";
-  s.solver.spacing = spacing;
+  SceneDef s = test::tank("wcsph", 2, 2, spacing);
   s.solver.viscosity = 0.0;
-  BodyDef b;
-  for (const auto& f : std::vector<std::pair<Vec2d, Vec2d>>{
-           {{1.0, -0.1}, {1.2, 0.1}}, {{1.0, 2.1}, {1.2, 0.1}}, {{-0.1, 1.0}, {0.1, 1.2}}, {{2.1, 1.0}, {0.1, 1.2}}}) {
-    ShapeDef sh;
-    sh.type = ShapeDef::Type::Box;
-    sh.center = f.first;
-    sh.halfSize = f.second;
-    b.fixtures.push_back(sh);
-  }
-  s.bodies.push_back(b);
   return s;
-}
-
-std::size_t outsideBox(const World& w, double lo, double hi) {
-  std::size_t n = 0;
-  for (std::size_t i = 0; i < w.particleCount(); ++i) {
-    const Vec2d p = w.worldPosition(i);
-    n += !(p.x() >= lo && p.y() >= lo && p.x() <= hi && p.y() <= hi);
-  }
-  return n;
-}
-
-Vec2d momentum(const World& w) {
-  Vec2d m(0, 0);
-  for (std::size_t i = 0; i < w.particleCount(); ++i)
-    m += Vec2d(w.particles().v[i].x(), w.particles().v[i].y()) * double(w.particleMass());
-  return m;
 }
 
 }  // namespace
@@ -184,9 +156,9 @@ TEST_CASE("pairwise effects conserve linear momentum to rounding (no walls, no g
     s.blocks.push_back(blk);
     World w(s, WorldOptions{2});
     // Give it a swirl so relative velocities are not zero.
-    const Vec2d m0 = momentum(w);
+    const Vec2d m0 = test::momentum(w);
     for (int i = 0; i < 30; ++i) w.substep();
-    const Vec2d m1 = momentum(w);
+    const Vec2d m1 = test::momentum(w);
     const double scale = double(w.particleCount()) * double(w.particleMass()) * 0.36;
     MESSAGE(which << ": momentum change " << (m1 - m0).norm() << " of " << scale);
     CHECK((m1 - m0).norm() <= 1e-5 * scale);
@@ -299,7 +271,7 @@ void runEffectAlone(int k) {
   for (int f = 0; f < 120; ++f) w.stepFrame();
   CHECK(w.time() == doctest::Approx(2.0));
   CHECK(test::allFiniteState(w));
-  CHECK(outsideBox(w, 0, 2) == 0);
+  CHECK(test::outside(w, 2, 2) == 0);
 }
 }  // namespace
 

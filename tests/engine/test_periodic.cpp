@@ -19,11 +19,7 @@
 
 using namespace sph2d;
 
-namespace {
-
-std::string asset(const std::string& rel) { return std::string(SPH2D_ASSETS) + "/" + rel; }
-
-}  // namespace
+using test::asset;
 
 TEST_CASE("periodic grid: the candidates within R are exactly the nearest-image neighbours, across both seams") {
   ThreadPool pool(2);

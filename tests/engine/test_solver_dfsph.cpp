@@ -9,9 +9,12 @@
 
 #include "solvers/solver.hpp"  // solverParams
 #include "sph2d/world.hpp"
-#include "test_util.hpp"
+#include "support/fixture.hpp"
 
 using namespace sph2d;
+using test::frontX;
+using test::meanSpeed;
+using test::outside;
 
 namespace {
 
@@ -24,22 +27,6 @@ SceneDef dfsphScene(const std::string& rel) {
   return s;
 }
 
-/// Particles outside the rectangle [x0, x1] × [y0, y1] (world frame).
-std::size_t outside(const World& w, double x0, double y0, double x1, double y1) {
-  std::size_t n = 0;
-  for (std::size_t i = 0; i < w.particleCount(); ++i) {
-    const Vec2d p = w.worldPosition(i);
-    if (!(p.x() >= x0 && p.x() <= x1 && p.y() >= y0 && p.y() <= y1)) ++n;
-  }
-  return n;
-}
-
-double meanSpeed(const Particles& P) {
-  double s = 0;
-  for (std::size_t i = 0; i < P.size(); ++i) s += double(P.v[i].norm());
-  return P.size() ? s / double(P.size()) : 0;
-}
-
 }  // namespace
 
 TEST_CASE("dfsph: a resting tank settles incompressible and calm") {
@@ -50,7 +37,7 @@ TEST_CASE("dfsph: a resting tank settles incompressible and calm") {
   for (int f = 0; f < 120; ++f) {  // 2 s; the second second is measured
     w.stepFrame();
     if (f < 60) continue;
-    const double v = meanSpeed(w.particles());
+    const double v = meanSpeed(w);
     vSum += v;
     vMax = std::max(vMax, v);
     errMax = std::max(errMax, w.densityStats().meanError);
@@ -140,25 +127,17 @@ TEST_CASE("dfsph: both implicit solves reach their tolerances within the iterati
 TEST_CASE("dfsph: the small dam break runs 1 s: no NaN, nothing escapes, the front moves right, energy bounded") {
   const SceneDef s = dfsphScene("tests/small_dam_break.json");
   World w(s, WorldOptions{1});
-  double front0 = -1e300, sumY0 = 0;
-  for (std::size_t i = 0; i < w.particleCount(); ++i) {
-    front0 = std::max(front0, w.worldPosition(i).x());
-    sumY0 += w.worldPosition(i).y();
-  }
+  const double front0 = frontX(w), sumY0 = test::sumY(w);
   const std::size_t n0 = w.particleCount();
   for (int f = 0; f < 60; ++f) w.stepFrame();
   CHECK(w.time() == doctest::Approx(1.0).epsilon(1e-6));
   REQUIRE(test::allFiniteState(w));
   CHECK(w.particleCount() == n0);
   CHECK(outside(w, 0, 0, 4, 3) == 0);
-  double front = -1e300, sumY = 0;
-  for (std::size_t i = 0; i < w.particleCount(); ++i) {
-    front = std::max(front, w.worldPosition(i).x());
-    sumY += w.worldPosition(i).y();
-  }
+  const double front = frontX(w);
   MESSAGE("front moved from " << front0 << " to " << front << " m");
   CHECK(front > front0 + 1.5);
-  const double released = double(w.particleMass()) * 9.81 * (sumY0 - sumY);
+  const double released = double(w.particleMass()) * 9.81 * (sumY0 - test::sumY(w));
   MESSAGE("kinetic " << w.kineticEnergy() << " J/m, potential released " << released << " J/m, mean compression "
                      << w.densityStats().meanError);
   CHECK(released > 0);

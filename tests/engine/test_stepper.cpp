@@ -7,7 +7,7 @@
 #include <cmath>
 
 #include "sph2d/world.hpp"
-#include "test_util.hpp"
+#include "support/fixture.hpp"
 
 using namespace sph2d;
 
@@ -19,11 +19,7 @@ std::uint64_t callsOf(const World& w, const std::string& stage) {
   return 0;
 }
 
-double maxSpeed(const World& w) {
-  double m = 0;
-  for (std::size_t i = 0; i < w.particleCount(); ++i) m = std::max(m, double(w.particles().v[i].norm()));
-  return m;
-}
+using test::maxSpeed;
 
 }  // namespace
 

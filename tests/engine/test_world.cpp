@@ -7,29 +7,11 @@
 #include <sstream>
 
 #include "sph2d/world.hpp"
-#include "test_util.hpp"
+#include "support/fixture.hpp"
 
 using namespace sph2d;
-
-namespace {
-
-/// Particles outside the tank's inner rectangle (plus a small tolerance).
-std::size_t outside(const World& w, double x0, double y0, double x1, double y1) {
-  std::size_t n = 0;
-  for (std::size_t i = 0; i < w.particleCount(); ++i) {
-    const Vec2d p = w.worldPosition(i);
-    if (!(p.x() >= x0 && p.x() <= x1 && p.y() >= y0 && p.y() <= y1)) ++n;
-  }
-  return n;
-}
-
-double frontX(const World& w) {
-  double m = -1e300;
-  for (std::size_t i = 0; i < w.particleCount(); ++i) m = std::max(m, w.worldPosition(i).x());
-  return m;
-}
-
-}  // namespace
+using test::frontX;
+using test::outside;
 
 TEST_CASE("a resting column settles: density within 5 % of rho0, its motion decays and stays small") {
   // muller2003 (the scene's default solver) with its single-term walls: the
@@ -42,9 +24,7 @@ TEST_CASE("a resting column settles: density within 5 % of rho0, its motion deca
   double first = 0, second = 0;
   for (int f = 0; f < 120; ++f) {  // 2 s
     w.stepFrame();
-    double m = 0;
-    for (std::size_t i = 0; i < w.particleCount(); ++i) m += w.particles().v[i].norm();
-    (f < 60 ? first : second) += m / double(w.particleCount()) / 60;
+    (f < 60 ? first : second) += test::meanSpeed(w) / 60;
   }
   REQUIRE(test::allFiniteState(w));
   const DensityStats d = w.densityStats();
@@ -62,8 +42,7 @@ TEST_CASE("the dam break runs 1 s: no NaN, nothing leaves the tank, the front mo
   World w(s, WorldOptions{2});
   const double front0 = frontX(w);
   CHECK(w.kineticEnergy() == 0);
-  double sumY0 = 0;
-  for (std::size_t i = 0; i < w.particleCount(); ++i) sumY0 += w.worldPosition(i).y();
+  const double sumY0 = test::sumY(w);
   const std::size_t n0 = w.particleCount();
   for (int f = 0; f < 60; ++f) w.stepFrame();
   CHECK(w.time() == doctest::Approx(1.0).epsilon(1e-6));
@@ -75,9 +54,7 @@ TEST_CASE("the dam break runs 1 s: no NaN, nothing leaves the tank, the front mo
   // Shallow-water theory puts the front speed at 2·sqrt(g·2) ≈ 8.9 m/s; the tank is 4 m long.
   CHECK(front > front0 + 1.5);
   // Kinetic energy is bounded by the potential energy released (viscosity and walls only remove energy).
-  double sumY = 0;
-  for (std::size_t i = 0; i < w.particleCount(); ++i) sumY += w.worldPosition(i).y();
-  const double released = double(w.particleMass()) * 9.81 * (sumY0 - sumY);
+  const double released = double(w.particleMass()) * 9.81 * (sumY0 - test::sumY(w));
   MESSAGE("kinetic " << w.kineticEnergy() << " J/m, potential released " << released << " J/m");
   CHECK(released > 0);
   CHECK(w.kineticEnergy() <= released);

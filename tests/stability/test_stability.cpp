@@ -10,45 +10,18 @@
 
 #include "solvers/solver.hpp"
 #include "sph2d/world.hpp"
-#include "test_util.hpp"
+#include "support/fixture.hpp"
 
 using namespace sph2d;
+using test::outside;
+using test::sumY;
 
 namespace {
 
-ShapeDef box(Vec2d c, Vec2d h) {
-  ShapeDef s;
-  s.type = ShapeDef::Type::Box;
-  s.center = c;
-  s.halfSize = h;
-  return s;
-}
-
-/// A closed W × H tank [0, W] × [0, H] with `solver`.
+/// The closed tank [0, W] × [0, H] with `solver` (wcsph: c0 for flows up to 6 m/s).
 SceneDef tank(const std::string& solver, double W, double H, double spacing) {
-  SceneDef s;
-  s.solver.type = solver;
-  s.solver.spacing = spacing;
+  SceneDef s = test::tank(solver, W, H, spacing);
   if (solver == "wcsph") s.solver.params["expected_speed"] = 6;
-  BodyDef b;
-  b.fixtures = {box({W / 2, -0.1}, {W / 2 + 0.2, 0.1}), box({W / 2, H + 0.1}, {W / 2 + 0.2, 0.1}),
-                box({-0.1, H / 2}, {0.1, H / 2 + 0.2}), box({W + 0.1, H / 2}, {0.1, H / 2 + 0.2})};
-  s.bodies.push_back(b);
-  return s;
-}
-
-std::size_t outside(const World& w, double W, double H) {
-  std::size_t n = 0;
-  for (std::size_t i = 0; i < w.particleCount(); ++i) {
-    const Vec2d p = w.worldPosition(i);
-    n += !(p.x() >= 0 && p.x() <= W && p.y() >= 0 && p.y() <= H);
-  }
-  return n;
-}
-
-double sumY(const World& w) {
-  double s = 0;
-  for (std::size_t i = 0; i < w.particleCount(); ++i) s += w.worldPosition(i).y();
   return s;
 }
 
@@ -89,13 +62,7 @@ TEST_CASE("stability: all particles created at one point separate without NaN, f
 
 namespace {
 
-/// The smallest distance between two particles.
-double minPairDistance(const World& w) {
-  double m = 1e300;
-  for (std::size_t i = 0; i < w.particleCount(); ++i)
-    for (std::size_t j = i + 1; j < w.particleCount(); ++j) m = std::min(m, (w.worldPosition(i) - w.worldPosition(j)).norm());
-  return m;
-}
+using test::minPairDistance;
 
 /// Zero gravity, fluid at rest, and a second block added on top of it (twice the
 /// density where they overlap; where the lattices meet, particles coincide): within
@@ -324,14 +291,9 @@ void longRest(const std::string& solver, int substeps) {
   blk.max = Vec2d(0.6, 0.45);
   s.blocks.push_back(blk);
   World w(s, WorldOptions{2});
-  auto com = [&] {
-    Vec2d c(0, 0);
-    for (std::size_t i = 0; i < w.particleCount(); ++i) c += w.worldPosition(i);
-    return Vec2d(c / double(w.particleCount()));
-  };
   const int settle = substeps / 10;
   for (int i = 0; i < settle; ++i) w.substep();
-  const Vec2d c1 = com();
+  const Vec2d c1 = test::centroid(w);
   const double ke1 = w.kineticEnergy(), t1 = w.time();
   double keMax = 0, errMax = 0;
   for (int i = settle; i < substeps; ++i) {
@@ -341,7 +303,7 @@ void longRest(const std::string& solver, int substeps) {
       errMax = std::max(errMax, w.densityStats().meanError);
     }
   }
-  const Vec2d c2 = com();
+  const Vec2d c2 = test::centroid(w);
   const double ke2 = w.kineticEnergy();
   const double pe = double(w.particleMass()) * 9.81 * 0.45 / 2 * double(w.particleCount());  // potential energy scale of the column
   MESSAGE(solver << ": " << w.time() << " s simulated; KE after " << settle << " substeps (" << t1 << " s) " << ke1

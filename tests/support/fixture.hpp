@@ -1,0 +1,181 @@
+// tests/support/fixture.hpp — the shared test fixture (in the spirit of Jolt's
+// PhysicsTestContext): the tanks and shapes the tests build scenes from, and
+// the measurements they take of a World. One definition of each, so that two
+// tests that say "outside the tank" or "kinetic energy" mean the same thing.
+//
+// Scene builders: boxShape, pointsShape, tank (a closed W × H box of four
+// static boxes), arena (4 m × 4 m). Measurements (world coordinates, every
+// particle): outside, meanSpeed, maxSpeed, frontX, sumY, potentialEnergy,
+// momentum, centroid, minPairDistance, inertiaAspect, cornerRatio.
+#pragma once
+
+#include <Eigen/Eigenvalues>
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "sph2d/scene.hpp"
+#include "sph2d/world.hpp"
+#include "test_util.hpp"
+
+namespace sph2d::test {
+
+constexpr double kPi = 3.14159265358979323846;
+
+// --- scenes ------------------------------------------------------------------
+
+/// A static box fixture centred at `center` with half extents `half`, rotated by `angle` [rad].
+inline ShapeDef boxShape(const Vec2d& center, const Vec2d& half, double angle = 0) {
+  ShapeDef s;
+  s.type = ShapeDef::Type::Box;
+  s.center = center;
+  s.halfSize = half;
+  s.angle = angle;
+  return s;
+}
+
+/// A polygon, edge or chain fixture through `vertices`.
+inline ShapeDef pointsShape(ShapeDef::Type type, std::vector<Vec2d> vertices, bool loop = false) {
+  ShapeDef s;
+  s.type = type;
+  s.vertices = std::move(vertices);
+  s.loop = loop;
+  return s;
+}
+
+/// The four walls, 0.2 m thick, of the closed tank [0, W] × [0, H] (floor, lid, left, right).
+inline BodyDef tankWalls(double W, double H) {
+  BodyDef b;
+  b.fixtures = {boxShape({W / 2, -0.1}, {W / 2 + 0.2, 0.1}), boxShape({W / 2, H + 0.1}, {W / 2 + 0.2, 0.1}),
+                boxShape({-0.1, H / 2}, {0.1, H / 2 + 0.2}), boxShape({W + 0.1, H / 2}, {0.1, H / 2 + 0.2})};
+  return b;
+}
+
+/// A scene with `solver` at `spacing` (the solver's and the scene's defaults
+/// otherwise) in the closed tank [0, W] × [0, H]; no fluid yet.
+inline SceneDef tank(const std::string& solver, double W, double H, double spacing) {
+  SceneDef s;
+  s.solver.type = solver;
+  s.solver.spacing = spacing;
+  s.bodies.push_back(tankWalls(W, H));
+  return s;
+}
+
+/// A closed 4 m × 4 m arena [0, 4]², walls 0.2 m thick.
+inline BodyDef arena() {
+  BodyDef b;
+  b.fixtures = {boxShape({2, -0.2}, {2.4, 0.2}), boxShape({2, 4.2}, {2.4, 0.2}), boxShape({-0.2, 2}, {0.2, 2.4}),
+                boxShape({4.2, 2}, {0.2, 2.4})};
+  return b;
+}
+
+/// A fluid block [lo, hi] moving at `velocity`.
+inline FluidBlockDef block(const Vec2d& lo, const Vec2d& hi, const Vec2d& velocity = Vec2d(0, 0)) {
+  FluidBlockDef b;
+  b.min = lo;
+  b.max = hi;
+  b.velocity = velocity;
+  return b;
+}
+
+// --- measurements --------------------------------------------------------------
+
+/// Particles outside the rectangle [x0, x1] × [y0, y1] (world frame; the edges count as inside).
+inline std::size_t outside(const World& w, double x0, double y0, double x1, double y1) {
+  std::size_t n = 0;
+  for (std::size_t i = 0; i < w.particleCount(); ++i) {
+    const Vec2d p = w.worldPosition(i);
+    n += !(p.x() >= x0 && p.x() <= x1 && p.y() >= y0 && p.y() <= y1);
+  }
+  return n;
+}
+
+/// Particles outside the tank [0, W] × [0, H].
+inline std::size_t outside(const World& w, double W, double H) { return outside(w, 0, 0, W, H); }
+
+/// Mean particle speed [m/s] (0 without particles).
+inline double meanSpeed(const World& w) {
+  double s = 0;
+  for (std::size_t i = 0; i < w.particleCount(); ++i) s += double(w.particles().v[i].norm());
+  return w.particleCount() ? s / double(w.particleCount()) : 0;
+}
+
+/// Largest particle speed [m/s].
+inline double maxSpeed(const World& w) {
+  double s = 0;
+  for (std::size_t i = 0; i < w.particleCount(); ++i) s = std::max(s, double(w.particles().v[i].norm()));
+  return s;
+}
+
+/// The largest x of any particle: a surge front moving right.
+inline double frontX(const World& w) {
+  double m = -1e300;
+  for (std::size_t i = 0; i < w.particleCount(); ++i) m = std::max(m, w.worldPosition(i).x());
+  return m;
+}
+
+/// Σ y over the particles [m].
+inline double sumY(const World& w) {
+  double s = 0;
+  for (std::size_t i = 0; i < w.particleCount(); ++i) s += w.worldPosition(i).y();
+  return s;
+}
+
+/// Σ m g y over the particles [J per metre of depth]: the potential energy for gravity g downwards.
+inline double potentialEnergy(const World& w, double g = 9.81) { return double(w.particleMass()) * g * sumY(w); }
+
+/// Σ m v [kg m/s per metre of depth].
+inline Vec2d momentum(const World& w) {
+  Vec2d m(0, 0);
+  for (std::size_t i = 0; i < w.particleCount(); ++i)
+    m += Vec2d(w.particles().v[i].x(), w.particles().v[i].y()) * double(w.particleMass());
+  return m;
+}
+
+/// The mean position of the particles.
+inline Vec2d centroid(const World& w) {
+  Vec2d c(0, 0);
+  for (std::size_t i = 0; i < w.particleCount(); ++i) c += w.worldPosition(i);
+  return w.particleCount() ? Vec2d(c / double(w.particleCount())) : c;
+}
+
+/// The smallest distance between two particles (all pairs: for small tests).
+inline double minPairDistance(const World& w) {
+  double m = 1e300;
+  for (std::size_t i = 0; i < w.particleCount(); ++i)
+    for (std::size_t j = i + 1; j < w.particleCount(); ++j) m = std::min(m, (w.worldPosition(i) - w.worldPosition(j)).norm());
+  return m;
+}
+
+/// sqrt(λmax/λmin) of the second-moment matrix Σ (x − c)(x − c)ᵀ about the
+/// centroid: the axis ratio of the ellipse with the same second moments (a 2:1
+/// block: 2, a disc: 1; a square also reads 1, see cornerRatio).
+inline double inertiaAspect(const World& w) {
+  const Vec2d c = centroid(w);
+  Eigen::Matrix2d M = Eigen::Matrix2d::Zero();
+  for (std::size_t i = 0; i < w.particleCount(); ++i) {
+    const Vec2d d = w.worldPosition(i) - c;
+    M += d * d.transpose();
+  }
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> es(M);
+  return std::sqrt(es.eigenvalues()(1) / es.eigenvalues()(0));
+}
+
+/// The farthest particle's distance from the centroid in each of 16 equal
+/// angular sectors, largest over smallest (a square: 1.39; a lattice disc of
+/// 20 spacings: 1.02).
+inline double cornerRatio(const World& w) {
+  const Vec2d c = centroid(w);
+  std::vector<double> far(16, 0.0);
+  for (std::size_t i = 0; i < w.particleCount(); ++i) {
+    const Vec2d d = w.worldPosition(i) - c;
+    const double a = std::atan2(d.y(), d.x()) + kPi;  // 0..2π
+    const int k = std::min(15, int(a / (2 * kPi) * 16));
+    far[std::size_t(k)] = std::max(far[std::size_t(k)], d.norm());
+  }
+  return *std::max_element(far.begin(), far.end()) / *std::min_element(far.begin(), far.end());
+}
+
+}  // namespace sph2d::test
