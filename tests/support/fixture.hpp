@@ -4,9 +4,11 @@
 // tests that say "outside the tank" or "kinetic energy" mean the same thing.
 //
 // Scene builders: boxShape, pointsShape, tank (a closed W × H box of four
-// static boxes), arena (4 m × 4 m). Measurements (world coordinates, every
+// static boxes), arena (4 m × 4 m), block. Measurements (world coordinates, every
 // particle): outside, meanSpeed, maxSpeed, frontX, sumY, potentialEnergy,
-// momentum, centroid, minPairDistance, inertiaAspect, cornerRatio.
+// momentum, velocityVariance, layerVelocityDifference, centroid,
+// minPairDistance(Periodic), inertiaAspect, cornerRatio. Flows:
+// periodicShearLayer.
 #pragma once
 
 #include <Eigen/Eigenvalues>
@@ -80,6 +82,22 @@ inline FluidBlockDef block(const Vec2d& lo, const Vec2d& hi, const Vec2d& veloci
   return b;
 }
 
+/// validation/taylor_green.json's fully periodic 1 m box (zero gravity, no walls,
+/// pressure of either sign) with `solver` (its defaults) at `spacing`, holding a
+/// shear layer: the lower half [0, 1] × [0, 0.5] moving at (−U, 0), the upper half
+/// at (+U, 0). No effects (ν = 0, no shifting). The lower half's particles are
+/// created first: ids below the lower half's count.
+inline SceneDef periodicShearLayer(const std::string& solver, double U, double spacing) {
+  SceneDef s = scene("validation/taylor_green.json");
+  s.solver.type = solver;
+  s.solver.params.clear();
+  s.solver.spacing = spacing;
+  s.solver.viscosity = 0;
+  s.effects.shifting = false;
+  s.blocks = {block({0, 0}, {1, 0.5}, {-U, 0}), block({0, 0.5}, {1, 1}, {U, 0})};
+  return s;
+}
+
 // --- measurements --------------------------------------------------------------
 
 /// Particles outside the rectangle [x0, x1] × [y0, y1] (world frame; the edges count as inside).
@@ -131,6 +149,50 @@ inline Vec2d momentum(const World& w) {
   Vec2d m(0, 0);
   for (std::size_t i = 0; i < w.particleCount(); ++i)
     m += Vec2d(w.particles().v[i].x(), w.particles().v[i].y()) * double(w.particleMass());
+  return m;
+}
+
+/// The mean of |v − v̄|² over the particles, v̄ their mean velocity [m²/s²].
+inline double velocityVariance(const World& w) {
+  Vec2d mean(0, 0);
+  for (std::size_t i = 0; i < w.particleCount(); ++i) mean += Vec2d(w.particles().v[i].x(), w.particles().v[i].y());
+  if (w.particleCount() == 0) return 0;
+  mean /= double(w.particleCount());
+  double s = 0;
+  for (std::size_t i = 0; i < w.particleCount(); ++i)
+    s += (Vec2d(w.particles().v[i].x(), w.particles().v[i].y()) - mean).squaredNorm();
+  return s / double(w.particleCount());
+}
+
+/// Mean x velocity of the particles with id ≥ firstId minus that of those below it
+/// (a shear layer's velocity difference, periodicShearLayer).
+inline double layerVelocityDifference(const World& w, std::uint32_t firstId) {
+  double lo = 0, hi = 0;
+  std::size_t nLo = 0, nHi = 0;
+  for (std::size_t i = 0; i < w.particleCount(); ++i) {
+    const double vx = w.particles().v[i].x();
+    if (w.particles().id[i] < firstId) {
+      lo += vx;
+      ++nLo;
+    } else {
+      hi += vx;
+      ++nHi;
+    }
+  }
+  return hi / double(std::max<std::size_t>(nHi, 1)) - lo / double(std::max<std::size_t>(nLo, 1));
+}
+
+/// The smallest distance between two particles, nearest image in the periodic box
+/// [0, L]² (all pairs: for small tests).
+inline double minPairDistancePeriodic(const World& w, double L) {
+  double m = 1e300;
+  for (std::size_t i = 0; i < w.particleCount(); ++i)
+    for (std::size_t j = i + 1; j < w.particleCount(); ++j) {
+      Vec2d d = w.worldPosition(i) - w.worldPosition(j);
+      d.x() -= L * std::round(d.x() / L);
+      d.y() -= L * std::round(d.y() / L);
+      m = std::min(m, d.norm());
+    }
   return m;
 }
 
