@@ -65,10 +65,18 @@ namespace {
 using test::minPairDistance;
 
 /// Zero gravity, fluid at rest, and a second block added on top of it (twice the
-/// density where they overlap; where the lattices meet, particles coincide): within
-/// 1 s the compression is gone (the most compressed particle under 5 %), nothing
-/// escapes. (Coincident pairs need not part: once the fluid has spread into the empty
-/// tank its pressure is 0, and a pair at rest on top of each other stays so.)
+/// density where they overlap; every added particle coincides with one of the
+/// block's): within 1 s the compression is gone (the most compressed particle under
+/// 5 %), the coincident pairs have parted (the closest pair farther than 0.1 dx;
+/// measured 0.17 dx for muller2003, 0.37 for pbf, 0.19 for dfsph), nothing escapes.
+///
+/// wcsph does not part them (measured: the closest pair still at 0 after 1 s), and
+/// the test asserts that as it is: Wendland's |∇W| = |gradK|(1 − q)³ r vanishes as
+/// r → 0, and pairDelta's tie-break direction, 1e-6 R long, gives a coincident pair
+/// a direction without a magnitude, so each pair feels the same forces and moves as
+/// one particle. dfsph had the same defect (issue 17; its solves now keep the peak
+/// |∇W| for pairs closer than R/4, engine/src/solvers/dfsph/dfsph.cpp). When wcsph
+/// gets such a fix, its check below fails and should become the others'.
 void overlapSeparates(const std::string& solver) {
   SceneDef s = tank(solver, 1, 1, 0.04);
   s.gravity = Vec2d(0, 0);
@@ -93,6 +101,8 @@ void overlapSeparates(const std::string& solver) {
   CHECK(test::allFiniteState(w));
   CHECK(outside(w, 1, 1) == 0);
   CHECK(d.maxError < 0.05);
+  if (solver == "wcsph") CHECK(d1 < 1e-6 * s.solver.spacing);  // the known defect above
+  else CHECK(d1 > 0.1 * s.solver.spacing);
 }
 
 }  // namespace
