@@ -85,3 +85,17 @@ void sliverOnlyDrifts(const std::string& solver) {
 }  // namespace
 
 TEST_CASE_EVERY_SOLVER("a sliver of a step only drifts (no solver stage runs, nothing is kicked)", sliverOnlyDrifts)
+
+TEST_CASE("the guard stops a run at the first non-finite value and names stage and particle") {
+  SceneDef s = test::scene("tests/small_dam_break.json");
+  s.gravity = Vec2d(0, std::nan(""));
+  World w(s, WorldOptions{2});
+  try {
+    w.stepFrame();
+    FAIL("expected SimulationError");
+  } catch (const SimulationError& e) {
+    CHECK(e.stage == "pressure_force");  // gravity is added there: the first stage to see the NaN
+    CHECK(e.step == 0);
+    CHECK(std::string(e.what()).find("particle id") != std::string::npos);
+  }
+}

@@ -275,9 +275,9 @@ namespace {
 
 /// The mean compression each solver promises for water at rest (docs/SCENES.md), for a
 /// column H deep. dfsph: its solve's tolerance, 0.1 %, twice (the solve bounds a linear
-/// prediction of the density; tests/engine/test_solver_dfsph.cpp uses the same);
+/// prediction of the density; tests/engine/solvers/test_dfsph.cpp uses the same);
 /// pbf: its tolerance, 1 %, twice (measured after the last correction, as
-/// tests/engine/test_solver_pbf.cpp); wcsph: 1 % (c0 ≥ 10 v_max); muller2003: its
+/// tests/engine/solvers/test_pbf.cpp); wcsph: 1 % (c0 ≥ 10 v_max); muller2003: its
 /// equilibrium compression at the floor, 2gH/c² (p = c²(ρ − ρ0) and ∇p/2).
 double restBand(const SceneDef& s, double H) {
   const std::string& t = s.solver.type;

@@ -8,7 +8,7 @@
 // particle): outside, meanSpeed, maxSpeed, frontX, sumY, potentialEnergy,
 // momentum, velocityVariance, layerVelocityDifference, centroid,
 // minPairDistance(Periodic), inertiaAspect, cornerRatio. Flows:
-// periodicShearLayer.
+// wallScene, periodicShearLayer, freeMovingBlock (momentumOver).
 #pragma once
 
 #include <Eigen/Eigenvalues>
@@ -95,6 +95,40 @@ inline SceneDef periodicShearLayer(const std::string& solver, double U, double s
   s.solver.viscosity = 0;
   s.effects.shifting = false;
   s.blocks = {block({0, 0}, {1, 0.5}, {-U, 0}), block({0, 0.5}, {1, 1}, {U, 0})};
+  return s;
+}
+
+/// A scene with gravity and no bodies for fluid falling onto Box2D solids, with
+/// `solver` (default wcsph) at `spacing` and the settings such scenes need: they fall up to 3 m
+/// (v ≈ 7.7 m/s), and a weakly compressible fluid needs c0 ≥ 10 v_max (at c0 = 25 m/s
+/// an impact compresses it by v/c ≈ 15 % and the rebound throws particles out of
+/// cups). wcsph: c0 = 10 × 8 m/s, ν = 0 (its artificial viscosity damps). muller2003
+/// (p = c²(ρ − ρ0)): the same c = 80 m/s, and ν = 0.02 m²/s: its pressure force is not
+/// conservative (poly6 density, spiky gradient), so it needs a physical viscosity to stay
+/// calm (docs/SCENES.md: ν ≳ 0.005 at dx = 0.02 and c = 25; the heating grows with c).
+/// Measured on the 10° wedge at c = 80: ν = 0 gains 97 % of the potential energy
+/// released, ν = 0.01 comes to rest slowly, ν = 0.02 rests within 2 s.
+/// pbf and dfsph have no sound speed and run with their defaults and ν = 0.
+inline SceneDef wallScene(double spacing, const std::string& solver = "wcsph") {
+  SceneDef s;
+  s.solver.type = solver;
+  s.solver.spacing = spacing;
+  s.solver.viscosity = solver == "muller2003" ? 0.02 : 0.0;
+  if (solver == "wcsph") s.solver.params["expected_speed"] = 8;
+  if (solver == "muller2003") s.solver.soundSpeed = 80;
+  s.gravity = Vec2d(0, -9.81);
+  return s;
+}
+
+/// A free block [0, 0.8]² moving at (0.3, −0.2) m/s in zero gravity, no walls:
+/// wcsph at dx = 0.04, ν = 0, no effects (the pairwise-momentum tests add theirs).
+inline SceneDef freeMovingBlock() {
+  SceneDef s;
+  s.solver.type = "wcsph";
+  s.solver.spacing = 0.04;
+  s.solver.viscosity = 0.0;
+  s.gravity = Vec2d(0, 0);
+  s.blocks.push_back(block({0, 0}, {0.8, 0.8}, {0.3, -0.2}));
   return s;
 }
 
@@ -194,6 +228,25 @@ inline double minPairDistancePeriodic(const World& w, double L) {
       m = std::min(m, d.norm());
     }
   return m;
+}
+
+/// What `substeps` substeps did to the total momentum of a scene's World (2 threads).
+struct MomentumRun {
+  double change = 0;    ///< |Σ m v after − Σ m v before|
+  double scale = 0;     ///< N m · 0.36 m/s (freeMovingBlock's momentum is N m · 0.36 m/s)
+  bool finite = false;  ///< every position, velocity and density finite at the end
+};
+
+/// Runs `scene` for `substeps` substeps and measures the change of its momentum.
+inline MomentumRun momentumOver(const SceneDef& scene, int substeps) {
+  World w(scene, WorldOptions{2});
+  const Vec2d m0 = momentum(w);
+  for (int i = 0; i < substeps; ++i) w.substep();
+  MomentumRun r;
+  r.change = (momentum(w) - m0).norm();
+  r.scale = double(w.particleCount()) * double(w.particleMass()) * 0.36;
+  r.finite = allFiniteState(w);
+  return r;
 }
 
 /// The mean position of the particles.

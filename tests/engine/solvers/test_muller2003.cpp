@@ -1,10 +1,8 @@
-// The Müller 2003 step against Box2D walls: rest, the dam break, determinism.
+// The muller2003 solver (Müller, Charypar & Gross 2003; the scenes' default):
+// a resting column against Box2D walls, the dam break, determinism.
 #include <doctest/doctest.h>
 
-#include <box2d/box2d.h>
-
 #include <cmath>
-#include <sstream>
 
 #include "sph2d/world.hpp"
 #include "support/fixture.hpp"
@@ -13,7 +11,7 @@ using namespace sph2d;
 using test::frontX;
 using test::outside;
 
-TEST_CASE("a resting column settles: density within 5 % of rho0, its motion decays and stays small") {
+TEST_CASE("muller2003: a resting column settles: density within 5 % of rho0, its motion decays and stays small") {
   // muller2003 (the scene's default solver) with its single-term walls: the
   // column breathes as its wall rows settle (mean speed peaks near 0.09 m/s at
   // t = 0.7 s and falls to 0.02–0.05 m/s by 2 s, measured), so the check is on
@@ -37,7 +35,7 @@ TEST_CASE("a resting column settles: density within 5 % of rho0, its motion deca
   CHECK(outside(w, 0, 0, 0.6, 1.3) == 0);
 }
 
-TEST_CASE("the dam break runs 1 s: no NaN, nothing leaves the tank, the front moves right") {
+TEST_CASE("muller2003: the dam break runs 1 s: no NaN, nothing leaves the tank, the front moves right") {
   const SceneDef s = test::scene("tests/small_dam_break.json");
   World w(s, WorldOptions{2});
   const double front0 = frontX(w);
@@ -60,7 +58,7 @@ TEST_CASE("the dam break runs 1 s: no NaN, nothing leaves the tank, the front mo
   CHECK(w.kineticEnergy() <= released);
 }
 
-TEST_CASE("the state hash is the same for 1, 2 and 3 threads and for two runs") {
+TEST_CASE("muller2003: the state hash is the same for 1, 2 and 3 threads and for two runs") {
   const SceneDef s = test::scene("tests/small_dam_break.json");
   std::uint64_t hashes[4];
   const int threads[4] = {1, 2, 3, 2};
@@ -76,53 +74,4 @@ TEST_CASE("the state hash is the same for 1, 2 and 3 threads and for two runs") 
   World w(s, WorldOptions{1});
   for (int f = 0; f < 21; ++f) w.stepFrame();
   CHECK(w.stateHash() != hashes[0]);
-}
-
-TEST_CASE("the walls are real Box2D fixtures of the world's b2World") {
-  const SceneDef s = test::scene("dam_break.json");
-  World w(s, WorldOptions{1});
-  int bodies = 0, fixtures = 0;
-  for (b2Body* b = w.box2d().GetBodyList(); b; b = b->GetNext()) {
-    ++bodies;
-    CHECK(b->GetType() == b2_staticBody);
-    for (b2Fixture* f = b->GetFixtureList(); f; f = f->GetNext()) ++fixtures;
-  }
-  CHECK(bodies == 1);
-  CHECK(fixtures == 4);
-  CHECK(w.colliders().size() == 4);
-  // A point inside the floor box is inside a fixture; the tank's middle is not.
-  bool inFloor = false, inMiddle = false;
-  for (b2Body* b = w.box2d().GetBodyList(); b; b = b->GetNext())
-    for (b2Fixture* f = b->GetFixtureList(); f; f = f->GetNext()) {
-      inFloor = inFloor || f->TestPoint(b2Vec2(2.0f, -0.1f));
-      inMiddle = inMiddle || f->TestPoint(b2Vec2(2.0f, 1.5f));
-    }
-  CHECK(inFloor);
-  CHECK_FALSE(inMiddle);
-}
-
-TEST_CASE("particles a scene places inside a solid are dropped with one warning") {
-  SceneDef s = test::scene("tests/resting_column.json");
-  s.blocks[0].min = Vec2d(-0.1, 0.0);  // 0.1 m of the block inside the left wall
-  World w(s, WorldOptions{1});
-  const auto warnings = w.takeWarnings();
-  REQUIRE(warnings.size() == 1);
-  CHECK(warnings[0].find("dropped") != std::string::npos);
-  CHECK(warnings[0].find("dropped 150 particles") != std::string::npos);  // 5 columns × 30 rows
-  CHECK(w.particleCount() == 30u * 30u);
-  for (std::size_t i = 0; i < w.particleCount(); ++i) CHECK(w.worldPosition(i).x() > 0);
-}
-
-TEST_CASE("the guard stops a run at the first non-finite value and names stage and particle") {
-  SceneDef s = test::scene("tests/small_dam_break.json");
-  s.gravity = Vec2d(0, std::nan(""));
-  World w(s, WorldOptions{2});
-  try {
-    w.stepFrame();
-    FAIL("expected SimulationError");
-  } catch (const SimulationError& e) {
-    CHECK(e.stage == "pressure_force");  // gravity is added there: the first stage to see the NaN
-    CHECK(e.step == 0);
-    CHECK(std::string(e.what()).find("particle id") != std::string::npos);
-  }
 }

@@ -217,3 +217,14 @@ TEST_CASE("akinci surface tension: the pressure inside a drop is the cohesion's 
     CHECK(d.pressure / A == doctest::Approx(1.0).epsilon(0.2));
   }
 }
+
+TEST_CASE("akinci surface tension conserves linear momentum to rounding (no walls, no gravity)") {
+  SceneDef s = test::freeMovingBlock();
+  s.effects.surfaceTension = true;
+  s.effects.tension.model = "akinci";
+  s.effects.tension.gamma = 0.5;
+  const test::MomentumRun r = test::momentumOver(s, 30);
+  MESSAGE("akinci: momentum change " << r.change << " of " << r.scale);
+  CHECK(r.change <= 1e-5 * r.scale);
+  CHECK(r.finite);
+}
