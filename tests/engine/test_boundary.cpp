@@ -9,6 +9,7 @@
 
 #include <cmath>
 
+#include "boundary_set.hpp"
 #include "sph2d/world.hpp"
 #include "support/fixture.hpp"
 
@@ -18,6 +19,102 @@ using test::boxShape;
 using test::pointsShape;
 using test::potentialEnergy;
 using test::wallScene;
+
+namespace {
+
+/// A b2World holding one static body with `shape`, friction and restitution as given.
+struct OneSolid {
+  b2World world{b2Vec2(0, 0)};
+  OneSolid(const b2Shape& shape, float friction, float restitution) {
+    b2BodyDef bd;
+    b2Body* body = world.CreateBody(&bd);
+    b2FixtureDef fd;
+    fd.shape = &shape;
+    fd.friction = friction;
+    fd.restitution = restitution;
+    body->CreateFixture(&fd);
+  }
+  /// Its BoundarySet at spacing dx, sampled to `depth`, with the collision bins.
+  BoundarySet boundary(Real dx, Real depth) {
+    BoundarySet b;
+    ThreadPool pool(1);
+    b.collect(world, Vec2d(0, 0));
+    b.sample(dx, depth, pool);
+    b.buildBins(Real(4) * depth);
+    return b;
+  }
+};
+
+}  // namespace
+
+TEST_CASE("boundary samples fill a solid's rim down to the kernel's depth: their volumes add up to the rim's area") {
+  // Layers at depths dx/2, 3dx/2, ... below each face (dx = 0.02, depth 0.05: three
+  // layers, a rim 0.06 m thick). A box: the faces' layers tile the rim, corners
+  // included; a circle: each ring's samples share its circumference.
+  const Real dx = 0.02f, depth = 0.05f;
+  b2PolygonShape box;
+  box.SetAsBox(0.5f, 0.2f, b2Vec2(1.0f, 2.0f), 0.3f);  // rotated: the tiling does not rely on the axes
+  OneSolid a(box, 0.2f, 0);
+  const BoundarySet bb = a.boundary(dx, depth);
+  double area = 0, deepest = 0;
+  int outside = 0;
+  for (std::size_t k = 0; k < bb.samples.size(); ++k) {
+    area += bb.volume[k];
+    const double d = bb.insideDepth(bb.samples[k]);
+    outside += d <= 0;
+    deepest = std::max(deepest, d);
+  }
+  const double rim = 1.0 * 0.4 - (1.0 - 0.12) * (0.4 - 0.12);
+  MESSAGE("box: " << bb.samples.size() << " samples, volume " << area << " m² against the rim's " << rim << " m², deepest "
+                  << deepest / dx << " dx");
+  CHECK(outside == 0);
+  CHECK(deepest <= 2.5 * dx + 1e-5);
+  CHECK(area == doctest::Approx(rim).epsilon(0.02));
+  b2CircleShape circle;
+  circle.m_p.Set(-1.0f, 0.5f);
+  circle.m_radius = 0.3f;
+  OneSolid c(circle, 0.2f, 0);
+  const BoundarySet cb = c.boundary(dx, depth);
+  double ring = 0;
+  for (Real v : cb.volume) ring += v;
+  const double annulus = test::kPi * (0.3 * 0.3 - 0.24 * 0.24);
+  MESSAGE("circle: " << cb.samples.size() << " samples, volume " << ring << " m² against the annulus's " << annulus << " m²");
+  CHECK(ring == doctest::Approx(annulus).epsilon(1e-4));
+}
+
+TEST_CASE("the swept collision puts a particle that crossed an edge back on its side at the clearance, with the fixture's restitution and friction") {
+  b2EdgeShape edge;
+  edge.SetTwoSided(b2Vec2(0, 0), b2Vec2(1, 0));
+  const Real clearance = 0.005f;
+  for (const float restitution : {0.0f, 0.5f}) {
+    CAPTURE(restitution);
+    OneSolid s(edge, 0.0f, restitution);
+    const BoundarySet b = s.boundary(0.02f, 0.05f);
+    // From above to 0.1 m below in one substep, at (0.3, −4) m/s: through the edge.
+    Vec2 x(0.5f, -0.1f), v(0.3f, -4.0f);
+    CHECK(b.resolve(x, v, Vec2(0.5f, 0.1f), clearance));
+    CHECK(x.y() == doctest::Approx(clearance));  // back above, the clearance away
+    CHECK(x.x() == doctest::Approx(0.5f).epsilon(1e-5));
+    CHECK(v.x() == doctest::Approx(0.3f));        // no friction: the tangential velocity kept
+    CHECK(v.y() == doctest::Approx(4.0f * restitution));
+    // From below the same: the edge is two-sided.
+    Vec2 y(0.5f, 0.1f), u(0, 4.0f);
+    CHECK(b.resolve(y, u, Vec2(0.5f, -0.1f), clearance));
+    CHECK(y.y() == doctest::Approx(-clearance));
+    // A particle that stays on its side, farther than the clearance, is left alone.
+    Vec2 z(0.5f, 0.05f), w(0, -1.0f);
+    CHECK_FALSE(b.resolve(z, w, Vec2(0.5f, 0.06f), clearance));
+    CHECK(z == Vec2(0.5f, 0.05f));
+    CHECK(w == Vec2(0, -1.0f));
+  }
+  // Friction: the tangential velocity falls by μ times the change of the normal velocity.
+  OneSolid f(edge, 0.05f, 0.0f);
+  const BoundarySet b = f.boundary(0.02f, 0.05f);
+  Vec2 x(0.5f, -0.1f), v(1.0f, -4.0f);
+  CHECK(b.resolve(x, v, Vec2(0.5f, 0.1f), clearance));
+  CHECK(v.y() == doctest::Approx(0.0f));
+  CHECK(v.x() == doctest::Approx(1.0f - 0.05f * 4.0f));
+}
 
 namespace {
 

@@ -1,5 +1,6 @@
-// The stages every solver shares (engine/src/stages.cpp): the periodic wrap and
-// nearest images, reordering the particle arrays along the grid.
+// The stages every solver shares (engine/src/stages.cpp): the tie-break direction
+// of coincident pairs, integration and its displacement clamp, the periodic wrap
+// and nearest images, reordering the particle arrays along the grid.
 #include <doctest/doctest.h>
 
 #include <algorithm>
@@ -7,6 +8,7 @@
 #include <map>
 #include <string>
 
+#include "stages.hpp"
 #include "sph2d/world.hpp"
 #include "support/fixture.hpp"
 
@@ -73,4 +75,65 @@ TEST_CASE("reordering changes physics by rounding only: every step vs never, 20 
   CHECK(worst <= 1e-4 * s.solver.spacing);
   // And the particles did move: 20 substeps of the collapse are not a no-op.
   CHECK(a.kineticEnergy() > 0);
+}
+
+TEST_CASE("tieBreakDirection gives each coincident pair a unit direction, opposite for the two particles, spread over the circle") {
+  int sectors[8] = {0, 0, 0, 0, 0, 0, 0, 0};
+  for (std::uint32_t i = 0; i < 40; ++i)
+    for (std::uint32_t j = i + 1; j < 40; ++j) {
+      const Vec2 d = tieBreakDirection(i, j), e = tieBreakDirection(j, i);
+      CHECK(d.norm() == doctest::Approx(1.0f).epsilon(1e-6));
+      CHECK(e == Vec2(-d));  // antisymmetric: the pair forces built on it cancel
+      CHECK(tieBreakDirection(i, j) == d);  // fixed
+      const double a = std::atan2(double(d.y()), double(d.x())) + test::kPi;
+      ++sectors[std::min(7, int(a / (2 * test::kPi) * 8))];
+    }
+  // 780 pairs: every octant gets its share (no preferred direction that would drift a clump).
+  for (int k = 0; k < 8; ++k) {
+    CAPTURE(k);
+    CHECK(sectors[k] > 780 / 8 / 2);
+  }
+}
+
+namespace {
+
+/// Two particles and the parts a StepContext refers to (no neighbours needed).
+struct TwoParticles {
+  Particles P;
+  Grid grid;
+  NeighbourLists nbr;
+  BoundarySet boundary;
+  ThreadPool pool{1};
+  Scratch scratch;
+  SolverDef def;
+  StepContext c{P, grid, nbr, boundary, pool, scratch, def};
+  TwoParticles() {
+    P.push(Vec2(0, 0), Vec2(1, 0), 0, 1000);
+    P.push(Vec2(1, 1), Vec2(0, 0), 1, 1000);
+    c.R = 0.1f;
+    c.dt = 0.01f;
+    c.maxSpeed = 500;
+  }
+};
+
+}  // namespace
+
+TEST_CASE("integration is symplectic Euler (v += a dt, then x += v dt) and moves no particle more than half a support") {
+  TwoParticles t;
+  t.P.a[0] = Vec2(0, -10);      // ordinary: Δv = (0, −0.1), |v dt| = 0.01 m < R/2
+  t.P.a[1] = Vec2(0, 1e4);      // a jump: v = 100 m/s would move it 1 m
+  REQUIRE(stageIntegrate(t.c) == kNone);
+  CHECK(t.P.v[0].x() == doctest::Approx(1.0f));
+  CHECK(t.P.v[0].y() == doctest::Approx(-0.1f));
+  CHECK(t.P.x[0].x() == doctest::Approx(0.01f));     // with the new velocity
+  CHECK(t.P.x[0].y() == doctest::Approx(-0.001f));
+  CHECK(t.P.xPrev[0] == Vec2(0, 0));
+  // The clamp: R/2 in this substep, along the velocity, and the velocity to match.
+  CHECK((t.P.x[1] - t.P.xPrev[1]).norm() == doctest::Approx(0.5f * t.c.R));
+  CHECK(t.P.v[1].y() == doctest::Approx(0.5f * t.c.R / t.c.dt));
+  CHECK(t.P.v[1].x() == 0);
+  // Beyond solver.max_speed the guard reports the particle instead.
+  TwoParticles g;
+  g.P.a[1] = Vec2(0, 1e7);  // 100,000 m/s
+  CHECK(stageIntegrate(g.c) == 1);
 }
