@@ -7,7 +7,8 @@
 // static boxes), arena (4 m × 4 m), block. Measurements (world coordinates, every
 // particle): outside, meanSpeed, maxSpeed, frontX, sumY, potentialEnergy,
 // momentum, velocityVariance, layerVelocityDifference, centroid,
-// minPairDistance(Periodic), inertiaAspect, cornerRatio. Flows:
+// minPairDistance(Periodic), inertiaAspect, cornerRatio, surfaceHeight,
+// PressureProbe (fitLine). Flows:
 // wallScene, periodicShearLayer, freeMovingBlock (momentumOver).
 #pragma once
 
@@ -247,6 +248,74 @@ inline MomentumRun momentumOver(const SceneDef& scene, int substeps) {
   r.scale = double(w.particleCount()) * double(w.particleMass()) * 0.36;
   r.finite = allFiniteState(w);
   return r;
+}
+
+/// The free-surface height near x = xc: the mean height of the particles within
+/// one spacing of the highest one and within `halfWidth` of xc, plus half a spacing.
+inline double surfaceHeight(const World& w, double xc, double halfWidth) {
+  const double dx = double(w.spacing());
+  double top = -1e300;
+  for (std::size_t i = 0; i < w.particleCount(); ++i) top = std::max(top, w.worldPosition(i).y());
+  double H = 0;
+  int n = 0;
+  for (std::size_t i = 0; i < w.particleCount(); ++i) {
+    const Vec2d q = w.worldPosition(i);
+    if (q.y() > top - dx && std::fabs(q.x() - xc) < halfWidth) {
+      H += q.y();
+      ++n;
+    }
+  }
+  return H / std::max(n, 1) + 0.5 * dx;
+}
+
+/// A pressure probe: the particles' pressure averaged in horizontal bands centred
+/// at y = k·band (those within 0.3 band of the centre and within halfWidth of
+/// x = xc), summed over every add() (so a probe averages slow sloshing out).
+struct PressureProbe {
+  double xc, halfWidth, band;
+  std::vector<double> sum = std::vector<double>(400, 0.0);
+  std::vector<int> count = std::vector<int>(400, 0);
+  /// Adds the particles of the current state.
+  void add(const World& w) {
+    for (std::size_t i = 0; i < w.particleCount(); ++i) {
+      const Vec2d q = w.worldPosition(i);
+      const long k = std::lround(q.y() / band);
+      if (k < 0 || k >= long(sum.size()) || std::fabs(q.x() - xc) >= halfWidth || std::fabs(q.y() - band * double(k)) >= 0.3 * band)
+        continue;
+      sum[std::size_t(k)] += double(w.particles().p[i]);
+      ++count[std::size_t(k)];
+    }
+  }
+  /// (y, mean pressure) of the bands with particles, from y0 to y1.
+  std::vector<std::pair<double, double>> profile(double y0, double y1) const {
+    std::vector<std::pair<double, double>> out;
+    for (std::size_t k = 0; k < sum.size(); ++k) {
+      const double y = band * double(k);
+      if (y >= y0 && y <= y1 && count[k] > 0) out.emplace_back(y, sum[k] / count[k]);
+    }
+    return out;
+  }
+};
+
+/// Least-squares line p = intercept + slope·y through (y, p) points.
+struct Line {
+  double intercept = 0, slope = 0;
+  /// Where the line crosses p = 0.
+  double zero() const { return -intercept / slope; }
+};
+inline Line fitLine(const std::vector<std::pair<double, double>>& pts) {
+  double sx = 0, sy = 0, sxx = 0, sxy = 0;
+  const double n = double(pts.size());
+  for (const auto& [x, y] : pts) {
+    sx += x;
+    sy += y;
+    sxx += x * x;
+    sxy += x * y;
+  }
+  Line l;
+  l.slope = (n * sxy - sx * sy) / (n * sxx - sx * sx);
+  l.intercept = (sy - l.slope * sx) / n;
+  return l;
 }
 
 /// The mean position of the particles.

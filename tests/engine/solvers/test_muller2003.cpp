@@ -75,3 +75,28 @@ TEST_CASE("muller2003: the state hash is the same for 1, 2 and 3 threads and for
   for (int f = 0; f < 21; ++f) w.stepFrame();
   CHECK(w.stateHash() != hashes[0]);
 }
+
+TEST_CASE("muller2003: a resting column's pressure grows by 2 rho0 g per metre (within 20 %) and vanishes at its surface") {
+  // p = c²(ρ − ρ0) and the symmetric force m(p_i + p_j)/(2ρ_j)∇W recover ∇p/2
+  // (muller2003.cpp), so at rest p = 2ρ0g(H − y), not ρ0g(H − y). Probed at x =
+  // 0.3 ± 0.2 m in 5 cm bands over the second second, above the two rows at the
+  // floor (the single-term walls leave them compressed: 2× and 1.4× the profile).
+  // Measured: slope 1.12 × 2ρ0g, zero 1 mm above the surface.
+  const SceneDef s = test::scene("tests/resting_column.json");
+  REQUIRE(s.solver.type == "muller2003");
+  World w(s, WorldOptions{2});
+  test::PressureProbe probe{0.3, 0.2, 0.05};
+  for (int f = 0; f < 120; ++f) {
+    w.stepFrame();
+    if (f >= 60) probe.add(w);
+  }
+  REQUIRE(test::allFiniteState(w));
+  const double rho0 = 1000, g = 9.81, dx = s.solver.spacing, H = test::surfaceHeight(w, 0.3, 0.2);
+  const auto bands = probe.profile(0.1, H - 3 * dx);
+  REQUIRE(bands.size() >= 7);
+  const test::Line l = test::fitLine(bands);
+  MESSAGE("surface " << H << " m; over " << bands.size() << " bands dp/dy = " << l.slope << " Pa/m = "
+                     << l.slope / (-2 * rho0 * g) << " × (−2 rho0 g), p = 0 at " << l.zero() << " m");
+  CHECK(l.slope / (-2 * rho0 * g) == doctest::Approx(1.0).epsilon(0.2));
+  CHECK(std::fabs(l.zero() - H) < 2 * dx);
+}
