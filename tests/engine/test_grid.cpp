@@ -1,9 +1,11 @@
-// The neighbour grid and lists find exactly the brute-force neighbour sets.
+// The neighbour grid (engine/src/grid.cpp, grid.hpp): the candidates are exactly the
+// brute-force neighbour sets, also through periodic seams; PeriodicBox wraps.
 #include <doctest/doctest.h>
 
 #include <algorithm>
 #include <cstdint>
 #include <random>
+#include <set>
 #include <vector>
 
 #include "grid.hpp"
@@ -83,4 +85,81 @@ TEST_CASE("grid build keeps its cell count bounded for a huge bounding box") {
   int found = 0;
   g.forCandidates(x[0], [&](std::uint32_t j) { found += (x[0] - x[j]).squaredNorm() < 0.0025f; });
   CHECK(found == 2);
+}
+
+TEST_CASE("periodic grid: the candidates within R are exactly the nearest-image neighbours, across both seams") {
+  ThreadPool pool(2);
+  PeriodicBox box;
+  box.x = box.y = true;
+  box.lo = Vec2(-0.3f, 0.2f);
+  box.lx = 1.1f;
+  box.ly = 0.7f;
+  const Real R = 0.12f;
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<float> ux(0, 1);
+  std::vector<Vec2> x(3000);
+  for (auto& p : x) p = box.lo + Vec2(ux(rng) * box.lx, ux(rng) * box.ly);
+  for (int k = 0; k < 40; ++k) x[std::size_t(k)] = box.lo + Vec2(0.001f * k, box.ly * 0.999f);  // on the seams
+  Grid g;
+  g.build(x.data(), x.size(), R, pool, 2, &box);
+  CHECK(g.wrapX);
+  CHECK(g.wrapY);
+  std::size_t pairs = 0, seamPairs = 0;
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    std::multiset<std::uint32_t> found;
+    g.forCandidates(x[i], [&](std::uint32_t j) {
+      if (j != i && box.delta(x[i], x[j]).squaredNorm() < R * R) found.insert(j);
+    });
+    std::multiset<std::uint32_t> brute;
+    for (std::size_t j = 0; j < x.size(); ++j) {
+      if (j == i) continue;
+      const Vec2 d = box.delta(x[i], x[j]);
+      if (d.squaredNorm() < R * R) {
+        brute.insert(std::uint32_t(j));
+        seamPairs += (x[i] - x[j]).squaredNorm() >= R * R;  // only a neighbour through a seam
+      }
+    }
+    REQUIRE(found == brute);  // and no particle twice
+    pairs += brute.size();
+  }
+  MESSAGE(pairs << " neighbour pairs, " << seamPairs << " of them through a seam");
+  CHECK(seamPairs > 1000);
+}
+
+TEST_CASE("periodic grid: a period far longer than the fluid keeps the cell count bounded") {
+  ThreadPool pool(1);
+  PeriodicBox box;
+  box.x = true;
+  box.lo = Vec2(0, 0);
+  box.lx = 1.0e5f;  // 100 km period, 10 particles
+  std::vector<Vec2> x;
+  for (int i = 0; i < 10; ++i) x.push_back(Vec2(0.01f * float(i), 0.5f));
+  Grid g;
+  g.build(x.data(), x.size(), 0.025f, pool, 2, &box);
+  CHECK(double(g.nx) * double(g.ny) <= 4096.0 * 1.05);
+  std::size_t found = 0;
+  g.forCandidates(x[0], [&](std::uint32_t j) { found += box.delta(x[0], x[j]).squaredNorm() < 0.025f * 0.025f; });
+  CHECK(found == 3);  // itself and the two within 0.025 m
+  Grid empty;
+  empty.build(x.data(), 0, 0.025f, pool, 2, &box);
+  CHECK(empty.nx * empty.ny == 1);
+}
+
+TEST_CASE("periodic wrap: positions move into the box by whole periods, xPrev with them") {
+  PeriodicBox box;
+  box.x = true;
+  box.lo = Vec2(1.0f, 0.0f);
+  box.lx = 2.0f;
+  Vec2 p(3.25f, 7.0f);
+  const Vec2 s = box.wrap(p);
+  CHECK(p.x() == doctest::Approx(1.25f));
+  CHECK(p.y() == 7.0f);  // y is not periodic
+  CHECK(s.x() == doctest::Approx(-2.0f));
+  Vec2 q(0.5f, 0.0f);
+  box.wrap(q);
+  CHECK(q.x() == doctest::Approx(2.5f));
+  Vec2 edge(3.0f, 0.0f);  // the upper edge belongs to the next period
+  box.wrap(edge);
+  CHECK(edge.x() >= 1.0f);
+  CHECK(edge.x() < 3.0f);
 }

@@ -7,7 +7,7 @@
 #include <cmath>
 
 #include "sph2d/world.hpp"
-#include "test_util.hpp"
+#include "support/fixture.hpp"
 
 using namespace sph2d;
 
@@ -19,11 +19,7 @@ std::uint64_t callsOf(const World& w, const std::string& stage) {
   return 0;
 }
 
-double maxSpeed(const World& w) {
-  double m = 0;
-  for (std::size_t i = 0; i < w.particleCount(); ++i) m = std::max(m, double(w.particles().v[i].norm()));
-  return m;
-}
+using test::maxSpeed;
 
 }  // namespace
 
@@ -89,3 +85,17 @@ void sliverOnlyDrifts(const std::string& solver) {
 }  // namespace
 
 TEST_CASE_EVERY_SOLVER("a sliver of a step only drifts (no solver stage runs, nothing is kicked)", sliverOnlyDrifts)
+
+TEST_CASE("the guard stops a run at the first non-finite value and names stage and particle") {
+  SceneDef s = test::scene("tests/small_dam_break.json");
+  s.gravity = Vec2d(0, std::nan(""));
+  World w(s, WorldOptions{2});
+  try {
+    w.stepFrame();
+    FAIL("expected SimulationError");
+  } catch (const SimulationError& e) {
+    CHECK(e.stage == "pressure_force");  // gravity is added there: the first stage to see the NaN
+    CHECK(e.step == 0);
+    CHECK(std::string(e.what()).find("particle id") != std::string::npos);
+  }
+}

@@ -20,7 +20,7 @@
 //     across the surface is about 1/2, not 1: I is that sum on a flat half
 //     lattice (flatSurfaceDeltaIntegral, ≈ 0.5), and dividing by it makes the
 //     force across a surface integrate to σκ — the 2D Laplace jump σ/r
-//     (tests/engine/test_surface_tension.cpp: 1.00–1.08 σ/r).
+//     (tests/engine/effects/test_surface_tension.cpp: 1.00–1.08 σ/r).
 //   Per-particle (not pairwise). Time-step limit (Brackbill et al.):
 //   dt ≤ sqrt(ρ0 h³ / (2π σ)), h = R/2.
 //

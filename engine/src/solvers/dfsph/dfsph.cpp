@@ -1,139 +1,54 @@
 // dfsph — Divergence-free SPH (Bender & Koschier 2015, "Divergence-free
 // smoothed particle hydrodynamics", SCA; and 2017, "Divergence-free SPH for
 // incompressible and viscous fluids", IEEE TVCG). An implicit pressure
-// solver: two iterative solves per substep make the velocity field
-// divergence-free and the predicted density equal to ρ0, instead of an
-// equation of state with a stiffness (solver.sound_speed is not used).
+// solver: two iterative solves on the velocities per substep make the velocity
+// field divergence-free and the predicted density ρ0, instead of an equation of
+// state with a stiffness (solver.sound_speed is not read). Why each choice, the
+// variants tried and the measurements: docs/SOLVERS.md, section dfsph.
 //
-// Substep: grid → neighbours → density (Wendland C2 summation, boundary
-// samples as frozen fluid of mass ρ0Ψ_b) and the factor
-//   α_i = ρ_i / (|Σ_j m∇W_ij + Σ_b ρ0Ψ_b∇W_ib|² + Σ_j |m∇W_ij|²)
-// (0 when the denominator is tiny: an isolated particle) → divergence-free
-// solve on v → a = gravity + the scene's effects, v* = v + dt a →
-// constant-density solve on v* → x += dt v (the World then collides).
+// Quantities (Wendland C2 kernel W of support R; boundary samples b are frozen
+// fluid of mass ρ0Ψ_b at rest; q = r/R):
+//   (1) ρ_i = Σ_j m W_ij + Σ_b ρ0Ψ_b W_ib
+//   (2) g_ij = m∇W_ij, except that below q = 1/4 it keeps the peak |∇W| along
+//       x_i − x_j (a stacked pair has a direction and a magnitude; coincident
+//       pairs take pairDelta's direction); G_i = Σ_j g_ij + Σ_b ρ0Ψ_b∇W_ib
+//   (3) α_i = ρ_i / (|G_i|² + Σ_j |g_ij|²), the paper's factor (0 without neighbours)
+//   (4) Dρ_i/Dt = G_i·v_i − Σ_j g_ij·v_j
 //
-// Both solves iterate the same two gathers:
-//   A: the source s_i — the predicted density error ρ*_i − ρ0 with
-//      ρ*_i = ρ_i + dt Dρ_i/Dt (the divergence solve: Dρ_i/Dt itself), where
-//      Dρ_i/Dt = Σ_j m (v_i − v_j)·∇W_ij + Σ_b ρ0Ψ_b v_i·∇W_ib (walls at rest);
-//      the increment δκ_i = ω s_i α_i / dt² (divergence: ω s_i α_i / dt);
-//      the residual, summed per block;
-//   B: v_i −= dt [Σ_j m (δκ_i/ρ_i + δκ_j/ρ_j) ∇W_ij + Σ_b ρ0Ψ_b (δκ_i/ρ_i) ∇W_ib],
-//      κ_i += δκ_i.
-// Walls mirror the particle's κ with the paper's (and SPlisHSPlasH's)
-// single term δκ_i/ρ_i: then the velocity update is the adjoint of the
-// density prediction, so a converged solve only removes energy. (Measured on
-// the resting column: the symmetric-looking 2δκ_i/ρ_i, with or without
-// Adami-style hydrostatic extrapolation, holds the true pressure ρgH at the
-// floor, but the warm start then adds energy and the tank churns at
-// 0.04–0.2 m/s; with the single term it rests at ~0.01 m/s, and the
-// wall-row pressure reads about 1.4 ρgH.)
-// Relaxation ω (solver.relaxation, default 0.5): plain Jacobi (ω = 1)
-// diverges in 2D. α_i is the exact diagonal, but on a square lattice with
-// R = 2.5 dx the largest eigenvalue of diag⁻¹·A is 2.47 (2.12 for R = 2 dx),
-// so ω must stay below 0.81; 0.8 diverged on both dam breaks, 0.7 held at
-// dx = 0.02, and 0.6 diverged at the floor of the 1 m tank at dx = 12.5 mm
-// (the wall rows' eigenvalues are larger than the bulk's); 0.5 held there.
-// Chebyshev acceleration (solver.chebyshev_rho, default 0.98; Wang 2015,
-// "A Chebyshev semi-iterative approach for accelerating projective and
-// position-based dynamics"): after 5 plain iterations each new iterate is
-// w_k (Jacobi iterate − previous iterate) + previous iterate, for v and κ
-// alike (κ clamped at 0 again), w = 2/(2 − ρ²), then 4/(4 − ρ² w); a residual
-// that grows restarts it. The relaxed Jacobi stalls on smooth modes (the
-// divergence residual falls ~0.6 % per iteration at rest); Chebyshev halves
-// the divergence iterations of the dam break (29 → 13 per substep).
-// The free surface: κ_i stays ≥ 0 (no tension). Where κ_i = 0 that is the
-// paper's clamp ρ* ≥ ρ0 (δκ_i ≥ 0); where κ_i > 0 a negative δκ_i takes back
-// pressure the warm start or an earlier iteration over-applied, down to 0
-// (projected Jacobi for the unilateral constraint). The residual is the
-// complementarity one: |s_i| where κ_i > 0, max(s_i, 0) where κ_i = 0; its
-// mean must be ≤ tolerance·ρ0 (divergence: ≤ divergence_tolerance·ρ0/dt,
-// the density change one substep's divergence error makes, as in
-// SPlisHSPlasH), after at least min_iterations and at most max_iterations.
-// The divergence tolerance used to be per second (0.01 ρ0/s): on the 20k dam
-// break (1.6 ms substeps) that took 35 divergence iterations a substep, 74 %
-// of the step; at 1e-4 per substep (0.06 ρ0/s there) it takes 14, the whole
-// step needs half the iterations, and the mean density error is unchanged
-// (the constant-density solve holds it). The Taylor–Green vortex (5.6 ms
-// substeps: 0.018 ρ0/s) decays within 1.8 % as before; at 0.1 ρ0/s it was 7 %.
-// With solver.clamp_negative_pressure = false (a flow with no free surface)
-// κ takes either sign and every |s_i| counts. When, in addition, both axes
-// are periodic and there are no walls, a constant κ is (nearly) in the null
-// space of the solve, and the mean of the summation-density error is not a
-// compression: each pass A then removes the mean of the source first (one
-// extra reduction), or κ drifts without bound (measured: a Taylor–Green
-// vortex's pressure reached −7e33 Pa).
-// Warm start: each solve starts from its previous substep's κ (particle
-// fields "dfsph.kappa" [m²/s², = p/ρ] and "dfsph.kappa_v" [m²/s, κ_v·dt],
-// permuted with the particles on reorder), applied once before iterating.
+// Substep (stages()):
+//   1. grid, neighbours; ρ, g, G, α by (1)–(3), kept for the whole substep.
+//   2. Divergence-free solve on v: source s_i = Dρ_i/Dt (4), until the mean
+//      residual ≤ divergence_tolerance·ρ0/dt.
+//   3. a = gravity + the scene's effects; v* = v + dt a.
+//   4. Constant-density solve on v*: source s_i = ρ_i + dt Dρ_i/Dt − ρ0, the
+//      compression ρ_i − ρ0 already present counting at most
+//      ρ0·2·(3 m/s)·dt/dx (a pushout speed), until the mean residual ≤ tolerance·ρ0.
+//   5. x += dt v (the World's swept collision follows); p = κρ for readers.
+// Each solve starts from its previous substep's κ (fields "dfsph.kappa" = p/ρ,
+// "dfsph.kappa_v" = κ_v·dt, permuted with the particles), applied once by B,
+// then iterates two gathers:
+//   A. δκ_i = ω s_i α_i / dt² (divergence: / dt), times 1.1 ρ0/ρ_i beyond
+//      1.1 ρ0; κ_i + δκ_i ≥ 0 (no tension at a free surface: projected Jacobi
+//      with the complementarity residual |s_i| where κ_i > 0, max(s_i, 0) where
+//      κ_i = 0); the residuals summed per block.
+//   B. v_i −= dt [Σ_j (δκ_i/ρ_i + δκ_j/ρ_j) g_ij + (δκ_i/ρ_i) Σ_b ρ0Ψ_b∇W_ib];
+//      κ_i += δκ_i. The wall term is the paper's single term, so B is the
+//      adjoint of A's prediction and a converged solve only removes energy.
+// ω = solver.relaxation (0.5: plain Jacobi diverges in 2D); after 5 plain
+// iterations Chebyshev semi-iteration (Wang 2015) with ρ = chebyshev_rho,
+// restarted when the residual grows; min_iterations to max_iterations. With
+// clamp_negative_pressure = false κ takes either sign, and in a closed periodic
+// box (both axes periodic, no walls) A first removes the source's mean.
 //
-// Gradients m∇W_ij are computed once per substep with the density and kept
-// with the neighbour's slot per neighbour entry (same layout as
-// NeighbourLists), and Σ_j m∇W_ij + Σ_b ρ0Ψ_b∇W_ib once per particle, so an
-// iteration reads no positions and takes no square roots. Every pass is a
-// gather over fixed blocks and every mean is a block reduction combined in
-// block order: the same bits for any thread count.
+// Time step: the least of velocity_cfl·R/v_max, 0.25·sqrt(R/a_max) (a without
+// pressure), 0.1·sqrt(R/|g|) and 0.35·R/sqrt(|g| D), D the greatest depth
+// below the highest particle of a column (strips of width R; gravity along a
+// periodic axis counts for neither this nor the warm start). A substep shorter
+// than 1 % of that limit and of the last solved substep (a frame's float
+// remainder) runs without the solves.
 //
-// Time step: dt ≤ velocity_cfl·R/v_max (velocity only; solver.cfl, the other
-// solvers' CFL number on c + v_max, is not read), the other solvers' force
-// limit 0.25·sqrt(R/a_max) with a the non-pressure acceleration (gravity +
-// effects), and dt ≤ 0.1·sqrt(R/|g|), which sets the step of a fluid at rest:
-// at 0.25·sqrt(R/g) the first, cold-started steps of the resting column did
-// not converge within 100 iterations and at ν ≤ 0.001 m²/s it blew up; at
-// 0.1·sqrt(R/g) it rests at ν = 0. velocity_cfl defaults to 0.4: on the dam
-// break (10k particles) that is 10 substeps a frame instead of 15 at 0.25,
-// and the mean density error stays below 0.02 %.
-// And dt ≤ 0.35·R/sqrt(|g| D), D the greatest depth of a particle below
-// the highest particle of its column (strips of width R across gravity, as
-// the hydrostatic warm start; gravity along a periodic axis does not count
-// for either, since a body force along a periodic channel builds no
-// hydrostatic pressure): the stiffness of the hydrostatic pressure
-// itself. The solves make ρ* = ρ0 for the positions of this substep; how the
-// pressure force changes as the particles move (∇W under a pressure
-// κ ≈ |g| D, a stiffness ~ κ/R²) is explicit, a wave of speed ~ sqrt(κ), and
-// at rest the other limits do not see it: at dt = 0.1·sqrt(R/g),
-// dt·sqrt(gD)/R = 0.1·sqrt(D/R), which grows with the depth in supports.
-// Measured on the 2 m × 1 m tank at dx = 12.5 mm (12,800 particles, ν = 0,
-// R = 31 mm, D = 1 m): at dt = 0.1·sqrt(R/g) (5.6 ms: 0.57 R/sqrt(κ_max),
-// κ_max ≈ 1.2 g·1 m) the rows near the floor move in alternation (even rows
-// down, odd rows up: a mode the SPH divergence does not see in the bulk, so
-// neither solve damps it), the pattern flips sign every substep and its
-// amplitude doubles (floor row v_y +0.012, −0.024, +0.11, −0.14 m/s over the
-// first four substeps, with the symmetric wall term; with the single term
-// the warm start's first kick, −1.4 m/s, hides it), the floor rows are
-// crushed at the collision clearance (single particles 50 % compressed) and
-// the tank erupts at t ≈ 0.09 s. Halving that step (0.05·sqrt(R/g)) rests;
-// so does 0.5 R/sqrt(κ_max) for 0.5 s. The coarse tank (dx = 25 mm) ran at
-// 0.40 R/sqrt(κ_max) under the old limits and held. Not the cause (each
-// still erupted within 0.1–0.3 s at the old step): 500–2,000 iterations, a
-// tenfold tighter tolerance, chebyshev_rho = 0, the symmetric wall term
-// 2δκ_i/ρ_i (with α's wall part to match), no divergence solve, no or a
-// halved warm start of κ_v, ν ≤ 0.003 m²/s (ν = 0.01 held, through its own,
-// smaller, viscous step limit). A first version of the limit on the largest
-// κ instead of the depth let a jammed particle's κ spike shorten the step,
-// and a shorter step makes the density solve push harder (the wedge test
-// gained 4× its potential energy): the depth is geometric and has no such
-// feedback. With the limit (0.35 ≈ 0.38 R/sqrt(κ_max) at rest) the fine
-// tank runs 5 substeps a frame instead of 3 and rests like the coarse one
-// (measured with a driver, not the bench: 1.5 s, no blow-up, kinetic energy
-// falling from 8.6 to 4.1 J, max speed ≤ 0.46 m/s after 0.25 s, mean density
-// error 0.04 %, floor rows at 1.08–1.18 ρ0 g H). The coarse tank still runs
-// 3 substeps a frame (the same bits). The dam break (a 2 m column; the
-// limit binds until it has collapsed) takes 294 substeps instead of 258 at
-// dx = 0.02 m and 541 instead of 493 at 0.01 m (20k particles; 9.4 wall s
-// per simulated s on a busy machine before the per-substep divergence
-// tolerance, 4.9 in the bench after it), its mean density error unchanged
-// (0.07 %, 0.05 %). Known cost: the depth runs from the highest particle of
-// a column, air gaps included, so a jet or spray above a pool shortens the
-// step more than the pool's own depth needs.
-// A substep shorter than 1 % of the solver's own limit and of the last solved
-// substep (the World's float rounding remainder of a frame, ~1e-10 s) runs
-// without the solves: the density solve would correct the existing
-// compression at a speed ∝ 1/dt and leave κ ∝ 1/dt for the next warm start
-// (it blew up the resting column). The limit alone is not enough: without
-// gravity and at rest it is velocity_cfl·R/(1e-6 R), 4·10⁵ s, so every
-// frame-long substep looked like a remainder: fluid added on top of fluid at
-// rest in zero gravity (the stability suite) stayed twice as dense for good.
+// Every pass is a gather over fixed blocks and every mean a block reduction
+// combined in block order: the same bits for any thread count.
 //
 // Parameters (solver.*): tolerance, divergence_tolerance, max_iterations,
 // min_iterations, relaxation, chebyshev_rho, velocity_cfl, divergence_solve. stats()
@@ -233,13 +148,14 @@ class Dfsph final : public Solver {
     for (std::size_t i = 0; i < P.size(); ++i) f(i, top[strip(P.x[i])] - up.dot(P.x[i]));
   }
 
-  /// velocity_cfl·R/v_max, 0.1·sqrt(R/|g|), 0.25·sqrt(R/a_max) and 0.35·R/sqrt(|g| D), whichever is least.
+  /// velocity_cfl·R/v_max, 0.1·sqrt(R/|g|), 0.25·sqrt(R/a_max) and 0.35·R/sqrt(|g| D), whichever is least
+  /// (docs/SOLVERS.md: the hydrostatic stiffness limit).
   Real maxTimeStep(const StepContext& c, Real vmax, Real amax) const override {
     Real dt = cfl_ * c.R / std::max(vmax, Real(1e-6) * c.R);
     const Real g = c.gravity.norm();
     if (g > 0) dt = std::min(dt, Real(0.1) * std::sqrt(c.R / g));
     if (amax > 0) dt = std::min(dt, kForceCfl * std::sqrt(c.R / amax));
-    // The hydrostatic pressure's own stiffness: dt ≤ 0.35·R/sqrt(|g| D) (see the header).
+    // The hydrostatic pressure's own stiffness: dt ≤ 0.35·R/sqrt(|g| D) (docs/SOLVERS.md).
     const Real gh = hydrostaticGravity(c).norm();
     if (gh > 0 && c.P.size() > 0) {
       Real dMax = 0;
@@ -298,6 +214,8 @@ class Dfsph final : public Solver {
     const Real R = c.R;
     const Real gradK = W.gradientScale;  // ∇W = gradK (1 − q)³ d
     const Real mGradK = c.mass * gradK;
+    const Real aFlat = Real(1) - kFlatQ;
+    const Real mGradFlat = mGradK * aFlat * aFlat * aFlat * (kFlatQ * R);  // m|∇W| at q = 1/4, times r/|d|
     const Real self = W.value(0);
     // Below this the factor's denominator means no neighbours at all (a full
     // neighbourhood gives about (ρ0/R)²).
@@ -316,10 +234,13 @@ class Dfsph final : public Solver {
           const std::uint32_t j = nb[k];
           Real dx, dy, r2;
           pairDelta(c, i, j, dx, dy, r2);  // coincident pairs: a fixed, antisymmetric direction
-          const Real q = std::sqrt(r2) * W.invR;
+          const Real r = std::sqrt(r2);
+          const Real q = r * W.invR;
           const Real a = Real(1) - q;
           sum += W.valueQ(q);
-          const Real g = mGradK * a * a * a;  // m∇W_ij = g·d
+          // m∇W_ij = g·d; below q = 1/4, where |∇W| peaks, the solves' gradient keeps
+          // its peak magnitude along d (the header's (2); docs/SOLVERS.md, issue 17).
+          const Real g = q < kFlatQ ? mGradFlat / r : mGradK * a * a * a;
           const Real gxk = g * dx, gyk = g * dy;
           Gi[k] = Pair{j, gxk, gyk};
           gx += gxk;
@@ -448,6 +369,8 @@ class Dfsph final : public Solver {
     const Real wInvDt = omega_ * invDt, wInvDt2 = wInvDt * invDt;
     const bool unilateral = unilateral_;
     const Real kMin = kMin_;
+    const Real kneeRho = kKneeDensity * rho0;
+    const Real pushout = rho0 * Real(2) * kPushoutSpeed * dt / c.dx;  // [kg/m³] per substep
     return c.pool.reduce(
         P.size(), kBlock, Sums{},
         [&](std::size_t b, std::size_t e) {
@@ -470,8 +393,13 @@ class Dfsph final : public Solver {
               dk = src * alpha_[i] * wInvDt;
             } else {
               src = P.rho[i] + dt * div - rho0 - shift;
+              // Compression already there is removed at most at the pushout rate.
+              const Real excess = P.rho[i] - rho0 - pushout;
+              if (excess > 0) src -= excess;
               dk = src * alpha_[i] * wInvDt2;
             }
+            // Beyond the knee density the Jacobi step shrinks as ρ_knee/ρ_i (the header's A).
+            if (P.rho[i] > kneeRho) dk *= kneeRho * P.invRho[i];
             // Complementarity residual: where κ_i > 0 the constraint is active and
             // any deviation counts; where κ_i = 0 only compression does.
             errSum += double(K[i] > 0 || !unilateral ? std::fabs(src) : std::max(src, Real(0)));
@@ -554,6 +482,9 @@ class Dfsph final : public Solver {
   Real cfl_;                             ///< dt ≤ cfl_·R/v_max
   static constexpr int kChebDelay = 5;   ///< plain iterations before the acceleration starts
   static constexpr Real kPressureCfl = Real(0.35);  ///< dt ≤ kPressureCfl·R/sqrt(|g| D), D the greatest depth
+  static constexpr Real kFlatQ = Real(0.25);        ///< below q = r/R = 1/4 the solves' |∇W| keeps its peak value
+  static constexpr Real kKneeDensity = Real(1.1);   ///< beyond ρ = 1.1 ρ0 the Jacobi step shrinks as 1.1 ρ0/ρ
+  static constexpr Real kPushoutSpeed = Real(3);    ///< [m/s] existing compression is removed at most this fast
   std::vector<Vec2> vPrev_;              ///< velocity before the last iteration (Chebyshev)
   std::vector<Real> kPrev_;              ///< κ before the last iteration (Chebyshev)
   /// One neighbour entry of an iteration: the neighbour's slot and m∇W_ij.

@@ -17,38 +17,31 @@
 //   4. ρ of the final x* (what the World reports), v = (x* − x)/dt, and XSPH:
 //      v_i += c Σ_j (m/ρ_j)(v_j − v_i) W_ij, gathered into a copy.
 //
-// Choices (docs/SCENES.md, section "pbf", has the measurements behind them):
+// Design choices (the measurements behind them and the variants dropped:
+// docs/SOLVERS.md and docs/SCENES.md, sections pbf):
 // - One kernel, spiky (Müller et al. 2003), for the density and for ∇C, so ∇C is
 //   the true gradient of C (a Newton step) and close pairs still repel (its
 //   gradient does not vanish at r = 0; coincident pairs use tieBreakDirection).
 //   Pairs that drift past R during the iterations get W = 0.
 // - Walls: boundary samples are static particles of mass ρ0Ψ_b in ρ_i and in
 //   ∇_i C_i, and have no constraint of their own (λ_b = 0: the Jacobian of C is
-//   used as it is). Mirroring λ_b = λ_i instead drives a steady circulation of
-//   about 0.1 m/s in a resting tank, because the mirrored multiplier has no
-//   hydrostatic gradient along a side wall.
+//   used as it is).
 // - Multipliers accumulate over the iterations of a substep and are clamped
 //   λ_i ≤ 0: only compression is corrected (no tension, no clumping), and a later
 //   iteration may undo part of an earlier push. P.p = −ρ0 λ / dt².
 // - Step size: ε = relaxation · D0 with D0 = Σ_j |∇_j C_i|² on a full rest
 //   lattice (scale-free). A compressed particle's step is scaled by s_i = ρ0/ρ_i:
-//   on a square lattice the largest eigenvalue of the Jacobi step grows about as
-//   ρ^0.7 with compression, and past 2 the iteration diverges.
+//   the largest eigenvalue of the Jacobi step grows with compression.
 // - Chebyshev semi-iteration on the positions (Wang 2015, "A Chebyshev
 //   semi-iterative approach for accelerating projective and position-based
-//   dynamics"): Jacobi corrects the long (hydrostatic) modes slowly, about N/layers²
-//   per N iterations; Chebyshev makes that N²/layers².
-// - No warm start from the previous substep's multipliers: with a few
-//   iterations it acts as an integral controller and the column rings up
-//   (measured; the same in a linear model for any warm-start fraction > 0.5).
-// - The convergence test needs the largest compression too: a deep column that
-//   the iterations have not yet reached falls freely and piles up in its bottom
-//   layers (16 % there) while the mean over all particles is still under 1 %.
+//   dynamics"): Jacobi corrects the long (hydrostatic) modes by about N/layers²
+//   per N iterations, Chebyshev by N²/layers².
+// - No warm start from the previous substep's multipliers.
+// - Convergence needs the mean compression and the largest below their tolerances.
 // - Time step: min(max_dt, max_move · R / v_max, limit). The compression left
 //   after N iterations grows as dt²/N², so when max_iterations end unconverged
 //   the limit drops to 0.5–0.9 of this substep (not below max_dt/32); when half
-//   of them sufficed it grows back by 1.2 per substep. max_move = 2 already gains
-//   energy in the dam break (KE > released PE).
+//   of them sufficed it grows back by 1.2 per substep.
 //
 // Parameters (solver.*): iterations, max_iterations, tolerance, tolerance_max,
 // relaxation, chebyshev, tensile_k, tensile_n, tensile_dq, xsph, max_dt, max_move.

@@ -9,9 +9,13 @@
 
 #include "solvers/solver.hpp"  // solverParams
 #include "sph2d/world.hpp"
-#include "test_util.hpp"
+#include "support/fixture.hpp"
+#include "support/taylor_green.hpp"
 
 using namespace sph2d;
+using test::frontX;
+using test::meanSpeed;
+using test::outside;
 
 namespace {
 
@@ -24,22 +28,6 @@ SceneDef dfsphScene(const std::string& rel) {
   return s;
 }
 
-/// Particles outside the rectangle [x0, x1] × [y0, y1] (world frame).
-std::size_t outside(const World& w, double x0, double y0, double x1, double y1) {
-  std::size_t n = 0;
-  for (std::size_t i = 0; i < w.particleCount(); ++i) {
-    const Vec2d p = w.worldPosition(i);
-    if (!(p.x() >= x0 && p.x() <= x1 && p.y() >= y0 && p.y() <= y1)) ++n;
-  }
-  return n;
-}
-
-double meanSpeed(const Particles& P) {
-  double s = 0;
-  for (std::size_t i = 0; i < P.size(); ++i) s += double(P.v[i].norm());
-  return P.size() ? s / double(P.size()) : 0;
-}
-
 }  // namespace
 
 TEST_CASE("dfsph: a resting tank settles incompressible and calm") {
@@ -50,7 +38,7 @@ TEST_CASE("dfsph: a resting tank settles incompressible and calm") {
   for (int f = 0; f < 120; ++f) {  // 2 s; the second second is measured
     w.stepFrame();
     if (f < 60) continue;
-    const double v = meanSpeed(w.particles());
+    const double v = meanSpeed(w);
     vSum += v;
     vMax = std::max(vMax, v);
     errMax = std::max(errMax, w.densityStats().meanError);
@@ -140,25 +128,17 @@ TEST_CASE("dfsph: both implicit solves reach their tolerances within the iterati
 TEST_CASE("dfsph: the small dam break runs 1 s: no NaN, nothing escapes, the front moves right, energy bounded") {
   const SceneDef s = dfsphScene("tests/small_dam_break.json");
   World w(s, WorldOptions{1});
-  double front0 = -1e300, sumY0 = 0;
-  for (std::size_t i = 0; i < w.particleCount(); ++i) {
-    front0 = std::max(front0, w.worldPosition(i).x());
-    sumY0 += w.worldPosition(i).y();
-  }
+  const double front0 = frontX(w), sumY0 = test::sumY(w);
   const std::size_t n0 = w.particleCount();
   for (int f = 0; f < 60; ++f) w.stepFrame();
   CHECK(w.time() == doctest::Approx(1.0).epsilon(1e-6));
   REQUIRE(test::allFiniteState(w));
   CHECK(w.particleCount() == n0);
   CHECK(outside(w, 0, 0, 4, 3) == 0);
-  double front = -1e300, sumY = 0;
-  for (std::size_t i = 0; i < w.particleCount(); ++i) {
-    front = std::max(front, w.worldPosition(i).x());
-    sumY += w.worldPosition(i).y();
-  }
+  const double front = frontX(w);
   MESSAGE("front moved from " << front0 << " to " << front << " m");
   CHECK(front > front0 + 1.5);
-  const double released = double(w.particleMass()) * 9.81 * (sumY0 - sumY);
+  const double released = double(w.particleMass()) * 9.81 * (sumY0 - test::sumY(w));
   MESSAGE("kinetic " << w.kineticEnergy() << " J/m, potential released " << released << " J/m, mean compression "
                      << w.densityStats().meanError);
   CHECK(released > 0);
@@ -192,4 +172,23 @@ TEST_CASE("dfsph: scene keys are read, defaulted and range-checked") {
   CHECK(s.solver.param("velocity_cfl") == doctest::Approx(0.4));
   CHECK_THROWS(parseScene(base + R"(, "relaxation": 1.5}})", "inline.json"));
   CHECK_THROWS(parseScene(R"({"solver": {"type": "wcsph", "tolerance": 0.001}})", "inline.json"));
+}
+
+TEST_CASE("Taylor-Green vortex at Re = 100 (dfsph, 2500 particles): the decay rate within 10 % of -8 pi^2 / Re") {
+  test::taylorGreenRe100("dfsph");
+}
+
+TEST_CASE("Taylor-Green vortex at Re = 5 (dfsph, bilateral pressure in a closed periodic box): the decay rate within 10 %") {
+  // At U = 0.05 m/s the lattice barely distorts within the run, so this checks
+  // the solver's pressure and viscosity alone: no shifting, no particle disorder.
+  const auto table = validation::readReferenceCsv(test::asset("reference/taylor_green_decay.csv"));
+  SceneDef s = loadScene(test::asset("scenes/validation/taylor_green.json"));
+  s.solver.type = "dfsph";
+  s.solver.params.clear();
+  s.effects.shifting = false;
+  s.blocks[0].field.amplitude = 0.05;
+  const auto r = validation::runTaylorGreen(s, 2.0, table, 2);
+  MESSAGE("decay rate " << r.rate << " /s against " << r.analyticRate << " /s (" << 100 * r.rateError << " %)");
+  CHECK(r.rateError < 0.10);
+  CHECK(r.amplitude.back() == doctest::Approx(std::exp(r.analyticRate * r.simSeconds)).epsilon(0.1));
 }

@@ -6,9 +6,14 @@
 #include <cmath>
 
 #include "sph2d/world.hpp"
-#include "test_util.hpp"
+#include "support/fixture.hpp"
 
 using namespace sph2d;
+using test::frontX;
+using test::maxSpeed;
+using test::meanSpeed;
+using test::outside;
+using test::sumY;
 
 namespace {
 
@@ -20,33 +25,6 @@ SceneDef pbfScene(const std::string& rel) {
   s.solver.params.clear();  // the World fills pbf's defaults
   s.solver.viscosity = 0;
   s.gravity = Vec2d(0, -9.81);
-  return s;
-}
-
-std::size_t outside(const World& w, double x0, double y0, double x1, double y1) {
-  std::size_t n = 0;
-  for (std::size_t i = 0; i < w.particleCount(); ++i) {
-    const Vec2d p = w.worldPosition(i);
-    if (!(p.x() >= x0 && p.x() <= x1 && p.y() >= y0 && p.y() <= y1)) ++n;
-  }
-  return n;
-}
-
-double meanSpeed(const World& w) {
-  double s = 0;
-  for (std::size_t i = 0; i < w.particleCount(); ++i) s += w.particles().v[i].norm();
-  return s / double(w.particleCount());
-}
-
-double maxSpeed(const World& w) {
-  double s = 0;
-  for (std::size_t i = 0; i < w.particleCount(); ++i) s = std::max(s, double(w.particles().v[i].norm()));
-  return s;
-}
-
-double sumY(const World& w) {
-  double s = 0;
-  for (std::size_t i = 0; i < w.particleCount(); ++i) s += w.worldPosition(i).y();
   return s;
 }
 
@@ -75,8 +53,7 @@ TEST_CASE("pbf: a resting tank at one substep per frame settles within 2 % of rh
 TEST_CASE("pbf: the small dam break runs 1 s at frame-sized steps: no NaN, nothing escapes, energy bounded") {
   const SceneDef s = pbfScene("tests/small_dam_break.json");
   World w(s, WorldOptions{2});
-  double front0 = -1e300;
-  for (std::size_t i = 0; i < w.particleCount(); ++i) front0 = std::max(front0, w.worldPosition(i).x());
+  const double front0 = frontX(w);
   const double y0 = sumY(w);
   const std::size_t n0 = w.particleCount();
   for (int f = 0; f < 60; ++f) w.stepFrame();
@@ -86,8 +63,7 @@ TEST_CASE("pbf: the small dam break runs 1 s at frame-sized steps: no NaN, nothi
   REQUIRE(test::allFiniteState(w));
   CHECK(w.particleCount() == n0);
   CHECK(outside(w, 0, 0, 4, 3) == 0);
-  double front = -1e300;
-  for (std::size_t i = 0; i < w.particleCount(); ++i) front = std::max(front, w.worldPosition(i).x());
+  const double front = frontX(w);
   MESSAGE("front moved from " << front0 << " to " << front << " m");
   CHECK(front > front0 + 1.5);
   const double released = double(w.particleMass()) * 9.81 * (y0 - sumY(w));

@@ -23,19 +23,21 @@
 //   akinci, drop pressure: p/A = 1.01–1.07, A = γρ0²∫C r dA/4 (R = 0.1, 0.05 m; γ = 0.1, 0.3).
 #include <doctest/doctest.h>
 
-#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
 #include <vector>
 
 #include "sph2d/world.hpp"
-#include "test_util.hpp"
+#include "support/fixture.hpp"
 
 using namespace sph2d;
+using test::centroid;
+using test::cornerRatio;
+using test::inertiaAspect;
 
 namespace {
 
-constexpr double kPiD = 3.14159265358979323846;
+constexpr double kPiD = test::kPi;
 
 /// Free fluid in zero gravity: wcsph at dx = 0.005 m, c = 5 m/s, ν = 0.01 m²/s.
 SceneDef freeFluid(const std::string& model, double strength) {
@@ -60,37 +62,6 @@ SceneDef withBlock(SceneDef s, double r, double aspect) {
   b.max = -b.min;
   s.blocks.push_back(b);
   return s;
-}
-
-Vec2d centroid(const World& w) {
-  Vec2d c(0, 0);
-  for (std::size_t i = 0; i < w.particleCount(); ++i) c += w.worldPosition(i);
-  return c / double(w.particleCount());
-}
-
-/// sqrt(λmax/λmin) of the second-moment matrix about the centroid.
-double inertiaAspect(const World& w) {
-  const Vec2d c = centroid(w);
-  Eigen::Matrix2d M = Eigen::Matrix2d::Zero();
-  for (std::size_t i = 0; i < w.particleCount(); ++i) {
-    const Vec2d d = w.worldPosition(i) - c;
-    M += d * d.transpose();
-  }
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> es(M);
-  return std::sqrt(es.eigenvalues()(1) / es.eigenvalues()(0));
-}
-
-/// Farthest distance from the centroid per 16 angular sectors: largest over smallest.
-double cornerRatio(const World& w) {
-  const Vec2d c = centroid(w);
-  std::vector<double> far(16, 0.0);
-  for (std::size_t i = 0; i < w.particleCount(); ++i) {
-    const Vec2d d = w.worldPosition(i) - c;
-    const double a = std::atan2(d.y(), d.x()) + kPiD;  // 0..2π
-    const int k = std::min(15, int(a / (2 * kPiD) * 16));
-    far[std::size_t(k)] = std::max(far[std::size_t(k)], d.norm());
-  }
-  return *std::max_element(far.begin(), far.end()) / *std::min_element(far.begin(), far.end());
 }
 
 /// The drop's radius sqrt(2<|x − c|²>) (a uniform disc's radius) and its interior mean pressure.
@@ -245,4 +216,15 @@ TEST_CASE("akinci surface tension: the pressure inside a drop is the cohesion's 
     CHECK(d.interior >= 50);
     CHECK(d.pressure / A == doctest::Approx(1.0).epsilon(0.2));
   }
+}
+
+TEST_CASE("akinci surface tension conserves linear momentum to rounding (no walls, no gravity)") {
+  SceneDef s = test::freeMovingBlock();
+  s.effects.surfaceTension = true;
+  s.effects.tension.model = "akinci";
+  s.effects.tension.gamma = 0.5;
+  const test::MomentumRun r = test::momentumOver(s, 30);
+  MESSAGE("akinci: momentum change " << r.change << " of " << r.scale);
+  CHECK(r.change <= 1e-5 * r.scale);
+  CHECK(r.finite);
 }

@@ -1,0 +1,148 @@
+// The World's particle system (engine/src/particle_system.cpp): fluid blocks on
+// the lattice, seeded emitters, lifetimes, sinks and the particle budget.
+#include <doctest/doctest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <set>
+
+#include "sph2d/world.hpp"
+#include "support/fixture.hpp"
+
+using namespace sph2d;
+
+namespace {
+
+bool has(const std::vector<std::string>& v, const std::string& s) { return std::find(v.begin(), v.end(), s) != v.end(); }
+
+/// The closed tank [0, 2]² (wcsph, no viscosity), no fluid.
+SceneDef box(double spacing = 0.04) {
+  SceneDef s = test::tank("wcsph", 2, 2, spacing);
+  s.solver.viscosity = 0.0;
+  return s;
+}
+
+}  // namespace
+
+TEST_CASE("an emitter emits rate·t particles (±1), and the same seed emits the same particles") {
+  SceneDef s = box();
+  EmitterDef e;
+  e.position = Vec2d(1.0, 1.8);
+  e.direction = Vec2d(0, -1);
+  e.rate = 300;
+  e.speed = 1.5;
+  e.spread = 0.3;
+  e.width = 0.1;
+  e.jitter = 0.2;
+  e.start = 0.1;
+  e.seed = 42;
+  s.effects.emitters.push_back(e);
+  std::uint64_t hashes[3];
+  for (int run = 0; run < 3; ++run) {
+    SceneDef sr = s;
+    if (run == 2) sr.effects.emitters[0].seed = 43;
+    World w(sr, WorldOptions{2});
+    for (int f = 0; f < 30; ++f) w.stepFrame();  // 0.5 s
+    const double t = w.time();
+    const double expected = e.rate * (t - e.start);
+    CHECK(std::fabs(double(w.emittedCount(0)) - expected) <= 1.0);
+    CHECK(w.particleCount() == w.emittedCount(0));
+    CHECK(test::allFiniteState(w));
+    hashes[run] = w.stateHash();
+  }
+  CHECK(hashes[0] == hashes[1]);
+  CHECK(hashes[0] != hashes[2]);
+}
+
+TEST_CASE("lifetimes remove exactly the particles older than max_age, and only they carry an age") {
+  SceneDef s = box();
+  s.effects.lifetime = true;
+  s.effects.maxAge = 0.25;
+  EmitterDef e;
+  e.position = Vec2d(1.0, 1.5);
+  e.rate = 200;
+  e.speed = 1.0;
+  s.effects.emitters.push_back(e);
+  World w(s, WorldOptions{2});
+  CHECK(has(w.particleFields(), "age"));
+  for (int f = 0; f < 40; ++f) {
+    w.stepFrame();
+    const std::vector<Real>& age = *w.particles().find("age");
+    for (Real a : age) CHECK(a <= Real(0.25) + Real(1e-6));
+  }
+  // At steady state the particles alive are those emitted in the last max_age seconds.
+  const double alive = double(w.particleCount());
+  CHECK(std::fabs(alive - 200 * 0.25) <= 2.0);
+  CHECK(w.removedCount() + w.particleCount() == w.emittedCount(0));
+  SceneDef none = box();
+  World w2(none, WorldOptions{1});
+  CHECK_FALSE(has(w2.particleFields(), "age"));
+}
+
+TEST_CASE("a sink removes what enters it and nothing else") {
+  SceneDef s = box();
+  s.gravity = Vec2d(0, -9.81);
+  FluidBlockDef blk;
+  blk.min = Vec2d(0.0, 0.0);
+  blk.max = Vec2d(0.6, 1.0);
+  s.blocks.push_back(blk);
+  RegionDef sink;
+  sink.min = Vec2d(1.5, 0.0);
+  sink.max = Vec2d(2.0, 0.3);
+  s.effects.sinks.push_back(sink);
+  World w(s, WorldOptions{2});
+  const std::size_t n0 = w.particleCount();
+  std::size_t removedSeen = 0;
+  for (int f = 0; f < 90; ++f) {
+    std::set<std::uint32_t> before(w.particles().id.begin(), w.particles().id.end());
+    w.stepFrame();
+    for (std::size_t i = 0; i < w.particleCount(); ++i) CHECK_FALSE(sink.contains(w.worldPosition(i)));
+    std::set<std::uint32_t> after(w.particles().id.begin(), w.particles().id.end());
+    removedSeen += before.size() - after.size();
+  }
+  MESSAGE("sink removed " << removedSeen << " of " << n0);
+  CHECK(removedSeen > 0);
+  CHECK(removedSeen == w.removedCount());
+  CHECK(w.particleCount() + w.removedCount() == n0);
+  CHECK(has(w.stages(), "sinks"));
+}
+
+TEST_CASE("the particle budget: stop_emitting caps the count and warns once, recycle_oldest removes the oldest") {
+  SceneDef s = box();
+  EmitterDef e;
+  e.position = Vec2d(1.0, 1.5);
+  e.rate = 600;
+  e.speed = 1.0;
+  e.width = 0.4;
+  s.effects.emitters.push_back(e);
+  s.effects.budget = 100;
+  {
+    World w(s, WorldOptions{1});
+    for (int f = 0; f < 30; ++f) w.stepFrame();
+    CHECK(w.particleCount() == 100);
+    const auto warnings = w.takeWarnings();
+    CHECK(warnings.size() == 1);
+    CHECK(warnings[0].find("budget 100") != std::string::npos);
+  }
+  s.effects.budgetPolicy = BudgetPolicy::RecycleOldest;
+  {
+    World w(s, WorldOptions{1});
+    for (int f = 0; f < 30; ++f) w.stepFrame();
+    CHECK(w.particleCount() == 100);
+    const std::uint32_t minId = *std::min_element(w.particles().id.begin(), w.particles().id.end());
+    CHECK(minId == w.emittedCount(0) - 100);  // exactly the 100 newest remain
+    CHECK(w.removedCount() == w.emittedCount(0) - 100);
+  }
+}
+
+TEST_CASE("particles a scene places inside a solid are dropped with one warning") {
+  SceneDef s = test::scene("tests/resting_column.json");
+  s.blocks[0].min = Vec2d(-0.1, 0.0);  // 0.1 m of the block inside the left wall
+  World w(s, WorldOptions{1});
+  const auto warnings = w.takeWarnings();
+  REQUIRE(warnings.size() == 1);
+  CHECK(warnings[0].find("dropped") != std::string::npos);
+  CHECK(warnings[0].find("dropped 150 particles") != std::string::npos);  // 5 columns × 30 rows
+  CHECK(w.particleCount() == 30u * 30u);
+  for (std::size_t i = 0; i < w.particleCount(); ++i) CHECK(w.worldPosition(i).x() > 0);
+}

@@ -1,0 +1,118 @@
+// What readers ask of a World (engine/src/queries.cpp): searches by region,
+// SPH samples of the fields, energy and density statistics, neighbour pairs,
+// the state hash.
+#include <doctest/doctest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include "sph2d/world.hpp"
+#include "support/fixture.hpp"
+
+using namespace sph2d;
+
+namespace {
+
+/// validation/taylor_green.json's fully periodic 1 m box filled by one block
+/// moving at `u` (every particle has a full lattice neighbourhood), with `solver`.
+SceneDef periodicBlock(const std::string& solver, const Vec2d& u, double spacing = 0.04) {
+  SceneDef s = test::periodicShearLayer(solver, 0, spacing);
+  s.blocks = {test::block({0, 0}, {1, 1}, u)};
+  return s;
+}
+
+}  // namespace
+
+TEST_CASE("particlesInRadius and particlesInBox return exactly the slots a brute-force scan finds, in slot order") {
+  SceneDef s = test::scene("tests/small_dam_break.json");
+  World w(s, WorldOptions{2});
+  for (int f = 0; f < 20; ++f) w.stepFrame();  // a collapsing column: an irregular set
+  int nonEmpty = 0;
+  for (const Vec2d& c : {Vec2d(0.2, 0.2), Vec2d(1.0, 0.1), Vec2d(0.5, 1.5), Vec2d(3.0, 2.5)}) {
+    for (double r : {0.05, 0.3, 1.0}) {
+      std::vector<std::size_t> brute;
+      for (std::size_t i = 0; i < w.particleCount(); ++i)
+        if ((w.worldPosition(i) - c).squaredNorm() <= r * r) brute.push_back(i);
+      CHECK(w.particlesInRadius(c, r) == brute);
+      nonEmpty += !brute.empty();
+      const Vec2d lo = c - Vec2d(r, 0.5 * r), hi = c + Vec2d(0.5 * r, r);
+      std::vector<std::size_t> inBox;
+      for (std::size_t i = 0; i < w.particleCount(); ++i) {
+        const Vec2d p = w.worldPosition(i);
+        if (p.x() >= lo.x() && p.y() >= lo.y() && p.x() <= hi.x() && p.y() <= hi.y()) inBox.push_back(i);
+      }
+      CHECK(w.particlesInBox(lo, hi) == inBox);
+    }
+  }
+  CHECK(nonEmpty >= 6);  // the searches found particles, not only empty sets
+}
+
+TEST_CASE("sampleAt inside a uniform moving block returns rho0 and the block's velocity, with weight 1, and nothing far from it") {
+  const Vec2d u(0.7, -0.3);
+  World w(periodicBlock("wcsph", u), WorldOptions{1});
+  for (const Vec2d& p : {Vec2d(0.5, 0.5), Vec2d(0.13, 0.71), Vec2d(0.021, 0.978)}) {
+    CAPTURE(p.x());
+    CAPTURE(p.y());
+    const World::FieldSample f = w.sampleAt(p);
+    CHECK(f.density == doctest::Approx(1000.0).epsilon(1e-5));
+    CHECK(f.velocity.x() == doctest::Approx(u.x()).epsilon(1e-6));
+    CHECK(f.velocity.y() == doctest::Approx(u.y()).epsilon(1e-6));
+    // Σ V W of a full lattice under Wendland C2 at R = 2.5 dx is 1 to within the
+    // kernel's lattice error; sampleAt does not wrap, so near a seam only one side counts.
+    if (p.x() > 0.1 && p.y() < 0.9) CHECK(f.weight == doctest::Approx(1.0).epsilon(0.02));
+    else CHECK(f.weight < 0.8);
+  }
+  // Beyond the support of every particle: no fluid there.
+  const World::FieldSample far = w.sampleAt(Vec2d(5, 5));
+  CHECK(far.weight == 0);
+  CHECK(far.density == 0);
+  CHECK(far.velocity == Vec2d(0, 0));
+}
+
+TEST_CASE("kineticEnergy is half m v squared summed, densityStats the mean and largest compression and the mean density") {
+  const Vec2d u(0.7, -0.3);
+  World w(periodicBlock("wcsph", u), WorldOptions{1});
+  const double N = double(w.particleCount()), m = double(w.particleMass());
+  REQUIRE(N == 625);
+  // Every particle moves at u: E = ½ N m |u|² (float velocities: to 1e-6).
+  CHECK(w.kineticEnergy() == doctest::Approx(0.5 * N * m * u.squaredNorm()).epsilon(1e-6));
+  const DensityStats rest = w.densityStats();  // a full lattice: ρ0 everywhere (test_world.cpp)
+  CHECK(rest.meanError <= 1e-5);
+  CHECK(rest.maxError <= 1e-5);
+  // A second block on the lower half of the box, every new particle on top of an old one:
+  // 2 ρ0 there, ρ0 above, a row or two between.
+  const std::size_t added = w.addBlock(test::block({0, 0}, {1, 0.5}));
+  w.substep();  // the densities of the new state
+  const DensityStats d = w.densityStats();
+  const double doubled = 2.0 * double(added) / double(w.particleCount());  // the share of particles in the overlap
+  MESSAGE(added << " added; mean compression " << d.meanError << ", largest " << d.maxError << ", mean density "
+                << d.meanDensity << " (" << doubled << " of the particles in the overlap)");
+  CHECK(d.maxError == doctest::Approx(1.0).epsilon(0.01));                          // 2 ρ0: compression 1
+  CHECK(d.meanError == doctest::Approx(doubled).epsilon(0.1));                      // ≈ 1 × the overlap's share
+  CHECK(d.meanDensity == doctest::Approx(1000.0 * (1 + doubled)).epsilon(0.1));
+}
+
+TEST_CASE("neighbourPairs counts each particle's 20 lattice neighbours within 2.5 dx, from both sides") {
+  // On a full square lattice the points within R = 2.5 dx of a particle are the 20
+  // with i² + j² ≤ 5 (i² + j² = 6.25 has no integer solution; √8 = 2.83 dx is out).
+  World w(periodicBlock("wcsph", Vec2d(0, 0)), WorldOptions{2});
+  w.substep();
+  CHECK(w.neighbourPairs() == 20 * w.particleCount());
+}
+
+TEST_CASE("the state hash is the same for the same state and changes with any particle's motion or removal") {
+  const SceneDef s = test::scene("tests/small_dam_break.json");
+  World a(s, WorldOptions{1}), b(s, WorldOptions{3});
+  CHECK(a.stateHash() == b.stateHash());
+  a.substep();
+  CHECK(a.stateHash() != b.stateHash());  // one substep moved the particles
+  b.substep();
+  CHECK(a.stateHash() == b.stateHash());
+  // Removing one particle changes it, and removing the same one in the other world agrees again.
+  const Vec2d p = a.worldPosition(0);
+  CHECK(a.removeParticlesInBox(p, p) == 1);
+  CHECK(a.stateHash() != b.stateHash());
+  CHECK(b.removeParticlesInBox(p, p) == 1);
+  CHECK(a.stateHash() == b.stateHash());
+}

@@ -1,0 +1,113 @@
+// The job system (engine/src/thread_pool.cpp): fixed blocks that cover every
+// index once whatever the thread count, reductions combined in block order (the
+// engine's bit-identity across thread counts rests on it), and exceptions
+// carried back to the caller.
+#include <doctest/doctest.h>
+
+#include <atomic>
+#include <algorithm>
+#include <cmath>
+#include <memory>
+#include <random>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "sph2d/thread_pool.hpp"
+
+using namespace sph2d;
+
+// Block k is [k·block, min(n, (k+1)·block)).
+TEST_CASE("parallelFor calls each block of the fixed split once, begin to end, and covers every index once, for 1 to 4 threads") {
+  for (int threads = 1; threads <= 4; ++threads) {
+    ThreadPool pool(threads);
+    CHECK(pool.size() == threads);
+    for (std::size_t n : {0u, 1u, 2u, 7u, 255u, 256u, 257u, 1000u, 4097u}) {
+      for (std::size_t block : {1u, 3u, 64u, 256u, 4096u}) {
+        CAPTURE(threads);
+        CAPTURE(n);
+        CAPTURE(block);
+        std::unique_ptr<std::atomic<int>[]> hits(new std::atomic<int>[n + 1]);
+        for (std::size_t i = 0; i <= n; ++i) hits[i] = 0;
+        const std::size_t blocks = (n + block - 1) / block;
+        std::unique_ptr<std::atomic<int>[]> calls(new std::atomic<int>[blocks + 1]);
+        for (std::size_t k = 0; k <= blocks; ++k) calls[k] = 0;
+        std::atomic<int> misaligned{0};
+        pool.parallelFor(n, block, [&](std::size_t b, std::size_t e) {
+          if (b % block != 0 || e != std::min(n, b + block) || b >= e) ++misaligned;
+          ++calls[b / block];
+          for (std::size_t i = b; i < e; ++i) ++hits[i];
+        });
+        int wrongIndex = 0, wrongBlock = 0;
+        for (std::size_t i = 0; i < n; ++i) wrongIndex += hits[i] != 1;
+        for (std::size_t k = 0; k < blocks; ++k) wrongBlock += calls[k] != 1;
+        CHECK(misaligned == 0);
+        CHECK(wrongIndex == 0);
+        CHECK(wrongBlock == 0);
+      }
+    }
+  }
+}
+
+TEST_CASE("reduce combines the blocks' results in block order: a non-associative float sum is bit-identical for 1 to 4 threads") {
+  // Values of both signs over nine decades: their float sum depends on the order.
+  const std::size_t n = 10000, block = 256;
+  std::vector<float> x(n);
+  std::mt19937 g(11);
+  for (std::size_t i = 0; i < n; ++i)
+    x[i] = (float(g() % 20001) / 10000.0f - 1.0f) * std::pow(10.0f, float(int(i % 9) - 4));
+  const auto blockSum = [&](std::size_t b, std::size_t e) {
+    float s = 0;
+    for (std::size_t i = b; i < e; ++i) s += x[i];
+    return s;
+  };
+  // The reference: block sums combined in increasing block order, and the same sums in the opposite order.
+  float forward = 0, backward = 0;
+  const std::size_t blocks = (n + block - 1) / block;
+  for (std::size_t k = 0; k < blocks; ++k) forward += blockSum(k * block, std::min(n, (k + 1) * block));
+  for (std::size_t k = blocks; k-- > 0;) backward += blockSum(k * block, std::min(n, (k + 1) * block));
+  MESSAGE("block order " << forward << ", reversed " << backward);
+  REQUIRE(forward != backward);  // the order matters for this sum, so the check below can fail
+  for (int threads = 1; threads <= 4; ++threads) {
+    CAPTURE(threads);
+    ThreadPool pool(threads);
+    for (int repeat = 0; repeat < 20; ++repeat) {
+      const float r = pool.reduce(n, block, 0.0f, blockSum, [](float a, float b) { return a + b; });
+      CHECK(r == forward);
+    }
+  }
+}
+
+TEST_CASE("an exception thrown in a job is rethrown by parallelFor on the caller, and the pool keeps working") {
+  for (int threads = 1; threads <= 4; ++threads) {
+    CAPTURE(threads);
+    ThreadPool pool(threads);
+    std::atomic<int> ran{0};
+    // Block 5 of 40 throws; the others run.
+    try {
+      pool.parallelFor(40 * 16, 16, [&](std::size_t b, std::size_t) {
+        if (b / 16 == 5) throw std::runtime_error("block 5 failed");
+        ++ran;
+      });
+      FAIL("the exception was lost");
+    } catch (const std::runtime_error& e) {
+      CHECK(std::string(e.what()) == "block 5 failed");
+    }
+    CHECK(ran <= 39);
+    // Every block throws: one of their exceptions arrives, once.
+    CHECK_THROWS_AS(pool.parallelFor(1000, 10, [](std::size_t, std::size_t) { throw std::logic_error("every block"); }),
+                    std::logic_error);
+    // The pool is not left broken: the next job runs every block.
+    std::atomic<int> after{0};
+    pool.parallelFor(1000, 10, [&](std::size_t b, std::size_t e) { after += int(e - b); });
+    CHECK(after == 1000);
+  }
+}
+
+TEST_CASE("a pool of 0 threads takes the hardware's, at least one") {
+  ThreadPool pool(0);
+  CHECK(pool.size() >= 1);
+  std::atomic<int> sum{0};
+  pool.parallelFor(100, 7, [&](std::size_t b, std::size_t e) { sum += int(e - b); });
+  CHECK(sum == 100);
+}
