@@ -26,7 +26,7 @@ inline bool allFiniteState(const World& w) {
 /// Every pressure solver, in the registry's order (a test checks it matches
 /// engine/src/solvers/registry.cpp, so a new solver cannot be left out).
 inline const std::vector<std::string>& solvers() {
-  static const std::vector<std::string> s = {"muller2003", "wcsph", "pbf", "dfsph"};
+  static const std::vector<std::string> s = {"muller2003", "wcsph", "pbf", "dfsph", "game"};
   return s;
 }
 
@@ -39,4 +39,5 @@ inline const std::vector<std::string>& solvers() {
   TEST_CASE(NAME " (muller2003)") { FN(std::string("muller2003")); } \
   TEST_CASE(NAME " (wcsph)") { FN(std::string("wcsph")); }           \
   TEST_CASE(NAME " (pbf)") { FN(std::string("pbf")); }               \
-  TEST_CASE(NAME " (dfsph)") { FN(std::string("dfsph")); }
+  TEST_CASE(NAME " (dfsph)") { FN(std::string("dfsph")); }             \
+  TEST_CASE(NAME " (game)") { FN(std::string("game")); }

@@ -398,6 +398,23 @@ void BoundarySet::buildBins(Real hint) {
   }
 }
 
+bool BoundarySet::blocks(const Vec2& a, const Vec2& b) const {
+  if (insideDepth(a) > 0 || insideDepth(b) > 0) return true;
+  const Vec2 lo = a.cwiseMin(b), hi = a.cwiseMax(b);
+  for (const Collider& c : colliders) {
+    if (c.hi.x() < lo.x() || c.hi.y() < lo.y() || c.lo.x() > hi.x() || c.lo.y() > hi.y()) continue;
+    Vec2 hit, n;
+    bool crossed = false;
+    switch (c.kind) {
+      case Collider::Kind::Polygon: crossed = polygonSweep(c, a, b, hit, n); break;
+      case Collider::Kind::Circle: crossed = circleSweep(c, a, b, hit, n); break;
+      case Collider::Kind::Segment: crossed = segmentSweep(c, a, b, hit, n); break;
+    }
+    if (crossed) return true;
+  }
+  return false;
+}
+
 bool BoundarySet::resolve(Vec2& x, Vec2& v, const Vec2& xOld, Real clearance) const {
   if (bnx == 0) return false;
   // Swept box of the move, grown by the clearance, in bin coordinates.

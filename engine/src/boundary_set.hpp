@@ -61,6 +61,9 @@ struct BoundarySet {
   void buildBins(Real binSizeHint);
   /// Depth of p inside any solid collider (polygon or circle); ≤ 0 when outside all.
   Real insideDepth(const Vec2& p) const;
+  /// True when the segment a → b crosses a solid's surface or an end lies inside a
+  /// solid (a coarse grid's face between two cell centres is then closed).
+  bool blocks(const Vec2& a, const Vec2& b) const;
   /// Swept collision of one particle (x, v) that moved from xOld. Returns true on contact.
   bool resolve(Vec2& x, Vec2& v, const Vec2& xOld, Real clearance) const;
 };

@@ -84,7 +84,8 @@ struct Grid {
 
   /// Cell coordinate along one axis (inverse cell size `inv`), clamped into the grid.
   static int coord(Real v, Real origin, Real inv, int count) {
-    Real c = std::floor((v - origin) * inv);
+    // Clamped first, then truncated: for c ≥ 0 truncation is floor, without a libm call.
+    Real c = (v - origin) * inv;
     c = std::min(std::max(c, Real(0)), Real(count - 1));
     return static_cast<int>(c);
   }

@@ -111,6 +111,8 @@ void World::resetTimings() { impl_->stages.resetTimings(); }
 
 SolverStats World::solverStats() const { return impl_->solver->stats(); }
 
+std::uint64_t World::solverIterations() const { return impl_->iterations; }
+
 std::size_t World::memoryBytes() const {
   const Impl& w = *impl_;
   auto cap = [](const auto& v) { return v.capacity() * sizeof(v[0]); };

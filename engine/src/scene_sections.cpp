@@ -266,14 +266,23 @@ void readSolver(const Reader& r, const json& root, SceneDef& s) {
   // A preset instead of a solver, chosen from docs/ACCURACY.md's measurements.
   if (j.contains("quality")) {
     if (j.contains("type")) r.fail(Reader::sub(p, "quality"), "give either solver.type or solver.quality, not both");
-    const std::string q = r.string(j, p, "quality", "balanced", {"game", "balanced", "accurate"});
-    d.type = q == "game" ? "pbf" : q == "accurate" ? "dfsph" : "wcsph";
+    const std::string q = r.string(j, p, "quality", "balanced", qualityPresets());
+    const SolverDef preset = qualityPreset(q);
+    d.type = preset.type;
+    d.viscosity = preset.viscosity;
+    d.supportRatio = preset.supportRatio;
+    d.params = preset.params;
   }
+  // The shared keys the solver tunes (e.g. the game solver's viscosity) take its
+  // values unless the scene gives them.
+  tuneSolverDefaults(d);
   std::vector<std::string> keys = {"type", "quality", "spacing", "support_ratio", "rest_density", "sound_speed", "viscosity", "no_slip", "cfl",
                                    "max_substeps", "clamp_negative_pressure", "reorder_interval", "max_speed"};
   for (const SolverParam& sp : solverParams(d.type)) keys.push_back(sp.key);
   r.checkKeys(j, p, keys);
-  for (const SolverParam& sp : solverParams(d.type)) d.params[sp.key] = r.number(j, p, sp.key, sp.def, sp.lo, sp.hi);
+  // A preset's parameter values are the defaults a scene may change.
+  for (const SolverParam& sp : solverParams(d.type))
+    d.params[sp.key] = r.number(j, p, sp.key, d.params.count(sp.key) ? d.params.at(sp.key) : sp.def, sp.lo, sp.hi);
   d.spacing = r.number(j, p, "spacing", d.spacing, 0, 10, true);
   d.supportRatio = r.number(j, p, "support_ratio", d.supportRatio, 1.5, 4);
   d.restDensity = r.number(j, p, "rest_density", d.restDensity, 0, 1e5, true);

@@ -5,6 +5,10 @@
 // each reads and writes is in docs/ARCHITECTURE.md.
 #pragma once
 
+#include <algorithm>
+#include <limits>
+#include <vector>
+
 #include "step_context.hpp"
 
 namespace sph2d {
@@ -32,6 +36,43 @@ void stageCollide(StepContext& c);
 Real maxSpeedOf(const Particles& P, ThreadPool& pool);
 /// Largest acceleration magnitude (deterministic reduction).
 Real maxAccelOf(const Particles& P, ThreadPool& pool);
+/// The gravity that builds a hydrostatic pressure: its components along
+/// periodic axes are dropped (a body force along a periodic channel drives
+/// a flow; the pressure does not grow along it).
+inline Vec2 hydrostaticGravity(const StepContext& c) {
+  Vec2 g = c.gravity;
+  if (c.periodic.x) g.x() = 0;
+  if (c.periodic.y) g.y() = 0;
+  return g;
+}
+
+/// Calls f(i, depth) for every particle with its depth below the highest
+/// particle of the same column (strips of width R across the hydrostatic
+/// gravity): the depth of a hydrostatic pressure guess. Serial, O(n); `top`
+/// is scratch kept by the caller. Needs hydrostaticGravity(c) ≠ 0.
+template <class F>
+void columnDepths(const StepContext& c, std::vector<Real>& top, F f) {
+  const Particles& P = c.P;
+  const Vec2 gh = hydrostaticGravity(c);
+  const Vec2 up = -gh / gh.norm(), across(up.y(), -up.x());
+  Real sMin = std::numeric_limits<Real>::infinity(), sMax = -sMin;
+  for (std::size_t i = 0; i < P.size(); ++i) {
+    const Real s = across.dot(P.x[i]);
+    sMin = std::min(sMin, s);
+    sMax = std::max(sMax, s);
+  }
+  const std::size_t strips = std::min<std::size_t>(std::size_t((sMax - sMin) / c.R) + 1, 1u << 20);
+  top.assign(strips, -std::numeric_limits<Real>::infinity());
+  auto strip = [&](const Vec2& x) {
+    return std::min(strips - 1, std::size_t(std::max(Real(0), (across.dot(x) - sMin) / c.R)));
+  };
+  for (std::size_t i = 0; i < P.size(); ++i) {
+    Real& t = top[strip(P.x[i])];
+    t = std::max(t, up.dot(P.x[i]));
+  }
+  for (std::size_t i = 0; i < P.size(); ++i) f(i, top[strip(P.x[i])] - up.dot(P.x[i]));
+}
+
 /// Permutes every particle field into `order` (slot k takes old slot order[k]).
 void permuteParticles(Particles& P, const std::vector<std::uint32_t>& order, Scratch& s, ThreadPool& pool);
 

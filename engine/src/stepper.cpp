@@ -41,6 +41,7 @@ StepContext World::Impl::context(Real dt) {
   c.time = time;
   c.origin = origin;
   c.periodic = periodic;
+  c.boundaryVersion = boundarySignature;
   return c;
 }
 
@@ -103,6 +104,10 @@ void World::Impl::fail(const std::string& stage, std::size_t slot) {
 void World::Impl::substep(Real dt, bool driftOnly) {
   StepContext c = context(dt);
   (driftOnly ? drift : stages).run(c, [this](const std::string& stage, std::size_t slot) { fail(stage, slot); });
+  if (!driftOnly) {
+    const SolverStats st = solver->stats();
+    iterations += std::uint64_t(st.pressureIterations) + std::uint64_t(st.divergenceIterations);
+  }
   time += double(dt);
   ++steps;
 }

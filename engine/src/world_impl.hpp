@@ -45,6 +45,7 @@ struct World::Impl {
   Real lastAccel = 0;                 ///< largest acceleration of the last substep (the force limit)
   double lastDt = 0;                  ///< the last full substep's length (0 before the first)
   std::uint32_t nextId = 0;
+  std::uint64_t iterations = 0;       ///< solver iterations summed over the substeps
   std::vector<std::string> warnings;
   std::uint64_t boundarySignature = 0;  ///< staticSignature() when the colliders were last read
 

@@ -91,7 +91,7 @@ TEST_CASE("a missing scene file names the file") {
 }
 
 TEST_CASE("solver.quality presets pick a solver, and cannot be combined with solver.type") {
-  CHECK(parseScene("{\"solver\": {\"quality\": \"game\"}}", "q.json").solver.type == "pbf");
+  CHECK(parseScene("{\"solver\": {\"quality\": \"game\"}}", "q.json").solver.type == "game");
   CHECK(parseScene("{\"solver\": {\"quality\": \"balanced\"}}", "q.json").solver.type == "wcsph");
   CHECK(parseScene("{\"solver\": {\"quality\": \"accurate\"}}", "q.json").solver.type == "dfsph");
   try {

@@ -143,10 +143,10 @@ TEST_CASE("stability: viscosity far beyond its explicit limit shrinks the step t
     blk.min = Vec2d(0, 0);
     blk.max = Vec2d(0.5, 0.5);
     s.blocks.push_back(blk);
-    if (solver == "pbf") {  // a position-based step cannot go that small: the scene is refused, naming the limit
+    if (solver == "pbf" || solver == "game") {  // a position-based step cannot go that small: refused, naming the limit
       try {
         World refused(s, WorldOptions{1});
-        FAIL("pbf accepted a viscosity it cannot follow");
+        FAIL(solver << " accepted a viscosity it cannot follow");
       } catch (const SceneError& e) {
         CHECK(e.key == "solver.viscosity");
         CHECK(e.message.find("at most") != std::string::npos);
@@ -166,7 +166,7 @@ TEST_CASE("stability: viscosity far beyond its explicit limit shrinks the step t
 
 TEST_CASE("stability: stiffness far beyond its explicit limit (c = 5000 m/s) stays stable at the substep cap") {
   for (const auto& solver : test::solvers()) {
-    if (solver == "pbf" || solver == "dfsph") continue;  // no sound speed: incompressible by projection or solve
+    if (solver == "pbf" || solver == "game" || solver == "dfsph") continue;  // no sound speed: incompressible by projection or solve
     CAPTURE(solver);
     SceneDef s = tank(solver, 1, 1, 0.04);
     s.solver.soundSpeed = 5000;
@@ -198,10 +198,10 @@ void surfaceTensionBeyondLimit(const std::string& solver) {
   blk.min = Vec2d(0.3, 0.3);
   blk.max = Vec2d(0.7, 0.7);
   s.blocks.push_back(blk);
-  if (solver == "pbf") {  // pbf's smallest substep (max_dt/32) is above the limit: refused, naming the key
+  if (solver == "pbf" || solver == "game") {  // the smallest position-based substep (max_dt/32) is above the limit: refused
     try {
       World w(s, WorldOptions{2});
-      FAIL("pbf accepted a surface-tension step limit it cannot follow");
+      FAIL(solver << " accepted a surface-tension step limit it cannot follow");
     } catch (const SceneError& e) {
       CHECK(e.key == "effects.surface_tension.sigma");
       CHECK(std::string(e.what()).find("surface_tension") != std::string::npos);
@@ -282,7 +282,7 @@ namespace {
 double restBand(const SceneDef& s, double H) {
   const std::string& t = s.solver.type;
   if (t == "dfsph") return 2 * 0.001;
-  if (t == "pbf") return 2 * 0.01;
+  if (t == "pbf" || t == "game") return 2 * 0.01;
   if (t == "wcsph") return 0.01;
   return 2 * 9.81 * H / (s.solver.soundSpeed * s.solver.soundSpeed);
 }

@@ -60,7 +60,7 @@ inline BodyDef tankWalls(double W, double H) {
 /// otherwise) in the closed tank [0, W] × [0, H]; no fluid yet.
 inline SceneDef tank(const std::string& solver, double W, double H, double spacing) {
   SceneDef s;
-  s.solver.type = solver;
+  s.solver = solverDefaults(solver);  // the solver's own defaults (game: its viscosity and support)
   s.solver.spacing = spacing;
   s.bodies.push_back(tankWalls(W, H));
   return s;
@@ -90,8 +90,10 @@ inline FluidBlockDef block(const Vec2d& lo, const Vec2d& hi, const Vec2d& veloci
 /// created first: ids below the lower half's count.
 inline SceneDef periodicShearLayer(const std::string& solver, double U, double spacing) {
   SceneDef s = scene("validation/taylor_green.json");
+  const SolverDef defaults = solverDefaults(solver);
   s.solver.type = solver;
-  s.solver.params.clear();
+  s.solver.params = defaults.params;
+  s.solver.supportRatio = defaults.supportRatio;
   s.solver.spacing = spacing;
   s.solver.viscosity = 0;
   s.effects.shifting = false;
@@ -112,7 +114,7 @@ inline SceneDef periodicShearLayer(const std::string& solver, double U, double s
 /// pbf and dfsph have no sound speed and run with their defaults and ν = 0.
 inline SceneDef wallScene(double spacing, const std::string& solver = "wcsph") {
   SceneDef s;
-  s.solver.type = solver;
+  s.solver = solverDefaults(solver);
   s.solver.spacing = spacing;
   s.solver.viscosity = solver == "muller2003" ? 0.02 : 0.0;
   if (solver == "wcsph") s.solver.params["expected_speed"] = 8;

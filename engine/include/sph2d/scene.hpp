@@ -85,6 +85,20 @@ struct SolverDef {
   double param(const std::string& key) const { return params.at(key); }
 };
 
+/// The quality presets a scene (`solver.quality`) or a program can ask for.
+/// "game": real time (the game solver), "balanced": wcsph, "accurate": dfsph.
+const std::vector<std::string>& qualityPresets();
+
+/// The solver definition of a quality preset: its solver type, the shared keys
+/// that solver tunes by default (e.g. the game solver's viscosity and support)
+/// and every parameter at its default. Throws std::invalid_argument naming the
+/// presets for an unknown name.
+SolverDef qualityPreset(const std::string& quality);
+
+/// The solver definition of solver `type` with its defaults (shared keys it
+/// tunes and its own parameters). Throws std::invalid_argument for an unknown type.
+SolverDef solverDefaults(const std::string& type);
+
 /// The world rectangle the image shows (aspect preserved by widening).
 struct CameraDef {
   Vec2d min{0, 0};

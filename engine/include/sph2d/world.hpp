@@ -135,6 +135,8 @@ class World {
   double kineticEnergy() const;
   /// Iterations and residuals of the pressure solver in the last substep (explicit solvers: all zero).
   SolverStats solverStats() const;
+  /// Pressure and divergence solve iterations summed over every substep so far.
+  std::uint64_t solverIterations() const;
   /// Per-stage wall time and calls since construction (or the last resetTimings()), by stage name in list order.
   std::vector<StageTiming> timings() const;
   /// Zeroes the stage timings.

@@ -44,6 +44,33 @@ const std::vector<SolverParam>& solverParams(const std::string& type) {
   return e ? e->params : none;
 }
 
+void tuneSolverDefaults(SolverDef& def) {
+  const SolverInfo* e = find(def.type);
+  if (e && e->tune) e->tune(def);
+}
+
+const std::vector<std::string>& qualityPresets() {
+  static const std::vector<std::string> q = {"game", "balanced", "accurate"};
+  return q;
+}
+
+SolverDef solverDefaults(const std::string& type) {
+  if (!find(type)) throw std::invalid_argument("unknown solver '" + type + "'");
+  SolverDef d;
+  d.type = type;
+  tuneSolverDefaults(d);
+  fillSolverDefaults(d);
+  return d;
+}
+
+SolverDef qualityPreset(const std::string& quality) {
+  // The solver of each preset, chosen from docs/ACCURACY.md's and docs/PERFORMANCE.md's measurements.
+  if (quality == "game") return solverDefaults("game");
+  if (quality == "balanced") return solverDefaults("wcsph");
+  if (quality == "accurate") return solverDefaults("dfsph");
+  throw std::invalid_argument("unknown quality preset '" + quality + "'; presets: game, balanced, accurate");
+}
+
 void fillSolverDefaults(SolverDef& def) {
   for (const SolverParam& p : solverParams(def.type))
     if (!def.params.count(p.key)) def.params[p.key] = p.def;

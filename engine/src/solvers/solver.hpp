@@ -70,7 +70,13 @@ struct SolverInfo {
   const char* name;                                      ///< solver.type
   std::vector<SolverParam> params;                       ///< its solver.* keys
   std::unique_ptr<Solver> (*make)(const SolverDef& def); ///< builds it (params filled)
+  /// Sets the shared keys (viscosity, support ratio...) this solver wants
+  /// different from SolverDef's defaults when the scene leaves them out (may be null).
+  void (*tune)(SolverDef& def) = nullptr;
 };
+
+/// Applies the tune of `def.type`'s solver (SolverInfo::tune), if it has one.
+void tuneSolverDefaults(SolverDef& def);
 
 /// The solver a scene names. Throws std::invalid_argument for an unknown name.
 std::unique_ptr<Solver> makeSolver(const SolverDef& def);

@@ -111,41 +111,10 @@ class Dfsph final : public Solver {
     });
   }
 
-  /// The gravity that builds a hydrostatic pressure: its components along
-  /// periodic axes are dropped (a body force along a periodic channel drives
-  /// a flow; the pressure does not grow along it).
-  static Vec2 hydrostaticGravity(const StepContext& c) {
-    Vec2 g = c.gravity;
-    if (c.periodic.x) g.x() = 0;
-    if (c.periodic.y) g.y() = 0;
-    return g;
-  }
-
-  /// Calls f(i, depth) for every particle with its depth below the highest
-  /// particle of the same column (strips of width R across the hydrostatic
-  /// gravity). Needs hydrostaticGravity(c) ≠ 0.
+  /// Calls f(i, depth) with every particle's depth below the top of its column (stages.hpp).
   template <class F>
   void depths(const StepContext& c, F f) const {
-    const Particles& P = c.P;
-    const Vec2 gh = hydrostaticGravity(c);
-    const Vec2 up = -gh / gh.norm(), across(up.y(), -up.x());
-    Real sMin = std::numeric_limits<Real>::infinity(), sMax = -sMin;
-    for (std::size_t i = 0; i < P.size(); ++i) {
-      const Real s = across.dot(P.x[i]);
-      sMin = std::min(sMin, s);
-      sMax = std::max(sMax, s);
-    }
-    const std::size_t strips = std::min<std::size_t>(std::size_t((sMax - sMin) / c.R) + 1, 1u << 20);
-    std::vector<Real>& top = topScratch_;  // reused: maxTimeStep runs this every substep
-    top.assign(strips, -std::numeric_limits<Real>::infinity());
-    auto strip = [&](const Vec2& x) {
-      return std::min(strips - 1, std::size_t(std::max(Real(0), (across.dot(x) - sMin) / c.R)));
-    };
-    for (std::size_t i = 0; i < P.size(); ++i) {
-      Real& t = top[strip(P.x[i])];
-      t = std::max(t, up.dot(P.x[i]));
-    }
-    for (std::size_t i = 0; i < P.size(); ++i) f(i, top[strip(P.x[i])] - up.dot(P.x[i]));
+    columnDepths(c, topScratch_, f);
   }
 
   /// velocity_cfl·R/v_max, 0.1·sqrt(R/|g|), 0.25·sqrt(R/a_max) and 0.35·R/sqrt(|g| D), whichever is least

@@ -1,0 +1,100 @@
+// grid_projection.hpp (internal) — a coarse-grid pressure projection of the
+// particle velocities (the grid half of Hybrid SPH: Raveendran, Wojtan & Turk
+// 2011, "Hybrid smoothed particle hydrodynamics", SCA; the grid solve of
+// Bridson's FLIP book, "Fluid Simulation for Computer Graphics", ch. 5).
+//
+// SPH pressure iterations fix short-range density errors fast, but a deep
+// column's long (hydrostatic) mode needs ~(depth/dx)² Jacobi iterations. On a
+// MAC grid of cells a few spacings wide that mode is a small linear system:
+// the particles' velocities go to the grid faces (bilinear weights), cells
+// are solid (inside a collider), fluid (enough particle weight) or air; a
+// Poisson equation for κ = p/ρ0 makes the grid velocity divergence-free and
+// removes the cells' mean compression over one substep; the change of the
+// face velocities goes back to the particles (a FLIP increment, so nothing is
+// smoothed away). Walls are closed faces (no-through-flow, free slip), air
+// cells hold κ = 0. The pressure acts through a smooth interpolated field,
+// so it adds no stiffness to the particle arrangement (unlike SPH pressure
+// sums under a large uniform pressure).
+//
+// Deterministic: particles go to the grid in slot order (one thread), the
+// conjugate-gradient sums are taken in cell order.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "step_context.hpp"
+
+namespace sph2d {
+
+/// What one projection did.
+struct GridProjectionStats {
+  int iterations = 0;       ///< conjugate-gradient iterations
+  int fluidCells = 0;       ///< unknowns
+  double residual = 0;      ///< largest |Δρ/ρ0| the remaining residual stands for over the substep
+};
+
+class GridProjection {
+ public:
+  /// Cells of `cellInSpacings`·dx; a cell is fluid above `fluidFraction` of a full cell's
+  /// particle weight; the cells' mean compression is removed at `compressionRate` per
+  /// substep; CG stops at `tolerance` (density change per substep) or `maxIterations`.
+  GridProjection(Real cellInSpacings, Real fluidFraction, Real compressionRate, Real tolerance, int maxIterations);
+  /// Projects P.v (reads x, v, rho; writes v). Returns the first bad slot or kNone.
+  std::size_t project(StepContext& c);
+  /// The last projection's figures.
+  const GridProjectionStats& stats() const { return stats_; }
+
+ private:
+  enum : std::uint8_t { kAir = 0, kFluid = 1, kSolid = 2 };
+  void layout(const StepContext& c);
+  void classify(const StepContext& c);
+  void transferToGrid(const StepContext& c);
+  void assemble();
+  void apply(const std::vector<Real>& in, std::vector<Real>& out) const;
+  void precondition(const std::vector<Real>& r, std::vector<Real>& z) const;
+  int pcg(std::vector<Real>& x, const std::vector<Real>& b, Real tol, Real& res);
+  void solve(const StepContext& c);
+  Vec2 interpolate(const Vec2& x) const;
+  Vec2 gridVelocity(Real px, Real py) const;
+
+ public:
+  Real pic_ = 0;  ///< share of the projected grid velocity given to the particles (PIC; the rest FLIP)
+
+ private:
+  std::size_t transferToParticles(StepContext& c);
+  static void extrapolate(std::vector<Real>& d, int w, int h, const std::vector<std::uint8_t>& known);
+  /// Cached solid flags of cell (I, J) and blocked flags of its left/bottom faces (anchored indices).
+  std::uint8_t cacheEntry(const StepContext& c, long I, long J);
+
+  Real cellRatio_, fluidFraction_, rate_, tol_;
+  int maxIt_;
+  Real h_ = 0, invH_ = 0;
+  long I0_ = 0, J0_ = 0;  ///< anchored index of cell (0, 0)
+  int nx_ = 0, ny_ = 0;
+  std::vector<std::uint8_t> type_;          ///< per cell
+  std::vector<std::uint8_t> uOpen_, vOpen_;  ///< per face: flow may cross it
+  std::vector<std::uint8_t> fluidU_, fluidV_;  ///< per face: next to a fluid cell (its change is known)
+  std::vector<Real> w_, comp_;              ///< per cell: particle weight, weighted compression
+  std::vector<Real> u_, uw_, v_, vw_;       ///< face velocities and weights
+  std::vector<Real> du_, dv_;               ///< face velocity changes
+  std::vector<Real> uNew_, vNew_;           ///< projected face velocities (for the PIC share)
+  std::vector<Real> kappa_, rhs_, r_, z_, d_, q_, diag_;
+  std::vector<std::int32_t> index_;         ///< cell → unknown (−1: none)
+  std::vector<std::int32_t> cells_;         ///< unknown → cell
+  std::vector<std::int32_t> adj_;           ///< per unknown: left, right, down, up unknown (−1: none)
+  std::vector<Real> precon_;                ///< MIC(0) factor
+  // Warm start: the last substep's κ by anchored cell.
+  long pI0_ = 0, pJ0_ = 0;
+  int pnx_ = 0, pny_ = 0;
+  std::vector<Real> prevKappa_;
+  // Solid/face cache over an anchored box, valid for one boundary version.
+  std::uint64_t cacheVersion_ = 0;
+  bool cacheValid_ = false;
+  long cI0_ = 0, cJ0_ = 0;
+  int cnx_ = 0, cny_ = 0;
+  std::vector<std::uint8_t> cache_;  ///< bit 0 known, bit 1 solid, bit 2 left face blocked, bit 3 bottom face blocked
+  GridProjectionStats stats_;
+};
+
+}  // namespace sph2d
