@@ -23,6 +23,8 @@ int cmdInfo(const std::vector<std::string>& args);
 int cmdBenchStep(const std::vector<std::string>& args);
 /// `sph2d bench accuracy` (cmd_bench_accuracy.cpp).
 int cmdBenchAccuracy(const std::vector<std::string>& args);
+/// `sph2d bench game` (cmd_bench_game.cpp).
+int cmdBenchGame(const std::vector<std::string>& args);
 /// `sph2d bench effects` (cmd_bench_effects.cpp).
 int cmdBenchEffects(const std::vector<std::string>& args);
 

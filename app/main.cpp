@@ -31,6 +31,7 @@ const char* kMainHelp =
     "  sph2d bench render [options]     per-stage render and PNG timings\n"
     "  sph2d bench accuracy [options]   every solver against experiment and theory: error vs cost\n"
     "  sph2d bench effects [options]    milliseconds per substep with and without each effect\n"
+    "  sph2d bench game [options]       the real-time end: the dam break per quality preset, beside LiquidFun\n"
     "  sph2d --help | COMMAND --help\n"
     "\n"
     "Exit codes: 0 ok, 1 runtime failure (check: frames differ), 2 bad input, 3 simulation stopped by the guard, 130 interrupted.\n";
@@ -52,6 +53,7 @@ int main(int argc, char** argv) {
     if (cmd == "render") return cmdRender(args);
     if (cmd == "bench") {
       if (!args.empty() && args[0] == "step") return cmdBenchStep(std::vector<std::string>(args.begin() + 1, args.end()));
+      if (!args.empty() && args[0] == "game") return cmdBenchGame(std::vector<std::string>(args.begin() + 1, args.end()));
       if (!args.empty() && args[0] == "effects")
         return cmdBenchEffects(std::vector<std::string>(args.begin() + 1, args.end()));
       if (!args.empty() && args[0] == "accuracy")
