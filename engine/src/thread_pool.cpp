@@ -27,11 +27,24 @@ ThreadPool::~ThreadPool() {
   for (auto& t : workers_) t.join();
 }
 
+// The hand-off. A job is published as one 64-bit ticket: its block count in the
+// high bits, the next unclaimed block in the low 24. Claiming is one fetch_add;
+// a claim at or past the count claims nothing, so a worker that wakes late (it
+// was descheduled on a busy machine) finds the ticket of a finished job closed
+// and never reads that job's state. The caller waits for the job's blocks to be
+// done, not for every worker to check in: a worker that is not running holds
+// nothing up unless it holds a block.
+namespace {
+constexpr std::uint64_t kIndexBits = 24;
+constexpr std::uint64_t kIndexMask = (std::uint64_t(1) << kIndexBits) - 1;
+}  // namespace
+
 void ThreadPool::runBlocks() {
   for (;;) {
-    const std::size_t k = next_.fetch_add(1, std::memory_order_relaxed);
+    const std::uint64_t t = ticket_.fetch_add(1, std::memory_order_acq_rel);
+    const std::size_t k = std::size_t(t & kIndexMask), blocks = std::size_t(t >> kIndexBits);
+    if (k >= blocks) break;  // closed: every block of the job under way (if any) is claimed
     const std::size_t b = k * block_;
-    if (b >= n_) break;
     const std::size_t e = b + block_ < n_ ? b + block_ : n_;
     try {
       (*fn_)(b, e);
@@ -39,6 +52,7 @@ void ThreadPool::runBlocks() {
       std::lock_guard<std::mutex> lock(errorMutex_);
       if (!error_) error_ = std::current_exception();
     }
+    done_.fetch_add(1, std::memory_order_acq_rel);
   }
 }
 
@@ -60,7 +74,6 @@ void ThreadPool::workerLoop() {
     seen = epoch_.load(std::memory_order_acquire);
     if (stop_.load()) return;
     runBlocks();
-    busy_.fetch_sub(1, std::memory_order_acq_rel);
   }
 }
 
@@ -68,25 +81,29 @@ void ThreadPool::parallelFor(std::size_t n, std::size_t block,
                              const std::function<void(std::size_t, std::size_t)>& fn) {
   if (n == 0) return;
   if (block == 0) block = 1;
-  if (workers_.empty() || n <= block) {
+  const std::size_t blocks = (n + block - 1) / block;
+  // Serial when alone, when one block holds everything, and (never met: blocks are
+  // hundreds of items) beyond the ticket's block count. The same blocks either way.
+  if (workers_.empty() || blocks == 1 || blocks + 1024 > kIndexMask) {
     for (std::size_t b = 0; b < n; b += block) fn(b, b + block < n ? b + block : n);
     return;
   }
+  // The ticket is closed here (the last job's blocks are all claimed): no worker
+  // reads what is written before it opens.
   fn_ = &fn;
   n_ = n;
   block_ = block;
   error_ = nullptr;
-  next_.store(0, std::memory_order_relaxed);
-  busy_.store(static_cast<int>(workers_.size()), std::memory_order_relaxed);
+  done_.store(0, std::memory_order_relaxed);
+  ticket_.store(std::uint64_t(blocks) << kIndexBits, std::memory_order_release);
   {
     std::lock_guard<std::mutex> lock(mutex_);
     epoch_.fetch_add(1, std::memory_order_acq_rel);
   }
   wake_.notify_all();
   runBlocks();
-  // Wait for the workers: spin briefly, then yield the core (on a busy machine
-  // the worker may be descheduled, and spinning would only delay it).
-  for (unsigned spins = 0; busy_.load(std::memory_order_acquire) != 0; ++spins) {
+  // Wait for blocks other threads hold: spin briefly, then yield the core.
+  for (unsigned spins = 0; done_.load(std::memory_order_acquire) != blocks; ++spins) {
     if (spins < 2048) SPH2D_PAUSE();
     else std::this_thread::yield();
   }

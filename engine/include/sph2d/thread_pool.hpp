@@ -11,6 +11,7 @@
 #include <atomic>
 #include <condition_variable>
 #include <cstddef>
+#include <cstdint>
 #include <exception>
 #include <functional>
 #include <mutex>
@@ -56,8 +57,8 @@ class ThreadPool {
   std::mutex mutex_;
   std::condition_variable wake_;
   std::atomic<unsigned long long> epoch_{0};
-  std::atomic<int> busy_{0};
-  std::atomic<std::size_t> next_{0};
+  std::atomic<std::uint64_t> ticket_{0};  ///< the job's block count (high bits) and next block (low 24 bits)
+  std::atomic<std::size_t> done_{0};      ///< blocks of the job finished
   std::atomic<bool> stop_{false};
   const std::function<void(std::size_t, std::size_t)>* fn_ = nullptr;
   std::size_t n_ = 0, block_ = 1;
