@@ -94,19 +94,19 @@ class FrameCheck : public LoopObserver {
     std::printf("note: frame %d: %s not applied: %s\n", int(frame), describeEvent(t.event).c_str(), why.c_str());
   }
   bool keeps(std::int64_t frame) override { return frame % m_.every == 0 && m_.expected.count(int(frame)); }
-  bool frame(const World& world, std::int64_t frame, const Frame& fr) override {
-    const int f = int(frame);
+  bool frame(const FrameState& state, const Frame& fr) override {
+    const int f = int(state.frame);
     const json& e = m_.expected.at(f);
     const std::string got = hex64(xxh64(fr.rgba.data(), fr.rgba.size()));
     const std::string want = e.value("rgba_xxh64", "");
     ++compared;
     if (got == want) return true;
     failed = true;
-    const std::string state = hex64(world.stateHash()), wantState = e.value("state_hash", "");
+    const std::string stateHash = hex64(state.stateHash), wantState = e.value("state_hash", "");
     std::printf("check: frame %d differs: RGBA XXH64 %s here, %s in the manifest\n", f, got.c_str(), want.c_str());
-    std::printf("check: state hash %s\n", state == wantState
+    std::printf("check: state hash %s\n", stateHash == wantState
                                              ? "matches: the simulation agrees, the rendering differs"
-                                             : ("differs too (" + state + " vs " + wantState + "): the simulation changed").c_str());
+                                             : ("differs too (" + stateHash + " vs " + wantState + "): the simulation changed").c_str());
     std::error_code ec;
     fs::create_directories(out_, ec);
     const std::string name = frameFileName(f);

@@ -55,17 +55,20 @@ class RunOutputs : public LoopObserver {
   void notApplied(const TimedEvent& t, std::int64_t frame, const std::string& why) override {
     console_.warn(t.where + ": " + describeEvent(t.event) + " at frame " + std::to_string(frame) + " not applied: " + why);
   }
-  void boundary(const World& world, std::int64_t frame) override { density.measure(world, frame); }
-  bool keeps(std::int64_t frame) override { return frame % a_.every == 0; }
-  bool frame(const World& world, std::int64_t frame, const Frame& image) override {
-    std::shared_ptr<const ParticleSnapshot> snap;
-    if (a_.exportFormat) {
+  void boundary(const World& world, std::int64_t frame) override {
+    density.measure(world, frame);
+    // The export reads the World here: frame() runs while the World steps on.
+    snap_.reset();
+    if (a_.exportFormat && keeps(frame)) {
       const auto s0 = std::chrono::steady_clock::now();
-      snap = std::make_shared<ParticleSnapshot>(snapshotOf(world));
+      snap_ = std::make_shared<ParticleSnapshot>(snapshotOf(world));
       exportSeconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - s0).count();
     }
-    writer_->push(int(frame), image.width, image.height, image.rgba, snap);
-    manifest_->addFrame(frame, world.time(), xxh64(image.rgba.data(), image.rgba.size()), world.stateHash());
+  }
+  bool keeps(std::int64_t frame) override { return frame % a_.every == 0; }
+  bool frame(const FrameState& state, const Frame& image) override {
+    writer_->push(int(state.frame), image.width, image.height, image.rgba, std::move(snap_));
+    manifest_->addFrame(state.frame, state.time, xxh64(image.rgba.data(), image.rgba.size()), state.stateHash);
     return true;
   }
   void progress(const World& world, const LoopStatus& s, bool force) override { console_.progress(world, s, force); }
@@ -79,6 +82,7 @@ class RunOutputs : public LoopObserver {
   EventRecord& record_;
   FrameWriter* writer_;
   RunManifest* manifest_;
+  std::shared_ptr<const ParticleSnapshot> snap_;  ///< the export of the kept frame being rendered
 };
 
 /// Creates the output directory or throws UsageError.

@@ -3,6 +3,7 @@
 #include "game_loop.hpp"
 
 #include <algorithm>
+#include <exception>
 #include <thread>
 #include <utility>
 
@@ -31,7 +32,10 @@ LoopEnd GameLoop::run() {
   f = 0;
   applyDue(0);
   if (!finishBoundary(false)) return LoopEnd::Ended;
-  if (settings_.frames == 1) observer_.progress(world_, status_, true);
+  if (settings_.frames == 1) {
+    if (!renderPending()) return LoopEnd::Ended;
+    observer_.progress(world_, status_, true);
+  }
   clock_.resync(wallNow());
   // One more step is due now (the clock says so; headless: always) and may be taken
   // in this render iteration.
@@ -40,23 +44,26 @@ LoopEnd GameLoop::run() {
     return clock_.due() && steps < clock_.maxStepsPerRender() && f + 1 < settings_.frames && !applier_.paused();
   };
   while (f + 1 < settings_.frames) {
-    if (stopRequested()) return LoopEnd::Interrupted;
+    if (stopRequested()) {
+      renderPending();
+      return LoopEnd::Interrupted;
+    }
     if (applier_.paused()) {
+      if (!renderPending()) return LoopEnd::Ended;
       holdPause();
       clock_.resync(wallNow());
       continue;
     }
     clock_.tick(wallNow());
     if (!clock_.due()) {
+      if (!renderPending()) return LoopEnd::Ended;  // show the frame before waiting for the clock
       // Ahead of the wall clock: sleep (in short slices, so Ctrl-C stays prompt).
       std::this_thread::sleep_for(std::chrono::duration<double>(std::min(clock_.untilDue(), 0.02)));
       continue;
     }
     steps = 0;
     while (stepDue()) {
-      const auto s0 = std::chrono::steady_clock::now();
-      world_.stepFrame();
-      status_.simSeconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - s0).count();
+      if (!stepAndRender()) return LoopEnd::Ended;
       ++f;
       ++steps;
       clock_.consume();
@@ -70,6 +77,7 @@ LoopEnd GameLoop::run() {
     status_.late = clock_.late();
     status_.behindSeconds = clock_.behindSeconds();
     status_.paused = applier_.paused();
+    if (f + 1 == settings_.frames && !renderPending()) return LoopEnd::Ended;
     observer_.progress(world_, status_, f + 1 == settings_.frames);
   }
   return LoopEnd::Finished;
@@ -101,10 +109,73 @@ bool GameLoop::finishBoundary(bool drop) {
     ++status_.dropped;
     return true;
   }
+  capture(f);
+  return true;
+}
+
+void GameLoop::capture(std::int64_t f) {
+  Pending& q = pending_;
+  const Particles& P = world_.particles();
+  q.particles.x = P.x;
+  q.particles.v = P.v;
+  q.particles.rho = P.rho;
+  q.particles.p = P.p;
+  q.particles.id = P.id;
+  q.colliders = world_.colliders();
+  const std::vector<Real>* age = P.find("age");
+  if (age) q.age = *age;
+  q.input = RenderInput{};
+  q.input.particles = &q.particles;
+  q.input.origin = world_.origin();
+  q.input.spacing = world_.spacing();
+  q.input.colliders = &q.colliders;
+  q.input.age = age ? q.age.data() : nullptr;
+  q.input.gravity = world_.scene().gravity.norm();
+  q.input.frame = world_.frame();
+  q.input.time = world_.time();
+  q.state = FrameState{f, world_.time(), world_.stateHash()};
+  q.active = true;
+}
+
+bool GameLoop::renderPending() {
+  if (!pending_.active) return true;
+  pending_.active = false;
   const auto r0 = std::chrono::steady_clock::now();
-  const Frame& image = renderer_->render(world_);
+  const Frame& image = renderer_->render(pending_.input);
   status_.renderSeconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - r0).count();
-  return observer_.frame(world_, f, image);
+  return observer_.frame(pending_.state, image);
+}
+
+bool GameLoop::stepAndRender() {
+  auto step = [this] {
+    const auto s0 = std::chrono::steady_clock::now();
+    world_.stepFrame();
+    status_.simSeconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - s0).count();
+  };
+  if (!pending_.active) {
+    step();
+    return true;
+  }
+  // The World steps on a second thread; the renderer stays on this one (its GL
+  // context's). Both are joined before anything else touches the World.
+  std::exception_ptr stepError, renderError;
+  std::thread stepper([&] {
+    try {
+      step();
+    } catch (...) {
+      stepError = std::current_exception();
+    }
+  });
+  bool more = true;
+  try {
+    more = renderPending();
+  } catch (...) {
+    renderError = std::current_exception();
+  }
+  stepper.join();
+  if (stepError) std::rethrow_exception(stepError);
+  if (renderError) std::rethrow_exception(renderError);
+  return more;
 }
 
 // Paused at boundary f (already rendered): waits for a resume, or the pause's own seconds

@@ -1,9 +1,18 @@
 // app/game_loop.hpp — the fixed-step game loop that `sph2d run` and `sph2d check` share.
 //
-//   boundary 0: apply events ─> observer.boundary ─> render if kept ─> observer.frame
+//   boundary 0: apply events ─> observer.boundary ─> snapshot if kept
 //   then, while frames remain:  [paused? hold]  [real time: wait until a frame is due]
-//     World::stepFrame ─> apply events due at the new boundary ─> observer.boundary
-//       ─> render if kept (unless the loop is behind the wall clock: dropped) ─> observer.frame
+//     World::stepFrame  ‖  render the snapshot ─> observer.frame   (two threads, joined)
+//       ─> apply events due at the new boundary ─> observer.boundary
+//       ─> snapshot if kept (unless the loop is behind the wall clock: dropped)
+//   a snapshot still pending is rendered before a pause, a wait for the clock and the end.
+//
+// Rendering overlaps the next step: the renderer draws a copy of what it reads
+// (positions, velocities, density, pressure, ids, ages, colliders) on the thread
+// that owns its GL context, while a second thread steps the World. The frame is
+// the same image as when drawn from the World itself, and it reaches the
+// observer before the next boundary; the observer gets the boundary's time and
+// state hash, never the World (which is stepping then).
 //
 // Design: a run is a function of the scene and the list (frame, event) alone. The
 // loop applies every event at a frame boundary, before that frame is rendered and
@@ -51,6 +60,13 @@ struct LoopStatus {
   bool paused = false;         ///< between a pause and a resume
 };
 
+/// A kept frame's boundary, as the loop captured it before stepping on.
+struct FrameState {
+  std::int64_t frame = 0;        ///< the boundary
+  double time = 0;               ///< World::time() there [s]
+  std::uint64_t stateHash = 0;   ///< World::stateHash() there
+};
+
 /// How the loop ended (exceptions from the World, the renderer or the observer propagate).
 enum class LoopEnd {
   Finished,     ///< every frame was stepped
@@ -74,8 +90,10 @@ class LoopObserver {
   virtual void boundary(const World& world, std::int64_t frame) {}
   /// True when frame `frame` is to be rendered (a kept frame).
   virtual bool keeps(std::int64_t frame) = 0;
-  /// The rendered kept frame `frame` (valid during the call). False ends the loop.
-  virtual bool frame(const World& world, std::int64_t frame, const Frame& image) = 0;
+  /// The rendered kept frame (valid during the call) of boundary `state`. Called while the
+  /// World steps on another thread: read what else it needs from the World in boundary().
+  /// False ends the loop (after the step under way).
+  virtual bool frame(const FrameState& state, const Frame& image) = 0;
   /// Called after each loop iteration and while paused; `force` at the last frame.
   virtual void progress(const World& world, const LoopStatus& status, bool force) {}
 };
@@ -103,6 +121,13 @@ class GameLoop {
   bool finishBoundary(bool drop);
   /// Holds a pause at the current boundary until it ends (or the stop flag is set).
   void holdPause();
+  /// Copies what the renderer reads of the World at boundary `f` (the pending frame).
+  void capture(std::int64_t f);
+  /// Renders the pending frame and hands it to the observer. False: the observer ended the loop.
+  bool renderPending();
+  /// One World::stepFrame, with the pending frame rendered on this thread meanwhile.
+  /// False: the observer ended the loop.
+  bool stepAndRender();
 
   World& world_;
   EventIntake& input_;
@@ -113,6 +138,15 @@ class GameLoop {
   EventApplier applier_;
   LoopStatus status_;
   std::chrono::steady_clock::time_point start_;
+  /// The kept frame captured at its boundary and not rendered yet.
+  struct Pending {
+    bool active = false;
+    FrameState state;
+    Particles particles;              ///< x, v, rho, p, id (the fields the renderer reads)
+    std::vector<Collider> colliders;
+    std::vector<Real> age;
+    RenderInput input;
+  } pending_;
 };
 
 }  // namespace sph2d::cli
