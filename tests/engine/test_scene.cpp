@@ -30,9 +30,22 @@ TEST_CASE("the default dam break scene loads with its documented values") {
   CHECK(s.duration == 4);
   CHECK(s.render.width == 960);
   CHECK(s.render.height == 540);
+  CHECK(s.solver.type == "game");  // quality: game, real time (issue 15)
+  CHECK(s.solver.spacing == 0.014);
   const std::size_t n = countBlockParticles(s);
   CHECK(n > 9000);
   CHECK(n < 11000);
+}
+
+TEST_CASE("the seed's dam break keeps the seed's solver one scene away, with the same tank and column") {
+  const SceneDef a = test::scene("dam_break.json"), m = test::scene("dam_break_muller2003.json");
+  CHECK(m.solver.type == "muller2003");
+  CHECK(m.solver.soundSpeed == 25);
+  CHECK(m.solver.viscosity == 0.01);
+  CHECK(m.solver.spacing == a.solver.spacing);
+  CHECK(countBlockParticles(m) == countBlockParticles(a));
+  CHECK(m.bodies[0].fixtures.size() == a.bodies[0].fixtures.size());
+  CHECK(m.render.width == a.render.width);
 }
 
 TEST_CASE("an unknown key names file, line, column, the key path and the allowed keys") {

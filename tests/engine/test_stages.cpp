@@ -51,7 +51,10 @@ TEST_CASE("a uniform flow through a periodic box stays uniform across the seams 
 }
 
 TEST_CASE("reordering changes physics by rounding only: every step vs never, 20 substeps, matched by id") {
-  SceneDef s = test::scene("dam_break.json");
+  // The seed's solver: its step has no data-dependent branch. The game solver's
+  // tolerance-driven iteration counts and active lists can turn a rounding
+  // difference (sums in another slot order) into a discrete one.
+  SceneDef s = test::scene("dam_break_muller2003.json");
   s.solver.reorderInterval = 1;
   World a(s, WorldOptions{2});
   s.solver.reorderInterval = 0;
