@@ -471,6 +471,24 @@ std::size_t GridProjection::transferToParticles(StepContext& c) {
   });
 }
 
+Real GridProjection::kappaAt(const Vec2& x) const {
+  if (nx_ < 2 || ny_ < 2 || kappa_.size() != std::size_t(nx_) * std::size_t(ny_)) return 0;
+  const Real fx = x.x() * invH_ - Real(I0_) - Real(0.5), fy = x.y() * invH_ - Real(J0_) - Real(0.5);
+  if (!(fx >= 0 && fy >= 0 && fx < Real(nx_ - 1) && fy < Real(ny_ - 1))) return 0;  // also NaN
+  const int i0 = int(fx), j0 = int(fy);
+  const Real tx = fx - Real(i0), ty = fy - Real(j0);
+  const std::size_t k = std::size_t(j0) * nx_ + i0;
+  const std::size_t ks[4] = {k, k + 1, k + nx_, k + nx_ + 1};
+  const Real wq[4] = {(1 - tx) * (1 - ty), tx * (1 - ty), (1 - tx) * ty, tx * ty};
+  Real sum = 0, wsum = 0;
+  for (int q = 0; q < 4; ++q) {
+    if (type_[ks[q]] == kSolid) continue;
+    wsum += wq[q];
+    if (type_[ks[q]] == kFluid) sum += wq[q] * kappa_[ks[q]];
+  }
+  return wsum > 0 ? sum / wsum : Real(0);
+}
+
 std::size_t GridProjection::project(StepContext& c) {
   if (c.P.size() == 0 || !(c.dt > 0)) return kNone;
   layout(c);

@@ -42,6 +42,9 @@ class GridProjection {
   GridProjection(Real cellInSpacings, Real fluidFraction, Real compressionRate, Real tolerance, int maxIterations);
   /// Projects P.v (reads x, v, rho; writes v). Returns the first bad slot or kNone.
   std::size_t project(StepContext& c);
+  /// κ = p/ρ0 of the last projection at `x` (bilinear over the fluid and air cells, air
+  /// holding 0; solid cells are left out; 0 outside the grid or before any projection).
+  Real kappaAt(const Vec2& x) const;
   /// The last projection's figures.
   const GridProjectionStats& stats() const { return stats_; }
 

@@ -17,6 +17,15 @@
 //   4. ρ of the final x* (what the World reports), v = (x* − x)/dt, and XSPH:
 //      v_i += c Σ_j (m/ρ_j)(v_j − v_i) W_ij, gathered into a copy.
 //
+// The game solver ("game" in solvers.def, quality "game") is this code with the
+// defaults of pbfParams(true) and support 2 dx, no viscosity: 1 to 4 iterations
+// a substep under a tolerance band, then local iterations over the particles still
+// compressed (an active list); a substep set by a speed quantile and a per-particle
+// move cap instead of the fastest particle; corrections that move positions only;
+// and, before the prediction, the coarse-grid pressure projection of the
+// velocities (grid_projection.hpp: Hybrid SPH, Raveendran et al. 2011), which
+// carries the long hydrostatic mode that Jacobi iterations reach only slowly.
+//
 // Design choices (the measurements behind them and the variants dropped:
 // docs/SOLVERS.md and docs/SCENES.md, sections pbf):
 // - One kernel, spiky (Müller et al. 2003), for the density and for ∇C, so ∇C is
@@ -619,7 +628,15 @@ class Pbf final : public Solver {
     return first;
   }
 
-  /// ρ of the final positions (what the World reports), 1/ρ, p = −ρ0 λ/dt². Caches W_ij/wK for XSPH.
+  /// The pressure reported for particle i: −ρ0 λ_i/dt² of the constraint, plus ρ0 κ of the
+  /// grid projection when there is one (it carries the hydrostatic part).
+  Real pressure(const StepContext& c, const std::vector<Real>* lam, Real pK, std::size_t i) const {
+    Real p = lam ? std::max(Real(0), pK * (*lam)[i]) : Real(0);
+    if (projection_) p += c.rho0 * std::max(Real(0), projection_->kappaAt(c.P.x[i]));
+    return p;
+  }
+
+  /// ρ of the final positions (what the World reports), 1/ρ, p (pressure()). Caches W_ij/wK for XSPH.
   std::size_t finalDensity(StepContext& c, Real dt) {
     Particles& P = c.P;
     if (rhoCurrent_) {  // the last constraint pass already summed ρ (and cached W) at these positions
@@ -627,7 +644,7 @@ class Pbf final : public Solver {
       const Real pK = dt > 0 ? -c.rho0 / (dt * dt) : Real(0);
       c.pool.parallelFor(P.size(), kStreamBlock, [&](std::size_t b, std::size_t e) {
         for (std::size_t i = b; i < e; ++i) {
-          const Real p = lam ? std::max(Real(0), pK * (*lam)[i]) : Real(0);
+          const Real p = pressure(c, lam, pK, i);
           P.invRho[i] = Real(1) / P.rho[i];
           P.p[i] = p;
           P.pOverRho[i] = p * P.invRho[i];
@@ -672,7 +689,7 @@ class Pbf final : public Solver {
           }
           rho += c.rho0 * wK * bw;
         }
-        const Real p = lam ? std::max(Real(0), pK * (*lam)[i]) : Real(0);
+        const Real p = pressure(c, lam, pK, i);
         P.rho[i] = rho;
         P.invRho[i] = Real(1) / rho;
         P.p[i] = p;
@@ -778,7 +795,7 @@ std::vector<SolverParam> pbfParams(bool game) {
   return {
       {"iterations", g(4, 1), 1, 1000, "Jacobi iterations of the density constraint per substep, at least (integer)"},
       {"max_iterations", g(100, 4), 1, 1000, "iterations over all particles per substep, at most (integer)"},
-      {"tolerance", 0.01, 0, 1, "stop once mean(max(ρ/ρ0 − 1, 0)) ≤ this … (0: exactly `iterations`)"},
+      {"tolerance", 0.01, 0, 1, "stop once mean(max(ρ/ρ0 − 1, 0)) ≤ this … (0: only when nothing is compressed, so usually `max_iterations`)"},
       {"tolerance_max", g(0.05, 0.08), 0.001, 10, "… and the largest compression max(ρ/ρ0 − 1) ≤ this"},
       {"local_iterations", g(0, 20), 0, 1000,
        "then at most this many iterations on the particles near a compression above tolerance_max (and their neighbours)"},
