@@ -38,7 +38,7 @@ const char* kHelp =
     "                           [--rounds R] [--effects A,B,...] [--solver NAME] [--clock wall|cpu]\n"
     "                           [--csv FILE]\n"
     "\n"
-    "Runs scene S (default assets/scenes/dam_break.json) resampled to about N particles\n"
+    "Runs scene S (default assets/scenes/dam_break_muller2003.json) resampled to about N particles\n"
     "(default 20000) once per configuration: none (gravity and pressure only: viscosity 0,\n"
     "no effects), none_again (a second, identical World: the A/A control, whose ratio to none\n"
     "shows what the machine's noise and memory placement alone do), viscosity (the scene's nu, or 0.01), xsph (c = 0.05), force_field (one\n"
@@ -91,7 +91,7 @@ double wallSeconds() {
 }  // namespace
 
 int cmdBenchEffects(const std::vector<std::string>& args) {
-  std::string scenePath = "assets/scenes/dam_break.json", csvPath, solver, clock = "wall";
+  std::string scenePath = "assets/scenes/dam_break_muller2003.json", csvPath, solver, clock = "wall";
   int particles = 20000, threads = 1, steps = 50, warmup = 50, rounds = 5;
   std::vector<std::string> only;
   for (std::size_t i = 0; i < args.size(); ++i) {

@@ -19,7 +19,7 @@ namespace {
 const char* kHelp =
     "Usage: sph2d bench step [--scene S] [--particles N[,N...]] [--threads T[,T...]] [--steps K] [--warmup W] [--csv]\n"
     "\n"
-    "Runs scene S (default assets/scenes/dam_break.json) with its spacing scaled so the fluid\n"
+    "Runs scene S (default assets/scenes/dam_break_muller2003.json, the seed's step) with its spacing scaled so the fluid\n"
     "blocks hold about N particles, for W warm-up substeps (default 20) and K timed substeps\n"
     "(default: enough for about 2e7 particle-steps, at least 10), at each thread count\n"
     "(default: 1 and all cores). Default sweep: 5000,20000,100000,500000,1000000 particles.\n"
@@ -38,7 +38,7 @@ long peakRssBytes() {
 }  // namespace
 
 int cmdBenchStep(const std::vector<std::string>& args) {
-  std::string scenePath = "assets/scenes/dam_break.json";
+  std::string scenePath = "assets/scenes/dam_break_muller2003.json";
   std::vector<int> counts = {5000, 20000, 100000, 500000, 1000000};
   std::vector<int> threads = {1, 0};
   int steps = 0, warmup = 20;

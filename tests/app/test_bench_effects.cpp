@@ -15,7 +15,7 @@ using namespace sph2d::apptest;
 TEST_CASE("bench effects with a tiny dam break writes the CSV with one row per configuration") {
   const std::string dir = freshDir("bench_effects");
   const std::string csvPath = dir + "/effects.csv";
-  const Result r = run("bench effects --scene " + q(asset("scenes/dam_break.json")) +
+  const Result r = run("bench effects --scene " + q(asset("scenes/dam_break_muller2003.json")) +
                        " --particles 400 --steps 3 --warmup 2 --rounds 2 --threads 1 --csv " + q(csvPath));
   INFO(r.out);
   REQUIRE(r.code == 0);
@@ -51,7 +51,7 @@ TEST_CASE("bench effects with a tiny dam break writes the CSV with one row per c
 TEST_CASE("bench effects --effects runs only the listed configurations and none, and refuses an unknown one") {
   const std::string dir = freshDir("bench_effects_only");
   const std::string csvPath = dir + "/effects.csv";
-  Result r = run("bench effects --scene " + q(asset("scenes/dam_break.json")) +
+  Result r = run("bench effects --scene " + q(asset("scenes/dam_break_muller2003.json")) +
                  " --particles 300 --steps 2 --warmup 0 --rounds 1 --effects csf --clock cpu --csv " + q(csvPath));
   INFO(r.out);
   REQUIRE(r.code == 0);
