@@ -1,6 +1,6 @@
 // app/game_loop.hpp — the fixed-step game loop that `sph2d run` and `sph2d check` share.
 //
-//   boundary 0: apply events ─> observer.boundary ─> snapshot if kept
+//   boundary 0: apply events ─> observer.boundary ─> render if kept ─> observer.frame
 //   then, while frames remain:  [paused? hold]  [real time: wait until a frame is due]
 //     World::stepFrame  ‖  render the snapshot ─> observer.frame   (two threads, joined)
 //       ─> apply events due at the new boundary ─> observer.boundary
