@@ -797,7 +797,7 @@ std::vector<SolverParam> pbfParams(bool game) {
       {"max_iterations", g(100, 4), 1, 1000, "iterations over all particles per substep, at most (integer)"},
       {"tolerance", 0.01, 0, 1, "stop once mean(max(ρ/ρ0 − 1, 0)) ≤ this … (0: only when nothing is compressed, so usually `max_iterations`)"},
       {"tolerance_max", g(0.05, 0.08), 0.001, 10, "… and the largest compression max(ρ/ρ0 − 1) ≤ this"},
-      {"local_iterations", g(0, 20), 0, 1000,
+      {"local_iterations", g(0, 40), 0, 1000,
        "then at most this many iterations on the particles near a compression above tolerance_max (and their neighbours)"},
       {"relaxation", 0.5, 0, 100, "ε of the constraint denominator, in units of its value on a full rest lattice"},
       {"chebyshev", 0.9, 0, 0.99, "Chebyshev acceleration: spectral radius estimate ρ (0: plain Jacobi)"},
