@@ -1,0 +1,190 @@
+// solvers/pbf/pbf.hpp (internal) — the Pbf class, shared by pbf.cpp (the
+// substep: prediction, the solve loop, the final density and the velocity),
+// pbf_constraint.cpp (the two passes of one Jacobi iteration: constraint and
+// correction) and pbf_params.cpp (the parameter table and the registrations of
+// pbf and game).
+//
+// pbf — Position Based Fluids (Macklin & Müller 2013, "Position Based Fluids",
+// ACM TOG 32(4)) in 2D, for games: substeps up to a frame (max_dt, 1/60 s).
+//
+// One substep of length dt:
+//   1. a = gravity (+ the scene's effects, on neighbour lists of the current x);
+//      v* = v + dt a; x* = x + dt v*, swept out of the solids; x stays in xPrev
+//      (the World's swept collision runs from xPrev after the substep).
+//   2. Grid and neighbour lists on x*, kept for the whole substep as in the paper,
+//      and the boundary samples within R of each x*.
+//   3. Jacobi iterations of the density constraints C_i = ρ_i/ρ0 − 1:
+//        Δλ_i = −s_i C_i / (|∇_i C_i|² + Σ_j |∇_j C_i|² + ε),
+//        Δx_i = (m/ρ0) Σ_j (Δλ_i + Δλ_j + s_corr) ∇W_ij + Δλ_i Σ_b Ψ_b ∇W_ib,
+//      each particle gathering its own Δx into a second buffer (no races), then
+//      swept out of the solids. At least `iterations`, then until the mean
+//      compression mean(max(C_i, 0)) ≤ tolerance and max(C_i) ≤ tolerance_max,
+//      at most max_iterations.
+//   4. ρ of the final x* (what the World reports), v = (x* − x)/dt, and XSPH:
+//      v_i += c Σ_j (m/ρ_j)(v_j − v_i) W_ij, gathered into a copy.
+//
+// The game solver ("game" in solvers.def, quality "game") is this code with the
+// defaults of pbfParams(true) and support 2 dx, no viscosity: 1 to 4 iterations
+// a substep under a tolerance band, then local iterations over the particles still
+// compressed (an active list); a substep set by a speed quantile and a per-particle
+// move cap instead of the fastest particle; corrections that move positions only;
+// and, before the prediction, the coarse-grid pressure projection of the
+// velocities (grid_projection.hpp: Hybrid SPH, Raveendran et al. 2011), which
+// carries the long hydrostatic mode that Jacobi iterations reach only slowly.
+//
+// Design choices (the measurements behind them and the variants dropped:
+// docs/SOLVERS.md and docs/SCENES.md, sections pbf):
+// - One kernel, spiky (Müller et al. 2003), for the density and for ∇C, so ∇C is
+//   the true gradient of C (a Newton step) and close pairs still repel (its
+//   gradient does not vanish at r = 0; coincident pairs use tieBreakDirection).
+//   Pairs that drift past R during the iterations get W = 0.
+// - Walls: boundary samples are static particles of mass ρ0Ψ_b in ρ_i and in
+//   ∇_i C_i, and have no constraint of their own (λ_b = 0: the Jacobian of C is
+//   used as it is).
+// - Multipliers accumulate over the iterations of a substep and are clamped
+//   λ_i ≤ 0: only compression is corrected (no tension, no clumping), and a later
+//   iteration may undo part of an earlier push. P.p = −ρ0 λ / dt².
+// - Step size: ε = relaxation · D0 with D0 = Σ_j |∇_j C_i|² on a full rest
+//   lattice (scale-free). A compressed particle's step is scaled by s_i = ρ0/ρ_i:
+//   the largest eigenvalue of the Jacobi step grows with compression.
+// - Chebyshev semi-iteration on the positions (Wang 2015, "A Chebyshev
+//   semi-iterative approach for accelerating projective and position-based
+//   dynamics"): Jacobi corrects the long (hydrostatic) modes by about N/layers²
+//   per N iterations, Chebyshev by N²/layers².
+// - No warm start from the previous substep's multipliers.
+// - Convergence needs the mean compression and the largest below their tolerances.
+// - Time step: min(max_dt, max_move · R / v_max, limit). The compression left
+//   after N iterations grows as dt²/N², so when max_iterations end unconverged
+//   the limit drops to 0.5–0.9 of this substep (not below max_dt/32); when half
+//   of them sufficed it grows back by 1.2 per substep.
+//
+// Parameters (solver.*): the table pbfParams (pbf_params.cpp), one column for pbf
+// and one for game; docs/SCENES.md lists them.
+#pragma once
+
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <memory>
+#include <vector>
+
+#include "grid_projection.hpp"
+#include "solvers/solver.hpp"
+
+namespace sph2d {
+
+/// The parameters of pbf and of game (the same method; game's defaults make it real-time).
+std::vector<SolverParam> pbfParams(bool game);
+
+/// Position Based Fluids: one object per World, for solver.type "pbf" or "game".
+class Pbf final : public Solver {
+ public:
+  /// Reads the solver.* parameters of `d` (all filled: fillSolverDefaults).
+  explicit Pbf(const SolverDef& d);
+
+  /// "pbf" or "game".
+  const char* name() const override { return name_; }
+  /// 0: start uncompressed (the solve holds ρ0 at any depth, up to the tolerance).
+  double hydrostaticFactor() const override { return 0; }
+
+  /// The spiky kernel (Müller et al. 2003), the one the constraint sums density with.
+  double densityKernel(double r, double R) const override { return Spiky<double>(R).value(r); }
+
+  /// Calibrates D0, then the density and pressure of the current positions.
+  void prepare(StepContext& c) override;
+
+  /// max_dt/32, the floor of the step-limit controller (a correction becomes a
+  /// velocity by dividing by dt, so shorter substeps are refused).
+  double minTimeStep(const StepContext& c) const override {
+    (void)c;
+    return double(maxDt_) / 32;
+  }
+
+  /// min(max_dt, the non-convergence limit, max_move · R / v), v the speed
+  /// quantile's speed when speed_quantile > 0.
+  Real maxTimeStep(const StepContext& c, Real vmax, Real amax) const override;
+
+  /// The speed that at most speed_quantile of the particles exceed (at least
+  /// one particle may): spray does not set everyone's substep; predict caps
+  /// the few faster particles' move instead.
+  Real robustSpeed(const StepContext& c) const;
+
+  /// Correction passes and the mean compression after them, of the last substep.
+  SolverStats stats() const override { return stats_; }
+
+  /// [grid → neighbours, when effects run] → external → effects → predict →
+  /// predicted_grid → predicted_neighbours → density_solve → density → velocity.
+  std::vector<Stage> stages(bool effects) override;
+
+ private:
+  /// Jacobi iterations of the density constraints on the predicted positions
+  /// (Chebyshev-accelerated) until the tolerances; then the step-limit controller.
+  std::size_t solve(StepContext& c);
+
+  /// The last constraint pass met both tolerances.
+  bool converged() const { return meanCompression_ <= tolerance_ && maxCompression_ <= toleranceMax_; }
+
+  /// D0 = Σ_j (m/ρ0)² |∇W|² over a full square lattice (the typical constraint denominator).
+  void calibrate(const StepContext& c);
+
+  /// xPrev = x; v += dt a; x += dt v, swept out of the solids; λ = 0.
+  std::size_t predict(StepContext& c, std::vector<Real>& lambda);
+
+  // pbf_constraint.cpp: the two passes of one Jacobi iteration.
+  /// Density of x*, the constraint and the multiplier step Δλ_i (keeping λ ≤ 0); the
+  /// mean compression. Caches the spiky gradient factor per pair (∇W = gK g d) and
+  /// the wall part of ∇_i C_i for correct() (same positions).
+  /// With `list` (a local iteration), only the listed particles; the mean is then not updated.
+  std::size_t constraint(StepContext& c, const std::vector<Real>& lambda, const std::vector<std::uint32_t>* list = nullptr);
+
+  /// x*_i += (m/ρ0) Σ_j (Δλ_i + Δλ_j + s_corr) ∇W_ij + Δλ_i Σ_b Ψ_b ∇W_ib (a gather into
+  /// a second buffer), combined with the previous iterate by the Chebyshev weight ω and
+  /// swept out of the solids; λ follows the same combination.
+  /// With `list` (a local iteration): only the listed particles move, in place (the
+  /// pass reads no neighbour position), and without Chebyshev.
+  std::size_t correct(StepContext& c, std::vector<Real>& lambda, Real omega, const std::vector<std::uint32_t>* list = nullptr);
+
+  /// The pressure reported for particle i: −ρ0 λ_i/dt² of the constraint, plus ρ0 κ of the
+  /// grid projection when there is one (it carries the hydrostatic part).
+  Real pressure(const StepContext& c, const std::vector<Real>* lam, Real pK, std::size_t i) const;
+
+  /// ρ of the final positions (what the World reports), 1/ρ, p (pressure()). Caches W_ij/wK for XSPH.
+  std::size_t finalDensity(StepContext& c, Real dt);
+
+  /// v = (x* − x)/dt, then XSPH v_i += c Σ_j (m/ρ_j)(v_j − v_i) W_ij (a gather into a copy).
+  std::size_t velocity(StepContext& c);
+
+  const char* name_;  ///< "pbf" or "game" (the same method, registered with other defaults)
+  int iterations_, maxIterations_;
+  Real tolerance_, toleranceMax_, relaxation_, chebyshev_, tensileK_;
+  int tensileN_;
+  Real tensileDq_, xsph_, maxDt_, maxMove_, toVelocity_;
+  bool adaptiveDt_;
+  Real quantile_, moveCap_;
+  int localIterations_;
+  bool resolveEach_;
+  std::vector<std::uint8_t> active_;
+  std::vector<std::uint32_t> activeList_;
+  std::vector<std::uint8_t> halo_;
+  static constexpr std::size_t kLocalBlock = 32;  ///< particles per job of a local iteration (few, clustered)
+  mutable std::vector<Real> speedScratch_;
+  std::unique_ptr<GridProjection> projection_;  ///< the coarse-grid projection (grid_cell > 0)
+
+  Real d0_ = 0, eps_ = 0, invWdq_ = 0, sCorrScale_ = 0;
+  Real meanCompression_ = 0, maxCompression_ = 0;
+  bool rhoCurrent_ = false;  ///< the last constraint pass saw every particle at its current position
+  SolverStats stats_;
+  Real dtLimit_ = std::numeric_limits<Real>::infinity();  ///< shortened while the iterations do not converge
+  std::vector<Real> dLambda_, lOld_;
+  std::vector<Vec2> wallGrad_;             ///< the boundary part of ∇_i C_i
+  std::vector<double> blockErr_;           ///< compression per block (fixed-order sum)
+  std::vector<Real> blockMax_;             ///< largest compression per block
+  std::vector<std::vector<Real>> gCache_;  ///< per pair W/wK (final density, XSPH), laid out like NeighbourLists
+  struct Grad {
+    Real x, y;
+  };
+  std::vector<std::vector<Grad>> gradCache_;  ///< per pair G_ij = (m/ρ0)∇W_ij of the last constraint pass
+  std::vector<Vec2> xNew_, vNew_, xOld_;
+};
+
+}  // namespace sph2d

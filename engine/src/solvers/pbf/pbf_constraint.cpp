@@ -1,0 +1,324 @@
+// pbf_constraint.cpp — the two passes of one Jacobi iteration of Position Based
+// Fluids (Macklin & Müller 2013, "Position Based Fluids", ACM TOG 32(4)), the
+// solver's hot loop: constraint() sums ρ_i with the spiky kernel (Müller et al.
+// 2003) over fluid and wall samples, C_i = ρ_i/ρ0 − 1 and the multiplier step
+// Δλ_i (four neighbour pairs at a time, Lane4); correct() gathers
+// Δx_i = (m/ρ0) Σ_j (Δλ_i + Δλ_j + s_corr) ∇W_ij + Δλ_i Σ_b Ψ_b ∇W_ib and
+// combines it with the previous iterate by the Chebyshev weight (Wang 2015).
+// The loop that calls them: pbf.cpp; the method: pbf.hpp.
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <type_traits>
+
+#if defined(__SSE2__) && !defined(SPH2D_NO_SIMD)
+#include <emmintrin.h>
+#endif
+
+#include "solvers/pbf/pbf.hpp"
+
+namespace sph2d {
+namespace {
+
+/// Four floats operated on together: SSE2 when the compiler targets it, else four
+/// scalar operations. Every operation is IEEE single precision, correctly rounded
+/// per lane (add, mul, div, sqrt, max), so both paths give the same bits.
+struct Lane4 {
+#if defined(__SSE2__) && !defined(SPH2D_NO_SIMD)
+  __m128 v;
+  static Lane4 load(const float* p) { return {_mm_loadu_ps(p)}; }
+  static Lane4 all(float x) { return {_mm_set1_ps(x)}; }
+  void store(float* p) const { _mm_storeu_ps(p, v); }
+  friend Lane4 operator+(Lane4 a, Lane4 b) { return {_mm_add_ps(a.v, b.v)}; }
+  friend Lane4 operator-(Lane4 a, Lane4 b) { return {_mm_sub_ps(a.v, b.v)}; }
+  friend Lane4 operator*(Lane4 a, Lane4 b) { return {_mm_mul_ps(a.v, b.v)}; }
+  friend Lane4 operator/(Lane4 a, Lane4 b) { return {_mm_div_ps(a.v, b.v)}; }
+  static Lane4 sqrt(Lane4 a) { return {_mm_sqrt_ps(a.v)}; }
+  static Lane4 max(Lane4 a, Lane4 b) { return {_mm_max_ps(a.v, b.v)}; }
+  /// Lanes below `valid` from a, the rest from b.
+  static Lane4 firstLanes(unsigned valid, Lane4 a, Lane4 b) {
+    const __m128 m = _mm_castsi128_ps(_mm_cmplt_epi32(_mm_set_epi32(3, 2, 1, 0), _mm_set1_epi32(int(valid))));
+    return {_mm_or_ps(_mm_and_ps(m, a.v), _mm_andnot_ps(m, b.v))};
+  }
+  /// Bit l set where lane l of a < b.
+  static int less(Lane4 a, Lane4 b) { return _mm_movemask_ps(_mm_cmplt_ps(a.v, b.v)); }
+  /// The x and y of X[j[0..3]] (pairs of floats), one 64-bit load each.
+  static void gatherXY(const float* xy, const std::uint32_t* j, Lane4& xs, Lane4& ys) {
+    const __m128 a = _mm_loadh_pi(_mm_castpd_ps(_mm_load_sd(reinterpret_cast<const double*>(xy + 2 * std::size_t(j[0])))),
+                                  reinterpret_cast<const __m64*>(xy + 2 * std::size_t(j[1])));
+    const __m128 b = _mm_loadh_pi(_mm_castpd_ps(_mm_load_sd(reinterpret_cast<const double*>(xy + 2 * std::size_t(j[2])))),
+                                  reinterpret_cast<const __m64*>(xy + 2 * std::size_t(j[3])));
+    xs.v = _mm_shuffle_ps(a, b, _MM_SHUFFLE(2, 0, 2, 0));
+    ys.v = _mm_shuffle_ps(a, b, _MM_SHUFFLE(3, 1, 3, 1));
+  }
+#else
+  float v[4];
+  static Lane4 load(const float* p) { return {{p[0], p[1], p[2], p[3]}}; }
+  static Lane4 all(float x) { return {{x, x, x, x}}; }
+  void store(float* p) const { std::memcpy(p, v, sizeof v); }
+  template <class F>
+  static Lane4 map(Lane4 a, Lane4 b, F f) {
+    return {{f(a.v[0], b.v[0]), f(a.v[1], b.v[1]), f(a.v[2], b.v[2]), f(a.v[3], b.v[3])}};
+  }
+  friend Lane4 operator+(Lane4 a, Lane4 b) { return map(a, b, [](float x, float y) { return x + y; }); }
+  friend Lane4 operator-(Lane4 a, Lane4 b) { return map(a, b, [](float x, float y) { return x - y; }); }
+  friend Lane4 operator*(Lane4 a, Lane4 b) { return map(a, b, [](float x, float y) { return x * y; }); }
+  friend Lane4 operator/(Lane4 a, Lane4 b) { return map(a, b, [](float x, float y) { return x / y; }); }
+  static Lane4 sqrt(Lane4 a) { return {{std::sqrt(a.v[0]), std::sqrt(a.v[1]), std::sqrt(a.v[2]), std::sqrt(a.v[3])}}; }
+  // _mm_max_ps(a, b) returns b when either is NaN: so does this.
+  static Lane4 max(Lane4 a, Lane4 b) { return map(a, b, [](float x, float y) { return x > y ? x : y; }); }
+  static Lane4 firstLanes(unsigned valid, Lane4 a, Lane4 b) {
+    return {{valid > 0 ? a.v[0] : b.v[0], valid > 1 ? a.v[1] : b.v[1], valid > 2 ? a.v[2] : b.v[2], valid > 3 ? a.v[3] : b.v[3]}};
+  }
+  static int less(Lane4 a, Lane4 b) {
+    return (a.v[0] < b.v[0]) | ((a.v[1] < b.v[1]) << 1) | ((a.v[2] < b.v[2]) << 2) | ((a.v[3] < b.v[3]) << 3);
+  }
+  static void gatherXY(const float* xy, const std::uint32_t* j, Lane4& xs, Lane4& ys) {
+    for (int l = 0; l < 4; ++l) {
+      xs.v[l] = xy[2 * std::size_t(j[l])];
+      ys.v[l] = xy[2 * std::size_t(j[l]) + 1];
+    }
+  }
+#endif
+  /// ((l0 + l1) + l2) + l3, the same order on both paths.
+  float sum() const {
+    float t[4];
+    store(t);
+    return ((t[0] + t[1]) + t[2]) + t[3];
+  }
+};
+static_assert(std::is_same<Real, float>::value, "Lane4 is single precision");
+
+}  // namespace
+
+std::size_t Pbf::constraint(StepContext& c, const std::vector<Real>& lambda, const std::vector<std::uint32_t>* list) {
+  Particles& P = c.P;
+  const BoundarySet& B = c.boundary;
+  const Spiky<Real> S(c.R);
+  const Real invR = Real(1) / c.R, wK = S.c * c.R * c.R * c.R, gK = Real(-3) * S.c * c.R * c.R;
+  const Real V = c.mass / c.rho0, Vg = V * gK;
+  const Real tiny2 = Real(1e-12) * c.R * c.R;
+  const Real far2 = Real(4) * c.R * c.R;
+  const std::size_t blocks = c.nbr.perBlock.size();
+  gradCache_.resize(blocks);
+  gCache_.resize(blocks);
+  for (std::size_t k = 0; k < blocks; ++k) {
+    const std::size_t need = c.nbr.perBlock[k].size() + 4;  // + padding of the last particle
+    if (gradCache_[k].size() < need) gradCache_[k].resize(need);
+    if (gCache_[k].size() < need) gCache_[k].resize(need);
+  }
+  const std::size_t count = list ? list->size() : P.size();
+  const std::size_t step = list ? kLocalBlock : kBlock;
+  const std::size_t parts = (count + step - 1) / step;
+  blockErr_.resize(parts);
+  blockMax_.resize(parts);
+  const Vec2* X = P.x.data();
+  const bool periodic = c.periodic.any();
+  const std::size_t first = c.pool.reduce(count, step, kNone, [&](std::size_t b, std::size_t e) {
+    std::size_t bad = kNone;
+    double err = 0;
+    Real worst = 0;
+    const Lane4 zero = Lane4::all(0), one = Lane4::all(1), vInvR = Lane4::all(invR), vVg = Lane4::all(Vg);
+    const Lane4 vFar2 = Lane4::all(far2), vTiny2 = Lane4::all(tiny2);
+    const float* xy = reinterpret_cast<const float*>(X);
+    alignas(16) Real dxs[4], dys[4], r2s[4], gx4[4], gy4[4], w4[4];
+    for (std::size_t idx = b; idx < e; ++idx) {
+      const std::size_t i = list ? (*list)[idx] : idx;
+      const std::uint32_t cnt = c.nbr.count[i];
+      const std::uint32_t* nb = c.nbr.of(i);
+      Grad* gc = gradCache_[i / kBlock].data() + c.nbr.start[i];
+      Real* wc = gCache_[i / kBlock].data() + c.nbr.start[i];
+      const Real xix = X[i].x(), xiy = X[i].y();
+      // a = 1 − r/R; W = wK a³; G_ij = V gK (a²/r) d; four pairs at a time, the
+      // last group padded with pairs outside the support (r² = 4R², d = 0).
+      Lane4 sw = zero, sx = zero, sy = zero, s2 = zero;
+      const Lane4 xi4 = Lane4::all(xix), yi4 = Lane4::all(xiy);
+      for (std::uint32_t k = 0; k < cnt; k += 4) {
+        Lane4 dxv, dyv, q2;
+        const std::uint32_t valid = std::min<std::uint32_t>(4, cnt - k);
+        if (!periodic) {
+          // Four neighbours at once; lanes past the list read particle i and become
+          // pairs outside the support (r² = 4R², d = 0).
+          std::uint32_t js[4] = {nb[k], valid > 1 ? nb[k + 1] : std::uint32_t(i), valid > 2 ? nb[k + 2] : std::uint32_t(i),
+                                 valid > 3 ? nb[k + 3] : std::uint32_t(i)};
+          Lane4 xs, ys;
+          Lane4::gatherXY(xy, js, xs, ys);
+          dxv = Lane4::firstLanes(valid, xi4 - xs, zero);
+          dyv = Lane4::firstLanes(valid, yi4 - ys, zero);
+          q2 = Lane4::firstLanes(valid, dxv * dxv + dyv * dyv, vFar2);
+          if (Lane4::less(q2, vTiny2)) {  // a coincident pair (rare): the scalar path below
+            dxv.store(dxs);
+            dyv.store(dys);
+            q2.store(r2s);
+            for (std::uint32_t l = 0; l < valid; ++l)
+              if (r2s[l] < tiny2) {
+                const Vec2 tb = tieBreakDirection(P.id[i], P.id[js[l]]) * std::sqrt(tiny2);
+                dxs[l] = tb.x();
+                dys[l] = tb.y();
+                r2s[l] = dxs[l] * dxs[l] + dys[l] * dys[l];
+              }
+            dxv = Lane4::load(dxs);
+            dyv = Lane4::load(dys);
+            q2 = Lane4::load(r2s);
+          }
+        } else {
+        for (std::uint32_t l = 0; l < 4; ++l) {
+          if (k + l < cnt) {
+            const std::uint32_t jj = nb[k + l];
+            Real dx = xix - X[jj].x(), dy = xiy - X[jj].y();
+            if (periodic) c.periodic.nearest(dx, dy);
+            Real r2 = dx * dx + dy * dy;
+            if (r2 < tiny2) {  // coincident: a fixed, antisymmetric direction
+              const Vec2 tb = tieBreakDirection(P.id[i], P.id[jj]) * std::sqrt(tiny2);
+              dx = tb.x();
+              dy = tb.y();
+              r2 = dx * dx + dy * dy;
+            }
+            dxs[l] = dx;
+            dys[l] = dy;
+            r2s[l] = r2;
+          } else {
+            dxs[l] = dys[l] = 0;
+            r2s[l] = far2;
+          }
+        }
+        dxv = Lane4::load(dxs);
+        dyv = Lane4::load(dys);
+        q2 = Lane4::load(r2s);
+        }
+        const Lane4 r = Lane4::sqrt(q2);
+        const Lane4 a = Lane4::max(one - r * vInvR, zero);
+        const Lane4 g = a * a / r;
+        const Lane4 gxv = vVg * g * dxv, gyv = vVg * g * dyv;
+        gxv.store(gx4);
+        gyv.store(gy4);
+        const Lane4 a3 = a * a * a;
+        a3.store(w4);
+        for (std::uint32_t l = 0; l < valid; ++l) {  // only i's own entries (a local pass runs particles in any order)
+          gc[k + l] = Grad{gx4[l], gy4[l]};
+          wc[k + l] = w4[l];
+        }
+        sw = sw + a3;
+        sx = sx + gxv;
+        sy = sy + gyv;
+        s2 = s2 + gxv * gxv + gyv * gyv;
+      }
+      const Real w = Real(1) + sw.sum(), g2 = s2.sum();  // self: W(0) = wK
+      Real rho = c.mass * wK * w;
+      Real gix = sx.sum(), giy = sy.sum();
+      Vec2 wall = Vec2::Zero();
+      const std::uint32_t bc = c.nbr.boundaryCount[i];
+      if (bc) {
+        const std::uint32_t* bl = c.nbr.boundaryOf(i);
+        const Vec2 xi = P.x[i];
+        Real bw = 0, bx = 0, by = 0;
+        for (std::uint32_t k = 0; k < bc; ++k) {
+          const std::uint32_t s = bl[k];
+          const Vec2 d = xi - B.samples[s];
+          const Real r = std::max(std::sqrt(d.squaredNorm()), std::sqrt(tiny2));
+          const Real a = std::max(Real(0), Real(1) - r * invR);
+          const Real psi = B.volume[s];
+          bw += psi * a * a * a;
+          const Real g = psi * a * a / r;
+          bx += g * d.x();
+          by += g * d.y();
+        }
+        rho += c.rho0 * wK * bw;
+        wall = Vec2(gK * bx, gK * by);
+        gix += wall.x();
+        giy += wall.y();
+      }
+      wallGrad_[i] = wall;
+      const Real C = rho / c.rho0 - Real(1);
+      const Real D = gix * gix + giy * giy + g2;
+      const Real scale = rho > c.rho0 ? c.rho0 / rho : Real(1);
+      const Real lOld = lambda[i];
+      const Real lNew = std::min(Real(0), lOld - scale * C / (D + eps_));
+      dLambda_[i] = lNew - lOld;
+      P.rho[i] = rho;
+      err += double(std::max(Real(0), C));
+      worst = std::max(worst, C);
+      if (bad == kNone && !std::isfinite(lNew)) bad = i;
+    }
+    blockErr_[b / step] = err;
+    blockMax_[b / step] = worst;
+    return bad;
+  }, [](std::size_t a, std::size_t b2) { return std::min(a, b2); });
+  double sum = 0;
+  Real mx = 0;
+  for (std::size_t k = 0; k < parts; ++k) {  // in block order: the same for any thread count
+    sum += blockErr_[k];
+    mx = std::max(mx, blockMax_[k]);
+  }
+  if (!list) meanCompression_ = Real(sum / double(P.size()));
+  maxCompression_ = mx;
+  rhoCurrent_ = list == nullptr;  // a full pass: ρ and W are those of the current positions
+  return first;
+}
+
+std::size_t Pbf::correct(StepContext& c, std::vector<Real>& lambda, Real omega, const std::vector<std::uint32_t>* list) {
+  Particles& P = c.P;
+  const Spiky<Real> S(c.R);
+  const Real wK = S.c * c.R * c.R * c.R, gK = Real(-3) * S.c * c.R * c.R;
+  const Real invVg = Real(1) / -(c.mass / c.rho0 * gK);
+  const bool tensile = sCorrScale_ != 0;
+  const Real wRatio = wK * invWdq_;
+  const int sn = tensileN_;
+  const Real* L = dLambda_.data();
+  const bool cheb = omega != Real(1);
+  xNew_.resize(P.size());
+  const std::size_t count = list ? list->size() : P.size();
+  const std::size_t step = list ? kLocalBlock : kBlock;
+  const std::size_t first = c.pool.reduce(count, step, kNone, [&](std::size_t b, std::size_t e) {
+    std::size_t bad = kNone;
+    for (std::size_t idx = b; idx < e; ++idx) {
+      const std::size_t i = list ? (*list)[idx] : idx;
+      const std::uint32_t cnt = c.nbr.count[i];
+      const std::uint32_t* nb = c.nbr.of(i);
+      const Grad* gc = gradCache_[i / kBlock].data() + c.nbr.start[i];
+      const Real li = L[i];
+      Real tx = 0, ty = 0;
+      for (std::uint32_t k = 0; k < cnt; ++k) {
+        const std::uint32_t j = nb[k];
+        Real f = li + L[j];
+        if (tensile) {
+          // s_corr = −k (W(r)/W(Δq))^n; |G_ij| = V gK a²/r·r gives a back.
+          const Real gr = std::sqrt(gc[k].x * gc[k].x + gc[k].y * gc[k].y) * invVg;  // a²
+          const Real a = std::sqrt(gr);
+          const Real ratio = wRatio * a * a * a;  // W(r)/W(Δq)
+          Real p = ratio;
+          for (int t = 1; t < sn; ++t) p *= ratio;
+          f += sCorrScale_ * p;
+        }
+        tx += f * gc[k].x;
+        ty += f * gc[k].y;
+      }
+      const Vec2 d = Vec2(tx, ty) + wallGrad_[i] * li;
+      const Vec2 x0 = P.x[i];
+      Vec2 x = x0 + d;
+      const Real lk = lambda[i];
+      if (cheb) {
+        x = xOld_[i] + (x - xOld_[i]) * omega;
+        lambda[i] = lOld_[i] + (lk + li - lOld_[i]) * omega;
+      } else {
+        lambda[i] = lk + li;
+      }
+      lOld_[i] = lk;
+      if (resolveEach_ && c.nbr.boundaryCount[i]) {
+        Vec2 vd = Vec2::Zero();
+        c.boundary.resolve(x, vd, x0, c.clearance);
+      }
+      (list ? P.x[i] : xNew_[i]) = x;
+      if (bad == kNone && !allFinite(x)) bad = i;
+    }
+    return bad;
+  }, [](std::size_t a, std::size_t b2) { return std::min(a, b2); });
+  rhoCurrent_ = false;
+  if (list) return first;
+  // x^{k−1} ← x^k, x^k ← x^{k+1}: buffers rotate, nothing is copied.
+  xOld_.swap(P.x);
+  P.x.swap(xNew_);
+  return first;
+}
+
+}  // namespace sph2d

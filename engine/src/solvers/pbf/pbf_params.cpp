@@ -1,0 +1,59 @@
+// pbf_params.cpp — the scene keys of the Position Based Fluids solver (Macklin &
+// Müller 2013) and its two registrations in solvers.def: "pbf", the classic
+// defaults, and "game", the same code with real-time defaults and the coarse-grid
+// pressure projection on (Hybrid SPH, Raveendran, Wojtan & Turk 2011). What each
+// key does: pbf.hpp and docs/SCENES.md.
+#include "solvers/pbf/pbf.hpp"
+
+namespace sph2d {
+
+/// The parameters of pbf and of game (the same method; game's defaults make it real-time).
+std::vector<SolverParam> pbfParams(bool game) {
+  auto g = [game](double classic, double realtime) { return game ? realtime : classic; };
+  return {
+      {"iterations", g(4, 1), 1, 1000, "Jacobi iterations of the density constraint per substep, at least (integer)"},
+      {"max_iterations", g(100, 4), 1, 1000, "iterations over all particles per substep, at most (integer)"},
+      {"tolerance", 0.01, 0, 1, "stop once mean(max(ρ/ρ0 − 1, 0)) ≤ this … (0: only when nothing is compressed, so usually `max_iterations`)"},
+      {"tolerance_max", g(0.05, 0.08), 0.001, 10, "… and the largest compression max(ρ/ρ0 − 1) ≤ this"},
+      {"local_iterations", g(0, 40), 0, 1000,
+       "then at most this many iterations on the particles near a compression above tolerance_max (and their neighbours)"},
+      {"relaxation", 0.5, 0, 100, "ε of the constraint denominator, in units of its value on a full rest lattice"},
+      {"chebyshev", 0.9, 0, 0.99, "Chebyshev acceleration: spectral radius estimate ρ (0: plain Jacobi)"},
+      {"tensile_k", 0, 0, 1, "s_corr strength k, in multipliers of a unit density error (0: off)"},
+      {"tensile_n", 4, 1, 8, "s_corr exponent n (integer)"},
+      {"tensile_dq", 0.2, 0.01, 0.9, "s_corr reference distance Δq, in units of the support R"},
+      {"xsph", 0.01, 0, 1, "XSPH velocity smoothing c"},
+      {"max_dt", 1.0 / 60.0, 1e-5, 0.1, "largest substep (s)"},
+      {"max_move", g(1, 2), 0.05, 10, "dt ≤ max_move · R / v_speed: largest move per substep, in support radii"},
+      {"speed_quantile", g(0, 0.002), 0, 0.1,
+       "v_speed is the speed this share of the particles exceeds (0: the largest): spray does not set the substep"},
+      {"move_cap", g(0, 1.5), 0, 100, "> 0: no particle moves more than move_cap · max_move · R in a substep (its speed is cut)"},
+      {"adaptive_dt", g(1, 0), 0, 1, "1: shorter substeps while max_iterations end above the tolerances"},
+      {"correction_to_velocity", g(1, 0), 0, 1, "share of the density correction's move that becomes velocity"},
+      {"resolve_each", 1, 0, 1, "1: every correction is swept out of the solids (0: the World's collision after the substep)"},
+      {"grid_cell", g(0, 2), 0, 16, "coarse-grid projection (Hybrid SPH): cell size in spacings (0: none)"},
+      {"grid_fluid_fraction", g(0.5, 0.15), 0.01, 1,
+       "a grid cell is fluid above this fraction of a full cell's particle weight (low: the surface's cells count, and a pool comes to rest)"},
+      {"grid_compression_rate", 0, 0, 1, "share of a grid cell's mean compression its velocity removes per substep"},
+      {"grid_tolerance", 1e-3, 1e-7, 1, "grid solve: the density change per substep its largest residual may stand for"},
+      {"grid_max_iterations", 200, 1, 10000, "grid solve: conjugate-gradient iterations at most"},
+      {"grid_pic", g(0, 0.05), 0, 1, "share of the projected grid velocity the particles take (PIC; the rest is the FLIP change)"},
+  };
+}
+
+/// pbf's registration (solvers.def): classic Position Based Fluids.
+SolverInfo pbfSolver() {
+  return {"pbf", pbfParams(false), [](const SolverDef& d) -> std::unique_ptr<Solver> { return std::make_unique<Pbf>(d); }};
+}
+
+/// game's registration (solvers.def): pbf with the coarse-grid projection, local
+/// iterations and a robust substep, the real-time end (docs/PERFORMANCE.md).
+SolverInfo gameSolver() {
+  return {"game", pbfParams(true), [](const SolverDef& d) -> std::unique_ptr<Solver> { return std::make_unique<Pbf>(d); },
+          [](SolverDef& d) {
+            d.viscosity = 0;      // XSPH smooths; an explicit viscosity would limit the substep
+            d.supportRatio = 2;   // 8 neighbours at rest: measured as accurate as 2.5 here, at half the pairs
+          }};
+}
+
+}  // namespace sph2d
