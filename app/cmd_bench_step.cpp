@@ -19,7 +19,7 @@ namespace {
 const char* kHelp =
     "Usage: sph2d bench step [--scene S] [--particles N[,N...]] [--threads T[,T...]] [--steps K] [--warmup W] [--csv]\n"
     "\n"
-    "Runs scene S (default assets/scenes/dam_break_muller2003.json, the seed's step) with its spacing scaled so the fluid\n"
+    "Runs scene S (default assets/scenes/dam_break_muller2003.json, Müller et al. 2003's step) with its spacing scaled so the fluid\n"
     "blocks hold about N particles, for W warm-up substeps (default 20) and K timed substeps\n"
     "(default: enough for about 2e7 particle-steps, at least 10), at each thread count\n"
     "(default: 1 and all cores). Default sweep: 5000,20000,100000,500000,1000000 particles.\n"

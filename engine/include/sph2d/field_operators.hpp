@@ -1,5 +1,6 @@
 // sph2d/field_operators.hpp — SPH interpolation and differential operators on
-// any particle set (seed 000: A(x) = Σ_j V_j A_j W(x − x_j), V_j = m_j/ρ_j).
+// any particle set (the SPH interpolant of the GAMES103 course notes' SPH
+// introduction: A(x) = Σ_j V_j A_j W(x − x_j), V_j = m_j/ρ_j).
 //
 // Design note.
 // - Nothing here knows about the fluid solver: a `ParticleView` is three
@@ -181,7 +182,7 @@ class FieldOperators {
     });
   }
 
-  /// Plain SPH interpolation Σ_j V_j A_j W(x − x_j) at any point x (the seed's form).
+  /// Plain SPH interpolation Σ_j V_j A_j W(x − x_j) at any point x (the textbook form).
   /// Exact in the continuum limit; near a free surface or the edge of the set it
   /// under-estimates (the kernel is truncated). Use it when the deficit is the
   /// point, e.g. density by summation (A = ρ gives Σ m_j W).
@@ -296,7 +297,7 @@ class FieldOperators {
     return J(0, 1) - J(1, 0);
   }
 
-  /// Laplacian, kernel-Laplacian form Σ_j V_j (A_j − A_i) ∇²W_ij (the seed's).
+  /// Laplacian, kernel-Laplacian form Σ_j V_j (A_j − A_i) ∇²W_ij (the textbook form).
   /// Cheap and zero for constants, but it uses the second kernel derivative, so
   /// it is sensitive to particle disorder and converges only with many
   /// neighbours; on a lattice with fixed h/dx it stalls at a lattice-dependent

@@ -30,7 +30,7 @@ inline Eigen::Matrix<T, 2, 1, Eigen::DontAlign> radialGradient(const Eigen::Matr
 }
 
 /// Poly6 (Müller, Charypar & Gross 2003): W = 4/(π R^8) (R² − r²)³ in 2D.
-/// Smooth at r = 0; the density kernel of the seed's solver.
+/// Smooth at r = 0; the density kernel of that paper's solver (muller2003).
 template <class T = Real>
 struct Poly6 {
   using V = Eigen::Matrix<T, 2, 1, Eigen::DontAlign>;
@@ -149,7 +149,8 @@ struct ViscosityKernel {
   }
 };
 
-/// Cubic spline (Monaghan's M4, seed 000), written with support radius R
+/// Cubic spline (Monaghan's M4, the example kernel of the GAMES103 course
+/// notes' SPH introduction), written with support radius R
 /// (R = 2h in the h-convention): σ = 40/(7π R²), q = r/R,
 /// W = σ(6q³ − 6q² + 1) for q ≤ ½, 2σ(1 − q)³ for q ≤ 1.
 template <class T = Real>

@@ -142,7 +142,8 @@ struct SurfaceTensionDef {
   double threshold = 0.1;     ///< csf: |∇c| below threshold·(1/R) is not surface
 };
 
-/// An emitter of the particle system (seed 001): a nozzle at `position`
+/// An emitter of the particle system (emitters, lifetimes, forces, as in the
+/// RWTH Aachen SPH tutorial's simple particle system): a nozzle at `position`
 /// of `width`, shooting along `direction`.
 struct EmitterDef {
   Vec2d position{0, 0};

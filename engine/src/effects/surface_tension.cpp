@@ -1,7 +1,7 @@
 // Surface tension, two models (effects.surface_tension.model):
 //
 // "csf" — continuum surface force (Brackbill, Kothe & Zemach 1992) on the
-//   colour field of Müller, Charypar & Gross 2003 (seed 002): c = Σ V0 W_poly6
+//   colour field of Müller, Charypar & Gross 2003 (SCA 2003): c = Σ V0 W_poly6
 //   (V0 = m/ρ0), n = ∇c (pointing into the fluid), κ = −∇·n̂, and
 //   a = σ κ n / (I ρ0) where |n| > threshold/R.
 //   * Curvature. Müller's κ = −∇²c/|n| is wrong at a free surface: the colour

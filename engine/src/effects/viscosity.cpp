@@ -1,6 +1,7 @@
-// Viscosity, the Laplacian form of Müller, Charypar & Gross 2003 (seed 002,
-// eq. 14): a_i += (μ/ρ_i) Σ_j m (v_j − v_i)/ρ_j ∇²W_visc(r_ij), with the 2D
-// Laplacian of the viscosity kernel (kernels.hpp: 5(R−r)(R³+R²r+Rr²+9r³)/(3πR⁵r³),
+// Viscosity, the Laplacian form of Müller, Charypar & Gross 2003 ("Particle-based
+// fluid simulation for interactive applications", SCA 2003, eq. 14):
+// a_i += (μ/ρ_i) Σ_j m (v_j − v_i)/ρ_j ∇²W_visc(r_ij), with the 2D Laplacian
+// of the viscosity kernel (kernels.hpp: 5(R−r)(R³+R²r+Rr²+9r³)/(3πR⁵r³),
 // not the 3D c·(R − r)), r clamped to 0.05 R. μ = ν·ρ0. The sum is divided by
 // the Laplacian's lattice moment (kernels.hpp: 0.834 at R = 2.5 dx), so that a
 // shear flow feels ν and not 0.83 ν (measured on start-up Poiseuille flow).

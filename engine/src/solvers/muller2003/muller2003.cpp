@@ -1,5 +1,5 @@
 // muller2003 — the SPH step of Müller, Charypar & Gross 2003, "Particle-based
-// fluid simulation for interactive applications" (seed 002), in 2D: poly6
+// fluid simulation for interactive applications" (SCA 2003), in 2D: poly6
 // density, p = K(ρ − ρ0) with K = c², the symmetric spiky pressure force
 // m (p_i + p_j)/(2ρ_j) ∇W, gravity, the scene's effects (viscosity: the
 // viscosity-kernel Laplacian), symplectic Euler. Walls: the boundary samples
