@@ -203,7 +203,7 @@ void BoundarySet::collect(b2World& world, const Vec2d& origin) {
           const auto* poly = static_cast<const b2PolygonShape*>(shape);
           Collider c = base;
           c.kind = Collider::Kind::Polygon;
-          c.sourceShape = 0;
+          c.sourceShape = Collider::SourceShape::Polygon;
           for (int i = 0; i < poly->m_count; ++i) {
             c.vertices.push_back(toLocal(b2Mul(xf, poly->m_vertices[i]), origin));
             const b2Vec2 n = b2Mul(xf.q, poly->m_normals[i]);
@@ -217,7 +217,7 @@ void BoundarySet::collect(b2World& world, const Vec2d& origin) {
           const auto* circle = static_cast<const b2CircleShape*>(shape);
           Collider c = base;
           c.kind = Collider::Kind::Circle;
-          c.sourceShape = 1;
+          c.sourceShape = Collider::SourceShape::Circle;
           c.center = toLocal(b2Mul(xf, circle->m_p), origin);
           c.radius = circle->m_radius;
           finishBounds(c);
@@ -228,7 +228,7 @@ void BoundarySet::collect(b2World& world, const Vec2d& origin) {
           const auto* edge = static_cast<const b2EdgeShape*>(shape);
           Collider c = base;
           c.kind = Collider::Kind::Segment;
-          c.sourceShape = 2;
+          c.sourceShape = Collider::SourceShape::Edge;
           c.vertices = {toLocal(b2Mul(xf, edge->m_vertex1), origin), toLocal(b2Mul(xf, edge->m_vertex2), origin)};
           finishBounds(c);
           colliders.push_back(c);
@@ -239,7 +239,7 @@ void BoundarySet::collect(b2World& world, const Vec2d& origin) {
           for (int i = 0; i + 1 < chain->m_count; ++i) {
             Collider c = base;
             c.kind = Collider::Kind::Segment;
-            c.sourceShape = 3;
+            c.sourceShape = Collider::SourceShape::Chain;
             c.vertices = {toLocal(b2Mul(xf, chain->m_vertices[i]), origin),
                           toLocal(b2Mul(xf, chain->m_vertices[i + 1]), origin)};
             finishBounds(c);

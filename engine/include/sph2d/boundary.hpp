@@ -15,6 +15,14 @@ namespace sph2d {
 struct Collider {
   /// What the primitive is.
   enum class Kind { Polygon, Circle, Segment };
+  /// The Box2D shape a primitive came from (for drawing and stats: an edge and
+  /// each segment of a chain are both Kind::Segment).
+  enum class SourceShape {
+    Polygon,  ///< a b2PolygonShape (boxes and polygons)
+    Circle,   ///< a b2CircleShape
+    Edge,     ///< a b2EdgeShape
+    Chain,    ///< one segment of a b2ChainShape
+  };
   Kind kind = Kind::Polygon;
   std::vector<Vec2> vertices;  ///< polygon (counter-clockwise) or segment end points
   std::vector<Vec2> normals;   ///< polygon outward face normals (normals[k] for edge k→k+1)
@@ -24,7 +32,7 @@ struct Collider {
   Real restitution = 0.0f;     ///< normal restitution used against the fluid
   Vec2 lo = Vec2::Zero();      ///< bounding box, low corner
   Vec2 hi = Vec2::Zero();      ///< bounding box, high corner
-  int sourceShape = 0;         ///< 0 box/polygon, 1 circle, 2 edge, 3 chain (for drawing and stats)
+  SourceShape sourceShape = SourceShape::Polygon;  ///< the Box2D shape it came from
 };
 
 }  // namespace sph2d
