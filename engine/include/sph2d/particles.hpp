@@ -25,7 +25,7 @@ struct Particles {
   std::vector<Real> rho;          ///< density [kg/m³]
   std::vector<Real> p;            ///< pressure [Pa]
   std::vector<Real> invRho;       ///< 1/ρ, set by the pressure stage (saves divisions in pair loops)
-  std::vector<Real> pOverRho;     ///< p/ρ, set by the pressure stage
+  std::vector<Real> pOverRho;     ///< p/ρ, set with p by the solver (every solver)
   std::vector<std::uint32_t> id;  ///< stable identifier
 
   /// Optional per-particle scalar fields, created only by the solver or effect

@@ -111,8 +111,9 @@ class Wcsph final : public Solver {
     });
   }
 
-  void pressure(StepContext& c) const {
+  void pressure(StepContext& c) {
     Particles& P = c.P;
+    pOverRho2_.resize(P.size());
     const Real B = c.rho0 * c0_ * c0_ / gamma_;
     const bool clamp = c.def.clampNegativePressure;
     // Beyond ρ = 1.1 ρ0 (never reached by a weakly compressible flow with a
@@ -130,7 +131,9 @@ class Wcsph final : public Solver {
         if (clamp && p < 0) p = 0;
         P.p[i] = p;
         P.invRho[i] = Real(1) / P.rho[i];
-        P.pOverRho[i] = p * P.invRho[i] * P.invRho[i];  // p/ρ² for this solver's symmetric form
+        const Real pr = p * P.invRho[i];
+        P.pOverRho[i] = pr;
+        pOverRho2_[i] = pr * P.invRho[i];  // p/ρ² for the symmetric pressure form
       }
     });
   }
@@ -149,7 +152,7 @@ class Wcsph final : public Solver {
     const Vec2* X = P.x.data();
     const Vec2* V = P.v.data();
     const Real* IR = P.invRho.data();
-    const Real* POR2 = P.pOverRho.data();
+    const Real* POR2 = pOverRho2_.data();
     return firstBad(c.pool, P.size(), [&](std::size_t b, std::size_t e) {
       std::size_t bad = kNone;
       for (std::size_t i = b; i < e; ++i) {
@@ -207,6 +210,9 @@ class Wcsph final : public Solver {
   }
 
   Real gamma_, alpha_, c0_;
+  /// p/ρ² per particle, written by the pressure stage for the pressure force of the
+  /// same substep (no reordering between them).
+  std::vector<Real> pOverRho2_;
 };
 
 }  // namespace
