@@ -223,7 +223,7 @@ int cmdBenchEffects(const std::vector<std::string>& args) {
   double (*const now)() = clock == "cpu" ? &cpuSeconds : &wallSeconds;
   std::fflush(stdout);
   for (Row& r : rows)
-    for (int i = 0; i < warmup; ++i) r.world->substep();
+    for (int i = 0; i < warmup; ++i) r.world->stepSubstep();
   for (int round = 0; round < rounds; ++round) {
     std::vector<double> msThisRound(rows.size());
     for (std::size_t k = 0; k < rows.size(); ++k) {
@@ -231,7 +231,7 @@ int cmdBenchEffects(const std::vector<std::string>& args) {
       Row& r = rows[idx];
       r.world->resetTimings();
       const double t0 = now(), w0 = wallSeconds();
-      for (int i = 0; i < steps; ++i) r.world->substep();
+      for (int i = 0; i < steps; ++i) r.world->stepSubstep();
       const double sec = now() - t0, wallSec = wallSeconds() - w0;
       msThisRound[idx] = 1e3 * sec / steps;
       double effectSec = 0;

@@ -74,12 +74,12 @@ int cmdBenchStep(const std::vector<std::string>& args) {
       w.takeWarnings();
       const std::size_t np = w.particleCount();
       const int k = steps > 0 ? steps : std::max(10, int(2e7 / double(np)));
-      for (int i = 0; i < warmup; ++i) w.substep();
+      for (int i = 0; i < warmup; ++i) w.stepSubstep();
       w.resetTimings();
       std::size_t pairs = 0;
       const auto t0 = std::chrono::steady_clock::now();
       for (int i = 0; i < k; ++i) {
-        w.substep();
+        w.stepSubstep();
         pairs += w.neighbourPairs();
       }
       const double sec = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

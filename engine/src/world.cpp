@@ -229,7 +229,7 @@ std::uint64_t World::emittedCount(std::size_t index) const { return impl_->emitt
 
 std::uint64_t World::removedCount() const { return impl_->removed; }
 
-void World::substep() { impl_->substep(impl_->stableDt()); }
+void World::stepSubstep() { impl_->substep(impl_->stableDt()); }
 
 std::vector<std::string> World::takeWarnings() {
   std::vector<std::string> out;

@@ -83,7 +83,7 @@ TEST_CASE("kineticEnergy is half m v squared summed, densityStats the mean and l
   // A second block on the lower half of the box, every new particle on top of an old one:
   // 2 ρ0 there, ρ0 above, a row or two between.
   const std::size_t added = w.addBlock(test::block({0, 0}, {1, 0.5}));
-  w.substep();  // the densities of the new state
+  w.stepSubstep();  // the densities of the new state
   const DensityStats d = w.densityStats();
   const double doubled = 2.0 * double(added) / double(w.particleCount());  // the share of particles in the overlap
   MESSAGE(added << " added; mean compression " << d.meanError << ", largest " << d.maxError << ", mean density "
@@ -97,7 +97,7 @@ TEST_CASE("neighbourPairs counts each particle's 20 lattice neighbours within 2.
   // On a full square lattice the points within R = 2.5 dx of a particle are the 20
   // with i² + j² ≤ 5 (i² + j² = 6.25 has no integer solution; √8 = 2.83 dx is out).
   World w(periodicBlock("wcsph", Vec2d(0, 0)), WorldOptions{2});
-  w.substep();
+  w.stepSubstep();
   CHECK(w.neighbourPairs() == 20 * w.particleCount());
 }
 
@@ -105,9 +105,9 @@ TEST_CASE("the state hash is the same for the same state and changes with any pa
   const SceneDef s = test::scene("tests/small_dam_break.json");
   World a(s, WorldOptions{1}), b(s, WorldOptions{3});
   CHECK(a.stateHash() == b.stateHash());
-  a.substep();
+  a.stepSubstep();
   CHECK(a.stateHash() != b.stateHash());  // one substep moved the particles
-  b.substep();
+  b.stepSubstep();
   CHECK(a.stateHash() == b.stateHash());
   // Removing one particle changes it, and removing the same one in the other world agrees again.
   const Vec2d p = a.worldPosition(0);

@@ -58,7 +58,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   if (particles > 2000 || worldCost(scene) > 20000 || scene.effects.emitters.size() > 4) return 0;
   try {
     sph2d::World world(scene, sph2d::WorldOptions{1});
-    world.substep();
+    world.stepSubstep();
   } catch (const sph2d::SimulationError&) {
     // The guard stopping a wild scene is a correct outcome.
   }

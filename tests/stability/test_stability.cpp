@@ -302,12 +302,12 @@ void longRest(const std::string& solver, int substeps) {
   s.blocks.push_back(blk);
   World w(s, WorldOptions{2});
   const int settle = substeps / 10;
-  for (int i = 0; i < settle; ++i) w.substep();
+  for (int i = 0; i < settle; ++i) w.stepSubstep();
   const Vec2d c1 = test::centroid(w);
   const double ke1 = w.kineticEnergy(), t1 = w.time();
   double keMax = 0, errMax = 0;
   for (int i = settle; i < substeps; ++i) {
-    w.substep();
+    w.stepSubstep();
     if (i % 500 == 0) {
       keMax = std::max(keMax, w.kineticEnergy());
       errMax = std::max(errMax, w.densityStats().meanError);

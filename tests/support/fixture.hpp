@@ -244,7 +244,7 @@ struct MomentumRun {
 inline MomentumRun momentumOver(const SceneDef& scene, int substeps) {
   World w(scene, WorldOptions{2});
   const Vec2d m0 = momentum(w);
-  for (int i = 0; i < substeps; ++i) w.substep();
+  for (int i = 0; i < substeps; ++i) w.stepSubstep();
   MomentumRun r;
   r.change = (momentum(w) - m0).norm();
   r.scale = double(w.particleCount()) * double(w.particleMass()) * 0.36;

@@ -89,7 +89,7 @@ class World {
   /// Advances `dt` seconds in CFL substeps. Throws SimulationError.
   void step(double dt);
   /// Advances one CFL-limited substep (for benchmarks and tests). Throws SimulationError.
-  void substep();
+  void stepSubstep();
 
   /// The particles (local frame; add origin() for world coordinates).
   const Particles& particles() const;
