@@ -133,8 +133,7 @@ Run runHydrostatic(SceneDef s, int threads) {
   World w(s, WorldOptions{threads});
   w.takeWarnings();
   const double rho0 = s.solver.restDensity, g = 9.81, dx = s.solver.spacing;
-  std::vector<double> sum(40, 0.0);
-  std::vector<int> count(40, 0);
+  validation::PressureProfile profile;
   const int frames = int(std::lround(s.duration * s.fps)), avgFrom = frames * 2 / 3;
   double densSum = 0, densMax = 0;
   const auto t0 = std::chrono::steady_clock::now();
@@ -144,37 +143,15 @@ Run runHydrostatic(SceneDef s, int threads) {
     const DensityStats d = w.densityStats();
     densSum += d.meanError;
     densMax = std::max(densMax, d.maxError);
-    for (std::size_t i = 0; i < w.particleCount(); ++i) {
-      const Vec2d q = w.worldPosition(i);
-      const int band = int(std::lround(q.y() / 0.05));
-      // Slabs 5 cm thick around each band's height (p is linear in y: the slab's mean is its centre's).
-      if (std::fabs(q.x() - 1.0) < 0.2 && band >= 0 && band < 40) {
-        sum[std::size_t(band)] += w.particles().p[i];
-        ++count[std::size_t(band)];
-      }
-    }
+    profile.add(w);
   }
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  double top = 0, H = 0;
-  int n = 0;
-  for (std::size_t i = 0; i < w.particleCount(); ++i) top = std::max(top, w.worldPosition(i).y());
-  for (std::size_t i = 0; i < w.particleCount(); ++i)
-    if (w.worldPosition(i).y() > top - dx && std::fabs(w.worldPosition(i).x() - 1) < 0.5) {
-      H += w.worldPosition(i).y();
-      ++n;
-    }
-  H = n ? H / n + 0.5 * dx : 0;
+  const double H = validation::PressureProfile::surface(w, 1.0, dx);
   // muller2003's symmetric force recovers ∇p/2: its pressure at rest is 2ρg(H − y) by design;
   // compare its profile against that, so the error measures the scheme, not the convention.
   const double expectScale = s.solver.type == "muller2003" ? 2.0 : 1.0;
-  double worst = 0;
-  int measured = 0;
-  for (int band = 1; 0.05 * band < H - 3 * dx; ++band)
-    if (count[std::size_t(band)] > 0) {
-      ++measured;
-      const double p = sum[std::size_t(band)] / count[std::size_t(band)];
-      worst = std::max(worst, std::fabs(p - expectScale * rho0 * g * (H - 0.05 * band)) / (expectScale * rho0 * g * H));
-    }
+  int measured = 0, empty = 0;
+  const double worst = profile.worstError(H, rho0, g, dx, expectScale, measured, empty);
   r.caseName = "hydrostatic";
   r.errorName = "pressure_profile_max_rel";
   r.error = measured ? worst : NAN;  // nothing measured: no figure, not a perfect one

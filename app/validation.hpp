@@ -16,6 +16,10 @@
 // and y/H, scaled by the steady centre speed F H²/(8ν). Measured: the mean
 // x-velocity of the particles within one spacing of each tabulated y/H, at
 // each tabulated τ (rows in τ order).
+//
+// Hydrostatic tank (a resting column): the pressure averaged in 5 cm slabs of
+// height near x = xc against ρ0 g (H − y), H the free surface (the mean height
+// of the top particles plus half a spacing).
 #pragma once
 
 #include <algorithm>
@@ -198,5 +202,58 @@ inline PoiseuilleResult runPoiseuille(const SceneDef& s, double y0, double heigh
   r.substeps = w.substeps();
   return r;
 }
+
+/// The pressure profile of a resting column, accumulated over frames in 5 cm slabs of height
+/// (|x − xc| < 0.2 m; p is linear in y, so a slab's mean is its centre's).
+struct PressureProfile {
+  static constexpr double kSlab = 0.05;  ///< slab height [m]
+  std::vector<double> sum = std::vector<double>(40, 0.0);
+  std::vector<int> count = std::vector<int>(40, 0);
+  double xc = 1.0;  ///< the column's middle [m]
+
+  /// Adds every particle's pressure to its slab.
+  void add(const World& w) {
+    for (std::size_t i = 0; i < w.particleCount(); ++i) {
+      const Vec2d q = w.worldPosition(i);
+      const int band = int(std::lround(q.y() / kSlab));
+      if (std::fabs(q.x() - xc) < 0.2 && band >= 0 && band < int(sum.size())) {
+        sum[std::size_t(band)] += w.particles().p[i];
+        ++count[std::size_t(band)];
+      }
+    }
+  }
+
+  /// The free surface near xc: the mean height of the particles within dx of the highest
+  /// (|x − xc| < 0.5 m), plus dx/2.
+  static double surface(const World& w, double xc, double dx) {
+    double top = 0, H = 0;
+    int n = 0;
+    for (std::size_t i = 0; i < w.particleCount(); ++i) top = std::max(top, w.worldPosition(i).y());
+    for (std::size_t i = 0; i < w.particleCount(); ++i)
+      if (w.worldPosition(i).y() > top - dx && std::fabs(w.worldPosition(i).x() - xc) < 0.5) {
+        H += w.worldPosition(i).y();
+        ++n;
+      }
+    return n ? H / n + 0.5 * dx : 0;
+  }
+
+  /// The largest |p − scale ρ0 g (H − y)| over the slabs below the top three spacings, as a
+  /// fraction of scale ρ0 g H; `measured` gets the number of slabs that held particles, `empty`
+  /// the number that did not.
+  double worstError(double H, double rho0, double g, double dx, double scale, int& measured, int& empty) const {
+    double worst = 0;
+    measured = empty = 0;
+    for (int band = 1; kSlab * band < H - 3 * dx && band < int(sum.size()); ++band) {
+      if (count[std::size_t(band)] == 0) {
+        ++empty;
+        continue;
+      }
+      ++measured;
+      const double p = sum[std::size_t(band)] / count[std::size_t(band)];
+      worst = std::max(worst, std::fabs(p - scale * rho0 * g * (H - kSlab * band)) / (scale * rho0 * g * H));
+    }
+    return worst;
+  }
+};
 
 }  // namespace sph2d::validation

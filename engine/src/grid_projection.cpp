@@ -348,7 +348,9 @@ void GridProjection::solve(const StepContext& c) {
   prevKappa_ = kappa_;
 }
 
-Vec2 GridProjection::gridVelocity(Real px, Real py) const {
+Vec2 GridProjection::sampleFaces(const std::vector<Real>& u, const std::vector<Real>& v, Real px, Real py) const {
+  // Bilinear over the MAC faces: u at (i, j + 1/2), v at (i + 1/2, j), in cell units of the
+  // grid (px, py ≥ 0: the grid has a margin, so truncation is floor).
   const int nu = nx_ + 1;
   Real ux, uy;
   {
@@ -356,37 +358,16 @@ Vec2 GridProjection::gridVelocity(Real px, Real py) const {
     const int i0 = int(fx), j0 = int(fy);
     const Real tx = fx - Real(i0), ty = fy - Real(j0);
     const std::size_t k = std::size_t(j0) * nu + i0;
-    ux = (1 - tx) * (1 - ty) * uNew_[k] + tx * (1 - ty) * uNew_[k + 1] + (1 - tx) * ty * uNew_[k + nu] + tx * ty * uNew_[k + nu + 1];
+    ux = (1 - tx) * (1 - ty) * u[k] + tx * (1 - ty) * u[k + 1] + (1 - tx) * ty * u[k + nu] + tx * ty * u[k + nu + 1];
   }
   {
     const Real fx = px - Real(0.5), fy = py;
     const int i0 = int(fx), j0 = int(fy);
     const Real tx = fx - Real(i0), ty = fy - Real(j0);
     const std::size_t k = std::size_t(j0) * nx_ + i0;
-    uy = (1 - tx) * (1 - ty) * vNew_[k] + tx * (1 - ty) * vNew_[k + 1] + (1 - tx) * ty * vNew_[k + nx_] + tx * ty * vNew_[k + nx_ + 1];
+    uy = (1 - tx) * (1 - ty) * v[k] + tx * (1 - ty) * v[k + 1] + (1 - tx) * ty * v[k + nx_] + tx * ty * v[k + nx_ + 1];
   }
   return Vec2(ux, uy);
-}
-
-Vec2 GridProjection::interpolate(const Vec2& x) const {
-  const int nu = nx_ + 1;
-  const Real px = x.x() * invH_ - Real(I0_), py = x.y() * invH_ - Real(J0_);
-  Real dvx, dvy;
-  {
-    const Real fx = px, fy = py - Real(0.5);
-    const int i0 = int(fx), j0 = int(fy);  // fx, fy ≥ 0 (the grid has a margin): truncation is floor
-    const Real tx = fx - Real(i0), ty = fy - Real(j0);
-    const std::size_t k = std::size_t(j0) * nu + i0;
-    dvx = (1 - tx) * (1 - ty) * du_[k] + tx * (1 - ty) * du_[k + 1] + (1 - tx) * ty * du_[k + nu] + tx * ty * du_[k + nu + 1];
-  }
-  {
-    const Real fx = px - Real(0.5), fy = py;
-    const int i0 = int(fx), j0 = int(fy);  // fx, fy ≥ 0 (the grid has a margin): truncation is floor
-    const Real tx = fx - Real(i0), ty = fy - Real(j0);
-    const std::size_t k = std::size_t(j0) * nx_ + i0;
-    dvy = (1 - tx) * (1 - ty) * dv_[k] + tx * (1 - ty) * dv_[k + 1] + (1 - tx) * ty * dv_[k + nx_] + tx * ty * dv_[k + nx_ + 1];
-  }
-  return Vec2(dvx, dvy);
 }
 
 void GridProjection::extrapolate(std::vector<Real>& d, int w, int h, const std::vector<std::uint8_t>& known) {
@@ -443,25 +424,10 @@ std::size_t GridProjection::transferToParticles(StepContext& c) {
     std::size_t bad = kNone;
     for (std::size_t p = b; p < e; ++p) {
       const Real px = P.x[p].x() * invH_ - Real(I0_), py = P.x[p].y() * invH_ - Real(J0_);
-      Real dvx, dvy;
-      {
-        const Real fx = px, fy = py - Real(0.5);
-        const int i0 = int(fx), j0 = int(fy);  // fx, fy ≥ 0 (the grid has a margin): truncation is floor
-        const Real tx = fx - Real(i0), ty = fy - Real(j0);
-        const std::size_t k = std::size_t(j0) * nu + i0;
-        dvx = (1 - tx) * (1 - ty) * du_[k] + tx * (1 - ty) * du_[k + 1] + (1 - tx) * ty * du_[k + nu] + tx * ty * du_[k + nu + 1];
-      }
-      {
-        const Real fx = px - Real(0.5), fy = py;
-        const int i0 = int(fx), j0 = int(fy);  // fx, fy ≥ 0 (the grid has a margin): truncation is floor
-        const Real tx = fx - Real(i0), ty = fy - Real(j0);
-        const std::size_t k = std::size_t(j0) * nx_ + i0;
-        dvy = (1 - tx) * (1 - ty) * dv_[k] + tx * (1 - ty) * dv_[k + 1] + (1 - tx) * ty * dv_[k + nx_] + tx * ty * dv_[k + nx_ + 1];
-      }
-      Vec2 vp = P.v[p] + Vec2(dvx, dvy);  // FLIP: the change of the grid velocity
+      Vec2 vp = P.v[p] + sampleFaces(du_, dv_, px, py);  // FLIP: the change of the grid velocity
       if (pic_ > 0) {
         // PIC share: towards the projected grid velocity itself (smooths particle noise).
-        const Vec2 ug = gridVelocity(px, py);
+        const Vec2 ug = sampleFaces(uNew_, vNew_, px, py);
         vp += (ug - vp) * pic_;
       }
       P.v[p] = vp;

@@ -58,8 +58,8 @@ class GridProjection {
   void precondition(const std::vector<Real>& r, std::vector<Real>& z) const;
   int pcg(std::vector<Real>& x, const std::vector<Real>& b, Real tol, Real& res);
   void solve(const StepContext& c);
-  Vec2 interpolate(const Vec2& x) const;
-  Vec2 gridVelocity(Real px, Real py) const;
+  /// Bilinear sample of face fields u, v at (px, py) in cell units of the grid.
+  Vec2 sampleFaces(const std::vector<Real>& u, const std::vector<Real>& v, Real px, Real py) const;
 
  public:
   Real pic_ = 0;  ///< share of the projected grid velocity given to the particles (PIC; the rest FLIP)
