@@ -89,6 +89,7 @@ void World::Impl::rebuildBoundary() {
   boundary.sample(dx, R, pool);
   boundary.buildBins(Real(4) * R);
   boundarySignature = staticSignature();
+  ++boundaryVersion;  // a count, not the signature: a rebuilt fixture may reuse a freed one's address
 }
 
 void World::refreshBoundaries() {

@@ -81,7 +81,7 @@ struct StepContext {
   double time = 0;              ///< simulated time at the start of the substep
   Vec2d origin{0, 0};           ///< local frame offset (world = local + origin)
   PeriodicBox periodic{};       ///< periodic axes: every pair difference takes the nearest image
-  std::uint64_t boundaryVersion = 0;  ///< changes whenever the colliders are read again
+  std::uint64_t boundaryVersion = 0;  ///< counts the times the colliders were read: changes whenever they are read again
 };
 
 /// Lowest slot reported by the blocks (the blocks are in slot order).

@@ -41,7 +41,7 @@ StepContext World::Impl::context(Real dt) {
   c.time = time;
   c.origin = origin;
   c.periodic = periodic;
-  c.boundaryVersion = boundarySignature;
+  c.boundaryVersion = boundaryVersion;
   return c;
 }
 

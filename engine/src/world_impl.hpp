@@ -48,6 +48,7 @@ struct World::Impl {
   std::uint64_t iterations = 0;       ///< solver iterations summed over the substeps
   std::vector<std::string> warnings;
   std::uint64_t boundarySignature = 0;  ///< staticSignature() when the colliders were last read
+  std::uint64_t boundaryVersion = 0;    ///< how many times the colliders were read (StepContext::boundaryVersion)
 
   // The particle system (particle_system.cpp): emitters, lifetimes, sinks, budget.
   struct EmitterState {
