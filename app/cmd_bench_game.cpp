@@ -194,9 +194,10 @@ bool runPeer(const std::string& exe, double spacing, double seconds, bool stat, 
     throw std::runtime_error("the peer " + exe + " failed: " + out);
   const auto w = out.find(" wall s per simulated s");
   if (w != std::string::npos) {
-    std::size_t b = out.rfind(", ", w);
-    wps = std::atof(out.c_str() + b + 2);
+    const std::size_t b = out.rfind(", ", w);
+    if (b != std::string::npos) wps = std::atof(out.c_str() + b + 2);
   }
+  if (!(wps > 0)) throw std::runtime_error("the peer " + exe + " printed no wall time per simulated second: " + out);
   r.name = stat ? "liquidfun_static" : "liquidfun";
   r.particles = std::size_t(particles);
   r.threads = 1;
@@ -261,7 +262,8 @@ int cmdBenchGame(const std::vector<std::string>& args) {
     else if (a == "--threads") threads = parseIntList(a, value(), 1, 256);
     else if (a == "--seconds") {
       seconds = parseNumber(a, value());
-      if (!(seconds > 0 && seconds <= 60)) throw UsageError("--seconds must be in (0, 60]");
+      // At least one frame of 1/60 s, so that every figure measures something.
+      if (!(seconds >= 1.0 / 60 && seconds <= 60)) throw UsageError("--seconds must be in [1/60, 60]");
     } else if (a == "--presets") {
       presets = splitList(value());
       for (const std::string& p : presets)

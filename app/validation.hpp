@@ -18,8 +18,8 @@
 // each tabulated τ (rows in τ order).
 //
 // Hydrostatic tank (a resting column): the pressure averaged in 5 cm slabs of
-// height near x = xc against ρ0 g (H − y), H the free surface (the mean height
-// of the top particles plus half a spacing).
+// height near x = xc against ρ0 g (H − ȳ), ȳ the slab's mean particle height and
+// H the free surface (the mean height of the top particles plus half a spacing).
 #pragma once
 
 #include <algorithm>
@@ -204,10 +204,13 @@ inline PoiseuilleResult runPoiseuille(const SceneDef& s, double y0, double heigh
 }
 
 /// The pressure profile of a resting column, accumulated over frames in 5 cm slabs of height
-/// (|x − xc| < 0.2 m; p is linear in y, so a slab's mean is its centre's).
+/// (|x − xc| < 0.2 m). p is linear in y, so a slab's mean pressure is compared with the
+/// pressure at its particles' mean height (a slab need not be filled evenly: at dx = 5 cm a
+/// lattice row sits on a slab's edge).
 struct PressureProfile {
   static constexpr double kSlab = 0.05;  ///< slab height [m]
   std::vector<double> sum = std::vector<double>(40, 0.0);
+  std::vector<double> sumY = std::vector<double>(40, 0.0);
   std::vector<int> count = std::vector<int>(40, 0);
   double xc = 1.0;  ///< the column's middle [m]
 
@@ -218,6 +221,7 @@ struct PressureProfile {
       const int band = int(std::lround(q.y() / kSlab));
       if (std::fabs(q.x() - xc) < 0.2 && band >= 0 && band < int(sum.size())) {
         sum[std::size_t(band)] += w.particles().p[i];
+        sumY[std::size_t(band)] += q.y();
         ++count[std::size_t(band)];
       }
     }
@@ -237,7 +241,7 @@ struct PressureProfile {
     return n ? H / n + 0.5 * dx : 0;
   }
 
-  /// The largest |p − scale ρ0 g (H − y)| over the slabs below the top three spacings, as a
+  /// The largest |p̄ − scale ρ0 g (H − ȳ)| over the slabs below the top three spacings, as a
   /// fraction of scale ρ0 g H; `measured` gets the number of slabs that held particles, `empty`
   /// the number that did not.
   double worstError(double H, double rho0, double g, double dx, double scale, int& measured, int& empty) const {
@@ -250,7 +254,8 @@ struct PressureProfile {
       }
       ++measured;
       const double p = sum[std::size_t(band)] / count[std::size_t(band)];
-      worst = std::max(worst, std::fabs(p - scale * rho0 * g * (H - kSlab * band)) / (scale * rho0 * g * H));
+      const double y = sumY[std::size_t(band)] / count[std::size_t(band)];
+      worst = std::max(worst, std::fabs(p - scale * rho0 * g * (H - y)) / (scale * rho0 * g * H));
     }
     return worst;
   }
