@@ -320,11 +320,13 @@ void GridProjection::solve(const StepContext& c) {
   if (m == 0) return;
   rhs_.assign(m, 0);
   std::vector<Real> x(m, 0);
-  // Warm start from the last substep's κ of the same anchored cells.
+  // Warm start from the last substep's κ of the same anchored cells (none when the cells
+  // grew to hold spray: the same index is then another place).
+  const bool sameCells = h_ == pH_;
   for (std::size_t a = 0; a < m; ++a) {
     const int i = cells_[a] % nx_, j = cells_[a] / nx_;
     const long I = I0_ + i - pI0_, J = J0_ + j - pJ0_;
-    if (I >= 0 && J >= 0 && I < pnx_ && J < pny_) x[a] = prevKappa_[std::size_t(J) * pnx_ + std::size_t(I)];
+    if (sameCells && I >= 0 && J >= 0 && I < pnx_ && J < pny_) x[a] = prevKappa_[std::size_t(J) * pnx_ + std::size_t(I)];
   }
   auto uf = [&](int i, int j) { return uOpen_[std::size_t(j) * nu + i] ? u_[std::size_t(j) * nu + i] : Real(0); };
   auto vf = [&](int i, int j) { return vOpen_[std::size_t(j) * nx_ + i] ? v_[std::size_t(j) * nx_ + i] : Real(0); };
@@ -341,6 +343,7 @@ void GridProjection::solve(const StepContext& c) {
   stats_.residual = double(res * dt * dt * invH_ * invH_);
   std::fill(kappa_.begin(), kappa_.end(), Real(0));
   for (std::size_t a = 0; a < m; ++a) kappa_[std::size_t(cells_[a])] = x[a];
+  pH_ = h_;
   pI0_ = I0_;
   pJ0_ = J0_;
   pnx_ = nx_;

@@ -88,6 +88,7 @@ class GridProjection {
   std::vector<std::int32_t> adj_;           ///< per unknown: left, right, down, up unknown (−1: none)
   std::vector<Real> precon_;                ///< MIC(0) factor
   // Warm start: the last substep's κ by anchored cell.
+  Real pH_ = 0;  ///< the cell size of prevKappa_
   long pI0_ = 0, pJ0_ = 0;
   int pnx_ = 0, pny_ = 0;
   std::vector<Real> prevKappa_;
