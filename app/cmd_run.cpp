@@ -55,11 +55,12 @@ class RunOutputs : public LoopObserver {
   void notApplied(const TimedEvent& t, std::int64_t frame, const std::string& why) override {
     console_.warn(t.where + ": " + describeEvent(t.event) + " at frame " + std::to_string(frame) + " not applied: " + why);
   }
-  void boundary(const World& world, std::int64_t frame) override {
+  void boundary(const World& world, std::int64_t frame, bool rendered) override {
     density.measure(world, frame);
-    // The export reads the World here: frame() runs while the World steps on.
+    // The export reads the World here (frame() runs while the World steps on), and only
+    // for a frame that will be rendered: a dropped frame is neither drawn nor exported.
     snap_.reset();
-    if (a_.exportFormat && keeps(frame)) {
+    if (a_.exportFormat && rendered) {
       const auto s0 = std::chrono::steady_clock::now();
       snap_ = std::make_shared<ParticleSnapshot>(snapshotOf(world));
       exportSeconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - s0).count();

@@ -102,9 +102,10 @@ void GameLoop::applyDue(std::int64_t frame) {
 
 bool GameLoop::finishBoundary(bool drop) {
   const std::int64_t f = status_.frame;
-  observer_.boundary(world_, f);
+  const bool kept = renderer_ && observer_.keeps(f);
+  observer_.boundary(world_, f, kept && !drop);
   status_.done = f + 1;
-  if (!renderer_ || !observer_.keeps(f)) return true;
+  if (!kept) return true;
   if (drop) {
     ++status_.dropped;
     return true;

@@ -87,7 +87,8 @@ class LoopObserver {
   /// Event `e` could not be applied at boundary `frame` (`why`); the World is unchanged.
   virtual void notApplied(const TimedEvent& e, std::int64_t frame, const std::string& why) = 0;
   /// Boundary `frame` is complete: stepped to and its events applied; not rendered yet.
-  virtual void boundary(const World& world, std::int64_t frame) {}
+  /// `rendered`: frame() will follow for it (a kept frame, not dropped).
+  virtual void boundary(const World& world, std::int64_t frame, bool rendered) {}
   /// True when frame `frame` is to be rendered (a kept frame).
   virtual bool keeps(std::int64_t frame) = 0;
   /// The rendered kept frame (valid during the call) of boundary `state`. Called while the
