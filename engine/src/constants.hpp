@@ -29,6 +29,13 @@ constexpr Real kCoincident2 = Real(1e-12);
 /// kernel value, long enough to give a finite gradient direction.
 constexpr Real kTieBreakLength = Real(1e-6);
 
+/// Below q = r/R = kFlatGradientQ a pair's Wendland gradient keeps its peak
+/// magnitude (|∇W| peaks at q = 1/4) along its direction, instead of falling to
+/// 0 as r → 0 (Thomas & Couchman 1992's modified gradient): a stacked or
+/// coincident pair then pushes apart. Pairs of fluid near its rest spacing are
+/// farther apart and unaffected (dfsph's solves, wcsph's pressure force).
+constexpr Real kFlatGradientQ = Real(0.25);
+
 /// The force limit of explicit schemes, dt ≤ kForceCfl·sqrt(R/a_max)
 /// (Monaghan 1992's force condition; 0.25 is the usual safety factor).
 constexpr Real kForceCfl = Real(0.25);

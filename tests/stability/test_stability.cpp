@@ -70,13 +70,11 @@ using test::minPairDistance;
 /// 5 %), the coincident pairs have parted (the closest pair farther than 0.1 dx;
 /// measured 0.17 dx for muller2003, 0.37 for pbf, 0.19 for dfsph), nothing escapes.
 ///
-/// wcsph does not part them (measured: the closest pair still at 0 after 1 s), and
-/// the test asserts that as it is: Wendland's |∇W| = |gradK|(1 − q)³ r vanishes as
-/// r → 0, and pairDelta's tie-break direction, 1e-6 R long, gives a coincident pair
-/// a direction without a magnitude, so each pair feels the same forces and moves as
-/// one particle. dfsph had the same defect (issue 17; its solves now keep the peak
-/// |∇W| for pairs closer than R/4, engine/src/solvers/dfsph/dfsph.cpp). When wcsph
-/// gets such a fix, its check below fails and should become the others'.
+/// Wendland's |∇W| = |gradK|(1 − q)³ r vanishes as r → 0, so pairDelta's tie-break
+/// direction alone (1e-6 R long) gives a coincident pair a direction without a
+/// magnitude: dfsph's solves and wcsph's pressure force keep the peak |∇W| for pairs
+/// closer than R/4 (constants.hpp, kFlatGradientQ). Before that, wcsph's pairs stayed
+/// at 0 dx after 1 s and this test asserted the defect as it was.
 void overlapSeparates(const std::string& solver) {
   SceneDef s = tank(solver, 1, 1, 0.04);
   s.gravity = Vec2d(0, 0);
@@ -101,8 +99,7 @@ void overlapSeparates(const std::string& solver) {
   CHECK(test::allFiniteState(w));
   CHECK(outside(w, 1, 1) == 0);
   CHECK(d.maxError < 0.05);
-  if (solver == "wcsph") CHECK(d1 < 1e-6 * s.solver.spacing);  // the known defect above
-  else CHECK(d1 > 0.1 * s.solver.spacing);
+  CHECK(d1 > 0.1 * s.solver.spacing);
 }
 
 }  // namespace

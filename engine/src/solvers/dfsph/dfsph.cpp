@@ -183,8 +183,8 @@ class Dfsph final : public Solver {
     const Real R = c.R;
     const Real gradK = W.gradientScale;  // ∇W = gradK (1 − q)³ d
     const Real mGradK = c.mass * gradK;
-    const Real aFlat = Real(1) - kFlatQ;
-    const Real mGradFlat = mGradK * aFlat * aFlat * aFlat * (kFlatQ * R);  // m|∇W| at q = 1/4, times r/|d|
+    const Real aFlat = Real(1) - kFlatGradientQ;
+    const Real mGradFlat = mGradK * aFlat * aFlat * aFlat * (kFlatGradientQ * R);  // m|∇W| at q = 1/4, times r/|d|
     const Real self = W.value(0);
     // Below this the factor's denominator means no neighbours at all (a full
     // neighbourhood gives about (ρ0/R)²).
@@ -209,7 +209,7 @@ class Dfsph final : public Solver {
           sum += W.valueQ(q);
           // m∇W_ij = g·d; below q = 1/4, where |∇W| peaks, the solves' gradient keeps
           // its peak magnitude along d (the header's (2); docs/SOLVERS.md, issue 17).
-          const Real g = q < kFlatQ ? mGradFlat / r : mGradK * a * a * a;
+          const Real g = q < kFlatGradientQ ? mGradFlat / r : mGradK * a * a * a;
           const Real gxk = g * dx, gyk = g * dy;
           Gi[k] = Pair{j, gxk, gyk};
           gx += gxk;
@@ -451,7 +451,6 @@ class Dfsph final : public Solver {
   Real cfl_;                             ///< dt ≤ cfl_·R/v_max
   static constexpr int kChebDelay = 5;   ///< plain iterations before the acceleration starts
   static constexpr Real kPressureCfl = Real(0.35);  ///< dt ≤ kPressureCfl·R/sqrt(|g| D), D the greatest depth
-  static constexpr Real kFlatQ = Real(0.25);        ///< below q = r/R = 1/4 the solves' |∇W| keeps its peak value
   static constexpr Real kKneeDensity = Real(1.1);   ///< beyond ρ = 1.1 ρ0 the Jacobi step shrinks as 1.1 ρ0/ρ
   static constexpr Real kPushoutSpeed = Real(3);    ///< [m/s] existing compression is removed at most this fast
   std::vector<Vec2> vPrev_;              ///< velocity before the last iteration (Chebyshev)

@@ -146,6 +146,8 @@ class Wcsph final : public Solver {
     // ∇W = gradK (1 − q)³ d, with the pressure term renormalised by the lattice
     // gradient moment (kernels.hpp) so a hydrostatic column gets ρ g per metre.
     const Real gradK = W.gradientScale;
+    const Real aFlat = Real(1) - kFlatGradientQ;
+    const Real gradFlat = gradK * aFlat * aFlat * aFlat * (kFlatGradientQ * R);  // |∇W| at its peak, times r/|d|
     const Real pScale = Real(1.0 / latticeGradientMoment(WendlandC2<double>(double(c.R)), double(c.dx), double(c.mass / c.rho0)));
     const Real avK = alpha_ * c0_;  // Π = −α c μ / ρ̄ with μ = h v·x / (r² + 0.01h²)
     const Real eta2 = Real(0.01) * h * h;
@@ -165,9 +167,12 @@ class Wcsph final : public Solver {
           const std::uint32_t j = nb[k];
           Real dx, dy, r2;
           pairDelta(c, i, j, dx, dy, r2);
-          const Real q = std::sqrt(r2) * W.invR;
+          const Real r = std::sqrt(r2);
+          const Real q = r * W.invR;
           const Real a = Real(1) - q;
-          const Real g = gradK * a * a * a;  // ∇W = g·d
+          // ∇W = g·d; closer than R/4 it keeps its peak magnitude along d, so a stacked or
+          // coincident pair pushes apart (constants.hpp, kFlatGradientQ).
+          const Real g = q < kFlatGradientQ ? gradFlat / r : gradK * a * a * a;
           // Pressure: −m (p_i/ρ_i² + p_j/ρ_j²) ∇W.
           Real coef = -c.mass * pScale * (pri + POR2[j]);
           // Artificial viscosity for approaching pairs.
