@@ -276,6 +276,8 @@ int cmdBenchGame(const std::vector<std::string>& args) {
     else if (a == "--csv") csvPath = value();
     else throw UsageError("unknown option '" + a + "' (see sph2d bench game --help)");
   }
+  if (peer.find('\'') != std::string::npos)  // it goes into a shell command between single quotes
+    throw UsageError("--peer " + peer + ": a path with a single quote is not accepted");
   if (!peer.empty() && ::access(peer.c_str(), X_OK) != 0)
     throw UsageError("--peer " + peer + ": not an executable (build it with ../shared/peers/liquidfun/build.sh)");
   const std::string assets = assetsPath;

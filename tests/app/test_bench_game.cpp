@@ -1,0 +1,73 @@
+// `sph2d bench game`: the game-end benchmark's smoke test. A tiny dam break for a
+// quarter of a simulated second: it asserts the CSV's columns, that every figure
+// is a measured fraction in its range, and that one and two threads give the
+// same physics (the bits are the same: only the wall time may differ). Never a
+// timing: timings belong to the benchmark itself (docs/PERFORMANCE.md).
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <sstream>
+#include <vector>
+
+#include "app_util.hpp"
+
+using namespace sph2d::apptest;
+
+namespace {
+std::vector<std::vector<std::string>> rows(const std::string& csv, std::string& header) {
+  std::istringstream in(csv);
+  std::getline(in, header);
+  std::vector<std::vector<std::string>> out;
+  std::string line;
+  while (std::getline(in, line)) {
+    std::vector<std::string> f;
+    std::stringstream ls(line);
+    std::string cell;
+    while (std::getline(ls, cell, ',')) f.push_back(cell);
+    out.push_back(f);
+  }
+  return out;
+}
+}  // namespace
+
+TEST_CASE("bench game writes one row per preset and thread count, fractions in range, the same physics on 1 and 2 threads") {
+  const std::string dir = freshDir("bench_game");
+  const std::string csvPath = dir + "/game.csv";
+  const Result r = run("bench game --particles 600 --seconds 0.25 --presets game,accurate --threads 1,2 --assets " +
+                       q(std::string(SPH2D_ASSETS)) + " --csv " + q(csvPath));
+  INFO(r.out);
+  REQUIRE(r.code == 0);
+  std::string header;
+  const auto rs = rows(readText(csvPath), header);
+  CHECK(header ==
+        "name,particles,threads,wall_s_per_sim_s,ratio_to_peer,substeps_per_frame,iterations_per_frame,mean_compression,"
+        "max_compression,energy_gain,surge_rms,outside,end_compression,end_surface_m");
+  REQUIRE(rs.size() == 4);
+  for (const auto& f : rs) {
+    REQUIRE(f.size() == 14);
+    CHECK((f[0] == "sph2d_game" || f[0] == "sph2d_accurate"));
+    CHECK(std::stoul(f[1]) > 400);
+    CHECK(std::stod(f[3]) > 0);             // wall seconds per simulated second: measured
+    CHECK(std::stod(f[5]) >= 1);            // at least one substep a frame
+    const double mean = std::stod(f[7]), mx = std::stod(f[8]);
+    CHECK(mean >= 0);
+    CHECK(mean < 0.05);                     // a fraction, not percent
+    CHECK(mx >= mean);
+    CHECK(mx < 0.5);
+    CHECK(std::stod(f[9]) >= 0);            // energy gain: a fraction of the initial energy
+    CHECK(std::isfinite(std::stod(f[10])));  // surge RMS against Martin & Moyce
+    CHECK(std::stod(f[11]) == 0);           // nothing outside the tank
+  }
+  // Rows come per preset, thread counts in order: the physics columns agree.
+  for (std::size_t k = 0; k < rs.size(); k += 2)
+    for (std::size_t c : {5u, 6u, 7u, 8u, 9u, 10u, 12u, 13u}) CHECK(rs[k][c] == rs[k + 1][c]);
+}
+
+TEST_CASE("bench game refuses a peer that is not an executable, and less than one frame") {
+  const Result p = run("bench game --particles 600 --seconds 0.25 --presets game --threads 1 --peer /nonexistent/lf_dam_break");
+  CHECK(p.code == 2);
+  CHECK(p.out.find("--peer /nonexistent/lf_dam_break") != std::string::npos);
+  const Result s = run("bench game --particles 600 --seconds 0.001");
+  CHECK(s.code == 2);
+  CHECK(s.out.find("--seconds") != std::string::npos);
+}
