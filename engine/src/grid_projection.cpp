@@ -141,46 +141,28 @@ void GridProjection::transferToGrid(const StepContext& c) {
   const Particles& P = c.P;
   const Real rho0 = c.rho0;
   const int nu = nx_ + 1;
+  // Adds the bilinear weights at (fx, fy), in the units of a field `stride` wide, to
+  // `weight`, and `value` times them to `sum` when given (fx, fy ≥ 0: the grid has a
+  // margin, so truncation is floor).
+  auto splat = [](Real* sum, std::vector<Real>& weight, int stride, Real fx, Real fy, Real value) {
+    const int i0 = int(fx), j0 = int(fy);
+    const Real tx = fx - Real(i0), ty = fy - Real(j0);
+    const Real wq[4] = {(1 - tx) * (1 - ty), tx * (1 - ty), (1 - tx) * ty, tx * ty};
+    const std::size_t k = std::size_t(j0) * std::size_t(stride) + std::size_t(i0);
+    const std::size_t ks[4] = {k, k + 1, k + std::size_t(stride), k + std::size_t(stride) + 1};
+    for (int q = 0; q < 4; ++q) {
+      if (sum) sum[ks[q]] += wq[q] * value;
+      weight[ks[q]] += wq[q];
+    }
+  };
+  // The cells' compression is read only by the compression source (rate > 0).
+  Real* comp = rate_ > 0 ? comp_.data() : nullptr;
   // Serial, in slot order: the same sums for any thread count.
   for (std::size_t p = 0; p < P.size(); ++p) {
     const Real px = P.x[p].x() * invH_ - Real(I0_), py = P.x[p].y() * invH_ - Real(J0_);
-    const Real comp = P.rho[p] / rho0 - Real(1);
-    {  // cell centres
-      const Real fx = px - Real(0.5), fy = py - Real(0.5);
-      const int i0 = int(fx), j0 = int(fy);  // fx, fy ≥ 0 (the grid has a margin): truncation is floor
-      const Real tx = fx - Real(i0), ty = fy - Real(j0);
-      const Real wq[4] = {(1 - tx) * (1 - ty), tx * (1 - ty), (1 - tx) * ty, tx * ty};
-      const std::size_t k = std::size_t(j0) * nx_ + i0;
-      const std::size_t ks[4] = {k, k + 1, k + nx_, k + nx_ + 1};
-      for (int q = 0; q < 4; ++q) {
-        w_[ks[q]] += wq[q];
-        comp_[ks[q]] += wq[q] * comp;
-      }
-    }
-    {  // u faces at (i, j + 1/2)
-      const Real fx = px, fy = py - Real(0.5);
-      const int i0 = int(fx), j0 = int(fy);  // fx, fy ≥ 0 (the grid has a margin): truncation is floor
-      const Real tx = fx - Real(i0), ty = fy - Real(j0);
-      const Real wq[4] = {(1 - tx) * (1 - ty), tx * (1 - ty), (1 - tx) * ty, tx * ty};
-      const std::size_t k = std::size_t(j0) * nu + i0;
-      const std::size_t ks[4] = {k, k + 1, k + nu, k + nu + 1};
-      for (int q = 0; q < 4; ++q) {
-        u_[ks[q]] += wq[q] * P.v[p].x();
-        uw_[ks[q]] += wq[q];
-      }
-    }
-    {  // v faces at (i + 1/2, j)
-      const Real fx = px - Real(0.5), fy = py;
-      const int i0 = int(fx), j0 = int(fy);  // fx, fy ≥ 0 (the grid has a margin): truncation is floor
-      const Real tx = fx - Real(i0), ty = fy - Real(j0);
-      const Real wq[4] = {(1 - tx) * (1 - ty), tx * (1 - ty), (1 - tx) * ty, tx * ty};
-      const std::size_t k = std::size_t(j0) * nx_ + i0;
-      const std::size_t ks[4] = {k, k + 1, k + nx_, k + nx_ + 1};
-      for (int q = 0; q < 4; ++q) {
-        v_[ks[q]] += wq[q] * P.v[p].y();
-        vw_[ks[q]] += wq[q];
-      }
-    }
+    splat(comp, w_, nx_, px - Real(0.5), py - Real(0.5), P.rho[p] / rho0 - Real(1));  // cell centres
+    splat(u_.data(), uw_, nu, px, py - Real(0.5), P.v[p].x());                       // u faces at (i, j + 1/2)
+    splat(v_.data(), vw_, nx_, px - Real(0.5), py, P.v[p].y());                      // v faces at (i + 1/2, j)
   }
   for (std::size_t k = 0; k < u_.size(); ++k)
     if (uw_[k] > 0) u_[k] /= uw_[k];
@@ -319,7 +301,8 @@ void GridProjection::solve(const StepContext& c) {
   stats_.fluidCells = int(m);
   if (m == 0) return;
   rhs_.assign(m, 0);
-  std::vector<Real> x(m, 0);
+  std::vector<Real>& x = x_;  // the unknowns, in cell order (kept: no allocation in the step)
+  x.assign(m, 0);
   // Warm start from the last substep's κ of the same anchored cells (none when the cells
   // grew to hold spray: the same index is then another place).
   const bool sameCells = h_ == pH_;

@@ -82,7 +82,7 @@ class GridProjection {
   std::vector<Real> u_, uw_, v_, vw_;       ///< face velocities and weights
   std::vector<Real> du_, dv_;               ///< face velocity changes
   std::vector<Real> uNew_, vNew_;           ///< projected face velocities (for the PIC share)
-  std::vector<Real> kappa_, rhs_, r_, z_, d_, q_, diag_;
+  std::vector<Real> kappa_, rhs_, x_, r_, z_, d_, q_, diag_;
   std::vector<std::int32_t> index_;         ///< cell → unknown (−1: none)
   std::vector<std::int32_t> cells_;         ///< unknown → cell
   std::vector<std::int32_t> adj_;           ///< per unknown: left, right, down, up unknown (−1: none)
