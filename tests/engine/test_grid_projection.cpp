@@ -19,9 +19,7 @@ using test::boxShape;
 
 TEST_CASE("grid projection: a resting 2 m x 1 m tank reports a hydrostatic pressure, and stays at rest beside the walls") {
   SceneDef s = test::wallScene(0.025, "game");
-  BodyDef b;
-  b.fixtures = {boxShape({1, -0.2}, {1.4, 0.2}), boxShape({-0.2, 0.8}, {0.2, 1.0}), boxShape({2.2, 0.8}, {0.2, 1.0})};
-  s.bodies.push_back(b);
+  s.bodies.push_back(test::tankWalls(2, 1.6));
   FluidBlockDef blk;
   blk.min = Vec2d(0, 0);
   blk.max = Vec2d(2, 1);
@@ -61,8 +59,7 @@ TEST_CASE("grid projection: a wall the game replaces (same body, a new fixture i
   // gate had never been there: the grid's solid cells and closed faces are read again.
   auto build = [](bool gate) {
     SceneDef s = test::wallScene(0.025, "game");
-    BodyDef b;
-    b.fixtures = {boxShape({1, -0.2}, {1.4, 0.2}), boxShape({-0.2, 0.8}, {0.2, 1.0}), boxShape({2.2, 0.8}, {0.2, 1.0})};
+    BodyDef b = test::tankWalls(2, 1.6);
     if (gate) b.fixtures.push_back(boxShape({0.55, 0.5}, {0.05, 0.5}));
     s.bodies.push_back(b);
     FluidBlockDef blk;
@@ -89,7 +86,7 @@ TEST_CASE("grid projection: a wall the game replaces (same body, a new fixture i
   const void* old = gate;
   body->DestroyFixture(gate);
   b2PolygonShape small;
-  small.SetAsBox(0.05f, 0.05f, b2Vec2(1.0f, -0.3f), 0);  // inside the floor: no effect on the water
+  small.SetAsBox(0.05f, 0.05f, b2Vec2(1.0f, -0.1f), 0);  // inside the floor: no effect on the water
   const b2Fixture* replaced = body->CreateFixture(&small, 0);
   gated.refreshBoundaries();
   // A 0.8 m column released at x = 0.5 m: its front moves at ~2 sqrt(g h) ≈ 5.6 m/s, so a
