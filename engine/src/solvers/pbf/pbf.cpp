@@ -134,19 +134,27 @@ std::size_t Pbf::solve(StepContext& c) {
       const std::size_t bad = constraint(c, lambda);
       if (bad != kNone) return bad;
     }
+    const Real limit = c.rho0 * (Real(1) + thr);
     for (; local < localIterations_ && maxCompression_ > toleranceMax_; ++local) {
-      // Active: compressed above half the tolerance, or next to such a particle.
-      c.pool.parallelFor(n, kBlock, [&](std::size_t b, std::size_t e) {
-        for (std::size_t i = b; i < e; ++i) {
-          bool on = c.P.rho[i] > c.rho0 * (Real(1) + thr);
-          const std::uint32_t* nb = c.nbr.of(i);
-          for (std::uint32_t k = 0; k < c.nbr.count[i] && !on; ++k) on = c.P.rho[nb[k]] > c.rho0 * (Real(1) + thr);
-          active_[i] = on;
-        }
-      });
-      activeList_.clear();
-      for (std::size_t i = 0; i < n; ++i)
-        if (active_[i]) activeList_.push_back(std::uint32_t(i));
+      // Active: compressed above half the tolerance, or next to such a particle. The
+      // first time every ρ is fresh and all particles are looked at; later only the
+      // last list's ρ changed, and every particle off that list stayed at or below
+      // the threshold, so the compressed ones are on it: they and their neighbours
+      // (the lists are symmetric) are the new active set, the same set a full scan
+      // finds.
+      if (local == 0) {
+        c.pool.parallelFor(n, kBlock, [&](std::size_t b, std::size_t e) {
+          for (std::size_t i = b; i < e; ++i) {
+            bool on = c.P.rho[i] > limit;
+            const std::uint32_t* nb = c.nbr.of(i);
+            for (std::uint32_t k = 0; k < c.nbr.count[i] && !on; ++k) on = c.P.rho[nb[k]] > limit;
+            active_[i] = on;
+          }
+        });
+      } else {
+        markNeighbourhood(c, activeList_, &limit, active_);
+      }
+      listMarked(active_, activeList_);
       for (std::size_t i = 0; i < n; ++i)  // only the listed particles take their step of the last pass
         if (!active_[i]) dLambda_[i] = 0;
       std::size_t bad = correct(c, lambda, Real(1), &activeList_);
@@ -158,17 +166,8 @@ std::size_t Pbf::solve(StepContext& c) {
   if (local > 0) {
     // The local iterations moved the listed particles: the density of those and of
     // their neighbours is summed again (the rest kept ρ and W of the last full pass).
-    c.pool.parallelFor(n, kBlock, [&](std::size_t b, std::size_t e) {
-      for (std::size_t i = b; i < e; ++i) {
-        bool on = active_[i] != 0;
-        const std::uint32_t* nb = c.nbr.of(i);
-        for (std::uint32_t k = 0; k < c.nbr.count[i] && !on; ++k) on = active_[nb[k]] != 0;
-        halo_[i] = on;
-      }
-    });
-    activeList_.clear();
-    for (std::size_t i = 0; i < n; ++i)
-      if (halo_[i]) activeList_.push_back(std::uint32_t(i));
+    markNeighbourhood(c, activeList_, nullptr, halo_);
+    listMarked(halo_, activeList_);
     const std::size_t bad = constraint(c, lambda, &activeList_);
     if (bad != kNone) return bad;
     rhoCurrent_ = true;  // every ρ (and W) is that of the current positions again
@@ -188,6 +187,25 @@ std::size_t Pbf::solve(StepContext& c) {
     }
   }
   return kNone;
+}
+
+void Pbf::markNeighbourhood(const StepContext& c, const std::vector<std::uint32_t>& list, const Real* limit,
+                            std::vector<std::uint8_t>& marks) {
+  // Serial over the list (a local iteration's few particles): marks are only set,
+  // so the result does not depend on the order.
+  std::fill(marks.begin(), marks.end(), std::uint8_t(0));
+  for (const std::uint32_t i : list) {
+    if (limit && !(c.P.rho[i] > *limit)) continue;
+    marks[i] = 1;
+    const std::uint32_t* nb = c.nbr.of(i);
+    for (std::uint32_t k = 0; k < c.nbr.count[i]; ++k) marks[nb[k]] = 1;
+  }
+}
+
+void Pbf::listMarked(const std::vector<std::uint8_t>& marks, std::vector<std::uint32_t>& list) {
+  list.clear();
+  for (std::size_t i = 0; i < marks.size(); ++i)
+    if (marks[i]) list.push_back(std::uint32_t(i));
 }
 
 void Pbf::calibrate(const StepContext& c) {

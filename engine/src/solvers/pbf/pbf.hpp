@@ -163,6 +163,12 @@ class Pbf final : public Solver {
   Real quantile_, moveCap_;
   int localIterations_;
   bool resolveEach_;
+  /// Sets marks[i] for every particle of `list` (only those with ρ > *limit when
+  /// given) and for their neighbours; clears the rest.
+  static void markNeighbourhood(const StepContext& c, const std::vector<std::uint32_t>& list, const Real* limit,
+                                std::vector<std::uint8_t>& marks);
+  /// The marked slots, in slot order.
+  static void listMarked(const std::vector<std::uint8_t>& marks, std::vector<std::uint32_t>& list);
   std::vector<std::uint8_t> active_;
   std::vector<std::uint32_t> activeList_;
   std::vector<std::uint8_t> halo_;
