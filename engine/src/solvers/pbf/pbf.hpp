@@ -189,6 +189,7 @@ class Pbf final : public Solver {
   struct Grad {
     Real x, y;
   };
+  static_assert(sizeof(Grad) == 2 * sizeof(Real), "a Grad is two packed reals (the constraint stores four pairs at a time)");
   std::vector<std::vector<Grad>> gradCache_;  ///< per pair G_ij = (m/ρ0)∇W_ij of the last constraint pass
   std::vector<Vec2> xNew_, vNew_, xOld_;
 };

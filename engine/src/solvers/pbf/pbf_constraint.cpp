@@ -42,6 +42,11 @@ struct Lane4 {
   }
   /// Bit l set where lane l of a < b.
   static int less(Lane4 a, Lane4 b) { return _mm_movemask_ps(_mm_cmplt_ps(a.v, b.v)); }
+  /// p[0..7] = x0, y0, x1, y1, x2, y2, x3, y3.
+  static void storeInterleaved(float* p, Lane4 x, Lane4 y) {
+    _mm_storeu_ps(p, _mm_unpacklo_ps(x.v, y.v));
+    _mm_storeu_ps(p + 4, _mm_unpackhi_ps(x.v, y.v));
+  }
   /// The x and y of X[j[0..3]] (pairs of floats), one 64-bit load each.
   static void gatherXY(const float* xy, const std::uint32_t* j, Lane4& xs, Lane4& ys) {
     const __m128 a = _mm_loadh_pi(_mm_castpd_ps(_mm_load_sd(reinterpret_cast<const double*>(xy + 2 * std::size_t(j[0])))),
@@ -72,6 +77,12 @@ struct Lane4 {
   }
   static int less(Lane4 a, Lane4 b) {
     return (a.v[0] < b.v[0]) | ((a.v[1] < b.v[1]) << 1) | ((a.v[2] < b.v[2]) << 2) | ((a.v[3] < b.v[3]) << 3);
+  }
+  static void storeInterleaved(float* p, Lane4 x, Lane4 y) {
+    for (int l = 0; l < 4; ++l) {
+      p[2 * l] = x.v[l];
+      p[2 * l + 1] = y.v[l];
+    }
   }
   static void gatherXY(const float* xy, const std::uint32_t* j, Lane4& xs, Lane4& ys) {
     for (int l = 0; l < 4; ++l) {
@@ -190,13 +201,21 @@ std::size_t Pbf::constraint(StepContext& c, const std::vector<Real>& lambda, con
         const Lane4 a = Lane4::max(one - r * vInvR, zero);
         const Lane4 g = a * a / r;
         const Lane4 gxv = vVg * g * dxv, gyv = vVg * g * dyv;
-        gxv.store(gx4);
-        gyv.store(gy4);
         const Lane4 a3 = a * a * a;
-        a3.store(w4);
-        for (std::uint32_t l = 0; l < valid; ++l) {  // only i's own entries (a local pass runs particles in any order)
-          gc[k + l] = Grad{gx4[l], gy4[l]};
-          wc[k + l] = w4[l];
+        if (!list) {
+          // A full pass runs a block's particles in slot order: lanes past i's list
+          // land on the next particle's entries (or the block's padding), which that
+          // particle writes afterwards.
+          Lane4::storeInterleaved(reinterpret_cast<float*>(gc + k), gxv, gyv);
+          a3.store(wc + k);
+        } else {  // only i's own entries (a local pass runs particles in any order)
+          gxv.store(gx4);
+          gyv.store(gy4);
+          a3.store(w4);
+          for (std::uint32_t l = 0; l < valid; ++l) {
+            gc[k + l] = Grad{gx4[l], gy4[l]};
+            wc[k + l] = w4[l];
+          }
         }
         sw = sw + a3;
         sx = sx + gxv;
