@@ -29,37 +29,55 @@ double uniform(std::uint64_t& state) { return double(splitmix(state) >> 11) * (1
 /// ρ = ρ0(1 + f g z) with the solver's factor f (2/c² for muller2003, whose
 /// symmetric force recovers ∇p/2; 1/c0² for wcsph). Started uncompressed, a
 /// column would ring in its acoustic mode with a speed amplitude of about g·H/c.
-/// `keep` (optional) selects lattice points by world position (addDrop's disc).
-std::size_t World::Impl::fillBlock(const FluidBlockDef& b, bool hydrostaticStart,
-                                   const std::function<bool(const Vec2d&)>& keep) {
+/// `disc` (optional) keeps only the lattice points within a radius (addDrop).
+/// The particle budget holds: once the world holds `budget` particles the rest of
+/// the block is refused with one warning, and no work or memory grows with the
+/// block's size beyond the particles added (rows are computed as they are
+/// filled, a drop's rows only over its chord).
+std::size_t World::Impl::fillBlock(const FluidBlockDef& b, bool hydrostaticStart, const Disc* disc) {
   const SolverDef& sd = scene.solver;
   const double hydroFactor = solver->hydrostaticFactor();
   const bool hydrostatic = hydrostaticStart && hydroFactor > 0 && scene.gravity.x() == 0 && scene.gravity.y() < 0;
   const double gz = -scene.gravity.y();
   const Real rho0 = Real(sd.restDensity);
-  const long nx = long(std::floor((b.max.x() - b.min.x()) / sd.spacing + 1e-9));
-  const long ny = long(std::floor((b.max.y() - b.min.y()) / sd.spacing + 1e-9));
-  std::vector<double> rowY(std::size_t(std::max(ny, 0L)));
-  double prevScale = 1;
-  for (long j = 0; j < ny; ++j) {
+  const double nxd = std::floor((b.max.x() - b.min.x()) / sd.spacing + 1e-9);
+  const double nyd = std::floor((b.max.y() - b.min.y()) / sd.spacing + 1e-9);
+  if (!(nxd >= 1 && nyd >= 1)) return 0;  // empty (or NaN)
+  // Lattice indices stay far inside a long: a block wider than 2^52 spacings is cut there
+  // (it could never be filled within a budget anyway).
+  const double cap = 4503599627370496.0;
+  const long nx = long(std::min(nxd, cap)), ny = long(std::min(nyd, cap));
+  std::size_t added = 0, dropped = 0;
+  bool refused = false;
+  Vec2d dlo(0, 0), dhi(0, 0);
+  double y = 0, prevScale = 1;
+  for (long j = 0; j < ny && !refused; ++j) {
     const double depth = (double(ny - j) - 0.5) * sd.spacing;
     const double scale = hydrostatic ? 1.0 / (1.0 + hydroFactor * gz * depth) : 1.0;
-    rowY[std::size_t(j)] = j == 0 ? b.min.y() + 0.5 * sd.spacing * scale
-                                  : rowY[std::size_t(j - 1)] + 0.5 * sd.spacing * (prevScale + scale);
+    y = j == 0 ? b.min.y() + 0.5 * sd.spacing * scale : y + 0.5 * sd.spacing * (prevScale + scale);
     prevScale = scale;
-  }
-  std::size_t added = 0, dropped = 0;
-  Vec2d dlo(0, 0), dhi(0, 0);
-  for (long j = 0; j < ny; ++j)
-    for (long i = 0; i < nx; ++i) {
-      const Vec2d pw(b.min.x() + (double(i) + 0.5) * sd.spacing, rowY[std::size_t(j)]);
-      if (keep && !keep(pw)) continue;
+    long i0 = 0, i1 = nx;  // the row's lattice points [i0, i1)
+    if (disc) {
+      const double dy = y - disc->center.y(), r2 = disc->radius * disc->radius;
+      if (dy * dy > r2) continue;
+      // The chord, one spacing wider each side; the exact test below decides.
+      const double half = std::sqrt(r2 - dy * dy) + sd.spacing;
+      i0 = long(std::max(0.0, std::floor((disc->center.x() - half - b.min.x()) / sd.spacing - 0.5)));
+      i1 = long(std::min(double(nx), std::ceil((disc->center.x() + half - b.min.x()) / sd.spacing + 0.5)));
+    }
+    for (long i = i0; i < i1; ++i) {
+      const Vec2d pw(b.min.x() + (double(i) + 0.5) * sd.spacing, y);
+      if (disc && !((pw - disc->center).squaredNorm() <= disc->radius * disc->radius)) continue;
       const Vec2 p = Vec2(Real(pw.x() - origin.x()), Real(pw.y() - origin.y()));
       if (boundary.insideDepth(p) > 0) {
         dlo = dropped ? dlo.cwiseMin(pw) : pw;
         dhi = dropped ? dhi.cwiseMax(pw) : pw;
         ++dropped;
         continue;
+      }
+      if (P.size() >= budget) {
+        refused = true;
+        break;
       }
       Vec2d vel = b.velocity;
       if (b.field.type == VelocityFieldDef::Type::TaylorGreen) {
@@ -70,13 +88,25 @@ std::size_t World::Impl::fillBlock(const FluidBlockDef& b, bool hydrostaticStart
       P.push(p, Vec2(Real(vel.x()), Real(vel.y())), nextId++, rho0);
       ++added;
     }
+  }
   if (dropped) {
     std::ostringstream o;
     o << "dropped " << dropped << " particles that the scene placed inside solids, in the box [" << dlo.x() << ", "
       << dlo.y() << "] – [" << dhi.x() << ", " << dhi.y() << "]";
     warnings.push_back(o.str());
   }
+  if (refused) {
+    const double lattice = disc ? 3.14159265358979323846 * disc->radius * disc->radius / (sd.spacing * sd.spacing) : nxd * nyd;
+    std::ostringstream o;
+    o << "particle budget of " << budget << " (" << budgetKey() << ") reached: added " << added << " of the " << (disc ? "drop" : "block") << "'s about " << lattice
+      << " and refused the rest (raise " << budgetKey() << " or add less)";
+    warnings.push_back(o.str());
+  }
   return added;
+}
+
+const char* World::Impl::budgetKey() const {
+  return scene.effects.budget > 0 ? "effects.budget.max_particles" : "max_particles";
 }
 
 void World::Impl::removeFlagged() { removed += P.compact(dead); }

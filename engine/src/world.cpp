@@ -151,7 +151,8 @@ std::size_t World::addDrop(const Vec2d& center, double radius, const Vec2d& velo
   b.min = center - Vec2d(half, half);
   b.max = center + Vec2d(half + 0.5 * dx, half + 0.5 * dx);
   b.velocity = velocity;
-  return impl_->fillBlock(b, false, [&](const Vec2d& p) { return (p - center).squaredNorm() <= radius * radius; });
+  const Impl::Disc disc{center, radius};
+  return impl_->fillBlock(b, false, &disc);
 }
 
 void World::moveEmitter(std::size_t index, const Vec2d& position, const Vec2d& direction) {

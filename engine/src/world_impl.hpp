@@ -83,10 +83,17 @@ struct World::Impl {
   [[noreturn]] void fail(const std::string& stage, std::size_t slot);
 
   // particle_system.cpp
+  /// Lattice points within `radius` of `center` (world coordinates): a drop.
+  struct Disc {
+    Vec2d center;
+    double radius;
+  };
   /// Fills a block on the lattice of the spacing (hydrostaticStart: rows closer with
-  /// depth, at the density the solver holds at rest); `keep` selects lattice points.
-  std::size_t fillBlock(const FluidBlockDef& b, bool hydrostaticStart,
-                        const std::function<bool(const Vec2d&)>& keep = nullptr);
+  /// depth, at the density the solver holds at rest); `disc` keeps the points of a
+  /// drop. Stops at the particle budget (one warning for the rest).
+  std::size_t fillBlock(const FluidBlockDef& b, bool hydrostaticStart, const Disc* disc = nullptr);
+  /// The scene key that sets the particle budget.
+  const char* budgetKey() const;
   /// The emit stage: every enabled emitter's particles due by the end of the substep.
   void emit(Real dt);
   /// The lifetimes stage: ages particles and removes those older than max_age.

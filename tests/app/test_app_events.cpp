@@ -168,6 +168,29 @@ TEST_CASE("a bad event line is reported with its line number and skipped, and th
   CHECK(r.out.find("worst density error") != std::string::npos);
 }
 
+TEST_CASE("block and drop events of any size, from the timeline or a file, stop at max_particles with a warning") {
+  // Before (issue 18): a block event of ±1e6 m or a drop of radius 1e4 allocated 4–7 GB,
+  // then std::bad_alloc; with max_particles 2000 a block still added 999,400 particles.
+  const std::string dir = freshDir("budget_events");
+  std::string text = readText(kSmall);
+  const auto at = text.find("\"fps\": 60,");
+  REQUIRE(at != std::string::npos);
+  text.insert(at, "\"max_particles\": 2000, ");
+  const auto end = text.rfind('}');
+  text = text.substr(0, end) +
+         ",\n  \"events\": [{\"frame\": 1, \"type\": \"block\", \"min\": [-1e6, -1e6], \"max\": [1e6, 1e6]}]\n}\n";
+  const std::string scene = dir + "/scene.json", events = dir + "/events.jsonl";
+  std::ofstream(scene) << text;
+  std::ofstream(events) << "{\"frame\": 2, \"type\": \"drop\", \"center\": [2, 2], \"radius\": 1e4}\n";
+  const Result r = run("run " + q(scene) + " --frames 4 --threads 2 --no-images --input " + q(events));
+  INFO(r.out);
+  CHECK(r.code == 0);
+  CHECK(r.out.find("sph2d: 4 frames, 2000 particles") != std::string::npos);
+  CHECK(r.out.find("particle budget of 2000 (max_particles) reached: added 750 of the block's") != std::string::npos);
+  CHECK(r.out.find("particle budget of 2000 (max_particles) reached: added 0 of the drop's") != std::string::npos);
+  CHECK(r.out.find("2 events applied, 2 warnings") != std::string::npos);
+}
+
 TEST_CASE("bad input sources and timeline events exit 2 with a message") {
   Result r = run("run " + q(kSmall) + " --frames 2 --no-images --input /nonexistent/events.jsonl");
   CHECK(r.code == 2);

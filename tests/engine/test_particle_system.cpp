@@ -135,6 +135,61 @@ TEST_CASE("the particle budget: stop_emitting caps the count and warns once, rec
   }
 }
 
+TEST_CASE("blocks and drops of any size stop at max_particles: the rest is refused with one warning naming it") {
+  // Before: a block event of ±1e6 m or a drop of radius 1e4 allocated until the machine ran
+  // out (issue 18); with max_particles 2000 a block still added 999,400 particles.
+  SceneDef s = box();
+  s.maxParticles = 2000;
+  auto budgetWarnings = [](World& w) {
+    int n = 0;
+    for (const std::string& m : w.takeWarnings())
+      if (m.find("particle budget") != std::string::npos) {
+        ++n;
+        CHECK(m.find("budget of 2000 (max_particles)") != std::string::npos);
+      }
+    return n;
+  };
+  {
+    World w(s, WorldOptions{1});
+    FluidBlockDef huge;
+    huge.min = Vec2d(-1e6, -1e6);
+    huge.max = Vec2d(1e6, 1e6);
+    CHECK(w.addBlock(huge) == 2000);
+    CHECK(w.particleCount() == 2000);
+    CHECK(budgetWarnings(w) == 1);
+    CHECK(w.addDrop(Vec2d(1, 1), 0.2) == 0);  // full: nothing more, and it says so once
+    CHECK(w.particleCount() == 2000);
+    CHECK(budgetWarnings(w) == 1);
+  }
+  {
+    // A drop of radius 1e4 centred in the tank: filled from its lowest rows up to the
+    // budget, every particle inside the disc (and none inside the tank's walls).
+    World w(s, WorldOptions{1});
+    CHECK(w.addDrop(Vec2d(1, 1), 1e4) == 2000);
+    CHECK(budgetWarnings(w) == 1);
+    const Vec2d origin = w.origin();
+    for (std::size_t i = 0; i < w.particleCount(); ++i) {
+      const Vec2d p = Vec2d(double(w.particles().x[i].x()), double(w.particles().x[i].y())) + origin;
+      CHECK((p - Vec2d(1, 1)).norm() <= 1e4 + 0.01);  // positions are floats: 1 mm apart at 1e4 m
+    }
+  }
+  {
+    // The effects' own budget, when set, is the one named.
+    SceneDef e = s;
+    e.effects.budget = 300;
+    World w(e, WorldOptions{1});
+    FluidBlockDef b;
+    b.min = Vec2d(0.1, 0.1);
+    b.max = Vec2d(1.9, 1.9);
+    CHECK(w.addBlock(b) == 300);
+    const auto warnings = w.takeWarnings();
+    REQUIRE(warnings.size() == 1);
+    CHECK(warnings[0].find("budget of 300 (effects.budget.max_particles)") != std::string::npos);
+    for (int f = 0; f < 5; ++f) w.stepFrame();  // the capped block steps like any other
+    CHECK(test::allFiniteState(w));
+  }
+}
+
 TEST_CASE("particles a scene places inside a solid are dropped with one warning") {
   SceneDef s = test::scene("tests/resting_column.json");
   s.blocks[0].min = Vec2d(-0.1, 0.0);  // 0.1 m of the block inside the left wall

@@ -151,11 +151,14 @@ class World {
   /// Sets gravity [m/s²] from the next substep on (tilting the tank).
   void setGravity(const Vec2d& g);
   /// Adds a block of fluid on the lattice of the scene's spacing (particles
-  /// inside solids are skipped). Returns the number of particles added.
+  /// inside solids are skipped), row by row from the bottom, until the world holds
+  /// its particle budget (max_particles, or effects.budget when set): the rest is
+  /// refused with one warning (takeWarnings). Returns the number of particles added.
   std::size_t addBlock(const FluidBlockDef& block);
   /// Adds a drop of fluid: the lattice points of a block around `center` that lie
   /// within `radius` (world coordinates), moving at `velocity`; points inside
-  /// solids are skipped. Returns the number of particles added.
+  /// solids are skipped; the particle budget holds as for addBlock. Returns the
+  /// number of particles added.
   std::size_t addDrop(const Vec2d& center, double radius, const Vec2d& velocity = Vec2d(0, 0));
   /// Removes the particles inside the box [lo, hi] (world coordinates). Returns how many.
   std::size_t removeParticlesInBox(const Vec2d& lo, const Vec2d& hi);
