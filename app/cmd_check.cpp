@@ -4,6 +4,8 @@
 // is run's own GameLoop (headless), fed the events the manifest lists at their
 // frames, so a run driven by input checks like any other.
 #include <algorithm>
+#include <cctype>
+#include <cstring>
 #include <cstdlib>
 #include <cstdio>
 #include <filesystem>
@@ -39,11 +41,15 @@ const char* kCheckHelp =
     "DIR/diff_NNNNN.png (differences in red over a dimmed reference), and exits 1.\n"
     "The events the manifest lists (the run's timeline, --input files and live input)\n"
     "are applied at their frames, so runs driven by input check like any other.\n"
-    "Mesa settings the manifest recorded (GALLIUM_OVERRIDE_CPU_CAPS, ...) are used\n"
-    "unless set in this environment; a different renderer or CPU is named plainly.\n"
+    "The manifest's environment is compared with this one, never trusted: only the\n"
+    "Mesa settings sph2d itself records (GALLIUM_OVERRIDE_CPU_CAPS, LP_NUM_THREADS, ...)\n"
+    "are read, each difference is named, and --adopt-env uses the manifest's values of\n"
+    "those (where this environment does not set them); any other entry is ignored and\n"
+    "named. A different renderer or CPU is named plainly.\n"
     "\n"
     "Options:\n"
     "  --against FILE  the manifest (required)\n"
+    "  --adopt-env     render with the Mesa settings the manifest recorded (see above)\n"
     "  --out DIR       where the diff image goes (default: out/check-<scene name>)\n"
     "  --threads T     simulation threads (default: all cores; frames do not depend on it)\n"
     "  --quiet         print only the verdict\n";
@@ -152,6 +158,52 @@ class FrameCheck : public LoopObserver {
   fs::path refDir_;
 };
 
+/// One entry of a manifest's `environment`, checked: `problem` says why it is ignored.
+struct ManifestEnv {
+  std::string name, value, problem;
+};
+
+/// The manifest's environment entries. Only a name sph2d records (recordedEnvironmentNames)
+/// is accepted, with a value of at most 64 characters from [A-Za-z0-9_.,:=+-]; anything
+/// else (LD_PRELOAD, GALLIUM_TRACE, a path, a control character) gets a problem.
+std::vector<ManifestEnv> manifestEnvironment(const json& m) {
+  std::vector<ManifestEnv> out;
+  if (!m.contains("environment") || !m["environment"].is_array()) return out;
+  const std::vector<std::string> known = recordedEnvironmentNames();
+  auto printable = [](const std::string& t) {
+    std::string r;
+    for (char ch : t.substr(0, 40)) r += (ch >= 0x20 && ch < 0x7f) ? ch : '?';
+    return r + (t.size() > 40 ? "..." : "");
+  };
+  for (const json& e : m["environment"]) {
+    ManifestEnv me;
+    if (!e.is_object() || !e.contains("name") || !e["name"].is_string() || (e.contains("value") && !e["value"].is_string())) {
+      me.name = "(malformed)";
+      me.problem = "an entry is an object with a string name and value";
+      out.push_back(me);
+      continue;
+    }
+    me.name = e["name"].get<std::string>();
+    me.value = e.value("value", "");
+    const bool recorded = std::find(known.begin(), known.end(), me.name) != known.end();
+    const bool plain = me.value.size() <= 64 && std::all_of(me.value.begin(), me.value.end(), [](char ch) {
+                         return std::isalnum(static_cast<unsigned char>(ch)) || std::strchr("_.,:=+-", ch) != nullptr;
+                       });
+    if (!recorded) {
+      me.problem = "sph2d records only its renderer's settings (" + [&] {
+        std::string l;
+        for (const std::string& k : known) l += (l.empty() ? "" : ", ") + k;
+        return l;
+      }() + ")";
+      me.name = printable(me.name);
+    } else if (!plain) {
+      me.problem = "its value is not a plain setting (at most 64 of A-Z a-z 0-9 _ . , : = + -)";
+    }
+    out.push_back(me);
+  }
+  return out;
+}
+
 /// The events the manifest's run applied, at their frames (a manifest without an event
 /// list: the scene's own timeline).
 void addManifestEvents(EventIntake& input, const json& m, const std::string& manifestPath, const SceneDef& scene) {
@@ -178,7 +230,7 @@ void addManifestEvents(EventIntake& input, const json& m, const std::string& man
 int cmdCheck(const std::vector<std::string>& args) {
   std::string scenePath, manifestPath, out;
   int threads = 0;
-  bool quiet = false;
+  bool quiet = false, adoptEnv = false;
   for (std::size_t i = 0; i < args.size(); ++i) {
     const std::string& s = args[i];
     auto value = [&]() -> std::string {
@@ -193,6 +245,7 @@ int cmdCheck(const std::vector<std::string>& args) {
     else if (s == "--out") out = value();
     else if (s == "--threads") threads = parseInt(s, value(), 1, 256);
     else if (s == "--quiet") quiet = true;
+    else if (s == "--adopt-env") adoptEnv = true;
     else if (!s.empty() && s[0] == '-') throw UsageError("unknown option '" + s + "' (see sph2d check --help)");
     else if (scenePath.empty()) scenePath = s;
     else throw UsageError("unexpected argument '" + s + "'");
@@ -219,16 +272,19 @@ int cmdCheck(const std::vector<std::string>& args) {
     std::printf("note: the manifest's run stopped early (%s: %s); checking the %zu frames it lists\n",
                 m["stop"].value("reason", "?").c_str(), m["stop"].value("message", "").c_str(), mv.expected.size());
 
-  // Rerun as the manifest's run rendered: adopt the Mesa settings it recorded (e.g. a pinned
-  // GALLIUM_OVERRIDE_CPU_CAPS) unless this environment sets them itself.
-  if (m.contains("environment") && m["environment"].is_array())
-    for (const json& e : m["environment"]) {
-      const std::string name = e.value("name", ""), value = e.value("value", "");
-      if (name.empty() || value.empty() || std::getenv(name.c_str())) continue;
-      setenv(name.c_str(), value.c_str(), 0);
-      if (!quiet && e.value("source", "") == "user")
-        std::printf("note: using %s=%s as the manifest's run did\n", name.c_str(), value.c_str());
+  // The manifest's environment is input from elsewhere: only the variables sph2d records for
+  // the renderer's identity are looked at, with plain values; with --adopt-env those are
+  // used where this environment does not set them. Nothing else is ever set.
+  const std::vector<ManifestEnv> env = manifestEnvironment(m);
+  for (const ManifestEnv& e : env) {
+    if (!e.problem.empty()) {
+      std::printf("note: the manifest's environment entry %s is ignored: %s\n", e.name.c_str(), e.problem.c_str());
+      continue;
     }
+    if (!adoptEnv || e.value.empty() || std::getenv(e.name.c_str())) continue;
+    setenv(e.name.c_str(), e.value.c_str(), 0);
+    if (!quiet) std::printf("note: using %s=%s as the manifest's run did (--adopt-env)\n", e.name.c_str(), e.value.c_str());
+  }
   EventIntake input(scene, [](const std::string&) {});
   addManifestEvents(input, m, manifestPath, scene);
   World world(scene, WorldOptions{threads});
@@ -242,15 +298,13 @@ int cmdCheck(const std::vector<std::string>& args) {
   const std::string cpu = cpuSummary();
   if (!mv.cpu.empty() && cpu != mv.cpu)
     std::printf("note: this CPU is \"%s\"; the manifest's was \"%s\"\n", cpu.c_str(), mv.cpu.c_str());
-  if (m.contains("environment") && m["environment"].is_array()) {
+  {
     std::map<std::string, std::string> now;
     for (const EnvSetting& e : pinRenderEnvironment()) now[e.name] = e.value;
-    for (const json& e : m["environment"]) {
-      const std::string name = e.value("name", ""), value = e.value("value", "");
-      if (now.count(name) && now[name] != value)
-        std::printf("note: %s is \"%s\" here but was \"%s\" for the manifest\n", name.c_str(), now[name].c_str(),
-                    value.c_str());
-    }
+    for (const ManifestEnv& e : env)
+      if (e.problem.empty() && now.count(e.name) && now[e.name] != e.value)
+        std::printf("note: %s is \"%s\" here but was \"%s\" for the manifest%s\n", e.name.c_str(), now[e.name].c_str(),
+                    e.value.c_str(), adoptEnv ? "" : " (--adopt-env uses the manifest's value)");
   }
   if (!quiet) std::printf("check: rerunning %s, %d frames, comparing %zu\n", scenePath.c_str(), mv.frames, mv.expected.size());
 

@@ -168,6 +168,45 @@ TEST_CASE("sph2d check: exit 0 on a match, and on a difference names the frame, 
   CHECK(run("check " + q(kSmall) + " --against " + q(dir + "/nope.json")).code == 2);
 }
 
+TEST_CASE("sph2d check never takes a variable from a manifest that sph2d does not record, and adopts its own only with --adopt-env") {
+  // Before (issue 18): every entry was set with setenv; GALLIUM_TRACE=victim.txt overwrote
+  // that file with Mesa trace XML and check hung; LD_PRELOAD and the like were adopted.
+  const std::string dir = freshDir("check_env"), out = freshDir("check_env_out");
+  REQUIRE(run("run " + q(kSmall) + " --frames 3 --every 2 --quiet --out " + q(dir)).code == 0);
+  const std::string victim = dir + "/victim.txt";
+  std::ofstream(victim) << "keep me\n";
+  json m = readManifest(dir);
+  m["environment"].push_back({{"name", "GALLIUM_TRACE"}, {"value", victim}, {"source", "user"}});
+  m["environment"].push_back({{"name", "LD_PRELOAD"}, {"value", dir + "/evil.so"}, {"source", "user"}});
+  m["environment"].push_back({{"name", "LP_DEBUG"}, {"value", "$(touch " + dir + "/owned)"}, {"source", "user"}});
+  m["environment"].push_back({{"name", 42}, {"value", "x"}});
+  for (json& e : m["environment"])
+    if (e["name"] == "LP_PERF") e = {{"name", "LP_PERF"}, {"value", "no_mipmap"}, {"source", "user"}};
+  std::ofstream(dir + "/manifest.json") << m.dump(1);
+  for (const std::string flag : {"", " --adopt-env"}) {
+    const Result r = run("check " + q(kSmall) + " --against " + q(dir + "/manifest.json") + " --out " + q(out) + flag);
+    INFO(flag, r.out);
+    CHECK(r.code == 0);  // the frames still match: nothing the manifest said was used to render them
+    CHECK(r.out.find("OK, 2 frames match") != std::string::npos);
+    CHECK(readText(victim) == "keep me\n");
+    CHECK_FALSE(fs::exists(dir + "/owned"));
+    CHECK(r.out.find("entry GALLIUM_TRACE is ignored: sph2d records only its renderer's settings") != std::string::npos);
+    CHECK(r.out.find("entry LD_PRELOAD is ignored") != std::string::npos);
+    CHECK(r.out.find("entry LP_DEBUG is ignored: its value is not a plain setting") != std::string::npos);
+    CHECK(r.out.find("entry (malformed) is ignored") != std::string::npos);
+    // A setting sph2d records, with a plain value: compared and named; used only with the flag.
+    if (flag.empty()) {
+      CHECK(r.out.find("LP_PERF is \"\" here but was \"no_mipmap\" for the manifest (--adopt-env uses the manifest's value)") !=
+            std::string::npos);
+      CHECK(r.out.find("note: using LP_PERF") == std::string::npos);
+    } else {
+      CHECK(r.out.find("note: using LP_PERF=no_mipmap as the manifest's run did (--adopt-env)") != std::string::npos);
+    }
+    CHECK(r.out.find("note: using GALLIUM_TRACE") == std::string::npos);
+    CHECK(r.out.find("note: using LD_PRELOAD") == std::string::npos);
+  }
+}
+
 TEST_CASE("--export csv and vtk write each kept frame's particles in id order, world coordinates") {
   const std::string dir = freshDir("export_csv"), vdir = freshDir("export_vtk"), adir = freshDir("export_vtka");
   REQUIRE(run("run " + q(kSmall) + " --frames 5 --every 4 --quiet --export csv --out " + q(dir)).code == 0);

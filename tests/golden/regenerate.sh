@@ -4,7 +4,7 @@
 # the new frames before committing them. Usage: tests/golden/regenerate.sh [build dir]
 set -euo pipefail
 # Pixels are bit-identical on CPUs with and without AVX, FMA or AVX-512 only when llvmpipe is
-# limited to SSE4.1 code; the manifests record this and `sph2d check` adopts it.
+# limited to SSE4.1 code; the manifests record this and `sph2d check --adopt-env` adopts it.
 export GALLIUM_OVERRIDE_CPU_CAPS=sse4.1
 here="$(cd "$(dirname "$0")" && pwd)"
 exe="$(cd "${1:-$here/../../build}" && pwd)/app/sph2d"

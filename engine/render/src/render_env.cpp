@@ -54,6 +54,12 @@ std::vector<EnvSetting> pinRenderEnvironment() {
   return record;
 }
 
+std::vector<std::string> recordedEnvironmentNames() {
+  std::vector<std::string> names;
+  for (const EnvPin& e : kEnv) names.push_back(e.name);
+  return names;
+}
+
 std::string cpuSummary() {
   std::ifstream in("/proc/cpuinfo");
   std::string line, model, flags;

@@ -22,6 +22,10 @@ struct EnvSetting {
 /// manifest. Called by the Renderer constructor; later calls only report.
 std::vector<EnvSetting> pinRenderEnvironment();
 
+/// The names of the settings pinRenderEnvironment() records, without pinning anything
+/// (what `sph2d check` accepts from a manifest's environment).
+std::vector<std::string> recordedEnvironmentNames();
+
 /// The CPU features that llvmpipe's code generation depends on (from /proc/cpuinfo),
 /// e.g. "AMD EPYC; avx avx2 fma f16c avx512f".
 std::string cpuSummary();
