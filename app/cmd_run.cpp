@@ -127,6 +127,12 @@ int cmdRun(const std::vector<std::string>& args) {
   if (input.skippedSceneEvents())
     console.say("sph2d: " + std::to_string(input.skippedSceneEvents()) +
                 " recorded events of the scene's own timeline skipped (the scene applies them)");
+  // The record file must not be one of the inputs: opening it truncates the file.
+  for (const std::string& in : a.inputs) {
+    std::error_code ec;
+    if (!a.record.empty() && in != "-" && fs::exists(a.record, ec) && fs::equivalent(in, a.record, ec))
+      throw UsageError("--record " + a.record + " is also an --input file: recording would overwrite it; record to another file");
+  }
   EventRecord record(a.record);
 
   installStopHandler();
@@ -214,7 +220,7 @@ int cmdRun(const std::vector<std::string>& args) {
   report.images = a.images;
   if (a.exportFormat) report.exportExtension = exportExtension(*a.exportFormat);
   report.video = a.video;
-  report.record = record.open() ? record.path() : "";
+  report.record = record.open() && !record.failed() ? record.path() : "";
   report.pending = input.pending();
   report.realtime = a.realtime;
   report.fps = scene.fps;

@@ -2,6 +2,8 @@
 // and the --record file; see event_intake.hpp.
 #include "event_intake.hpp"
 
+#include <cerrno>
+#include <cstring>
 #include <stdexcept>
 #include <utility>
 
@@ -86,8 +88,16 @@ EventRecord::EventRecord(const std::string& path) : path_(path) {
 
 void EventRecord::write(const std::string& line) {
   if (!out_.is_open()) return;
+  errno = 0;
   out_ << line << '\n';
   out_.flush();
+  // A record that silently lost its lines would replay another run: stop the run (exit 1).
+  if (!out_) {
+    const int err = errno;
+    failed_ = true;
+    throw std::runtime_error("cannot write the record file '" + path_ + "'" +
+                             (err ? std::string(": ") + std::strerror(err) : std::string()));
+  }
 }
 
 }  // namespace sph2d::cli

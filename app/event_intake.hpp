@@ -78,11 +78,15 @@ class EventRecord {
   /// The file's path ("" when not recording).
   const std::string& path() const { return path_; }
   /// Appends one line (recordLine) and flushes it; nothing when not recording.
+  /// Throws std::runtime_error naming the file when the line could not be written.
   void write(const std::string& line);
+  /// True once a write failed (the file is not a whole record of the run).
+  bool failed() const { return failed_; }
 
  private:
   std::string path_;
   std::ofstream out_;
+  bool failed_ = false;
 };
 
 }  // namespace sph2d::cli

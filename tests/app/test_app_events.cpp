@@ -191,6 +191,30 @@ TEST_CASE("block and drop events of any size, from the timeline or a file, stop 
   CHECK(r.out.find("2 events applied, 2 warnings") != std::string::npos);
 }
 
+TEST_CASE("--record: a write error stops the run with exit 1 naming the file, and an --input file is never the record") {
+  // Before (issue 18): --record on a full disk wrote 0 bytes, exited 0 and the summary said the
+  // events were recorded; --input F --record F truncated F.
+  const std::string dir = freshDir("record_errors");
+  const std::string events = dir + "/events.jsonl";
+  const std::string text = "{\"frame\": 1, \"type\": \"drop\", \"center\": [2, 2], \"radius\": 0.1}\n"
+                           "{\"frame\": 2, \"type\": \"gravity\", \"tilt\": 0.2}\n";
+  std::ofstream(events) << text;
+  if (fs::exists("/dev/full")) {
+    const Result r = run("run " + q(kSmall) + " --frames 4 --no-images --input " + q(events) + " --record /dev/full");
+    INFO(r.out);
+    CHECK(r.code == 1);
+    CHECK(r.out.find("error: cannot write the record file '/dev/full': No space left on device") != std::string::npos);
+    CHECK(r.out.find("events recorded in") == std::string::npos);
+  }
+  // The same file under another spelling is refused before anything is opened for writing.
+  const Result same = run("run " + q(kSmall) + " --frames 4 --no-images --input " + q(events) + " --record " +
+                          q(dir + "/./events.jsonl"));
+  INFO(same.out);
+  CHECK(same.code == 2);
+  CHECK(same.out.find("is also an --input file: recording would overwrite it") != std::string::npos);
+  CHECK(readText(events) == text);
+}
+
 TEST_CASE("bad input sources and timeline events exit 2 with a message") {
   Result r = run("run " + q(kSmall) + " --frames 2 --no-images --input /nonexistent/events.jsonl");
   CHECK(r.code == 2);
