@@ -35,6 +35,7 @@ std::vector<TimedEvent> EventIntake::takeScheduled(std::int64_t frame) { return 
 
 void EventIntake::pollLive() {
   if (!live_) return;
+  for (const std::string& w : live_->takeWarnings()) warn_(w);
   for (auto& [lineNo, text] : live_->take()) {
     if (text.find_first_not_of(" \t\r") == std::string::npos) continue;
     try {

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cerrno>
+#include <cstring>
 #include <cstdio>
 #include <fstream>
 #include <sstream>
@@ -73,25 +74,36 @@ LiveInput::~LiveInput() {
 }
 
 void LiveInput::loop(int fd) {
+  // Each byte is looked at once (memchr over what was just read), and a line holds at
+  // most kMaxLiveLine bytes: a longer one is dropped as it arrives, up to its newline,
+  // and reported with its number and size.
   std::string partial;
+  bool skipping = false;
+  std::size_t skipped = 0;
   int lineNo = 0;
-  char buf[4096];
-  auto flush = [&](bool all) {
-    std::size_t start = 0, nl;
-    std::vector<std::pair<int, std::string>> got;
-    while ((nl = partial.find('\n', start)) != std::string::npos) {
-      got.emplace_back(++lineNo, partial.substr(start, nl - start));
-      start = nl + 1;
+  char buf[65536];
+  std::vector<std::pair<int, std::string>> got;
+  std::vector<std::string> warned;
+  auto endLine = [&] {
+    ++lineNo;
+    if (skipping) {
+      warned.push_back("stdin:" + std::to_string(lineNo) + ": a line of " + std::to_string(skipped) +
+                       " bytes, more than the " + std::to_string(kMaxLiveLine) +
+                       " an event line may hold, was skipped (one JSON object per line)");
+      skipping = false;
+      skipped = 0;
+    } else {
+      got.emplace_back(lineNo, std::move(partial));
     }
-    partial.erase(0, start);
-    if (all && !partial.empty()) {
-      got.emplace_back(++lineNo, partial);
-      partial.clear();
-    }
-    if (!got.empty()) {
-      std::lock_guard<std::mutex> lock(mutex_);
-      for (auto& g : got) lines_.push_back(std::move(g));
-    }
+    partial.clear();
+  };
+  auto publish = [&] {
+    if (got.empty() && warned.empty()) return;
+    std::lock_guard<std::mutex> lock(mutex_);
+    for (auto& g : got) lines_.push_back(std::move(g));
+    for (auto& w : warned) warnings_.push_back(std::move(w));
+    got.clear();
+    warned.clear();
   };
   while (!stop_.load()) {
     pollfd p{fd, POLLIN, 0};
@@ -102,11 +114,36 @@ void LiveInput::loop(int fd) {
     const ssize_t n = ::read(fd, buf, sizeof buf);
     if (n < 0 && (errno == EINTR || errno == EAGAIN)) continue;
     if (n <= 0) break;  // end of input (or an error: treated alike)
-    partial.append(buf, std::size_t(n));
-    flush(false);
+    std::size_t pos = 0;
+    while (pos < std::size_t(n)) {
+      const void* hit = std::memchr(buf + pos, '\n', std::size_t(n) - pos);
+      const std::size_t end = hit ? std::size_t(static_cast<const char*>(hit) - buf) : std::size_t(n);
+      if (skipping) {
+        skipped += end - pos;
+      } else {
+        partial.append(buf + pos, end - pos);
+        if (partial.size() > kMaxLiveLine) {
+          skipping = true;
+          skipped = partial.size();
+          std::string().swap(partial);  // give the memory back
+        }
+      }
+      if (!hit) break;
+      endLine();
+      pos = end + 1;
+    }
+    publish();
   }
-  flush(true);
+  if (skipping || !partial.empty()) endLine();
+  publish();
   eof_.store(true);
+}
+
+std::vector<std::string> LiveInput::takeWarnings() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  std::vector<std::string> out;
+  out.swap(warnings_);
+  return out;
 }
 
 std::vector<std::pair<int, std::string>> LiveInput::take() {

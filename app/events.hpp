@@ -68,6 +68,10 @@ class EventSchedule {
 };
 
 /// Lines of live input read on a separate thread; the loop takes them without waiting.
+/// The longest live input line kept (1 MiB): an event is a few hundred bytes; a longer
+/// line is skipped as it arrives, so a runaway writer costs neither memory nor time.
+constexpr std::size_t kMaxLiveLine = std::size_t(1) << 20;
+
 class LiveInput {
  public:
   /// Starts reading `fd` (standard input by default).
@@ -78,6 +82,8 @@ class LiveInput {
   LiveInput& operator=(const LiveInput&) = delete;
   /// The complete lines read since the last call, with their 1-based line numbers.
   std::vector<std::pair<int, std::string>> take();
+  /// Lines too long to be an event (over kMaxLiveLine bytes), skipped since the last call.
+  std::vector<std::string> takeWarnings();
   /// False once the input reached its end (or failed) and every line was taken.
   bool open() const;
 
@@ -85,6 +91,7 @@ class LiveInput {
   void loop(int fd);
   mutable std::mutex mutex_;
   std::vector<std::pair<int, std::string>> lines_;
+  std::vector<std::string> warnings_;
   std::atomic<bool> stop_{false};
   std::atomic<bool> eof_{false};
   std::thread thread_;

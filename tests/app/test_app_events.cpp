@@ -215,6 +215,22 @@ TEST_CASE("--record: a write error stops the run with exit 1 naming the file, an
   CHECK(readText(events) == text);
 }
 
+TEST_CASE("a live input line over 1 MiB is skipped with a warning naming its line, and the next line is read") {
+  // Before (issue 18): a partial line was scanned again on every read (a 30 MB line held the
+  // next event back by 225 frames) and grew without bound (1 GB of memory for a 1 GB line).
+  const std::string feed =
+      "(head -c 3000000 /dev/zero | tr '\\0' 'x'; "
+      "printf '\\n%s\\n' '{\"type\": \"drop\", \"center\": [2, 2], \"radius\": 0.15}') | ";
+  // --realtime: the run lasts 0.5 s of wall time, so the lines arrive while it goes.
+  const Result r = run("run " + q(kSmall) + " --frames 30 --realtime --no-images --input -", feed);
+  INFO(r.out);
+  CHECK(r.code == 0);
+  CHECK(r.out.find("warning: stdin:1: a line of 3000000 bytes, more than the 1048576 an event line may hold, was skipped") !=
+        std::string::npos);
+  CHECK(r.out.find("drop at (2, 2), radius 0.15 m (stdin:2)") != std::string::npos);
+  CHECK(r.out.find("1 event applied, 1 warning") != std::string::npos);
+}
+
 TEST_CASE("bad input sources and timeline events exit 2 with a message") {
   Result r = run("run " + q(kSmall) + " --frames 2 --no-images --input /nonexistent/events.jsonl");
   CHECK(r.code == 2);
