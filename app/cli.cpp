@@ -8,17 +8,38 @@
 #include <cstdlib>
 #include <sstream>
 
+#include <signal.h>
+#include <unistd.h>
+
 namespace sph2d::cli {
 
 std::atomic<bool> stopRequested{false};
 
 namespace {
 extern "C" void onSignal(int) { stopRequested.store(true); }
+extern "C" void onSignalExit(int) {
+  static const char msg[] = "sph2d: interrupted (SIGINT or SIGTERM)\n";
+  const ssize_t w = ::write(2, msg, sizeof msg - 1);  // async-signal-safe, unlike stdio
+  (void)w;
+  ::_exit(130);
+}
+void setHandler(int sig, void (*fn)(int)) {
+  struct sigaction sa {};
+  sa.sa_handler = fn;
+  sigemptyset(&sa.sa_mask);
+  sa.sa_flags = SA_RESTART;
+  sigaction(sig, &sa, nullptr);
+}
 }  // namespace
 
 void installStopHandler() {
-  std::signal(SIGINT, onSignal);
-  std::signal(SIGTERM, onSignal);
+  setHandler(SIGINT, onSignal);
+  setHandler(SIGTERM, onSignal);
+}
+
+void installExitHandler() {
+  setHandler(SIGINT, onSignalExit);
+  setHandler(SIGTERM, onSignalExit);
 }
 
 int parseInt(const std::string& flag, const std::string& v, int lo, int hi) {

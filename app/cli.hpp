@@ -27,8 +27,14 @@ std::vector<int> parseIntList(const std::string& flag, const std::string& v, int
 std::vector<std::string> splitList(const std::string& s);
 /// Set by SIGINT/SIGTERM once installStopHandler() ran.
 extern std::atomic<bool> stopRequested;
-/// Makes SIGINT/SIGTERM set stopRequested instead of killing the process.
+/// Makes SIGINT/SIGTERM set stopRequested instead of killing the process (the run's
+/// loop then stops at the next frame and finishes its files).
 void installStopHandler();
+/// Makes SIGINT/SIGTERM end the process at once with exit 130 and one line on stderr,
+/// even where the parent ignored them (a background job of a script): set-up (reading
+/// a scene, sampling a long chain, info's estimates) writes nothing that could be left
+/// half done, so it need not finish. main() calls it first.
+void installExitHandler();
 
 /// Parses the render flag at args[i] (--mode, --color-by, --range, --overlay, --foam-speed,
 /// --depth-scale), advancing i past its value; false when args[i] is not a render flag.

@@ -135,7 +135,6 @@ int cmdRun(const std::vector<std::string>& args) {
   }
   EventRecord record(a.record);
 
-  installStopHandler();
   std::signal(SIGPIPE, SIG_IGN);  // a dead ffmpeg shows up as EPIPE, not as a kill
   console.start();
   World world(scene, WorldOptions{a.threads});
@@ -165,6 +164,9 @@ int cmdRun(const std::vector<std::string>& args) {
   settings.catchUp = a.catchUp;
   settings.stop = &stopRequested;
   GameLoop loop(world, input, outputs, renderer.get(), settings);
+  // From here a signal stops the loop at the next frame and the files are finished (set-up
+  // above wrote nothing that needs finishing: until now a signal ends the process at once).
+  installStopHandler();
   int status = 0;
   std::string failure, stopReason;
   try {

@@ -39,6 +39,7 @@ const char* kMainHelp =
 }  // namespace
 
 int main(int argc, char** argv) {
+  installExitHandler();  // until a command's loop says otherwise, a signal ends the process now
   std::vector<std::string> args(argv + 1, argv + argc);
   try {
     if (args.empty() || args[0] == "--help" || args[0] == "-h" || args[0] == "help") {
