@@ -50,6 +50,8 @@ const char* kCheckHelp =
     "Options:\n"
     "  --against FILE  the manifest (required)\n"
     "  --adopt-env     render with the Mesa settings the manifest recorded (see above)\n"
+    "  --files         also check the PNG files beside the manifest: each listed frame's\n"
+    "                  file decodes to its recorded hash, and no other frame_*.png is there\n"
     "  --out DIR       where the diff image goes (default: out/check-<scene name>)\n"
     "  --threads T     simulation threads (default: all cores; frames do not depend on it)\n"
     "  --quiet         print only the verdict\n";
@@ -105,10 +107,16 @@ class FrameCheck : public LoopObserver {
     const json& e = m_.expected.at(f);
     const std::string got = hex64(xxh64(fr.rgba.data(), fr.rgba.size()));
     const std::string want = e.value("rgba_xxh64", "");
-    ++compared;
-    if (got == want) return true;
-    failed = true;
     const std::string stateHash = hex64(state.stateHash), wantState = e.value("state_hash", "");
+    ++compared;
+    if (got == want && stateHash == wantState) return true;
+    failed = true;
+    if (got == want) {  // the pixels agree, the simulation does not: both hashes must match
+      std::printf("check: frame %d: the pixels match but the state hash differs (%s here, %s in the manifest): the "
+                  "simulation changed\n", f, stateHash.c_str(), wantState.c_str());
+      std::printf("check: FAILED at frame %d (%d frames matched before it)\n", f, compared - 1);
+      return false;
+    }
     std::printf("check: frame %d differs: RGBA XXH64 %s here, %s in the manifest\n", f, got.c_str(), want.c_str());
     std::printf("check: state hash %s\n", stateHash == wantState
                                              ? "matches: the simulation agrees, the rendering differs"
@@ -157,6 +165,49 @@ class FrameCheck : public LoopObserver {
   std::string out_;
   fs::path refDir_;
 };
+
+/// --files: every listed frame's PNG beside the manifest decodes to its recorded hash, and
+/// no frame_*.png there is unlisted (a stale frame of another run). Prints each problem.
+bool checkFiles(const ManifestView& mv, const fs::path& dir) {
+  int bad = 0;
+  for (const auto& [frame, e] : mv.expected) {
+    const fs::path file = dir / frameFileName(frame);
+    int w = 0, h = 0;
+    std::vector<std::uint8_t> rgba;
+    try {
+      readPng(file.string(), w, h, rgba);
+    } catch (const std::exception& ex) {
+      std::printf("check: %s: %s\n", file.string().c_str(), ex.what());
+      ++bad;
+      continue;
+    }
+    const std::string got = hex64(xxh64(rgba.data(), rgba.size()));
+    if (got != e.value("rgba_xxh64", "")) {
+      std::printf("check: %s decodes to RGBA XXH64 %s, the manifest says %s\n", file.string().c_str(), got.c_str(),
+                  e.value("rgba_xxh64", "").c_str());
+      ++bad;
+    }
+  }
+  std::error_code ec;
+  std::vector<std::string> stale;
+  for (const auto& entry : fs::directory_iterator(dir.empty() ? fs::path(".") : dir, ec)) {
+    const std::string name = entry.path().filename().string();
+    int frame = -1;
+    char tail = 0;
+    if (std::sscanf(name.c_str(), "frame_%d.pn%c", &frame, &tail) == 2 && tail == 'g' && name == frameFileName(frame) &&
+        !mv.expected.count(frame))
+      stale.push_back(name);
+  }
+  std::sort(stale.begin(), stale.end());
+  if (!stale.empty()) {
+    std::printf("check: %zu frame file%s beside the manifest %s not listed in it (another run's?): %s%s\n", stale.size(),
+                stale.size() == 1 ? "" : "s", stale.size() == 1 ? "is" : "are", stale.front().c_str(),
+                stale.size() > 1 ? " ..." : "");
+    bad += int(stale.size());
+  }
+  if (bad) std::printf("check: FAILED: %d problem%s with the files beside the manifest\n", bad, bad == 1 ? "" : "s");
+  return bad == 0;
+}
 
 /// One entry of a manifest's `environment`, checked: `problem` says why it is ignored.
 struct ManifestEnv {
@@ -230,7 +281,7 @@ void addManifestEvents(EventIntake& input, const json& m, const std::string& man
 int cmdCheck(const std::vector<std::string>& args) {
   std::string scenePath, manifestPath, out;
   int threads = 0;
-  bool quiet = false, adoptEnv = false;
+  bool quiet = false, adoptEnv = false, files = false;
   for (std::size_t i = 0; i < args.size(); ++i) {
     const std::string& s = args[i];
     auto value = [&]() -> std::string {
@@ -246,6 +297,7 @@ int cmdCheck(const std::vector<std::string>& args) {
     else if (s == "--threads") threads = parseInt(s, value(), 1, 256);
     else if (s == "--quiet") quiet = true;
     else if (s == "--adopt-env") adoptEnv = true;
+    else if (s == "--files") files = true;
     else if (!s.empty() && s[0] == '-') throw UsageError("unknown option '" + s + "' (see sph2d check --help)");
     else if (scenePath.empty()) scenePath = s;
     else throw UsageError("unexpected argument '" + s + "'");
@@ -259,9 +311,14 @@ int cmdCheck(const std::vector<std::string>& args) {
     std::printf("check: %s lists no frames; nothing to compare\n", manifestPath.c_str());
     return 1;
   }
+  if (!mv.listProblems.empty()) {
+    for (const std::string& p : mv.listProblems) std::printf("check: FAILED: %s\n", p.c_str());
+    return 1;
+  }
   const SceneDef scene = loadScene(scenePath);
   if (out.empty()) out = "out/check-" + scene.name;
   const fs::path refDir = fs::path(manifestPath).parent_path();
+  if (files && !checkFiles(mv, refDir)) return 1;
 
   const std::string sceneHash = fileHash(scenePath);
   if (sceneHash != mv.sceneHash)

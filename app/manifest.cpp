@@ -2,6 +2,7 @@
 #include "manifest.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <cstdio>
 #include <fstream>
 #include <sstream>
@@ -123,7 +124,51 @@ ManifestView readManifest(const std::string& path) {
     v.cpu = m.value("cpu", "");
     v.sceneHash = m.at("scene").at("xxh64").get<std::string>();
     v.render = renderOptionsFromJson(m.at("render"));
-    for (const json& f : m.at("frames")) v.expected[f.at("frame").get<int>()] = f;
+    if (v.frames < 0 || v.frames > 100000000) throw UsageError(path + ": run.frames must be 0..100000000");
+    auto hex16 = [](const std::string& h) {
+      return h.size() == 16 && std::all_of(h.begin(), h.end(), [](char c) { return std::isxdigit(static_cast<unsigned char>(c)); });
+    };
+    int last = -1;
+    const json& list = m.at("frames");
+    for (std::size_t k = 0; k < list.size(); ++k) {
+      const json& f = list[k];
+      const std::string at = path + ": frames[" + std::to_string(k) + "]";
+      const int frame = f.at("frame").get<int>();
+      if (frame < 0 || frame >= v.frames || frame % v.every != 0 || frame <= last)
+        throw UsageError(at + ": frame " + std::to_string(frame) + " is not a kept frame of the run after frame " +
+                         std::to_string(last) + " (frames 0.." + std::to_string(v.frames - 1) + ", every " +
+                         std::to_string(v.every) + ", in order)");
+      if (f.at("file").get<std::string>() != frameFileName(frame))
+        throw UsageError(at + ": its file must be " + frameFileName(frame) + " (a manifest names only its own frames)");
+      if (!hex16(f.at("rgba_xxh64").get<std::string>()) || !hex16(f.at("state_hash").get<std::string>()))
+        throw UsageError(at + ": rgba_xxh64 and state_hash must be 16 hex digits");
+      v.expected[frame] = f;
+      last = frame;
+    }
+    // The list against the run: complete → every kept frame (a real-time run may have
+    // dropped some); stopped → the first frames_written of them.
+    const bool complete = m.value("complete", false);
+    const bool realtime = m.at("run").value("realtime", false);
+    std::vector<int> kept;
+    for (int f = 0; f < v.frames; f += v.every) kept.push_back(f);
+    std::size_t prefix = kept.size();
+    if (!complete) {
+      const json& stop = m.contains("stop") && m["stop"].is_object() ? m["stop"] : json::object();
+      prefix = std::min(kept.size(), std::size_t(std::max(0, stop.value("frames_written", int(v.expected.size())))));
+      if (!realtime && v.expected.size() != prefix)
+        v.listProblems.push_back("the run stopped after writing " + std::to_string(prefix) + " frames, but the manifest lists " +
+                                 std::to_string(v.expected.size()));
+    }
+    if (!realtime) {
+      for (std::size_t k = 0; k < prefix; ++k)
+        if (!v.expected.count(kept[k])) {
+          v.listProblems.push_back(std::string(complete ? "the manifest says the run is complete, but " : "") +
+                                   "it lists " + std::to_string(v.expected.size()) + " of the run's " +
+                                   std::to_string(prefix) + " kept frames (the first missing: frame " +
+                                   std::to_string(kept[k]) + ")");
+          break;
+        }
+    }
   } catch (const json::exception& e) {
     throw UsageError(path + " lacks a field `sph2d check` needs: " + e.what());
   }

@@ -14,6 +14,7 @@
 #include <cstdint>
 #include <map>
 #include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -62,10 +63,16 @@ struct ManifestView {
   std::map<int, nlohmann::ordered_json> expected;  ///< the listed frames by number
   std::string renderer, cpu, sceneHash;            ///< what it was made with
   RenderOptions render;                            ///< the render options of the run
+  /// Why the frame list is not the run's (empty when it is): a complete run lists every
+  /// kept frame (0, every, 2·every, … below frames; a real-time run may have dropped
+  /// some), a stopped one the first frames_written of them.
+  std::vector<std::string> listProblems;
 };
 
 /// Reads a manifest for `sph2d check`. Throws UsageError when it cannot be read, is not
-/// JSON, is not an sph2d frames manifest or lacks a field check needs.
+/// JSON, is not an sph2d frames manifest, lacks a field check needs, or a frame entry is
+/// malformed (its number not a kept frame of the run or out of order, its file not the
+/// frame's own name, a hash not 16 hex digits): a manifest names no other file.
 ManifestView readManifest(const std::string& path);
 
 }  // namespace sph2d::cli

@@ -212,6 +212,65 @@ TEST_CASE("sph2d check: exit 0 on a match, and on a difference names the frame, 
   CHECK(run("check " + q(kSmall) + " --against " + q(dir + "/nope.json")).code == 2);
 }
 
+TEST_CASE("sph2d check checks both hashes of every frame, the frame list against the run, and with --files the PNGs") {
+  // Before (issue 18): a manifest whose state_hash was changed passed when the pixels matched,
+  // and so did one with frame entries deleted that still said complete: true.
+  const std::string dir = freshDir("check_trust"), out = freshDir("check_trust_out");
+  REQUIRE(run("run " + q(kSmall) + " --frames 5 --every 2 --quiet --out " + q(dir)).code == 0);
+  const json good = readManifest(dir);
+  auto check = [&](const json& m, const std::string& flags = "") {
+    std::ofstream(dir + "/manifest.json") << m.dump(1);
+    return run("check " + q(kSmall) + " --against " + q(dir + "/manifest.json") + " --out " + q(out) + flags);
+  };
+  {
+    const Result r = check(good, " --files");
+    INFO(r.out);
+    CHECK(r.code == 0);
+    CHECK(r.out.find("OK, 3 frames match") != std::string::npos);
+  }
+  {
+    json m = good;
+    std::string& h = m["frames"][1]["state_hash"].get_ref<std::string&>();
+    h[0] = h[0] == '0' ? '1' : '0';
+    const Result r = check(m);
+    INFO(r.out);
+    CHECK(r.code == 1);
+    CHECK(r.out.find("frame 2: the pixels match but the state hash differs") != std::string::npos);
+  }
+  {
+    json m = good;
+    m["frames"].erase(1);  // frame 2 gone, and the manifest still says complete
+    const Result r = check(m);
+    INFO(r.out);
+    CHECK(r.code == 1);
+    CHECK(r.out.find("FAILED: the manifest says the run is complete, but it lists 2 of the run's 3 kept frames (the first "
+                     "missing: frame 2)") != std::string::npos);
+  }
+  {
+    json m = good;
+    m["frames"][2]["frame"] = 3;  // not a kept frame with every 2
+    CHECK(check(m).code == 2);
+    m = good;
+    m["frames"][0]["file"] = "../../etc/passwd";  // a manifest names only its own frames
+    const Result r = check(m);
+    CHECK(r.code == 2);
+    CHECK(r.out.find("frames[0]: its file must be frame_00000.png") != std::string::npos);
+  }
+  {
+    // --files: a frame file swapped for another frame's, and a stale frame of another run.
+    fs::copy_file(dir + "/frame_00000.png", dir + "/frame_00002.png", fs::copy_options::overwrite_existing);
+    fs::copy_file(dir + "/frame_00004.png", dir + "/frame_00006.png");
+    Result r = check(good);
+    CHECK(r.code == 0);  // without --files only the rerun is compared
+    r = check(good, " --files");
+    INFO(r.out);
+    CHECK(r.code == 1);
+    CHECK(r.out.find("frame_00002.png decodes to RGBA XXH64") != std::string::npos);
+    CHECK(r.out.find("1 frame file beside the manifest is not listed in it (another run's?): frame_00006.png") !=
+          std::string::npos);
+  }
+}
+
 TEST_CASE("sph2d check never takes a variable from a manifest that sph2d does not record, and adopts its own only with --adopt-env") {
   // Before (issue 18): every entry was set with setenv; GALLIUM_TRACE=victim.txt overwrote
   // that file with Mesa trace XML and check hung; LD_PRELOAD and the like were adopted.
