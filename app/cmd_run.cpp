@@ -15,12 +15,14 @@
 #include <cstdio>
 #include <filesystem>
 #include <memory>
+#include <optional>
 
 #include "cli.hpp"
 #include "commands.hpp"
 #include "event_intake.hpp"
 #include "game_loop.hpp"
 #include "manifest.hpp"
+#include "output_dir.hpp"
 #include "run_args.hpp"
 #include "run_console.hpp"
 #include "sph2d/hash.hpp"
@@ -87,12 +89,6 @@ class RunOutputs : public LoopObserver {
 };
 
 /// Creates the output directory or throws UsageError.
-void makeOutputDir(const std::string& out) {
-  std::error_code ec;
-  fs::create_directories(out, ec);
-  if (ec || !fs::is_directory(out)) throw UsageError("cannot create the output directory '" + out + "': " + ec.message());
-  if (::access(out.c_str(), W_OK) != 0) throw UsageError("the output directory '" + out + "' is not writable");
-}
 
 }  // namespace
 
@@ -113,7 +109,12 @@ int cmdRun(const std::vector<std::string>& args) {
   if (a.images && a.render.colorBy == ColorField::Age && (a.render.mode == "particles" || (a.render.mode.empty() && scene.render.mode == "particles")))
     if (!scene.effects.lifetime)
       throw UsageError("--color-by age needs particle ages: enable effects.lifetime in the scene");
-  if (a.images) makeOutputDir(out);
+  // The output directory: one run at a time holds it (a second one is refused, naming the first).
+  std::optional<OutputLock> outLock;
+  if (a.images) {
+    makeOutputDir(out);
+    outLock.emplace(out);
+  }
 
   // The input: the scene's timeline, events files, the record (live input opens last).
   RunConsole console(a.quiet, a.realtime);
@@ -152,6 +153,14 @@ int cmdRun(const std::vector<std::string>& args) {
     wo.videoFps = scene.fps / a.every;
     writer = std::make_unique<FrameWriter>(wo);
     manifest = std::make_unique<RunManifest>(a, scene, *renderer, frames, world.threads());
+    // Before the first frame: an earlier run's frames and manifest go (a shorter rerun leaves
+    // none behind), and the manifest says "running" until the end, so a run killed midway
+    // never leaves a complete manifest beside its frames.
+    const int removed = removeEarlierRun(out);
+    if (removed)
+      console.say("sph2d: removed " + std::to_string(removed) + " files of an earlier run from " + out +
+                  " (frames, exports, manifest, temporary files)");
+    manifest->writeRunning(out);
   }
   if (std::count(a.inputs.begin(), a.inputs.end(), "-")) input.openLive(STDIN_FILENO);
 

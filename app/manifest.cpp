@@ -104,6 +104,16 @@ void RunManifest::finish(int written, int status, const std::string& reason, con
 
 void RunManifest::write(const std::string& dir) const { writeFileAtomic(dir + "/manifest.json", j_.dump(1) + "\n"); }
 
+void RunManifest::writeRunning(const std::string& dir) const {
+  json j = j_;
+  j["complete"] = false;
+  j["stop"] = {{"reason", "running"},
+               {"message", "the run had not ended when this was written (killed, or still running)"},
+               {"frames_simulated", 0},
+               {"frames_written", 0}};
+  writeFileAtomic(dir + "/manifest.json", j.dump(1) + "\n");
+}
+
 ManifestView readManifest(const std::string& path) {
   ManifestView v;
   json& m = v.json;

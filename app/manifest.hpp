@@ -50,6 +50,9 @@ class RunManifest {
   void finish(int written, int status, const std::string& reason, const std::string& message, std::int64_t simulated);
   /// Writes DIR/manifest.json whole or not at all. Throws std::runtime_error.
   void write(const std::string& dir) const;
+  /// Writes DIR/manifest.json as a run under way: no frames, complete false, stop reason
+  /// "running" (what a run killed before its end leaves). Throws std::runtime_error.
+  void writeRunning(const std::string& dir) const;
 
  private:
   nlohmann::ordered_json j_;

@@ -33,10 +33,12 @@ std::vector<std::string> listDir(const std::string& dir) {
 }
 
 /// Checks that `dir` holds exactly frame_00000.png … frame_{n-1}.png, each a
-/// whole 192x144 PNG, and nothing else but the run's manifest.json (no temporary file).
+/// whole 192x144 PNG, and nothing else but the run's manifest.json and the directory's
+/// lock file .sph2d.lock (no temporary file).
 void expectWholeFrames(const std::string& dir, int n) {
   std::vector<std::string> names = listDir(dir);
-  names.erase(std::remove(names.begin(), names.end(), std::string("manifest.json")), names.end());
+  for (const char* own : {"manifest.json", ".sph2d.lock"})
+    names.erase(std::remove(names.begin(), names.end(), std::string(own)), names.end());
   REQUIRE(names.size() == std::size_t(n));
   for (int f = 0; f < n; ++f) {
     char name[32];
@@ -159,8 +161,10 @@ TEST_CASE("cli misuse: a full disk (a 200 KiB tmpfs) exits 1 naming the file, ea
   CHECK(r.out.find("cannot write " + mnt + "/frame_") != std::string::npos);
   CHECK(r.out.find("No space left on device") != std::string::npos);
   std::vector<std::string> names = listDir(copy);
-  // The manifest is written when the run stops, if the disk still has room for it.
-  names.erase(std::remove(names.begin(), names.end(), std::string("manifest.json")), names.end());
+  // The manifest is written when the run stops, if the disk still has room for it; the
+  // directory's lock file is the run's too.
+  for (const char* own : {"manifest.json", ".sph2d.lock"})
+    names.erase(std::remove(names.begin(), names.end(), std::string(own)), names.end());
   MESSAGE(names.size() << " whole frames fit in 200 KiB");
   CHECK(names.size() >= 3);
   CHECK(names.size() < 200);

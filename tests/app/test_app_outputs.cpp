@@ -146,6 +146,64 @@ TEST_CASE("SIGINT or SIGTERM during set-up ends run and info at once with exit 1
   }
 }
 
+TEST_CASE("the output directory: one run at a time, a killed run never leaves a complete manifest, no stale frames") {
+  // Before (issue 18): two runs into one directory both exited 0 and the manifest disagreed
+  // with 40 of 120 PNGs; a run SIGKILLed over an older one left the old complete manifest
+  // beside new PNGs; a shorter rerun left stale frames.
+  const std::string dir = freshDir("outdir_lock");
+  REQUIRE(run("run " + q(kSmall) + " --frames 8 --quiet --out " + q(dir)).code == 0);
+  std::ofstream(dir + "/frame_00011.png.tmp4242") << "a killed run's half-written frame";
+  std::ofstream(dir + "/notes.txt") << "the user's own file";
+  const std::string log = dir + ".log";
+  const pid_t pid = fork();
+  REQUIRE(pid >= 0);
+  if (pid == 0) {
+    const int fd = ::open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    ::dup2(fd, 1);
+    ::dup2(fd, 2);
+    execl(SPH2D_EXE, SPH2D_EXE, "run", kSmall.c_str(), "--frames", "100000", "--threads", "1", "--out", dir.c_str(),
+          "--quiet", static_cast<char*>(nullptr));
+    _exit(127);
+  }
+  // The long run has started once the earlier run's manifest says "running".
+  const auto t0 = std::chrono::steady_clock::now();
+  auto running = [&] {
+    try {
+      return readManifest(dir).at("stop").at("reason") == "running";
+    } catch (...) {
+      return false;
+    }
+  };
+  while (!running() && std::chrono::steady_clock::now() - t0 < std::chrono::seconds(30))
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  REQUIRE(running());
+  // The earlier run's frames beyond the new ones, its manifest and the stale temporary file are
+  // gone before the first new frame; the user's file stays.
+  CHECK_FALSE(fs::exists(dir + "/frame_00011.png.tmp4242"));
+  CHECK(fs::exists(dir + "/notes.txt"));
+  // A second run into the directory is refused, naming the holder.
+  const Result second = run("run " + q(kSmall) + " --frames 3 --quiet --out " + q(dir));
+  CHECK(second.code == 2);
+  CHECK(second.out.find("is in use by another sph2d run (pid " + std::to_string(pid) + ")") != std::string::npos);
+  while (filesEnding(dir, ".png").size() < 12 && std::chrono::steady_clock::now() - t0 < std::chrono::seconds(30))
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  REQUIRE(::kill(pid, SIGKILL) == 0);
+  int status = 0;
+  REQUIRE(::waitpid(pid, &status, 0) == pid);
+  const json killed = readManifest(dir);
+  CHECK_FALSE(killed.at("complete").get<bool>());
+  CHECK(killed.at("stop").at("reason") == "running");
+  CHECK(run("check " + q(kSmall) + " --against " + q(dir + "/manifest.json")).code == 1);  // nothing to vouch for
+  // The lock died with the process; a shorter rerun leaves exactly its own frames.
+  const Result again = run("run " + q(kSmall) + " --frames 3 --out " + q(dir));
+  INFO(again.out);
+  CHECK(again.code == 0);
+  CHECK(again.out.find("removed ") != std::string::npos);
+  CHECK(filesEnding(dir, ".png") == std::vector<std::string>{"frame_00000.png", "frame_00001.png", "frame_00002.png"});
+  CHECK(readManifest(dir).at("complete").get<bool>());
+  CHECK(run("check " + q(kSmall) + " --against " + q(dir + "/manifest.json") + " --files").code == 0);
+}
+
 TEST_CASE("frames are bit-identical across runs and across 1 and 2 simulation threads") {
   const std::string a = freshDir("det_a"), b = freshDir("det_b"), c = freshDir("det_c");
   const std::string args = "run " + q(kSmall) + " --frames 13 --every 4 --quiet --out ";
