@@ -6,6 +6,7 @@
 #include <csignal>
 #include <cstdio>
 #include <cstdlib>
+#include <fstream>
 #include <sstream>
 
 #include <signal.h>
@@ -40,6 +41,66 @@ void installStopHandler() {
 void installExitHandler() {
   setHandler(SIGINT, onSignalExit);
   setHandler(SIGTERM, onSignalExit);
+}
+
+double parseBytes(const std::string& flag, const std::string& v) {
+  char* end = nullptr;
+  errno = 0;
+  double x = std::strtod(v.c_str(), &end);
+  std::string unit = end ? std::string(end) : std::string();
+  if (!unit.empty() && (unit.back() == 'B' || unit.back() == 'b')) unit.pop_back();
+  double scale = 1;
+  if (unit == "K" || unit == "k") scale = 1e3;
+  else if (unit == "M" || unit == "m") scale = 1e6;
+  else if (unit == "G" || unit == "g") scale = 1e9;
+  else if (!unit.empty()) x = -1;
+  if (v.empty() || errno || !(x > 0) || !std::isfinite(x * scale))
+    throw UsageError(flag + " expects a size such as 512M or 2G (bytes, K, M or G), got '" + v + "'");
+  return x * scale;
+}
+
+double availableMemoryBytes() {
+  double avail = 0;
+  {
+    std::ifstream in("/proc/meminfo");
+    std::string key;
+    double kb = 0;
+    std::string unit;
+    while (in >> key >> kb >> unit)
+      if (key == "MemAvailable:") {
+        avail = kb * 1024;
+        break;
+      }
+  }
+  // A container's limit (cgroup v2), when it is lower.
+  std::ifstream maxIn("/sys/fs/cgroup/memory.max"), curIn("/sys/fs/cgroup/memory.current");
+  std::string maxText;
+  double cur = 0;
+  if (maxIn >> maxText && maxText != "max" && curIn >> cur) {
+    const double left = std::strtod(maxText.c_str(), nullptr) - cur;
+    if (left > 0 && (avail == 0 || left < avail)) avail = left;
+  }
+  return avail;
+}
+
+double estimateRunBytes(const SceneDef& scene, bool images) {
+  return estimateWorldBytes(scene) + (images ? Renderer::estimateBytes(scene.render.width, scene.render.height) : 0.0);
+}
+
+void checkMemory(const SceneDef& scene, bool images, double limit) {
+  const bool given = limit > 0;
+  if (!given) limit = availableMemoryBytes();
+  const double need = estimateRunBytes(scene, images);
+  if (!(limit > 0) || need <= limit) return;
+  std::ostringstream o;
+  o.setf(std::ios::fixed);
+  o.precision(0);
+  o << "the scene would hold about " << need / 1e6 << " MB at its peak (" << peakParticles(scene)
+    << " particles: its blocks, emitters and timeline, capped by the particle budget"
+    << (images ? "; the renderer and its images" : "") << "), more than " << (given ? "--max-memory" : "the memory available")
+    << " (" << limit / 1e6 << " MB); use a larger spacing, a lower max_particles or effects.budget"
+    << (given ? ", or raise --max-memory" : "");
+  throw UsageError(o.str());
 }
 
 int parseInt(const std::string& flag, const std::string& v, int lo, int hi) {

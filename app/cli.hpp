@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "sph2d/render/renderer.hpp"
+#include "sph2d/scene.hpp"
 
 namespace sph2d::cli {
 
@@ -21,6 +22,22 @@ struct UsageError : std::runtime_error {
 int parseInt(const std::string& flag, const std::string& v, int lo, int hi);
 /// Parses a finite number or throws UsageError naming the flag.
 double parseNumber(const std::string& flag, const std::string& v);
+/// A size in bytes: a number with an optional K, M or G (powers of 1000, "B" allowed:
+/// "512M", "1.5GB", "2000000"). Throws UsageError naming `flag`.
+double parseBytes(const std::string& flag, const std::string& v);
+
+/// Memory this process may still take [bytes]: MemAvailable of /proc/meminfo, or the
+/// cgroup's memory.max less its usage when lower; 0 when neither can be read.
+double availableMemoryBytes();
+
+/// The peak a run of `scene` will hold: estimateWorldBytes plus, when rendering, the
+/// renderer's context and images (`width` × `height`).
+double estimateRunBytes(const SceneDef& scene, bool images);
+
+/// Refuses (UsageError, exit 2) a run whose estimated peak exceeds `limit` bytes
+/// (--max-memory), or the memory available when `limit` is 0, before anything is
+/// allocated: the message gives the estimate, its parts and the limit.
+void checkMemory(const SceneDef& scene, bool images, double limit);
 /// Parses a comma-separated list of integers in [lo, hi].
 std::vector<int> parseIntList(const std::string& flag, const std::string& v, int lo, int hi);
 /// Splits a comma-separated list (empty items dropped).

@@ -344,6 +344,7 @@ int cmdCheck(const std::vector<std::string>& args) {
   }
   EventIntake input(scene, [](const std::string&) {});
   addManifestEvents(input, m, manifestPath, scene);
+  checkMemory(scene, true, 0);  // before anything is allocated
   World world(scene, WorldOptions{threads});
   world.takeWarnings();
   Renderer renderer(scene.render, mv.render);

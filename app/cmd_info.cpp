@@ -13,7 +13,7 @@ namespace sph2d::cli {
 namespace {
 
 const char* kInfoHelp =
-    "Usage: sph2d info SCENE.json [--threads T]\n"
+    "Usage: sph2d info SCENE.json [--threads T] [--max-memory S]\n"
     "\n"
     "Prints what SCENE will simulate, without running it: particles, solver, effects\n"
     "and stages, emitters, boundaries, frames and the substeps per frame the initial\n"
@@ -21,6 +21,8 @@ const char* kInfoHelp =
     "\n"
     "Options:\n"
     "  --threads T     job-system threads (default: all cores)\n"
+    "  --max-memory S  the limit the memory estimate is held to (default: the memory\n"
+    "                  available); above it info prints the estimate and exits 2\n"
     "  --help          this text\n";
 
 }  // namespace
@@ -28,6 +30,7 @@ const char* kInfoHelp =
 int cmdInfo(const std::vector<std::string>& args) {
   std::string path;
   int threads = 0;
+  double maxMemory = 0;
   for (std::size_t i = 0; i < args.size(); ++i) {
     if (args[i] == "--help" || args[i] == "-h") {
       std::fputs(kInfoHelp, stdout);
@@ -36,6 +39,9 @@ int cmdInfo(const std::vector<std::string>& args) {
     if (args[i] == "--threads") {
       if (i + 1 >= args.size()) throw UsageError("--threads needs a value");
       threads = parseInt("--threads", args[++i], 1, 256);
+    } else if (args[i] == "--max-memory") {
+      if (i + 1 >= args.size()) throw UsageError("--max-memory needs a value");
+      maxMemory = parseBytes("--max-memory", args[++i]);
     } else if (args[i][0] == '-') {
       throw UsageError("unknown option '" + args[i] + "' (see sph2d info --help)");
     } else if (path.empty()) {
@@ -46,6 +52,13 @@ int cmdInfo(const std::vector<std::string>& args) {
   }
   if (path.empty()) throw UsageError("missing the scene file (see sph2d info --help)");
   const SceneDef s = loadScene(path);
+  // The estimate comes first: info builds the World (its boundary samples, its particles),
+  // and a scene too large for the machine is refused before that.
+  const double estimate = estimateRunBytes(s, true);
+  std::printf("memory       about %.1f MB at the peak, estimated before allocating (%zu particles at most, "
+              "about %.0f boundary samples, the renderer at %dx%d)\n",
+              estimate / 1e6, peakParticles(s), estimateBoundarySamples(s), s.render.width, s.render.height);
+  checkMemory(s, true, maxMemory);
   World w(s, WorldOptions{threads});
   for (const auto& m : w.takeWarnings()) std::printf("warning: %s\n", m.c_str());
   std::size_t fixtures = 0;
@@ -92,14 +105,9 @@ int cmdInfo(const std::vector<std::string>& args) {
   std::printf("events       %zu in the timeline\n", s.events.size());
   for (const EventDef& e : s.events)
     std::printf("             frame %lld: %s\n", (long long)eventFrame(e, s.fps), describeEvent(e).c_str());
-  const double mb = double(w.memoryBytes()) / 1e6;
-  std::printf("memory       %.1f MB (particle arrays %.1f MB; grid, neighbour lists, boundary samples)", mb,
-              double(w.particles().bytes()) / 1e6);
-  if (w.emitterCount() && w.particleCount() > 0) {
-    const std::size_t budget = s.effects.budget ? s.effects.budget : s.maxParticles;
-    std::printf("; about %.1f MB at the budget of %zu particles", mb / double(w.particleCount()) * double(budget), budget);
-  }
-  std::printf("\n");
+  std::printf("engine       %.1f MB held by the World now (particle arrays %.1f MB; grid, neighbour lists, "
+              "boundary samples)\n",
+              double(w.memoryBytes()) / 1e6, double(w.particles().bytes()) / 1e6);
   std::printf("image        %dx%d, %s mode\n", s.render.width, s.render.height, s.render.mode.c_str());
   return 0;
 }

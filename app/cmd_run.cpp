@@ -109,6 +109,9 @@ int cmdRun(const std::vector<std::string>& args) {
   if (a.images && a.render.colorBy == ColorField::Age && (a.render.mode == "particles" || (a.render.mode.empty() && scene.render.mode == "particles")))
     if (!scene.effects.lifetime)
       throw UsageError("--color-by age needs particle ages: enable effects.lifetime in the scene");
+  // Memory, before anything is allocated: a scene that cannot fit is refused now, not after
+  // seconds of set-up with std::bad_alloc.
+  checkMemory(scene, a.images, a.maxMemory);
   // The output directory: one run at a time holds it (a second one is refused, naming the first).
   std::optional<OutputLock> outLock;
   if (a.images) {

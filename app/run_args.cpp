@@ -33,6 +33,8 @@ const char* kRunHelp =
     "  --input -       apply events read from standard input, one JSON object per line,\n"
     "                  at the next frame; a bad line is reported and skipped\n"
     "  --record FILE   write every applied event with its frame (replay it with --input)\n"
+    "  --max-memory S  refuse (exit 2) a scene whose estimated peak memory exceeds S (512M,\n"
+    "                  2G, ...; default: the memory available)\n"
     "  --png-level N   PNG compression 0..9 (default 1: fast)\n"
     "  --export FMT    also write each kept frame's particles: csv, vtk (binary) or vtk-ascii\n"
     "  --video FILE    also encode the kept frames into FILE with ffmpeg (must be installed)\n"
@@ -84,6 +86,7 @@ RunArgs parseRunArgs(const std::vector<std::string>& a) {
       if (r.inputs.back() == "-" && std::count(r.inputs.begin(), r.inputs.end(), "-") > 1)
         throw UsageError("--input - may be given once (there is one standard input)");
     } else if (s == "--record") r.record = value();
+    else if (s == "--max-memory") r.maxMemory = parseBytes(s, value());
     else if (s == "--no-images") r.images = false;
     else if (s == "--state-hash") r.stateHash = true;
     else if (s == "--profile") r.profile = true;

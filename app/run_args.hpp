@@ -19,6 +19,7 @@ struct RunArgs {
   int threads = 0;                           ///< --threads (0: all cores)
   int every = 1;                             ///< --every
   int pngLevel = 1;                          ///< --png-level
+  double maxMemory = 0;                      ///< --max-memory [bytes] (0: the memory available)
   std::optional<ExportFormat> exportFormat;  ///< --export
   RenderOptions render;                      ///< the render flags
   bool images = true;                        ///< false with --no-images

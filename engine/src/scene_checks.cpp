@@ -103,35 +103,6 @@ std::pair<double, double> blockLattice(const FluidBlockDef& b, double dx) {
   return {std::floor((b.max.x() - b.min.x()) / dx + 1e-9), std::floor((b.max.y() - b.min.y()) / dx + 1e-9)};
 }
 
-/// An upper estimate of the boundary samples the World will lay in the solids
-/// (layers of ceil(R/dx) rows under every face, both sides of segments).
-double estimateBoundarySamples(const SceneDef& s) {
-  const double dx = s.solver.spacing;
-  const double layers = std::max(1.0, std::ceil(s.solver.supportRatio - 1e-9));
-  const auto along = [&](double len) { return std::max(1.0, std::round(len / dx)); };
-  double total = 0;
-  for (const BodyDef& b : s.bodies)
-    for (const ShapeDef& f : b.fixtures) {
-      switch (f.type) {
-        case ShapeDef::Type::Box:
-          total += layers * 2 * (along(2 * f.halfSize.x()) + along(2 * f.halfSize.y()));
-          break;
-        case ShapeDef::Type::Polygon:
-          for (std::size_t i = 0; i < f.vertices.size(); ++i)
-            total += layers * along((f.vertices[(i + 1) % f.vertices.size()] - f.vertices[i]).norm());
-          break;
-        case ShapeDef::Type::Circle:
-          total += layers * std::max(3.0, std::round(2 * 3.14159265358979 * f.radius / dx));
-          break;
-        case ShapeDef::Type::Edge:
-        case ShapeDef::Type::Chain:
-          for (std::size_t i = 0; i + 1 < f.vertices.size(); ++i) total += 2 * layers * along((f.vertices[i + 1] - f.vertices[i]).norm());
-          if (f.loop) total += 2 * layers * along((f.vertices.front() - f.vertices.back()).norm());
-          break;
-      }
-    }
-  return total;
-}
 
 Vec2d rotate(const Vec2d& v, double angle) {
   const double c = std::cos(angle), s = std::sin(angle);
@@ -323,6 +294,60 @@ void checkParticleBudget(const Reader& r, const SceneDef& s) {
                                  " boundary samples, more than max(max_particles, " + std::to_string(kMinSampleBudget) +
                                  ") = " + std::to_string(sampleBudget) +
                                  "; use a larger spacing or smaller solids");
+}
+
+/// An upper estimate of the boundary samples the World will lay in the solids
+/// (layers of ceil(R/dx) rows under every face, both sides of segments).
+double estimateBoundarySamples(const SceneDef& s) {
+  const double dx = s.solver.spacing;
+  const double layers = std::max(1.0, std::ceil(s.solver.supportRatio - 1e-9));
+  const auto along = [&](double len) { return std::max(1.0, std::round(len / dx)); };
+  double total = 0;
+  for (const BodyDef& b : s.bodies)
+    for (const ShapeDef& f : b.fixtures) {
+      switch (f.type) {
+        case ShapeDef::Type::Box:
+          total += layers * 2 * (along(2 * f.halfSize.x()) + along(2 * f.halfSize.y()));
+          break;
+        case ShapeDef::Type::Polygon:
+          for (std::size_t i = 0; i < f.vertices.size(); ++i)
+            total += layers * along((f.vertices[(i + 1) % f.vertices.size()] - f.vertices[i]).norm());
+          break;
+        case ShapeDef::Type::Circle:
+          total += layers * std::max(3.0, std::round(2 * 3.14159265358979 * f.radius / dx));
+          break;
+        case ShapeDef::Type::Edge:
+        case ShapeDef::Type::Chain:
+          for (std::size_t i = 0; i + 1 < f.vertices.size(); ++i) total += 2 * layers * along((f.vertices[i + 1] - f.vertices[i]).norm());
+          if (f.loop) total += 2 * layers * along((f.vertices.front() - f.vertices.back()).norm());
+          break;
+      }
+    }
+  return total;
+}
+
+std::size_t peakParticles(const SceneDef& scene) {
+  const double dx = scene.solver.spacing;
+  double n = double(countBlockParticles(scene));
+  for (const EmitterDef& e : scene.effects.emitters) {
+    const double from = std::max(0.0, e.start), to = std::min(e.stop, scene.duration);
+    if (to > from && e.rate > 0) n += e.rate * (to - from);
+  }
+  for (const EventDef& e : scene.events) {
+    if (e.type == EventDef::Type::Block) {
+      const auto [nx, ny] = blockLattice(e.block, dx);
+      if (nx > 0 && ny > 0) n += nx * ny;
+    } else if (e.type == EventDef::Type::Drop) {
+      n += 3.14159265358979323846 * (e.radius / dx + 1) * (e.radius / dx + 1);
+    }
+  }
+  const std::size_t budget = scene.effects.budget > 0 ? scene.effects.budget : scene.maxParticles;
+  return n >= double(budget) ? budget : std::size_t(n);
+}
+
+double estimateWorldBytes(const SceneDef& scene) {
+  return kProcessBytes + kBytesPerParticle * double(peakParticles(scene)) +
+         kBytesPerSample * estimateBoundarySamples(scene);
 }
 
 std::size_t countBlockParticles(const SceneDef& scene) {

@@ -57,6 +57,15 @@ void checkPeriod(const Reader& r, const Vec2d& range, double R, const std::strin
 /// A camera (at `path`) with max > min and at least kMinCameraSize wide and high.
 void checkCamera(const Reader& r, const CameraDef& camera, const std::string& path);
 
+/// Bytes of the estimate of a run's peak (estimateWorldBytes): the process (code, libraries,
+/// thread stacks), each particle at the peak (its arrays, neighbour lists, the solvers' pair
+/// caches, the grids, allocator slack) and each boundary sample. Measured as the peak
+/// resident set of `sph2d run --no-images`: 55–61 MB with a few thousand particles; 149–151 MB
+/// at 163k (game, dfsph): 580 B a particle above the process.
+constexpr double kProcessBytes = 60e6;
+constexpr double kBytesPerParticle = 600;
+constexpr double kBytesPerSample = 64;
+
 /// The particles of the blocks and the boundary samples of the solids of the whole
 /// scene fit its budget (max_particles; samples: max(max_particles, kMinSampleBudget)).
 /// Reported at solver.spacing.

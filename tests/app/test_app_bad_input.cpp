@@ -4,8 +4,14 @@
 // here each class goes through the executable once.
 #include <doctest/doctest.h>
 
+#include <fcntl.h>
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <string>
 
 #include "app_runner.hpp"
@@ -99,5 +105,82 @@ TEST_CASE("app bad input: a missing scene file and a directory exit 2 naming the
   CHECK(r.code == 2);
   CHECK(r.out.find("sph2d: bad scene: " + dir + ": is a directory, not a scene file") != std::string::npos);
   CHECK_FALSE(fs::exists(dir + "/frames"));
+  fs::remove_all(dir);
+}
+
+TEST_CASE("bad input: a scene whose estimated peak memory exceeds the limit is refused before allocating") {
+  // Before (issue 18): 50M or 99M particles under max_particles 1e8, or an emitter of 1e8
+  // particles/s, failed after 9–27 s with std::bad_alloc at 5–7 GB, while info said 28.6 MB.
+  const std::string dir = scratch("memory_estimate");
+  const std::string huge = dir + "/huge.json", emitter = dir + "/emitter.json";
+  std::ofstream(huge) << R"({"name": "huge", "max_particles": 100000000,
+    "solver": {"type": "wcsph", "spacing": 0.0002},
+    "boundaries": [{"fixtures": [{"shape": "box", "center": [2, -0.1], "half_size": [2.2, 0.1]}]}],
+    "fluid": [{"min": [0, 0], "max": [1, 2]}]})";
+  std::ofstream(emitter) << R"({"name": "emitter", "max_particles": 100000000, "duration": 4,
+    "solver": {"type": "wcsph", "spacing": 0.02},
+    "boundaries": [{"fixtures": [{"shape": "box", "center": [2, -0.1], "half_size": [2.2, 0.1]}]}],
+    "effects": {"emitters": [{"position": [1, 1], "direction": [1, 0], "rate": 1e8, "speed": 1}]}})";
+  for (const std::string& scene : {huge, emitter}) {
+    const std::string out = dir + "/frames";
+    // --max-memory makes the limit the same on every machine (the default is the memory available).
+    const Result r = runSph2d("run " + q(scene) + " --frames 2 --max-memory 1G --out " + q(out));
+    INFO(r.out);
+    CHECK(r.code == 2);
+    CHECK(r.out.find("sph2d: the scene would hold about ") != std::string::npos);
+    CHECK(r.out.find("more than --max-memory (1000 MB)") != std::string::npos);
+    CHECK_FALSE(fs::exists(out));
+    const Result info = runSph2d("info " + q(scene) + " --max-memory 1G");
+    CHECK(info.code == 2);
+    CHECK(info.out.find("memory       about ") != std::string::npos);
+  }
+  CHECK(runSph2d("info " + q(huge) + " --max-memory 1G").out.find("50000000 particles at most") != std::string::npos);
+  CHECK(runSph2d("info " + q(emitter) + " --max-memory 1G").out.find("100000000 particles at most") != std::string::npos);
+  CHECK(runSph2d("run " + q(huge) + " --max-memory lots").code == 2);
+  fs::remove_all(dir);
+}
+
+TEST_CASE("info's memory estimate is within a factor of 2 of the run's measured peak") {
+  // The default scene, and the dam break at about 100k particles (spacing 0.0045).
+  const std::string dir = scratch("memory_peak");
+  std::string text;
+  {
+    std::ifstream in(asset("scenes/dam_break.json"));
+    text.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  }
+  const std::string big = dir + "/dam_break_100k.json";
+  {
+    std::string t = text;
+    const auto at = t.find("\"spacing\": 0.014");
+    REQUIRE(at != std::string::npos);
+    t.replace(at, 16, "\"spacing\": 0.0045");
+    std::ofstream(big) << t;
+  }
+  for (const std::string& scene : {asset("scenes/dam_break.json"), big}) {
+    const Result info = runSph2d("info " + q(scene));
+    const auto at = info.out.find("memory       about ");
+    REQUIRE(at != std::string::npos);
+    const double estimate = std::stod(info.out.substr(at + 19)) * 1e6;
+    const std::string log = dir + "/run.log", out = dir + "/frames";
+    const pid_t pid = fork();
+    REQUIRE(pid >= 0);
+    if (pid == 0) {
+      const int fd = ::open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+      ::dup2(fd, 1);
+      ::dup2(fd, 2);
+      execl(SPH2D_EXE, SPH2D_EXE, "run", scene.c_str(), "--frames", "30", "--quiet", "--out", out.c_str(),
+            static_cast<char*>(nullptr));
+      _exit(127);
+    }
+    int status = 0;
+    struct rusage ru {};
+    REQUIRE(::wait4(pid, &status, 0, &ru) == pid);
+    REQUIRE(WIFEXITED(status));
+    CHECK(WEXITSTATUS(status) == 0);
+    const double peak = double(ru.ru_maxrss) * 1024.0;
+    MESSAGE(scene << ": estimate " << estimate / 1e6 << " MB, measured peak " << peak / 1e6 << " MB");
+    CHECK(peak <= 2 * estimate);
+    CHECK(estimate <= 2 * peak);
+  }
   fs::remove_all(dir);
 }

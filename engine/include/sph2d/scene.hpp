@@ -208,4 +208,19 @@ SceneDef parseScene(const std::string& text, const std::string& file);
 /// Number of particles the blocks of `scene` will create.
 std::size_t countBlockParticles(const SceneDef& scene);
 
+/// An upper estimate of the boundary samples the World will lay in the solids of `scene`
+/// (layers of ceil(R/dx) rows under every face, both sides of segments).
+double estimateBoundarySamples(const SceneDef& scene);
+
+/// The most particles a run of `scene` can hold: its blocks, what its emitters emit over
+/// its duration and its timeline's blocks and drops, capped by the particle budget
+/// (effects.budget, else max_particles). Events from elsewhere are capped by the budget too.
+std::size_t peakParticles(const SceneDef& scene);
+
+/// The peak memory a process simulating `scene` will hold [bytes], estimated from the
+/// scene alone (nothing is allocated): the process itself, the particles at
+/// peakParticles() and the boundary samples; within a factor of 2 of the measured peak
+/// resident set (tested). A renderer adds its images (sph2d::Renderer's estimate).
+double estimateWorldBytes(const SceneDef& scene);
+
 }  // namespace sph2d

@@ -97,6 +97,10 @@ struct RenderTimings {
 /// Renders frames of a World.
 class Renderer {
  public:
+  /// The memory a renderer of `width` × `height` frames holds at most [bytes]: the OSMesa
+  /// context and llvmpipe (about 40 MB, measured) and eight RGBA images (framebuffers,
+  /// readback, the PNG writer's queue).
+  static double estimateBytes(int width, int height) { return 40e6 + 8.0 * 4.0 * double(width) * double(height); }
   /// Creates the OSMesa context and GL resources for `def`. Throws std::runtime_error.
   explicit Renderer(const RenderDef& def, const RenderOptions& options = {});
   ~Renderer();
