@@ -23,8 +23,8 @@ const EnvPin kEnv[] = {
     {"MESA_SHADER_CACHE_DISABLE", "true"},  // hermetic runs: nothing read from or written to ~/.cache
     // Pixels are identical for 0, 1, 2 and 8 (docs/RENDERING.md). 0 rasterises on the GL
     // thread: the simulation's threads already hold the cores, and llvmpipe's own threads
-    // only add hand-offs (the demo on 2 cores: 3.7-4.0 s with 0, 4.0-4.1 s unset, 4.2-4.6
-    // s with 1, four paired rounds).
+    // only add hand-offs (the demo on 2 cores, median of paired rounds: 4.2 s with 0, 4.5 s
+    // with 2; the figures in docs/RENDERING.md).
     {"LP_NUM_THREADS", "0"},
     {"LP_NATIVE_VECTOR_WIDTH", nullptr},  // measured: 128 and 256 give identical pixels
     {"GALLIUM_OVERRIDE_CPU_CAPS", nullptr},  // changes pixels when it removes AVX/FMA (measured)
