@@ -464,3 +464,35 @@ TEST_CASE("sph2d render redraws an exported CSV frame bit-identically to the run
               q(dir + "/discs.png") + " --mode particles --color-by density").code == 0);
   CHECK(pngHash(dir + "/discs.png") != pngHash(dir + "/again.png"));
 }
+
+TEST_CASE("sph2d render refuses a CSV with a NaN or infinite value, naming the line and the column") {
+  // Before (issue 18): NaN and infinite positions were accepted and a picture was written.
+  const std::string dir = freshDir("rerender_nan");
+  REQUIRE(run("run " + q(kSmall) + " --frames 1 --quiet --export csv --out " + q(dir)).code == 0);
+  const std::string text = readText(dir + "/frame_00000.csv");
+  // Line 4 is the second particle: replace one value at a time.
+  const auto lineStart = [&](int n) {
+    std::size_t at = 0;
+    for (int k = 1; k < n; ++k) at = text.find('\n', at) + 1;
+    return at;
+  };
+  struct Bad {
+    int column;  // 1 = x, 2 = y, 4 = vy
+    const char* value;
+    const char* name;
+  };
+  for (const Bad b : {Bad{1, "nan", "x"}, Bad{2, "inf", "y"}, Bad{4, "-inf", "vy"}, Bad{1, "1e999", "x"}, Bad{4, "1e300", "vy"}}) {
+    std::string t = text;
+    std::size_t at = lineStart(4);
+    for (int c = 0; c < b.column; ++c) at = t.find(',', at) + 1;
+    t.replace(at, t.find_first_of(",\n", at) - at, b.value);
+    const std::string bad = dir + "/bad.csv", png = dir + "/bad.png";
+    std::ofstream(bad) << t;
+    const Result r = run("render " + q(kSmall) + " --particles " + q(bad) + " --out " + q(png));
+    INFO(b.value, " ", r.out);
+    CHECK(r.code == 2);
+    CHECK(r.out.find(bad + ":4: column " + b.name + " is ") != std::string::npos);
+    CHECK(r.out.find("every value must be a finite number") != std::string::npos);
+    CHECK_FALSE(fs::exists(png));
+  }
+}

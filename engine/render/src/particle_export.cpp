@@ -6,6 +6,7 @@
 #include <cstdarg>
 #include <type_traits>
 #include <cerrno>
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <fstream>
@@ -205,6 +206,18 @@ ParticleSnapshot readParticlesCsv(const std::string& path) {
     const int want = hasAge ? 8 : 7;
     if (std::sscanf(line.c_str(), "%u,%lf,%lf,%lf,%lf,%lf,%lf,%lf", &id, &x, &y, &vx, &vy, &rho, &p, &age) != want)
       throw std::runtime_error(path + ":" + std::to_string(lineNo) + ": expected " + std::to_string(want) + " values");
+    {
+      // Every value must be a finite number (in float for the stored columns): a NaN or an
+      // infinity would be drawn as garbage, or nothing, without a word.
+      const char* names[8] = {"x", "y", "vx", "vy", "density", "pressure", "age", ""};
+      const double values[8] = {x, y, vx, vy, rho, p, age, 0};
+      for (int k = 0; k < want - 1; ++k) {
+        const bool asFloat = k >= 2;  // x, y are kept in double
+        if (!std::isfinite(values[k]) || (asFloat && !std::isfinite(float(values[k]))))
+          throw std::runtime_error(path + ":" + std::to_string(lineNo) + ": column " + names[k] + " is " +
+                                   std::to_string(values[k]) + "; every value must be a finite number");
+      }
+    }
     s.id.push_back(id);
     s.x.push_back(x);
     s.y.push_back(y);
