@@ -496,3 +496,16 @@ TEST_CASE("sph2d render refuses a CSV with a NaN or infinite value, naming the l
     CHECK_FALSE(fs::exists(png));
   }
 }
+
+TEST_CASE("an image written to a device is written in place: /dev/full says No space left on device and stays a device") {
+  // Before: the atomic writer renamed its temporary file over the target, so as root
+  // `--out /dev/full` replaced the device node with a PNG file and reported success.
+  if (!fs::exists("/dev/full") || !fs::is_character_file("/dev/full")) return;
+  const std::string dir = freshDir("render_device");
+  REQUIRE(run("run " + q(kSmall) + " --frames 1 --quiet --export csv --out " + q(dir)).code == 0);
+  const Result r = run("render " + q(kSmall) + " --particles " + q(dir + "/frame_00000.csv") + " --out /dev/full");
+  INFO(r.out);
+  CHECK(r.code == 1);
+  CHECK(r.out.find("cannot write /dev/full: No space left on device") != std::string::npos);
+  CHECK(fs::is_character_file("/dev/full"));
+}

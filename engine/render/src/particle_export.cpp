@@ -1,5 +1,7 @@
 #include "sph2d/render/particle_export.hpp"
 
+#include "file_io.hpp"
+
 #include <unistd.h>
 
 #include <algorithm>
@@ -81,6 +83,7 @@ bool parseExportFormat(const std::string& s, ExportFormat& out) {
 std::string exportExtension(ExportFormat f) { return f == ExportFormat::Csv ? "csv" : "vtk"; }
 
 void writeFileAtomic(const std::string& path, const std::string& bytes) {
+  if (isSpecialFile(path)) return writeInPlace(path, bytes.data(), bytes.size());  // a device, a FIFO: no rename over it
   const std::string tmp = path + ".tmp" + std::to_string(::getpid());
   FILE* f = std::fopen(tmp.c_str(), "wb");
   if (!f) throw std::runtime_error("cannot create " + tmp + ": " + std::strerror(errno));

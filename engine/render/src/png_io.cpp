@@ -2,6 +2,8 @@
 // written to a temporary name and renamed.
 #include "sph2d/render/png_io.hpp"
 
+#include "file_io.hpp"
+
 #include <png.h>
 #include <zlib.h>
 #include <unistd.h>
@@ -163,6 +165,7 @@ void writePngAtomic(const std::string& path, int width, int height, const std::u
   } catch (const std::exception& e) {
     throw std::runtime_error("cannot write " + path + ": " + e.what());
   }
+  if (isSpecialFile(path)) return writeInPlace(path, bytes.data(), bytes.size());  // a device, a FIFO: no rename over it
   const std::string tmp = path + ".tmp" + std::to_string(::getpid());
   FILE* f = std::fopen(tmp.c_str(), "wb");
   if (!f) throw std::runtime_error("cannot create " + tmp + ": " + std::strerror(errno));

@@ -1,0 +1,39 @@
+// file_io.hpp (internal) — writing a file's bytes where the path is not a regular file.
+// The writers replace regular files atomically (a temporary file renamed over the
+// target), but renaming over a device, a FIFO or a socket would replace the node itself
+// (as root, `--out /dev/full` turned the device into a PNG file): such a target is
+// written in place instead, and its errors (ENOSPC on /dev/full) reported.
+#pragma once
+
+#include <sys/stat.h>
+
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <stdexcept>
+#include <string>
+
+namespace sph2d {
+
+/// True when `path` exists and is not a regular file (after symlinks).
+inline bool isSpecialFile(const std::string& path) {
+  struct stat st {};
+  return ::stat(path.c_str(), &st) == 0 && !S_ISREG(st.st_mode);
+}
+
+/// Writes `size` bytes to `path` in place. Throws std::runtime_error naming the path and
+/// the system's reason.
+inline void writeInPlace(const std::string& path, const void* data, std::size_t size) {
+  FILE* f = std::fopen(path.c_str(), "wb");
+  if (!f) throw std::runtime_error("cannot open " + path + ": " + std::strerror(errno));
+  bool ok = std::fwrite(data, 1, size, f) == size;
+  ok = std::fflush(f) == 0 && ok;
+  std::string why = ok ? "" : std::strerror(errno);
+  if (std::fclose(f) != 0 && ok) {
+    ok = false;
+    why = std::strerror(errno);
+  }
+  if (!ok) throw std::runtime_error("cannot write " + path + ": " + why);
+}
+
+}  // namespace sph2d
