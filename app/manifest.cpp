@@ -57,8 +57,9 @@ RenderOptions renderOptionsFromJson(const json& j) {
     o.overlay = j.at("overlay").get<bool>();
     o.foamSpeed = j.at("foam_speed").get<double>();
     o.depthScale = j.at("depth_scale").get<double>();
-  } catch (const json::exception& e) {
-    throw UsageError(std::string("the manifest's render options are malformed: ") + e.what());
+  } catch (const json::exception&) {
+    throw UsageError("the manifest's render options are malformed: mode, color_by, range, overlay, foam_speed and "
+                     "depth_scale are read as sph2d run writes them");
   }
   return o;
 }
@@ -126,14 +127,37 @@ ManifestView readManifest(const std::string& path) {
       throw UsageError(path + " is not valid JSON: " + e.what());
     }
   }
+  // `key` names what is read, so that a missing or mistyped value is reported by its key
+  // and the type wanted, not by the JSON library's text.
+  std::string key = "format", want = "the string \"sph2d-frames\"";
   try {
-    if (m.at("format").get<std::string>() != "sph2d-frames") throw UsageError(path + " is not an sph2d frames manifest");
+    if (!m.is_object() || m.at("format").get<std::string>() != "sph2d-frames") throw UsageError(path + " is not an sph2d frames manifest");
+    key = "run.frames", want = "an integer";
     v.frames = m.at("run").at("frames").get<int>();
+    key = "run.every";
     v.every = std::max(1, m.at("run").at("every").get<int>());
+    key = "renderer", want = "a string";
     v.renderer = m.at("renderer").get<std::string>();
+    key = "cpu";
     v.cpu = m.value("cpu", "");
+    key = "scene.xxh64";
     v.sceneHash = m.at("scene").at("xxh64").get<std::string>();
+    key = "render", want = "the render options sph2d run writes";
     v.render = renderOptionsFromJson(m.at("render"));
+    key = "complete", want = "true or false";
+    (void)m.value("complete", false);
+    if (m.contains("stop") && !m["stop"].is_null()) {
+      key = "stop", want = "an object with reason and message strings and frames_written";
+      const json& st = m.at("stop");
+      (void)st.at("reason").get<std::string>();
+      (void)st.value("message", std::string());
+      (void)st.value("frames_written", 0);
+    }
+    if (m.contains("events")) {
+      key = "events", want = "an array";
+      if (!m["events"].is_array()) throw json::type_error::create(302, "not an array", &m["events"]);
+    }
+    key = "frames", want = "an array of objects with frame, file, rgba_xxh64 and state_hash";
     if (v.frames < 0 || v.frames > 100000000) throw UsageError(path + ": run.frames must be 0..100000000");
     auto hex16 = [](const std::string& h) {
       return h.size() == 16 && std::all_of(h.begin(), h.end(), [](char c) { return std::isxdigit(static_cast<unsigned char>(c)); });
@@ -179,8 +203,8 @@ ManifestView readManifest(const std::string& path) {
           break;
         }
     }
-  } catch (const json::exception& e) {
-    throw UsageError(path + " lacks a field `sph2d check` needs: " + e.what());
+  } catch (const json::exception&) {
+    throw UsageError(path + ": the key '" + key + "' is missing or not " + want + " (as sph2d run writes it)");
   }
   return v;
 }

@@ -11,6 +11,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <sstream>
 #include <limits>
 #include <utility>
 
@@ -275,9 +276,17 @@ void checkPeriod(const Reader& r, const Vec2d& range, double R, const std::strin
 void checkCamera(const Reader& r, const CameraDef& camera, const std::string& p) {
   checkMaxAboveMin(r, camera.min, camera.max, p);
   const Vec2d size = camera.max - camera.min;
-  if (size.x() < kMinCameraSize || size.y() < kMinCameraSize)
-    r.fail(Reader::sub(p, "max"), "the camera shows " + fmt(size.x()) + " m x " + fmt(size.y()) +
+  if (size.x() < kMinCameraSize || size.y() < kMinCameraSize) {
+    // Enough digits that a size just under the limit does not print as the limit itself.
+    auto exact = [](double v) {
+      std::ostringstream o;
+      o.precision(12);
+      o << v;
+      return o.str();
+    };
+    r.fail(Reader::sub(p, "max"), "the camera shows " + exact(size.x()) + " m x " + exact(size.y()) +
                                       " m; it must be at least 0.001 m wide and high");
+  }
 }
 
 void checkParticleBudget(const Reader& r, const SceneDef& s) {

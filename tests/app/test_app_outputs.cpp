@@ -313,6 +313,23 @@ TEST_CASE("sph2d check checks both hashes of every frame, the frame list against
     const Result r = check(m);
     CHECK(r.code == 2);
     CHECK(r.out.find("frames[0]: its file must be frame_00000.png") != std::string::npos);
+    // Mistyped values: exit 2 naming the key (before, issue 18: the JSON library's text, or exit 1).
+    m = good;
+    m["complete"] = "yes";
+    Result t = check(m);
+    CHECK(t.code == 2);
+    CHECK(t.out.find("the key 'complete' is missing or not true or false") != std::string::npos);
+    CHECK(t.out.find("json.exception") == std::string::npos);
+    m = good;
+    m["run"]["frames"] = "five";
+    t = check(m);
+    CHECK(t.code == 2);
+    CHECK(t.out.find("the key 'run.frames' is missing or not an integer") != std::string::npos);
+    m = good;
+    m["frames"][1]["state_hash"] = 7;
+    t = check(m);
+    CHECK(t.code == 2);
+    CHECK(t.out.find("the key 'frames' is missing or not an array of objects") != std::string::npos);
   }
   {
     // --files: a frame file swapped for another frame's, and a stale frame of another run.

@@ -467,6 +467,9 @@ TEST_CASE("bad input: a degenerate camera is refused") {
   CHECK(e.message == "max must be greater than min in x and in y");
   e = errorOf("{\"render\": {\"camera\": {\"min\": [0, 0], \"max\": [4, 0.0001]}}}");
   CHECK(e.message == "the camera shows 4 m x 0.0001 m; it must be at least 0.001 m wide and high");
+  // Just under the limit (before, issue 18: "shows 0.001 m; must be at least 0.001 m").
+  e = errorOf("{\"render\": {\"camera\": {\"min\": [0, 0], \"max\": [4, 0.0009999]}}}");
+  CHECK(e.message == "the camera shows 4 m x 0.0009999 m; it must be at least 0.001 m wide and high");
   e = errorOf("{\"render\": {\"camera\": {\"min\": [0, 0]}}}");
   CHECK(e.key == "render.camera.max");
   CHECK(e.message == "missing; expected [x, y]");
