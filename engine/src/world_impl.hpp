@@ -92,6 +92,9 @@ struct World::Impl {
   /// depth, at the density the solver holds at rest); `disc` keeps the points of a
   /// drop. Stops at the particle budget (one warning for the rest).
   std::size_t fillBlock(const FluidBlockDef& b, bool hydrostaticStart, const Disc* disc = nullptr);
+  /// Warns once when a weakly compressible solver's sound speed is below 10 × the fastest
+  /// speed the scene sets (blocks, emitters, timeline events).
+  void warnLowSoundSpeed();
   /// The scene key that sets the particle budget.
   const char* budgetKey() const;
   /// The emit stage: every enabled emitter's particles due by the end of the substep.
