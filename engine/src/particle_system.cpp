@@ -163,8 +163,15 @@ void World::Impl::emit(Real dt) {
       const double speed = d.speed * (1.0 + d.jitter * (2.0 * u3 - 1.0));
       const Vec2d vel = vdir * speed;
       // Placed where a particle emitted at te would be at the substep start,
-      // so that the stream is continuous after this substep's integration.
-      const Vec2d pw = d.position + across * (slot * d.width + (u1 - 0.5) * 0.2 * double(dx)) + vel * (time - te);
+      // so that the stream is continuous after this substep's integration; that
+      // point lies upstream of the nozzle by up to speed × substep (a whole frame for
+      // pbf's first substep), so when the way back crosses a solid, or ends in one,
+      // the particle starts at the nozzle instead (it is a little late, never beyond a wall).
+      const Vec2d nozzle = d.position + across * (slot * d.width + (u1 - 0.5) * 0.2 * double(dx));
+      Vec2d pw = nozzle + vel * (time - te);
+      const Vec2 a = Vec2(Real(nozzle.x() - origin.x()), Real(nozzle.y() - origin.y()));
+      const Vec2 b = Vec2(Real(pw.x() - origin.x()), Real(pw.y() - origin.y()));
+      if (!(pw == nozzle) && boundary.blocks(a, b)) pw = nozzle;
       P.push(Vec2(Real(pw.x() - origin.x()), Real(pw.y() - origin.y())), Vec2(Real(vel.x()), Real(vel.y())), nextId++, rho0);
     }
   }
