@@ -2,6 +2,8 @@
 // its exit code and output (stdout and stderr, interleaved).
 #pragma once
 
+#include <fcntl.h>
+#include <signal.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -11,6 +13,7 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <vector>
 
 namespace sph2d::apptest {
 
@@ -45,6 +48,23 @@ inline Result runShell(const std::string& command) {
 /// Runs `prefix sph2d args` (prefix: environment assignments or a wrapper).
 inline Result runSph2d(const std::string& args, const std::string& prefix = "") {
   return runShell(prefix + " \"" + SPH2D_EXE + "\" " + args);
+}
+
+/// Starts `sph2d args` as a child process without a shell, its stdout and stderr into
+/// `log`; with `ignoreSigint` the child starts with SIGINT ignored, as a background job
+/// of a script does. Returns the pid (the caller signals and waits for it).
+inline pid_t spawnSph2d(const std::vector<std::string>& args, const std::string& log, bool ignoreSigint = false) {
+  const pid_t pid = fork();
+  if (pid != 0) return pid;
+  const int fd = ::open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  ::dup2(fd, 1);
+  ::dup2(fd, 2);
+  if (ignoreSigint) signal(SIGINT, SIG_IGN);
+  std::vector<char*> argv{const_cast<char*>(SPH2D_EXE)};
+  for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+  argv.push_back(nullptr);
+  execv(SPH2D_EXE, argv.data());
+  _exit(127);
 }
 
 /// Shell-quotes a path (single quotes).

@@ -4,10 +4,8 @@
 // here each class goes through the executable once.
 #include <doctest/doctest.h>
 
-#include <fcntl.h>
 #include <sys/resource.h>
 #include <sys/wait.h>
-#include <unistd.h>
 
 #include <filesystem>
 #include <fstream>
@@ -162,16 +160,8 @@ TEST_CASE("info's memory estimate is within a factor of 2 of the run's measured 
     REQUIRE(at != std::string::npos);
     const double estimate = std::stod(info.out.substr(at + 19)) * 1e6;
     const std::string log = dir + "/run.log", out = dir + "/frames";
-    const pid_t pid = fork();
-    REQUIRE(pid >= 0);
-    if (pid == 0) {
-      const int fd = ::open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-      ::dup2(fd, 1);
-      ::dup2(fd, 2);
-      execl(SPH2D_EXE, SPH2D_EXE, "run", scene.c_str(), "--frames", "30", "--quiet", "--out", out.c_str(),
-            static_cast<char*>(nullptr));
-      _exit(127);
-    }
+    const pid_t pid = spawnSph2d({"run", scene, "--frames", "30", "--quiet", "--out", out}, log);
+    REQUIRE(pid > 0);
     int status = 0;
     struct rusage ru {};
     REQUIRE(::wait4(pid, &status, 0, &ru) == pid);

@@ -67,17 +67,8 @@ TEST_CASE("--every keeps every K-th frame and the manifest lists each with hashe
 TEST_CASE("SIGINT stops a run: exit 130, every PNG whole, no temporary file, the manifest says so") {
   const std::string dir = freshDir("sigint");
   const std::string log = dir + ".log";
-  const pid_t pid = fork();
-  REQUIRE(pid >= 0);
-  if (pid == 0) {
-    const int fd = ::open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    ::dup2(fd, 1);
-    ::dup2(fd, 2);
-    const std::string out = dir;
-    execl(SPH2D_EXE, SPH2D_EXE, "run", kSmall.c_str(), "--frames", "100000", "--threads", "1", "--out", out.c_str(),
-          "--quiet", static_cast<char*>(nullptr));
-    _exit(127);
-  }
+  const pid_t pid = spawnSph2d({"run", kSmall, "--frames", "100000", "--threads", "1", "--out", dir, "--quiet"}, log);
+  REQUIRE(pid > 0);
   // Wait for a few frames, then interrupt.
   const auto t0 = std::chrono::steady_clock::now();
   while (filesEnding(dir, ".png").size() < 4 && std::chrono::steady_clock::now() - t0 < std::chrono::seconds(15))
@@ -119,18 +110,11 @@ TEST_CASE("SIGINT or SIGTERM during set-up ends run and info at once with exit 1
   };
   for (const Case c : {Case{"info", SIGINT}, Case{"run", SIGTERM}, Case{"run", SIGINT}}) {
     const std::string log = dir + "/" + c.command + std::to_string(c.sig) + ".log";
-    const pid_t pid = fork();
-    REQUIRE(pid >= 0);
-    if (pid == 0) {
-      const int fd = ::open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-      ::dup2(fd, 1);
-      ::dup2(fd, 2);
-      signal(SIGINT, SIG_IGN);  // as a background job of a script inherits it
-      const std::string out = dir + "/out";
-      execl(SPH2D_EXE, SPH2D_EXE, c.command, path.c_str(), std::strcmp(c.command, "run") == 0 ? "--out" : nullptr,
-            out.c_str(), static_cast<char*>(nullptr));
-      _exit(127);
-    }
+    std::vector<std::string> args{c.command, path};
+    if (std::strcmp(c.command, "run") == 0) args.insert(args.end(), {"--out", dir + "/out"});
+    // SIGINT ignored as a background job of a script inherits it.
+    const pid_t pid = spawnSph2d(args, log, true);
+    REQUIRE(pid > 0);
     std::this_thread::sleep_for(std::chrono::milliseconds(700));  // inside the chain's set-up (tens of seconds)
     const auto t0 = std::chrono::steady_clock::now();
     REQUIRE(::kill(pid, c.sig) == 0);
@@ -155,16 +139,8 @@ TEST_CASE("the output directory: one run at a time, a killed run never leaves a 
   std::ofstream(dir + "/frame_00011.png.tmp4242") << "a killed run's half-written frame";
   std::ofstream(dir + "/notes.txt") << "the user's own file";
   const std::string log = dir + ".log";
-  const pid_t pid = fork();
-  REQUIRE(pid >= 0);
-  if (pid == 0) {
-    const int fd = ::open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    ::dup2(fd, 1);
-    ::dup2(fd, 2);
-    execl(SPH2D_EXE, SPH2D_EXE, "run", kSmall.c_str(), "--frames", "100000", "--threads", "1", "--out", dir.c_str(),
-          "--quiet", static_cast<char*>(nullptr));
-    _exit(127);
-  }
+  const pid_t pid = spawnSph2d({"run", kSmall, "--frames", "100000", "--threads", "1", "--out", dir, "--quiet"}, log);
+  REQUIRE(pid > 0);
   // The long run has started once the earlier run's manifest says "running".
   const auto t0 = std::chrono::steady_clock::now();
   auto running = [&] {
