@@ -85,6 +85,10 @@ std::size_t World::Impl::fillBlock(const FluidBlockDef& b, bool hydrostaticStart
         const Vec2d q = pw - b.field.origin;
         vel += Vec2d(-U * std::cos(k * q.x()) * std::sin(k * q.y()), U * std::sin(k * q.x()) * std::cos(k * q.y()));
       }
+      if (b.field.type == VelocityFieldDef::Type::Strain) {
+        const Vec2d q = pw - b.field.origin;
+        vel += Vec2d(-b.field.rate * q.x(), b.field.rate * q.y());
+      }
       P.push(p, Vec2(Real(vel.x()), Real(vel.y())), nextId++, rho0);
       ++added;
     }

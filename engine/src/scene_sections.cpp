@@ -82,13 +82,20 @@ BodyDef readBody(const Reader& r, const json& j, const std::string& p) {
 
 VelocityFieldDef readVelocityField(const Reader& r, const json& f, const std::string& pf) {
   r.requireObject(f, pf);
-  r.checkKeys(f, pf, {"type", "amplitude", "wavelength", "origin"});
-  if (!f.contains("type")) r.fail(Reader::sub(pf, "type"), "missing; allowed values: taylor_green");
-  r.string(f, pf, "type", "", {"taylor_green"});
+  if (!f.contains("type")) r.fail(Reader::sub(pf, "type"), "missing; allowed values: taylor_green, strain");
+  const std::string type = r.string(f, pf, "type", "", {"taylor_green", "strain"});
   VelocityFieldDef field;
-  field.type = VelocityFieldDef::Type::TaylorGreen;
-  field.amplitude = r.number(f, pf, "amplitude", field.amplitude, -1e3, 1e3);
-  field.wavelength = r.number(f, pf, "wavelength", field.wavelength, 0, 1e4, true);
+  if (type == "strain") {
+    r.checkKeys(f, pf, {"type", "rate", "origin"});
+    field.type = VelocityFieldDef::Type::Strain;
+    if (!f.contains("rate")) r.fail(Reader::sub(pf, "rate"), "missing; expected the strain rate s in 1/s (u = -s x, v = s y)");
+    field.rate = r.number(f, pf, "rate", 0, -1e4, 1e4);
+  } else {
+    r.checkKeys(f, pf, {"type", "amplitude", "wavelength", "origin"});
+    field.type = VelocityFieldDef::Type::TaylorGreen;
+    field.amplitude = r.number(f, pf, "amplitude", field.amplitude, -1e3, 1e3);
+    field.wavelength = r.number(f, pf, "wavelength", field.wavelength, 0, 1e4, true);
+  }
   field.origin = r.vec2(f, pf, "origin", field.origin);
   return field;
 }

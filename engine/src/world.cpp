@@ -63,7 +63,10 @@ void World::Impl::warnLowSoundSpeed() {
   };
   for (std::size_t k = 0; k < scene.blocks.size(); ++k) {
     const FluidBlockDef& b = scene.blocks[k];
-    const double field = b.field.type == VelocityFieldDef::Type::TaylorGreen ? b.field.amplitude : 0.0;
+    double field = b.field.type == VelocityFieldDef::Type::TaylorGreen ? std::fabs(b.field.amplitude) : 0.0;
+    if (b.field.type == VelocityFieldDef::Type::Strain)  // |s| times the farthest corner from the origin
+      for (const Vec2d& c : {b.min, b.max, Vec2d(b.min.x(), b.max.y()), Vec2d(b.max.x(), b.min.y())})
+        field = std::max(field, std::fabs(b.field.rate) * (c - b.field.origin).norm());
     consider(b.velocity.norm() + field, "fluid[" + std::to_string(k) + "].velocity");
   }
   for (std::size_t k = 0; k < scene.effects.emitters.size(); ++k) {

@@ -275,3 +275,26 @@ TEST_CASE("an emitter never places a particle inside or beyond a solid, whatever
     }
   }
 }
+
+TEST_CASE("a strain velocity field starts each particle at u = -s x, v = s y from its origin; a missing rate is refused") {
+  // A free drop squeezed along x and stretched along y (issue 18's hard case 11 is posed in it).
+  SceneDef s = parseScene(R"({"gravity": [0, 0], "solver": {"type": "wcsph", "spacing": 0.02, "sound_speed": 300},
+    "fluid": [{"min": [0.8, 0.8], "max": [1.2, 1.2],
+               "velocity_field": {"type": "strain", "rate": 50, "origin": [1, 1]}}]})",
+                          "strain.json");
+  World w(s, WorldOptions{1});
+  REQUIRE(w.particleCount() == 400);
+  double worst = 0;
+  for (std::size_t i = 0; i < w.particleCount(); ++i) {
+    const Vec2d x = Vec2d(double(w.particles().x[i].x()), double(w.particles().x[i].y())) + w.origin() - Vec2d(1, 1);
+    const Vec2d v(double(w.particles().v[i].x()), double(w.particles().v[i].y()));
+    worst = std::max(worst, (v - Vec2d(-50 * x.x(), 50 * x.y())).norm());
+  }
+  CHECK(worst < 1e-4);  // float positions and velocities
+  try {
+    parseScene(R"({"fluid": [{"min": [0, 0], "max": [1, 1], "velocity_field": {"type": "strain"}}]})", "bad.json");
+    FAIL("a strain field without a rate was accepted");
+  } catch (const SceneError& e) {
+    CHECK(e.key == "fluid[0].velocity_field.rate");
+  }
+}

@@ -9,12 +9,14 @@ namespace sph2d {
 
 /// An initial velocity field added to a block's uniform velocity.
 struct VelocityFieldDef {
-  /// None, or the Taylor–Green vortex u = −U cos(kx) sin(ky), v = U sin(kx) cos(ky),
-  /// k = 2π / wavelength (x, y measured from the field's origin).
-  enum class Type { None, TaylorGreen };
+  /// None; the Taylor–Green vortex u = −U cos(kx) sin(ky), v = U sin(kx) cos(ky),
+  /// k = 2π / wavelength; or a pure strain u = −s·x, v = s·y (area-preserving: a drop
+  /// squeezed along x and stretched along y at rate s). x, y from the field's origin.
+  enum class Type { None, TaylorGreen, Strain };
   Type type = Type::None;
-  double amplitude = 1;          ///< U [m/s]
-  double wavelength = 1;         ///< L [m]
+  double amplitude = 1;          ///< U [m/s] (Taylor–Green)
+  double wavelength = 1;         ///< L [m] (Taylor–Green)
+  double rate = 0;               ///< s [1/s] (strain)
   Vec2d origin{0, 0};            ///< where x = y = 0 [m]
 };
 
