@@ -276,7 +276,7 @@ TEST_CASE("an emitter never places a particle inside or beyond a solid, whatever
   }
 }
 
-TEST_CASE("a strain velocity field starts each particle at u = -s x, v = s y from its origin; a missing rate is refused") {
+TEST_CASE("a strain velocity field starts each particle at u = -s x, v = s y from its origin, and a missing rate is refused") {
   // A free drop squeezed along x and stretched along y (issue 18's hard case 11 is posed in it).
   SceneDef s = parseScene(R"({"gravity": [0, 0], "solver": {"type": "wcsph", "spacing": 0.02, "sound_speed": 300},
     "fluid": [{"min": [0.8, 0.8], "max": [1.2, 1.2],
