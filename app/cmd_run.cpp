@@ -176,8 +176,9 @@ int cmdRun(const std::vector<std::string>& args) {
   settings.catchUp = a.catchUp;
   settings.stop = &stopRequested;
   GameLoop loop(world, input, outputs, renderer.get(), settings);
-  // From here a signal stops the loop at the next frame and the files are finished (set-up
-  // above wrote nothing that needs finishing: until now a signal ends the process at once).
+  // From here a signal stops the loop at the next frame and the files are finished. Until
+  // now it ended the process at once: set-up wrote nothing that needs finishing (the
+  // manifest, if any, already says "running", which is true of a process that ends there).
   installStopHandler();
   int status = 0;
   std::string failure, stopReason;
