@@ -31,11 +31,13 @@ namespace sph2d::cli {
 namespace {
 
 const char* kCheckHelp =
-    "Usage: sph2d check SCENE.json --against MANIFEST [--out DIR] [--threads T] [--quiet]\n"
+    "Usage: sph2d check SCENE.json --against MANIFEST [--out DIR] [--threads T] [--adopt-env] [--files]\n"
+    "                   [--quiet]\n"
     "\n"
     "Reruns SCENE with the frame count, frame step and render options recorded in\n"
     "MANIFEST (a manifest.json written by `sph2d run`) and compares each frame's\n"
-    "RGBA hash. Exit 0 when every frame matches. Otherwise names the first differing\n"
+    "RGBA hash and state hash, after checking that the manifest's frame list is the\n"
+    "run's (a malformed manifest exits 2). Exit 0 when every frame matches. Otherwise names the first differing\n"
     "frame, counts its differing pixels and the largest channel difference against the\n"
     "reference PNG beside MANIFEST, writes DIR/frame_NNNNN.png (this run) and\n"
     "DIR/diff_NNNNN.png (differences in red over a dimmed reference), and exits 1.\n"
