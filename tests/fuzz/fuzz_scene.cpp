@@ -1,5 +1,10 @@
-// libFuzzer target for the scene loader (built by -DSPH2D_FUZZ=ON with clang;
-// run it with tests/fuzz/run.sh, see docs/STABILITY.md).
+// libFuzzer target for the scene loader and the event parser (built by
+// -DSPH2D_FUZZ=ON with clang; run it with tests/fuzz/run.sh, see docs/STABILITY.md).
+//
+// Every input is also read as one line of events (an events file, live input,
+// a manifest's events replayed by check): it must parse or throw SceneError with
+// a message and a sane position, and what parses must write back (eventToJson)
+// to a line that parses to the same line, bit for bit.
 //
 // Every input must either load or throw SceneError with a message and a sane
 // position; anything else (another exception, a crash, a leak, undefined
@@ -13,6 +18,7 @@
 #include <cstdlib>
 #include <string>
 
+#include "sph2d/events.hpp"
 #include "sph2d/scene.hpp"
 #include "sph2d/world.hpp"
 
@@ -36,18 +42,50 @@ double worldCost(const sph2d::SceneDef& s) {
   return vertices * 50 + len / s.solver.spacing;
 }
 
+void checkError(const sph2d::SceneError& e, const char* file) {
+  if (e.message.empty()) finding("SceneError without a message", e.what());
+  if (e.file != file) finding("SceneError names another file", e.what());
+  if (e.line < 0 || e.column < 0 || (e.line == 0) != (e.column == 0)) finding("SceneError with a bad position", e.what());
+  if (std::string(e.what()).rfind(file, 0) != 0) finding("what() does not start with the file", e.what());
+}
+
+/// The scene events are read against: an emitter and an effect to name.
+const sph2d::SceneDef& eventScene() {
+  static const sph2d::SceneDef s = sph2d::parseScene(
+      R"({"solver": {"type": "wcsph", "spacing": 0.05}, "fluid": [{"min": [0, 0], "max": [1, 1]}],
+          "effects": {"xsph": {"c": 0.1}, "emitters": [{"position": [0.5, 2], "direction": [0, -1]}]}})",
+      "event_scene.json");
+  return s;
+}
+
+void fuzzEvent(const std::string& text) {
+  sph2d::EventDef e;
+  try {
+    e = sph2d::parseEvent(text, "fuzz.jsonl", 1, eventScene(), sph2d::EventStamp::Optional);
+  } catch (const sph2d::SceneError& err) {
+    checkError(err, "fuzz.jsonl");
+    return;
+  }
+  const std::string once = sph2d::eventToJson(e);
+  std::string twice;
+  try {
+    twice = sph2d::eventToJson(sph2d::parseEvent(once, "again.jsonl", 1, eventScene(), sph2d::EventStamp::Optional));
+  } catch (const sph2d::SceneError& err) {
+    finding("an accepted event does not read back", once + " -> " + err.what());
+  }
+  if (twice != once) finding("an event does not read back to itself", once + " -> " + twice);
+}
+
 }  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const std::string text(reinterpret_cast<const char*>(data), size);
+  fuzzEvent(text);
   sph2d::SceneDef scene;
   try {
     scene = sph2d::parseScene(text, "fuzz.json");
   } catch (const sph2d::SceneError& e) {
-    if (e.message.empty()) finding("SceneError without a message", e.what());
-    if (e.file != "fuzz.json") finding("SceneError names another file", e.what());
-    if (e.line < 0 || e.column < 0 || (e.line == 0) != (e.column == 0)) finding("SceneError with a bad position", e.what());
-    if (std::string(e.what()).rfind("fuzz.json", 0) != 0) finding("what() does not start with the file", e.what());
+    checkError(e, "fuzz.json");
     return 0;
   }
   // What the loader promises about an accepted scene.
