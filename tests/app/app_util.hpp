@@ -74,6 +74,15 @@ inline std::vector<std::string> filesEnding(const std::string& dir, const std::s
 }
 
 /// True when a file name in `dir` contains ".tmp" (a write that was not finished).
+/// The cells of one CSV line (no quoting: sph2d's CSVs hold numbers and plain names).
+inline std::vector<std::string> csvCells(const std::string& line) {
+  std::vector<std::string> f;
+  std::stringstream ls(line);
+  std::string cell;
+  while (std::getline(ls, cell, ',')) f.push_back(cell);
+  return f;
+}
+
 inline bool anyTemporary(const std::string& dir) {
   for (const auto& e : fs::directory_iterator(dir))
     if (e.path().filename().string().find(".tmp") != std::string::npos) return true;

@@ -29,10 +29,7 @@ TEST_CASE("bench effects with a tiny dam break writes the CSV with one row per c
   std::vector<std::string> names;
   std::string line;
   while (std::getline(in, line)) {
-    std::vector<std::string> f;
-    std::stringstream ls(line);
-    std::string cell;
-    while (std::getline(ls, cell, ',')) f.push_back(cell);
+    const std::vector<std::string> f = csvCells(line);
     REQUIRE(f.size() == 12);
     names.push_back(f[0]);
     CHECK(std::stoul(f[1]) > 300);

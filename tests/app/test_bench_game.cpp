@@ -19,13 +19,7 @@ std::vector<std::vector<std::string>> rows(const std::string& csv, std::string& 
   std::getline(in, header);
   std::vector<std::vector<std::string>> out;
   std::string line;
-  while (std::getline(in, line)) {
-    std::vector<std::string> f;
-    std::stringstream ls(line);
-    std::string cell;
-    while (std::getline(ls, cell, ',')) f.push_back(cell);
-    out.push_back(f);
-  }
+  while (std::getline(in, line)) out.push_back(csvCells(line));
   return out;
 }
 }  // namespace
