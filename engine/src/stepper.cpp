@@ -13,7 +13,10 @@
 // effects report their limits; a frame is split into equal substeps no longer
 // than the least of them, at most solver.max_substeps a frame (beyond that the
 // frame advances less time and a warning names it); what remains of a frame
-// below kFrameLeftover of it is float rounding and is dropped. A step()
+// below kFrameLeftover of it is float rounding and is dropped. A stage may
+// shorten its substep (c.dt; the explicit solvers' force_limit, when this
+// substep's forces allow less than the last one's did): the clock advances by
+// the substep taken, and the frame's next substep starts from there. A step()
 // shorter than kMinStepOfLast of the last substep (a caller stepping "up to
 // time t") is a drift: the particles move with their velocity under gravity,
 // collide, and the particle system runs, but no solver stage: the density
@@ -101,15 +104,17 @@ void World::Impl::fail(const std::string& stage, std::size_t slot) {
   throw SimulationError(o.str(), stage, P.id[slot], steps, time);
 }
 
-void World::Impl::substep(Real dt, bool driftOnly) {
+Real World::Impl::substep(Real dt, bool driftOnly) {
   StepContext c = context(dt);
   (driftOnly ? drift : stages).run(c, [this](const std::string& stage, std::size_t slot) { fail(stage, slot); });
+  dt = c.dt;
   if (!driftOnly) {
     const SolverStats st = solver->stats();
     iterations += std::uint64_t(st.pressureIterations) + std::uint64_t(st.divergenceIterations);
   }
   time += double(dt);
   ++steps;
+  return dt;
 }
 
 void World::Impl::advance(double frameDt) {
@@ -133,9 +138,9 @@ void World::Impl::advance(double frameDt) {
     const Real limit = stableDt();
     const double k = std::ceil(remaining / double(limit) - 1e-9);
     const double dt = k <= 1 ? remaining : remaining / k;
-    substep(Real(dt));
-    lastDt = double(Real(dt));
-    remaining -= double(Real(dt));
+    const Real taken = substep(Real(dt));
+    lastDt = double(taken);
+    remaining -= double(taken);
     ++n;
   }
   lastSubsteps = n;

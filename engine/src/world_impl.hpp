@@ -75,8 +75,9 @@ struct World::Impl {
   void addParticleSystemStages(StageList& list);
   /// The substep length the solver's and the enabled effects' limits allow now.
   Real stableDt();
-  /// One substep of length dt: the stage list (driftOnly: the drift list), then the clock.
-  void substep(Real dt, bool driftOnly = false);
+  /// One substep of length dt (or shorter, if a stage shortened it): the stage list
+  /// (driftOnly: the drift list), then the clock. Returns the substep taken.
+  Real substep(Real dt, bool driftOnly = false);
   /// Advances frameDt in equal substeps within the limits (the frame's split is the World's alone).
   void advance(double frameDt);
   /// Throws the SimulationError naming the stage, the particle and its values.

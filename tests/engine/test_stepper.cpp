@@ -27,7 +27,7 @@ TEST_CASE("the stage list exists from construction: the solver's stages, the eff
   const SceneDef s = test::scene("tests/resting_column.json");  // muller2003 with viscosity
   World w(s, WorldOptions{1});
   const std::vector<std::string> expected = {"grid",      "neighbours", "density",          "pressure", "pressure_force",
-                                             "viscosity", "integrate",  "max_acceleration", "collide"};
+                                             "viscosity", "force_limit", "integrate", "max_acceleration", "collide"};
   CHECK(w.stages() == expected);
   w.stepFrame();
   CHECK(w.stages() == expected);  // running it does not change it

@@ -53,7 +53,8 @@ class Solver {
 };
 
 /// The stages of the equation-of-state solvers (muller2003, wcsph): grid →
-/// neighbours → density → pressure → pressure_force → effects → integrate.
+/// neighbours → density → pressure → pressure_force → effects → force_limit →
+/// integrate (force_limit shortens the substep to its own forces' limit).
 /// density and pressureForce return the first bad slot; pressure returns nothing.
 std::vector<Stage> explicitStages(Stage::Fn density, std::function<void(StepContext&)> pressure, Stage::Fn pressureForce);
 

@@ -156,7 +156,7 @@ class Muller2003 final : public Solver {
     return dt;
   }
 
-  /// grid → neighbours → density (poly6) → pressure → pressure_force (spiky) → effects → integrate.
+  /// grid → neighbours → density (poly6) → pressure → pressure_force (spiky) → effects → force_limit → integrate.
   std::vector<Stage> stages(bool) override {
     return explicitStages([](StepContext& c) { return density(c, Poly6<Real>(c.R)); }, pressure,
                           [](StepContext& c) { return pressureForce(c, Spiky<Real>(c.R)); });
