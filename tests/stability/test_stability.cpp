@@ -228,8 +228,8 @@ namespace {
 /// Each solver keeps its default viscosity (muller2003 needs ν ≳ 0.005 m²/s: its
 /// pressure force is not the gradient of an energy, docs/SCENES.md), pbf none.
 ///
-/// Before: with clamp_negative_pressure false muller2003's kinetic energy grew 7× in
-/// 0.1 s and particles reached 300 m/s (at 1.25 mm the guard stopped the run). A
+/// Before: with clamp_negative_pressure false muller2003's kinetic energy reached
+/// 625 J/m within these 0.2 s (from 84; bound 126) and particles 304 m/s. A
 /// surface particle pulled onto its neighbour by the tension met a repulsion that
 /// jumped by orders of magnitude within one substep, while the substep had been
 /// sized by the previous substep's accelerations; the explicit step turned the
