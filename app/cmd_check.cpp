@@ -211,52 +211,6 @@ bool checkFiles(const ManifestView& mv, const fs::path& dir) {
   return bad == 0;
 }
 
-/// One entry of a manifest's `environment`, checked: `problem` says why it is ignored.
-struct ManifestEnv {
-  std::string name, value, problem;
-};
-
-/// The manifest's environment entries. Only a name sph2d records (recordedEnvironmentNames)
-/// is accepted, with a value of at most 64 characters from [A-Za-z0-9_.,:=+-]; anything
-/// else (LD_PRELOAD, GALLIUM_TRACE, a path, a control character) gets a problem.
-std::vector<ManifestEnv> manifestEnvironment(const json& m) {
-  std::vector<ManifestEnv> out;
-  if (!m.contains("environment") || !m["environment"].is_array()) return out;
-  const std::vector<std::string> known = recordedEnvironmentNames();
-  auto printable = [](const std::string& t) {
-    std::string r;
-    for (char ch : t.substr(0, 40)) r += (ch >= 0x20 && ch < 0x7f) ? ch : '?';
-    return r + (t.size() > 40 ? "..." : "");
-  };
-  for (const json& e : m["environment"]) {
-    ManifestEnv me;
-    if (!e.is_object() || !e.contains("name") || !e["name"].is_string() || (e.contains("value") && !e["value"].is_string())) {
-      me.name = "(malformed)";
-      me.problem = "an entry is an object with a string name and value";
-      out.push_back(me);
-      continue;
-    }
-    me.name = e["name"].get<std::string>();
-    me.value = e.value("value", "");
-    const bool recorded = std::find(known.begin(), known.end(), me.name) != known.end();
-    const bool plain = me.value.size() <= 64 && std::all_of(me.value.begin(), me.value.end(), [](char ch) {
-                         return std::isalnum(static_cast<unsigned char>(ch)) || std::strchr("_.,:=+-", ch) != nullptr;
-                       });
-    if (!recorded) {
-      me.problem = "sph2d records only its renderer's settings (" + [&] {
-        std::string l;
-        for (const std::string& k : known) l += (l.empty() ? "" : ", ") + k;
-        return l;
-      }() + ")";
-      me.name = printable(me.name);
-    } else if (!plain) {
-      me.problem = "its value is not a plain setting (at most 64 of A-Z a-z 0-9 _ . , : = + -)";
-    }
-    out.push_back(me);
-  }
-  return out;
-}
-
 /// The events the manifest's run applied, at their frames (a manifest without an event
 /// list: the scene's own timeline).
 void addManifestEvents(EventIntake& input, const json& m, const std::string& manifestPath, const SceneDef& scene) {

@@ -1,5 +1,5 @@
 // app/manifest.hpp — manifest.json: what `sph2d run` writes beside its frames and
-// `sph2d check` reads back.
+// `sph2d check` reads back (the reader: manifest_reader.hpp).
 //
 // A manifest names the scene (path, name, XXH64 of the file), the engine version,
 // the renderer, the CPU and the Mesa settings, the image, the render options, the
@@ -12,28 +12,24 @@
 #pragma once
 
 #include <cstdint>
-#include <map>
 #include <string>
 #include <vector>
 
 #include <nlohmann/json.hpp>
 
+#include "manifest_reader.hpp"
 #include "run_args.hpp"
 #include "sph2d/render/renderer.hpp"
 #include "sph2d/scene.hpp"
 
 namespace sph2d::cli {
 
-/// "frame_NNNNN.png", the file name of frame `frame`.
-std::string frameFileName(std::int64_t frame);
 /// XXH64 of a file's bytes as 16 hex digits. Throws UsageError when it cannot be read.
 std::string fileHash(const std::string& path);
 /// The llvmpipe environment as recorded in a manifest (pins it first).
 nlohmann::ordered_json environmentJson();
 /// The render options as recorded in a manifest.
 nlohmann::ordered_json renderOptionsJson(const RenderOptions& o);
-/// The render options a manifest recorded. Throws UsageError on a malformed entry.
-RenderOptions renderOptionsFromJson(const nlohmann::ordered_json& j);
 
 /// The manifest of one `sph2d run`, filled while it runs.
 class RunManifest {
@@ -57,25 +53,5 @@ class RunManifest {
  private:
   nlohmann::ordered_json j_;
 };
-
-/// A manifest as `sph2d check` reads it.
-struct ManifestView {
-  nlohmann::ordered_json json;                     ///< the whole manifest
-  int frames = 0;                                  ///< run.frames
-  int every = 1;                                   ///< run.every (at least 1)
-  std::map<int, nlohmann::ordered_json> expected;  ///< the listed frames by number
-  std::string renderer, cpu, sceneHash;            ///< what it was made with
-  RenderOptions render;                            ///< the render options of the run
-  /// Why the frame list is not the run's (empty when it is): a complete run lists every
-  /// kept frame (0, every, 2·every, … below frames; a real-time run may have dropped
-  /// some), a stopped one the first frames_written of them.
-  std::vector<std::string> listProblems;
-};
-
-/// Reads a manifest for `sph2d check`. Throws UsageError when it cannot be read, is not
-/// JSON, is not an sph2d frames manifest, lacks a field check needs, or a frame entry is
-/// malformed (its number not a kept frame of the run or out of order, its file not the
-/// frame's own name, a hash not 16 hex digits): a manifest names no other file.
-ManifestView readManifest(const std::string& path);
 
 }  // namespace sph2d::cli

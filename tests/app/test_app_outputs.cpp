@@ -305,7 +305,7 @@ TEST_CASE("sph2d check checks both hashes of every frame, the frame list against
     m["frames"][1]["state_hash"] = 7;
     t = check(m);
     CHECK(t.code == 2);
-    CHECK(t.out.find("the key 'frames' is missing or not an array of objects") != std::string::npos);
+    CHECK(t.out.find("the key 'frames[1].state_hash' is missing or not a string") != std::string::npos);
   }
   {
     // --files: a frame file swapped for another frame's, and a stale frame of another run.

@@ -1,5 +1,12 @@
-// libFuzzer target for the scene loader and the event parser (built by
-// -DSPH2D_FUZZ=ON with clang; run it with tests/fuzz/run.sh, see docs/STABILITY.md).
+// libFuzzer target for the scene loader, the event parser and the manifest reader
+// (built by -DSPH2D_FUZZ=ON with clang; run it with tests/fuzz/run.sh, see
+// docs/STABILITY.md).
+//
+// Every input is also read as a manifest (what `sph2d check` trusts from elsewhere):
+// it must be accepted or refused with a UsageError naming the file, and what is
+// accepted keeps the reader's promises (listed frames are kept frames of the run in
+// order, each naming only its own file, hashes of 16 hex digits; an environment
+// entry without a problem is a variable sph2d records, with a plain value).
 //
 // Every input is also read as one line of events (an events file, live input,
 // a manifest's events replayed by check): it must parse or throw SceneError with
@@ -12,11 +19,18 @@
 // also built into a World and stepped once, so that what the loader lets
 // through is known to be acceptable to Box2D (whose assertions abort) and to
 // the engine.
+#include <algorithm>
+#include <cctype>
 #include <cstddef>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <string>
+
+#include "cli.hpp"
+#include "manifest_reader.hpp"
+#include "sph2d/render/render_env.hpp"
 
 #include "sph2d/events.hpp"
 #include "sph2d/scene.hpp"
@@ -76,11 +90,42 @@ void fuzzEvent(const std::string& text) {
   if (twice != once) finding("an event does not read back to itself", once + " -> " + twice);
 }
 
+void fuzzManifest(const std::string& text) {
+  sph2d::cli::ManifestView v;
+  try {
+    v = sph2d::cli::parseManifest(text, "fuzz_manifest.json");
+  } catch (const sph2d::cli::UsageError& e) {
+    if (std::string(e.what()).rfind("fuzz_manifest.json", 0) != 0) finding("a manifest error does not name the file", e.what());
+    return;
+  }
+  if (v.frames < 0 || v.every < 1) finding("accepted manifest with a bad run", text);
+  int last = -1;
+  for (const auto& [frame, entry] : v.expected) {
+    if (frame <= last || frame >= v.frames || frame % v.every != 0) finding("accepted manifest lists a frame the run did not keep", text);
+    if (entry.at("file").get<std::string>() != sph2d::cli::frameFileName(frame)) finding("accepted manifest names another file", text);
+    last = frame;
+  }
+  for (const std::string& p : v.listProblems)
+    if (p.empty()) finding("an empty list problem", text);
+  const std::vector<std::string> known = sph2d::recordedEnvironmentNames();
+  for (const sph2d::cli::ManifestEnv& e : sph2d::cli::manifestEnvironment(v.json)) {
+    if (!e.problem.empty()) {
+      for (const char ch : e.name)
+        if (ch < 0x20 || ch == 0x7f) finding("an ignored environment name is printed with a control character", text);
+      continue;
+    }
+    if (std::find(known.begin(), known.end(), e.name) == known.end()) finding("a manifest variable sph2d does not record is accepted", e.name);
+    for (const char ch : e.value)
+      if (!std::isalnum(static_cast<unsigned char>(ch)) && !std::strchr("_.,:=+-", ch)) finding("a manifest value is not plain", e.value);
+  }
+}
+
 }  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const std::string text(reinterpret_cast<const char*>(data), size);
   fuzzEvent(text);
+  fuzzManifest(text);
   sph2d::SceneDef scene;
   try {
     scene = sph2d::parseScene(text, "fuzz.json");

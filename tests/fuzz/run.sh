@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# tests/fuzz/run.sh [SECONDS] — fuzz the scene loader with libFuzzer.
+# tests/fuzz/run.sh [SECONDS] — fuzz the scene loader, the event parser and the
+# manifest reader with libFuzzer.
 #
 # Configures a separate build directory with clang (-DSPH2D_FUZZ=ON: the
 # engine and the target built with -fsanitize=fuzzer,address,undefined),
@@ -27,7 +28,7 @@ cmake --build "$build" --target sph2d_fuzz_scene -j"${SPH2D_FUZZ_JOBS:-2}"
 mkdir -p "$build/fuzz-corpus" "$build/fuzz-artifacts"
 export ASAN_OPTIONS="${ASAN_OPTIONS:-detect_leaks=1:abort_on_error=1}"
 export UBSAN_OPTIONS="${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}"
-echo "run.sh: fuzzing the scene loader for ${secs} s"
+echo "run.sh: fuzzing the scene loader, event parser and manifest reader for ${secs} s"
 exec "$build/tests/sph2d_fuzz_scene" "$build/fuzz-corpus" "$root/tests/fuzz/corpus" \
   -dict="$root/tests/fuzz/scene.dict" -max_total_time="$secs" -max_len=8192 -timeout=10 -rss_limit_mb=2048 \
   -artifact_prefix="$build/fuzz-artifacts/" -print_final_stats=1 ${SPH2D_FUZZ_SEED:+-seed="$SPH2D_FUZZ_SEED"}
