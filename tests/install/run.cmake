@@ -32,3 +32,35 @@ endif()
 if(NOT EXISTS "${WORK}/frame.png")
   message(FATAL_ERROR "no frame written")
 endif()
+
+# The engine alone, on a view of the machine without OSMesa and libpng (pkg-config sees
+# no modules, find_package(PNG) is disabled): it configures, builds and runs, and its
+# own source is compiled without our floating-point flags unless it opts in.
+set(ENGINE_ONLY "${CONSUMER}/../engine_only")
+set(NO_RENDER_DEPS ${CMAKE_COMMAND} -E env PKG_CONFIG_LIBDIR=${WORK}/no-pkgconfig PKG_CONFIG_PATH=)
+set(NO_RENDER_ARGS -DCMAKE_DISABLE_FIND_PACKAGE_PNG=ON -DCMAKE_PREFIX_PATH=${WORK}/prefix
+    -DCMAKE_FIND_USE_PACKAGE_REGISTRY=OFF -DCMAKE_CXX_COMPILER=${CXX} -G "${GENERATOR}")
+step("configure engine_only" ${NO_RENDER_DEPS} ${CMAKE_COMMAND} -S "${ENGINE_ONLY}" -B "${WORK}/engine_only"
+     -DCMAKE_BUILD_TYPE=Release -DCMAKE_EXPORT_COMPILE_COMMANDS=ON ${NO_RENDER_ARGS})
+file(READ "${WORK}/engine_only/compile_commands.json" commands)
+if(commands MATCHES "ffp-contract")
+  message(FATAL_ERROR "sph2d::engine imposed its floating-point flags on the game's source:\n${commands}")
+endif()
+step("build engine_only" ${CMAKE_COMMAND} --build "${WORK}/engine_only")
+step("run engine_only" "${WORK}/engine_only/engine_only")
+message("${STEP_OUT}")
+step("configure engine_only, deterministic" ${NO_RENDER_DEPS} ${CMAKE_COMMAND} -S "${ENGINE_ONLY}"
+     -B "${WORK}/engine_only_det" -DCMAKE_EXPORT_COMPILE_COMMANDS=ON -DSPH2D_CONSUMER_DETERMINISTIC=ON ${NO_RENDER_ARGS})
+file(READ "${WORK}/engine_only_det/compile_commands.json" commands)
+if(NOT commands MATCHES "-ffp-contract=off" OR NOT commands MATCHES "-fno-fast-math")
+  message(FATAL_ERROR "sph2d::deterministic did not add the floating-point flags:\n${commands}")
+endif()
+# The renderer asked for on that view: refused, naming what is missing.
+execute_process(COMMAND ${NO_RENDER_DEPS} ${CMAKE_COMMAND} -S "${CONSUMER}" -B "${WORK}/consumer_no_deps" ${NO_RENDER_ARGS}
+                RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+string(REGEX REPLACE "[ \n]+" " " err "${err}")  # CMake wraps the package's message
+if(rc EQUAL 0 OR NOT err MATCHES "render needs OSMesa \\(pkg-config module osmesa; Debian: libosmesa6-dev"
+   OR NOT err MATCHES "render needs libpng \\(Debian: libpng-dev\\)")
+  message(FATAL_ERROR "find_package(sph2d) with render on a machine without OSMesa and libpng: exit ${rc}\n${out}\n${err}")
+endif()
+message("install test: engine alone without OSMesa/libpng: OK; render refused naming them")
