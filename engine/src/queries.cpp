@@ -123,6 +123,7 @@ std::size_t World::memoryBytes() const {
   for (const auto& v : w.nbr.boundaryPerBlock) b += cap(v);
   b += cap(w.scratch.v) + cap(w.scratch.r) + cap(w.scratch.u);
   b += cap(w.boundary.samples) + cap(w.boundary.volume) + cap(w.boundary.sideNormal) + cap(w.boundary.sideOffset);
+  b += cap(w.idIndex);  // only once a game looked a particle up by id
   return b;
 }
 

@@ -5,13 +5,16 @@
 //   particle_system.cpp  fluid blocks and drops, emitters, lifetimes, sinks, the budget
 //   box2d_bridge.cpp     the scene's b2World and the colliders read from a b2World
 //   queries.cpp          what readers ask of the state (hash, statistics, searches)
+//   particle_access.cpp  particles by id: read, write, add at points, remove
 #pragma once
 
 #include <box2d/box2d.h>
 
+#include <cstdint>
 #include <functional>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "effects/effect.hpp"
@@ -63,6 +66,9 @@ struct World::Impl {
   std::vector<UserForce> userForces;
   bool userForceEffect = false;
   std::vector<unsigned char> dead;  ///< scratch: removal flags
+  /// (id, slot) of every particle sorted by id: World::slotOf's index, rebuilt when a lookup
+  /// finds it stale (particle_access.cpp). Mutable: a lookup on a const World refreshes it.
+  mutable std::vector<std::pair<std::uint32_t, std::uint32_t>> idIndex;
 
   /// The state of the particles and the scene's constants for a substep of length dt.
   Impl(const SceneDef& s, const WorldOptions& o) : scene(s), pool(o.threads) {}

@@ -162,6 +162,42 @@ class World {
   std::size_t addDrop(const Vec2d& center, double radius, const Vec2d& velocity = Vec2d(0, 0));
   /// Removes the particles inside the box [lo, hi] (world coordinates). Returns how many.
   std::size_t removeParticlesInBox(const Vec2d& lo, const Vec2d& hi);
+
+  // Particles by id (particle_access.cpp). A slot changes when the grid reorders the
+  // particles or some are removed; an id never does, so a game holds particles by id.
+
+  /// The value slotOf() returns for an id no particle has.
+  static constexpr std::size_t npos = static_cast<std::size_t>(-1);
+  /// The storage slot of the particle with id `id` (P.id[slot] == id), or npos when no
+  /// particle has it (removed, or never made). O(log n); the id index is rebuilt, O(n log n),
+  /// only when a lookup finds it stale (after a step reordered or changed the particles).
+  std::size_t slotOf(std::uint32_t id) const;
+  /// Position (world coordinates) and velocity of particle `id`; false (outputs untouched)
+  /// when no particle has the id.
+  bool getParticle(std::uint32_t id, Vec2d& position, Vec2d& velocity) const;
+  /// Moves particle `id` to `position` (world coordinates) with `velocity`, as a teleport:
+  /// the next swept collision starts there. False, changing nothing, when no particle has
+  /// the id or the position is inside a solid. Throws std::invalid_argument for a
+  /// non-finite position or velocity.
+  bool setParticle(std::uint32_t id, const Vec2d& position, const Vec2d& velocity);
+  /// Sets the velocity of particle `id`; false when no particle has it. Throws
+  /// std::invalid_argument for a non-finite velocity.
+  bool setParticleVelocity(std::uint32_t id, const Vec2d& velocity);
+  /// Bulk: the velocity of particle ids[k] becomes velocities[k]. Returns how many of the
+  /// ids a particle has (the rest are skipped). Throws std::invalid_argument when the
+  /// lengths differ or a velocity is not finite (then nothing is changed).
+  std::size_t setVelocities(const std::vector<std::uint32_t>& ids, const std::vector<Vec2d>& velocities);
+  /// Adds one particle at each of `points` (world coordinates, any arrangement; the
+  /// caller keeps them about a spacing apart) moving at velocities[k] (`velocities`
+  /// empty: at rest). Points inside solids are skipped, and the particle budget holds as
+  /// for addBlock (one warning for the refused rest). Returns the ids of the particles
+  /// added, in the order of their points. Throws std::invalid_argument when the lengths
+  /// differ or a value is not finite (then nothing is added).
+  std::vector<std::uint32_t> addParticles(const std::vector<Vec2d>& points, const std::vector<Vec2d>& velocities = {});
+  /// Removes the particles with these ids (ids no particle has are ignored; removedCount()
+  /// counts them). Returns how many were removed.
+  std::size_t removeParticles(const std::vector<std::uint32_t>& ids);
+
   /// Slots of the particles within `radius` of `center` (world coordinates), in slot order.
   std::vector<std::size_t> particlesInRadius(const Vec2d& center, double radius) const;
   /// Slots of the particles inside the box [lo, hi] (world coordinates), in slot order.

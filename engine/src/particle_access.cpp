@@ -1,0 +1,145 @@
+// particle_access.cpp — particles by id for a game (World::slotOf, getParticle,
+// setParticle, setVelocities, addParticles, removeParticles), after LiquidFun's
+// writable particle buffers and b2ParticleHandle: slots move (the grid reorders the
+// particles for locality, removals compact them), ids do not.
+//
+// The id index is a vector of (id, slot) sorted by id, searched by bisection. It is
+// never invalidated explicitly: a lookup checks that the slot it found still holds
+// the id and rebuilds the index (O(n log n)) when it does not, so no stage has to
+// remember to mark it stale, and a World whose game never asks holds no index.
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+
+#include "world_impl.hpp"
+
+namespace sph2d {
+namespace {
+
+bool finite(const Vec2d& v) { return std::isfinite(v.x()) && std::isfinite(v.y()); }
+
+/// Rebuilds the id index of `P`.
+void rebuild(std::vector<std::pair<std::uint32_t, std::uint32_t>>& index, const Particles& P) {
+  index.resize(P.size());
+  for (std::size_t i = 0; i < P.size(); ++i) index[i] = {P.id[i], std::uint32_t(i)};
+  std::sort(index.begin(), index.end());
+}
+
+/// The slot `id` has in `index` (sorted by id), or World::npos.
+std::size_t find(const std::vector<std::pair<std::uint32_t, std::uint32_t>>& index, std::uint32_t id) {
+  const auto it = std::lower_bound(index.begin(), index.end(), std::make_pair(id, std::uint32_t(0)));
+  return it != index.end() && it->first == id ? std::size_t(it->second) : World::npos;
+}
+
+}  // namespace
+
+std::size_t World::slotOf(std::uint32_t id) const {
+  const Impl& w = *impl_;
+  std::size_t slot = find(w.idIndex, id);
+  if (slot < w.P.size() && w.P.id[slot] == id) return slot;
+  // Stale (the slot moved, or the id is absent, perhaps because it is newer than the
+  // index): rebuild, then the answer is exact.
+  rebuild(w.idIndex, w.P);
+  return find(w.idIndex, id);
+}
+
+bool World::getParticle(std::uint32_t id, Vec2d& position, Vec2d& velocity) const {
+  const std::size_t i = slotOf(id);
+  if (i == npos) return false;
+  position = worldPosition(i);
+  velocity = Vec2d(impl_->P.v[i].x(), impl_->P.v[i].y());
+  return true;
+}
+
+bool World::setParticle(std::uint32_t id, const Vec2d& position, const Vec2d& velocity) {
+  if (!finite(position) || !finite(velocity))
+    throw std::invalid_argument("setParticle: the position and the velocity must be finite");
+  Impl& w = *impl_;
+  const std::size_t i = slotOf(id);
+  if (i == npos) return false;
+  const Vec2 p(Real(position.x() - w.origin.x()), Real(position.y() - w.origin.y()));
+  if (w.boundary.insideDepth(p) > 0) return false;
+  w.P.x[i] = p;
+  w.P.xPrev[i] = p;  // a teleport: the swept collision starts here, not on the old path
+  w.P.v[i] = Vec2(Real(velocity.x()), Real(velocity.y()));
+  return true;
+}
+
+bool World::setParticleVelocity(std::uint32_t id, const Vec2d& velocity) {
+  if (!finite(velocity)) throw std::invalid_argument("setParticleVelocity: the velocity must be finite");
+  const std::size_t i = slotOf(id);
+  if (i == npos) return false;
+  impl_->P.v[i] = Vec2(Real(velocity.x()), Real(velocity.y()));
+  return true;
+}
+
+std::size_t World::setVelocities(const std::vector<std::uint32_t>& ids, const std::vector<Vec2d>& velocities) {
+  if (ids.size() != velocities.size())
+    throw std::invalid_argument("setVelocities: " + std::to_string(ids.size()) + " ids but " +
+                                std::to_string(velocities.size()) + " velocities");
+  for (const Vec2d& v : velocities)
+    if (!finite(v)) throw std::invalid_argument("setVelocities: every velocity must be finite");
+  Impl& w = *impl_;
+  rebuild(w.idIndex, w.P);  // once: absent ids then cost a search each, not a rebuild
+  std::size_t found = 0;
+  for (std::size_t k = 0; k < ids.size(); ++k) {
+    const std::size_t i = find(w.idIndex, ids[k]);
+    if (i == npos) continue;
+    w.P.v[i] = Vec2(Real(velocities[k].x()), Real(velocities[k].y()));
+    ++found;
+  }
+  return found;
+}
+
+std::vector<std::uint32_t> World::addParticles(const std::vector<Vec2d>& points, const std::vector<Vec2d>& velocities) {
+  if (!velocities.empty() && velocities.size() != points.size())
+    throw std::invalid_argument("addParticles: " + std::to_string(points.size()) + " points but " +
+                                std::to_string(velocities.size()) + " velocities");
+  for (const Vec2d& p : points)
+    if (!finite(p)) throw std::invalid_argument("addParticles: every point must be finite");
+  for (const Vec2d& v : velocities)
+    if (!finite(v)) throw std::invalid_argument("addParticles: every velocity must be finite");
+  Impl& w = *impl_;
+  const Real rho0 = Real(w.scene.solver.restDensity);
+  std::vector<std::uint32_t> ids;
+  std::size_t inside = 0, refused = 0;
+  for (std::size_t k = 0; k < points.size(); ++k) {
+    const Vec2 p(Real(points[k].x() - w.origin.x()), Real(points[k].y() - w.origin.y()));
+    if (w.boundary.insideDepth(p) > 0) {
+      ++inside;
+      continue;
+    }
+    if (w.P.size() >= w.budget) {
+      refused = points.size() - k;
+      break;
+    }
+    const Vec2d v = velocities.empty() ? Vec2d(0, 0) : velocities[k];
+    ids.push_back(w.nextId);
+    w.P.push(p, Vec2(Real(v.x()), Real(v.y())), w.nextId++, rho0);
+  }
+  if (inside) w.warnings.push_back("addParticles: skipped " + std::to_string(inside) + " points inside solids");
+  if (refused) {
+    std::ostringstream o;
+    o << "particle budget of " << w.budget << " (" << w.budgetKey() << ") reached: addParticles added " << ids.size()
+      << " and refused the last " << refused << " points (raise " << w.budgetKey() << " or add less)";
+    w.warnings.push_back(o.str());
+  }
+  return ids;
+}
+
+std::size_t World::removeParticles(const std::vector<std::uint32_t>& ids) {
+  Impl& w = *impl_;
+  std::vector<std::uint32_t> sorted(ids);
+  std::sort(sorted.begin(), sorted.end());
+  w.dead.assign(w.P.size(), 0);
+  std::size_t n = 0;
+  for (std::size_t i = 0; i < w.P.size(); ++i) {
+    w.dead[i] = std::binary_search(sorted.begin(), sorted.end(), w.P.id[i]);
+    n += w.dead[i];
+  }
+  if (n) w.removeFlagged();
+  return n;
+}
+
+}  // namespace sph2d
