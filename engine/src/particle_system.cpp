@@ -35,6 +35,9 @@ double uniform(std::uint64_t& state) { return double(splitmix(state) >> 11) * (1
 /// block's size beyond the particles added (rows are computed as they are
 /// filled, a drop's rows only over its chord).
 std::size_t World::Impl::fillBlock(const FluidBlockDef& b, bool hydrostaticStart, const Disc* disc) {
+  const Disc circle{b.center, b.radius};
+  std::vector<double> crossings;  // a polygon's edges across the current row
+  if (!disc && b.shape == FluidBlockDef::Shape::Circle) disc = &circle;  // a circle region: the drop's row chords
   const SolverDef& sd = scene.solver;
   const double hydroFactor = solver->hydrostaticFactor();
   const bool hydrostatic = hydrostaticStart && hydroFactor > 0 && scene.gravity.x() == 0 && scene.gravity.y() < 0;
@@ -57,6 +60,7 @@ std::size_t World::Impl::fillBlock(const FluidBlockDef& b, bool hydrostaticStart
     y = j == 0 ? b.min.y() + 0.5 * sd.spacing * scale : y + 0.5 * sd.spacing * (prevScale + scale);
     prevScale = scale;
     long i0 = 0, i1 = nx;  // the row's lattice points [i0, i1)
+    b.rowCrossings(y, crossings);  // a polygon's edges across this row (none otherwise)
     if (disc) {
       const double dy = y - disc->center.y(), r2 = disc->radius * disc->radius;
       if (dy * dy > r2) continue;
@@ -68,6 +72,7 @@ std::size_t World::Impl::fillBlock(const FluidBlockDef& b, bool hydrostaticStart
     for (long i = i0; i < i1; ++i) {
       const Vec2d pw(b.min.x() + (double(i) + 0.5) * sd.spacing, y);
       if (disc && !((pw - disc->center).squaredNorm() <= disc->radius * disc->radius)) continue;
+      if (b.shape == FluidBlockDef::Shape::Polygon && !FluidBlockDef::insideRow(crossings, pw.x())) continue;
       const Vec2 p = Vec2(Real(pw.x() - origin.x()), Real(pw.y() - origin.y()));
       if (boundary.insideDepth(p) > 0) {
         dlo = dropped ? dlo.cwiseMin(pw) : pw;
@@ -79,16 +84,7 @@ std::size_t World::Impl::fillBlock(const FluidBlockDef& b, bool hydrostaticStart
         refused = true;
         break;
       }
-      Vec2d vel = b.velocity;
-      if (b.field.type == VelocityFieldDef::Type::TaylorGreen) {
-        const double k = 2 * 3.14159265358979323846 / b.field.wavelength, U = b.field.amplitude;
-        const Vec2d q = pw - b.field.origin;
-        vel += Vec2d(-U * std::cos(k * q.x()) * std::sin(k * q.y()), U * std::sin(k * q.x()) * std::cos(k * q.y()));
-      }
-      if (b.field.type == VelocityFieldDef::Type::Strain) {
-        const Vec2d q = pw - b.field.origin;
-        vel += Vec2d(-b.field.rate * q.x(), b.field.rate * q.y());
-      }
+      const Vec2d vel = b.velocityAt(pw);
       P.push(p, Vec2(Real(vel.x()), Real(vel.y())), nextId++, rho0);
       ++added;
     }

@@ -240,9 +240,67 @@ void checkChain(const Reader& r, const std::vector<Vec2d>& vertices, bool loop, 
            "the last vertex of a looped chain is closer than 0.005 m to the first (the loop closes itself: do not repeat the first vertex)");
 }
 
+void checkFluidPolygon(const Reader& r, const std::vector<Vec2d>& v, const std::string& p) {
+  if (v.size() < 3 || v.size() > 256)
+    r.fail(p, "a fluid polygon has 3 to 256 vertices, got " + std::to_string(v.size()));
+  double area2 = 0, extent = 0;
+  for (std::size_t i = 0, j = v.size() - 1; i < v.size(); j = i++) {
+    area2 += v[j].x() * v[i].y() - v[i].x() * v[j].y();
+    extent = std::max(extent, (v[i] - v[0]).norm());
+  }
+  if (!(std::fabs(area2) > 1e-12 * extent * extent))
+    r.fail(p, "the polygon encloses no area (its vertices are on one line or repeat)");
+}
+
+double regionLatticeCount(const FluidBlockDef& b, double dx) {
+  const auto [nx, ny] = blockLattice(b, dx);
+  if (!(nx >= 1 && ny >= 1)) return 0;
+  if (b.shape == FluidBlockDef::Shape::Box || ny > 1e7) return nx * ny;
+  // Row by row: the points inside form intervals of the row (the circle's chord; for a
+  // polygon, between crossings, by parity). Each interval's ends are found from an
+  // estimate and settled with contains() itself, so the count is exactly the points
+  // World's fill keeps, in O(rows × vertices) however many points the box holds.
+  const long n = long(nx);
+  auto x = [&](long i) { return b.min.x() + (double(i) + 0.5) * dx; };
+  double count = 0, y = 0;
+  std::vector<double> xs;
+  for (long j = 0; j < long(ny); ++j) {
+    y = j == 0 ? b.min.y() + 0.5 * dx * 1.0 : y + 0.5 * dx * (1.0 + 1.0);  // the rows as fillBlock steps them
+    auto in = [&](long i) { return b.contains(Vec2d(x(i), y)); };
+    /// The first index whose point is at or right of `xc` (n when none is).
+    auto firstAtOrRight = [&](double xc) {
+      long i = long(std::clamp(std::ceil((xc - b.min.x()) / dx - 0.5), 0.0, double(n)));
+      while (i > 0 && x(i - 1) >= xc) --i;
+      while (i < n && x(i) < xc) ++i;
+      return i;
+    };
+    if (b.shape == FluidBlockDef::Shape::Circle) {
+      const double dy = y - b.center.y(), h2 = b.radius * b.radius - dy * dy;
+      if (!(h2 >= 0)) continue;
+      const double h = std::sqrt(h2);
+      long lo = firstAtOrRight(b.center.x() - h), hi = firstAtOrRight(b.center.x() + h);  // about [lo, hi)
+      while (lo > 0 && in(lo - 1)) --lo;
+      while (lo < hi && !in(lo)) ++lo;
+      while (hi < n && in(hi)) ++hi;
+      while (hi > lo && !in(hi - 1)) --hi;
+      count += double(hi - lo);
+      continue;
+    }
+    b.rowCrossings(y, xs);
+    // A point in [xs[m-1], xs[m]) has xs.size() − m crossings right of it (> x); inside
+    // when that is odd. Left of xs[0] there is an even number (a closed outline).
+    for (std::size_t m = 1; m < xs.size(); ++m)
+      if (((xs.size() - m) & 1) != 0) count += double(firstAtOrRight(xs[m]) - firstAtOrRight(xs[m - 1]));
+  }
+  return count;
+}
+
 void checkBlock(const Reader& r, const SceneDef& s, const FluidBlockDef& blk, const std::string& p) {
   const double dx = s.solver.spacing;
   const auto [nx, ny] = blockLattice(blk, dx);
+  if (blk.shape != FluidBlockDef::Shape::Box && nx >= 1 && ny >= 1 && regionLatticeCount(blk, dx) == 0)
+    r.fail(Reader::sub(p, blk.shape == FluidBlockDef::Shape::Circle ? "radius" : "vertices"),
+           "the region holds no point of the particle lattice (spacing " + fmt(dx) + " m): it would hold no particle");
   if (nx < 1 || ny < 1)
     r.fail(Reader::sub(p, "max"), "the block is " + fmt(blk.max.x() - blk.min.x()) + " m x " + fmt(blk.max.y() - blk.min.y()) +
                                       " m, less than one particle spacing (" + fmt(dx) + " m) " + (nx < 1 ? "wide" : "high") +
@@ -361,10 +419,7 @@ double estimateWorldBytes(const SceneDef& scene) {
 
 std::size_t countBlockParticles(const SceneDef& scene) {
   double n = 0;
-  for (const auto& b : scene.blocks) {
-    const auto [nx, ny] = blockLattice(b, scene.solver.spacing);
-    if (nx > 0 && ny > 0) n += nx * ny;
-  }
+  for (const auto& b : scene.blocks) n += regionLatticeCount(b, scene.solver.spacing);
   const double most = double(std::numeric_limits<std::size_t>::max() / 2);
   return !(n < most) ? std::numeric_limits<std::size_t>::max() / 2 : static_cast<std::size_t>(n);
 }

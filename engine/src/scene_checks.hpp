@@ -50,6 +50,13 @@ void checkChain(const Reader& r, const std::vector<Vec2d>& vertices, bool loop, 
 /// A fluid block (at `path`) that could hold a particle at `s`'s spacing: at least one
 /// spacing wide and high, and not entirely inside one solid fixture of `s`'s bodies.
 void checkBlock(const Reader& r, const SceneDef& s, const FluidBlockDef& block, const std::string& path);
+/// A fluid polygon: 3..256 finite vertices enclosing a non-zero area (any simple or
+/// self-crossing outline; the fill follows the even-odd rule).
+void checkFluidPolygon(const Reader& r, const std::vector<Vec2d>& vertices, const std::string& path);
+/// The lattice points of a region at spacing dx: its bounding box's, and for a circle or
+/// polygon those inside it, counted when the box holds at most 10^7 (else the box's count,
+/// an upper bound). The rows as a block without the hydrostatic start places them.
+double regionLatticeCount(const FluidBlockDef& b, double dx);
 
 /// A periodic range (at `path`) spans at least three support radii `R` (min < max).
 void checkPeriod(const Reader& r, const Vec2d& range, double R, const std::string& path);

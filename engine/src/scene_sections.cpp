@@ -82,10 +82,24 @@ BodyDef readBody(const Reader& r, const json& j, const std::string& p) {
 
 VelocityFieldDef readVelocityField(const Reader& r, const json& f, const std::string& pf) {
   r.requireObject(f, pf);
-  if (!f.contains("type")) r.fail(Reader::sub(pf, "type"), "missing; allowed values: taylor_green, strain");
-  const std::string type = r.string(f, pf, "type", "", {"taylor_green", "strain"});
+  if (!f.contains("type")) r.fail(Reader::sub(pf, "type"), "missing; allowed values: taylor_green, strain, linear");
+  const std::string type = r.string(f, pf, "type", "", {"taylor_green", "strain", "linear"});
   VelocityFieldDef field;
-  if (type == "strain") {
+  if (type == "linear") {
+    r.checkKeys(f, pf, {"type", "gradient", "origin"});
+    field.type = VelocityFieldDef::Type::Linear;
+    const std::string pg = Reader::sub(pf, "gradient");
+    const char* want = "expected the velocity gradient [[du/dx, du/dy], [dv/dx, dv/dy]] in 1/s, each within -1e4..1e4";
+    if (!f.contains("gradient")) r.fail(pg, std::string("missing; ") + want);
+    const json& g = f.at("gradient");
+    if (!g.is_array() || g.size() != 2 || !g[0].is_array() || !g[1].is_array()) r.fail(pg, want);
+    for (int row = 0; row < 2; ++row) {
+      const Vec2d v = r.vec2(g[std::size_t(row)], pg + "[" + std::to_string(row) + "]");
+      if (!(std::fabs(v.x()) <= 1e4 && std::fabs(v.y()) <= 1e4)) r.fail(pg, want);
+      field.gradient[std::size_t(2 * row)] = v.x();
+      field.gradient[std::size_t(2 * row + 1)] = v.y();
+    }
+  } else if (type == "strain") {
     r.checkKeys(f, pf, {"type", "rate", "origin"});
     field.type = VelocityFieldDef::Type::Strain;
     if (!f.contains("rate")) r.fail(Reader::sub(pf, "rate"), "missing; expected the strain rate s in 1/s (u = -s x, v = s y)");
@@ -102,13 +116,37 @@ VelocityFieldDef readVelocityField(const Reader& r, const json& f, const std::st
 
 FluidBlockDef readBlock(const Reader& r, const json& j, const std::string& p, const SceneDef& s) {
   r.requireObject(j, p);
-  r.checkKeys(j, p, {"min", "max", "velocity", "velocity_field"});
   FluidBlockDef blk;
-  blk.min = r.requiredVec2(j, p, "min");
-  blk.max = r.requiredVec2(j, p, "max");
+  const std::string shape = j.contains("shape") ? r.string(j, p, "shape", "box", {"box", "circle", "polygon"}) : "box";
+  const double dx = s.solver.spacing;
+  if (shape == "circle") {
+    // The lattice of a drop (World::addDrop): a square of whole spacings around the centre.
+    r.checkKeys(j, p, {"shape", "center", "radius", "velocity", "velocity_field"});
+    blk.shape = FluidBlockDef::Shape::Circle;
+    blk.center = r.requiredVec2(j, p, "center");
+    if (!j.contains("radius")) r.fail(Reader::sub(p, "radius"), "missing; expected a number > 0 [m]");
+    blk.radius = r.number(j, p, "radius", 0, 0, 1e6, true);
+    const double half = std::ceil(blk.radius / dx - 1e-9) * dx;
+    blk.min = blk.center - Vec2d(half, half);
+    blk.max = blk.center + Vec2d(half + 0.5 * dx, half + 0.5 * dx);
+  } else if (shape == "polygon") {
+    r.checkKeys(j, p, {"shape", "vertices", "velocity", "velocity_field"});
+    blk.shape = FluidBlockDef::Shape::Polygon;
+    blk.vertices = r.points(j, p, "vertices");
+    checkFluidPolygon(r, blk.vertices, Reader::sub(p, "vertices"));
+    blk.min = blk.max = blk.vertices[0];
+    for (const Vec2d& v : blk.vertices) {
+      blk.min = blk.min.cwiseMin(v);
+      blk.max = blk.max.cwiseMax(v);
+    }
+  } else {
+    r.checkKeys(j, p, {"shape", "min", "max", "velocity", "velocity_field"});
+    blk.min = r.requiredVec2(j, p, "min");
+    blk.max = r.requiredVec2(j, p, "max");
+    checkMaxAboveMin(r, blk.min, blk.max, p);
+  }
   blk.velocity = r.vec2(j, p, "velocity", blk.velocity);
   if (j.contains("velocity_field")) blk.field = readVelocityField(r, j.at("velocity_field"), Reader::sub(p, "velocity_field"));
-  checkMaxAboveMin(r, blk.min, blk.max, p);
   checkBlock(r, s, blk, p);
   return blk;
 }

@@ -67,6 +67,9 @@ void World::Impl::warnLowSoundSpeed() {
     if (b.field.type == VelocityFieldDef::Type::Strain)  // |s| times the farthest corner from the origin
       for (const Vec2d& c : {b.min, b.max, Vec2d(b.min.x(), b.max.y()), Vec2d(b.max.x(), b.min.y())})
         field = std::max(field, std::fabs(b.field.rate) * (c - b.field.origin).norm());
+    if (b.field.type == VelocityFieldDef::Type::Linear)  // |A x| is largest at a corner of the box (convex)
+      for (const Vec2d& c : {b.min, b.max, Vec2d(b.min.x(), b.max.y()), Vec2d(b.max.x(), b.min.y())})
+        field = std::max(field, b.field.at(c).norm());
     consider(b.velocity.norm() + field, "fluid[" + std::to_string(k) + "].velocity");
   }
   for (std::size_t k = 0; k < scene.effects.emitters.size(); ++k) {

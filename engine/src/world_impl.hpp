@@ -96,8 +96,8 @@ struct World::Impl {
     double radius;
   };
   /// Fills a block on the lattice of the spacing (hydrostaticStart: rows closer with
-  /// depth, at the density the solver holds at rest); `disc` keeps the points of a
-  /// drop. Stops at the particle budget (one warning for the rest).
+  /// depth, at the density the solver holds at rest), keeping the points of its circle
+  /// or polygon; `disc` keeps the points of a drop. Stops at the particle budget (one warning for the rest).
   std::size_t fillBlock(const FluidBlockDef& b, bool hydrostaticStart, const Disc* disc = nullptr);
   /// Warns once when a weakly compressible solver's sound speed is below 10 × the fastest
   /// speed the scene sets (blocks, emitters, timeline events).

@@ -298,3 +298,88 @@ TEST_CASE("a strain velocity field starts each particle at u = -s x, v = s y fro
     CHECK(e.key == "fluid[0].velocity_field.rate");
   }
 }
+
+TEST_CASE("a linear velocity field u = A x + b gives a rigidly rotating disc the angular momentum I omega") {
+  // A disc of radius 0.3 turning at 5 rad/s about its centre (A = [[0, -5], [5, 0]]), moving
+  // at b = (0.5, 0): every particle starts at b + A (x - c), so the linear momentum is M b and
+  // the angular momentum about the centre is Σ m r² ω (the lattice's own moment of inertia).
+  SceneDef s = parseScene(R"({"gravity": [0, 0], "solver": {"type": "wcsph", "spacing": 0.02},
+    "fluid": [{"shape": "circle", "center": [1, 1], "radius": 0.3, "velocity": [0.5, 0],
+               "velocity_field": {"type": "linear", "gradient": [[0, -5], [5, 0]], "origin": [1, 1]}}]})",
+                          "spin.json");
+  World w(s, WorldOptions{1});
+  const double m = double(w.particleMass());
+  Vec2d p(0, 0);
+  double L = 0, I = 0;
+  for (std::size_t i = 0; i < w.particleCount(); ++i) {
+    const Vec2d r = w.worldPosition(i) - Vec2d(1, 1);
+    const Vec2d v(double(w.particles().v[i].x()), double(w.particles().v[i].y()));
+    p += m * v;
+    L += m * (r.x() * (v.y() - 0) - r.y() * (v.x() - 0.5));
+    I += m * r.squaredNorm();
+  }
+  const double M = m * double(w.particleCount());
+  CHECK((p - M * Vec2d(0.5, 0)).norm() < 1e-5 * M);
+  CHECK(std::abs(L - I * 5) < 1e-5 * I * 5);
+  // The disc holds the lattice points within the radius: about π r² / dx² of them.
+  const double expected = 3.14159265358979 * 0.09 / (0.02 * 0.02);
+  MESSAGE("disc: " << w.particleCount() << " particles, pi r^2/dx^2 = " << expected);
+  CHECK(std::abs(double(w.particleCount()) - expected) < 0.03 * expected);
+  CHECK(double(countBlockParticles(s)) == double(w.particleCount()));
+  try {
+    parseScene(R"({"fluid": [{"min": [0, 0], "max": [1, 1], "velocity_field": {"type": "linear", "gradient": [[0, 1], [2]]}}]})",
+               "bad.json");
+    FAIL("a gradient with a short row was accepted");
+  } catch (const SceneError& e) {
+    CHECK(e.key.rfind("fluid[0].velocity_field.gradient", 0) == 0);
+  }
+}
+
+TEST_CASE("a polygon region fills the lattice points inside its outline, concave or not, and nothing outside") {
+  // An L-shaped region (concave): the 1 x 1 square minus its upper-right quarter, area 0.75.
+  SceneDef s = parseScene(R"({"gravity": [0, 0], "solver": {"type": "wcsph", "spacing": 0.02},
+    "fluid": [{"shape": "polygon", "vertices": [[0, 0], [1, 0], [1, 0.5], [0.5, 0.5], [0.5, 1], [0, 1]]}]})",
+                          "ell.json");
+  World w(s, WorldOptions{1});
+  CHECK(w.particleCount() == std::size_t(0.75 / (0.02 * 0.02) + 0.5));  // the lattice tiles the L exactly
+  for (std::size_t i = 0; i < w.particleCount(); ++i) {
+    const Vec2d x = w.worldPosition(i);
+    const bool inL = x.x() > 0 && x.y() > 0 && x.x() < 1 && x.y() < 1 && !(x.x() > 0.5 && x.y() > 0.5);
+    if (!inL) FAIL("a particle outside the L at " << x.transpose());
+  }
+  CHECK(double(countBlockParticles(s)) == double(w.particleCount()));
+  // A self-crossing 64-point star (even-odd: its core is outside): the loader's row-by-row
+  // count is exactly the World's fill, and every particle is inside by the even-odd rule.
+  SceneDef star = parseScene(R"({"gravity": [0, 0], "solver": {"type": "wcsph", "spacing": 0.01}})", "star.json");
+  FluidBlockDef st;
+  st.shape = FluidBlockDef::Shape::Polygon;
+  for (int k = 0; k < 64; ++k) {
+    const double a = 2 * 3.14159265358979 * (27.0 * k) / 64.0, r = 0.5 + 0.1 * std::sin(7.0 * k);
+    st.vertices.push_back(Vec2d(1 + r * std::cos(a), 1 + r * std::sin(a)));
+  }
+  st.min = st.max = st.vertices[0];
+  for (const Vec2d& v : st.vertices) {
+    st.min = st.min.cwiseMin(v);
+    st.max = st.max.cwiseMax(v);
+  }
+  star.blocks.push_back(st);
+  World ws(star, WorldOptions{1});
+  MESSAGE("star: " << ws.particleCount() << " particles");
+  CHECK(ws.particleCount() > 1000);
+  CHECK(double(countBlockParticles(star)) == double(ws.particleCount()));
+  for (std::size_t i = 0; i < ws.particleCount(); ++i)
+    if (!st.contains(ws.worldPosition(i))) FAIL("a star particle outside the outline");
+  // Bad outlines are refused naming the key.
+  for (const char* bad : {R"({"fluid": [{"shape": "polygon", "vertices": [[0, 0], [1, 0]]}]})",
+                          R"({"fluid": [{"shape": "polygon", "vertices": [[0, 0], [1, 1], [2, 2]]}]})",
+                          R"({"fluid": [{"shape": "circle", "center": [0, 0], "radius": 0.001}]})",
+                          R"({"fluid": [{"shape": "circle", "radius": 1}]})"}) {
+    try {
+      parseScene(bad, "bad.json");
+      FAIL("accepted: " << bad);
+    } catch (const SceneError& e) {
+      INFO(e.what());
+      CHECK((e.key == "fluid[0].vertices" || e.key == "fluid[0].radius" || e.key == "fluid[0].center"));
+    }
+  }
+}

@@ -104,7 +104,12 @@ TEST_CASE("checkBlock refuses a block thinner than a spacing or entirely inside 
   ring.vertices = {{-10, -10}, {10, -10}, {10, 10}, {-10, 10}};
   body.fixtures.push_back(ring);
   s.bodies.push_back(body);
-  const auto block = [](Vec2d min, Vec2d max) { return FluidBlockDef{min, max, Vec2d(0, 0), {}}; };
+  const auto block = [](Vec2d min, Vec2d max) {
+    FluidBlockDef b;
+    b.min = min;
+    b.max = max;
+    return b;
+  };
   std::string key;
   CHECK(failure([&](const Reader& r) { checkBlock(r, s, block({0.8, 0.8}, {1.2, 1.2}), "fluid[0]"); }, &key) ==
         "the block lies entirely inside boundaries[0].fixtures[0] (a box): every particle would be dropped");
@@ -154,8 +159,13 @@ TEST_CASE("names, frame counts, periods and cameras are checked at their limits"
 TEST_CASE("the particle budget counts the blocks' lattice and the solids' samples, without overflow") {
   SceneDef s;
   s.solver.spacing = 0.1;
-  s.blocks.push_back({Vec2d(0, 0), Vec2d(1, 0.5), Vec2d(0, 0), {}});
-  s.blocks.push_back({Vec2d(2, 0), Vec2d(2.05, 1), Vec2d(0, 0), {}});  // thinner than a spacing: none
+  FluidBlockDef wide, thin;
+  wide.min = Vec2d(0, 0);
+  wide.max = Vec2d(1, 0.5);
+  thin.min = Vec2d(2, 0);
+  thin.max = Vec2d(2.05, 1);  // thinner than a spacing: none
+  s.blocks.push_back(wide);
+  s.blocks.push_back(thin);
   CHECK(countBlockParticles(s) == 50);
   s.maxParticles = 50;
   CHECK(failure([&](const Reader& r) { checkParticleBudget(r, s); }) == "");
