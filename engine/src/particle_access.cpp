@@ -12,6 +12,8 @@
 #include <sstream>
 #include <stdexcept>
 
+#include <box2d/box2d.h>
+
 #include "world_impl.hpp"
 
 namespace sph2d {
@@ -63,6 +65,7 @@ bool World::setParticle(std::uint32_t id, const Vec2d& position, const Vec2d& ve
   w.P.x[i] = p;
   w.P.xPrev[i] = p;  // a teleport: the swept collision starts here, not on the old path
   w.P.v[i] = Vec2(Real(velocity.x()), Real(velocity.y()));
+  ++w.edits;  // the query grid is stale
   return true;
 }
 
@@ -118,6 +121,7 @@ std::vector<std::uint32_t> World::addParticles(const std::vector<Vec2d>& points,
     ids.push_back(w.nextId);
     w.P.push(p, Vec2(Real(v.x()), Real(v.y())), w.nextId++, rho0);
   }
+  ++w.edits;  // the query grid is stale
   if (inside) w.warnings.push_back("addParticles: skipped " + std::to_string(inside) + " points inside solids");
   if (refused) {
     std::ostringstream o;
@@ -140,6 +144,44 @@ std::size_t World::removeParticles(const std::vector<std::uint32_t>& ids) {
   }
   if (n) w.removeFlagged();
   return n;
+}
+
+std::size_t World::removeParticlesInShape(const b2Shape& shape, const b2Transform& xf) {
+  const std::vector<std::size_t> in = particlesInShape(shape, xf);
+  std::vector<std::uint32_t> ids;
+  for (const std::size_t i : in) ids.push_back(impl_->P.id[i]);
+  return removeParticles(ids);
+}
+
+std::size_t World::addShape(const b2Shape& shape, const b2Transform& xf, const Vec2d& velocity) {
+  FluidBlockDef b;
+  b.velocity = velocity;
+  const double dx = impl_->scene.solver.spacing;
+  if (shape.GetType() == b2Shape::e_circle) {
+    const auto& c = static_cast<const b2CircleShape&>(shape);
+    const b2Vec2 p = b2Mul(xf, c.m_p);
+    b.shape = FluidBlockDef::Shape::Circle;
+    b.center = Vec2d(p.x, p.y);
+    b.radius = c.m_radius;
+    const double half = std::ceil(b.radius / dx - 1e-9) * dx;  // the lattice of a drop
+    b.min = b.center - Vec2d(half, half);
+    b.max = b.center + Vec2d(half + 0.5 * dx, half + 0.5 * dx);
+  } else if (shape.GetType() == b2Shape::e_polygon) {
+    const auto& poly = static_cast<const b2PolygonShape&>(shape);
+    b.shape = FluidBlockDef::Shape::Polygon;
+    for (int k = 0; k < poly.m_count; ++k) {
+      const b2Vec2 p = b2Mul(xf, poly.m_vertices[k]);
+      b.vertices.push_back(Vec2d(p.x, p.y));
+    }
+    b.min = b.max = b.vertices[0];
+    for (const Vec2d& v : b.vertices) {
+      b.min = b.min.cwiseMin(v);
+      b.max = b.max.cwiseMax(v);
+    }
+  } else {
+    throw std::invalid_argument("addShape: only a polygon or a circle holds fluid (an edge or chain has no inside)");
+  }
+  return addBlock(b);
 }
 
 }  // namespace sph2d

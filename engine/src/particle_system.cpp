@@ -102,6 +102,7 @@ std::size_t World::Impl::fillBlock(const FluidBlockDef& b, bool hydrostaticStart
       << " and refused the rest (raise " << budgetKey() << " or add less)";
     warnings.push_back(o.str());
   }
+  ++edits;  // the query grid is stale
   return added;
 }
 
@@ -109,7 +110,10 @@ const char* World::Impl::budgetKey() const {
   return scene.effects.budget > 0 ? "effects.budget.max_particles" : "max_particles";
 }
 
-void World::Impl::removeFlagged() { removed += P.compact(dead); }
+void World::Impl::removeFlagged() {
+  removed += P.compact(dead);
+  ++edits;  // the query grid is stale
+}
 
 /// Removes the k particles with the smallest ids (the oldest).
 void World::Impl::removeOldest(std::size_t k) {

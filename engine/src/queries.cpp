@@ -1,6 +1,7 @@
 // What readers ask of a World's state: searches by region, field samples,
 // the state hash, density and energy statistics, memory, and the names of
 // the fields, effects and stages.
+#include <algorithm>
 #include <cmath>
 
 #include "sph2d/hash.hpp"
@@ -8,19 +9,84 @@
 
 namespace sph2d {
 
-std::vector<std::size_t> World::particlesInRadius(const Vec2d& c, double radius) const {
+const World::Impl::QueryGrid& World::Impl::currentQueryGrid() const {
+  QueryGrid& g = queryGrid;
+  if (g.steps == steps && g.edits == edits && g.count == P.size()) return g;
+  g.steps = steps;
+  g.edits = edits;
+  g.count = P.size();
+  g.nx = g.ny = 0;
+  g.start.clear();
+  g.items.clear();
+  if (P.size() == 0) return g;
+  double x0 = P.x[0].x(), y0 = P.x[0].y(), x1 = x0, y1 = y0;
+  for (const Vec2& x : P.x) {
+    x0 = std::min(x0, double(x.x()));
+    x1 = std::max(x1, double(x.x()));
+    y0 = std::min(y0, double(x.y()));
+    y1 = std::max(y1, double(x.y()));
+  }
+  // Cells of the support radius, grown when spray makes the bounds huge (at most 4 cells a particle).
+  g.h = double(R);
+  const double most = 4.0 * double(P.size()) + 64;
+  while (((x1 - x0) / g.h + 1) * ((y1 - y0) / g.h + 1) > most) g.h *= 2;
+  g.x0 = x0;
+  g.y0 = y0;
+  g.nx = long((x1 - x0) / g.h) + 1;
+  g.ny = long((y1 - y0) / g.h) + 1;
+  const std::size_t cells = std::size_t(g.nx * g.ny);
+  std::vector<std::uint32_t> cellOf(P.size());
+  g.start.assign(cells + 1, 0);
+  for (std::size_t i = 0; i < P.size(); ++i) {
+    const long ci = std::min(g.nx - 1, long((double(P.x[i].x()) - x0) / g.h));
+    const long cj = std::min(g.ny - 1, long((double(P.x[i].y()) - y0) / g.h));
+    cellOf[i] = std::uint32_t(cj * g.nx + ci);
+    ++g.start[cellOf[i] + 1];
+  }
+  for (std::size_t k = 0; k < cells; ++k) g.start[k + 1] += g.start[k];
+  g.items.resize(P.size());
+  std::vector<std::uint32_t> fill(g.start.begin(), g.start.end() - 1);
+  for (std::size_t i = 0; i < P.size(); ++i) g.items[fill[cellOf[i]]++] = std::uint32_t(i);  // slot order within a cell
+  return g;
+}
+
+namespace {
+/// The slots `f` accepts among the candidates of [lo, hi], in slot order.
+template <class Accept>
+std::vector<std::size_t> collect(const World::Impl& w, const Vec2d& lo, const Vec2d& hi, Accept&& accept) {
   std::vector<std::size_t> out;
-  for (std::size_t i = 0; i < impl_->P.size(); ++i)
-    if ((worldPosition(i) - c).squaredNorm() <= radius * radius) out.push_back(i);
+  w.forCandidates(lo, hi, [&](std::size_t i) {
+    if (accept(i)) out.push_back(i);
+  });
+  std::sort(out.begin(), out.end());
   return out;
+}
+}  // namespace
+
+std::vector<std::size_t> World::particlesInRadius(const Vec2d& c, double radius) const {
+  const Vec2d r(radius, radius);
+  return collect(*impl_, c - r, c + r, [&](std::size_t i) { return (worldPosition(i) - c).squaredNorm() <= radius * radius; });
 }
 
 std::vector<std::size_t> World::particlesInBox(const Vec2d& lo, const Vec2d& hi) const {
-  std::vector<std::size_t> out;
   const RegionDef r{lo, hi};
-  for (std::size_t i = 0; i < impl_->P.size(); ++i)
-    if (r.contains(worldPosition(i))) out.push_back(i);
-  return out;
+  return collect(*impl_, lo, hi, [&](std::size_t i) { return r.contains(worldPosition(i)); });
+}
+
+std::vector<std::size_t> World::particlesInShape(const b2Shape& shape, const b2Transform& xf) const {
+  b2AABB box;
+  box.lowerBound = box.upperBound = b2Vec2(0, 0);
+  for (int c = 0; c < shape.GetChildCount(); ++c) {
+    b2AABB a;
+    shape.ComputeAABB(&a, xf, c);
+    if (c == 0) box = a;
+    else box.Combine(a);
+  }
+  const Vec2d lo(box.lowerBound.x, box.lowerBound.y), hi(box.upperBound.x, box.upperBound.y);
+  return collect(*impl_, lo, hi, [&](std::size_t i) {
+    const Vec2d p = worldPosition(i);
+    return shape.TestPoint(xf, b2Vec2(float(p.x()), float(p.y())));
+  });
 }
 
 World::FieldSample World::sampleAt(const Vec2d& point) const {
@@ -29,7 +95,9 @@ World::FieldSample World::sampleAt(const Vec2d& point) const {
   FieldSample s;
   double rho = 0;
   Vec2d vel(0, 0);
-  for (std::size_t i = 0; i < w.P.size(); ++i) {
+  // The particles within R, summed in slot order (the same sum as a scan of every particle).
+  const Vec2d reach(W.R, W.R);
+  for (const std::size_t i : collect(w, point - reach, point + reach, [](std::size_t) { return true; })) {
     const double r = (worldPosition(i) - point).norm();
     if (r >= W.R) continue;
     const double wv = W.value(r) * double(w.mass) / double(w.P.rho[i]);  // V_j W
@@ -124,6 +192,7 @@ std::size_t World::memoryBytes() const {
   b += cap(w.scratch.v) + cap(w.scratch.r) + cap(w.scratch.u);
   b += cap(w.boundary.samples) + cap(w.boundary.volume) + cap(w.boundary.sideNormal) + cap(w.boundary.sideOffset);
   b += cap(w.idIndex);  // only once a game looked a particle up by id
+  b += cap(w.queryGrid.start) + cap(w.queryGrid.items);  // only once a game searched
   return b;
 }
 

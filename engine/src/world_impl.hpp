@@ -10,6 +10,8 @@
 
 #include <box2d/box2d.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -69,6 +71,44 @@ struct World::Impl {
   /// (id, slot) of every particle sorted by id: World::slotOf's index, rebuilt when a lookup
   /// finds it stale (particle_access.cpp). Mutable: a lookup on a const World refreshes it.
   mutable std::vector<std::pair<std::uint32_t, std::uint32_t>> idIndex;
+  /// Changes of the particles made between steps (the API's adds, removals and moves):
+  /// with `steps` and the count, what the query grid is valid for.
+  std::uint64_t edits = 0;
+  /// A uniform grid of the current particles for World's queries (queries.cpp): cells of
+  /// side `h` from (x0, y0) over the particles' bounds, slots counting-sorted by cell.
+  /// Built on the first query after a change, then each query visits only its cells.
+  struct QueryGrid {
+    std::uint64_t steps = ~std::uint64_t(0), edits = 0;
+    std::size_t count = 0;
+    double x0 = 0, y0 = 0, h = 1;
+    long nx = 0, ny = 0;
+    std::vector<std::uint32_t> start, items;  ///< cell k holds items[start[k] .. start[k + 1])
+  };
+  mutable QueryGrid queryGrid;
+  /// The query grid of the current particles (rebuilt when stale).
+  const QueryGrid& currentQueryGrid() const;
+  /// Calls f(slot) for every particle whose world position may lie in [lo, hi] (the
+  /// cells the box touches), in no particular order.
+  template <class F>
+  void forCandidates(const Vec2d& lo, const Vec2d& hi, F&& f) const {
+    const QueryGrid& g = currentQueryGrid();
+    if (g.nx == 0) return;
+    // Local = world − origin, up to rounding: the box grows by a micrometre so that a particle
+    // on a cell's edge is never missed (callers test each candidate exactly).
+    const double ox = origin.x(), oy = origin.y();
+    const Vec2d lo2 = lo - Vec2d(1e-6, 1e-6), hi2 = hi + Vec2d(1e-6, 1e-6);
+    auto cell = [&](double v, double v0, long n) { return std::clamp(long(std::floor((v - v0) / g.h)), 0L, n - 1); };
+    if (!(hi2.x() - ox >= g.x0 && hi2.y() - oy >= g.y0 && lo2.x() - ox <= g.x0 + double(g.nx) * g.h &&
+          lo2.y() - oy <= g.y0 + double(g.ny) * g.h))
+      return;  // outside the particles' bounds (or NaN)
+    const long i0 = cell(lo2.x() - ox, g.x0, g.nx), i1 = cell(hi2.x() - ox, g.x0, g.nx);
+    const long j0 = cell(lo2.y() - oy, g.y0, g.ny), j1 = cell(hi2.y() - oy, g.y0, g.ny);
+    for (long j = j0; j <= j1; ++j)
+      for (long i = i0; i <= i1; ++i) {
+        const std::size_t k = std::size_t(j * g.nx + i);
+        for (std::uint32_t q = g.start[k]; q < g.start[k + 1]; ++q) f(std::size_t(g.items[q]));
+      }
+  }
 
   /// The state of the particles and the scene's constants for a substep of length dt.
   Impl(const SceneDef& s, const WorldOptions& o) : scene(s), pool(o.threads) {}

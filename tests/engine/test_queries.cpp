@@ -7,6 +7,10 @@
 #include <cmath>
 #include <vector>
 
+#include <box2d/box2d.h>
+
+#include <stdexcept>
+
 #include "sph2d/world.hpp"
 #include "support/fixture.hpp"
 
@@ -46,6 +50,65 @@ TEST_CASE("particlesInRadius and particlesInBox return exactly the slots a brute
     }
   }
   CHECK(nonEmpty >= 6);  // the searches found particles, not only empty sets
+}
+
+TEST_CASE("searches see every change made between steps: a moved, an added and a removed particle") {
+  // The searches go through a grid of the particles built on the first search after a change;
+  // a grid kept across a change would miss these.
+  World w(test::scene("tests/small_dam_break.json"), WorldOptions{1});
+  for (int f = 0; f < 5; ++f) w.stepFrame();
+  const Vec2d spot(3.5, 2.5);  // empty air, far from the water
+  REQUIRE(w.particlesInRadius(spot, 0.05).empty());  // builds the grid
+  const std::uint32_t id = w.particles().id[0];
+  REQUIRE(w.setParticle(id, spot, Vec2d(0, 0)));
+  std::vector<std::size_t> found = w.particlesInRadius(spot, 0.05);
+  REQUIRE(found.size() == 1);
+  CHECK(w.particles().id[found[0]] == id);
+  const std::vector<std::uint32_t> added = w.addParticles({spot + Vec2d(0.2, 0)});
+  REQUIRE(added.size() == 1);
+  CHECK(w.particlesInBox(spot + Vec2d(0.1, -0.1), spot + Vec2d(0.3, 0.1)).size() == 1);
+  CHECK(w.removeParticles({id}) == 1);
+  CHECK(w.particlesInRadius(spot, 0.05).empty());
+  CHECK(w.particlesInRadius(spot, 0.25).size() == 1);  // the added one
+}
+
+TEST_CASE("shapes: particlesInShape matches b2Shape::TestPoint over every particle, and addShape and removeParticlesInShape fill and empty a rotated box") {
+  SceneDef s = test::tank("wcsph", 2, 2, 0.02);
+  s.gravity = Vec2d(0, 0);
+  World w(s, WorldOptions{2});
+  b2PolygonShape box;
+  box.SetAsBox(0.3f, 0.15f, b2Vec2(0, 0), 0.6f);  // 0.6 m × 0.3 m, turned 0.6 rad
+  const b2Transform xf(b2Vec2(1.0f, 1.0f), b2Rot(0.0f));
+  const std::size_t n = w.addShape(box, xf, Vec2d(0.1, 0));
+  MESSAGE("a 0.18 m^2 box at spacing 0.02: " << n << " particles");
+  CHECK(std::abs(double(n) - 0.18 / (0.02 * 0.02)) < 0.05 * 450);
+  for (std::size_t i = 0; i < w.particleCount(); ++i) {
+    const Vec2d p = w.worldPosition(i);
+    const b2Vec2 q(float(p.x()), float(p.y()));
+    if (!box.TestPoint(xf, b2Vec2(q.x, q.y)) && !box.TestPoint(xf, b2Vec2(q.x + 1e-5f, q.y)) &&
+        !box.TestPoint(xf, b2Vec2(q.x - 1e-5f, q.y)))
+      FAIL("a particle of the box outside it at " << p.transpose());
+  }
+  b2CircleShape disc;
+  disc.m_p = b2Vec2(0.1f, 0.05f);
+  disc.m_radius = 0.2f;
+  for (const b2Shape* shape : {static_cast<const b2Shape*>(&box), static_cast<const b2Shape*>(&disc)}) {
+    std::vector<std::size_t> brute;
+    for (std::size_t i = 0; i < w.particleCount(); ++i) {
+      const Vec2d p = w.worldPosition(i);
+      if (shape->TestPoint(xf, b2Vec2(float(p.x()), float(p.y())))) brute.push_back(i);
+    }
+    CHECK(!brute.empty());
+    CHECK(w.particlesInShape(*shape, xf) == brute);
+  }
+  const std::size_t inDisc = w.particlesInShape(disc, xf).size();
+  CHECK(w.removeParticlesInShape(disc, xf) == inDisc);
+  CHECK(w.particlesInShape(disc, xf).empty());
+  CHECK(w.particleCount() == n - inDisc);
+  b2EdgeShape edge;
+  edge.SetTwoSided(b2Vec2(0, 0), b2Vec2(1, 0));
+  CHECK_THROWS_AS(w.addShape(edge, xf), std::invalid_argument);
+  CHECK(w.particlesInShape(edge, xf).empty());
 }
 
 TEST_CASE("sampleAt inside a uniform moving block returns rho0 and the block's velocity, with weight 1, and nothing far from it") {

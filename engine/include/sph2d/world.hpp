@@ -20,6 +20,8 @@
 #include "sph2d/scene.hpp"
 
 class b2World;
+class b2Shape;
+struct b2Transform;
 
 namespace sph2d {
 
@@ -198,6 +200,17 @@ class World {
   /// counts them). Returns how many were removed.
   std::size_t removeParticles(const std::vector<std::uint32_t>& ids);
 
+  /// Slots of the particles inside `shape` placed by `xf` (world coordinates; b2Shape::TestPoint:
+  /// polygons and circles hold points, edges and chains none), in slot order.
+  std::vector<std::size_t> particlesInShape(const b2Shape& shape, const b2Transform& xf) const;
+  /// Removes the particles inside `shape` placed by `xf`. Returns how many.
+  std::size_t removeParticlesInShape(const b2Shape& shape, const b2Transform& xf);
+  /// Fills `shape` placed by `xf` (a b2PolygonShape or b2CircleShape) with fluid on the lattice
+  /// of the scene's spacing, moving at `velocity`, as addBlock does (solids skipped, the budget
+  /// held). Returns the number added. Throws std::invalid_argument for an edge or chain.
+  std::size_t addShape(const b2Shape& shape, const b2Transform& xf, const Vec2d& velocity = Vec2d(0, 0));
+  // The searches below visit only the cells of a grid of the current particles, built on the
+  // first search after a step or a change (O(n)), not every particle.
   /// Slots of the particles within `radius` of `center` (world coordinates), in slot order.
   std::vector<std::size_t> particlesInRadius(const Vec2d& center, double radius) const;
   /// Slots of the particles inside the box [lo, hi] (world coordinates), in slot order.
