@@ -1,5 +1,6 @@
 // The coarse-grid pressure projection (grid_projection.hpp).
 #include "grid_projection.hpp"
+#include "state_io.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -449,6 +450,31 @@ std::size_t GridProjection::project(StepContext& c) {
   assemble();
   solve(c);
   return transferToParticles(c);
+}
+
+void GridProjection::saveState(StateOut& out) const {
+  out.put(pH_);
+  out.put(std::int64_t(pI0_));
+  out.put(std::int64_t(pJ0_));
+  out.put(std::int32_t(pnx_));
+  out.put(std::int32_t(pny_));
+  out.putVector(prevKappa_);
+}
+
+void GridProjection::loadState(StateIn& in, std::size_t maxCells) {
+  const Real h = in.get<Real>("the grid's cell size");
+  const std::int64_t i0 = in.get<std::int64_t>("the grid's origin"), j0 = in.get<std::int64_t>("the grid's origin");
+  const std::int32_t nx = in.get<std::int32_t>("the grid's size"), ny = in.get<std::int32_t>("the grid's size");
+  std::vector<Real> k;
+  in.getVector(k, maxCells, "the grid's pressure");
+  if (!(h >= 0) || nx < 0 || ny < 0 || std::uint64_t(nx) * std::uint64_t(ny) != k.size())
+    throw SaveError("the saved state is malformed: the grid's pressure does not fit its size");
+  pH_ = h;
+  pI0_ = long(i0);
+  pJ0_ = long(j0);
+  pnx_ = nx;
+  pny_ = ny;
+  prevKappa_ = std::move(k);
 }
 
 }  // namespace sph2d

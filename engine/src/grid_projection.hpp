@@ -27,6 +27,9 @@
 
 namespace sph2d {
 
+class StateOut;
+class StateIn;
+
 /// What one projection did.
 struct GridProjectionStats {
   int iterations = 0;       ///< conjugate-gradient iterations
@@ -45,6 +48,10 @@ class GridProjection {
   /// κ = p/ρ0 of the last projection at `x` (bilinear over the fluid and air cells, air
   /// holding 0; solid cells are left out; 0 outside the grid or before any projection).
   Real kappaAt(const Vec2& x) const;
+  /// Writes the warm start the next projection starts from (World::save).
+  void saveState(StateOut& out) const;
+  /// Reads what saveState() wrote; at most `maxCells` cells.
+  void loadState(StateIn& in, std::size_t maxCells);
   /// The last projection's figures.
   const GridProjectionStats& stats() const { return stats_; }
 

@@ -6,6 +6,7 @@
 //   box2d_bridge.cpp     the scene's b2World and the colliders read from a b2World
 //   queries.cpp          what readers ask of the state (hash, statistics, searches)
 //   particle_access.cpp  particles by id: read, write, add at points, remove
+//   save_load.cpp        the changing state to and from a byte stream
 #pragma once
 
 #include <box2d/box2d.h>

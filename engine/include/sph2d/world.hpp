@@ -10,6 +10,7 @@
 #pragma once
 
 #include <cstdint>
+#include <iosfwd>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -54,6 +55,11 @@ struct UserForce {
   Vec2d point{0, 0};   ///< world coordinates [m]
   double radius = 0.5; ///< reach [m]
   double strength = 0; ///< acceleration at the centre [m/s²]; > 0 pulls towards the point, < 0 pushes away
+};
+
+/// A saved state that World::load refuses: not a save, another scene's, or damaged.
+struct SaveError : std::runtime_error {
+  using std::runtime_error::runtime_error;
 };
 
 /// What an iterative pressure solver did in its last substep (all zero for explicit solvers).
@@ -164,6 +170,17 @@ class World {
   std::size_t addDrop(const Vec2d& center, double radius, const Vec2d& velocity = Vec2d(0, 0));
   /// Removes the particles inside the box [lo, hi] (world coordinates). Returns how many.
   std::size_t removeParticlesInBox(const Vec2d& lo, const Vec2d& hi);
+
+  /// Writes the World's whole changing state (particles with every field, time and
+  /// counters, emitters with their random streams, gravity, user forces, switched
+  /// effects, the solver's warm starts) to `out`, in this machine's byte order. A World
+  /// built from the same scene and load()ed from it steps on to the same state hashes.
+  void save(std::ostream& out) const;
+  /// Replaces this World's state with one save() wrote for the same scene (on a machine
+  /// with the same byte order). Throws SaveError, changing nothing, when the input is not
+  /// a save, belongs to another scene or solver, is truncated, or holds a count beyond
+  /// the particle budget or the scene's emitters.
+  void load(std::istream& in);
 
   // Particles by id (particle_access.cpp). A slot changes when the grid reorders the
   // particles or some are removed; an id never does, so a game holds particles by id.

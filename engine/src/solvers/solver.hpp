@@ -19,6 +19,9 @@
 
 namespace sph2d {
 
+class StateOut;
+class StateIn;
+
 class Solver {
  public:
   virtual ~Solver() = default;
@@ -50,6 +53,11 @@ class Solver {
   virtual std::vector<Stage> stages(bool effects) = 0;
   /// Iterations and residuals of the last substep (explicit solvers: all zero).
   virtual SolverStats stats() const { return {}; }
+  /// Writes what the solver carries from one substep to the next outside the particle
+  /// fields (warm starts, step limits), for World::save. Nothing by default.
+  virtual void saveState(StateOut& out) const { (void)out; }
+  /// Reads back what saveState() wrote (throws SaveError on malformed input).
+  virtual void loadState(StateIn& in) { (void)in; }
 };
 
 /// The stages of the equation-of-state solvers (muller2003, wcsph): grid →

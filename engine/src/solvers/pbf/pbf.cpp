@@ -11,6 +11,7 @@
 #include <limits>
 
 #include "solvers/pbf/pbf.hpp"
+#include "state_io.hpp"
 
 namespace sph2d {
 
@@ -372,6 +373,20 @@ std::size_t Pbf::velocity(StepContext& c) {
   });
   P.v.swap(vNew_);
   return first;
+}
+
+void Pbf::saveState(StateOut& out) const {
+  out.put(dtLimit_);
+  out.put(std::uint8_t(projection_ ? 1 : 0));
+  if (projection_) projection_->saveState(out);
+}
+
+void Pbf::loadState(StateIn& in) {
+  const Real limit = in.get<Real>("the solver's step limit");
+  const bool grid = in.get<std::uint8_t>("the solver's grid flag") != 0;
+  if (grid != bool(projection_) || !(limit > 0)) throw SaveError("the saved state is malformed: its solver state is not this solver's");
+  if (projection_) projection_->loadState(in, std::size_t(1) << 26);  // reads all, then assigns
+  dtLimit_ = limit;
 }
 
 }  // namespace sph2d

@@ -111,6 +111,10 @@ class Pbf final : public Solver {
 
   /// Correction passes and the mean compression after them, of the last substep.
   SolverStats stats() const override { return stats_; }
+  /// The step limit and the grid projection's warm start (World::save).
+  void saveState(StateOut& out) const override;
+  /// Reads what saveState() wrote.
+  void loadState(StateIn& in) override;
 
   /// [grid → neighbours, when effects run] → external → effects → predict →
   /// predicted_grid → predicted_neighbours → density_solve → density → velocity.

@@ -1,0 +1,274 @@
+// save_load.cpp — World::save and World::load: the World's changing state as one
+// byte stream (state_io.hpp), after LiquidFun's and Box2D's notion that a game
+// snapshots its physics between frames.
+//
+// What is saved is everything a step reads that the scene does not fix: the
+// particles with every field (fixed and optional, in their slot order), the clock
+// and counters, the emitters' random streams and counts and where a game moved
+// them, gravity, the user forces, which effects are switched on, and what the
+// solver carries between substeps (Solver::saveState). Grids, neighbour lists and
+// caches are rebuilt by the next substep. A fingerprint of the scene's solver,
+// spacing, emitters and effects makes a save load only into a World of its scene.
+//
+// load() reads the whole input into temporaries and checks it (magic, version,
+// fingerprint, every count against the budget or the scene, field names and sizes,
+// unique ids below the next id) before it changes anything.
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <istream>
+#include <iterator>
+#include <ostream>
+
+#include "sph2d/hash.hpp"
+#include "state_io.hpp"
+#include "world_impl.hpp"
+
+namespace sph2d {
+namespace {
+
+constexpr char kMagic[8] = {'S', 'P', 'H', '2', 'D', 'S', 'A', 'V'};
+constexpr std::uint32_t kVersion = 1;
+constexpr std::size_t kMaxFields = 64, kMaxName = 128;
+constexpr const char* kUserForce = "user_force";  ///< the effect setUserForces adds
+
+/// What a save must match: the solver and its spacing, the emitters, the effects.
+std::uint64_t fingerprint(const World::Impl& w) {
+  Xxh64 h;
+  auto str = [&](const std::string& s) {
+    const std::uint64_t n = s.size();
+    h.update(&n, sizeof n);
+    h.update(s.data(), s.size());
+  };
+  str(w.solver->name());
+  const double keys[] = {w.scene.solver.spacing, w.scene.solver.supportRatio, w.scene.solver.restDensity};
+  h.update(keys, sizeof keys);
+  const std::uint64_t emitters = w.emitters.size();
+  h.update(&emitters, sizeof emitters);
+  for (const auto& e : w.effects)
+    if (std::string(e->name()) != kUserForce) str(e->name());  // a game adds it at run time
+  return h.digest();
+}
+
+void putVec(StateOut& o, const Vec2d& v) {
+  o.put(v.x());
+  o.put(v.y());
+}
+
+Vec2d getVec(StateIn& in, const char* what) {
+  const double x = in.get<double>(what), y = in.get<double>(what);
+  return Vec2d(x, y);
+}
+
+}  // namespace
+
+void World::save(std::ostream& out) const {
+  const Impl& w = *impl_;
+  StateOut o;
+  for (const char c : kMagic) o.put(c);
+  o.put(kVersion);
+  o.put(fingerprint(w));
+  o.put(w.time);
+  o.put(w.frames);
+  o.put(w.steps);
+  o.put(std::int32_t(w.lastSubsteps));
+  o.put(w.lastAccel);
+  o.put(w.lastDt);
+  o.put(w.nextId);
+  o.put(w.iterations);
+  o.put(w.removed);
+  putVec(o, w.scene.gravity);
+  o.put(std::uint64_t(w.emitters.size()));
+  for (const Impl::EmitterState& e : w.emitters) {
+    o.put(e.rng);
+    o.put(e.emitted);
+    o.put(std::uint8_t(e.warnedBudget));
+    putVec(o, e.def.position);
+    putVec(o, e.def.direction);
+    o.put(std::uint8_t(e.def.enabled));
+  }
+  o.put(std::uint8_t(w.userForceEffect));
+  o.put(std::uint64_t(w.userForces.size()));
+  for (const UserForce& f : w.userForces) {
+    putVec(o, f.point);
+    o.put(f.radius);
+    o.put(f.strength);
+  }
+  std::uint64_t sceneEffects = 0;
+  for (const auto& e : w.effects) sceneEffects += std::string(e->name()) != kUserForce;
+  o.put(sceneEffects);
+  for (const auto& e : w.effects) {
+    if (std::string(e->name()) == kUserForce) continue;
+    o.putString(e->name());
+    o.put(std::uint8_t(e->enabled));
+  }
+  o.put(std::uint64_t(w.P.size()));
+  std::uint64_t fields = 0;
+  w.P.forEachField([&](const char*, const auto&) { ++fields; });
+  o.put(fields);
+  w.P.forEachField([&](const char* name, const auto& f) {
+    o.putString(name);
+    o.put(std::uint32_t(sizeof(f[0])));
+    o.putBytes(f.data(), f.size() * sizeof(f[0]));
+  });
+  w.solver->saveState(o);
+  out.write(reinterpret_cast<const char*>(o.bytes.data()), std::streamsize(o.bytes.size()));
+  if (!out) throw SaveError("World::save: the stream refused the state (" + std::to_string(o.bytes.size()) + " bytes)");
+}
+
+void World::load(std::istream& input) {
+  Impl& w = *impl_;
+  const std::vector<std::uint8_t> bytes((std::istreambuf_iterator<char>(input)), std::istreambuf_iterator<char>());
+  StateIn in(bytes.data(), bytes.size());
+  for (const char c : kMagic)
+    if (in.get<char>("the header") != c) throw SaveError("not an sph2d saved state (its first bytes are not SPH2DSAV)");
+  const std::uint32_t version = in.get<std::uint32_t>("the header");
+  if (version != kVersion)
+    throw SaveError("the saved state has version " + std::to_string(version) + "; this sph2d reads version " +
+                    std::to_string(kVersion));
+  if (in.get<std::uint64_t>("the header") != fingerprint(w))
+    throw SaveError("the saved state belongs to another scene (its solver, spacing, emitters or effects differ)");
+  const double time = in.get<double>("the clock");
+  const std::uint64_t frames = in.get<std::uint64_t>("the clock"), steps = in.get<std::uint64_t>("the clock");
+  const std::int32_t lastSubsteps = in.get<std::int32_t>("the clock");
+  const Real lastAccel = in.get<Real>("the clock");
+  const double lastDt = in.get<double>("the clock");
+  const std::uint32_t nextId = in.get<std::uint32_t>("the counters");
+  const std::uint64_t iterations = in.get<std::uint64_t>("the counters"), removed = in.get<std::uint64_t>("the counters");
+  const Vec2d gravity = getVec(in, "gravity");
+  if (!std::isfinite(time) || !std::isfinite(lastDt) || !std::isfinite(gravity.x()) || !std::isfinite(gravity.y()))
+    throw SaveError("the saved state is malformed: its clock or gravity is not finite");
+  if (in.get<std::uint64_t>("the emitters") != w.emitters.size())
+    throw SaveError("the saved state is malformed: its emitter count is not the scene's " + std::to_string(w.emitters.size()));
+  std::vector<Impl::EmitterState> emitters = w.emitters;
+  for (Impl::EmitterState& e : emitters) {
+    e.rng = in.get<std::uint64_t>("an emitter");
+    e.emitted = in.get<std::uint64_t>("an emitter");
+    e.warnedBudget = in.get<std::uint8_t>("an emitter") != 0;
+    e.def.position = getVec(in, "an emitter");
+    e.def.direction = getVec(in, "an emitter");
+    e.def.enabled = in.get<std::uint8_t>("an emitter") != 0;
+    if (!std::isfinite(e.def.position.x()) || !std::isfinite(e.def.position.y()) || !(std::abs(e.def.direction.norm() - 1) < 1e-6))
+      throw SaveError("the saved state is malformed: an emitter's position or direction");
+  }
+  const bool userForceEffect = in.get<std::uint8_t>("the user forces") != 0;
+  const std::uint64_t forces = in.get<std::uint64_t>("the user forces");
+  if (forces > 4096) throw SaveError("the saved state is malformed: " + std::to_string(forces) + " user forces (at most 4096)");
+  std::vector<UserForce> userForces(static_cast<std::size_t>(forces));
+  for (UserForce& f : userForces) {
+    f.point = getVec(in, "a user force");
+    f.radius = in.get<double>("a user force");
+    f.strength = in.get<double>("a user force");
+  }
+  std::vector<std::string> effectNames;
+  for (const auto& e : w.effects)
+    if (std::string(e->name()) != kUserForce) effectNames.push_back(e->name());
+  if (in.get<std::uint64_t>("the effects") != effectNames.size())
+    throw SaveError("the saved state is malformed: its effect count is not the World's");
+  std::vector<bool> enabled;
+  for (const std::string& name : effectNames) {
+    if (in.getString(kMaxName, "an effect's name") != name)
+      throw SaveError("the saved state is malformed: the effects differ (expected " + name + ")");
+    enabled.push_back(in.get<std::uint8_t>("an effect") != 0);
+  }
+  const std::uint64_t n = in.get<std::uint64_t>("the particle count");
+  if (n > w.budget)
+    throw SaveError("the saved state holds " + std::to_string(n) + " particles, beyond the scene's budget of " +
+                    std::to_string(w.budget) + " (" + w.budgetKey() + ")");
+  const std::uint64_t fieldCount = in.get<std::uint64_t>("the field count");
+  if (fieldCount > kMaxFields) throw SaveError("the saved state is malformed: " + std::to_string(fieldCount) + " particle fields");
+  struct Field {
+    std::string name;
+    std::uint32_t element = 0;
+    std::vector<std::uint8_t> data;
+  };
+  std::vector<Field> saved(static_cast<std::size_t>(fieldCount));
+  for (Field& f : saved) {
+    f.name = in.getString(kMaxName, "a field's name");
+    f.element = in.get<std::uint32_t>("a field");
+    if (f.element != 4 && f.element != 8) throw SaveError("the saved state is malformed: field " + f.name + "'s element size");
+    in.getVector(f.data, std::size_t(n) * f.element, "a field's values");
+    if (f.data.size() != std::size_t(n) * f.element)
+      throw SaveError("the saved state is malformed: field " + f.name + " does not hold one value per particle");
+  }
+  auto find = [&](const std::string& name) -> const Field* {
+    for (const Field& f : saved)
+      if (f.name == name) return &f;
+    return nullptr;
+  };
+  // Every field of this World (fixed and optional) must be in the save, with its element size.
+  std::string missing;
+  w.P.forEachField([&](const char* name, const auto& vec) {
+    const Field* f = find(name);
+    if (!f || f->element != sizeof(vec[0])) missing += (missing.empty() ? "" : ", ") + std::string(name);
+  });
+  if (!missing.empty()) throw SaveError("the saved state is malformed: it lacks the particle fields " + missing);
+  for (const Field& f : saved) {
+    bool fixed = false;
+    w.P.forEachField([&](const char* name, const auto&) { fixed = fixed || f.name == name; });
+    if (!fixed && f.element != sizeof(Real)) throw SaveError("the saved state is malformed: field " + f.name + "'s element size");
+  }
+  std::vector<std::uint32_t> ids(static_cast<std::size_t>(n));
+  if (n) std::memcpy(ids.data(), find("id")->data.data(), ids.size() * sizeof(std::uint32_t));
+  std::sort(ids.begin(), ids.end());
+  if (std::adjacent_find(ids.begin(), ids.end()) != ids.end() || (!ids.empty() && ids.back() >= nextId))
+    throw SaveError("the saved state is malformed: particle ids repeat or reach the next id");
+  // The solver's state is the stream's tail. Its own loadState reads all before it assigns;
+  // if it throws, or bytes are left over, the solver gets its previous state back.
+  StateOut backup;
+  w.solver->saveState(backup);
+  try {
+    w.solver->loadState(in);
+    if (!in.done()) throw SaveError("the saved state is malformed: bytes follow the solver's state");
+  } catch (...) {
+    StateIn restore(backup.bytes.data(), backup.bytes.size());
+    w.solver->loadState(restore);
+    throw;
+  }
+  // Commit.
+  for (const Field& f : saved) {
+    bool fixed = false;
+    w.P.forEachField([&](const char* name, auto& vec) {
+      if (f.name != name) return;
+      fixed = true;
+      vec.resize(static_cast<std::size_t>(n));
+      if (n) std::memcpy(static_cast<void*>(vec.data()), f.data.data(), f.data.size());
+    });
+    if (!fixed) {
+      std::vector<Real>& vec = w.P.field(f.name);
+      vec.resize(static_cast<std::size_t>(n));
+      if (n) std::memcpy(vec.data(), f.data.data(), f.data.size());
+    }
+  }
+  w.time = time;
+  w.frames = frames;
+  w.steps = steps;
+  w.lastSubsteps = lastSubsteps;
+  w.lastAccel = lastAccel;
+  w.lastDt = lastDt;
+  w.nextId = nextId;
+  w.iterations = iterations;
+  w.removed = removed;
+  w.scene.gravity = gravity;
+  w.emitters = std::move(emitters);
+  // The user-force effect exactly when the saved World had it (setUserForces adds it on the
+  // first non-empty list); then the scene's effects as they were switched.
+  if (userForceEffect && !w.userForceEffect) {
+    w.effects.push_back(makeUserForceEffect(&w.userForces));
+    w.userForceEffect = true;
+  } else if (!userForceEffect && w.userForceEffect) {
+    w.effects.erase(std::remove_if(w.effects.begin(), w.effects.end(),
+                                   [](const auto& e) { return std::string(e->name()) == kUserForce; }),
+                    w.effects.end());
+    w.userForceEffect = false;
+  }
+  w.userForces = std::move(userForces);
+  for (std::size_t k = 0; k < effectNames.size(); ++k)
+    for (auto& e : w.effects)
+      if (effectNames[k] == e->name()) e->enabled = enabled[k];
+  w.buildStages();
+  ++w.edits;
+  w.idIndex.clear();
+}
+
+}  // namespace sph2d

@@ -1,0 +1,117 @@
+// World::save and World::load (engine/src/save_load.cpp): a saved and reloaded World
+// steps on to exactly the state hashes of the World that was not interrupted, for every
+// solver, with emitters, lifetimes, effects, user forces and moved gravity; and a save
+// that is not this scene's, truncated or inflated is refused without changing the World.
+#include <doctest/doctest.h>
+
+#include <sstream>
+#include <string>
+
+#include "support/fixture.hpp"
+
+using namespace sph2d;
+
+namespace {
+
+/// A 1.2 m × 1.2 m tank with a column, a jittered emitter, lifetimes and XSPH.
+SceneDef busyScene(const std::string& solver) {
+  SceneDef s = test::tank(solver, 1.2, 1.2, 0.03);
+  s.blocks.push_back(test::block({0, 0}, {0.3, 0.5}));
+  EmitterDef e;
+  e.position = Vec2d(0.8, 1.0);
+  e.direction = Vec2d(0, -1);
+  e.rate = 120;
+  e.speed = 1.5;
+  e.spread = 0.3;
+  e.jitter = 0.2;
+  e.seed = 7;
+  s.effects.emitters.push_back(e);
+  s.effects.lifetime = true;
+  s.effects.maxAge = 0.4;
+  s.effects.xsph = true;
+  return s;
+}
+
+std::string saved(const World& w) {
+  std::ostringstream o;
+  w.save(o);
+  return o.str();
+}
+
+}  // namespace
+
+TEST_CASE("save and load: every solver steps on to the same state hashes as the World that was not interrupted") {
+  for (const char* solver : {"muller2003", "wcsph", "pbf", "dfsph", "game"}) {
+    INFO(solver);
+    const SceneDef s = busyScene(solver);
+    World a(s, WorldOptions{2});
+    for (int f = 0; f < 12; ++f) a.stepFrame();
+    // State a scene does not hold: moved gravity, a user force, a switched effect, a moved emitter.
+    a.setGravity(Vec2d(1.0, -9.0));
+    a.setUserForces({UserForce{Vec2d(0.3, 0.3), 0.3, -20.0}});
+    a.setEffectEnabled("xsph", false);
+    a.moveEmitter(0, Vec2d(0.7, 1.0), Vec2d(0.2, -1));
+    for (int f = 0; f < 3; ++f) a.stepFrame();
+    const std::string bytes = saved(a);
+    World b(s, WorldOptions{1});  // another thread count: the same bits
+    std::istringstream in(bytes);
+    b.load(in);
+    CHECK(b.stateHash() == a.stateHash());
+    CHECK(b.time() == a.time());
+    CHECK(b.particleCount() == a.particleCount());
+    CHECK(b.stages() == a.stages());
+    for (int f = 0; f < 15; ++f) {
+      a.stepFrame();
+      b.stepFrame();
+      REQUIRE_MESSAGE(b.stateHash() == a.stateHash(), "frame " << f << " after the load");
+    }
+    CHECK(b.emittedCount(0) == a.emittedCount(0));
+    CHECK(b.removedCount() == a.removedCount());
+    CHECK(saved(b) == saved(a));
+  }
+}
+
+TEST_CASE("save and load: a save of another scene, a damaged or an inflated save is refused and the World is unchanged") {
+  const SceneDef s = busyScene("game");
+  World a(s, WorldOptions{1});
+  for (int f = 0; f < 10; ++f) a.stepFrame();
+  const std::string good = saved(a);
+  World b(s, WorldOptions{1});
+  for (int f = 0; f < 3; ++f) b.stepFrame();
+  const std::uint64_t before = b.stateHash();
+  const std::string beforeBytes = saved(b);
+  auto refusal = [&](const std::string& bytes) -> std::string {
+    std::istringstream in(bytes);
+    try {
+      b.load(in);
+    } catch (const SaveError& e) {
+      return e.what();
+    }
+    return "";
+  };
+  CHECK(refusal("hello, world").find("not an sph2d saved state") != std::string::npos);
+  SceneDef other = s;
+  other.solver.spacing = 0.025;
+  CHECK(refusal(saved(World(other))).find("belongs to another scene") != std::string::npos);
+  // Truncated anywhere: refused, never read past the end.
+  for (std::size_t cut = 8; cut < good.size(); cut += good.size() / 37 + 1) {
+    const std::string r = refusal(good.substr(0, cut));
+    INFO("cut at " << cut << " of " << good.size());
+    CHECK(r.find("the saved state is") != std::string::npos);
+  }
+  CHECK(refusal(good + "x").find("bytes follow") != std::string::npos);
+  // The particle count inflated past the budget (it follows the effects; found by value).
+  std::string big = good;
+  const std::uint64_t n = a.particleCount();
+  const std::size_t at = big.find(std::string(reinterpret_cast<const char*>(&n), sizeof n));
+  REQUIRE(at != std::string::npos);
+  const std::uint64_t huge = std::uint64_t(1) << 40;
+  big.replace(at, sizeof huge, std::string(reinterpret_cast<const char*>(&huge), sizeof huge));
+  CHECK(refusal(big).find("beyond the scene's budget") != std::string::npos);
+  // Nothing changed by any refusal: the World steps on as it would have.
+  CHECK(b.stateHash() == before);
+  CHECK(saved(b) == beforeBytes);
+  std::istringstream in(good);
+  b.load(in);
+  CHECK(b.stateHash() == a.stateHash());
+}
