@@ -130,6 +130,7 @@ void GameLoop::capture(std::int64_t f) {
   q.input.origin = world_.origin();
   q.input.spacing = world_.spacing();
   q.input.colliders = &q.colliders;
+  q.input.moving = world_.movingColliders();  // where the moving bodies are in this frame
   q.input.age = age ? q.age.data() : nullptr;
   q.input.gravity = world_.scene().gravity.norm();
   q.input.frame = world_.frame();

@@ -1,4 +1,4 @@
-// The bridge between the fluid and Box2D: the scene's static bodies built in
+// The bridge between the fluid and Box2D: the scene's bodies built in
 // a real b2World, and the colliders and boundary samples read back from any
 // b2World (the scene's or a game's), again whenever its static fixtures change.
 #include "sph2d/hash.hpp"
@@ -10,10 +10,10 @@ namespace {
 
 b2Vec2 bv(const Vec2d& v) { return b2Vec2(float(v.x()), float(v.y())); }
 
-/// Builds one static body of the scene with its fixtures.
+/// Builds one body of the scene (static, or kinematic with its velocity) with its fixtures.
 void addBody(b2World& world, const BodyDef& def) {
   b2BodyDef bd;
-  bd.type = b2_staticBody;
+  bd.type = def.type == BodyDef::Type::Kinematic ? b2_kinematicBody : b2_staticBody;
   bd.position = bv(def.position);
   bd.angle = float(def.angle);
   b2Body* body = world.CreateBody(&bd);
@@ -57,6 +57,11 @@ void addBody(b2World& world, const BodyDef& def) {
         break;
     }
     body->CreateFixture(&fd);
+  }
+  if (def.type == BodyDef::Type::Kinematic) {
+    // Box2D turns a kinematic body about its origin (it has no mass): `position`.
+    body->SetLinearVelocity(bv(def.velocity));
+    body->SetAngularVelocity(float(def.angularVelocity));
   }
 }
 

@@ -74,7 +74,7 @@ std::size_t World::Impl::fillBlock(const FluidBlockDef& b, bool hydrostaticStart
       if (disc && !((pw - disc->center).squaredNorm() <= disc->radius * disc->radius)) continue;
       if (b.shape == FluidBlockDef::Shape::Polygon && !FluidBlockDef::insideRow(crossings, pw.x())) continue;
       const Vec2 p = Vec2(Real(pw.x() - origin.x()), Real(pw.y() - origin.y()));
-      if (boundary.insideDepth(p) > 0) {
+      if (boundary.insideDepth(p) > 0 || insideMoving(p)) {
         dlo = dropped ? dlo.cwiseMin(pw) : pw;
         dhi = dropped ? dhi.cwiseMax(pw) : pw;
         ++dropped;

@@ -20,6 +20,8 @@
 #include <iterator>
 #include <ostream>
 
+#include <box2d/box2d.h>
+
 #include "sph2d/hash.hpp"
 #include "state_io.hpp"
 #include "world_impl.hpp"
@@ -111,6 +113,19 @@ void World::save(std::ostream& out) const {
     o.put(std::uint32_t(sizeof(f[0])));
     o.putBytes(f.data(), f.size() * sizeof(f[0]));
   });
+  // The scene's own moving bodies (a game saves its own b2World).
+  std::uint64_t bodies = 0;
+  if (w.ownWorld)
+    for (b2Body* b = w.ownWorld->GetBodyList(); b; b = b->GetNext()) bodies += b->GetType() != b2_staticBody;
+  o.put(bodies);
+  if (w.ownWorld)
+    for (b2Body* b = w.ownWorld->GetBodyList(); b; b = b->GetNext()) {
+      if (b->GetType() == b2_staticBody) continue;
+      o.put(b->GetPosition());
+      o.put(b->GetAngle());
+      o.put(b->GetLinearVelocity());
+      o.put(b->GetAngularVelocity());
+    }
   w.solver->saveState(o);
   out.write(reinterpret_cast<const char*>(o.bytes.data()), std::streamsize(o.bytes.size()));
   if (!out) throw SaveError("World::save: the stream refused the state (" + std::to_string(o.bytes.size()) + " bytes)");
@@ -213,6 +228,25 @@ void World::load(std::istream& input) {
   std::sort(ids.begin(), ids.end());
   if (std::adjacent_find(ids.begin(), ids.end()) != ids.end() || (!ids.empty() && ids.back() >= nextId))
     throw SaveError("the saved state is malformed: particle ids repeat or reach the next id");
+  std::vector<b2Body*> movable;
+  if (w.ownWorld)
+    for (b2Body* b = w.ownWorld->GetBodyList(); b; b = b->GetNext())
+      if (b->GetType() != b2_staticBody) movable.push_back(b);
+  if (in.get<std::uint64_t>("the bodies") != movable.size())
+    throw SaveError("the saved state is malformed: its moving bodies are not the scene's " + std::to_string(movable.size()));
+  struct BodyState {
+    b2Vec2 p, v;
+    float angle, omega;
+  };
+  std::vector<BodyState> bodyStates(movable.size());
+  for (BodyState& b : bodyStates) {
+    b.p = in.get<b2Vec2>("a body");
+    b.angle = in.get<float>("a body");
+    b.v = in.get<b2Vec2>("a body");
+    b.omega = in.get<float>("a body");
+    if (!b.p.IsValid() || !b.v.IsValid() || !std::isfinite(b.angle) || !std::isfinite(b.omega))
+      throw SaveError("the saved state is malformed: a body's pose or velocity is not finite");
+  }
   // The solver's state is the stream's tail. Its own loadState reads all before it assigns;
   // if it throws, or bytes are left over, the solver gets its previous state back.
   StateOut backup;
@@ -239,6 +273,11 @@ void World::load(std::istream& input) {
       vec.resize(static_cast<std::size_t>(n));
       if (n) std::memcpy(vec.data(), f.data.data(), f.data.size());
     }
+  }
+  for (std::size_t k = 0; k < movable.size(); ++k) {
+    movable[k]->SetTransform(bodyStates[k].p, bodyStates[k].angle);
+    movable[k]->SetLinearVelocity(bodyStates[k].v);
+    movable[k]->SetAngularVelocity(bodyStates[k].omega);
   }
   w.time = time;
   w.frames = frames;

@@ -67,14 +67,32 @@ ShapeDef readFixture(const Reader& r, const json& j, const std::string& path) {
 
 BodyDef readBody(const Reader& r, const json& j, const std::string& p) {
   r.requireObject(j, p);
-  r.checkKeys(j, p, {"position", "angle", "fixtures"});
   BodyDef body;
+  const std::string type = j.contains("type") ? r.string(j, p, "type", "static", {"static", "kinematic", "dynamic"}) : "static";
+  if (type == "dynamic")
+    r.fail(Reader::sub(p, "type"), "dynamic bodies are not supported yet: the fluid does not push bodies; use kinematic "
+                                   "(moved at a set velocity, pushing the fluid) or static");
+  if (type == "kinematic") {
+    body.type = BodyDef::Type::Kinematic;
+    r.checkKeys(j, p, {"type", "position", "angle", "velocity", "angular_velocity", "fixtures"});
+    body.velocity = r.vec2(j, p, "velocity", body.velocity);
+    if (!(body.velocity.norm() <= 1e3)) r.fail(Reader::sub(p, "velocity"), "at most 1000 m/s");
+    body.angularVelocity = r.number(j, p, "angular_velocity", 0, -1e3, 1e3);
+  } else {
+    r.checkKeys(j, p, {"type", "position", "angle", "fixtures"});
+  }
   body.position = r.vec2(j, p, "position", body.position);
   body.angle = r.number(j, p, "angle", 0, -1e3, 1e3);
   if (!j.contains("fixtures")) r.fail(Reader::sub(p, "fixtures"), "missing; expected an array of fixtures");
   const json& fx = j.at("fixtures");
   if (!fx.is_array()) r.fail(Reader::sub(p, "fixtures"), "expected an array of fixtures, got " + describe(fx));
-  for (std::size_t f = 0; f < fx.size(); ++f) body.fixtures.push_back(readFixture(r, fx[f], p + ".fixtures[" + std::to_string(f) + "]"));
+  for (std::size_t f = 0; f < fx.size(); ++f) {
+    const std::string pf = p + ".fixtures[" + std::to_string(f) + "]";
+    body.fixtures.push_back(readFixture(r, fx[f], pf));
+    const ShapeDef::Type t = body.fixtures.back().type;
+    if (body.type == BodyDef::Type::Kinematic && (t == ShapeDef::Type::Edge || t == ShapeDef::Type::Chain))
+      r.fail(Reader::sub(pf, "shape"), "a kinematic body's fixtures enclose an area: box, polygon or circle");
+  }
   return body;
 }
 

@@ -154,7 +154,8 @@ void World::init() {
     w.periodic.ly = pd.y ? Real(pd.max.y() - pd.min.y()) : Real(0);
   }
   w.rebuildBoundary();
-  // Fluid blocks on a square lattice; particles inside solids are dropped.
+  w.captureBodies();
+  // Fluid blocks on a square lattice; particles inside solids (moving ones too) are dropped.
   for (const FluidBlockDef& b : scene.blocks) w.fillBlock(b, true);
   // An effect whose explicit step limit is below the smallest substep the
   // solver can take cannot be followed: refuse the scene, naming the limit.
@@ -184,7 +185,10 @@ void World::stepFrame() { step(1.0 / impl_->scene.fps); }
 void World::step(double dt) {
   // A game may edit its level between frames: re-read the static fixtures when they changed.
   if (impl_->staticSignature() != impl_->boundarySignature) refreshBoundaries();
+  impl_->captureBodies();  // the moving bodies' pose and velocity for this step
+  const double t0 = impl_->time;
   impl_->advance(dt);
+  impl_->moveOwnBodies(impl_->time - t0);
   ++impl_->frames;
 }
 
@@ -280,7 +284,10 @@ std::uint64_t World::emittedCount(std::size_t index) const { return impl_->emitt
 
 std::uint64_t World::removedCount() const { return impl_->removed; }
 
-void World::stepSubstep() { impl_->substep(impl_->stableDt()); }
+void World::stepSubstep() {
+  impl_->captureBodies();
+  impl_->moveOwnBodies(double(impl_->substep(impl_->stableDt())));
+}
 
 std::vector<std::string> World::takeWarnings() {
   std::vector<std::string> out;

@@ -72,6 +72,34 @@ struct World::Impl {
   /// (id, slot) of every particle sorted by id: World::slotOf's index, rebuilt when a lookup
   /// finds it stale (particle_access.cpp). Mutable: a lookup on a const World refreshes it.
   mutable std::vector<std::pair<std::uint32_t, std::uint32_t>> idIndex;
+  // Moving bodies (moving_bodies.cpp): the kinematic and dynamic bodies of the b2World,
+  // captured at the start of each step with their pose and velocity, and moved with that
+  // velocity through the step's substeps; the `bodies` stage pushes the fluid out of them.
+  struct MovingBody {
+    b2Body* body = nullptr;
+    std::vector<Collider> shapes;  ///< polygons and circles in body coordinates
+    Vec2d com0{0, 0};              ///< centre of mass at the step's start (World's local frame)
+    Vec2d localCenter{0, 0};       ///< centre of mass in body coordinates
+    double angle0 = 0;             ///< angle at the step's start [rad]
+    Vec2d v{0, 0};                 ///< velocity of the centre of mass [m/s]
+    double omega = 0;              ///< angular velocity [rad/s]
+    double radius = 0;             ///< the shapes' reach from the centre of mass [m]
+    /// The pose τ seconds into the step: rotation θ, body origin o (local frame).
+    void pose(double tau, double& theta, Vec2d& o) const;
+  };
+  std::vector<MovingBody> moving;
+  double bodyTime0 = 0;  ///< World time of the capture
+  /// Reads the non-static bodies of the b2World (rebuilding the stage list when their
+  /// presence changed) at the current time.
+  void captureBodies();
+  /// After a step of `dt`: the scene's own b2World moves its bodies (a game steps its own).
+  void moveOwnBodies(double dt);
+  /// True when local point p lies inside a moving body at the captured pose.
+  bool insideMoving(const Vec2& p) const;
+  /// The `bodies` stage: particles that entered a moving body during the substep are put
+  /// back on its surface, their velocity into it replaced by the body's (free slip).
+  void collideMoving(StepContext& c);
+
   /// Changes of the particles made between steps (the API's adds, removals and moves):
   /// with `steps` and the count, what the query grid is valid for.
   std::uint64_t edits = 0;

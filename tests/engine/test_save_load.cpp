@@ -13,7 +13,7 @@ using namespace sph2d;
 
 namespace {
 
-/// A 1.2 m × 1.2 m tank with a column, a jittered emitter, lifetimes and XSPH.
+/// A 1.2 m × 1.2 m tank with a column, a jittered emitter, lifetimes, XSPH and a turning bar.
 SceneDef busyScene(const std::string& solver) {
   SceneDef s = test::tank(solver, 1.2, 1.2, 0.03);
   s.blocks.push_back(test::block({0, 0}, {0.3, 0.5}));
@@ -29,6 +29,12 @@ SceneDef busyScene(const std::string& solver) {
   s.effects.lifetime = true;
   s.effects.maxAge = 0.4;
   s.effects.xsph = true;
+  BodyDef bar;  // a kinematic bar turning in the open water
+  bar.type = BodyDef::Type::Kinematic;
+  bar.position = Vec2d(0.7, 0.25);
+  bar.angularVelocity = 3;
+  bar.fixtures.push_back(test::boxShape({0, 0}, {0.15, 0.02}));
+  s.bodies.push_back(bar);
   return s;
 }
 

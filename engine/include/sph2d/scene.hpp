@@ -45,10 +45,16 @@ struct ShapeDef {
   double restitution = 0.0;      ///< fixture restitution (Box2D and fluid)
 };
 
-/// A static Box2D body with its fixtures.
+/// A Box2D body with its fixtures: static (a wall), or kinematic (moved at a set velocity
+/// by Box2D; it pushes the fluid, the fluid does not push it).
 struct BodyDef {
+  /// How the body moves.
+  enum class Type { Static, Kinematic };
+  Type type = Type::Static;
   Vec2d position{0, 0};          ///< body origin in world coordinates [m]
   double angle = 0;              ///< body rotation [rad]
+  Vec2d velocity{0, 0};          ///< kinematic: velocity [m/s]
+  double angularVelocity = 0;    ///< kinematic: [rad/s], about `position` (Box2D turns a kinematic body about its origin)
   std::vector<ShapeDef> fixtures;
 };
 

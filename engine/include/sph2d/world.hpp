@@ -171,6 +171,10 @@ class World {
   /// Removes the particles inside the box [lo, hi] (world coordinates). Returns how many.
   std::size_t removeParticlesInBox(const Vec2d& lo, const Vec2d& hi);
 
+  /// The shapes of the moving (kinematic and dynamic) bodies at their current pose, in the
+  /// local frame like colliders() (polygons and circles; for drawing). They push the fluid;
+  /// the fluid does not push them yet.
+  std::vector<Collider> movingColliders() const;
   /// Writes the World's whole changing state (particles with every field, time and
   /// counters, emitters with their random streams, gravity, user forces, switched
   /// effects, the solver's warm starts) to `out`, in this machine's byte order. A World

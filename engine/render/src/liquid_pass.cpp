@@ -73,6 +73,11 @@ class LiquidPass final : public RenderPass {
   }
 
   std::pair<int, int> changedRows() const override { return changedRows_; }
+  void restoreRows(std::pair<int, int> rows) override {
+    if (rows.first >= rows.second) return;
+    if (drawnRows_.first >= drawnRows_.second) drawnRows_ = rows;
+    else drawnRows_ = {std::min(drawnRows_.first, rows.first), std::max(drawnRows_.second, rows.second)};
+  }
 
   void draw(const PassFrame& f, StageTimer& timer, RenderTimings& timings) override {
     splat(f);

@@ -89,6 +89,10 @@ class RenderPass {
   /// the background or drawn over); elsewhere the target still holds the last frame's pixels,
   /// solids included. Default: every row.
   virtual std::pair<int, int> changedRows() const { return {0, 1 << 30}; }
+  /// Target rows [first, last) that the next draw() must give back to the background too
+  /// (where moving bodies were drawn over the last frame). Passes that start every frame
+  /// from the whole background need nothing.
+  virtual void restoreRows(std::pair<int, int> rows) { (void)rows; }
   /// CPU drawing into the read-back frame (the colour bar); `textScale` is the font scale.
   virtual void annotate(Frame& /*frame*/, int /*textScale*/) const {}
   /// True when the last draw() used instanced quads instead of points.

@@ -31,6 +31,7 @@ RenderInput inputOf(const World& world, const Real* age) {
   in.origin = world.origin();
   in.spacing = world.spacing();
   in.colliders = &world.colliders();
+  in.moving = world.movingColliders();
   // Ages come from the caller, or from the engine's "age" field when the scene has lifetimes.
   const std::vector<Real>* engineAge = world.particles().find("age");
   in.age = age ? age : (engineAge ? engineAge->data() : nullptr);
@@ -57,6 +58,7 @@ struct Renderer::Impl {
   FrameGeometry geo;
   ColorTarget color;
   double spacingSeen = -1;
+  std::pair<int, int> movingRows{0, 0};  // target rows the moving bodies covered in the last frame
   Frame frame;
   std::vector<std::uint32_t> order, slotOfId;  // slots in id order; scratch
   std::vector<float> weight;                   // age fade per particle, id order
@@ -171,9 +173,11 @@ const Frame& Renderer::render(const RenderInput& in) {
   glViewport(0, 0, r.geo.EW, r.geo.EH);
   timer.end(r.timings.upload);
 
+  r.pass->restoreRows(r.movingRows);  // where moving bodies were last frame goes back to the background
   r.pass->draw(f, timer, r.timings);
   const auto rows = r.pass->changedRows();  // solids on top, where the pass may have drawn over them
   r.scenery.drawSolids(d, rows.first, rows.second);
+  r.movingRows = r.scenery.drawMoving(d, r.geo, in);
   timer.end(r.timings.solids);
 
   glPixelStorei(GL_PACK_ALIGNMENT, 1);

@@ -13,6 +13,8 @@ void Scenery::init() {
   glGenVertexArrays(1, &solidVao_);
   glGenBuffers(1, &solidVbo_);
   glGenVertexArrays(1, &emptyVao_);
+  glGenVertexArrays(1, &movingVao_);
+  glGenBuffers(1, &movingVbo_);
 }
 
 void Scenery::build(const RenderDef& def, const FrameGeometry& geo, const RenderInput& in) {
@@ -33,10 +35,9 @@ void Scenery::buildBackground(const RenderDef& def, const FrameGeometry& geo) {
   glDrawArrays(GL_TRIANGLES, 0, 3);
 }
 
-void Scenery::buildSolids(const FrameGeometry& geo, const RenderInput& in) {
-  // Triangles in NDC (the camera is fixed for a run).
+std::vector<float> solidTriangles(const FrameGeometry& geo, const Vec2d& o, const std::vector<Collider>& colliders) {
+  // Triangles in NDC.
   const std::vector<double>& ext = geo.ext;
-  const Vec2d o = in.origin;
   const double sx = 2.0 / (ext[2] - ext[0]), sy = 2.0 / (ext[3] - ext[1]);
   auto ndc = [&](const Vec2& p) {
     return std::array<float, 2>{float((p.x() + o.x() - ext[0]) * sx - 1.0), float(1.0 - (p.y() + o.y() - ext[1]) * sy)};
@@ -47,8 +48,7 @@ void Scenery::buildSolids(const FrameGeometry& geo, const RenderInput& in) {
     tri.push_back(a[1]);
   };
   const double pxX = 2.0 / geo.EW, pxY = 2.0 / geo.EH;
-  if (in.colliders)
-    for (const Collider& c : *in.colliders) {
+  for (const Collider& c : colliders) {
       if (c.kind == Collider::Kind::Polygon) {
         for (std::size_t k = 1; k + 1 < c.vertices.size(); ++k) {
           put(ndc(c.vertices[0]));
@@ -81,6 +81,12 @@ void Scenery::buildSolids(const FrameGeometry& geo, const RenderInput& in) {
         put(p3);
       }
     }
+  return tri;
+}
+
+void Scenery::buildSolids(const FrameGeometry& geo, const RenderInput& in) {
+  // The camera is fixed for a run: built once per target.
+  const std::vector<float> tri = in.colliders ? solidTriangles(geo, in.origin, *in.colliders) : std::vector<float>();
   solidCount_ = GLsizei(tri.size() / 2);
   glBindVertexArray(solidVao_);
   glBindBuffer(GL_ARRAY_BUFFER, solidVbo_);
@@ -101,6 +107,29 @@ void Scenery::drawSolids(const RenderDef& def, int rowFirst, int rowLast) const 
   glScissor(0, rowFirst, vp[2], std::min(rowLast, vp[3]) - rowFirst);
   glDrawArrays(GL_TRIANGLES, 0, solidCount_);
   glDisable(GL_SCISSOR_TEST);
+}
+
+std::pair<int, int> Scenery::drawMoving(const RenderDef& def, const FrameGeometry& geo, const RenderInput& in) {
+  if (in.moving.empty()) return {0, 0};
+  const std::vector<float> tri = solidTriangles(geo, in.origin, in.moving);
+  if (tri.empty()) return {0, 0};
+  float lo = tri[1], hi = tri[1];
+  for (std::size_t k = 1; k < tri.size(); k += 2) {
+    lo = std::min(lo, tri[k]);
+    hi = std::max(hi, tri[k]);
+  }
+  glUseProgram(solidProg_);
+  glUniform3f(gl::uniform(solidProg_, "uColor"), float(def.solid[0]), float(def.solid[1]), float(def.solid[2]));
+  glBindVertexArray(movingVao_);
+  glBindBuffer(GL_ARRAY_BUFFER, movingVbo_);
+  glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(tri.size() * sizeof(float)), tri.data(), GL_STREAM_DRAW);
+  glEnableVertexAttribArray(0);
+  glVertexAttribPointer(0, 2, GL_FLOAT, GL_FALSE, 0, nullptr);
+  glDrawArrays(GL_TRIANGLES, 0, GLsizei(tri.size() / 2));
+  // NDC y to target rows, a row of margin each side (anti-aliasing, rounding).
+  const int first = std::max(0, int(std::floor((double(lo) + 1) * 0.5 * geo.EH)) - 1);
+  const int last = std::min(geo.EH, int(std::ceil((double(hi) + 1) * 0.5 * geo.EH)) + 1);
+  return {first, last};
 }
 
 }  // namespace sph2d

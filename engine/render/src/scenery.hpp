@@ -5,6 +5,7 @@
 // it, so both agree to the bit. The solids are the World's colliders as triangles in the
 // targets' NDC, built once per camera: polygons as fans, circles as 64-gons, segments (edges,
 // chain links, zero thickness) as 3 px wide quads. Both are rebuilt when the guard band changes.
+// Moving bodies are the exception: their triangles are built and drawn every frame.
 #pragma once
 
 #include "camera.hpp"
@@ -25,6 +26,9 @@ class Scenery {
   /// Draws the solids in `def.solid`'s colour into the bound framebuffer, over the target rows
   /// [rowFirst, rowLast) only (the rest still shows them from an earlier frame).
   void drawSolids(const RenderDef& def, int rowFirst, int rowLast) const;
+  /// Draws the moving bodies of `in` (their pose this frame) over the whole bound target;
+  /// returns the target rows [first, last) they cover (empty when there are none).
+  std::pair<int, int> drawMoving(const RenderDef& def, const FrameGeometry& geo, const RenderInput& in);
 
  private:
   void buildBackground(const RenderDef& def, const FrameGeometry& geo);
@@ -32,6 +36,7 @@ class Scenery {
 
   GLuint bgProg_ = 0, solidProg_ = 0, emptyVao_ = 0, solidVao_ = 0, solidVbo_ = 0, bgTex_ = 0, bgFbo_ = 0;
   GLsizei solidCount_ = 0;
+  GLuint movingVao_ = 0, movingVbo_ = 0;
 };
 
 }  // namespace sph2d

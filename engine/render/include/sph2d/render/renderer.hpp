@@ -77,6 +77,7 @@ struct RenderInput {
   Vec2d origin{0, 0};                              ///< local frame offset [m]
   double spacing = 0.02;                           ///< particle spacing dx [m]
   const std::vector<Collider>* colliders = nullptr;///< solids in the local frame (may be null)
+  std::vector<Collider> moving;                    ///< moving bodies at their pose this frame (local frame), drawn every frame
   const Real* age = nullptr;                       ///< optional: one age [s] per particle slot
   double gravity = 9.81;                           ///< |g| [m/s²], scales the default foam speed
   std::uint64_t frame = 0;                         ///< for the overlay
