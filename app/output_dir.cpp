@@ -49,7 +49,7 @@ OutputLock::~OutputLock() {
 }
 
 int removeEarlierRun(const std::string& dir) {
-  static const std::regex mine(R"((frame_\d{5,}\.(png|csv|vtk)|manifest\.json)(\.tmp\d+)?)");
+  static const std::regex mine(R"((frame_\d{5,}\.(png|csv|vtk)|bodies_\d{5,}\.csv|manifest\.json)(\.tmp\d+)?)");
   int removed = 0;
   std::error_code ec;
   for (const auto& entry : fs::directory_iterator(dir, ec)) {

@@ -240,6 +240,7 @@ Vec2d World::worldPosition(std::size_t i) const {
 const std::vector<Collider>& World::colliders() const { return impl_->boundary.colliders; }
 const std::vector<Vec2>& World::boundarySamples() const { return impl_->boundary.samples; }
 b2World& World::box2d() { return *impl_->b2; }
+const b2World& World::box2d() const { return *impl_->b2; }
 const SceneDef& World::scene() const { return impl_->scene; }
 double World::time() const { return impl_->time; }
 std::uint64_t World::frame() const { return impl_->frames; }

@@ -361,6 +361,40 @@ TEST_CASE("sph2d check never takes a variable from a manifest that sph2d does no
   }
 }
 
+TEST_CASE("--export csv writes bodies_NNNNN.csv with each kinematic body's pose and velocity, in scene order") {
+  const std::string dir = freshDir("export_bodies");
+  REQUIRE(run("run " + q(asset("scenes/tests/kinematic_paddle.json")) + " --frames 31 --every 30 --quiet --export csv --out " +
+              q(dir)).code == 0);
+  CHECK(filesEnding(dir, ".csv") ==
+        std::vector<std::string>{"bodies_00000.csv", "bodies_00030.csv", "frame_00000.csv", "frame_00030.csv"});
+  // body, x, y, angle, vx, vy, omega per row; boundaries[1] the paddle, boundaries[2] the turning arm.
+  auto rows = [&](const std::string& file) {
+    std::vector<std::vector<double>> out;
+    std::istringstream in(readText(dir + "/" + file));
+    std::string line;
+    std::getline(in, line);  // the comment
+    std::getline(in, line);
+    CHECK(line == "body,x,y,angle,vx,vy,omega");
+    while (std::getline(in, line)) {
+      std::vector<double> r;
+      std::istringstream cells(line);
+      std::string c;
+      while (std::getline(cells, c, ',')) r.push_back(std::stod(c));
+      out.push_back(r);
+    }
+    return out;
+  };
+  const auto a = rows("bodies_00000.csv"), b = rows("bodies_00030.csv");
+  REQUIRE(a.size() == 2);
+  REQUIRE(b.size() == 2);
+  CHECK(a[0][0] == 1);
+  CHECK(a[1][0] == 2);
+  CHECK(b[0][1] == doctest::Approx(0.5 + 1.0 * 0.5).epsilon(1e-4));  // x = x0 + v t after 30 frames
+  CHECK(b[0][4] == doctest::Approx(1.0));
+  CHECK(b[1][3] == doctest::Approx(2.0 * 0.5).epsilon(1e-4));  // angle = ω t
+  CHECK(b[1][6] == doctest::Approx(2.0));
+}
+
 TEST_CASE("--export csv and vtk write each kept frame's particles in id order, world coordinates") {
   const std::string dir = freshDir("export_csv"), vdir = freshDir("export_vtk"), adir = freshDir("export_vtka");
   REQUIRE(run("run " + q(kSmall) + " --frames 5 --every 4 --quiet --export csv --out " + q(dir)).code == 0);

@@ -113,6 +113,8 @@ class World {
   const std::vector<Vec2>& boundarySamples() const;
   /// The Box2D world the fluid collides with.
   b2World& box2d();
+  /// Const variant of box2d().
+  const b2World& box2d() const;
   /// The scene this world was built from.
   const SceneDef& scene() const;
 

@@ -71,6 +71,11 @@ void FrameWriter::loop() {
       }
       if (opt_.exportFormat) {
         writeParticlesAtomic(exportPathOf(job.index), *job.particles, *opt_.exportFormat);
+        if (*opt_.exportFormat == ExportFormat::Csv && !job.particles->bodies.empty()) {
+          char name[32];
+          std::snprintf(name, sizeof name, "/bodies_%05d.csv", job.index);
+          writeBodiesCsvAtomic(opt_.dir + name, *job.particles);
+        }
         std::lock_guard<std::mutex> lock(mutex_);
         ++counts_.exports;
       }

@@ -1,5 +1,7 @@
 #include "sph2d/render/particle_export.hpp"
 
+#include <box2d/box2d.h>
+
 #include "file_io.hpp"
 
 #include <unistd.h>
@@ -69,7 +71,27 @@ ParticleSnapshot snapshotOf(const World& world, const Real* age) {
     s.p[k] = P.p[i];
     if (age) s.age[k] = float(age[i]);
   }
+  // Box2D lists the newest body first: walk the list, then number in creation order.
+  std::vector<const b2Body*> bodies;
+  for (const b2Body* b = world.box2d().GetBodyList(); b; b = b->GetNext()) bodies.push_back(b);
+  std::reverse(bodies.begin(), bodies.end());
+  for (std::size_t k = 0; k < bodies.size(); ++k) {
+    const b2Body* b = bodies[k];
+    if (b->GetType() == b2_staticBody) continue;
+    const b2Vec2 p = b->GetPosition(), v = b->GetLinearVelocity();
+    s.bodies.push_back(BodySnapshot{int(k), p.x, p.y, b->GetAngle(), v.x, v.y, b->GetAngularVelocity()});
+  }
   return s;
+}
+
+void writeBodiesCsvAtomic(const std::string& path, const ParticleSnapshot& s) {
+  std::string out;
+  appendf(out, "# sph2d bodies: frame %llu, time %.9g s, %zu kinematic or dynamic bodies, world coordinates\n",
+          static_cast<unsigned long long>(s.frame), s.time, s.bodies.size());
+  out += "body,x,y,angle,vx,vy,omega\n";
+  for (const BodySnapshot& b : s.bodies)
+    appendf(out, "%d,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g\n", b.body, b.x, b.y, b.angle, b.vx, b.vy, b.omega);
+  writeFileAtomic(path, out);
 }
 
 bool parseExportFormat(const std::string& s, ExportFormat& out) {

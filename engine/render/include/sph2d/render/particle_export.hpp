@@ -22,6 +22,13 @@ namespace sph2d {
 class World;
 
 /// One frame's particles, sorted by id, positions in world coordinates.
+/// A kinematic or dynamic Box2D body in a snapshot (world coordinates).
+struct BodySnapshot {
+  int body = 0;                   ///< its index among all bodies of the b2World in creation order (a scene's: boundaries[] index)
+  double x = 0, y = 0, angle = 0; ///< the body origin [m] and angle [rad]
+  double vx = 0, vy = 0, omega = 0;  ///< velocity of its centre of mass [m/s], angular velocity [rad/s]
+};
+
 struct ParticleSnapshot {
   std::uint64_t frame = 0;        ///< frames stepped
   double time = 0;                ///< simulated time [s]
@@ -30,6 +37,7 @@ struct ParticleSnapshot {
   std::vector<float> vx, vy;      ///< velocity [m/s]
   std::vector<float> rho, p;      ///< density [kg/m³], pressure [Pa]
   std::vector<float> age;         ///< age [s]; empty when the particles have no age
+  std::vector<BodySnapshot> bodies;  ///< the non-static bodies, in creation (scene) order
   /// Number of particles.
   std::size_t size() const { return id.size(); }
 };
@@ -44,6 +52,10 @@ enum class ExportFormat { Csv, VtkBinary, VtkAscii };
 bool parseExportFormat(const std::string& s, ExportFormat& out);
 /// File extension without the dot: "csv" or "vtk".
 std::string exportExtension(ExportFormat f);
+
+/// Writes the bodies of `s` as CSV (`body,x,y,angle,vx,vy,omega`, one row per non-static body)
+/// to `path`, atomically. Throws std::runtime_error naming the path.
+void writeBodiesCsvAtomic(const std::string& path, const ParticleSnapshot& s);
 
 /// Writes `s` to `path` in format `f`, atomically. Throws std::runtime_error naming the path.
 void writeParticlesAtomic(const std::string& path, const ParticleSnapshot& s, ExportFormat f);
