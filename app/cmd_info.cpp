@@ -62,7 +62,8 @@ int cmdInfo(const std::vector<std::string>& args) {
   World w(s, WorldOptions{threads});
   for (const auto& m : w.takeWarnings()) std::printf("warning: %s\n", m.c_str());
   std::size_t fixtures = 0;
-  for (const auto& b : s.bodies) fixtures += b.fixtures.size();
+  for (const auto& b : s.bodies)
+    if (b.type == BodyDef::Type::Static) fixtures += b.fixtures.size();
   auto list = [](const std::vector<std::string>& v) {
     std::string out;
     for (const auto& x : v) out += (out.empty() ? "" : ", ") + x;
@@ -95,8 +96,13 @@ int cmdInfo(const std::vector<std::string>& args) {
                 s.effects.budget ? s.effects.budget : s.maxParticles,
                 s.effects.budgetPolicy == BudgetPolicy::RecycleOldest ? "recycle_oldest" : "stop_emitting");
   }
-  std::printf("boundaries   %zu static bodies, %zu fixtures, %zu colliders, %zu boundary samples\n", s.bodies.size(),
+  std::size_t kinematic = 0;
+  for (const BodyDef& b : s.bodies) kinematic += b.type == BodyDef::Type::Kinematic;
+  std::printf("boundaries   %zu static bodies, %zu fixtures, %zu colliders, %zu boundary samples\n", s.bodies.size() - kinematic,
               fixtures, w.colliders().size(), w.boundarySamples().size());
+  if (kinematic)
+    std::printf("moving       %zu kinematic bodies (%zu shapes; they push the fluid, stage 'bodies')\n", kinematic,
+                w.movingColliders().size());
   const double dt = w.stableTimeStep();
   const int substeps = std::min(s.solver.maxSubsteps, int(std::ceil(1.0 / s.fps / dt - 1e-9)));
   std::printf("frames       %d at %.4g fps (%.4g s); %d substeps per frame in the initial state (substep %.3g ms, "
