@@ -255,7 +255,10 @@ void checkFluidPolygon(const Reader& r, const std::vector<Vec2d>& v, const std::
 double regionLatticeCount(const FluidBlockDef& b, double dx) {
   const auto [nx, ny] = blockLattice(b, dx);
   if (!(nx >= 1 && ny >= 1)) return 0;
-  if (b.shape == FluidBlockDef::Shape::Box || ny > 1e7) return nx * ny;
+  // Beyond 10^7 rows (circles) or 2·10^5 rows (polygons, up to 256 edges a row) the box's count,
+  // an upper bound: a hostile scene must not make the loader count for seconds.
+  if (b.shape == FluidBlockDef::Shape::Box || ny > 1e7 || (b.shape == FluidBlockDef::Shape::Polygon && ny > 2e5))
+    return nx * ny;
   // Row by row: the points inside form intervals of the row (the circle's chord; for a
   // polygon, between crossings, by parity). Each interval's ends are found from an
   // estimate and settled with contains() itself, so the count is exactly the points

@@ -54,8 +54,9 @@ void checkBlock(const Reader& r, const SceneDef& s, const FluidBlockDef& block, 
 /// self-crossing outline; the fill follows the even-odd rule).
 void checkFluidPolygon(const Reader& r, const std::vector<Vec2d>& vertices, const std::string& path);
 /// The lattice points of a region at spacing dx: its bounding box's, and for a circle or
-/// polygon those inside it, counted when the box holds at most 10^7 (else the box's count,
-/// an upper bound). The rows as a block without the hydrostatic start places them.
+/// polygon those inside it, counted row by row up to 10^7 rows for a circle and 2·10^5 for a
+/// polygon (beyond: the box's count, an upper bound). The rows as a block without the
+/// hydrostatic start places them.
 double regionLatticeCount(const FluidBlockDef& b, double dx);
 
 /// A periodic range (at `path`) spans at least three support radii `R` (min < max).
