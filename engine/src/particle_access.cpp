@@ -155,32 +155,22 @@ std::size_t World::removeParticlesInShape(const b2Shape& shape, const b2Transfor
 
 std::size_t World::addShape(const b2Shape& shape, const b2Transform& xf, const Vec2d& velocity) {
   FluidBlockDef b;
-  b.velocity = velocity;
-  const double dx = impl_->scene.solver.spacing;
   if (shape.GetType() == b2Shape::e_circle) {
     const auto& c = static_cast<const b2CircleShape&>(shape);
     const b2Vec2 p = b2Mul(xf, c.m_p);
-    b.shape = FluidBlockDef::Shape::Circle;
-    b.center = Vec2d(p.x, p.y);
-    b.radius = c.m_radius;
-    const double half = std::ceil(b.radius / dx - 1e-9) * dx;  // the lattice of a drop
-    b.min = b.center - Vec2d(half, half);
-    b.max = b.center + Vec2d(half + 0.5 * dx, half + 0.5 * dx);
+    b = circleRegion(Vec2d(p.x, p.y), c.m_radius, impl_->scene.solver.spacing);
   } else if (shape.GetType() == b2Shape::e_polygon) {
     const auto& poly = static_cast<const b2PolygonShape&>(shape);
-    b.shape = FluidBlockDef::Shape::Polygon;
+    std::vector<Vec2d> vertices;
     for (int k = 0; k < poly.m_count; ++k) {
       const b2Vec2 p = b2Mul(xf, poly.m_vertices[k]);
-      b.vertices.push_back(Vec2d(p.x, p.y));
+      vertices.push_back(Vec2d(p.x, p.y));
     }
-    b.min = b.max = b.vertices[0];
-    for (const Vec2d& v : b.vertices) {
-      b.min = b.min.cwiseMin(v);
-      b.max = b.max.cwiseMax(v);
-    }
+    b = polygonRegion(std::move(vertices));
   } else {
     throw std::invalid_argument("addShape: only a polygon or a circle holds fluid (an edge or chain has no inside)");
   }
+  b.velocity = velocity;
   return addBlock(b);
 }
 

@@ -29,15 +29,14 @@ double uniform(std::uint64_t& state) { return double(splitmix(state) >> 11) * (1
 /// ρ = ρ0(1 + f g z) with the solver's factor f (2/c² for muller2003, whose
 /// symmetric force recovers ∇p/2; 1/c0² for wcsph). Started uncompressed, a
 /// column would ring in its acoustic mode with a speed amplitude of about g·H/c.
-/// `disc` (optional) keeps only the lattice points within a radius (addDrop).
+/// A circle region (a drop) keeps only the lattice points within its radius, a polygon those inside it.
 /// The particle budget holds: once the world holds `budget` particles the rest of
 /// the block is refused with one warning, and no work or memory grows with the
 /// block's size beyond the particles added (rows are computed as they are
 /// filled, a drop's rows only over its chord).
-std::size_t World::Impl::fillBlock(const FluidBlockDef& b, bool hydrostaticStart, const Disc* disc) {
-  const Disc circle{b.center, b.radius};
+std::size_t World::Impl::fillBlock(const FluidBlockDef& b, bool hydrostaticStart) {
+  const bool disc = b.shape == FluidBlockDef::Shape::Circle;  // a circle or a drop: row chords
   std::vector<double> crossings;  // a polygon's edges across the current row
-  if (!disc && b.shape == FluidBlockDef::Shape::Circle) disc = &circle;  // a circle region: the drop's row chords
   const SolverDef& sd = scene.solver;
   const double hydroFactor = solver->hydrostaticFactor();
   const bool hydrostatic = hydrostaticStart && hydroFactor > 0 && scene.gravity.x() == 0 && scene.gravity.y() < 0;
@@ -62,16 +61,16 @@ std::size_t World::Impl::fillBlock(const FluidBlockDef& b, bool hydrostaticStart
     long i0 = 0, i1 = nx;  // the row's lattice points [i0, i1)
     b.rowCrossings(y, crossings);  // a polygon's edges across this row (none otherwise)
     if (disc) {
-      const double dy = y - disc->center.y(), r2 = disc->radius * disc->radius;
+      const double dy = y - b.center.y(), r2 = b.radius * b.radius;
       if (dy * dy > r2) continue;
       // The chord, one spacing wider each side; the exact test below decides.
       const double half = std::sqrt(r2 - dy * dy) + sd.spacing;
-      i0 = long(std::max(0.0, std::floor((disc->center.x() - half - b.min.x()) / sd.spacing - 0.5)));
-      i1 = long(std::min(double(nx), std::ceil((disc->center.x() + half - b.min.x()) / sd.spacing + 0.5)));
+      i0 = long(std::max(0.0, std::floor((b.center.x() - half - b.min.x()) / sd.spacing - 0.5)));
+      i1 = long(std::min(double(nx), std::ceil((b.center.x() + half - b.min.x()) / sd.spacing + 0.5)));
     }
     for (long i = i0; i < i1; ++i) {
       const Vec2d pw(b.min.x() + (double(i) + 0.5) * sd.spacing, y);
-      if (disc && !((pw - disc->center).squaredNorm() <= disc->radius * disc->radius)) continue;
+      if (disc && !((pw - b.center).squaredNorm() <= b.radius * b.radius)) continue;
       if (b.shape == FluidBlockDef::Shape::Polygon && !FluidBlockDef::insideRow(crossings, pw.x())) continue;
       const Vec2 p = Vec2(Real(pw.x() - origin.x()), Real(pw.y() - origin.y()));
       if (boundary.insideDepth(p) > 0 || insideMoving(p)) {
@@ -96,7 +95,7 @@ std::size_t World::Impl::fillBlock(const FluidBlockDef& b, bool hydrostaticStart
     warnings.push_back(o.str());
   }
   if (refused) {
-    const double lattice = disc ? 3.14159265358979323846 * disc->radius * disc->radius / (sd.spacing * sd.spacing) : nxd * nyd;
+    const double lattice = disc ? 3.14159265358979323846 * b.radius * b.radius / (sd.spacing * sd.spacing) : nxd * nyd;
     std::ostringstream o;
     o << "particle budget of " << budget << " (" << budgetKey() << ") reached: added " << added << " of the " << (disc ? "drop" : "block") << "'s about " << lattice
       << " and refused the rest (raise " << budgetKey() << " or add less)";

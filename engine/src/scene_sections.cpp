@@ -140,23 +140,14 @@ FluidBlockDef readBlock(const Reader& r, const json& j, const std::string& p, co
   if (shape == "circle") {
     // The lattice of a drop (World::addDrop): a square of whole spacings around the centre.
     r.checkKeys(j, p, {"shape", "center", "radius", "velocity", "velocity_field"});
-    blk.shape = FluidBlockDef::Shape::Circle;
-    blk.center = r.requiredVec2(j, p, "center");
+    const Vec2d center = r.requiredVec2(j, p, "center");
     if (!j.contains("radius")) r.fail(Reader::sub(p, "radius"), "missing; expected a number > 0 [m]");
-    blk.radius = r.number(j, p, "radius", 0, 0, 1e6, true);
-    const double half = std::ceil(blk.radius / dx - 1e-9) * dx;
-    blk.min = blk.center - Vec2d(half, half);
-    blk.max = blk.center + Vec2d(half + 0.5 * dx, half + 0.5 * dx);
+    blk = circleRegion(center, r.number(j, p, "radius", 0, 0, 1e6, true), dx);
   } else if (shape == "polygon") {
     r.checkKeys(j, p, {"shape", "vertices", "velocity", "velocity_field"});
-    blk.shape = FluidBlockDef::Shape::Polygon;
-    blk.vertices = r.points(j, p, "vertices");
-    checkFluidPolygon(r, blk.vertices, Reader::sub(p, "vertices"));
-    blk.min = blk.max = blk.vertices[0];
-    for (const Vec2d& v : blk.vertices) {
-      blk.min = blk.min.cwiseMin(v);
-      blk.max = blk.max.cwiseMax(v);
-    }
+    std::vector<Vec2d> vertices = r.points(j, p, "vertices");
+    checkFluidPolygon(r, vertices, Reader::sub(p, "vertices"));
+    blk = polygonRegion(std::move(vertices));
   } else {
     r.checkKeys(j, p, {"shape", "min", "max", "velocity", "velocity_field"});
     blk.min = r.requiredVec2(j, p, "min");

@@ -197,16 +197,9 @@ void World::setGravity(const Vec2d& g) { impl_->scene.gravity = g; }
 std::size_t World::addBlock(const FluidBlockDef& block) { return impl_->fillBlock(block, false); }
 
 std::size_t World::addDrop(const Vec2d& center, double radius, const Vec2d& velocity) {
-  // A square patch of 2k × 2k lattice points centred on `center` (k spacings each
-  // side covers the radius); the extra half spacing makes the count exact in floats.
-  const double dx = impl_->scene.solver.spacing;
-  const double half = std::ceil(radius / dx - 1e-9) * dx;
-  FluidBlockDef b;
-  b.min = center - Vec2d(half, half);
-  b.max = center + Vec2d(half + 0.5 * dx, half + 0.5 * dx);
+  FluidBlockDef b = circleRegion(center, radius, impl_->scene.solver.spacing);
   b.velocity = velocity;
-  const Impl::Disc disc{center, radius};
-  return impl_->fillBlock(b, false, &disc);
+  return impl_->fillBlock(b, false);
 }
 
 void World::moveEmitter(std::size_t index, const Vec2d& position, const Vec2d& direction) {

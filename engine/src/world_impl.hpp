@@ -159,15 +159,10 @@ struct World::Impl {
   [[noreturn]] void fail(const std::string& stage, std::size_t slot);
 
   // particle_system.cpp
-  /// Lattice points within `radius` of `center` (world coordinates): a drop.
-  struct Disc {
-    Vec2d center;
-    double radius;
-  };
   /// Fills a block on the lattice of the spacing (hydrostaticStart: rows closer with
   /// depth, at the density the solver holds at rest), keeping the points of its circle
-  /// or polygon; `disc` keeps the points of a drop. Stops at the particle budget (one warning for the rest).
-  std::size_t fillBlock(const FluidBlockDef& b, bool hydrostaticStart, const Disc* disc = nullptr);
+  /// (a drop, addDrop) or polygon. Stops at the particle budget (one warning for the rest).
+  std::size_t fillBlock(const FluidBlockDef& b, bool hydrostaticStart);
   /// Warns once when a weakly compressible solver's sound speed is below 10 × the fastest
   /// speed the scene sets (blocks, emitters, timeline events).
   void warnLowSoundSpeed();

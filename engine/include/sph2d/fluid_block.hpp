@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <utility>
 #include <vector>
 
 #include "sph2d/math.hpp"
@@ -91,5 +92,32 @@ struct FluidBlockDef {
     return field.type == VelocityFieldDef::Type::None ? velocity : Vec2d(velocity + field.at(p));
   }
 };
+
+/// A circle region of `radius` about `center` on the lattice of spacing `dx` (a drop's): its
+/// bounding box spans whole spacings each side of the centre, and half a spacing more at the
+/// top right so that the count is exact in floats.
+inline FluidBlockDef circleRegion(const Vec2d& center, double radius, double dx) {
+  FluidBlockDef b;
+  b.shape = FluidBlockDef::Shape::Circle;
+  b.center = center;
+  b.radius = radius;
+  const double half = std::ceil(radius / dx - 1e-9) * dx;
+  b.min = center - Vec2d(half, half);
+  b.max = center + Vec2d(half + 0.5 * dx, half + 0.5 * dx);
+  return b;
+}
+
+/// A polygon region through `vertices` (at least one), bounded by their bounding box.
+inline FluidBlockDef polygonRegion(std::vector<Vec2d> vertices) {
+  FluidBlockDef b;
+  b.shape = FluidBlockDef::Shape::Polygon;
+  b.vertices = std::move(vertices);
+  b.min = b.max = b.vertices[0];
+  for (const Vec2d& v : b.vertices) {
+    b.min = b.min.cwiseMin(v);
+    b.max = b.max.cwiseMax(v);
+  }
+  return b;
+}
 
 }  // namespace sph2d
