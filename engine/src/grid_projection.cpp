@@ -10,12 +10,13 @@
 namespace sph2d {
 
 GridProjection::GridProjection(Real cellInSpacings, Real fluidFraction, Real compressionRate, Real tolerance,
-                               int maxIterations)
+                               int maxIterations, GridShift shift)
     : cellRatio_(cellInSpacings),
       fluidFraction_(fluidFraction),
       rate_(compressionRate),
       tol_(tolerance),
-      maxIt_(maxIterations) {}
+      maxIt_(maxIterations),
+      shiftDef_(shift) {}
 
 void GridProjection::layout(const StepContext& c) {
   const Particles& P = c.P;
@@ -157,7 +158,7 @@ void GridProjection::transferToGrid(const StepContext& c) {
     }
   };
   // The cells' compression is read only by the compression source (rate > 0).
-  Real* comp = rate_ > 0 ? comp_.data() : nullptr;
+  Real* comp = rate_ > 0 || shiftDef_.rate > 0 ? comp_.data() : nullptr;
   // Serial, in slot order: the same sums for any thread count.
   for (std::size_t p = 0; p < P.size(); ++p) {
     const Real px = P.x[p].x() * invH_ - Real(I0_), py = P.x[p].y() * invH_ - Real(J0_);
@@ -333,6 +334,20 @@ void GridProjection::solve(const StepContext& c) {
   pnx_ = nx_;
   pny_ = ny_;
   prevKappa_ = kappa_;
+  if (shiftDef_.rate > 0) {
+    // The compression shift: φ with −∇²φ = rate·(comp − above)/dt² per fluid cell; the
+    // particles move by −dt²∇φ (transferToParticles), their velocities unchanged.
+    xs_.assign(m, 0);
+    for (std::size_t a = 0; a < m; ++a) {
+      const std::size_t k = std::size_t(cells_[a]);
+      const Real comp = std::max(Real(0), comp_[k] / w_[k] - shiftDef_.above);
+      rhs_[a] = (h_ * h_ / dt) * shiftDef_.rate * comp / dt;
+    }
+    Real resS = 0;
+    stats_.iterations += pcg(xs_, rhs_, shiftDef_.tolerance * h_ * h_ / (dt * dt), resS);
+    kappaS_.assign(kappa_.size(), 0);
+    for (std::size_t a = 0; a < m; ++a) kappaS_[std::size_t(cells_[a])] = xs_[a];
+  }
 }
 
 Vec2 GridProjection::sampleFaces(const std::vector<Real>& u, const std::vector<Real>& v, Real px, Real py) const {
@@ -403,6 +418,32 @@ std::size_t GridProjection::transferToParticles(StepContext& c) {
   extrapolate(dv_, nx_, ny_ + 1, fluidV_);
   Particles& P = c.P;
   const Real vmax2 = c.maxSpeed * c.maxSpeed;
+  const bool shifting = shiftDef_.rate > 0;
+  if (shifting) {
+    // The shift's face moves: −dt²∇φ across open faces between fluid and air cells (none
+    // through a wall), extrapolated one layer as the velocity change is.
+    su_.assign(u_.size(), 0);
+    sv_.assign(v_.size(), 0);
+    auto phi = [&](int i, int j) { return type_[std::size_t(j) * nx_ + i] == kFluid ? kappaS_[std::size_t(j) * nx_ + i] : Real(0); };
+    const Real k2 = -dt * dt * invH_;
+    for (int j = 0; j < ny_; ++j)
+      for (int i = 1; i < nx_; ++i) {
+        const std::size_t f = std::size_t(j) * nu + i;
+        const bool solidSide = type_[std::size_t(j) * nx_ + i - 1] == kSolid || type_[std::size_t(j) * nx_ + i] == kSolid;
+        if (fluidU_[f] && uOpen_[f] && !solidSide) su_[f] = k2 * (phi(i, j) - phi(i - 1, j));
+      }
+    for (int j = 1; j < ny_; ++j)
+      for (int i = 0; i < nx_; ++i) {
+        const std::size_t f = std::size_t(j) * nx_ + i;
+        const bool solidSide = type_[std::size_t(j - 1) * nx_ + i] == kSolid || type_[std::size_t(j) * nx_ + i] == kSolid;
+        if (fluidV_[f] && vOpen_[f] && !solidSide) sv_[f] = k2 * (phi(i, j) - phi(i, j - 1));
+      }
+    extrapolate(su_, nu, ny_, fluidU_);
+    extrapolate(sv_, nx_, ny_ + 1, fluidV_);
+    shift_.resize(P.size());
+  } else {
+    shift_.clear();
+  }
   if (pic_ > 0) {  // the projected face velocities (closed faces: 0)
     for (std::size_t f = 0; f < u_.size(); ++f) uNew_[f] = u_[f] + du_[f];
     for (std::size_t f = 0; f < v_.size(); ++f) vNew_[f] = v_[f] + dv_[f];
@@ -418,6 +459,7 @@ std::size_t GridProjection::transferToParticles(StepContext& c) {
         vp += (ug - vp) * pic_;
       }
       P.v[p] = vp;
+      if (shifting) shift_[p] = sampleFaces(su_, sv_, px, py);
       if (bad == kNone && (!allFinite(P.v[p]) || P.v[p].squaredNorm() > vmax2)) bad = p;
     }
     return bad;

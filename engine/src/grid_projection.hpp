@@ -16,6 +16,13 @@
 // so it adds no stiffness to the particle arrangement (unlike SPH pressure
 // sums under a large uniform pressure).
 //
+// The compression shift (Kugelstadt, Longva, Thuerey & Bender 2019, "Implicit
+// density projection for volume conserving liquids", IEEE TVCG): the same
+// Poisson matrix solved once more with the cells' mean compression as the
+// source; its gradient is a move of positions, not of velocities, which the
+// prediction adds. It removes the compression that large substeps pile up
+// without putting kinetic energy in.
+//
 // Deterministic: particles go to the grid in slot order (one thread), the
 // conjugate-gradient sums are taken in cell order.
 #pragma once
@@ -30,6 +37,15 @@ namespace sph2d {
 class StateOut;
 class StateIn;
 
+/// The compression shift (Kugelstadt et al. 2019, "Implicit density projection for volume
+/// conserving liquids", IEEE TVCG: a second Poisson solve whose gradient moves positions, not
+/// velocities): off when `rate` is 0.
+struct GridShift {
+  Real rate = 0;   ///< share of a cell's mean compression (above `above`) removed per substep
+  Real above = 0;  ///< compression a cell keeps (left to the particle solve)
+  Real tolerance = 0.01;  ///< the solve stops when its largest residual stands for this density change
+};
+
 /// What one projection did.
 struct GridProjectionStats {
   int iterations = 0;       ///< conjugate-gradient iterations
@@ -42,7 +58,8 @@ class GridProjection {
   /// Cells of `cellInSpacings`·dx; a cell is fluid above `fluidFraction` of a full cell's
   /// particle weight; the cells' mean compression is removed at `compressionRate` per
   /// substep; CG stops at `tolerance` (density change per substep) or `maxIterations`.
-  GridProjection(Real cellInSpacings, Real fluidFraction, Real compressionRate, Real tolerance, int maxIterations);
+  GridProjection(Real cellInSpacings, Real fluidFraction, Real compressionRate, Real tolerance, int maxIterations,
+                 GridShift shift = {});
   /// Projects P.v (reads x, v, rho; writes v). Returns the first bad slot or kNone.
   std::size_t project(StepContext& c);
   /// κ = p/ρ0 of the last projection at `x` (bilinear over the fluid and air cells, air
@@ -70,6 +87,9 @@ class GridProjection {
 
  public:
   Real pic_ = 0;  ///< share of the projected grid velocity given to the particles (PIC; the rest FLIP)
+  /// Per particle (slot order), the move the last projection's compression shift asks for
+  /// (empty when the shift is off); read by the prediction of the same substep.
+  const std::vector<Vec2>& shift() const { return shift_; }
 
  private:
   std::size_t transferToParticles(StepContext& c);
@@ -90,6 +110,9 @@ class GridProjection {
   std::vector<Real> du_, dv_;               ///< face velocity changes
   std::vector<Real> uNew_, vNew_;           ///< projected face velocities (for the PIC share)
   std::vector<Real> kappa_, rhs_, x_, r_, z_, d_, q_, diag_;
+  GridShift shiftDef_;
+  std::vector<Real> kappaS_, xs_, su_, sv_;  ///< the shift's potential (per cell, per unknown) and face moves
+  std::vector<Vec2> shift_;                 ///< per particle
   std::vector<std::int32_t> index_;         ///< cell → unknown (−1: none)
   std::vector<std::int32_t> cells_;         ///< unknown → cell
   std::vector<std::int32_t> adj_;           ///< per unknown: left, right, down, up unknown (−1: none)

@@ -35,7 +35,9 @@ Pbf::Pbf(const SolverDef& d)
   if (d.param("grid_cell") > 0)
     projection_ = std::make_unique<GridProjection>(Real(d.param("grid_cell")), Real(d.param("grid_fluid_fraction")),
                                                    Real(d.param("grid_compression_rate")), Real(d.param("grid_tolerance")),
-                                                   int(std::lround(d.param("grid_max_iterations"))));
+                                                   int(std::lround(d.param("grid_max_iterations"))),
+                                                   GridShift{Real(d.param("grid_shift")), Real(d.param("grid_shift_above")),
+                                                             Real(d.param("grid_shift_tolerance"))});
   if (projection_) projection_->pic_ = Real(d.param("grid_pic"));
 }
 
@@ -136,42 +138,48 @@ std::size_t Pbf::solve(StepContext& c) {
       if (bad != kNone) return bad;
     }
     const Real limit = c.rho0 * (Real(1) + thr);
-    for (; local < localIterations_ && maxCompression_ > toleranceMax_; ++local) {
-      // Active: compressed above half the tolerance, or next to such a particle. The
-      // first time every ρ is fresh and all particles are looked at; later only the
-      // last list's ρ changed, and every particle off that list stayed at or below
-      // the threshold, so the compressed ones are on it: they and their neighbours
-      // (the lists are symmetric) are the new active set, the same set a full scan
-      // finds.
-      if (local == 0) {
-        c.pool.parallelFor(n, kBlock, [&](std::size_t b, std::size_t e) {
-          for (std::size_t i = b; i < e; ++i) {
-            bool on = c.P.rho[i] > limit;
-            const std::uint32_t* nb = c.nbr.of(i);
-            for (std::uint32_t k = 0; k < c.nbr.count[i] && !on; ++k) on = c.P.rho[nb[k]] > limit;
-            active_[i] = on;
-          }
-        });
-      } else {
-        markNeighbourhood(c, activeList_, &limit, active_);
+    bool scanAll = true;  // every ρ is fresh: all particles are looked at
+    while (local < localIterations_) {
+      for (; local < localIterations_ && maxCompression_ > toleranceMax_; ++local) {
+        // Active: compressed above half the tolerance, or next to such a particle.
+        // After a full scan only the last list's ρ changed, and every particle off
+        // that list kept the ρ it had when it was found at or below the threshold
+        // (or was summed again in the halo pass), so the compressed ones are on the
+        // list: they and their neighbours (the lists are symmetric) are the new
+        // active set, the same set a full scan finds.
+        if (scanAll) {
+          c.pool.parallelFor(n, kBlock, [&](std::size_t b, std::size_t e) {
+            for (std::size_t i = b; i < e; ++i) {
+              bool on = c.P.rho[i] > limit;
+              const std::uint32_t* nb = c.nbr.of(i);
+              for (std::uint32_t k = 0; k < c.nbr.count[i] && !on; ++k) on = c.P.rho[nb[k]] > limit;
+              active_[i] = on;
+            }
+          });
+          scanAll = false;
+        } else {
+          markNeighbourhood(c, activeList_, &limit, active_);
+        }
+        listMarked(active_, activeList_);
+        for (std::size_t i = 0; i < n; ++i)  // only the listed particles take their step of the last pass
+          if (!active_[i]) dLambda_[i] = 0;
+        std::size_t bad = correct(c, lambda, Real(1), &activeList_);
+        if (bad != kNone) return bad;
+        bad = constraint(c, lambda, &activeList_);
+        if (bad != kNone) return bad;
       }
-      listMarked(active_, activeList_);
-      for (std::size_t i = 0; i < n; ++i)  // only the listed particles take their step of the last pass
-        if (!active_[i]) dLambda_[i] = 0;
-      std::size_t bad = correct(c, lambda, Real(1), &activeList_);
+      if (local == 0) break;
+      // The listed particles moved: the density of those and of their neighbours is
+      // summed again (the rest kept ρ and W of the last full pass). A neighbour off
+      // the list may have been pushed above the tolerance: then the iterations go
+      // on from this halo, whose ρ are all fresh.
+      markNeighbourhood(c, activeList_, nullptr, halo_);
+      listMarked(halo_, activeList_);
+      const std::size_t bad = constraint(c, lambda, &activeList_);
       if (bad != kNone) return bad;
-      bad = constraint(c, lambda, &activeList_);
-      if (bad != kNone) return bad;
+      rhoCurrent_ = true;  // every ρ (and W) is that of the current positions again
+      if (maxCompression_ <= toleranceMax_) break;
     }
-  }
-  if (local > 0) {
-    // The local iterations moved the listed particles: the density of those and of
-    // their neighbours is summed again (the rest kept ρ and W of the last full pass).
-    markNeighbourhood(c, activeList_, nullptr, halo_);
-    listMarked(halo_, activeList_);
-    const std::size_t bad = constraint(c, lambda, &activeList_);
-    if (bad != kNone) return bad;
-    rhoCurrent_ = true;  // every ρ (and W) is that of the current positions again
   }
   stats_.pressureIterations = used + local;  // corrections applied
   stats_.densityError = double(meanCompression_);
@@ -231,6 +239,9 @@ void Pbf::calibrate(const StepContext& c) {
 std::size_t Pbf::predict(StepContext& c, std::vector<Real>& lambda) {
   Particles& P = c.P;
   const Real dt = c.dt, vmax2 = c.maxSpeed * c.maxSpeed;
+  // The grid projection's compression shift of this substep (positions only).
+  const std::vector<Vec2>* shift =
+      projection_ && projection_->shift().size() == P.size() ? &projection_->shift() : nullptr;
   const Real capSpeed = moveCap_ > 0 ? moveCap_ * maxMove_ * c.R / dt : Real(0), capSpeed2 = capSpeed * capSpeed;
   return firstBad(c.pool, P.size(), [&](std::size_t b, std::size_t e) {
     std::size_t bad = kNone;
@@ -242,6 +253,7 @@ std::size_t Pbf::predict(StepContext& c, std::vector<Real>& lambda) {
       }
       const Vec2 x0 = P.x[i];
       Vec2 x = x0 + v * dt;
+      if (shift) x += (*shift)[i];
       Vec2 vd = v;  // resolve()'s velocity response is not used: v follows from the positions
       c.boundary.resolve(x, vd, x0, c.clearance);
       P.xPrev[i] = x0;
