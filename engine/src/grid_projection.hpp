@@ -80,7 +80,11 @@ class GridProjection {
   void assemble();
   void apply(const std::vector<Real>& in, std::vector<Real>& out) const;
   void precondition(const std::vector<Real>& r, std::vector<Real>& z) const;
-  int pcg(std::vector<Real>& x, const std::vector<Real>& b, Real tol, Real& res);
+  /// The vectors of one conjugate-gradient solve (two solves may run at once).
+  struct CgWork {
+    std::vector<Real> r, z, d, q;
+  };
+  int pcg(std::vector<Real>& x, const std::vector<Real>& b, Real tol, Real& res, CgWork& w) const;
   void solve(const StepContext& c);
   /// Bilinear sample of face fields u, v at (px, py) in cell units of the grid.
   Vec2 sampleFaces(const std::vector<Real>& u, const std::vector<Real>& v, Real px, Real py) const;
@@ -109,9 +113,10 @@ class GridProjection {
   std::vector<Real> u_, uw_, v_, vw_;       ///< face velocities and weights
   std::vector<Real> du_, dv_;               ///< face velocity changes
   std::vector<Real> uNew_, vNew_;           ///< projected face velocities (for the PIC share)
-  std::vector<Real> kappa_, rhs_, x_, r_, z_, d_, q_, diag_;
+  std::vector<Real> kappa_, rhs_, x_, diag_;
+  CgWork cgMain_, cgShift_;
   GridShift shiftDef_;
-  std::vector<Real> kappaS_, xs_, su_, sv_;  ///< the shift's potential (per cell, per unknown) and face moves
+  std::vector<Real> kappaS_, rhsS_, xs_, su_, sv_;  ///< the shift's potential (per cell; right-hand side and unknowns) and face moves
   std::vector<Vec2> shift_;                 ///< per particle
   std::vector<std::int32_t> index_;         ///< cell → unknown (−1: none)
   std::vector<std::int32_t> cells_;         ///< unknown → cell

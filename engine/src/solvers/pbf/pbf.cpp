@@ -129,8 +129,7 @@ std::size_t Pbf::solve(StepContext& c) {
   // (and their neighbours) take further Jacobi steps; the rest keep their place.
   int local = 0;
   if (localIterations_ > 0 && maxCompression_ > toleranceMax_) {
-    active_.resize(n);
-    halo_.resize(n);
+    marks_.resize(n);
     const Real thr = Real(0.5) * toleranceMax_;
     const bool pending = used < maxIt;  // the last constraint pass's step is not applied yet
     if (!pending) {
@@ -138,7 +137,7 @@ std::size_t Pbf::solve(StepContext& c) {
       if (bad != kNone) return bad;
     }
     const Real limit = c.rho0 * (Real(1) + thr);
-    bool scanAll = true;  // every ρ is fresh: all particles are looked at
+    bool first = true;  // every ρ and Δλ is the last full pass's
     while (local < localIterations_) {
       for (; local < localIterations_ && maxCompression_ > toleranceMax_; ++local) {
         // Active: compressed above half the tolerance, or next to such a particle.
@@ -147,36 +146,46 @@ std::size_t Pbf::solve(StepContext& c) {
         // (or was summed again in the halo pass), so the compressed ones are on the
         // list: they and their neighbours (the lists are symmetric) are the new
         // active set, the same set a full scan finds.
-        if (scanAll) {
+        if (first) {
+          std::vector<std::uint8_t>& on = marks_;
           c.pool.parallelFor(n, kBlock, [&](std::size_t b, std::size_t e) {
             for (std::size_t i = b; i < e; ++i) {
-              bool on = c.P.rho[i] > limit;
+              bool a = c.P.rho[i] > limit;
               const std::uint32_t* nb = c.nbr.of(i);
-              for (std::uint32_t k = 0; k < c.nbr.count[i] && !on; ++k) on = c.P.rho[nb[k]] > limit;
-              active_[i] = on;
+              for (std::uint32_t k = 0; k < c.nbr.count[i] && !a; ++k) a = c.P.rho[nb[k]] > limit;
+              on[i] = a;
             }
           });
-          scanAll = false;
+          activeList_.clear();
+          for (std::size_t i = 0; i < n; ++i) {
+            if (on[i]) activeList_.push_back(std::uint32_t(i));
+            else dLambda_[i] = 0;  // only the listed particles take their step of the full pass
+            on[i] = 0;
+          }
+          first = false;
         } else {
-          markNeighbourhood(c, activeList_, &limit, active_);
+          neighbourhood(c, lastList_, &limit, activeList_);
+          // Off the new list, only the last list's Δλ can be non-zero: those are cleared.
+          for (const std::uint32_t i : activeList_) marks_[i] = 1;
+          for (const std::uint32_t i : lastList_)
+            if (!marks_[i]) dLambda_[i] = 0;
+          for (const std::uint32_t i : activeList_) marks_[i] = 0;
         }
-        listMarked(active_, activeList_);
-        for (std::size_t i = 0; i < n; ++i)  // only the listed particles take their step of the last pass
-          if (!active_[i]) dLambda_[i] = 0;
         std::size_t bad = correct(c, lambda, Real(1), &activeList_);
         if (bad != kNone) return bad;
         bad = constraint(c, lambda, &activeList_);
         if (bad != kNone) return bad;
+        lastList_.swap(activeList_);
       }
       if (local == 0) break;
       // The listed particles moved: the density of those and of their neighbours is
       // summed again (the rest kept ρ and W of the last full pass). A neighbour off
       // the list may have been pushed above the tolerance: then the iterations go
       // on from this halo, whose ρ are all fresh.
-      markNeighbourhood(c, activeList_, nullptr, halo_);
-      listMarked(halo_, activeList_);
+      neighbourhood(c, lastList_, nullptr, activeList_);
       const std::size_t bad = constraint(c, lambda, &activeList_);
       if (bad != kNone) return bad;
+      lastList_.swap(activeList_);
       rhoCurrent_ = true;  // every ρ (and W) is that of the current positions again
       if (maxCompression_ <= toleranceMax_) break;
     }
@@ -198,23 +207,25 @@ std::size_t Pbf::solve(StepContext& c) {
   return kNone;
 }
 
-void Pbf::markNeighbourhood(const StepContext& c, const std::vector<std::uint32_t>& list, const Real* limit,
-                            std::vector<std::uint8_t>& marks) {
-  // Serial over the list (a local iteration's few particles): marks are only set,
-  // so the result does not depend on the order.
-  std::fill(marks.begin(), marks.end(), std::uint8_t(0));
+void Pbf::neighbourhood(const StepContext& c, const std::vector<std::uint32_t>& list, const Real* limit,
+                        std::vector<std::uint32_t>& out) {
+  // Serial over the list (a local iteration's few particles); sorted afterwards, so
+  // the result does not depend on the order the list was built in.
+  out.clear();
+  auto add = [&](std::uint32_t i) {
+    if (!marks_[i]) {
+      marks_[i] = 1;
+      out.push_back(i);
+    }
+  };
   for (const std::uint32_t i : list) {
     if (limit && !(c.P.rho[i] > *limit)) continue;
-    marks[i] = 1;
+    add(i);
     const std::uint32_t* nb = c.nbr.of(i);
-    for (std::uint32_t k = 0; k < c.nbr.count[i]; ++k) marks[nb[k]] = 1;
+    for (std::uint32_t k = 0; k < c.nbr.count[i]; ++k) add(nb[k]);
   }
-}
-
-void Pbf::listMarked(const std::vector<std::uint8_t>& marks, std::vector<std::uint32_t>& list) {
-  list.clear();
-  for (std::size_t i = 0; i < marks.size(); ++i)
-    if (marks[i]) list.push_back(std::uint32_t(i));
+  std::sort(out.begin(), out.end());
+  for (const std::uint32_t i : out) marks_[i] = 0;
 }
 
 void Pbf::calibrate(const StepContext& c) {

@@ -167,15 +167,14 @@ class Pbf final : public Solver {
   Real quantile_, moveCap_;
   int localIterations_;
   bool resolveEach_;
-  /// Sets marks[i] for every particle of `list` (only those with ρ > *limit when
-  /// given) and for their neighbours; clears the rest.
-  static void markNeighbourhood(const StepContext& c, const std::vector<std::uint32_t>& list, const Real* limit,
-                                std::vector<std::uint8_t>& marks);
-  /// The marked slots, in slot order.
-  static void listMarked(const std::vector<std::uint8_t>& marks, std::vector<std::uint32_t>& list);
-  std::vector<std::uint8_t> active_;
-  std::vector<std::uint32_t> activeList_;
-  std::vector<std::uint8_t> halo_;
+  /// The particles of `list` (only those with ρ > *limit when given) and their
+  /// neighbours, in slot order, into `out`; costs in proportion to the list, not to
+  /// the particle count (`marks_` is all zero before and after).
+  void neighbourhood(const StepContext& c, const std::vector<std::uint32_t>& list, const Real* limit,
+                     std::vector<std::uint32_t>& out);
+  std::vector<std::uint8_t> marks_;          ///< per particle, zero between calls
+  std::vector<std::uint32_t> activeList_;    ///< the particles of a local iteration
+  std::vector<std::uint32_t> lastList_;      ///< the particles the last constraint pass of the local phase wrote Δλ for
   static constexpr std::size_t kLocalBlock = 32;  ///< particles per job of a local iteration (few, clustered)
   mutable std::vector<Real> speedScratch_;
   std::unique_ptr<GridProjection> projection_;  ///< the coarse-grid projection (grid_cell > 0)
