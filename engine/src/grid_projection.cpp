@@ -157,15 +157,19 @@ void GridProjection::transferToGrid(const StepContext& c) {
       weight[ks[q]] += wq[q];
     }
   };
-  // The cells' compression is read only by the compression source (rate > 0).
+  // The cells' compression is read only by the compression source and the shift.
   Real* comp = rate_ > 0 || shiftDef_.rate > 0 ? comp_.data() : nullptr;
-  // Serial, in slot order: the same sums for any thread count.
-  for (std::size_t p = 0; p < P.size(); ++p) {
-    const Real px = P.x[p].x() * invH_ - Real(I0_), py = P.x[p].y() * invH_ - Real(J0_);
-    splat(comp, w_, nx_, px - Real(0.5), py - Real(0.5), P.rho[p] / rho0 - Real(1));  // cell centres
-    splat(u_.data(), uw_, nu, px, py - Real(0.5), P.v[p].x());                       // u faces at (i, j + 1/2)
-    splat(v_.data(), vw_, nx_, px - Real(0.5), py, P.v[p].y());                      // v faces at (i + 1/2, j)
-  }
+  // Three sums, each serial in slot order (the same bits for any thread count), and
+  // independent of each other: the cells, the u faces and the v faces run side by side.
+  c.pool.parallelFor(3, 1, [&](std::size_t b, std::size_t e) {
+    for (std::size_t task = b; task < e; ++task)
+      for (std::size_t p = 0; p < P.size(); ++p) {
+        const Real px = P.x[p].x() * invH_ - Real(I0_), py = P.x[p].y() * invH_ - Real(J0_);
+        if (task == 0) splat(comp, w_, nx_, px - Real(0.5), py - Real(0.5), P.rho[p] / rho0 - Real(1));  // cell centres
+        else if (task == 1) splat(u_.data(), uw_, nu, px, py - Real(0.5), P.v[p].x());               // u faces at (i, j + 1/2)
+        else splat(v_.data(), vw_, nx_, px - Real(0.5), py, P.v[p].y());                              // v faces at (i + 1/2, j)
+      }
+  });
   for (std::size_t k = 0; k < u_.size(); ++k)
     if (uw_[k] > 0) u_[k] /= uw_[k];
   for (std::size_t k = 0; k < v_.size(); ++k)
@@ -409,54 +413,51 @@ std::size_t GridProjection::transferToParticles(StepContext& c) {
   const int nu = nx_ + 1;
   auto kap = [&](int i, int j) { return type_[std::size_t(j) * nx_ + i] == kFluid ? kappa_[std::size_t(j) * nx_ + i] : Real(0); };
   auto isFluid = [&](int i, int j) { return type_[std::size_t(j) * nx_ + i] == kFluid; };
-  // Face changes: open faces next to fluid take the pressure gradient; closed
-  // faces next to fluid lose their normal velocity (the wall).
-  for (int j = 0; j < ny_; ++j)
-    for (int i = 1; i < nx_; ++i) {
-      if (!isFluid(i - 1, j) && !isFluid(i, j)) continue;
-      const std::size_t f = std::size_t(j) * nu + i;
-      fluidU_[f] = 1;
-      const bool solidSide = type_[std::size_t(j) * nx_ + i - 1] == kSolid || type_[std::size_t(j) * nx_ + i] == kSolid;
-      du_[f] = uOpen_[f] && !solidSide ? -dt * (kap(i, j) - kap(i - 1, j)) * invH_ : -u_[f];
-    }
-  for (int j = 1; j < ny_; ++j)
-    for (int i = 0; i < nx_; ++i) {
-      if (!isFluid(i, j - 1) && !isFluid(i, j)) continue;
-      const std::size_t f = std::size_t(j) * nx_ + i;
-      fluidV_[f] = 1;
-      const bool solidSide = type_[std::size_t(j - 1) * nx_ + i] == kSolid || type_[std::size_t(j) * nx_ + i] == kSolid;
-      dv_[f] = vOpen_[f] && !solidSide ? -dt * (kap(i, j) - kap(i, j - 1)) * invH_ : -v_[f];
-    }
-  extrapolate(du_, nu, ny_, fluidU_);
-  extrapolate(dv_, nx_, ny_ + 1, fluidV_);
-  Particles& P = c.P;
-  const Real vmax2 = c.maxSpeed * c.maxSpeed;
   const bool shifting = shiftDef_.rate > 0;
+  const Real k2 = -dt * dt * invH_;
+  auto phi = [&](int i, int j) { return type_[std::size_t(j) * nx_ + i] == kFluid ? kappaS_[std::size_t(j) * nx_ + i] : Real(0); };
   if (shifting) {
-    // The shift's face moves: −dt²∇φ across open faces between fluid and air cells (none
-    // through a wall), extrapolated one layer as the velocity change is.
     su_.assign(u_.size(), 0);
     sv_.assign(v_.size(), 0);
-    auto phi = [&](int i, int j) { return type_[std::size_t(j) * nx_ + i] == kFluid ? kappaS_[std::size_t(j) * nx_ + i] : Real(0); };
-    const Real k2 = -dt * dt * invH_;
-    for (int j = 0; j < ny_; ++j)
-      for (int i = 1; i < nx_; ++i) {
-        const std::size_t f = std::size_t(j) * nu + i;
-        const bool solidSide = type_[std::size_t(j) * nx_ + i - 1] == kSolid || type_[std::size_t(j) * nx_ + i] == kSolid;
-        if (fluidU_[f] && uOpen_[f] && !solidSide) su_[f] = k2 * (phi(i, j) - phi(i - 1, j));
-      }
-    for (int j = 1; j < ny_; ++j)
-      for (int i = 0; i < nx_; ++i) {
-        const std::size_t f = std::size_t(j) * nx_ + i;
-        const bool solidSide = type_[std::size_t(j - 1) * nx_ + i] == kSolid || type_[std::size_t(j) * nx_ + i] == kSolid;
-        if (fluidV_[f] && vOpen_[f] && !solidSide) sv_[f] = k2 * (phi(i, j) - phi(i, j - 1));
-      }
-    extrapolate(su_, nu, ny_, fluidU_);
-    extrapolate(sv_, nx_, ny_ + 1, fluidV_);
-    shift_.resize(P.size());
-  } else {
-    shift_.clear();
   }
+  // The u faces and the v faces are independent: two tasks, each serial.
+  c.pool.parallelFor(2, 1, [&](std::size_t b, std::size_t e) {
+    for (std::size_t task = b; task < e; ++task) {
+      if (task == 0) {
+        // Face changes: open faces next to fluid take the pressure gradient; closed
+        // faces next to fluid lose their normal velocity (the wall).
+        for (int j = 0; j < ny_; ++j)
+          for (int i = 1; i < nx_; ++i) {
+            if (!isFluid(i - 1, j) && !isFluid(i, j)) continue;
+            const std::size_t f = std::size_t(j) * nu + i;
+            fluidU_[f] = 1;
+            const bool solidSide = type_[std::size_t(j) * nx_ + i - 1] == kSolid || type_[std::size_t(j) * nx_ + i] == kSolid;
+            du_[f] = uOpen_[f] && !solidSide ? -dt * (kap(i, j) - kap(i - 1, j)) * invH_ : -u_[f];
+            // The shift's face moves: −dt²∇φ across open faces between fluid and air
+            // cells (none through a wall), extrapolated one layer as the change is.
+            if (shifting && uOpen_[f] && !solidSide) su_[f] = k2 * (phi(i, j) - phi(i - 1, j));
+          }
+        extrapolate(du_, nu, ny_, fluidU_);
+        if (shifting) extrapolate(su_, nu, ny_, fluidU_);
+      } else {
+        for (int j = 1; j < ny_; ++j)
+          for (int i = 0; i < nx_; ++i) {
+            if (!isFluid(i, j - 1) && !isFluid(i, j)) continue;
+            const std::size_t f = std::size_t(j) * nx_ + i;
+            fluidV_[f] = 1;
+            const bool solidSide = type_[std::size_t(j - 1) * nx_ + i] == kSolid || type_[std::size_t(j) * nx_ + i] == kSolid;
+            dv_[f] = vOpen_[f] && !solidSide ? -dt * (kap(i, j) - kap(i, j - 1)) * invH_ : -v_[f];
+            if (shifting && vOpen_[f] && !solidSide) sv_[f] = k2 * (phi(i, j) - phi(i, j - 1));
+          }
+        extrapolate(dv_, nx_, ny_ + 1, fluidV_);
+        if (shifting) extrapolate(sv_, nx_, ny_ + 1, fluidV_);
+      }
+    }
+  });
+  Particles& P = c.P;
+  const Real vmax2 = c.maxSpeed * c.maxSpeed;
+  if (shifting) shift_.resize(P.size());
+  else shift_.clear();
   if (pic_ > 0) {  // the projected face velocities (closed faces: 0)
     for (std::size_t f = 0; f < u_.size(); ++f) uNew_[f] = u_[f] + du_[f];
     for (std::size_t f = 0; f < v_.size(); ++f) vNew_[f] = v_[f] + dv_[f];
