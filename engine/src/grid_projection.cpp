@@ -222,25 +222,36 @@ void GridProjection::assemble() {
     if (e < sigma * diag_[a]) e = diag_[a];
     precon_[a] = Real(1) / std::sqrt(e);
   }
+  precon2_.resize(m);
+  for (std::size_t a = 0; a < m; ++a) precon2_[a] = precon_[a] * precon_[a];
 }
 
-void GridProjection::precondition(const std::vector<Real>& r, std::vector<Real>& z) const {
+void GridProjection::precondition(const std::vector<Real>& r, std::vector<Real>& z, std::vector<Real>& y) const {
+  // z = (L Lᵀ)⁻¹ r with L = MIC(0)'s factor (p = precon_ = 1/diag(L), p2 = p²). Each
+  // substitution is a chain from one cell to the next in cell order: written so that
+  // the chain is one multiply and one add (the rest is computed beside it), and the
+  // left neighbour's value is carried in a register.
   const std::size_t m = cells_.size();
-  // Forward: q = L⁻¹ r.
+  const Real* p = precon_.data();
+  const Real* p2 = precon2_.data();
+  const std::int32_t* A = adj_.data();
+  y.resize(m);
+  // Forward: q = L⁻¹ r, kept as z (= q) and y = q·p (what the right and up cells read).
+  Real yPrev = 0;
   for (std::size_t a = 0; a < m; ++a) {
-    Real t = r[a];
-    const std::int32_t l = adj_[4 * a + 0], d = adj_[4 * a + 2];
-    if (l >= 0) t += z[std::size_t(l)] * precon_[std::size_t(l)];  // − A(l, a) = +1
-    if (d >= 0) t += z[std::size_t(d)] * precon_[std::size_t(d)];
-    z[a] = t * precon_[a];
+    const std::int32_t l = A[4 * a + 0], d = A[4 * a + 2];
+    const Real t = r[a] + (d >= 0 ? y[std::size_t(d)] : Real(0));
+    const Real yl = l < 0 ? Real(0) : (std::size_t(l) + 1 == a ? yPrev : y[std::size_t(l)]);
+    z[a] = (t + yl) * p[a];
+    yPrev = y[a] = t * p2[a] + yl * p2[a];
   }
   // Backward: z = L⁻ᵀ q.
+  Real zNext = 0;
   for (std::size_t a = m; a-- > 0;) {
-    Real t = z[a];
-    const std::int32_t rt = adj_[4 * a + 1], u = adj_[4 * a + 3];
-    if (rt >= 0) t += z[std::size_t(rt)] * precon_[a];
-    if (u >= 0) t += z[std::size_t(u)] * precon_[a];
-    z[a] = t * precon_[a];
+    const std::int32_t rt = A[4 * a + 1], u = A[4 * a + 3];
+    const Real s = z[a] * p[a] + (u >= 0 ? z[std::size_t(u)] : Real(0)) * p2[a];
+    const Real zr = rt < 0 ? Real(0) : (std::size_t(rt) == a + 1 ? zNext : z[std::size_t(rt)]);
+    zNext = z[a] = s + zr * p2[a];
   }
 }
 
@@ -271,7 +282,7 @@ int GridProjection::pcg(std::vector<Real>& x, const std::vector<Real>& b, Real t
     return mx;
   };
   double rz = 0;
-  precondition(r_, z_);
+  precondition(r_, z_, w.y);
   for (std::size_t a = 0; a < m; ++a) {
     d_[a] = z_[a];
     rz += double(r_[a]) * double(z_[a]);
@@ -289,7 +300,7 @@ int GridProjection::pcg(std::vector<Real>& x, const std::vector<Real>& b, Real t
       r_[a] -= alpha * q_[a];
     }
     double rzNew = 0;
-    precondition(r_, z_);
+    precondition(r_, z_, w.y);
     for (std::size_t a = 0; a < m; ++a) rzNew += double(r_[a]) * double(z_[a]);
     const Real beta = Real(rzNew / rz);
     rz = rzNew;

@@ -79,10 +79,10 @@ class GridProjection {
   void transferToGrid(const StepContext& c);
   void assemble();
   void apply(const std::vector<Real>& in, std::vector<Real>& out) const;
-  void precondition(const std::vector<Real>& r, std::vector<Real>& z) const;
+  void precondition(const std::vector<Real>& r, std::vector<Real>& z, std::vector<Real>& y) const;
   /// The vectors of one conjugate-gradient solve (two solves may run at once).
   struct CgWork {
-    std::vector<Real> r, z, d, q;
+    std::vector<Real> r, z, d, q, y;
   };
   int pcg(std::vector<Real>& x, const std::vector<Real>& b, Real tol, Real& res, CgWork& w) const;
   void solve(const StepContext& c);
@@ -121,7 +121,7 @@ class GridProjection {
   std::vector<std::int32_t> index_;         ///< cell → unknown (−1: none)
   std::vector<std::int32_t> cells_;         ///< unknown → cell
   std::vector<std::int32_t> adj_;           ///< per unknown: left, right, down, up unknown (−1: none)
-  std::vector<Real> precon_;                ///< MIC(0) factor
+  std::vector<Real> precon_, precon2_;      ///< MIC(0) factor: 1/diag(L), and its square
   // Warm start: the last substep's κ by anchored cell.
   Real pH_ = 0;  ///< the cell size of prevKappa_
   long pI0_ = 0, pJ0_ = 0;
