@@ -18,8 +18,8 @@
 //
 // The compression shift (Kugelstadt, Longva, Thuerey & Bender 2019, "Implicit
 // density projection for volume conserving liquids", IEEE TVCG): the same
-// Poisson matrix solved once more with the cells' mean compression as the
-// source; its gradient is a move of positions, not of velocities, which the
+// Poisson matrix solved once more with the cells' compression (particle weight
+// over a full cell's) as the source; its gradient is a move of positions, not of velocities, which the
 // prediction adds. It removes the compression that large substeps pile up
 // without putting kinetic energy in.
 //
@@ -41,7 +41,7 @@ class StateIn;
 /// conserving liquids", IEEE TVCG: a second Poisson solve whose gradient moves positions, not
 /// velocities): off when `rate` is 0.
 struct GridShift {
-  Real rate = 0;   ///< share of a cell's mean compression (above `above`) removed per substep
+  Real rate = 0;   ///< share of a cell's compression (particle weight over a full cell's, − 1, above `above`) removed per substep
   Real above = 0;  ///< compression a cell keeps (left to the particle solve)
   Real tolerance = 0.01;  ///< the solve stops when its largest residual stands for this density change
 };
