@@ -157,6 +157,9 @@ void World::init() {
   w.captureBodies();
   // Fluid blocks on a square lattice; particles inside solids (moving ones too) are dropped.
   for (const FluidBlockDef& b : scene.blocks) w.fillBlock(b, true);
+  // The blocks were filled particle by particle: give back what the arrays' doubling kept
+  // spare (up to 40 % of their bytes: 20,100 particles held room for 32,768).
+  w.P.forEachField([](const char*, auto& field) { field.shrink_to_fit(); });
   // An effect whose explicit step limit is below the smallest substep the
   // solver can take cannot be followed: refuse the scene, naming the limit.
   {
