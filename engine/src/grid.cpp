@@ -89,10 +89,12 @@ void Grid::build(const Vec2* x, std::size_t n, Real support, ThreadPool& pool, i
   for (std::size_t i = 0; i < n; ++i) ++cellStart[cellOf[i] + 1];
   for (std::size_t c = 0; c < cells; ++c) cellStart[c + 1] += cellStart[c];
   sorted.resize(n);
-  // Use `sorted` as the fill cursor source: a second pass writes in index order.
-  std::vector<std::uint32_t>& cursor = scratch_;
-  cursor.assign(cellStart.begin(), cellStart.end() - 1);
-  for (std::size_t i = 0; i < n; ++i) sorted[cursor[cellOf[i]]++] = std::uint32_t(i);
+  // cellStart[c + 1] is the end of cell c: filled from the last particle down (stable),
+  // it becomes the start of cell c, and one shift puts the starts in place (no cursor
+  // array: the grid holds only cellStart, sorted and cellOf).
+  for (std::size_t i = n; i-- > 0;) sorted[--cellStart[cellOf[i] + 1]] = std::uint32_t(i);
+  for (std::size_t c = 0; c < cells; ++c) cellStart[c] = cellStart[c + 1];
+  cellStart[cells] = std::uint32_t(n);
 }
 
 }  // namespace sph2d

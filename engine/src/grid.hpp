@@ -112,8 +112,6 @@ struct Grid {
     });
   }
 
-  std::vector<std::uint32_t> scratch_;  ///< counting-sort cursors (kept to avoid allocation)
-
  private:
   template <class F>
   void wrappedRanges(int cx, int cy, F& f) const {

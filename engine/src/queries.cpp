@@ -185,7 +185,7 @@ std::size_t World::memoryBytes() const {
   const Impl& w = *impl_;
   auto cap = [](const auto& v) { return v.capacity() * sizeof(v[0]); };
   std::size_t b = w.P.bytes();
-  b += cap(w.grid.cellStart) + cap(w.grid.sorted) + cap(w.grid.cellOf) + cap(w.grid.scratch_);
+  b += cap(w.grid.cellStart) + cap(w.grid.sorted) + cap(w.grid.cellOf);
   b += cap(w.nbr.start) + cap(w.nbr.count) + cap(w.nbr.boundaryStart) + cap(w.nbr.boundaryCount);
   for (const auto& v : w.nbr.perBlock) b += cap(v);
   for (const auto& v : w.nbr.boundaryPerBlock) b += cap(v);

@@ -98,7 +98,13 @@ void stageNeighbours(StepContext& c) {
       const Vec2 xi = P.x[i];
       L.start[i] = std::uint32_t(used);
       g.forCandidateRanges(xi, [&](std::uint32_t kb, std::uint32_t ke) {
-        if (out.size() < used + (ke - kb)) out.resize(std::max(out.size() * 2, used + (ke - kb)));
+        // Room for every candidate (written before the test); grown by an eighth, not
+        // doubled: the lists are most of the engine's memory, and a block's need settles.
+        const std::size_t need = used + (ke - kb);
+        if (out.size() < need) {
+          if (out.capacity() < need) out.reserve(need + need / 8);
+          out.resize(need);
+        }
         std::uint32_t* dst = out.data();
         const std::uint32_t* sorted = g.sorted.data();
         const Vec2* X = P.x.data();
