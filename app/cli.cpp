@@ -158,7 +158,7 @@ bool parseRenderFlag(const std::vector<std::string>& a, std::size_t& i, RenderOp
   } else if (s == "--color-by") {
     const std::string v = value();
     if (!parseColorField(v, o.colorBy))
-      throw UsageError("--color-by expects speed, pressure, density or age, got '" + v + "'");
+      throw UsageError("--color-by expects speed, pressure, density, age or color, got '" + v + "'");
   } else if (s == "--range") {
     const std::string v = value();
     const auto c = v.find(',');

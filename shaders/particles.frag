@@ -1,10 +1,12 @@
 #version 330 core
 // Particles mode: an anti-aliased disc per particle coloured by its value on a
-// blue-cyan-green-yellow-red ramp (the same formula as colorRamp() in image.cpp).
-in float vValue;         // value mapped to [0, 1] on the CPU
+// blue-cyan-green-yellow-red ramp (the same formula as colorRamp() in image.cpp),
+// or (uOwnColor) by its own 0xRRGGBB colour, carried as that integer (exact in a float).
+in float vValue;         // value mapped to [0, 1] on the CPU, or the colour
 in float vWeight;        // age fade (1 without ages)
 in vec2 vCorner;
 uniform bool uQuads;
+uniform bool uOwnColor;
 uniform float uRadiusPx; // disc radius [px]
 out vec4 outColor;
 vec3 ramp(float t) {
@@ -18,5 +20,12 @@ void main() {
   if (edge <= 0.0) discard;
   // A little relief: lighter towards the upper left, darker at the rim.
   float relief = 1.0 + 0.18 * (-d.x - d.y) * 0.5 - 0.2 * q * q;
-  outColor = vec4(ramp(vValue) * relief, edge * vWeight);
+  vec3 base;
+  if (uOwnColor) {
+    uint c = uint(vValue + 0.5);  // the same integer at every vertex: rounding cannot move it
+    base = vec3(float((c >> 16) & 255u), float((c >> 8) & 255u), float(c & 255u)) / 255.0;
+  } else {
+    base = ramp(vValue);
+  }
+  outColor = vec4(base * relief, edge * vWeight);
 }

@@ -1,7 +1,9 @@
 // particle_access.cpp — particles by id for a game (World::slotOf, getParticle,
-// setParticle, setVelocities, addParticles, removeParticles), after LiquidFun's
-// writable particle buffers and b2ParticleHandle: slots move (the grid reorders the
-// particles for locality, removals compact them), ids do not.
+// setParticle, setVelocities, addParticles, removeParticles, colours and user data),
+// after LiquidFun's writable particle buffers (b2ParticleColor, user data) and
+// b2ParticleHandle: slots move (the grid reorders the particles for locality,
+// removals compact them), ids do not. Colour and user data are optional integer
+// fields (Particles::extraU32), allocated by the first set.
 //
 // The id index is a vector of (id, slot) sorted by id, searched by bisection. It is
 // never invalidated explicitly: a lookup checks that the slot it found still holds
@@ -20,6 +22,9 @@ namespace sph2d {
 namespace {
 
 bool finite(const Vec2d& v) { return std::isfinite(v.x()) && std::isfinite(v.y()); }
+
+constexpr const char* kColorField = Particles::kColor;
+constexpr const char* kUserDataField = Particles::kUserData;
 
 /// Rebuilds the id index of `P`.
 void rebuild(std::vector<std::pair<std::uint32_t, std::uint32_t>>& index, const Particles& P) {
@@ -93,6 +98,51 @@ std::size_t World::setVelocities(const std::vector<std::uint32_t>& ids, const st
     ++found;
   }
   return found;
+}
+
+bool World::setParticleColor(std::uint32_t id, std::uint32_t rgb) {
+  const std::size_t i = slotOf(id);
+  if (i == npos) return false;
+  impl_->P.fieldU32(kColorField)[i] = rgb;
+  return true;
+}
+
+std::size_t World::setParticleColors(const std::vector<std::uint32_t>& ids, const std::vector<std::uint32_t>& colors) {
+  if (ids.size() != colors.size())
+    throw std::invalid_argument("setParticleColors: " + std::to_string(ids.size()) + " ids but " +
+                                std::to_string(colors.size()) + " colours");
+  Impl& w = *impl_;
+  rebuild(w.idIndex, w.P);  // once: absent ids then cost a search each, not a rebuild
+  std::vector<std::uint32_t>& c = w.P.fieldU32(kColorField);
+  std::size_t found = 0;
+  for (std::size_t k = 0; k < ids.size(); ++k) {
+    const std::size_t i = find(w.idIndex, ids[k]);
+    if (i == npos) continue;
+    c[i] = colors[k];
+    ++found;
+  }
+  return found;
+}
+
+std::uint32_t World::particleColor(std::uint32_t id) const {
+  const std::vector<std::uint32_t>* c = impl_->P.findU32(kColorField);
+  if (!c) return 0;
+  const std::size_t i = slotOf(id);
+  return i == npos ? 0u : (*c)[i];
+}
+
+bool World::setParticleUserData(std::uint32_t id, std::uint32_t value) {
+  const std::size_t i = slotOf(id);
+  if (i == npos) return false;
+  impl_->P.fieldU32(kUserDataField)[i] = value;
+  return true;
+}
+
+std::uint32_t World::particleUserData(std::uint32_t id) const {
+  const std::vector<std::uint32_t>* u = impl_->P.findU32(kUserDataField);
+  if (!u) return 0;
+  const std::size_t i = slotOf(id);
+  return i == npos ? 0u : (*u)[i];
 }
 
 std::vector<std::uint32_t> World::addParticles(const std::vector<Vec2d>& points, const std::vector<Vec2d>& velocities) {

@@ -268,7 +268,11 @@ void World::load(std::istream& input) {
       vec.resize(static_cast<std::size_t>(n));
       if (n) std::memcpy(static_cast<void*>(vec.data()), f.data.data(), f.data.size());
     });
-    if (!fixed) {
+    if (!fixed && Particles::integerField(f.name)) {  // colour or user data the save holds and this World lacks
+      std::vector<std::uint32_t>& vec = w.P.fieldU32(f.name);
+      vec.resize(static_cast<std::size_t>(n));
+      if (n) std::memcpy(vec.data(), f.data.data(), f.data.size());
+    } else if (!fixed) {
       std::vector<Real>& vec = w.P.field(f.name);
       vec.resize(static_cast<std::size_t>(n));
       if (n) std::memcpy(vec.data(), f.data.data(), f.data.size());

@@ -295,6 +295,68 @@ TEST_CASE("particles mode: the colour range is the field's min..max and the colo
   CHECK(fixed.lastRange()[1] == 1000.0);
 }
 
+TEST_CASE("particles mode: color_by color draws each particle in its own colour, the rest in the fluid's, and no colour bar") {
+  const SceneDef s = blockScene(240, 180, Vec2d(-0.1, -0.1), Vec2d(0.3, 0.3));
+  World world(s, WorldOptions{1});
+  // Left half of the block red, right half green, the top rows (y > 0.15) left uncoloured.
+  for (std::size_t i = 0; i < world.particleCount(); ++i) {
+    const Vec2d p = world.worldPosition(i);
+    if (p.y() > 0.15) continue;
+    world.setParticleColor(world.particles().id[i], p.x() < 0.1 ? 0xFF0000u : 0x00FF00u);
+  }
+  RenderOptions po;
+  po.mode = "particles";
+  po.colorBy = ColorField::Color;
+  Renderer r(s.render, po);
+  const Frame& f = r.render(world);
+  // The first pixel (row-major, rows top-down) of a colour class: red, green or the fluid's blue.
+  auto find = [&](const Frame& fr, int cls) -> const std::uint8_t* {
+    for (std::size_t k = 0; k + 3 < fr.rgba.size(); k += 4) {
+      const std::uint8_t* p = &fr.rgba[k];
+      if (cls == 0 && p[0] > 150 && p[1] < 60 && p[2] < 60) return p;
+      if (cls == 1 && p[1] > 150 && p[0] < 60 && p[2] < 60) return p;
+      if (cls == 2 && p[2] > 120 && p[2] > p[0] + 60 && p[1] > 60) return p;
+    }
+    return nullptr;
+  };
+  auto count = [&](const Frame& fr, int cls) {
+    std::size_t n = 0;
+    for (std::size_t k = 0; k + 3 < fr.rgba.size(); k += 4) {
+      const std::uint8_t* p = &fr.rgba[k];
+      n += (cls == 0 && p[0] > 150 && p[1] < 60 && p[2] < 60) || (cls == 1 && p[1] > 150 && p[0] < 60 && p[2] < 60) ||
+           (cls == 2 && p[2] > 120 && p[2] > p[0] + 60 && p[1] > 60);
+    }
+    return n;
+  };
+  // The three colours cover areas in proportion to their particles: red and green 8 rows of 5
+  // each, the fluid's blue the 2 top rows of 10 (y = 0.17, 0.19); red left of green.
+  const std::size_t nr = count(f, 0), ng = count(f, 1), nb = count(f, 2);
+  MESSAGE("red " << nr << " px, green " << ng << " px, fluid blue " << nb << " px");
+  CHECK(nr > 500);
+  CHECK(ng > 500);
+  CHECK(nb > 200);
+  CHECK(double(nr) / double(ng) == doctest::Approx(1.0).epsilon(0.2));
+  CHECK(double(nb) / double(nr) == doctest::Approx(0.5).epsilon(0.2));
+  const std::uint8_t* a = find(f, 0);
+  REQUIRE(a != nullptr);
+  const std::size_t ax = std::size_t(a - f.rgba.data()) / 4 % std::size_t(f.width);
+  std::size_t gx = 0;
+  for (std::size_t k = 0; k + 3 < f.rgba.size(); k += 4)
+    if (f.rgba[k + 1] > 150 && f.rgba[k] < 60 && f.rgba[k + 2] < 60) gx = std::max(gx, k / 4 % std::size_t(f.width));
+  CHECK(ax < gx);
+  // No colour bar: nothing on the ramp's dark-red end anywhere.
+  bool barRed = false;
+  for (std::size_t k = 0; k + 3 < f.rgba.size(); k += 4) barRed = barRed || (f.rgba[k] == 128 && f.rgba[k + 1] == 0 && f.rgba[k + 2] == 0);
+  CHECK_FALSE(barRed);
+  // Without any colour set, every particle is the fluid's colour.
+  World plain(s, WorldOptions{1});
+  Renderer r2(s.render, po);
+  const Frame& g = r2.render(plain);
+  CHECK(count(g, 0) == 0);
+  CHECK(count(g, 1) == 0);
+  CHECK(count(g, 2) > nr + ng);
+}
+
 TEST_CASE("the overlay changes only the pixels of its box in the top-left corner") {
   const SceneDef s = blockScene(320, 240, Vec2d(-0.1, -0.1), Vec2d(0.3, 0.3));
   World world(s, WorldOptions{1});

@@ -4,8 +4,10 @@
 // they feed (momentum, free fall) and on determinism.
 #include <doctest/doctest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
+#include <sstream>
 #include <stdexcept>
 
 #include "support/fixture.hpp"
@@ -171,5 +173,68 @@ TEST_CASE("particle access: writes by id give the same state hash for 1, 2 and 3
     for (int f = 0; f < 10; ++f) w.stepFrame();
     if (threads == 1) first = w.stateHash();
     CHECK_MESSAGE(w.stateHash() == first, "threads " << threads);
+  }
+}
+
+TEST_CASE("particle colour and user data: allocated by the first set, kept by id through steps, removals and save/load") {
+  SceneDef s = test::tank("game", 1.0, 1.0, 0.02);
+  s.blocks.push_back(test::block({0, 0}, {1, 0.4}));
+  World w(s, WorldOptions{2});
+  REQUIRE(w.particleCount() > 500);
+  auto has = [&](const char* name) {
+    const auto f = w.particleFields();
+    return std::find(f.begin(), f.end(), name) != f.end();
+  };
+  CHECK_FALSE(has("color"));
+  CHECK_FALSE(has("user_data"));
+  CHECK(w.particleColor(w.particles().id[0]) == 0u);  // nothing set: 0, and still no field
+  CHECK_FALSE(has("color"));
+  // Colour the left half red, tag every third particle with its id times 7.
+  std::vector<std::uint32_t> left, red;
+  for (std::size_t i = 0; i < w.particleCount(); ++i)
+    if (w.worldPosition(i).x() < 0.5) {
+      left.push_back(w.particles().id[i]);
+      red.push_back(0xFF0000u);
+    }
+  const std::uint64_t before = w.stateHash();
+  CHECK(w.setParticleColors(left, red) == left.size());
+  for (std::size_t k = 0; k < w.particleCount(); k += 3) CHECK(w.setParticleUserData(w.particles().id[k], w.particles().id[k] * 7u));
+  CHECK(has("color"));
+  CHECK(has("user_data"));
+  CHECK(w.stateHash() == before);  // not part of the state hash
+  CHECK_FALSE(w.setParticleColor(0xFFFFFFF0u, 1));  // no such id
+  CHECK_THROWS_AS(w.setParticleColors(left, {}), std::invalid_argument);
+  // Steps reorder the slots; removals compact them; new particles hold 0.
+  for (int f = 0; f < 30; ++f) w.stepFrame();
+  const std::vector<std::uint32_t> gone(left.begin(), left.begin() + 10);
+  CHECK(w.removeParticles(gone) == 10);
+  const std::vector<std::uint32_t> added = w.addParticles({Vec2d(0.5, 0.9)});
+  REQUIRE(added.size() == 1);
+  CHECK(w.particleColor(added[0]) == 0u);
+  CHECK(w.particleUserData(added[0]) == 0u);
+  std::size_t redLeft = 0;
+  for (std::size_t k = 10; k < left.size(); ++k) redLeft += w.particleColor(left[k]) == 0xFF0000u;
+  CHECK(redLeft == left.size() - 10);
+  CHECK(w.particleColor(left[0]) == 0u);  // removed
+  std::size_t tagged = 0, right = 0;
+  for (std::size_t i = 0; i < w.particleCount(); ++i) {
+    const std::uint32_t id = w.particles().id[i];
+    const std::uint32_t u = w.particleUserData(id);
+    tagged += u != 0;
+    CHECK((u == 0 || u == id * 7u));
+    right += std::find(left.begin(), left.end(), id) == left.end() && w.particleColor(id) == 0u;
+  }
+  CHECK(tagged > w.particleCount() / 4);
+  CHECK(right + (left.size() - 10) == w.particleCount());
+  // Save and load into a World that never set either: both fields come back, by id.
+  std::stringstream saved;
+  w.save(saved);
+  World v(s, WorldOptions{1});
+  v.load(saved);
+  CHECK(v.stateHash() == w.stateHash());
+  for (std::size_t i = 0; i < w.particleCount(); ++i) {
+    const std::uint32_t id = w.particles().id[i];
+    CHECK(v.particleColor(id) == w.particleColor(id));
+    CHECK(v.particleUserData(id) == w.particleUserData(id));
   }
 }

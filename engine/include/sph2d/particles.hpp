@@ -33,6 +33,10 @@ struct Particles {
   /// permutes them with the rest; push() gives new particles 0. A deque: creating
   /// a field never moves the others, so references from field() stay valid.
   std::deque<std::pair<std::string, std::vector<Real>>> extra;
+  /// Optional per-particle integer fields a game asks for (World::setParticleColor:
+  /// "color", World::setParticleUserData: "user_data"), in creation order; like
+  /// `extra`, permuted with the rest, 0 for new particles.
+  std::deque<std::pair<std::string, std::vector<std::uint32_t>>> extraU32;
 
   /// Number of particles.
   std::size_t size() const { return x.size(); }
@@ -54,6 +58,29 @@ struct Particles {
     extra.emplace_back(name, std::vector<Real>(size(), init));
     return extra.back().second;
   }
+  /// The names of the optional integer fields (a save that holds one makes it one).
+  static constexpr const char* kColor = "color";
+  static constexpr const char* kUserData = "user_data";
+  /// True for the name of an optional integer field.
+  static bool integerField(const std::string& name) { return name == kColor || name == kUserData; }
+  /// The optional integer field `name`, or nullptr when nothing created it.
+  std::vector<std::uint32_t>* findU32(const std::string& name) {
+    for (auto& f : extraU32)
+      if (f.first == name) return &f.second;
+    return nullptr;
+  }
+  /// Const variant of findU32().
+  const std::vector<std::uint32_t>* findU32(const std::string& name) const {
+    for (const auto& f : extraU32)
+      if (f.first == name) return &f.second;
+    return nullptr;
+  }
+  /// The optional integer field `name`, created (filled with 0) on first use.
+  std::vector<std::uint32_t>& fieldU32(const std::string& name) {
+    if (auto* f = findU32(name)) return *f;
+    extraU32.emplace_back(name, std::vector<std::uint32_t>(size(), 0u));
+    return extraU32.back().second;
+  }
   /// Calls f(name, field) for every per-particle array: the fixed ones, then
   /// the optional ones in creation order. The one list of fields: storage,
   /// removal, reordering and memory accounting all go through it.
@@ -69,6 +96,7 @@ struct Particles {
     f("pOverRho", pOverRho);
     f("id", id);
     for (auto& e : extra) f(e.first.c_str(), e.second);
+    for (auto& e : extraU32) f(e.first.c_str(), e.second);
   }
   /// Const variant of forEachField().
   template <class F>
@@ -87,6 +115,7 @@ struct Particles {
     pOverRho.push_back(0);
     id.push_back(pid);
     for (auto& f : extra) f.second.push_back(0);
+    for (auto& f : extraU32) f.second.push_back(0);
   }
   /// Removes the particles whose flag in `remove` is non-zero, keeping the
   /// order of the rest (serial: deterministic). Returns how many were removed.

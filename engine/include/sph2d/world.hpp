@@ -223,6 +223,25 @@ class World {
   /// counts them). Returns how many were removed.
   std::size_t removeParticles(const std::vector<std::uint32_t>& ids);
 
+  // Per-particle colour and user data: each field is allocated on the first set (every
+  // other particle, and every particle added later, holds 0), kept through reordering,
+  // removal and save/load, and not part of stateHash().
+
+  /// Sets the colour of particle `id` (0xRRGGBB; the renderer's particles mode draws it with
+  /// `color_by: color`; 0 means "none of its own"). False when no particle has the id.
+  bool setParticleColor(std::uint32_t id, std::uint32_t rgb);
+  /// Bulk: the colour of particle ids[k] becomes colors[k]. Returns how many of the ids a
+  /// particle has. Throws std::invalid_argument when the lengths differ.
+  std::size_t setParticleColors(const std::vector<std::uint32_t>& ids, const std::vector<std::uint32_t>& colors);
+  /// The colour of particle `id` (0 when it has none, no particle has the id, or no colour
+  /// was ever set).
+  std::uint32_t particleColor(std::uint32_t id) const;
+  /// Sets the game's value for particle `id` (an index into the game's own table, say).
+  /// False when no particle has the id.
+  bool setParticleUserData(std::uint32_t id, std::uint32_t value);
+  /// The game's value of particle `id` (0 when none was set or no particle has the id).
+  std::uint32_t particleUserData(std::uint32_t id) const;
+
   /// Slots of the particles inside `shape` placed by `xf` (world coordinates; b2Shape::TestPoint:
   /// polygons and circles hold points, edges and chains none), in slot order.
   std::vector<std::size_t> particlesInShape(const b2Shape& shape, const b2Transform& xf) const;

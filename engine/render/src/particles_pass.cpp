@@ -1,5 +1,6 @@
 // particles_pass.cpp — the particles mode: one anti-aliased disc per particle, coloured by a
-// field (speed, pressure, density or age) on the ramp of image.hpp, and a colour bar.
+// field (speed, pressure, density or age) on the ramp of image.hpp, and a colour bar; or by
+// each particle's own colour (the "color" field a game sets, World::setParticleColor).
 //
 // Design: the field is mapped to 0..1 on the CPU over the frame's min..max (or a fixed range;
 // speed and age start at 0) in double precision, so the colours do not depend on the GPU's
@@ -31,6 +32,22 @@ class ParticlesPass final : public RenderPass {
     const std::size_t n = f.order.size();
     if (in.age == nullptr && n > 0 && opt_.colorBy == ColorField::Age)
       throw std::runtime_error("colour by age needs particle ages, and none were given");
+    if (opt_.colorBy == ColorField::Color) {
+      // Each particle's own 0xRRGGBB (an integer below 2^24: exact in a float); none: the fluid's.
+      const std::vector<std::uint32_t>* own = P.findU32(Particles::kColor);
+      packed_.resize(n * 4);
+      for (std::size_t k = 0; k < n; ++k) {
+        const std::size_t i = f.order[k];
+        const std::uint32_t c = own && (*own)[i] != 0 ? (*own)[i] & 0xFFFFFFu : kFluidColor;
+        packed_[4 * k] = P.x[i].x();
+        packed_[4 * k + 1] = P.x[i].y();
+        packed_[4 * k + 2] = float(c);
+        packed_[4 * k + 3] = f.weight[k];
+      }
+      range_ = {0, 1};
+      sprites_.upload(packed_);
+      return;
+    }
     double lo = 0, hi = 1;
     if (opt_.range) {
       lo = (*opt_.range)[0];
@@ -65,12 +82,14 @@ class ParticlesPass final : public RenderPass {
     glEnable(GL_BLEND);
     glBlendFuncSeparate(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA, GL_ZERO, GL_ONE);
     sprites_.setUniforms(discProg_, f.scale, f.offset, diameter, f.geo.EW, f.geo.EH, quads_);
+    glUniform1i(glGetUniformLocation(discProg_, "uOwnColor"), opt_.colorBy == ColorField::Color ? 1 : 0);
     sprites_.draw(GLsizei(f.order.size()), quads_);
     glDisable(GL_BLEND);
     timer.end(timings.splat);
   }
 
   void annotate(Frame& frame, int textScale) const override {
+    if (opt_.colorBy == ColorField::Color) return;  // own colours: no scale to show
     static const char* titles[] = {"SPEED M/S", "PRESSURE PA", "DENSITY KG/M3", "AGE S"};
     drawColorBar(frame, range_[0], range_[1], titles[int(opt_.colorBy)], textScale);
   }
@@ -83,10 +102,12 @@ class ParticlesPass final : public RenderPass {
       case ColorField::Pressure: return double(P.p[i]);
       case ColorField::Density: return double(P.rho[i]);
       case ColorField::Age: return in.age ? double(in.age[i]) : 0.0;
+      case ColorField::Color: return 0.0;
     }
     return 0.0;
   }
 
+  static constexpr std::uint32_t kFluidColor = 0x2F7FD8;  ///< a particle without a colour of its own
   RenderOptions opt_;
   SpriteBatch& sprites_;
   GLuint discProg_ = 0;

@@ -12,6 +12,7 @@ bool parseColorField(const std::string& s, ColorField& out) {
   else if (s == "pressure") out = ColorField::Pressure;
   else if (s == "density") out = ColorField::Density;
   else if (s == "age") out = ColorField::Age;
+  else if (s == "color") out = ColorField::Color;
   else return false;
   return true;
 }
@@ -22,6 +23,7 @@ std::string colorFieldName(ColorField f) {
     case ColorField::Pressure: return "pressure";
     case ColorField::Density: return "density";
     case ColorField::Age: return "age";
+    case ColorField::Color: return "color";
   }
   return "?";
 }

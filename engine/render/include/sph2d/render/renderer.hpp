@@ -47,11 +47,13 @@ namespace sph2d {
 class World;
 
 /// The particle quantity the particles mode colours by.
-enum class ColorField { Speed, Pressure, Density, Age };
+/// What the particles mode colours by: a field on the ramp, or each particle's own colour
+/// (World::setParticleColor; particles without one in the fluid's colour).
+enum class ColorField { Speed, Pressure, Density, Age, Color };
 
-/// Parses "speed", "pressure", "density" or "age"; returns false for anything else.
+/// Parses "speed", "pressure", "density", "age" or "color"; returns false for anything else.
 bool parseColorField(const std::string& s, ColorField& out);
-/// "speed", "pressure", "density" or "age".
+/// "speed", "pressure", "density", "age" or "color".
 std::string colorFieldName(ColorField f);
 
 /// Render settings that the scene format does not carry (yet): they come from
