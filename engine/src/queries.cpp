@@ -1,8 +1,12 @@
-// What readers ask of a World's state: searches by region, field samples,
+// What readers ask of a World's state: searches by region, the particles
+// touching each fixture (LiquidFun's particle-body contacts), field samples,
 // the state hash, density and energy statistics, memory, and the names of
 // the fields, effects and stages.
 #include <algorithm>
 #include <cmath>
+
+#include <box2d/b2_distance.h>
+#include <box2d/box2d.h>
 
 #include "sph2d/hash.hpp"
 #include "world_impl.hpp"
@@ -87,6 +91,62 @@ std::vector<std::size_t> World::particlesInShape(const b2Shape& shape, const b2T
     const Vec2d p = worldPosition(i);
     return shape.TestPoint(xf, b2Vec2(float(p.x()), float(p.y())));
   });
+}
+
+std::vector<std::uint32_t> World::particlesTouching(const b2Fixture& fixture) const {
+  const Impl& w = *impl_;
+  const double reach = double(w.dx);  // the first layer of resting water sits 0.25–0.5 dx off a wall
+  const b2Shape& shape = *fixture.GetShape();
+  const b2Transform& xf = fixture.GetBody()->GetTransform();
+  std::vector<std::uint32_t> ids;
+  for (int child = 0; child < shape.GetChildCount(); ++child) {
+    b2AABB box;
+    shape.ComputeAABB(&box, xf, child);
+    const Vec2d lo(box.lowerBound.x - reach, box.lowerBound.y - reach), hi(box.upperBound.x + reach, box.upperBound.y + reach);
+    b2DistanceProxy part;
+    part.Set(&shape, child);
+    // Box2D's polygons carry a skin (b2_polygonRadius) the fluid does not see: distances are
+    // to the core shape, less a circle's own radius.
+    const double radius = shape.GetType() == b2Shape::e_circle ? double(shape.m_radius) : 0.0;
+    const std::vector<std::size_t> near = collect(w, lo, hi, [&](std::size_t i) {
+      const Vec2d p = worldPosition(i);
+      const b2Vec2 q(float(p.x()), float(p.y()));
+      b2DistanceProxy point;
+      point.m_vertices = &q;
+      point.m_count = 1;
+      point.m_radius = 0;
+      b2DistanceInput in;
+      in.proxyA = part;
+      in.proxyB = point;
+      in.transformA = xf;
+      in.transformB.SetIdentity();
+      in.useRadii = false;
+      b2SimplexCache cache;
+      cache.count = 0;
+      b2DistanceOutput out;
+      b2Distance(&out, &cache, &in);
+      return double(out.distance) - radius <= reach;
+    });
+    for (const std::size_t i : near) ids.push_back(w.P.id[i]);
+  }
+  if (shape.GetChildCount() > 1) {  // a chain: a particle near two links once, in slot order
+    std::vector<std::pair<std::size_t, std::uint32_t>> bySlot;
+    for (const std::uint32_t id : ids) bySlot.push_back({slotOf(id), id});
+    std::sort(bySlot.begin(), bySlot.end());
+    bySlot.erase(std::unique(bySlot.begin(), bySlot.end()), bySlot.end());
+    ids.clear();
+    for (const auto& s : bySlot) ids.push_back(s.second);
+  }
+  return ids;
+}
+
+void World::forEachContact(const std::function<void(const b2Fixture&, const std::vector<std::uint32_t>&)>& f) const {
+  const b2World& b2 = box2d();
+  for (const b2Body* body = b2.GetBodyList(); body; body = body->GetNext())
+    for (const b2Fixture* fx = body->GetFixtureList(); fx; fx = fx->GetNext()) {
+      const std::vector<std::uint32_t> ids = particlesTouching(*fx);
+      if (!ids.empty()) f(*fx, ids);
+    }
 }
 
 World::FieldSample World::sampleAt(const Vec2d& point) const {

@@ -179,3 +179,63 @@ TEST_CASE("the state hash is the same for the same state and changes with any pa
   CHECK(b.removeParticlesInBox(p, p) == 1);
   CHECK(a.stateHash() == b.stateHash());
 }
+
+TEST_CASE("queries: particlesTouching finds the particles within one spacing of a fixture, and forEachContact visits the fixtures the water touches") {
+  SceneDef s = test::tank("game", 1.0, 1.0, 0.02);
+  s.blocks.push_back(test::block({0, 0}, {1, 0.4}));
+  BodyDef pole;  // a submerged circle, r = 0.06 m, at (0.5, 0.2)
+  ShapeDef c;
+  c.type = ShapeDef::Type::Circle;
+  c.center = Vec2d(0.5, 0.2);
+  c.radius = 0.06;
+  pole.fixtures.push_back(c);
+  s.bodies.push_back(pole);
+  World w(s, WorldOptions{2});
+  for (int f = 0; f < 30; ++f) w.stepFrame();
+  const double dx = double(w.spacing());
+  // The fixtures by where they are: floor, ceiling, the pole.
+  const b2Fixture *floor = nullptr, *ceiling = nullptr, *circle = nullptr;
+  for (const b2Body* b = w.box2d().GetBodyList(); b; b = b->GetNext())
+    for (const b2Fixture* fx = b->GetFixtureList(); fx; fx = fx->GetNext()) {
+      const b2AABB a = fx->GetAABB(0);
+      if (fx->GetShape()->GetType() == b2Shape::e_circle) circle = fx;
+      else if (a.upperBound.y < 0.02f) floor = fx;  // AABBs hold the polygon skin (0.01 m)
+      else if (a.lowerBound.y > 0.98f) ceiling = fx;
+    }
+  REQUIRE(floor);
+  REQUIRE(ceiling);
+  REQUIRE(circle);
+  // Against a scan of every particle with the exact distance to each shape.
+  auto scan = [&](auto dist) {
+    std::vector<std::uint32_t> ids;
+    for (std::size_t i = 0; i < w.particleCount(); ++i)
+      if (dist(w.worldPosition(i)) <= dx) ids.push_back(w.particles().id[i]);
+    return ids;
+  };
+  const std::vector<std::uint32_t> onFloor = w.particlesTouching(*floor);
+  const std::vector<std::uint32_t> floorScan = scan([](const Vec2d& p) { return std::max(0.0, p.y()); });
+  const std::vector<std::uint32_t> onPole = w.particlesTouching(*circle);
+  const std::vector<std::uint32_t> poleScan =
+      scan([](const Vec2d& p) { return std::max(0.0, (p - Vec2d(0.5, 0.2)).norm() - 0.06); });
+  MESSAGE(onFloor.size() << " particles on the floor, " << onPole.size() << " around the pole");
+  CHECK(onFloor == floorScan);
+  CHECK(onPole == poleScan);
+  CHECK(onFloor.size() >= std::size_t(0.9 / dx));      // the whole bottom layer
+  CHECK(onPole.size() >= std::size_t(2 * 3.14159 * 0.06 / dx));  // a ring around it
+  CHECK(w.particlesTouching(*ceiling).empty());
+  // forEachContact: the floor, the side walls and the pole, never the ceiling; the same lists.
+  int visited = 0;
+  bool sawCeiling = false, sawPole = false;
+  w.forEachContact([&](const b2Fixture& fx, const std::vector<std::uint32_t>& ids) {
+    ++visited;
+    sawCeiling = sawCeiling || &fx == ceiling;
+    if (&fx == circle) {
+      sawPole = true;
+      CHECK(ids == onPole);
+    }
+    CHECK_FALSE(ids.empty());
+  });
+  CHECK(visited == 4);
+  CHECK(sawPole);
+  CHECK_FALSE(sawCeiling);
+}

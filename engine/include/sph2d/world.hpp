@@ -10,6 +10,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <iosfwd>
 #include <memory>
 #include <stdexcept>
@@ -22,6 +23,7 @@
 
 class b2World;
 class b2Shape;
+class b2Fixture;
 struct b2Transform;
 
 namespace sph2d {
@@ -267,6 +269,14 @@ class World {
   };
   /// Samples the fluid's fields at `point`.
   FieldSample sampleAt(const Vec2d& point) const;
+  /// The ids of the particles touching `fixture` now (between frames: at the end of the last
+  /// one): their centres within one spacing of its surface, or inside it; in slot order. Any
+  /// fixture of the b2World the fluid sees, static or moving, at the body's current pose.
+  std::vector<std::uint32_t> particlesTouching(const b2Fixture& fixture) const;
+  /// Calls f(fixture, ids) for every fixture of box2d() that particles touch now, with their
+  /// ids as particlesTouching() gives them; bodies and fixtures in Box2D's list order. The
+  /// game's contact listener for the fluid (a button the water reaches, a fire it puts out).
+  void forEachContact(const std::function<void(const b2Fixture&, const std::vector<std::uint32_t>&)>& f) const;
   /// Re-reads the static fixtures of the b2World now (stepFrame does it when they change).
   void refreshBoundaries();
 
