@@ -30,7 +30,8 @@ namespace sph2d {
 namespace {
 
 constexpr char kMagic[8] = {'S', 'P', 'H', '2', 'D', 'S', 'A', 'V'};
-constexpr std::uint32_t kVersion = 1;
+constexpr std::uint64_t kMaxEmitters = World::Impl::kMaxEmitters;  // a save holding more is not one of ours
+constexpr std::uint32_t kVersion = 2;  // 2: every emitter's whole definition (emitters added at run time)
 constexpr std::size_t kMaxFields = 64, kMaxName = 128;
 constexpr const char* kUserForce = "user_force";  ///< the effect setUserForces adds
 
@@ -45,7 +46,7 @@ std::uint64_t fingerprint(const World::Impl& w) {
   str(w.solver->name());
   const double keys[] = {w.scene.solver.spacing, w.scene.solver.supportRatio, w.scene.solver.restDensity};
   h.update(keys, sizeof keys);
-  const std::uint64_t emitters = w.emitters.size();
+  const std::uint64_t emitters = w.scene.effects.emitters.size();  // the scene's: a game adds and removes others
   h.update(&emitters, sizeof emitters);
   for (const auto& e : w.effects)
     if (std::string(e->name()) != kUserForce) str(e->name());  // a game adds it at run time
@@ -88,6 +89,9 @@ void World::save(std::ostream& out) const {
     putVec(o, e.def.position);
     putVec(o, e.def.direction);
     o.put(std::uint8_t(e.def.enabled));
+    const double shape[] = {e.def.width, e.def.rate, e.def.speed, e.def.spread, e.def.jitter, e.def.start, e.def.stop};
+    for (const double v : shape) o.put(v);
+    o.put(e.def.seed);
   }
   o.put(std::uint8_t(w.userForceEffect));
   o.put(std::uint64_t(w.userForces.size()));
@@ -153,9 +157,11 @@ void World::load(std::istream& input) {
   const Vec2d gravity = getVec(in, "gravity");
   if (!std::isfinite(time) || !std::isfinite(lastDt) || !std::isfinite(gravity.x()) || !std::isfinite(gravity.y()))
     throw SaveError("the saved state is malformed: its clock or gravity is not finite");
-  if (in.get<std::uint64_t>("the emitters") != w.emitters.size())
-    throw SaveError("the saved state is malformed: its emitter count is not the scene's " + std::to_string(w.emitters.size()));
-  std::vector<Impl::EmitterState> emitters = w.emitters;
+  const std::uint64_t emitterCount = in.get<std::uint64_t>("the emitters");
+  if (emitterCount > kMaxEmitters)
+    throw SaveError("the saved state is malformed: " + std::to_string(emitterCount) + " emitters (at most " +
+                    std::to_string(kMaxEmitters) + ")");
+  std::vector<Impl::EmitterState> emitters(static_cast<std::size_t>(emitterCount));
   for (Impl::EmitterState& e : emitters) {
     e.rng = in.get<std::uint64_t>("an emitter");
     e.emitted = in.get<std::uint64_t>("an emitter");
@@ -163,8 +169,12 @@ void World::load(std::istream& input) {
     e.def.position = getVec(in, "an emitter");
     e.def.direction = getVec(in, "an emitter");
     e.def.enabled = in.get<std::uint8_t>("an emitter") != 0;
-    if (!std::isfinite(e.def.position.x()) || !std::isfinite(e.def.position.y()) || !(std::abs(e.def.direction.norm() - 1) < 1e-6))
-      throw SaveError("the saved state is malformed: an emitter's position or direction");
+    double* shape[] = {&e.def.width, &e.def.rate, &e.def.speed, &e.def.spread, &e.def.jitter, &e.def.start, &e.def.stop};
+    for (double* v : shape) *v = in.get<double>("an emitter");
+    e.def.seed = in.get<std::uint64_t>("an emitter");
+    const std::string problem = Impl::emitterProblem(e.def);
+    if (!problem.empty() || !(std::abs(e.def.direction.norm() - 1) < 1e-6))
+      throw SaveError("the saved state is malformed: an emitter's " + (problem.empty() ? std::string("direction") : problem));
   }
   const bool userForceEffect = in.get<std::uint8_t>("the user forces") != 0;
   const std::uint64_t forces = in.get<std::uint64_t>("the user forces");

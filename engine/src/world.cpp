@@ -214,6 +214,32 @@ void World::moveEmitter(std::size_t index, const Vec2d& position, const Vec2d& d
 
 const EmitterDef& World::emitter(std::size_t index) const { return impl_->emitters.at(index).def; }
 
+std::size_t World::addEmitter(const EmitterDef& def) {
+  Impl& w = *impl_;
+  const std::string problem = Impl::emitterProblem(def);
+  if (!problem.empty()) throw std::invalid_argument("addEmitter: " + problem);
+  if (w.emitters.size() >= Impl::kMaxEmitters)
+    throw std::invalid_argument("addEmitter: the world has " + std::to_string(Impl::kMaxEmitters) + " emitters, the most it holds");
+  Impl::EmitterState st;
+  st.def = def;
+  st.def.direction = def.direction.normalized();
+  st.def.start = std::max(def.start, w.time);  // nothing is owed for the time before
+  st.def.stop = std::max(st.def.stop, st.def.start);
+  st.rng = def.seed;
+  w.emitters.push_back(st);
+  if (w.emitters.size() == 1) w.buildStages();  // the `emit` stage exists only with emitters
+  return w.emitters.size() - 1;
+}
+
+void World::removeEmitter(std::size_t index) {
+  Impl& w = *impl_;
+  if (index >= w.emitters.size())
+    throw std::out_of_range("removeEmitter: no emitter " + std::to_string(index) + " (the world has " +
+                            std::to_string(w.emitters.size()) + ")");
+  w.emitters.erase(w.emitters.begin() + std::ptrdiff_t(index));
+  if (w.emitters.empty()) w.buildStages();
+}
+
 std::size_t World::removeParticlesInBox(const Vec2d& lo, const Vec2d& hi) {
   Impl& w = *impl_;
   const RegionDef r{lo, hi};

@@ -64,6 +64,10 @@ struct World::Impl {
     bool warnedBudget = false;
   };
   std::vector<EmitterState> emitters;
+  /// What is wrong with an emitter built in code or read from a save, naming the field and
+  /// its range (the scene format's), or "" when nothing is (particle_system.cpp).
+  static std::string emitterProblem(const EmitterDef& d);
+  static constexpr std::size_t kMaxEmitters = 4096;  ///< addEmitter's and a save's limit
   std::size_t budget = 0;
   std::uint64_t removed = 0;
   std::vector<UserForce> userForces;

@@ -291,7 +291,16 @@ class World {
   void moveEmitter(std::size_t index, const Vec2d& position, const Vec2d& direction);
   /// The current settings of emitter `index` (position, direction, enabled...). Throws std::out_of_range.
   const EmitterDef& emitter(std::size_t index) const;
-  /// Number of emitters of the scene.
+  /// Adds an emitter (a faucet the player places) after the others; returns its index. Its
+  /// `start` and `stop` are simulated times: a start already past means now (nothing is owed
+  /// for the time before). Its seed gives its own random stream, as in a scene. Throws
+  /// std::invalid_argument naming the field when a value is outside the scene format's range
+  /// (docs/SCENES.md, `effects.emitters`) or the direction is zero.
+  std::size_t addEmitter(const EmitterDef& def);
+  /// Removes emitter `index` (its particles stay); the emitters after it move down one index.
+  /// Throws std::out_of_range.
+  void removeEmitter(std::size_t index);
+  /// Number of emitters: the scene's and those added since, less those removed.
   std::size_t emitterCount() const;
   /// Switches an effect the scene enables ("viscosity", "xsph", "force_fields",
   /// "surface_tension", "user_force") on or off. Throws std::invalid_argument
