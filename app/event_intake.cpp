@@ -17,7 +17,7 @@ void EventIntake::addScene() { schedule_.addScene(scene_); }
 
 std::size_t EventIntake::addFile(const std::string& path) {
   try {
-    return schedule_.addFile(path, scene_, warn_);
+    return addEventsFile(schedule_, path, scene_, warn_, skippedScene_);
   } catch (const std::runtime_error& e) {
     throw UsageError(e.what());
   }

@@ -30,7 +30,7 @@ class EventIntake {
   EventIntake(const SceneDef& scene, WarnFn warn);
   /// Adds the scene's timeline (source "scene").
   void addScene();
-  /// Adds the events of an events file (see EventSchedule::addFile) and returns how many.
+  /// Adds the events of an events file (see addEventsFile) and returns how many.
   /// Throws UsageError when the file cannot be read.
   std::size_t addFile(const std::string& path);
   /// Adds one event at its frame (e.g. an event a manifest lists).
@@ -52,13 +52,14 @@ class EventIntake {
   /// Scheduled events not taken yet.
   std::size_t pending() const { return schedule_.pending(); }
   /// Events files' lines skipped because a record took them from the scene's timeline.
-  std::size_t skippedSceneEvents() const { return schedule_.skippedSceneEvents(); }
+  std::size_t skippedSceneEvents() const { return skippedScene_; }
 
  private:
   void pollLive();
   const SceneDef& scene_;
   WarnFn warn_;
   EventSchedule schedule_;
+  std::size_t skippedScene_ = 0;  ///< events files' lines a record took from the timeline
   std::unique_ptr<LiveInput> live_;
   std::vector<TimedEvent> liveQueue_;  ///< parsed live events not taken yet
 };

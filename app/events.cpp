@@ -13,25 +13,8 @@
 
 namespace sph2d::cli {
 
-void EventSchedule::insert(TimedEvent e) {
-  // After every event of the same or an earlier frame: stable within a frame.
-  const auto at = std::upper_bound(events_.begin(), events_.end(), e.frame,
-                                   [](std::int64_t f, const TimedEvent& x) { return f < x.frame; });
-  events_.insert(at, std::move(e));
-}
-
-void EventSchedule::addScene(const SceneDef& scene) {
-  for (std::size_t k = 0; k < scene.events.size(); ++k) {
-    TimedEvent t;
-    t.event = scene.events[k];
-    t.event.source = "scene";
-    t.frame = eventFrame(t.event, scene.fps);
-    t.where = (scene.path.empty() ? std::string("scene") : scene.path) + " events[" + std::to_string(k) + "]";
-    insert(std::move(t));
-  }
-}
-
-std::size_t EventSchedule::addFile(const std::string& path, const SceneDef& scene, const WarnFn& warn) {
+std::size_t addEventsFile(EventSchedule& schedule, const std::string& path, const SceneDef& scene, const WarnFn& warn,
+                          std::size_t& skippedScene) {
   std::ifstream in(path);
   if (!in) throw std::runtime_error("cannot read the events file " + path);
   std::string line;
@@ -42,28 +25,19 @@ std::size_t EventSchedule::addFile(const std::string& path, const SceneDef& scen
       TimedEvent t;
       t.event = parseEvent(line, path, lineNo, scene, EventStamp::Required);
       if (t.event.source == "scene") {
-        ++skippedScene_;
+        ++skippedScene;
         continue;
       }
       if (t.event.source.empty()) t.event.source = "file";
       t.frame = eventFrame(t.event, scene.fps);
       t.where = path + ":" + std::to_string(lineNo);
-      insert(std::move(t));
+      schedule.add(std::move(t));
       ++n;
     } catch (const SceneError& e) {
       warn(std::string(e.what()) + " (line skipped)");
     }
   }
   return n;
-}
-
-std::vector<TimedEvent> EventSchedule::take(std::int64_t frame) {
-  std::vector<TimedEvent> out;
-  std::size_t k = 0;
-  while (k < events_.size() && events_[k].frame <= frame) ++k;
-  out.assign(std::make_move_iterator(events_.begin()), std::make_move_iterator(events_.begin() + std::ptrdiff_t(k)));
-  events_.erase(events_.begin(), events_.begin() + std::ptrdiff_t(k));
-  return out;
 }
 
 LiveInput::LiveInput(int fd) : thread_([this, fd] { loop(fd); }) {}
@@ -157,84 +131,6 @@ bool LiveInput::open() const {
   if (!eof_.load()) return true;
   std::lock_guard<std::mutex> lock(mutex_);
   return !lines_.empty();
-}
-
-std::string EventApplier::apply(World& w, const EventDef& e) {
-  using T = EventDef::Type;
-  try {
-    switch (e.type) {
-      case T::Force: {
-        UserForce f;
-        f.point = e.point;
-        f.radius = e.radius;
-        f.strength = e.strength;
-        forces_[e.id] = f;
-        break;
-      }
-      case T::Release:
-        if (e.id < 0) forces_.clear();
-        else forces_.erase(e.id);
-        break;
-      case T::Block: w.addBlock(e.block); break;
-      case T::Drop: w.addDrop(e.point, e.radius, e.velocity); break;
-      case T::Emitter:
-        if (e.hasPoint || e.hasDirection) {
-          const EmitterDef& cur = w.emitter(e.index);
-          w.moveEmitter(e.index, e.hasPoint ? e.point : cur.position, e.hasDirection ? e.direction : cur.direction);
-        }
-        if (e.hasEnabled) w.setEmitterEnabled(e.index, e.enabled);
-        break;
-      case T::Gravity: w.setGravity(e.gravity); break;
-      case T::Effect: w.setEffectEnabled(e.effect, e.enabled); break;
-      case T::Pause:
-        paused_ = true;
-        pauseSeconds_ = e.seconds;
-        break;
-      case T::Resume: paused_ = false; break;
-    }
-    if (e.type == T::Force || e.type == T::Release) {
-      std::vector<UserForce> list;
-      for (const auto& f : forces_) list.push_back(f.second);
-      w.setUserForces(list);
-    }
-  } catch (const std::exception& ex) {
-    return ex.what();
-  }
-  return "";
-}
-
-std::string describeEvent(const EventDef& e) {
-  using T = EventDef::Type;
-  std::ostringstream o;
-  o.precision(4);
-  auto v = [&](const Vec2d& p) {
-    std::ostringstream s;
-    s.precision(4);
-    s << "(" << p.x() << ", " << p.y() << ")";
-    return s.str();
-  };
-  o << eventTypeName(e.type);
-  switch (e.type) {
-    case T::Force:
-      o << " " << e.id << " at " << v(e.point) << ", radius " << e.radius << " m, " << e.strength << " m/s²";
-      break;
-    case T::Release: o << (e.id < 0 ? " all forces" : " force " + std::to_string(e.id)); break;
-    case T::Block: o << " " << v(e.block.min) << " – " << v(e.block.max); break;
-    case T::Drop: o << " at " << v(e.point) << ", radius " << e.radius << " m"; break;
-    case T::Emitter:
-      o << " " << e.index;
-      if (e.hasEnabled) o << (e.enabled ? " on" : " off");
-      if (e.hasPoint) o << " at " << v(e.point);
-      if (e.hasDirection) o << " towards " << v(e.direction);
-      break;
-    case T::Gravity: o << " " << v(e.gravity) << " m/s²"; break;
-    case T::Effect: o << " " << e.effect << (e.enabled ? " on" : " off"); break;
-    case T::Pause:
-      if (e.seconds > 0) o << " " << e.seconds << " s";
-      break;
-    case T::Resume: break;
-  }
-  return o.str();
 }
 
 }  // namespace sph2d::cli
