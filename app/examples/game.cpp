@@ -3,8 +3,10 @@
 // The game owns a Box2D world whose static platforms it builds in code; the fluid
 // lives in that world (sph2d::World(scene, b2World&)). The player holds a hose, an
 // emitter that a scripted input sweeps along the top and switches on and off; the
-// water pours down the platforms into a bucket, and the game counts what lands in
-// it. Frames are drawn with sph2d::render and written as PNG files.
+// water pours down the platforms into a bucket, where a kinematic paddle of the
+// game's stirs it, and the game counts what lands in it and what touches the
+// bumper (World::particlesTouching). Frames are drawn with sph2d::render and written
+// as PNG files.
 //
 // Usage: sph2d_example_game [OUT_DIR] [FRAMES]   (default out/example_game, 150)
 #include <box2d/box2d.h>
@@ -14,6 +16,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <string>
+#include <vector>
 
 #include "sph2d/render/frame_writer.hpp"
 #include "sph2d/render/renderer.hpp"
@@ -43,6 +46,18 @@ void buildLevel(b2World& level) {
   body->CreateFixture(&bumper, 0.0f);
 }
 
+// A kinematic paddle in the bucket: the game moves it, the water is pushed by it.
+b2Body* buildPaddle(b2World& level) {
+  b2BodyDef def;
+  def.type = b2_kinematicBody;
+  def.position.Set(3.5f, 0.2f);
+  b2Body* paddle = level.CreateBody(&def);
+  b2PolygonShape blade;
+  blade.SetAsBox(0.04f, 0.18f);
+  paddle->CreateFixture(&blade, 0.0f);
+  return paddle;
+}
+
 // The player, scripted: where the hose is at time t, and whether it sprays.
 struct PlayerInput {
   double x;
@@ -60,6 +75,7 @@ int main(int argc, char** argv) {
   // 1. The game's physics world and its level.
   b2World level(b2Vec2(0.0f, -9.81f));
   buildLevel(level);
+  b2Body* paddle = buildPaddle(level);
 
   // 2. The fluid's settings, in code: no boundaries (the level is the game's), one hose.
   sph2d::SceneDef scene;
@@ -93,9 +109,15 @@ int main(int argc, char** argv) {
       // Every 2 s a gust pushes the water on the top platform for a moment.
       const bool gust = std::fmod(fluid.time(), 2.0) > 1.0 && std::fmod(fluid.time(), 2.0) < 1.2;
       fluid.setUserForces({sph2d::UserForce{{0.6, 2.4}, 0.5, gust ? -30.0 : 0.0}});
+      // The paddle sweeps the bucket: 0.4 m/s, turning every second.
+      paddle->SetLinearVelocity(b2Vec2(std::fmod(fluid.time(), 2.0) < 1.0 ? 0.4f : -0.4f, 0.0f));
 
-      // 5. Step one frame (the game would step its own b2World here too), draw it.
-      if (f > 0) fluid.stepFrame();
+      // 5. Step one frame: the fluid (it pushes out of the paddle where the paddle is
+      // going), then the game's own b2World, which moves the paddle; draw it.
+      if (f > 0) {
+        fluid.stepFrame();
+        level.Step(float(1.0 / scene.fps), 8, 3);
+      }
       const sph2d::Frame& image = renderer.render(fluid);
       writer.push(f, image.width, image.height, image.rgba);
       for (const std::string& w : fluid.takeWarnings()) std::fprintf(stderr, "warning: %s\n", w.c_str());
@@ -104,8 +126,12 @@ int main(int argc, char** argv) {
       if (f % 30 == 29 || f == frames - 1) {
         const std::size_t inBucket = fluid.particlesInBox(bucketLo, bucketHi).size();
         const sph2d::World::FieldSample probe = fluid.sampleAt({3.5, 0.05});
-        std::printf("t = %.1f s: %zu particles, %zu in the bucket, density at its bottom %.0f kg/m3\n", fluid.time(),
-                    fluid.particleCount(), inBucket, probe.density);
+        std::size_t onBumper = 0;  // the bumper is the level's only circle: a "button" the water presses
+        fluid.forEachContact([&](const b2Fixture& fx, const std::vector<std::uint32_t>& ids) {
+          if (fx.GetShape()->GetType() == b2Shape::e_circle) onBumper = ids.size();
+        });
+        std::printf("t = %.1f s: %zu particles, %zu in the bucket, density at its bottom %.0f kg/m3, %zu on the bumper\n",
+                    fluid.time(), fluid.particleCount(), inBucket, probe.density, onBumper);
       }
     }
     writer.finish();
