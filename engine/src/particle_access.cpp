@@ -26,6 +26,22 @@ bool finite(const Vec2d& v) { return std::isfinite(v.x()) && std::isfinite(v.y()
 constexpr const char* kColorField = Particles::kColor;
 constexpr const char* kUserDataField = Particles::kUserData;
 
+/// Writes `value` into integer field `field` (created on first use) for particle `id`.
+bool setU32(World& w, Particles& P, const char* field, std::uint32_t id, std::uint32_t value) {
+  const std::size_t i = w.slotOf(id);
+  if (i == World::npos) return false;
+  P.fieldU32(field)[i] = value;
+  return true;
+}
+
+/// Integer field `field` of particle `id`: 0 without the field or the particle.
+std::uint32_t getU32(const World& w, const Particles& P, const char* field, std::uint32_t id) {
+  const std::vector<std::uint32_t>* f = P.findU32(field);
+  if (!f) return 0;
+  const std::size_t i = w.slotOf(id);
+  return i == World::npos ? 0u : (*f)[i];
+}
+
 /// Rebuilds the id index of `P`.
 void rebuild(std::vector<std::pair<std::uint32_t, std::uint32_t>>& index, const Particles& P) {
   index.resize(P.size());
@@ -100,12 +116,7 @@ std::size_t World::setVelocities(const std::vector<std::uint32_t>& ids, const st
   return found;
 }
 
-bool World::setParticleColor(std::uint32_t id, std::uint32_t rgb) {
-  const std::size_t i = slotOf(id);
-  if (i == npos) return false;
-  impl_->P.fieldU32(kColorField)[i] = rgb;
-  return true;
-}
+bool World::setParticleColor(std::uint32_t id, std::uint32_t rgb) { return setU32(*this, impl_->P, kColorField, id, rgb); }
 
 std::size_t World::setParticleColors(const std::vector<std::uint32_t>& ids, const std::vector<std::uint32_t>& colors) {
   if (ids.size() != colors.size())
@@ -124,26 +135,13 @@ std::size_t World::setParticleColors(const std::vector<std::uint32_t>& ids, cons
   return found;
 }
 
-std::uint32_t World::particleColor(std::uint32_t id) const {
-  const std::vector<std::uint32_t>* c = impl_->P.findU32(kColorField);
-  if (!c) return 0;
-  const std::size_t i = slotOf(id);
-  return i == npos ? 0u : (*c)[i];
-}
+std::uint32_t World::particleColor(std::uint32_t id) const { return getU32(*this, impl_->P, kColorField, id); }
 
 bool World::setParticleUserData(std::uint32_t id, std::uint32_t value) {
-  const std::size_t i = slotOf(id);
-  if (i == npos) return false;
-  impl_->P.fieldU32(kUserDataField)[i] = value;
-  return true;
+  return setU32(*this, impl_->P, kUserDataField, id, value);
 }
 
-std::uint32_t World::particleUserData(std::uint32_t id) const {
-  const std::vector<std::uint32_t>* u = impl_->P.findU32(kUserDataField);
-  if (!u) return 0;
-  const std::size_t i = slotOf(id);
-  return i == npos ? 0u : (*u)[i];
-}
+std::uint32_t World::particleUserData(std::uint32_t id) const { return getU32(*this, impl_->P, kUserDataField, id); }
 
 std::vector<std::uint32_t> World::addParticles(const std::vector<Vec2d>& points, const std::vector<Vec2d>& velocities) {
   if (!velocities.empty() && velocities.size() != points.size())
