@@ -8,6 +8,7 @@
 // the registrations of pbf and game: pbf_params.cpp.
 #include <algorithm>
 #include <cmath>
+#include <iterator>
 #include <limits>
 
 #include "solvers/pbf/pbf.hpp"
@@ -138,6 +139,7 @@ std::size_t Pbf::solve(StepContext& c) {
     }
     const Real limit = c.rho0 * (Real(1) + thr);
     bool first = true;  // every ρ and Δλ is the last full pass's
+    movedList_.clear();
     while (local < localIterations_) {
       for (; local < localIterations_ && maxCompression_ > toleranceMax_; ++local) {
         // Active: compressed above half the tolerance, or next to such a particle.
@@ -173,16 +175,21 @@ std::size_t Pbf::solve(StepContext& c) {
         }
         std::size_t bad = correct(c, lambda, Real(1), &activeList_);
         if (bad != kNone) return bad;
+        // Every particle moved in this phase (sorted): its neighbours' ρ changed too.
+        mergeScratch_.clear();
+        std::set_union(movedList_.begin(), movedList_.end(), activeList_.begin(), activeList_.end(),
+                       std::back_inserter(mergeScratch_));
+        movedList_.swap(mergeScratch_);
         bad = constraint(c, lambda, &activeList_);
         if (bad != kNone) return bad;
         lastList_.swap(activeList_);
       }
       if (local == 0) break;
-      // The listed particles moved: the density of those and of their neighbours is
-      // summed again (the rest kept ρ and W of the last full pass). A neighbour off
-      // the list may have been pushed above the tolerance: then the iterations go
-      // on from this halo, whose ρ are all fresh.
-      neighbourhood(c, lastList_, nullptr, activeList_);
+      // The particles moved in this phase, and their neighbours, have their density
+      // summed again (the rest kept ρ and W of the last full pass). A neighbour off the
+      // lists may have been pushed above the tolerance: then the iterations go on from
+      // this halo, whose ρ are all fresh.
+      neighbourhood(c, movedList_, nullptr, activeList_);
       const std::size_t bad = constraint(c, lambda, &activeList_);
       if (bad != kNone) return bad;
       lastList_.swap(activeList_);

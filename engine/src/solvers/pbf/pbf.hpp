@@ -175,6 +175,8 @@ class Pbf final : public Solver {
   std::vector<std::uint8_t> marks_;          ///< per particle, zero between calls
   std::vector<std::uint32_t> activeList_;    ///< the particles of a local iteration
   std::vector<std::uint32_t> lastList_;      ///< the particles the last constraint pass of the local phase wrote Δλ for
+  std::vector<std::uint32_t> movedList_;     ///< every particle the local phase moved (sorted)
+  std::vector<std::uint32_t> mergeScratch_;
   static constexpr std::size_t kLocalBlock = 32;  ///< particles per job of a local iteration (few, clustered)
   mutable std::vector<Real> speedScratch_;
   std::unique_ptr<GridProjection> projection_;  ///< the coarse-grid projection (grid_cell > 0)
