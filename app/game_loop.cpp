@@ -122,6 +122,8 @@ void GameLoop::capture(std::int64_t f) {
   q.particles.rho = P.rho;
   q.particles.p = P.p;
   q.particles.id = P.id;
+  q.particles.extraU32.clear();  // the particles' own colours, when something set them
+  if (const std::vector<std::uint32_t>* own = P.findU32(Particles::kColor)) q.particles.fieldU32(Particles::kColor) = *own;
   q.colliders = world_.colliders();
   const std::vector<Real>* age = P.find("age");
   if (age) q.age = *age;

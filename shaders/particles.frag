@@ -2,7 +2,7 @@
 // Particles mode: an anti-aliased disc per particle coloured by its value on a
 // blue-cyan-green-yellow-red ramp (the same formula as colorRamp() in image.cpp),
 // or (uOwnColor) by its own 0xRRGGBB colour, carried as that integer (exact in a float).
-in float vValue;         // value mapped to [0, 1] on the CPU, or the colour
+flat in float vValue;    // value mapped to [0, 1] on the CPU, or the colour
 in float vWeight;        // age fade (1 without ages)
 in vec2 vCorner;
 uniform bool uQuads;
@@ -22,7 +22,7 @@ void main() {
   float relief = 1.0 + 0.18 * (-d.x - d.y) * 0.5 - 0.2 * q * q;
   vec3 base;
   if (uOwnColor) {
-    uint c = uint(vValue + 0.5);  // the same integer at every vertex: rounding cannot move it
+    uint c = uint(vValue);  // an integer below 2^24, exact in a float and not interpolated (flat)
     base = vec3(float((c >> 16) & 255u), float((c >> 8) & 255u), float(c & 255u)) / 255.0;
   } else {
     base = ramp(vValue);

@@ -1,7 +1,7 @@
 #version 330 core
 // Splat pass: a soft, compact kernel w = (1 - q^2)^3 (times the age fade) added
 // into an RG32F target: R = sum of w, G = sum of w * speed (foam).
-in float vValue;
+flat in float vValue;
 in float vWeight;
 in vec2 vCorner;
 uniform bool uQuads;

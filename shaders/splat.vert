@@ -11,7 +11,7 @@ uniform vec2 uOffset;                  // local frame -> NDC offset
 uniform float uPointSize;              // sprite diameter [px] (points)
 uniform bool uQuads;                   // draw instanced quads instead of points
 uniform vec2 uHalfNdc;                 // quads: half the diameter in NDC (x, y)
-out float vValue;
+flat out float vValue;                 // one value per sprite (exact: a colour is an integer)
 out float vWeight;
 out vec2 vCorner;                      // quads: the sprite coordinate, like gl_PointCoord
 void main() {

@@ -48,9 +48,9 @@ struct GridShift {
 
 /// What one projection did.
 struct GridProjectionStats {
-  int iterations = 0;       ///< conjugate-gradient iterations
+  int iterations = 0;       ///< conjugate-gradient iterations (the pressure's and the shift's solves)
   int fluidCells = 0;       ///< unknowns
-  double residual = 0;      ///< largest |Δρ/ρ0| the remaining residual stands for over the substep
+  double residual = 0;      ///< largest |Δρ/ρ0| the pressure solve's remaining residual stands for over the substep
 };
 
 class GridProjection {

@@ -137,7 +137,8 @@ std::string World::Impl::emitterProblem(const EmitterDef& d) {
   else if (!in(d.speed, 0, 1e4)) o << "speed must be in 0..1e4 m/s, got " << d.speed;
   else if (!in(d.spread, 0, 6.2832)) o << "spread must be in 0..6.2832 rad, got " << d.spread;
   else if (!in(d.jitter, 0, 1)) o << "jitter must be in 0..1, got " << d.jitter;
-  else if (!in(d.start, 0, 1e30) || !in(d.stop, 0, 1e30)) o << "start and stop must be in 0..1e30 s";
+  else if (!in(d.start, 0, 1e9)) o << "start must be in 0..1e9 s, got " << d.start;
+  else if (!in(d.stop, 0, 1e30)) o << "stop must be in 0..1e30 s, got " << d.stop;
   else if (d.stop < d.start) o << "stop must not be before start";
   else if (d.seed > 9007199254740992ULL) o << "seed must be at most 2^53";
   return o.str();

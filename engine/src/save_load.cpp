@@ -225,6 +225,7 @@ void World::load(std::istream& input) {
   std::string missing;
   w.P.forEachField([&](const char* name, const auto& vec) {
     const Field* f = find(name);
+    if (!f && Particles::integerField(name)) return;  // a colour or tag set after the save: zeros on load
     if (!f || f->element != sizeof(vec[0])) missing += (missing.empty() ? "" : ", ") + std::string(name);
   });
   if (!missing.empty()) throw SaveError("the saved state is malformed: it lacks the particle fields " + missing);
@@ -288,6 +289,8 @@ void World::load(std::istream& input) {
       if (n) std::memcpy(vec.data(), f.data.data(), f.data.size());
     }
   }
+  for (auto& e : w.P.extraU32)  // integer fields the save lacks: none set at the time of the save
+    if (!find(e.first)) e.second.assign(static_cast<std::size_t>(n), 0u);
   for (std::size_t k = 0; k < movable.size(); ++k) {
     movable[k]->SetTransform(bodyStates[k].p, bodyStates[k].angle);
     movable[k]->SetLinearVelocity(bodyStates[k].v);

@@ -355,6 +355,20 @@ TEST_CASE("particles mode: color_by color draws each particle in its own colour,
   CHECK(count(g, 0) == 0);
   CHECK(count(g, 1) == 0);
   CHECK(count(g, 2) > nr + ng);
+  // Odd colours at and above 0x800000 come out as given (white, magenta), not rounded to a neighbour.
+  for (std::size_t i = 0; i < plain.particleCount(); ++i)
+    plain.setParticleColor(plain.particles().id[i], plain.worldPosition(i).x() < 0.1 ? 0xFFFFFFu : 0xFF00FFu);
+  Renderer r3(s.render, po);
+  const Frame& h = r3.render(plain);
+  std::size_t white = 0, magenta = 0;
+  for (std::size_t k = 0; k + 3 < h.rgba.size(); k += 4) {
+    const std::uint8_t* p = &h.rgba[k];
+    white += p[0] > 200 && p[1] > 200 && p[2] > 200;
+    magenta += p[0] > 180 && p[1] < 60 && p[2] > 180;
+  }
+  MESSAGE("white " << white << " px, magenta " << magenta << " px");
+  CHECK(white > 1000);
+  CHECK(magenta > 1000);
 }
 
 TEST_CASE("the overlay changes only the pixels of its box in the top-left corner") {

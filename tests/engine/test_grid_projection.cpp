@@ -149,6 +149,26 @@ TEST_CASE("grid projection: the compression shift moves a compressed block apart
   CHECK(wOn > wOff + 0.002);   // by moving the particles apart
 }
 
+TEST_CASE("grid projection: a compression shift with correction_to_velocity > 0 is refused, naming solver.grid_shift") {
+  // pbf turns its position corrections into velocity by default (correction_to_velocity 1):
+  // with the grid on, the shift's move would become velocity too.
+  SceneDef s = test::wallScene(0.025, "pbf");
+  s.bodies.push_back(test::tankWalls(1, 1));
+  s.blocks.push_back(test::block({0, 0}, {0.5, 0.5}));
+  s.solver.params["grid_cell"] = 2;
+  s.solver.params["grid_shift"] = 0.5;
+  try {
+    World w(s, WorldOptions{1});
+    FAIL("the scene was accepted");
+  } catch (const SceneError& e) {
+    CHECK(e.key == "solver.grid_shift");
+  }
+  s.solver.params["correction_to_velocity"] = 0;
+  World ok(s, WorldOptions{1});
+  ok.stepFrame();
+  CHECK(test::allFiniteState(ok));
+}
+
 TEST_CASE("game: the local iterations go on while any particle is above tolerance_max, not only the last list's") {
   // The local iterations move only the particles near a strong compression; a neighbour off
   // their list can be pushed above the tolerance by them. Until 24 Nov the loop stopped on the

@@ -237,4 +237,11 @@ TEST_CASE("particle colour and user data: allocated by the first set, kept by id
     CHECK(v.particleColor(id) == w.particleColor(id));
     CHECK(v.particleUserData(id) == w.particleUserData(id));
   }
+  // The other way: a World that set colours after a save loads it back (a rewind): no colours.
+  World r(s, WorldOptions{1});
+  std::stringstream early;
+  r.save(early);
+  CHECK(r.setParticleColor(r.particles().id[0], 0x123456u));
+  r.load(early);
+  CHECK(r.particleColor(r.particles().id[0]) == 0u);
 }

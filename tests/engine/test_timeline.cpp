@@ -92,4 +92,15 @@ TEST_CASE("timeline player: a pause event holds the frame until a resume, and a 
   for (int f = 0; f < 3; ++f) player.stepFrame(w);
   CHECK(w.frame() == 6);
   CHECK(player.pending() == 0);  // the gravity event applied after the pause
+  // A pause with its resume at the same frame holds nothing; a pause's seconds are reported.
+  pause.seconds = 2.5;
+  player.add(7, pause);
+  EventDef resume;
+  resume.type = EventDef::Type::Resume;
+  player.add(7, resume);
+  player.add(8, pause);
+  for (int f = 0; f < 3; ++f) player.stepFrame(w);
+  CHECK(w.frame() == 8);  // frame 7 passed; held at 8
+  CHECK(player.paused());
+  CHECK(player.pauseSeconds() == 2.5);
 }

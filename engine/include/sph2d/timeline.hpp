@@ -77,12 +77,16 @@ class TimelinePlayer {
   /// Adds an event at `frame` (after the events already at that frame).
   void add(std::int64_t frame, const EventDef& e, const std::string& where = "game");
   /// Applies the events due at `world`'s next frame boundary (world.frame()), then steps
-  /// the frame unless a pause event holds it (a pause lasts until a resume event; its
-  /// `seconds` are the app's wall clock and are not waited for here). Returns one message
-  /// per event that could not be applied ("WHERE: EVENT not applied: WHY"); the others apply.
+  /// the frame unless a pause event holds it. A pause holds the frame, so events of later
+  /// frames wait too: it ends with a resume event at the same frame, or when the game calls
+  /// resume() (a pause's `seconds` are wall time, pauseSeconds(): the game's clock to keep).
+  /// Returns one message per event that could not be applied ("WHERE: EVENT not applied:
+  /// WHY"); the others apply.
   std::vector<std::string> stepFrame(World& world);
   /// True between a pause and a resume event.
   bool paused() const { return applier_.paused(); }
+  /// Wall seconds the current pause asked for (0: until a resume).
+  double pauseSeconds() const { return applier_.pauseSeconds(); }
   /// Ends a pause (the game's own resume).
   void resume() { applier_.endPause(); }
   /// Events not applied yet.
