@@ -10,6 +10,8 @@
 #include <sstream>
 #include <stdexcept>
 
+#include <box2d/box2d.h>
+
 #include "support/fixture.hpp"
 
 using namespace sph2d;
@@ -244,4 +246,36 @@ TEST_CASE("particle colour and user data: allocated by the first set, kept by id
   CHECK(r.setParticleColor(r.particles().id[0], 0x123456u));
   r.load(early);
   CHECK(r.particleColor(r.particles().id[0]) == 0u);
+}
+
+TEST_CASE("particle access: the b2Vec2 overloads do what the Vec2d calls do, and braced pairs still pick the Vec2d calls") {
+  SceneDef s = smallDamBreak();
+  World a(s, WorldOptions{1}), b(s, WorldOptions{1});
+  const std::uint32_t id = a.particles().id[3];
+  // The same edits, once with Vec2d (braced pairs) and once with b2Vec2 (values exact in a float).
+  a.setGravity({0.5, -9.8125});
+  b.setGravity(b2Vec2(0.5f, -9.8125f));
+  a.addDrop({0.625, 0.75}, 0.0625, {0.0, -1.0});
+  b.addDrop(b2Vec2(0.625f, 0.75f), 0.0625, b2Vec2(0.0f, -1.0f));
+  a.setParticle(id, {0.5, 0.5}, {0.25, 0.5});
+  b.setParticle(id, b2Vec2(0.5f, 0.5f), b2Vec2(0.25f, 0.5f));
+  a.setParticleVelocity(a.particles().id[4], {1.0, 0.0});
+  b.setParticleVelocity(b.particles().id[4], b2Vec2(1.0f, 0.0f));
+  a.addParticles(std::vector<Vec2d>{{0.8125, 0.875}}, std::vector<Vec2d>{{0.0, 0.0}});
+  b.addParticles(std::vector<b2Vec2>{b2Vec2(0.8125f, 0.875f)}, std::vector<b2Vec2>{b2Vec2(0.0f, 0.0f)});
+  for (int f = 0; f < 5; ++f) {
+    a.stepFrame();
+    b.stepFrame();
+  }
+  CHECK(a.stateHash() == b.stateHash());
+  Vec2d pa, va;
+  b2Vec2 pb, vb;
+  REQUIRE(a.getParticle(id, pa, va));
+  REQUIRE(b.getParticle(id, pb, vb));
+  CHECK(pb.x == float(pa.x()));
+  CHECK(vb.y == float(va.y()));
+  CHECK(b.particlesInRadius(b2Vec2(0.125f, 0.1875f), 0.1) == a.particlesInRadius({0.125, 0.1875}, 0.1));
+  CHECK(b.particlesInBox(b2Vec2(0.0f, 0.0f), b2Vec2(0.1875f, 0.1875f)) == a.particlesInBox({0.0, 0.0}, {0.1875, 0.1875}));
+  CHECK(b.sampleAt(b2Vec2(0.125f, 0.125f)).density == a.sampleAt({0.125, 0.125}).density);
+  CHECK(b.particlesInRadius(b2Vec2(0.125f, 0.1875f), 0.1).size() > 10);
 }

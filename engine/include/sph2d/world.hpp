@@ -11,6 +11,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <type_traits>
 #include <iosfwd>
 #include <memory>
 #include <stdexcept>
@@ -24,6 +25,7 @@
 class b2World;
 class b2Shape;
 class b2Fixture;
+struct b2Vec2;
 struct b2Transform;
 
 namespace sph2d {
@@ -320,6 +322,65 @@ class World {
   /// then collision and the particle system), rebuilt when a user force is first
   /// set or an effect is switched.
   std::vector<std::string> stages() const;
+
+  // b2Vec2 overloads: a game passes its Box2D vectors as they are, with no Eigen at the call;
+  // each does exactly what the Vec2d call of the same name does. Templates on the type (only
+  // b2Vec2 qualifies), so a braced pair {x, y} still picks the Vec2d call unambiguously.
+  template <class T>
+  using IfB2 = std::enable_if_t<std::is_same<T, b2Vec2>::value, int>;
+  /// setGravity with a b2Vec2.
+  template <class B2, IfB2<B2> = 0>
+  void setGravity(const B2& g) { setGravity(Vec2d(g.x, g.y)); }
+  /// addDrop with b2Vec2 centre and velocity.
+  template <class B2, IfB2<B2> = 0>
+  std::size_t addDrop(const B2& center, double radius, const B2& velocity) {
+    return addDrop(Vec2d(center.x, center.y), radius, Vec2d(velocity.x, velocity.y));
+  }
+  /// getParticle into b2Vec2s (world coordinates).
+  template <class B2, IfB2<B2> = 0>
+  bool getParticle(std::uint32_t id, B2& position, B2& velocity) const {
+    Vec2d p, v;
+    if (!getParticle(id, p, v)) return false;
+    position.Set(float(p.x()), float(p.y()));
+    velocity.Set(float(v.x()), float(v.y()));
+    return true;
+  }
+  /// setParticle with b2Vec2s.
+  template <class B2, IfB2<B2> = 0>
+  bool setParticle(std::uint32_t id, const B2& position, const B2& velocity) {
+    return setParticle(id, Vec2d(position.x, position.y), Vec2d(velocity.x, velocity.y));
+  }
+  /// setParticleVelocity with a b2Vec2.
+  template <class B2, IfB2<B2> = 0>
+  bool setParticleVelocity(std::uint32_t id, const B2& velocity) {
+    return setParticleVelocity(id, Vec2d(velocity.x, velocity.y));
+  }
+  /// addParticles at b2Vec2 points (velocities empty: at rest).
+  template <class B2, IfB2<B2> = 0>
+  std::vector<std::uint32_t> addParticles(const std::vector<B2>& points, const std::vector<B2>& velocities) {
+    std::vector<Vec2d> p, v;
+    for (const B2& q : points) p.emplace_back(q.x, q.y);
+    for (const B2& q : velocities) v.emplace_back(q.x, q.y);
+    return addParticles(p, v);
+  }
+  /// particlesInRadius about a b2Vec2.
+  template <class B2, IfB2<B2> = 0>
+  std::vector<std::size_t> particlesInRadius(const B2& center, double radius) const {
+    return particlesInRadius(Vec2d(center.x, center.y), radius);
+  }
+  /// particlesInBox between b2Vec2 corners.
+  template <class B2, IfB2<B2> = 0>
+  std::vector<std::size_t> particlesInBox(const B2& lo, const B2& hi) const {
+    return particlesInBox(Vec2d(lo.x, lo.y), Vec2d(hi.x, hi.y));
+  }
+  /// sampleAt a b2Vec2.
+  template <class B2, IfB2<B2> = 0>
+  FieldSample sampleAt(const B2& point) const { return sampleAt(Vec2d(point.x, point.y)); }
+  /// moveEmitter with b2Vec2 position and direction.
+  template <class B2, IfB2<B2> = 0>
+  void moveEmitter(std::size_t index, const B2& position, const B2& direction) {
+    moveEmitter(index, Vec2d(position.x, position.y), Vec2d(direction.x, direction.y));
+  }
 
   struct Impl;
 
