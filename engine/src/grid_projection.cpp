@@ -426,11 +426,15 @@ void GridProjection::extrapolate(std::vector<Real>& d, int w, int h, const std::
 std::size_t GridProjection::transferToParticles(StepContext& c) {
   const Real dt = c.dt;
   const int nu = nx_ + 1;
-  auto kap = [&](int i, int j) { return type_[std::size_t(j) * nx_ + i] == kFluid ? kappa_[std::size_t(j) * nx_ + i] : Real(0); };
+  // A cell field's value in a fluid cell, 0 elsewhere (air holds 0; solid faces are not read).
+  auto inFluid = [&](const std::vector<Real>& field, int i, int j) {
+    return type_[std::size_t(j) * nx_ + i] == kFluid ? field[std::size_t(j) * nx_ + i] : Real(0);
+  };
+  auto kap = [&](int i, int j) { return inFluid(kappa_, i, j); };
   auto isFluid = [&](int i, int j) { return type_[std::size_t(j) * nx_ + i] == kFluid; };
   const bool shifting = shiftDef_.rate > 0;
   const Real k2 = -dt * dt * invH_;
-  auto phi = [&](int i, int j) { return type_[std::size_t(j) * nx_ + i] == kFluid ? kappaS_[std::size_t(j) * nx_ + i] : Real(0); };
+  auto phi = [&](int i, int j) { return inFluid(kappaS_, i, j); };
   if (shifting) {
     su_.assign(u_.size(), 0);
     sv_.assign(v_.size(), 0);

@@ -130,17 +130,18 @@ std::string World::Impl::emitterProblem(const EmitterDef& d) {
   auto finite = [](const Vec2d& v) { return std::isfinite(v.x()) && std::isfinite(v.y()); };
   auto in = [](double v, double lo, double hi) { return v >= lo && v <= hi; };  // false for NaN
   std::ostringstream o;
+  using E = EmitterDef;  // the scene format's ranges
   if (!finite(d.position)) o << "position must be finite";
   else if (!finite(d.direction) || !(d.direction.norm() > 1e-12)) o << "direction must be finite and not zero";
-  else if (!in(d.width, 0, 1e4)) o << "width must be in 0..1e4 m, got " << d.width;
-  else if (!in(d.rate, 0, 1e8)) o << "rate must be in 0..1e8 per s, got " << d.rate;
-  else if (!in(d.speed, 0, 1e4)) o << "speed must be in 0..1e4 m/s, got " << d.speed;
-  else if (!in(d.spread, 0, 6.2832)) o << "spread must be in 0..6.2832 rad, got " << d.spread;
-  else if (!in(d.jitter, 0, 1)) o << "jitter must be in 0..1, got " << d.jitter;
-  else if (!in(d.start, 0, 1e9)) o << "start must be in 0..1e9 s, got " << d.start;
-  else if (!in(d.stop, 0, 1e30)) o << "stop must be in 0..1e30 s, got " << d.stop;
+  else if (!in(d.width, 0, E::kMaxWidth)) o << "width must be in 0.." << E::kMaxWidth << " m, got " << d.width;
+  else if (!in(d.rate, 0, E::kMaxRate)) o << "rate must be in 0.." << E::kMaxRate << " per s, got " << d.rate;
+  else if (!in(d.speed, 0, E::kMaxSpeed)) o << "speed must be in 0.." << E::kMaxSpeed << " m/s, got " << d.speed;
+  else if (!in(d.spread, 0, E::kMaxSpread)) o << "spread must be in 0.." << E::kMaxSpread << " rad, got " << d.spread;
+  else if (!in(d.jitter, 0, E::kMaxJitter)) o << "jitter must be in 0.." << E::kMaxJitter << ", got " << d.jitter;
+  else if (!in(d.start, 0, E::kMaxStart)) o << "start must be in 0.." << E::kMaxStart << " s, got " << d.start;
+  else if (!in(d.stop, 0, E::kMaxStop)) o << "stop must be in 0.." << E::kMaxStop << " s, got " << d.stop;
   else if (d.stop < d.start) o << "stop must not be before start";
-  else if (d.seed > 9007199254740992ULL) o << "seed must be at most 2^53";
+  else if (d.seed > E::kMaxSeed) o << "seed must be at most 2^53";
   return o.str();
 }
 

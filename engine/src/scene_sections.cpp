@@ -252,15 +252,16 @@ EmitterDef readEmitter(const Reader& r, const json& j, const std::string& q) {
   m.direction = r.vec2(j, q, "direction", m.direction);
   if (m.direction.norm() < 1e-12) r.fail(Reader::sub(q, "direction"), "direction must not be zero");
   m.direction.normalize();
-  m.width = r.number(j, q, "width", m.width, 0, 1e4);
-  m.rate = r.number(j, q, "rate", m.rate, 0, 1e8);
-  m.speed = r.number(j, q, "speed", m.speed, 0, 1e4);
-  m.spread = r.number(j, q, "spread", m.spread, 0, 6.2832);
-  m.jitter = r.number(j, q, "jitter", m.jitter, 0, 1);
-  m.start = r.number(j, q, "start", m.start, 0, 1e9);
-  m.stop = r.number(j, q, "stop", m.stop, 0, 1e30);
+  m.width = r.number(j, q, "width", m.width, 0, EmitterDef::kMaxWidth);
+  m.rate = r.number(j, q, "rate", m.rate, 0, EmitterDef::kMaxRate);
+  m.speed = r.number(j, q, "speed", m.speed, 0, EmitterDef::kMaxSpeed);
+  m.spread = r.number(j, q, "spread", m.spread, 0, EmitterDef::kMaxSpread);
+  m.jitter = r.number(j, q, "jitter", m.jitter, 0, EmitterDef::kMaxJitter);
+  m.start = r.number(j, q, "start", m.start, 0, EmitterDef::kMaxStart);
+  m.stop = r.number(j, q, "stop", m.stop, 0, EmitterDef::kMaxStop);
   if (m.stop < m.start) r.fail(Reader::sub(q, "stop"), "stop must not be before start");
-  m.seed = static_cast<std::uint64_t>(r.integer64(j, q, "seed", static_cast<long long>(m.seed), 0, 9007199254740992LL));
+  m.seed = static_cast<std::uint64_t>(
+      r.integer64(j, q, "seed", static_cast<long long>(m.seed), 0, static_cast<long long>(EmitterDef::kMaxSeed)));
   m.enabled = r.boolean(j, q, "enabled", m.enabled);
   return m;
 }

@@ -98,13 +98,10 @@ void World::init() {
   fillSolverDefaults(w.scene.solver);
   const SceneDef& scene = w.scene;
   const SolverDef& sd = scene.solver;
-  // The compression shift moves positions only; a solver that turns its moves into velocity
-  // (correction_to_velocity > 0) would turn the shift into velocity too.
-  if (sd.params.count("grid_shift") && sd.params.count("correction_to_velocity") && sd.param("grid_shift") > 0 &&
-      sd.param("grid_cell") > 0 && sd.param("correction_to_velocity") > 0)
-    throw SceneError(scene.path.empty() ? "scene" : scene.path, 0, 0, "solver.grid_shift",
-                     "the grid's compression shift needs correction_to_velocity 0 (it would become velocity): set "
-                     "one of them to 0");
+  // A combination of parameters the solver cannot run (its own check) is refused by key.
+  const auto problem = solverParamProblem(sd);
+  if (!problem.first.empty())
+    throw SceneError(scene.path.empty() ? "scene" : scene.path, 0, 0, problem.first, problem.second);
   w.solver = makeSolver(sd);
   w.effects = makeEffects(scene);
   for (const EmitterDef& e : scene.effects.emitters) {

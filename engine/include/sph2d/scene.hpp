@@ -163,6 +163,10 @@ struct EmitterDef {
   double stop = 1e30;         ///< s
   std::uint64_t seed = 1;     ///< per-emitter random seed: same seed, same particles
   bool enabled = true;        ///< input events may switch it
+  // The ranges a scene's `effects.emitters[]` and World::addEmitter accept (0 up to these).
+  static constexpr double kMaxWidth = 1e4, kMaxRate = 1e8, kMaxSpeed = 1e4, kMaxSpread = 6.2832, kMaxJitter = 1;
+  static constexpr double kMaxStart = 1e9, kMaxStop = 1e30;
+  static constexpr std::uint64_t kMaxSeed = 9007199254740992ULL;  ///< 2^53: exact in a JSON number
 };
 
 /// What happens when the particle budget is reached.

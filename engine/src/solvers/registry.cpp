@@ -76,6 +76,11 @@ void fillSolverDefaults(SolverDef& def) {
     if (!def.params.count(p.key)) def.params[p.key] = p.def;
 }
 
+std::pair<std::string, std::string> solverParamProblem(const SolverDef& def) {
+  const SolverInfo* e = find(def.type);
+  return e && e->check ? e->check(def) : std::pair<std::string, std::string>{};
+}
+
 std::unique_ptr<Solver> makeSolver(const SolverDef& def) {
   const SolverInfo* e = find(def.type);
   if (!e) throw std::invalid_argument("unknown solver '" + def.type + "'");

@@ -11,6 +11,7 @@
 
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "sph2d/world.hpp"
@@ -82,10 +83,17 @@ struct SolverInfo {
   /// Sets the shared keys (viscosity, support ratio...) this solver wants
   /// different from SolverDef's defaults when the scene leaves them out (may be null).
   void (*tune)(SolverDef& def) = nullptr;
+  /// A combination of its parameters the solver cannot run, as {key, why} (an empty key:
+  /// none); the World refuses such a scene naming the key (may be null).
+  std::pair<std::string, std::string> (*check)(const SolverDef& def) = nullptr;
 };
 
 /// Applies the tune of `def.type`'s solver (SolverInfo::tune), if it has one.
 void tuneSolverDefaults(SolverDef& def);
+
+/// What `def`'s solver says against its parameters (SolverInfo::check): {key, why}, or an
+/// empty key when nothing (or the solver has no check).
+std::pair<std::string, std::string> solverParamProblem(const SolverDef& def);
 
 /// The solver a scene names. Throws std::invalid_argument for an unknown name.
 std::unique_ptr<Solver> makeSolver(const SolverDef& def);

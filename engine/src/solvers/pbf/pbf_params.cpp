@@ -46,9 +46,21 @@ std::vector<SolverParam> pbfParams(bool game) {
   };
 }
 
+namespace {
+/// The compression shift moves positions only; a solver that turns its moves into velocity
+/// (correction_to_velocity > 0) would turn the shift into velocity too.
+std::pair<std::string, std::string> pbfCheck(const SolverDef& d) {
+  if (d.param("grid_cell") > 0 && d.param("grid_shift") > 0 && d.param("correction_to_velocity") > 0)
+    return {"solver.grid_shift",
+            "the grid's compression shift needs correction_to_velocity 0 (it would become velocity): set one of them to 0"};
+  return {};
+}
+}  // namespace
+
 /// pbf's registration (solvers.def): classic Position Based Fluids.
 SolverInfo pbfSolver() {
-  return {"pbf", pbfParams(false), [](const SolverDef& d) -> std::unique_ptr<Solver> { return std::make_unique<Pbf>(d); }};
+  return {"pbf", pbfParams(false), [](const SolverDef& d) -> std::unique_ptr<Solver> { return std::make_unique<Pbf>(d); },
+          nullptr, pbfCheck};
 }
 
 /// game's registration (solvers.def): pbf with the coarse-grid projection, local
@@ -58,7 +70,8 @@ SolverInfo gameSolver() {
           [](SolverDef& d) {
             d.viscosity = 0;      // XSPH smooths; an explicit viscosity would limit the substep
             d.supportRatio = 2;   // 8 neighbours at rest: measured as accurate as 2.5 here, at half the pairs
-          }};
+          },
+          pbfCheck};
 }
 
 }  // namespace sph2d
