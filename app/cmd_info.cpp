@@ -96,13 +96,16 @@ int cmdInfo(const std::vector<std::string>& args) {
                 s.effects.budget ? s.effects.budget : s.maxParticles,
                 s.effects.budgetPolicy == BudgetPolicy::RecycleOldest ? "recycle_oldest" : "stop_emitting");
   }
-  std::size_t kinematic = 0;
-  for (const BodyDef& b : s.bodies) kinematic += b.type == BodyDef::Type::Kinematic;
-  std::printf("boundaries   %zu static bodies, %zu fixtures, %zu colliders, %zu boundary samples\n", s.bodies.size() - kinematic,
-              fixtures, w.colliders().size(), w.boundarySamples().size());
-  if (kinematic)
-    std::printf("moving       %zu kinematic bodies (%zu shapes; they push the fluid, stage 'bodies')\n", kinematic,
-                w.movingColliders().size());
+  std::size_t kinematic = 0, dynamic = 0;
+  for (const BodyDef& b : s.bodies) {
+    kinematic += b.type == BodyDef::Type::Kinematic;
+    dynamic += b.type == BodyDef::Type::Dynamic;
+  }
+  std::printf("boundaries   %zu static bodies, %zu fixtures, %zu colliders, %zu boundary samples\n",
+              s.bodies.size() - kinematic - dynamic, fixtures, w.colliders().size(), w.boundarySamples().size());
+  if (kinematic || dynamic)
+    std::printf("moving       %zu kinematic and %zu dynamic bodies (%zu shapes; they push the fluid, stage 'bodies'%s)\n",
+                kinematic, dynamic, w.movingColliders().size(), dynamic ? ", and the fluid pushes the dynamic ones" : "");
   const double dt = w.stableTimeStep();
   const int substeps = std::min(s.solver.maxSubsteps, int(std::ceil(1.0 / s.fps / dt - 1e-9)));
   std::printf("frames       %d at %.4g fps (%.4g s); %d substeps per frame in the initial state (substep %.3g ms, "

@@ -10,10 +10,13 @@ namespace {
 
 b2Vec2 bv(const Vec2d& v) { return b2Vec2(float(v.x()), float(v.y())); }
 
-/// Builds one body of the scene (static, or kinematic with its velocity) with its fixtures.
+/// Builds one body of the scene (static; kinematic with its velocity; dynamic with its
+/// initial velocity and its fixtures' density) with its fixtures.
 void addBody(b2World& world, const BodyDef& def) {
   b2BodyDef bd;
-  bd.type = def.type == BodyDef::Type::Kinematic ? b2_kinematicBody : b2_staticBody;
+  bd.type = def.type == BodyDef::Type::Kinematic ? b2_kinematicBody
+            : def.type == BodyDef::Type::Dynamic ? b2_dynamicBody
+                                                 : b2_staticBody;
   bd.position = bv(def.position);
   bd.angle = float(def.angle);
   b2Body* body = world.CreateBody(&bd);
@@ -21,6 +24,7 @@ void addBody(b2World& world, const BodyDef& def) {
     b2FixtureDef fd;
     fd.friction = float(s.friction);
     fd.restitution = float(s.restitution);
+    fd.density = float(s.density);
     b2PolygonShape poly;
     b2CircleShape circle;
     b2EdgeShape edge;
@@ -58,7 +62,7 @@ void addBody(b2World& world, const BodyDef& def) {
     }
     body->CreateFixture(&fd);
   }
-  if (def.type == BodyDef::Type::Kinematic) {
+  if (def.type != BodyDef::Type::Static) {
     // Box2D turns a kinematic body about its origin (it has no mass): `position`.
     body->SetLinearVelocity(bv(def.velocity));
     body->SetAngularVelocity(float(def.angularVelocity));

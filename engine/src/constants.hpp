@@ -50,6 +50,11 @@ constexpr Real kClearance = Real(0.25);
 /// the neighbour search radius before the next step's limits see it.
 constexpr Real kMaxMove = Real(0.5);
 
+/// The grid's ghost-fluid surface is never nearer a fluid cell's centre than this
+/// fraction of a cell: nearer, the cell's 1/θ would dominate its row for no gain (its
+/// pressure is ~0 either way) and slow the conjugate gradients.
+constexpr Real kMinSurfaceFraction = Real(0.1);
+
 /// A step() shorter than this fraction of the last substep only drifts (no
 /// solver stage): a solver that divides by dt (the density solves of pbf and
 /// dfsph) would turn the compression the last substep left into a huge

@@ -1,5 +1,6 @@
 // The coarse-grid pressure projection (grid_projection.hpp).
 #include "grid_projection.hpp"
+#include "moving_solid.hpp"
 #include "state_io.hpp"
 
 #include <algorithm>
@@ -55,6 +56,7 @@ void GridProjection::layout(const StepContext& c) {
   type_.assign(cells, kAir);
   w_.assign(cells, 0);
   comp_.assign(cells, 0);
+  if (surface_) top_.assign(cells, -std::numeric_limits<Real>::infinity());
   kappa_.assign(cells, 0);
   index_.assign(cells, -1);
   u_.assign(std::size_t(nx_ + 1) * ny_, 0);
@@ -120,6 +122,7 @@ void GridProjection::classify(const StepContext& c) {
       const std::uint8_t e = cacheEntry(c, I0_ + i, J0_ + j);
       type_[k] = (e & 2) ? kSolid : (w_[k] >= fluidFraction_ * full ? kFluid : kAir);
     }
+  markBodies(c);
   // Faces of fluid cells: open unless blocked; the neighbour's solidity from the cache.
   for (int j = 0; j < ny_; ++j)
     for (int i = 0; i < nx_; ++i) {
@@ -137,6 +140,139 @@ void GridProjection::classify(const StepContext& c) {
       if (j > 0 && (cacheEntry(c, I0_ + i, J0_ + j - 1) & 2)) type_[k - nx_] = kSolid;
       if (j + 1 < ny_ && (eT & 2)) type_[k + nx_] = kSolid;
     }
+}
+
+void GridProjection::markBodies(const StepContext& c) {
+  bodies_.clear();
+  if (!c.solids) {
+    bodyOf_.clear();
+    return;
+  }
+  const MovingSolids& S = *c.solids;
+  const double tau = c.time - S.time0, h = double(h_);
+  bodyOf_.assign(type_.size(), -1);
+  std::vector<std::uint8_t> in;  // the body's cells over its bounding box (one cell of margin)
+  for (std::size_t b = 0; b < S.bodies.size(); ++b) {
+    const MovingSolid& m = S.bodies[b];
+    BodyState st;
+    st.centre = m.centreAt(tau);
+    st.v = m.v;
+    st.omega = m.omega;
+    st.invMass = m.invMass;
+    st.invInertia = m.invInertia;
+    // The body's cells, anchored indices [bI0, bI0 + bn) × [bJ0, bJ0 + bm), over its whole
+    // reach (the grid may hold only part of it): a cell is the body's when its centre lies
+    // at least half a cell inside, so the fluid cells around have their centres (where
+    // the pressure is) on its surface.
+    const long bI0 = long(std::floor((st.centre.x() - m.radius) / h - 0.5)) - 1;
+    const long bJ0 = long(std::floor((st.centre.y() - m.radius) / h - 0.5)) - 1;
+    const long bn = long(std::ceil((st.centre.x() + m.radius) / h - 0.5)) + 2 - bI0;
+    const long bm = long(std::ceil((st.centre.y() + m.radius) / h - 0.5)) + 2 - bJ0;
+    in.assign(std::size_t(bn * bm), 0);
+    for (long J = 1; J + 1 < bm; ++J)
+      for (long I = 1; I + 1 < bn; ++I) {
+        const Vec2d ctr((double(bI0 + I) + 0.5) * h, (double(bJ0 + J) + 0.5) * h);
+        const double d = m.depth(tau, ctr);
+        const long i = bI0 + I - I0_, j = bJ0 + J - J0_;
+        const bool inGrid = i >= 0 && j >= 0 && i < nx_ && j < ny_;
+        const std::size_t k = inGrid ? std::size_t(j) * nx_ + std::size_t(i) : 0;
+        if (d >= 0.5 * h) {
+          in[std::size_t(J * bn + I)] = 1;
+          if (inGrid && type_[k] != kSolid && type_[k] != kBody) {
+            type_[k] = kBody;
+            bodyOf_[k] = std::int32_t(b);
+          }
+        } else if (d > 0 && inGrid && type_[k] == kAir && w_[k] > 0 && i > 0 && j > 0 && i + 1 < nx_ && j + 1 < ny_) {
+          // Covered less deeply, the cell holds fluid only beside the body: any particle
+          // weight makes it fluid (by its fill alone it would be air, and the pressure
+          // would vanish against the body); border cells stay air, as everywhere.
+          type_[k] = kFluid;
+        }
+      }
+    // The faces' moments: for a pressure κ linear in x, the faces' impulse Σ κ(x_c) h g
+    // (x_c the fluid cell's centre across the face) is K·∇κ with K = Σ h g x_cᵀ (3 × 2);
+    // the body's own surface gives (−A·I, 0) (A its area; no torque about its centre of
+    // mass, taken as its centroid). The faces miss that by about a cell along each side:
+    // T = [C 0; τᵀ 1] with C K_F = −A I and τᵀ K_F + k_θᵀ = 0 corrects every face's g
+    // (and the flux it carries), so a body floats by Archimedes at any cell size.
+    double KF[2][2] = {{0, 0}, {0, 0}}, kt[2] = {0, 0};
+    const long di[4] = {-1, 1, 0, 0}, dj[4] = {0, 0, -1, 1};
+    for (long J = 1; J + 1 < bm; ++J)
+      for (long I = 1; I + 1 < bn; ++I) {
+        if (!in[std::size_t(J * bn + I)]) continue;
+        const Vec2d ctr((double(bI0 + I) + 0.5) * h, (double(bJ0 + J) + 0.5) * h);
+        for (int q = 0; q < 4; ++q) {
+          if (in[std::size_t((J + dj[q]) * bn + I + di[q])]) continue;
+          const Vec2d n(-double(di[q]), -double(dj[q]));  // from the fluid cell into the body
+          const Vec2d xc = ctr - h * n - st.centre, rf = ctr - 0.5 * h * n - st.centre;
+          const double rn = rf.x() * n.y() - rf.y() * n.x();
+          for (int r = 0; r < 2; ++r) {
+            KF[0][r] += h * n.x() * xc[r];
+            KF[1][r] += h * n.y() * xc[r];
+            kt[r] += h * rn * xc[r];
+          }
+        }
+      }
+    const double det = KF[0][0] * KF[1][1] - KF[0][1] * KF[1][0];
+    if (std::fabs(det) > 1e-30) {
+      const double inv[2][2] = {{KF[1][1] / det, -KF[0][1] / det}, {-KF[1][0] / det, KF[0][0] / det}};
+      for (int r = 0; r < 2; ++r)
+        for (int q = 0; q < 2; ++q) {
+          st.T[r][q] = -m.area * inv[r][q];
+          st.T[2][q] -= kt[r] * inv[r][q];
+        }
+    }
+    bodies_.push_back(st);
+  }
+}
+
+int GridProjection::bodyAcross(std::size_t k1, std::size_t k2) const {
+  if (bodies_.empty()) return -1;
+  return type_[k1] == kBody ? bodyOf_[k1] : type_[k2] == kBody ? bodyOf_[k2] : -1;
+}
+
+void GridProjection::BodyState::coupling(const Vec2d& n, const Vec2d& face, double g[3]) const {
+  const Vec2d r = face - centre;
+  const double raw[3] = {n.x(), n.y(), r.x() * n.y() - r.y() * n.x()};
+  for (int a = 0; a < 3; ++a) g[a] = T[a][0] * raw[0] + T[a][1] * raw[1] + T[a][2] * raw[2];
+}
+
+Real GridProjection::bodyFaceVelocity(int body, int axis, int i, int j) const {
+  const BodyState& b = bodies_[std::size_t(body)];
+  const double h = double(h_);
+  const Vec2d face = axis == 0 ? Vec2d(double(I0_ + i) * h, (double(J0_ + j) + 0.5) * h)
+                               : Vec2d((double(I0_ + i) + 0.5) * h, double(J0_ + j) * h);
+  double g[3];
+  b.coupling(axis == 0 ? Vec2d(1, 0) : Vec2d(0, 1), face, g);
+  return Real(g[0] * b.v.x() + g[1] * b.v.y() + g[2] * b.omega);
+}
+
+void GridProjection::assembleCoupling() {
+  coupling_.clear();
+  if (bodies_.empty()) return;
+  const double h = double(h_);
+  for (std::size_t a = 0; a < cells_.size(); ++a) {
+    const int k = cells_[a], i = k % nx_, j = k / nx_;
+    const int nb[4] = {k - 1, k + 1, k - nx_, k + nx_};
+    const Vec2d normals[4] = {Vec2d(-1, 0), Vec2d(1, 0), Vec2d(0, -1), Vec2d(0, 1)};
+    const Vec2d faces[4] = {Vec2d(double(I0_ + i) * h, (double(J0_ + j) + 0.5) * h),
+                            Vec2d(double(I0_ + i + 1) * h, (double(J0_ + j) + 0.5) * h),
+                            Vec2d((double(I0_ + i) + 0.5) * h, double(J0_ + j) * h),
+                            Vec2d((double(I0_ + i) + 0.5) * h, double(J0_ + j + 1) * h)};
+    const std::size_t first = coupling_.size();
+    for (int q = 0; q < 4; ++q) {
+      if (type_[std::size_t(nb[q])] != kBody) continue;
+      const std::int32_t body = bodyOf_[std::size_t(nb[q])];
+      const BodyState& st = bodies_[std::size_t(body)];
+      if (!(st.invMass > 0)) continue;  // kinematic: a moving wall only
+      std::size_t e = first;
+      while (e < coupling_.size() && coupling_[e].body != body) ++e;
+      if (e == coupling_.size()) coupling_.push_back(Coupling{std::int32_t(a), body, {0, 0, 0}});
+      double g[3];
+      st.coupling(normals[q], faces[q], g);
+      for (int r = 0; r < 3; ++r) coupling_[e].g[r] += g[r];
+    }
+  }
 }
 
 void GridProjection::transferToGrid(const StepContext& c) {
@@ -165,7 +301,13 @@ void GridProjection::transferToGrid(const StepContext& c) {
     for (std::size_t task = b; task < e; ++task)
       for (std::size_t p = 0; p < P.size(); ++p) {
         const Real px = P.x[p].x() * invH_ - Real(I0_), py = P.x[p].y() * invH_ - Real(J0_);
-        if (task == 0) splat(comp, w_, nx_, px - Real(0.5), py - Real(0.5), P.rho[p] / rho0 - Real(1));  // cell centres
+        if (task == 0) {
+          splat(comp, w_, nx_, px - Real(0.5), py - Real(0.5), P.rho[p] / rho0 - Real(1));  // cell centres
+          if (surface_) {  // the highest particle of each cell (the ghost surface's height)
+            const std::size_t k = std::size_t(int(py)) * std::size_t(nx_) + std::size_t(int(px));
+            top_[k] = std::max(top_[k], P.x[p].y());
+          }
+        }
         else if (task == 1) splat(u_.data(), uw_, nu, px, py - Real(0.5), P.v[p].x());               // u faces at (i, j + 1/2)
         else splat(v_.data(), vw_, nx_, px - Real(0.5), py, P.v[p].y());                              // v faces at (i + 1/2, j)
       }
@@ -188,6 +330,7 @@ void GridProjection::assemble() {
     }
   const std::size_t m = cells_.size();
   diag_.assign(m, 0);
+  if (surface_) thetaUp_.assign(type_.size(), Real(1));
   adj_.assign(4 * m, -1);
   for (std::size_t a = 0; a < m; ++a) {
     const int k = cells_[a], i = k % nx_, j = k / nx_;
@@ -196,7 +339,20 @@ void GridProjection::assemble() {
     const int nb[4] = {k - 1, k + 1, k - nx_, k + nx_};
     Real dg = 0;
     for (int q = 0; q < 4; ++q) {
-      if (open[q] && type_[std::size_t(nb[q])] != kSolid) dg += 1;
+      const std::uint8_t t = type_[std::size_t(nb[q])];
+      if (q == 3 && open[q] && t == kAir && surface_) {
+        // Ghost fluid (Gibou, Fedkiw, Cheng & Kang 2002): κ = 0 on the surface, a fraction θ
+        // of the way to the air cell's centre: half a spacing above the highest particle of
+        // the two cells (the fill would say it too, but beside a wall or over a compressed
+        // layer its reading differs by a tenth of a cell, and that difference drives a flow).
+        const double ya = (double(J0_ + k / nx_) + 0.5) * double(h_);
+        const Real ytop = std::max(top_[std::size_t(k)], top_[std::size_t(nb[q])]);
+        const Real theta = std::clamp(Real((double(ytop) + 0.5 * double(dx_) - ya) * double(invH_)), kMinSurfaceFraction, Real(1));
+        dg += Real(1) / theta;
+        thetaUp_[std::size_t(k)] = theta;
+      } else if (open[q] && t != kSolid && t != kBody) {
+        dg += 1;
+      }
       adj_[4 * a + q] = open[q] ? index_[std::size_t(nb[q])] : -1;  // −1: air, solid or closed
     }
     diag_[a] = dg;
@@ -224,6 +380,7 @@ void GridProjection::assemble() {
   }
   precon2_.resize(m);
   for (std::size_t a = 0; a < m; ++a) precon2_[a] = precon_[a] * precon_[a];
+  assembleCoupling();
 }
 
 void GridProjection::precondition(const std::vector<Real>& r, std::vector<Real>& z, std::vector<Real>& y) const {
@@ -255,7 +412,7 @@ void GridProjection::precondition(const std::vector<Real>& r, std::vector<Real>&
   }
 }
 
-void GridProjection::apply(const std::vector<Real>& in, std::vector<Real>& out) const {
+void GridProjection::apply(const std::vector<Real>& in, std::vector<Real>& out, bool coupled) const {
   const std::size_t m = cells_.size();
   const std::int32_t* A = adj_.data();
   for (std::size_t a = 0; a < m; ++a) {
@@ -264,9 +421,26 @@ void GridProjection::apply(const std::vector<Real>& in, std::vector<Real>& out) 
       if (A[4 * a + q] >= 0) s -= in[std::size_t(A[4 * a + q])];
     out[a] = s;
   }
+  if (!coupled || coupling_.empty()) return;
+  // The dynamic bodies' response (Batty, Bertails & Bridson 2007, "A fast variational
+  // framework for accurate solid-fluid coupling", on a voxelized body): the pressure's
+  // impulse Gᵀκ moves a body by M⁻¹Gᵀκ, which changes the flux through its faces by G·that.
+  bodySum_.assign(3 * bodies_.size(), 0.0);
+  for (const Coupling& e : coupling_)
+    for (int q = 0; q < 3; ++q) bodySum_[3 * std::size_t(e.body) + std::size_t(q)] += e.g[q] * double(in[std::size_t(e.unknown)]);
+  for (std::size_t b = 0; b < bodies_.size(); ++b) {
+    bodySum_[3 * b + 0] *= couplingScale_ * bodies_[b].invMass;
+    bodySum_[3 * b + 1] *= couplingScale_ * bodies_[b].invMass;
+    bodySum_[3 * b + 2] *= couplingScale_ * bodies_[b].invInertia;
+  }
+  for (const Coupling& e : coupling_) {
+    const double* t = &bodySum_[3 * std::size_t(e.body)];
+    out[std::size_t(e.unknown)] += Real(e.g[0] * t[0] + e.g[1] * t[1] + e.g[2] * t[2]);
+  }
 }
 
-int GridProjection::pcg(std::vector<Real>& x, const std::vector<Real>& b, Real tol, Real& res, CgWork& w) const {
+int GridProjection::pcg(std::vector<Real>& x, const std::vector<Real>& b, Real tol, Real& res, CgWork& w,
+                        bool coupled) const {
   // Conjugate gradients with the MIC(0) preconditioner; sums in cell order.
   const std::size_t m = cells_.size();
   std::vector<Real>&r_ = w.r, &z_ = w.z, &d_ = w.d, &q_ = w.q;
@@ -274,7 +448,7 @@ int GridProjection::pcg(std::vector<Real>& x, const std::vector<Real>& b, Real t
   z_.resize(m);
   d_.resize(m);
   q_.resize(m);
-  apply(x, q_);
+  apply(x, q_, coupled);
   for (std::size_t a = 0; a < m; ++a) r_[a] = b[a] - q_[a];
   auto worst = [&] {
     Real mx = 0;
@@ -290,7 +464,7 @@ int GridProjection::pcg(std::vector<Real>& x, const std::vector<Real>& b, Real t
   int it = 0;
   res = worst();
   while (it < maxIt_ && res > tol && rz > 0) {
-    apply(d_, q_);
+    apply(d_, q_, coupled);
     double dq = 0;
     for (std::size_t a = 0; a < m; ++a) dq += double(d_[a]) * double(q_[a]);
     if (!(dq > 0)) break;
@@ -329,8 +503,19 @@ void GridProjection::solve(const StepContext& c) {
     const long I = I0_ + i - pI0_, J = J0_ + j - pJ0_;
     if (sameCells && I >= 0 && J >= 0 && I < pnx_ && J < pny_) x[a] = prevKappa_[std::size_t(J) * pnx_ + std::size_t(I)];
   }
-  auto uf = [&](int i, int j) { return uOpen_[std::size_t(j) * nu + i] ? u_[std::size_t(j) * nu + i] : Real(0); };
-  auto vf = [&](int i, int j) { return vOpen_[std::size_t(j) * nx_ + i] ? v_[std::size_t(j) * nx_ + i] : Real(0); };
+  // A face against a moving body's cell carries the body's velocity there.
+  auto uf = [&](int i, int j) {
+    const std::size_t k = std::size_t(j) * nx_ + std::size_t(i);
+    const int b = i > 0 && i < nx_ ? bodyAcross(k - 1, k) : -1;
+    if (b >= 0) return bodyFaceVelocity(b, 0, i, j);
+    return uOpen_[std::size_t(j) * nu + i] ? u_[std::size_t(j) * nu + i] : Real(0);
+  };
+  auto vf = [&](int i, int j) {
+    const std::size_t k = std::size_t(j) * nx_ + std::size_t(i);
+    const int b = j > 0 && j < ny_ ? bodyAcross(k - std::size_t(nx_), k) : -1;
+    if (b >= 0) return bodyFaceVelocity(b, 1, i, j);
+    return vOpen_[std::size_t(j) * nx_ + i] ? v_[std::size_t(j) * nx_ + i] : Real(0);
+  };
   for (std::size_t a = 0; a < m; ++a) {
     const int k = cells_[a], i = k % nx_, j = k / nx_;
     const Real div = (uf(i + 1, j) - uf(i, j) + vf(i, j + 1) - vf(i, j)) * invH_;
@@ -360,12 +545,31 @@ void GridProjection::solve(const StepContext& c) {
   Real res = 0, resS = 0;
   int itS = 0;
   const Real scale = h_ * h_ / (dt * dt);
+  couplingScale_ = double(c.rho0) * double(h_) * double(h_);
+  const bool coupled = !coupling_.empty();
   c.pool.parallelFor(shifting ? 2 : 1, 1, [&](std::size_t b, std::size_t e) {
     for (std::size_t k = b; k < e; ++k) {
-      if (k == 0) stats_.iterations = pcg(x, rhs_, tol_ * scale, res, cgMain_);
-      else itS = pcg(xs_, rhsS_, shiftDef_.tolerance * scale, resS, cgShift_);
+      if (k == 0) stats_.iterations = pcg(x, rhs_, tol_ * scale, res, cgMain_, coupled);
+      else itS = pcg(xs_, rhsS_, shiftDef_.tolerance * scale, resS, cgShift_, false);
     }
   });
+  if (coupled) {
+    // Each dynamic body takes the pressure's impulse J = ρ0 h dt Σ κ G (force p·h per face,
+    // along n into the body, and its torque about the centre of mass) at the substep's start.
+    std::vector<double> J(3 * bodies_.size(), 0.0);
+    for (const Coupling& e : coupling_)
+      for (int q = 0; q < 3; ++q) J[3 * std::size_t(e.body) + std::size_t(q)] += e.g[q] * double(x[std::size_t(e.unknown)]);
+    const double f = double(c.rho0) * double(h_) * double(dt);
+    const double tau0 = c.time - c.solids->time0;
+    for (std::size_t b = 0; b < bodies_.size(); ++b) {
+      if (!(bodies_[b].invMass > 0)) continue;
+      const Vec2d Jl(f * J[3 * b], f * J[3 * b + 1]);
+      const double L = f * J[3 * b + 2];
+      c.solids->bodies[b].push(tau0, Jl, L);
+      bodies_[b].v = c.solids->bodies[b].v;
+      bodies_[b].omega = c.solids->bodies[b].omega;
+    }
+  }
   stats_.iterations += itS;
   stats_.residual = double(res * dt * dt * invH_ * invH_);
   std::fill(kappa_.begin(), kappa_.end(), Real(0));
@@ -450,11 +654,15 @@ std::size_t GridProjection::transferToParticles(StepContext& c) {
             if (!isFluid(i - 1, j) && !isFluid(i, j)) continue;
             const std::size_t f = std::size_t(j) * nu + i;
             fluidU_[f] = 1;
-            const bool solidSide = type_[std::size_t(j) * nx_ + i - 1] == kSolid || type_[std::size_t(j) * nx_ + i] == kSolid;
-            du_[f] = uOpen_[f] && !solidSide ? -dt * (kap(i, j) - kap(i - 1, j)) * invH_ : -u_[f];
+            const std::size_t kl = std::size_t(j) * nx_ + i - 1, kr = kl + 1;
+            const bool solidSide = type_[kl] == kSolid || type_[kr] == kSolid;
+            const int body = solidSide ? -1 : bodyAcross(kl, kr);
+            du_[f] = body >= 0                    ? bodyFaceVelocity(body, 0, i, j) - u_[f]  // a moving body's face
+                     : uOpen_[f] && !solidSide ? -dt * (kap(i, j) - kap(i - 1, j)) * invH_
+                                               : -u_[f];
             // The shift's face moves: −dt²∇φ across open faces between fluid and air
             // cells (none through a wall), extrapolated one layer as the change is.
-            if (shifting && uOpen_[f] && !solidSide) su_[f] = k2 * (phi(i, j) - phi(i - 1, j));
+            if (shifting && uOpen_[f] && !solidSide && body < 0) su_[f] = k2 * (phi(i, j) - phi(i - 1, j));
           }
         extrapolate(du_, nu, ny_, fluidU_);
         if (shifting) extrapolate(su_, nu, ny_, fluidU_);
@@ -464,9 +672,15 @@ std::size_t GridProjection::transferToParticles(StepContext& c) {
             if (!isFluid(i, j - 1) && !isFluid(i, j)) continue;
             const std::size_t f = std::size_t(j) * nx_ + i;
             fluidV_[f] = 1;
-            const bool solidSide = type_[std::size_t(j - 1) * nx_ + i] == kSolid || type_[std::size_t(j) * nx_ + i] == kSolid;
-            dv_[f] = vOpen_[f] && !solidSide ? -dt * (kap(i, j) - kap(i, j - 1)) * invH_ : -v_[f];
-            if (shifting && vOpen_[f] && !solidSide) sv_[f] = k2 * (phi(i, j) - phi(i, j - 1));
+            const std::size_t kd = std::size_t(j - 1) * nx_ + i, ku = kd + std::size_t(nx_);
+            const bool solidSide = type_[kd] == kSolid || type_[ku] == kSolid;
+            const int body = solidSide ? -1 : bodyAcross(kd, ku);
+            // Under the ghost surface the gradient spans θ of a cell (the matrix's 1/θ).
+            const Real span = surface_ && type_[ku] == kAir ? thetaUp_[kd] : Real(1);
+            dv_[f] = body >= 0                    ? bodyFaceVelocity(body, 1, i, j) - v_[f]
+                     : vOpen_[f] && !solidSide ? -dt * (kap(i, j) - kap(i, j - 1)) * invH_ / span
+                                               : -v_[f];
+            if (shifting && vOpen_[f] && !solidSide && body < 0) sv_[f] = k2 * (phi(i, j) - phi(i, j - 1)) / span;
           }
         extrapolate(dv_, nx_, ny_ + 1, fluidV_);
         if (shifting) extrapolate(sv_, nx_, ny_ + 1, fluidV_);
@@ -510,7 +724,7 @@ Real GridProjection::kappaAt(const Vec2& x) const {
   const Real wq[4] = {(1 - tx) * (1 - ty), tx * (1 - ty), (1 - tx) * ty, tx * ty};
   Real sum = 0, wsum = 0;
   for (int q = 0; q < 4; ++q) {
-    if (type_[ks[q]] == kSolid) continue;
+    if (type_[ks[q]] == kSolid || type_[ks[q]] == kBody) continue;
     wsum += wq[q];
     if (type_[ks[q]] == kFluid) sum += wq[q] * kappa_[ks[q]];
   }
@@ -519,6 +733,7 @@ Real GridProjection::kappaAt(const Vec2& x) const {
 
 std::size_t GridProjection::project(StepContext& c) {
   if (c.P.size() == 0 || !(c.dt > 0)) return kNone;
+  dx_ = c.dx;
   layout(c);
   transferToGrid(c);
   classify(c);

@@ -73,24 +73,35 @@ class GridProjection {
   const GridProjectionStats& stats() const { return stats_; }
 
  private:
-  enum : std::uint8_t { kAir = 0, kFluid = 1, kSolid = 2 };
+  enum : std::uint8_t { kAir = 0, kFluid = 1, kSolid = 2, kBody = 3 };  ///< kBody: inside a moving body (bodyOf_)
   void layout(const StepContext& c);
   void classify(const StepContext& c);
   void transferToGrid(const StepContext& c);
   void assemble();
-  void apply(const std::vector<Real>& in, std::vector<Real>& out) const;
+  /// out = A·in; `coupled`: plus the dynamic bodies' response ρ0 h² G M⁻¹ Gᵀ·in.
+  void apply(const std::vector<Real>& in, std::vector<Real>& out, bool coupled) const;
   void precondition(const std::vector<Real>& r, std::vector<Real>& z, std::vector<Real>& y) const;
   /// The vectors of one conjugate-gradient solve (two solves may run at once).
   struct CgWork {
     std::vector<Real> r, z, d, q, y;
   };
-  int pcg(std::vector<Real>& x, const std::vector<Real>& b, Real tol, Real& res, CgWork& w) const;
+  int pcg(std::vector<Real>& x, const std::vector<Real>& b, Real tol, Real& res, CgWork& w, bool coupled) const;
+  /// Marks the cells whose centre lies inside a moving body (kBody), static solids excepted.
+  void markBodies(const StepContext& c);
+  /// The coupling rows G (one per fluid cell next to a dynamic body's cells).
+  void assembleCoupling();
+  /// The velocity along +x (axis 0, u face) or +y (axis 1, v face) that a moving body's
+  /// cell imposes on face (i, j): g·(v, ω) with the face's corrected coupling g.
+  Real bodyFaceVelocity(int body, int axis, int i, int j) const;
+  /// The body of whichever of cells k1, k2 is a moving body's (−1: neither).
+  int bodyAcross(std::size_t k1, std::size_t k2) const;
   void solve(const StepContext& c);
   /// Bilinear sample of face fields u, v at (px, py) in cell units of the grid.
   Vec2 sampleFaces(const std::vector<Real>& u, const std::vector<Real>& v, Real px, Real py) const;
 
  public:
   Real pic_ = 0;  ///< share of the projected grid velocity given to the particles (PIC; the rest FLIP)
+  bool surface_ = false;  ///< ghost-fluid free surface at the fill level (else at the air cells' centres)
   /// Per particle (slot order), the move the last projection's compression shift asks for
   /// (empty when the shift is off); read by the prediction of the same substep.
   const std::vector<Vec2>& shift() const { return shift_; }
@@ -110,6 +121,9 @@ class GridProjection {
   std::vector<std::uint8_t> uOpen_, vOpen_;  ///< per face: flow may cross it
   std::vector<std::uint8_t> fluidU_, fluidV_;  ///< per face: next to a fluid cell (its change is known)
   std::vector<Real> w_, comp_;              ///< per cell: particle weight, weighted compression
+  std::vector<Real> top_;                   ///< per cell: its highest particle's y (the ghost surface only)
+  std::vector<Real> thetaUp_;               ///< per cell: where the ghost surface lies above it, in cells (1: none)
+  Real dx_ = 0;                             ///< the particle spacing
   std::vector<Real> u_, uw_, v_, vw_;       ///< face velocities and weights
   std::vector<Real> du_, dv_;               ///< face velocity changes
   std::vector<Real> uNew_, vNew_;           ///< projected face velocities (for the PIC share)
@@ -134,6 +148,26 @@ class GridProjection {
   int cnx_ = 0, cny_ = 0;
   std::vector<std::uint8_t> cache_;  ///< bit 0 known, bit 1 solid, bit 2 left face blocked, bit 3 bottom face blocked
   GridProjectionStats stats_;
+  // Moving bodies (moving_solid.hpp) in this projection: their centre and velocity at the
+  // substep's start (the velocity after the solve for a dynamic body), and the coupling
+  // rows: fluid cell a's faces into body k sum to G = Σ (n, r × n) (n into the body).
+  struct BodyState {
+    Vec2d centre{0, 0}, v{0, 0};
+    double omega = 0, invMass = 0, invInertia = 0;
+    double T[3][3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};  ///< the faces' correction (markBodies)
+    /// g = T·(n, r × n) of a face at `face` with normal n into the body.
+    void coupling(const Vec2d& n, const Vec2d& face, double g[3]) const;
+  };
+  std::vector<BodyState> bodies_;
+  std::vector<std::int32_t> bodyOf_;  ///< per cell: the body of a kBody cell
+  struct Coupling {
+    std::int32_t unknown;  ///< the fluid cell's unknown
+    std::int32_t body;
+    double g[3];           ///< Σ over its faces into the body of (n_x, n_y, r × n)
+  };
+  std::vector<Coupling> coupling_;  ///< in unknown order
+  double couplingScale_ = 0;        ///< ρ0 h²
+  mutable std::vector<double> bodySum_;  ///< apply()'s scratch: Gᵀ·in per body (the main solve only)
 };
 
 }  // namespace sph2d

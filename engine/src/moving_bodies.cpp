@@ -1,21 +1,29 @@
-// moving_bodies.cpp — the fluid against moving Box2D bodies (kinematic, and a game's
-// dynamic ones): one-way coupling, bodies push the fluid. After LiquidFun's particle–
-// body contacts (b2ParticleSystem::SolveCollision), in the body's own frame.
+// moving_bodies.cpp — the fluid against moving Box2D bodies (kinematic and dynamic),
+// both ways. After LiquidFun's particle–body contacts (b2ParticleSystem::SolveCollision),
+// in the body's own frame, with the body's side of each contact from the impulse the
+// particles exchange with it.
 //
-// At the start of each step the World reads every non-static body's pose and velocity;
-// within the step a body moves with that velocity (its centre of mass along v, turning
-// at ω about it: what Box2D does to a kinematic body over the step). The `bodies` stage
-// runs after the static collision: a particle that ends a substep inside a body's
-// polygon or circle (or within the clearance of it) is put back on the surface, through
-// the face it came in by (its start position is taken in the body's frame at the
-// substep's start, its end in the frame at the substep's end, so a body's own motion
-// counts), and the part of its velocity into the body, relative to the body's velocity
-// at that point, is removed. Particles are independent: the stage gives the same bits
-// for any thread count.
-//
-// Not yet: the fluid's pressure on dynamic bodies (the bodies do not feel the water),
-// boundary samples on moving bodies (a particle beside one sees less density), and
-// moving bodies in the grid projection of the game solver.
+// At the start of each step the World reads every non-static body's pose, velocity,
+// mass and inertia (moving_solid.hpp: a body moves along a piecewise-linear path
+// within the step). Per substep:
+//  - `body_gravity` (first, with a dynamic body): its velocity takes g·dt;
+//  - the game solver's grid projection treats the bodies as moving solids and solves
+//    for a dynamic body's velocity together with the pressure (grid_projection.cpp);
+//  - `bodies` (after the static collision): a particle that ends the substep inside a
+//    body's polygon or circle (or within the clearance of it) is put back on the
+//    surface, through the face it came in by (its start position taken in the body's
+//    frame at the substep's start, its end in the frame at the substep's end, so a
+//    body's own motion counts). Against a kinematic body the part of its velocity into
+//    the body, relative to the body's velocity there, is removed. Against a dynamic
+//    body the two meet as an inelastic contact: the particle (mass m) and the body
+//    (effective mass 1/M_eff = 1/M + (r × n)²/I at the contact) share the relative
+//    normal velocity v_n, the N contacts of the body in the substep splitting its mass
+//    (impulse j = −v_n / (1/m + N/M_eff)): a light body meeting much water takes most
+//    of the change, the water little, and no contact can overshoot. The body takes −j
+//    (and its torque) at the substep's end; the step's sum goes to Box2D, which then
+//    moves the body.
+// Positions are pushed out in parallel (each particle alone); the contacts' impulses
+// are summed serially in slot order: the same bits for any thread count.
 #include <algorithm>
 #include <cmath>
 
@@ -29,10 +37,9 @@ Vec2d rot(double theta, const Vec2d& p) {
   return Vec2d(c * p.x() - s * p.y(), s * p.x() + c * p.y());
 }
 
-/// Signed distance of body-frame point b outside collider k (negative inside) and the
-/// outward normal it is measured along; for a polygon, the face the particle entered by
-/// when its start a was outside (else the least deep face).
-double outside(const Collider& k, const Vec2d& a, const Vec2d& b, Vec2d& normal) {
+}  // namespace
+
+double outsideCollider(const Collider& k, const Vec2d& a, const Vec2d& b, Vec2d& normal) {
   if (k.kind == Collider::Kind::Circle) {
     const Vec2d c(k.center.x(), k.center.y());
     Vec2d d = b - c;
@@ -62,20 +69,71 @@ double outside(const Collider& k, const Vec2d& a, const Vec2d& b, Vec2d& normal)
   return normal.dot(b - Vec2d(k.vertices[f].x(), k.vertices[f].y()));
 }
 
-}  // namespace
+bool sweptEntry(const Collider& k, const Vec2d& a, const Vec2d& b, double& t, Vec2d& normal) {
+  const Vec2d d = b - a;
+  if (k.kind == Collider::Kind::Circle) {
+    const Vec2d f = a - Vec2d(k.center.x(), k.center.y());
+    const double r = double(k.radius), A = d.squaredNorm(), B = f.dot(d), C = f.squaredNorm() - r * r;
+    if (!(A > 0) || C < 0) return false;  // no move, or starts inside (not a crossing)
+    const double disc = B * B - A * C;
+    if (disc < 0) return false;
+    t = (-B - std::sqrt(disc)) / A;
+    if (!(t >= 0 && t <= 1)) return false;
+    normal = (f + t * d) / r;
+    return true;
+  }
+  // Cyrus–Beck: the segment's part inside every face's half plane.
+  double tIn = 0, tOut = 1;
+  std::size_t entry = k.vertices.size();
+  for (std::size_t f = 0; f < k.vertices.size(); ++f) {
+    const Vec2d n(k.normals[f].x(), k.normals[f].y()), v(k.vertices[f].x(), k.vertices[f].y());
+    const double s0 = n.dot(a - v), sd = n.dot(d);
+    if (sd == 0) {
+      if (s0 > 0) return false;  // parallel and outside this face
+      continue;
+    }
+    const double tf = -s0 / sd;
+    if (sd < 0) {
+      if (tf > tIn) tIn = tf, entry = f;
+    } else {
+      tOut = std::min(tOut, tf);
+    }
+    if (tIn > tOut) return false;
+  }
+  if (entry == k.vertices.size()) return false;  // starts inside: not a crossing
+  t = tIn;
+  normal = Vec2d(k.normals[entry].x(), k.normals[entry].y());
+  return true;
+}
 
-void World::Impl::MovingBody::pose(double tau, double& theta, Vec2d& o) const {
-  theta = angle0 + omega * tau;
-  o = com0 + v * tau - rot(theta, localCenter);
+double MovingSolid::depth(double tau, const Vec2d& p) const {
+  if ((p - centreAt(tau)).squaredNorm() > radius * radius) return -1e300;
+  double theta;
+  Vec2d o;
+  pose(tau, theta, o);
+  const Vec2d b = rot(-theta, p - o);
+  double best = -1e300;
+  for (const Collider& c : shapes) {
+    Vec2d n;
+    best = std::max(best, -outsideCollider(c, b, b, n));
+  }
+  return best;
+}
+
+int solidAt(const MovingSolids& s, double tau, const Vec2d& p) {
+  for (std::size_t k = 0; k < s.bodies.size(); ++k)
+    if (s.bodies[k].contains(tau, p)) return int(k);
+  return -1;
 }
 
 void World::Impl::captureBodies() {
-  const bool had = !moving.empty();
-  moving.clear();
-  bodyTime0 = time;
+  const bool had = !moving.bodies.empty(), hadDynamic = moving.anyDynamic();
+  moving.bodies.clear();
+  moving.time0 = time;
+  const b2Vec2 g = b2->GetGravity();
   for (b2Body* body = b2->GetBodyList(); body; body = body->GetNext()) {
     if (body->GetType() == b2_staticBody) continue;
-    MovingBody m;
+    MovingSolid m;
     m.body = body;
     for (b2Fixture* fx = body->GetFixtureList(); fx; fx = fx->GetNext()) {
       const b2Shape* shape = fx->GetShape();
@@ -105,88 +163,186 @@ void World::Impl::captureBodies() {
     m.angle0 = body->GetAngle();
     m.v = Vec2d(v.x, v.y);
     m.omega = body->GetAngularVelocity();
-    for (const Collider& c : m.shapes) {
-      if (c.kind == Collider::Kind::Circle)
-        m.radius = std::max(m.radius, (Vec2d(c.center.x(), c.center.y()) - m.localCenter).norm() + double(c.radius));
-      for (const Vec2& p : c.vertices) m.radius = std::max(m.radius, (Vec2d(p.x(), p.y()) - m.localCenter).norm());
+    if (body->GetType() == b2_dynamicBody && body->GetMass() > 0) {
+      const double bodyMass = body->GetMass();
+      m.invMass = 1.0 / bodyMass;
+      // Box2D gives the inertia about the body origin; the contacts turn it about its centre of mass.
+      const double ic = double(body->GetInertia()) - bodyMass * m.localCenter.squaredNorm();
+      m.invInertia = body->IsFixedRotation() || !(ic > 0) ? 0.0 : 1.0 / ic;
+      m.gravity = Vec2d(g.x, g.y) * double(body->GetGravityScale());
     }
-    moving.push_back(std::move(m));
+    for (const Collider& c : m.shapes) {
+      if (c.kind == Collider::Kind::Circle) {
+        m.radius = std::max(m.radius, (Vec2d(c.center.x(), c.center.y()) - m.localCenter).norm() + double(c.radius));
+        m.area += 3.14159265358979323846 * double(c.radius) * double(c.radius);
+      }
+      for (std::size_t e = 0; e < c.vertices.size(); ++e) {
+        const Vec2& p = c.vertices[e];
+        const Vec2& q = c.vertices[(e + 1) % c.vertices.size()];
+        m.radius = std::max(m.radius, (Vec2d(p.x(), p.y()) - m.localCenter).norm());
+        m.area += 0.5 * (double(p.x()) * double(q.y()) - double(q.x()) * double(p.y()));  // counter-clockwise (Box2D)
+      }
+    }
+    double theta;
+    m.pose(0, theta, m.sweptOrigin);
+    m.sweptTheta = theta;
+    // A dynamic body's jump (Box2D moved it by more than the fluid saw: a contact's impulse
+    // acts on its pose too) is swept; a kinematic body moves as the fluid saw it, up to float
+    // rounding. Farther than its reach it was teleported (or is a new body at a freed address).
+    for (const MovingSolids::LastPose& l : moving.last)
+      if (m.dynamic() && l.body == body && (l.origin - m.sweptOrigin).norm() <= m.radius) {
+        m.sweptTheta = l.theta;
+        m.sweptOrigin = l.origin;
+      }
+    moving.bodies.push_back(std::move(m));
   }
-  if (had != !moving.empty()) buildStages();  // the `bodies` stage exists only with moving bodies
+  // The `bodies` stage exists only with moving bodies, `body_gravity` only with a dynamic one.
+  if (had != !moving.bodies.empty() || hadDynamic != moving.anyDynamic()) buildStages();
 }
 
 void World::Impl::moveOwnBodies(double dt) {
-  if (!ownWorld || moving.empty() || !(dt > 0)) return;
+  moving.last.clear();
+  for (const MovingSolid& m : moving.bodies) moving.last.push_back({m.body, m.sweptTheta, m.sweptOrigin});
+  for (const MovingSolid& m : moving.bodies) {
+    if (!m.dynamic() || (m.impulse.isZero() && m.angularImpulse == 0)) continue;
+    m.body->ApplyLinearImpulse(b2Vec2(float(m.impulse.x()), float(m.impulse.y())), m.body->GetWorldCenter(), true);
+    m.body->ApplyAngularImpulse(float(m.angularImpulse), true);
+  }
+  if (!ownWorld || moving.bodies.empty() || !(dt > 0)) return;
   ownWorld->Step(float(dt), 8, 3);
 }
 
 bool World::Impl::insideMoving(const Vec2& p) const {
-  const Vec2d x(p.x(), p.y());
-  for (const MovingBody& m : moving) {
-    double theta;
-    Vec2d o;
-    m.pose(time - bodyTime0, theta, o);
-    const Vec2d b = rot(-theta, x - o);
-    for (const Collider& c : m.shapes) {
-      Vec2d n;
-      if (outside(c, b, b, n) < 0) return true;
-    }
-  }
-  return false;
+  return solidAt(moving, time - moving.time0, Vec2d(p.x(), p.y())) >= 0;
+}
+
+void World::Impl::bodyGravity(StepContext& c) {
+  const double tau0 = c.time - moving.time0;
+  for (MovingSolid& m : moving.bodies)
+    if (m.dynamic()) m.changeVelocity(tau0, m.gravity * double(c.dt), 0);
 }
 
 void World::Impl::collideMoving(StepContext& c) {
-  if (moving.empty()) return;
-  const double tau0 = c.time - bodyTime0, tau1 = tau0 + double(c.dt), clearance = double(c.clearance);
+  if (moving.bodies.empty()) return;
+  const double tau0 = c.time - moving.time0, tau1 = tau0 + double(c.dt), clearance = double(c.clearance);
   struct Pose {
-    double theta0, theta1;
+    double theta0, theta1, c0, s0, c1, s1;  // the rotations at the substep's start and end
     Vec2d o0, o1, com1;
   };
-  std::vector<Pose> poses(moving.size());
-  for (std::size_t k = 0; k < moving.size(); ++k) {
-    moving[k].pose(tau0, poses[k].theta0, poses[k].o0);
-    moving[k].pose(tau1, poses[k].theta1, poses[k].o1);
-    poses[k].com1 = moving[k].com0 + moving[k].v * tau1;
+  const std::vector<MovingSolid>& bodies = moving.bodies;
+  std::vector<Pose> poses(bodies.size());
+  for (std::size_t k = 0; k < bodies.size(); ++k) {
+    Pose& q = poses[k];
+    q.theta0 = bodies[k].sweptTheta;  // where the particles last saw it
+    q.o0 = bodies[k].sweptOrigin;
+    bodies[k].pose(tau1, q.theta1, q.o1);
+    q.com1 = bodies[k].centreAt(tau1);
+    q.c0 = std::cos(q.theta0), q.s0 = std::sin(q.theta0), q.c1 = std::cos(q.theta1), q.s1 = std::sin(q.theta1);
   }
+  const bool anyDynamic = moving.anyDynamic();
+  if (anyDynamic) {
+    hitBody.assign(c.P.size(), -1);
+    hitNormal.resize(c.P.size());
+  }
+  // Body frame from the local frame: rotate by −θ about the body origin.
+  auto toBody = [](double co, double si, const Vec2d& p) { return Vec2d(co * p.x() + si * p.y(), -si * p.x() + co * p.y()); };
   c.pool.parallelFor(c.P.size(), kStreamBlock, [&](std::size_t b0, std::size_t e0) {
     for (std::size_t i = b0; i < e0; ++i) {
-      for (std::size_t k = 0; k < moving.size(); ++k) {
-        const MovingBody& m = moving[k];
+      for (std::size_t k = 0; k < bodies.size(); ++k) {
+        const MovingSolid& m = bodies[k];
         const Pose& q = poses[k];
         const Vec2d xw(c.P.x[i].x(), c.P.x[i].y());
-        if ((xw - q.com1).squaredNorm() > (m.radius + clearance) * (m.radius + clearance)) continue;
-        const Vec2d a = rot(-q.theta0, Vec2d(c.P.xPrev[i].x(), c.P.xPrev[i].y()) - q.o0);
-        Vec2d b = rot(-q.theta1, xw - q.o1);
+        const Vec2d a = toBody(q.c0, q.s0, Vec2d(c.P.xPrev[i].x(), c.P.xPrev[i].y()) - q.o0);
+        Vec2d b = toBody(q.c1, q.s1, xw - q.o1);
+        // Beyond reach: the path from a to b passes farther than the shapes reach.
+        const Vec2d ab = b - a, ac = m.localCenter - a;
+        const double len2 = ab.squaredNorm();
+        const double t = len2 > 0 ? std::clamp(ac.dot(ab) / len2, 0.0, 1.0) : 0.0;
+        const double reach = m.radius + clearance;
+        if ((a + t * ab - m.localCenter).squaredNorm() > reach * reach) continue;
         bool hit = false;
         Vec2d nb(0, 0);
         for (const Collider& s : m.shapes) {
           Vec2d n;
-          const double d = outside(s, a, b, n);
-          if (d >= clearance) continue;
-          b += (clearance - d) * n;  // back on the surface, the clearance off it
+          double te;
+          if (sweptEntry(s, a, b, te, n)) {
+            // It entered on the way (and may have crossed it: a fast particle, a thin body):
+            // stopped at the face it entered by, the clearance off it.
+            b = a + te * ab + clearance * n;
+          } else {
+            // It started inside, or ends within the clearance outside: back on the surface.
+            const double d = outsideCollider(s, a, b, n);
+            if (d >= clearance) continue;
+            b += (clearance - d) * n;
+          }
           nb = n;
           hit = true;
         }
         if (!hit) continue;
-        const Vec2d x = q.o1 + rot(q.theta1, b), n = rot(q.theta1, nb);
+        const Vec2d x = q.o1 + Vec2d(q.c1 * b.x() - q.s1 * b.y(), q.s1 * b.x() + q.c1 * b.y());
+        const Vec2d n(q.c1 * nb.x() - q.s1 * nb.y(), q.s1 * nb.x() + q.c1 * nb.y());
+        c.P.x[i] = Vec2(Real(x.x()), Real(x.y()));
+        if (m.dynamic()) {  // the contact is solved below, with the body's other contacts
+          hitBody[i] = std::int32_t(k);
+          hitNormal[i] = n;
+          continue;
+        }
         const Vec2d r = x - q.com1, vb = m.v + m.omega * Vec2d(-r.y(), r.x());
         Vec2d v(c.P.v[i].x(), c.P.v[i].y());
         const double vn = (v - vb).dot(n);
         if (vn < 0) v -= vn * n;  // no velocity into the body: it carries the particle along
-        c.P.x[i] = Vec2(Real(x.x()), Real(x.y()));
         c.P.v[i] = Vec2(Real(v.x()), Real(v.y()));
       }
     }
   });
+  for (std::size_t k = 0; k < bodies.size(); ++k) {
+    moving.bodies[k].sweptTheta = poses[k].theta1;
+    moving.bodies[k].sweptOrigin = poses[k].o1;
+  }
+  if (!anyDynamic) return;
+  // The dynamic bodies' contacts, in slot order: count each body's approaching contacts,
+  // then solve each as inelastic with the body's mass split among them.
+  std::vector<int> count(bodies.size(), 0);
+  auto approach = [&](std::size_t i, Vec2d& r, double& vn) {
+    const MovingSolid& m = bodies[std::size_t(hitBody[i])];
+    const Vec2d x(c.P.x[i].x(), c.P.x[i].y());
+    r = x - m.centreAt(tau1);
+    vn = (Vec2d(c.P.v[i].x(), c.P.v[i].y()) - m.velocityAt(tau1, x)).dot(hitNormal[i]);
+    return vn < 0;
+  };
+  for (std::size_t i = 0; i < c.P.size(); ++i) {
+    Vec2d r;
+    double vn;
+    if (hitBody[i] >= 0 && approach(i, r, vn)) ++count[std::size_t(hitBody[i])];
+  }
+  std::vector<Vec2d> J(bodies.size(), Vec2d(0, 0));
+  std::vector<double> L(bodies.size(), 0.0);
+  const double m0 = double(c.mass);
+  for (std::size_t i = 0; i < c.P.size(); ++i) {
+    Vec2d r;
+    double vn;
+    if (hitBody[i] < 0 || !approach(i, r, vn)) continue;
+    const std::size_t k = std::size_t(hitBody[i]);
+    const MovingSolid& m = bodies[k];
+    const Vec2d& n = hitNormal[i];
+    const double rn = r.x() * n.y() - r.y() * n.x();
+    const double invMeff = m.invMass + rn * rn * m.invInertia;
+    const double j = -vn / (1.0 / m0 + double(count[k]) * invMeff);  // > 0, along n for the particle
+    c.P.v[i] += (j / m0 * n).cast<Real>();
+    J[k] -= j * n;
+    L[k] -= j * rn;
+  }
+  for (std::size_t k = 0; k < bodies.size(); ++k)
+    if (count[k] > 0) moving.bodies[k].push(tau1, J[k], L[k]);
 }
 
 std::vector<Collider> World::movingColliders() const {
   const Impl& w = *impl_;
   std::vector<Collider> out;
-  for (const Impl::MovingBody& m : w.moving) {
+  for (const MovingSolid& m : w.moving.bodies) {
     double theta;
     Vec2d o;
-    m.pose(w.time - w.bodyTime0, theta, o);
+    m.pose(w.time - w.moving.time0, theta, o);
     for (Collider c : m.shapes) {
       auto place = [&](const Vec2& p) {
         const Vec2d q = o + rot(theta, Vec2d(p.x(), p.y()));

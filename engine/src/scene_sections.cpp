@@ -23,7 +23,7 @@ ShapeDef readFixture(const Reader& r, const json& j, const std::string& path) {
   ShapeDef s;
   if (!j.contains("shape")) r.fail(Reader::sub(path, "shape"), "missing; allowed values: box, polygon, circle, edge, chain");
   const std::string shape = r.string(j, path, "shape", "", {"box", "polygon", "circle", "edge", "chain"});
-  std::vector<std::string> keys = {"shape", "friction", "restitution"};
+  std::vector<std::string> keys = {"shape", "friction", "restitution", "density"};
   if (shape == "box") {
     s.type = ShapeDef::Type::Box;
     keys.insert(keys.end(), {"center", "half_size", "angle"});
@@ -62,6 +62,7 @@ ShapeDef readFixture(const Reader& r, const json& j, const std::string& path) {
   }
   s.friction = r.number(j, path, "friction", s.friction, 0, 10);
   s.restitution = r.number(j, path, "restitution", s.restitution, 0, 1);
+  s.density = r.number(j, path, "density", s.density, 0, 1e6, true);
   return s;
 }
 
@@ -69,11 +70,8 @@ BodyDef readBody(const Reader& r, const json& j, const std::string& p) {
   r.requireObject(j, p);
   BodyDef body;
   const std::string type = j.contains("type") ? r.string(j, p, "type", "static", {"static", "kinematic", "dynamic"}) : "static";
-  if (type == "dynamic")
-    r.fail(Reader::sub(p, "type"), "dynamic bodies are not supported yet: the fluid does not push bodies; use kinematic "
-                                   "(moved at a set velocity, pushing the fluid) or static");
-  if (type == "kinematic") {
-    body.type = BodyDef::Type::Kinematic;
+  if (type == "kinematic" || type == "dynamic") {
+    body.type = type == "dynamic" ? BodyDef::Type::Dynamic : BodyDef::Type::Kinematic;
     r.checkKeys(j, p, {"type", "position", "angle", "velocity", "angular_velocity", "fixtures"});
     body.velocity = r.vec2(j, p, "velocity", body.velocity);
     if (!(body.velocity.norm() <= 1e3)) r.fail(Reader::sub(p, "velocity"), "at most 1000 m/s");
@@ -90,8 +88,10 @@ BodyDef readBody(const Reader& r, const json& j, const std::string& p) {
     const std::string pf = p + ".fixtures[" + std::to_string(f) + "]";
     body.fixtures.push_back(readFixture(r, fx[f], pf));
     const ShapeDef::Type t = body.fixtures.back().type;
-    if (body.type == BodyDef::Type::Kinematic && (t == ShapeDef::Type::Edge || t == ShapeDef::Type::Chain))
-      r.fail(Reader::sub(pf, "shape"), "a kinematic body's fixtures enclose an area: box, polygon or circle");
+    if (body.type != BodyDef::Type::Static && (t == ShapeDef::Type::Edge || t == ShapeDef::Type::Chain))
+      r.fail(Reader::sub(pf, "shape"), "a " + type + " body's fixtures enclose an area: box, polygon or circle");
+    if (body.type != BodyDef::Type::Dynamic && fx[f].is_object() && fx[f].contains("density"))
+      r.fail(Reader::sub(pf, "density"), "only a dynamic body's fixtures have a density (a " + type + " body is not moved by forces)");
   }
   return body;
 }

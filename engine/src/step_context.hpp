@@ -27,6 +27,8 @@
 
 namespace sph2d {
 
+struct MovingSolids;
+
 constexpr std::size_t kNone = std::numeric_limits<std::size_t>::max();  ///< "no bad particle"
 
 /// Neighbour lists of one substep, stored per job block so that blocks fill
@@ -82,6 +84,7 @@ struct StepContext {
   Vec2d origin{0, 0};           ///< local frame offset (world = local + origin)
   PeriodicBox periodic{};       ///< periodic axes: every pair difference takes the nearest image
   std::uint64_t boundaryVersion = 0;  ///< counts the times the colliders were read: changes whenever they are read again
+  MovingSolids* solids = nullptr;     ///< the kinematic and dynamic bodies this step (moving_solid.hpp); null when none
 };
 
 /// Lowest slot reported by the blocks (the blocks are in slot order).

@@ -45,12 +45,14 @@ StepContext World::Impl::context(Real dt) {
   c.origin = origin;
   c.periodic = periodic;
   c.boundaryVersion = boundaryVersion;
+  c.solids = moving.bodies.empty() ? nullptr : &moving;
   return c;
 }
 
 void World::Impl::buildStages() {
   stages.clear();
   if (!emitters.empty()) stages.add(plainStage("emit", [this](StepContext& c) { emit(c.dt); }));
+  if (moving.anyDynamic()) stages.add(plainStage("body_gravity", [this](StepContext& c) { bodyGravity(c); }));
   bool anyEffect = false;
   for (const auto& e : effects) anyEffect = anyEffect || e->enabled;
   bool marker = false;
@@ -79,7 +81,7 @@ void World::Impl::buildStages() {
 
 void World::Impl::addParticleSystemStages(StageList& list) {
   list.add(plainStage("collide", [](StepContext& c) { stageCollide(c); }));
-  if (!moving.empty()) list.add(plainStage("bodies", [this](StepContext& c) { collideMoving(c); }));
+  if (!moving.bodies.empty()) list.add(plainStage("bodies", [this](StepContext& c) { collideMoving(c); }));
   if (periodic.any()) list.add(plainStage("wrap", [](StepContext& c) { stageWrap(c); }));
   if (scene.effects.lifetime) list.add(plainStage("lifetimes", [this](StepContext& c) { lifetimes(c.dt); }));
   if (!scene.effects.sinks.empty()) list.add(plainStage("sinks", [this](StepContext&) { sinks(); }));

@@ -21,6 +21,7 @@
 #include <vector>
 
 #include "effects/effect.hpp"
+#include "moving_solid.hpp"
 #include "solvers/solver.hpp"
 #include "sph2d/world.hpp"
 #include "stage_list.hpp"
@@ -76,33 +77,27 @@ struct World::Impl {
   /// (id, slot) of every particle sorted by id: World::slotOf's index, rebuilt when a lookup
   /// finds it stale (particle_access.cpp). Mutable: a lookup on a const World refreshes it.
   mutable std::vector<std::pair<std::uint32_t, std::uint32_t>> idIndex;
-  // Moving bodies (moving_bodies.cpp): the kinematic and dynamic bodies of the b2World,
-  // captured at the start of each step with their pose and velocity, and moved with that
-  // velocity through the step's substeps; the `bodies` stage pushes the fluid out of them.
-  struct MovingBody {
-    b2Body* body = nullptr;
-    std::vector<Collider> shapes;  ///< polygons and circles in body coordinates
-    Vec2d com0{0, 0};              ///< centre of mass at the step's start (World's local frame)
-    Vec2d localCenter{0, 0};       ///< centre of mass in body coordinates
-    double angle0 = 0;             ///< angle at the step's start [rad]
-    Vec2d v{0, 0};                 ///< velocity of the centre of mass [m/s]
-    double omega = 0;              ///< angular velocity [rad/s]
-    double radius = 0;             ///< the shapes' reach from the centre of mass [m]
-    /// The pose τ seconds into the step: rotation θ, body origin o (local frame).
-    void pose(double tau, double& theta, Vec2d& o) const;
-  };
-  std::vector<MovingBody> moving;
-  double bodyTime0 = 0;  ///< World time of the capture
+  // Moving bodies (moving_bodies.cpp, moving_solid.hpp): the kinematic and dynamic bodies
+  // of the b2World, captured at the start of each step with their pose and velocity; the
+  // `bodies` stage pushes the fluid out of them and, for a dynamic body, takes the
+  // contacts' impulse; the grid projection of the game solver sees them as moving solids.
+  MovingSolids moving;
   /// Reads the non-static bodies of the b2World (rebuilding the stage list when their
-  /// presence changed) at the current time.
+  /// presence or kind changed) at the current time.
   void captureBodies();
-  /// After a step of `dt`: the scene's own b2World moves its bodies (a game steps its own).
+  /// After a step of `dt`: the fluid's impulse goes to each dynamic body, and the scene's
+  /// own b2World moves its bodies (a game steps its own).
   void moveOwnBodies(double dt);
-  /// True when local point p lies inside a moving body at the captured pose.
+  /// True when local point p lies inside a moving body at the current pose.
   bool insideMoving(const Vec2& p) const;
+  /// The `body_gravity` stage: each dynamic body's velocity takes its gravity for the substep.
+  void bodyGravity(StepContext& c);
   /// The `bodies` stage: particles that entered a moving body during the substep are put
-  /// back on its surface, their velocity into it replaced by the body's (free slip).
+  /// back on its surface, their velocity into it replaced by the body's (free slip); with a
+  /// dynamic body they meet as an inelastic contact, and the body takes the impulse.
   void collideMoving(StepContext& c);
+  std::vector<std::int32_t> hitBody;  ///< the bodies stage's scratch: the dynamic body particle i met (−1: none)
+  std::vector<Vec2d> hitNormal;       ///< … and the body's outward normal there
 
   /// Changes of the particles made between steps (the API's adds, removals and moves):
   /// with `steps` and the count, what the query grid is valid for.

@@ -77,7 +77,7 @@ TEST_CASE("bad input: an unknown key lists the allowed keys and suggests the nea
 
   e = errorOf(withFixture("{\"shape\": \"circle\", \"radius\": 1, \"centre\": [0, 0]}"));
   CHECK(e.key == "boundaries[0].fixtures[0].centre");
-  CHECK(has(e, "unknown key 'centre' (did you mean 'center'?); allowed keys: shape, friction, restitution, center, radius"));
+  CHECK(has(e, "unknown key 'centre' (did you mean 'center'?); allowed keys: shape, friction, restitution, density, center, radius"));
 
   // Nothing close: no suggestion, still the list.
   e = errorOf("{\"render\": {\"zoom\": 2}}");

@@ -43,18 +43,20 @@ struct ShapeDef {
   bool loop = false;             ///< chain closes on itself
   double friction = 0.2;         ///< fixture friction (Box2D and fluid)
   double restitution = 0.0;      ///< fixture restitution (Box2D and fluid)
+  double density = 1000.0;       ///< dynamic bodies: mass per area [kg/m²] (the fluid's rest density floats at the surface)
 };
 
-/// A Box2D body with its fixtures: static (a wall), or kinematic (moved at a set velocity
-/// by Box2D; it pushes the fluid, the fluid does not push it).
+/// A Box2D body with its fixtures: static (a wall), kinematic (moved at a set velocity
+/// by Box2D; it pushes the fluid, the fluid does not push it) or dynamic (moved by Box2D
+/// under gravity, its contacts and the fluid's pressure; it pushes the fluid too).
 struct BodyDef {
   /// How the body moves.
-  enum class Type { Static, Kinematic };
+  enum class Type { Static, Kinematic, Dynamic };
   Type type = Type::Static;
   Vec2d position{0, 0};          ///< body origin in world coordinates [m]
   double angle = 0;              ///< body rotation [rad]
-  Vec2d velocity{0, 0};          ///< kinematic: velocity [m/s]
-  double angularVelocity = 0;    ///< kinematic: [rad/s], about `position` (Box2D turns a kinematic body about its origin)
+  Vec2d velocity{0, 0};          ///< kinematic: velocity; dynamic: initial velocity of its origin [m/s]
+  double angularVelocity = 0;    ///< kinematic: [rad/s], about `position` (Box2D turns a kinematic body about its origin); dynamic: initial
   std::vector<ShapeDef> fixtures;
 };
 

@@ -40,6 +40,7 @@ Pbf::Pbf(const SolverDef& d)
                                                    GridShift{Real(d.param("grid_shift")), Real(d.param("grid_shift_above")),
                                                              Real(d.param("grid_shift_tolerance"))});
   if (projection_) projection_->pic_ = Real(d.param("grid_pic"));
+  if (projection_) projection_->surface_ = d.param("grid_surface") > 0;
 }
 
 void Pbf::prepare(StepContext& c) {

@@ -40,6 +40,8 @@ std::vector<SolverParam> pbfParams(bool game) {
       {"grid_shift_above", 0.005, 0, 1,
        "the compression a cell keeps from the shift (left to the density solve)"},
       {"grid_shift_tolerance", 0.01, 1e-7, 1, "the shift's solve: the density change its largest residual may stand for (a correction: looser than grid_tolerance)"},
+      {"grid_surface", g(0, 1), 0, 1,
+       "1: the grid's free surface lies half a spacing above the highest particle (ghost fluid, Gibou et al. 2002: a floating body's draught by Archimedes), 0: at the air cells' centres"},
       {"grid_tolerance", 1e-3, 1e-7, 1, "grid solve: the density change per substep its largest residual may stand for"},
       {"grid_max_iterations", 200, 1, 10000, "grid solve: conjugate-gradient iterations at most"},
       {"grid_pic", g(0, 0.05), 0, 1, "share of the projected grid velocity the particles take (PIC; the rest is the FLIP change)"},
