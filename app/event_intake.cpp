@@ -29,11 +29,13 @@ void EventIntake::openLive(int fd) { live_ = std::make_unique<LiveInput>(fd); }
 
 void EventIntake::closeLive() { live_.reset(); }
 
-bool EventIntake::liveOpen() const { return live_ && live_->open(); }
+bool EventIntake::liveOpen() const { return (live_ && live_->open()) || queue_; }
 
 std::vector<TimedEvent> EventIntake::takeScheduled(std::int64_t frame) { return schedule_.take(frame); }
 
 void EventIntake::pollLive() {
+  if (queue_)
+    for (TimedEvent& t : queue_->take()) liveQueue_.push_back(std::move(t));
   if (!live_) return;
   for (const std::string& w : live_->takeWarnings()) warn_(w);
   for (auto& [lineNo, text] : live_->take()) {
@@ -72,6 +74,25 @@ std::vector<TimedEvent> EventIntake::takeLivePauses(std::int64_t frame) {
   }
   liveQueue_.swap(keep);
   return now;
+}
+
+bool EventQueue::push(TimedEvent e) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (events_.size() >= capacity_) return false;
+  events_.push_back(std::move(e));
+  return true;
+}
+
+std::vector<TimedEvent> EventQueue::take() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  std::vector<TimedEvent> out;
+  out.swap(events_);
+  return out;
+}
+
+std::size_t EventQueue::size() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return events_.size();
 }
 
 std::string recordLine(const EventDef& e, std::int64_t frame) {
