@@ -8,7 +8,8 @@
 // the server uses. Chromium runs in its own process group (killed as a group at the end).
 // Without /usr/bin/chromium (or $SPH2D_CHROMIUM) the test fails and says to install it
 // (./test.sh installs it through .ci/setup.sh). SPH2D_BROWSER_SCENE picks another scene and
-// SPH2D_BROWSER_SHOT copies the screenshot there (how docs/images/serve_page.png was made).
+// SPH2D_BROWSER_SHOT copies the screenshot there, SPH2D_BROWSER_SETTLE waits that many more
+// seconds before it (how docs/images/serve_page.png was made, README.md).
 #include <doctest/doctest.h>
 #include <fcntl.h>
 
@@ -56,7 +57,7 @@ struct Chromium {
       ::dup2(fd, 2);
       const std::string profile = "--user-data-dir=" + dir + "/profile";
       std::vector<std::string> args{exe, "--headless", "--no-sandbox", "--disable-gpu", "--disable-background-networking",
-                                    "--no-first-run", "--remote-debugging-port=0", "--window-size=1000,700",
+                                    "--no-first-run", "--remote-debugging-port=0", "--window-size=1000,760",
                                     "--disable-extensions", profile, "about:blank"};
       std::vector<char*> argv;
       for (auto& a : args) argv.push_back(a.data());
@@ -166,6 +167,8 @@ TEST_CASE("browser: headless Chromium shows the liquid, a mouse drag is recorded
     const auto v = cdp.eval("typeof meta !== 'undefined' && meta && received > 5 ? meta.frame : -1");
     return v.is_number() && v.get<int>() > 0;
   }));
+  // SPH2D_BROWSER_SETTLE: seconds more before the screenshot (for the documentation's picture).
+  if (const char* settle = std::getenv("SPH2D_BROWSER_SETTLE")) std::this_thread::sleep_for(std::chrono::duration<double>(std::atof(settle)));
   const auto rect = cdp.eval("JSON.stringify(view.getBoundingClientRect())");
   REQUIRE(rect.is_string());
   const auto r = nlohmann::json::parse(rect.get<std::string>());
