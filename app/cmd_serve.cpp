@@ -154,6 +154,9 @@ class ServeOutputs : public LoopObserver {
     record_.write(recordLine(t.event, frame));
     ++applied_;
     if (t.event.type == EventDef::Type::Effect) effects_[t.event.effect] = t.event.enabled;
+    // The frame rendered at a pause's boundary already says so (progress() comes after it).
+    if (t.event.type == EventDef::Type::Pause) paused_ = true;
+    if (t.event.type == EventDef::Type::Resume) paused_ = false;
     // A drag sends a force per frame: those are counted, not printed.
     if (!a_.quiet && t.event.type != EventDef::Type::Force) {
       std::printf("event at frame %lld: %s (%s)\n", static_cast<long long>(frame), describeEvent(t.event).c_str(),

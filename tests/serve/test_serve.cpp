@@ -188,7 +188,7 @@ TEST_CASE("serve: GET /snapshot.png decodes and POST /event with a drop raises t
   const auto r = s.post("{\"type\": \"drop\", \"center\": [2.5, 2.2], \"radius\": 0.15}");
   CHECK(r.status == 200);
   CHECK(waitFor([&] { return s.state().value("particles", std::size_t(0)) > n0; }));
-  CHECK(s.stop() == 130);
+  CHECK(s.stop(SIGINT) == 130);  // Ctrl-C
 }
 
 TEST_CASE("serve: SIGTERM ends it with exit 130 and a whole record that replays to the live frame and state hashes") {
