@@ -333,6 +333,9 @@ int cmdServe(const std::vector<std::string>& args) {
     EventRecord record(a.record);  // (re)started: the record replays the run since the last reset
     {
       std::lock_guard<std::mutex> lock(status.mutex);
+      status.state["frame"] = 0;
+      status.state["time"] = 0.0;
+      status.state["paused"] = false;
       status.state["particles"] = world.particleCount();
       status.state["solver"] = scene.solver.type;
       status.state["scene"] = scene.name;

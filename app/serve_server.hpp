@@ -81,6 +81,7 @@ class ServeServer {
   /// WebSocket clients connected now.
   int clients() const;
 
+  /// The sockets, threads and slots (serve_server.cpp).
   struct Impl;
 
  private:
