@@ -1,7 +1,8 @@
 // tests/serve/test_browser.cpp — `sph2d serve` in a real browser: Debian's headless Chromium,
 // driven through the DevTools protocol (a WebSocket to the page target, Boost.Beast), loads
 // the page, and the test checks that the screenshot shows the liquid, that a synthetic mouse
-// drag on the page reaches the record as `force` events, and that replaying the record with
+// drag on the page reaches the record as `force` events (a click as a drop, the left arrow as a
+// gravity tilt), and that replaying the record with
 // `sph2d run --input` gives the frame and state hashes of the live frames.
 //
 // Design: no Node, no Python packages: the DevTools client is ~60 lines over the same Beast
@@ -201,6 +202,18 @@ TEST_CASE("browser: headless Chromium shows the liquid, a mouse drag is recorded
     return t.find("\"type\":\"force\"") != std::string::npos && t.find("\"type\":\"release\"") != std::string::npos;
   }));
   CHECK(slurp(rec).find("\"source\":\"live\"") != std::string::npos);
+
+  // A click without a drag drops water; the left arrow tilts gravity.
+  const std::size_t before = s.state().value("particles", std::size_t(0));
+  cdp.mouse("mousePressed", cx + 0.6 * cw, cy + 0.3 * ch, 1);
+  cdp.mouse("mouseReleased", cx + 0.6 * cw, cy + 0.3 * ch, 0);
+  cdp.call("Input.dispatchKeyEvent", {{"type", "keyDown"}, {"key", "ArrowLeft"}, {"code", "ArrowLeft"}, {"windowsVirtualKeyCode", 37}});
+  cdp.call("Input.dispatchKeyEvent", {{"type", "keyUp"}, {"key", "ArrowLeft"}, {"code", "ArrowLeft"}, {"windowsVirtualKeyCode", 37}});
+  REQUIRE(waitFor([&] {
+    const std::string t = slurp(rec);
+    return t.find("\"type\":\"drop\"") != std::string::npos && t.find("\"type\":\"gravity\"") != std::string::npos;
+  }));
+  CHECK(waitFor([&] { return s.state().value("particles", std::size_t(0)) > before; }));
 
   // Live frames after the drag, as a client receives them, then the replay of the record.
   sc::WsClient c("127.0.0.1", s.port);
