@@ -270,7 +270,13 @@ TEST_CASE("serve: pause holds the frame, resume goes on, reset starts frame 0 an
 }
 
 TEST_CASE("serve: command-line errors name the option and what it allows") {
-  auto r = runSph2d("serve " + q(kScene) + " --port 70000");
+  auto r = runSph2d("serve --help");
+  CHECK(r.code == 0);
+  CHECK(r.out.find("--max-clients N") != std::string::npos);
+  r = runSph2d("serve");
+  CHECK(r.code == 2);
+  CHECK(r.out.find("serve needs a scene file") != std::string::npos);
+  r = runSph2d("serve " + q(kScene) + " --port 70000");
   CHECK(r.code == 2);
   CHECK(r.out.find("--port") != std::string::npos);
   r = runSph2d("serve " + q(kScene) + " --format gif");
