@@ -267,19 +267,22 @@ int cmdServe(const std::vector<std::string>& args) {
     // "reset" is the page's own message (not an event of the format: a replay cannot reset).
     const nlohmann::json j = nlohmann::json::parse(text, nullptr, false);
     if (!j.is_discarded() && j.is_object() && j.contains("type") && j["type"] == "reset") {
-      if (j.size() != 1) return "reset takes no other keys";
+      if (j.size() != 1) return where + ":" + std::to_string(n) + ": {\"type\": \"reset\"} takes no other keys; nothing reset";
       resetRequested.store(true);
       stopRequested.store(true);
       return "";
     }
     try {
-      TimedEvent t;
-      t.event = parseEvent(text, where, n, scene, EventStamp::Optional);
-      t.event.source = "live";
-      t.frame = eventFrame(t.event, scene.fps);
-      t.where = where;
+      TimedEvent t = parseLiveEvent(text, where, n, scene);
+      // A stamp would park the event in the schedule until its frame (unbounded for a
+      // client that sends far-future stamps): the network's events apply at the next boundary.
+      if (t.event.frame >= 0 || t.event.t >= 0)
+        return t.where + ": keys 'frame' and 't' are not allowed in events from the network (they apply at the next "
+                         "frame boundary); nothing applied";
+      const std::string at = t.where;
       if (!queue->push(std::move(t)))
-        return "too many events waiting for the next frame (256); this one was not applied";
+        return at + ": too many events waiting for the next frame (at most 256; while paused only pause and "
+                    "resume are taken); nothing applied";
       return "";
     } catch (const SceneError& e) {
       return std::string(e.what()) + " (not applied)";

@@ -68,6 +68,11 @@ TEST_CASE("serve: bad JSON, unknown event types and oversized messages get an er
   CHECK(r.value("error", "").find("over the limit of 16384 bytes") != std::string::npos);
   r = reply("[1, 2, 3]");
   CHECK(r.contains("error"));
+  // A stamp would keep the event waiting for its frame: the network's events apply at the next one.
+  r = reply("{\"type\": \"gravity\", \"tilt\": 0.1, \"frame\": 100000000}");
+  CHECK(r.value("error", "").find("'frame' and 't' are not allowed") != std::string::npos);
+  r = reply("{\"type\": \"gravity\", \"tilt\": 0.1, \"t\": 1e6}");
+  CHECK(r.value("error", "").find("'frame' and 't' are not allowed") != std::string::npos);
   // A valid one still works on the same connection.
   r = reply("{\"type\": \"gravity\", \"tilt\": 0.2}");
   CHECK(r.value("ok", false));
@@ -245,16 +250,43 @@ TEST_CASE("serve: pause holds the frame, resume goes on, reset starts frame 0 an
   const std::string rec = dir + "/rec.jsonl";
   Server s(kScene, {"--record", rec, "--threads", "1"}, dir + "/serve.log");
   REQUIRE_MESSAGE(s.port > 0, slurp(s.log));
+  sc::WsClient c("127.0.0.1", s.port);
+  REQUIRE(readFrames(c, 1).size() == 1);
   CHECK(s.post(R"({"type": "pause"})").status == 200);
-  REQUIRE(waitFor([&] { return s.state().value("paused", false); }));
-  std::this_thread::sleep_for(200ms);  // the pause's own frame is drawn just after the flag is set
-  const auto f0 = s.state().value("frame", std::int64_t(0));
+  // The frame drawn at the pause's boundary is the first that says paused, and the last drawn.
+  std::int64_t f0 = -1;
+  while (f0 < 0) {
+    auto m = c.read(60000ms);
+    REQUIRE(m);
+    if (m->frame && m->header.value("paused", false)) f0 = m->header["frame"].get<std::int64_t>();
+  }
   std::this_thread::sleep_for(500ms);
-  CHECK(s.state().value("frame", std::int64_t(0)) == f0);
+  nlohmann::json st = s.state();
+  CHECK(st.value("paused", false));
+  CHECK(st.value("frame", std::int64_t(-1)) == f0);
+
+  // While paused the other events wait in the bounded queue (256): more are refused, each
+  // with an error, and a resume still gets in.
+  int ok = 0, refused = 0;
+  for (int i = 0; i < 300; ++i) {
+    c.send(R"({"type": "gravity", "tilt": 0.01})");
+    auto r = c.readReply();
+    REQUIRE(r);
+    if (r->header.value("ok", false)) ++ok;
+    else if (r->header.value("error", "").find("too many events waiting") != std::string::npos) ++refused;
+  }
+  CHECK(ok == 256);
+  CHECK(refused == 44);
+  st = s.state();
+  CHECK(st.value("events_waiting", 0) == 256);
+  CHECK(st.value("frame", std::int64_t(-1)) == f0);
   CHECK(s.post(R"({"type": "resume"})").status == 200);
-  REQUIRE(waitFor([&] { return s.state().value("frame", std::int64_t(0)) > f0 + 10; }));
+  // The pause, the 256 waiting events and the resume: all applied and recorded.
+  REQUIRE(waitFor([&] { return s.state().value("applied", 0) == 258; }));
   REQUIRE(waitFor([&] { return s.state().value("frame", std::int64_t(0)) > f0 + 60; }));
-  CHECK(slurp(rec).find("\"type\":\"pause\"") != std::string::npos);
+  const std::string recText = slurp(rec);
+  CHECK(std::count(recText.begin(), recText.end(), '\n') == 258);
+  CHECK(recText.find("\"type\":\"pause\"") != std::string::npos);
 
   CHECK(s.post(R"({"type": "reset", "x": 1})").status == 400);
   CHECK(s.post(R"({"type": "reset"})").status == 200);
