@@ -255,6 +255,16 @@ int cmdServe(const std::vector<std::string>& args) {
     return 0;
   }
   const ServeArgs a = parseServeArgs(args);
+  // From here SIGINT/SIGTERM stop the loop (at once if it comes while starting): exit 130.
+  std::signal(SIGPIPE, SIG_IGN);  // a vanished client shows up as EPIPE, never as a kill
+  {
+    struct sigaction sa {};
+    sa.sa_handler = onServeSignal;
+    sigemptyset(&sa.sa_mask);
+    sa.sa_flags = SA_RESTART;
+    sigaction(SIGINT, &sa, nullptr);
+    sigaction(SIGTERM, &sa, nullptr);
+  }
   const SceneDef scene = loadScene(a.scene);
   checkMemory(scene, true, 0);
 
@@ -303,15 +313,6 @@ int cmdServe(const std::vector<std::string>& args) {
     server.start();
   } catch (const std::exception& e) {
     throw UsageError(std::string("--port/--bind: ") + e.what());
-  }
-  std::signal(SIGPIPE, SIG_IGN);  // a vanished client shows up as EPIPE, never as a kill
-  {
-    struct sigaction sa {};
-    sa.sa_handler = onServeSignal;
-    sigemptyset(&sa.sa_mask);
-    sa.sa_flags = SA_RESTART;
-    sigaction(SIGINT, &sa, nullptr);
-    sigaction(SIGTERM, &sa, nullptr);
   }
   const std::string host = a.server.bind.find(':') != std::string::npos ? "[" + a.server.bind + "]" : a.server.bind;
   std::printf("sph2d serve: http://%s:%d/ (scene %s, solver %s, %d×%d, %s frames; Ctrl-C stops)\n", host.c_str(),
