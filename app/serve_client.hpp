@@ -53,6 +53,7 @@ inline HttpResult httpRequest(const std::string& host, int port, http::verb meth
   beast::flat_buffer buf;
   http::response_parser<http::string_body> parser;
   parser.body_limit(64u << 20);
+  parser.skip(method == http::verb::head);  // a HEAD answer has headers only
   http::read(stream, buf, parser);
   HttpResult r;
   r.status = int(parser.get().result_int());

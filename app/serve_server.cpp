@@ -153,6 +153,7 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
       reply = err.empty() ? std::string("{\"ok\":true}") : errorJson(err);
     }
     buf_.consume(buf_.size());
+    if (buf_.capacity() > s_.cfg.maxEventBytes) buf_.shrink_to_fit();  // keep no oversized message's memory
     if (reply.rfind("{\"error\"", 0) == 0) s_.count(&ServeCounters::rejected);
     if (replies_.size() >= kMaxReplies) return close();  // it sends but never reads
     replies_.push_back(std::move(reply));
@@ -244,7 +245,13 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
       std::make_shared<WsSession>(stream_.release_socket(), s_)->run(std::move(req));
       return;
     }
-    send(handle(req, target), !req.keep_alive());
+    Response res = handle(req, target);
+    if (req.method() == http::verb::head) {  // GET's headers, without the body
+      const std::size_t n = res.body().size();
+      res.body().clear();
+      res.content_length(n);
+    }
+    send(std::move(res), !req.keep_alive());
   }
 
   Response make(http::status status, const char* type, std::string body) {

@@ -232,17 +232,7 @@ TEST_CASE("serve: SIGTERM ends it with exit 130 and a whole record that replays 
   }
   CHECK(n == 6);
 
-  const std::int64_t last = live.back()["frame"].get<std::int64_t>();
-  const auto r = runSph2d("run " + q(kScene) + " --input " + q(rec) + " --frames " + std::to_string(last + 1) +
-                          " --out " + q(dir + "/replay") + " --threads 2 --quiet");
-  REQUIRE_MESSAGE(r.code == 0, r.out);
-  const auto replay = manifestHashes(dir + "/replay/manifest.json");
-  for (const auto& f : live) {
-    const auto it = replay.find(f["frame"].get<std::int64_t>());
-    REQUIRE(it != replay.end());
-    CHECK(it->second.first == f["frame_hash"].get<std::string>());
-    CHECK(it->second.second == f["state_hash"].get<std::string>());
-  }
+  checkReplay(kScene, rec, live, dir);
 }
 
 TEST_CASE("serve: pause holds the frame, resume goes on, reset starts frame 0 and the record again") {
