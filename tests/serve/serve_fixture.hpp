@@ -20,6 +20,8 @@
 #include <thread>
 #include <vector>
 
+#include <doctest/doctest.h>
+
 #include "app/app_runner.hpp"
 #include "serve_client.hpp"
 #include "sph2d/render/png_io.hpp"
@@ -130,6 +132,25 @@ inline std::map<std::int64_t, std::pair<std::string, std::string>> manifestHashe
   const nlohmann::json m = nlohmann::json::parse(slurp(path));
   for (const auto& f : m.at("frames")) out[f.at("frame").get<std::int64_t>()] = {f.at("rgba_xxh64"), f.at("state_hash")};
   return out;
+}
+
+/// Replays `record` with `sph2d run SCENE --input RECORD` (into DIR/replay) up to the last of
+/// the `live` frames' headers and checks that each of them has the replay's frame and state hash.
+inline void checkReplay(const std::string& scene, const std::string& record, const std::vector<nlohmann::json>& live,
+                        const std::string& dir) {
+  REQUIRE(!live.empty());
+  const std::int64_t last = live.back()["frame"].get<std::int64_t>();
+  const auto r = apptest::runSph2d("run " + apptest::q(scene) + " --input " + apptest::q(record) + " --frames " +
+                                   std::to_string(last + 1) + " --out " + apptest::q(dir + "/replay") +
+                                   " --threads 2 --quiet");
+  REQUIRE_MESSAGE(r.code == 0, r.out);
+  const auto replay = manifestHashes(dir + "/replay/manifest.json");
+  for (const auto& f : live) {
+    const auto it = replay.find(f["frame"].get<std::int64_t>());
+    REQUIRE(it != replay.end());
+    CHECK(it->second.first == f["frame_hash"].get<std::string>());
+    CHECK(it->second.second == f["state_hash"].get<std::string>());
+  }
 }
 
 }  // namespace sph2d::servetest

@@ -21,8 +21,6 @@
 
 using namespace sph2d::servetest;
 using sph2d::apptest::asset;
-using sph2d::apptest::q;
-using sph2d::apptest::runSph2d;
 using sph2d::apptest::scratch;
 
 namespace {
@@ -224,15 +222,5 @@ TEST_CASE("browser: headless Chromium shows the liquid, a mouse drag is recorded
     if (m->frame) live.push_back(m->header);
   }
   CHECK(s.stop() == 130);
-  const std::int64_t last = live.back()["frame"].get<std::int64_t>();
-  const auto run = runSph2d("run " + q(scene) + " --input " + q(rec) + " --frames " + std::to_string(last + 1) +
-                            " --out " + q(dir + "/replay") + " --threads 2 --quiet");
-  REQUIRE_MESSAGE(run.code == 0, run.out);
-  const auto replay = manifestHashes(dir + "/replay/manifest.json");
-  for (const auto& f : live) {
-    const auto it = replay.find(f["frame"].get<std::int64_t>());
-    REQUIRE(it != replay.end());
-    CHECK(it->second.first == f["frame_hash"].get<std::string>());
-    CHECK(it->second.second == f["state_hash"].get<std::string>());
-  }
+  checkReplay(scene, rec, live, dir);
 }

@@ -152,8 +152,17 @@ TEST_CASE("serve: a client that never reads and one that vanishes mid-frame leav
   CHECK(increasing(after));
   CHECK(after.front()["seq"].get<std::uint64_t>() > before.back()["seq"].get<std::uint64_t>());
   CHECK(s.state().value("frame", std::int64_t(0)) > frameBefore + 100);
-  // A slot is free again once a client leaves.
+  // The never-reading client is dropped once a write to it stalls (10 s): `good`, still
+  // reading, is left alone once `filler` leaves too.
   filler.drop();
+  bool alone = false;
+  const auto until = std::chrono::steady_clock::now() + 120s;
+  while (!alone && std::chrono::steady_clock::now() < until) {
+    REQUIRE(readFrames(good, 1).size() == 1);
+    alone = s.state().value("clients", 0) == 1;
+  }
+  CHECK(alone);
+  // A slot is free again once a client leaves.
   CHECK(waitFor([&] {
     try {
       sc::WsClient again("127.0.0.1", s.port);
@@ -187,6 +196,19 @@ TEST_CASE("serve: GET /snapshot.png decodes and POST /event with a drop raises t
   const auto page = sc::httpRequest("127.0.0.1", s.port, sc::http::verb::get, "/");
   CHECK(page.status == 200);
   CHECK(page.body.find("new WebSocket") != std::string::npos);
+  // HEAD: GET's headers (its Content-Length) and no body.
+  {
+    boost::asio::io_context ioc;
+    boost::asio::ip::tcp::socket sock(ioc);
+    sock.connect({boost::asio::ip::make_address("127.0.0.1"), static_cast<unsigned short>(s.port)});
+    boost::asio::write(sock, boost::asio::buffer(std::string("HEAD / HTTP/1.1\r\nHost: 127.0.0.1\r\nConnection: close\r\n\r\n")));
+    std::string answer;
+    boost::system::error_code ec;
+    boost::asio::read(sock, boost::asio::dynamic_buffer(answer), ec);  // until the server closes
+    CHECK(answer.rfind("HTTP/1.1 200", 0) == 0);
+    CHECK(answer.find("Content-Length: " + std::to_string(page.body.size())) != std::string::npos);
+    CHECK(answer.size() == answer.find("\r\n\r\n") + 4);
+  }
 
   const std::size_t n0 = s.state().value("particles", std::size_t(0));
   CHECK(n0 == 1250);
