@@ -2,7 +2,9 @@
 # lacks (apt-get, sudo when not root) and build the Release tree in build/.
 # clang-14 + libclang-rt-14-dev: libFuzzer for the scene-loader fuzz smoke test
 # that ./test.sh runs through CTest (docs/STABILITY.md).
-SPH2D_PACKAGES="g++ cmake make pkg-config libbox2d-dev libosmesa6-dev libpng-dev libeigen3-dev doctest-dev nlohmann-json3-dev clang-14 libclang-rt-14-dev"
+# libboost-dev (Boost.Beast, header-only) + libturbojpeg0-dev: `sph2d serve`; chromium: its
+# browser test (tests/serve, label browser), which fails when chromium is missing.
+SPH2D_PACKAGES="g++ cmake make pkg-config libbox2d-dev libosmesa6-dev libpng-dev libeigen3-dev doctest-dev nlohmann-json3-dev clang-14 libclang-rt-14-dev libboost-dev libturbojpeg0-dev chromium"
 
 sph2d_install() {
   local missing=() p sudo=""

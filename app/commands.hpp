@@ -11,6 +11,10 @@ namespace sph2d::cli {
 
 /// `sph2d run` (cmd_run.cpp).
 int cmdRun(const std::vector<std::string>& args);
+/// `sph2d serve` (cmd_serve.cpp).
+int cmdServe(const std::vector<std::string>& args);
+/// `sph2d bench serve` (cmd_bench_serve.cpp).
+int cmdBenchServe(const std::vector<std::string>& args);
 /// `sph2d check` (cmd_check.cpp).
 int cmdCheck(const std::vector<std::string>& args);
 /// `sph2d render` (cmd_render.cpp).

@@ -11,6 +11,12 @@
 
 namespace sph2d::cli {
 
+namespace {
+bool pauseOrResume(const TimedEvent& t) {
+  return t.event.type == EventDef::Type::Pause || t.event.type == EventDef::Type::Resume;
+}
+}  // namespace
+
 EventIntake::EventIntake(const SceneDef& scene, WarnFn warn) : scene_(scene), warn_(std::move(warn)) {}
 
 void EventIntake::addScene() { schedule_.addScene(scene_); }
@@ -29,22 +35,20 @@ void EventIntake::openLive(int fd) { live_ = std::make_unique<LiveInput>(fd); }
 
 void EventIntake::closeLive() { live_.reset(); }
 
-bool EventIntake::liveOpen() const { return live_ && live_->open(); }
+bool EventIntake::liveOpen() const { return (live_ && live_->open()) || queue_; }
 
 std::vector<TimedEvent> EventIntake::takeScheduled(std::int64_t frame) { return schedule_.take(frame); }
 
-void EventIntake::pollLive() {
+void EventIntake::pollLive(bool pausesOnly) {
+  // While paused only pause and resume leave the queue: the others wait there, bounded.
+  if (queue_)
+    for (TimedEvent& t : pausesOnly ? queue_->takePauses() : queue_->take()) liveQueue_.push_back(std::move(t));
   if (!live_) return;
   for (const std::string& w : live_->takeWarnings()) warn_(w);
   for (auto& [lineNo, text] : live_->take()) {
     if (text.find_first_not_of(" \t\r") == std::string::npos) continue;
     try {
-      TimedEvent t;
-      t.event = parseEvent(text, "stdin", lineNo, scene_, EventStamp::Optional);
-      t.event.source = "live";
-      t.frame = eventFrame(t.event, scene_.fps);
-      t.where = "stdin:" + std::to_string(lineNo);
-      liveQueue_.push_back(std::move(t));
+      liveQueue_.push_back(parseLiveEvent(text, "stdin", lineNo, scene_));
     } catch (const SceneError& e) {
       warn_(std::string(e.what()) + " (line skipped)");
     }
@@ -52,7 +56,7 @@ void EventIntake::pollLive() {
 }
 
 std::vector<TimedEvent> EventIntake::takeLive(std::int64_t frame) {
-  pollLive();
+  pollLive(false);
   std::vector<TimedEvent> now, queued;
   queued.swap(liveQueue_);
   for (TimedEvent& t : queued) {
@@ -63,15 +67,51 @@ std::vector<TimedEvent> EventIntake::takeLive(std::int64_t frame) {
 }
 
 std::vector<TimedEvent> EventIntake::takeLivePauses(std::int64_t frame) {
-  pollLive();
+  pollLive(true);
   std::vector<TimedEvent> now, keep;
-  for (TimedEvent& t : liveQueue_) {
-    const auto type = t.event.type;
-    if ((type == EventDef::Type::Resume || type == EventDef::Type::Pause) && t.frame <= frame) now.push_back(std::move(t));
-    else keep.push_back(std::move(t));
-  }
+  for (TimedEvent& t : liveQueue_) (pauseOrResume(t) && t.frame <= frame ? now : keep).push_back(std::move(t));
   liveQueue_.swap(keep);
   return now;
+}
+
+bool EventQueue::push(TimedEvent e) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  const bool pause = pauseOrResume(e);
+  if (pause ? pauses_ >= capacity_ : events_.size() - pauses_ >= capacity_) return false;
+  events_.push_back(std::move(e));
+  pauses_ += pause;
+  return true;
+}
+
+std::vector<TimedEvent> EventQueue::take() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  std::vector<TimedEvent> out;
+  out.swap(events_);
+  pauses_ = 0;
+  return out;
+}
+
+std::vector<TimedEvent> EventQueue::takePauses() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  std::vector<TimedEvent> out, keep;
+  for (TimedEvent& t : events_) (pauseOrResume(t) ? out : keep).push_back(std::move(t));
+  events_.swap(keep);
+  pauses_ = 0;
+  return out;
+}
+
+std::size_t EventQueue::size() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return events_.size();
+}
+
+TimedEvent parseLiveEvent(const std::string& text, const std::string& name, int number, const SceneDef& scene) {
+  TimedEvent t;
+  t.event = parseEvent(text, name, number, scene, EventStamp::Optional);
+  t.event.source = "live";
+  t.frame = eventFrame(t.event, scene.fps);
+  t.where = name + ":" + std::to_string(number);
+  return t;
 }
 
 std::string recordLine(const EventDef& e, std::int64_t frame) {

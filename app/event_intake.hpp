@@ -2,19 +2,25 @@
 //
 //   scene timeline ─┐
 //   --input FILE ───┴─> EventSchedule (by frame) ─> takeScheduled(f) ─┐
-//   --input - ─────────> LiveInput ─> parsed here ─> takeLive(f) ─────┴─> GameLoop
+//   --input - ─────────> LiveInput ─> parsed here ─> takeLive(f) ─────┤
+//   sph2d serve ───────> EventQueue (parsed by the network threads) ───┴─> GameLoop
 //   applied events ────> EventRecord (--record FILE), recordLine() also for the manifest
 //
 // Design: the intake only collects and orders events; the game loop applies them
 // at frame boundaries. Live lines are parsed on the loop's thread when the loop
 // asks for them, so a bad line is reported (and skipped) between frames; a live
-// event stamped for a later frame joins the schedule. Events of one frame come in
+// event stamped for a later frame joins the schedule. Events from the network
+// (sph2d serve) are parsed on the network threads, so that a bad one is answered to
+// its client; they reach the loop through an EventQueue and are live events like
+// standard input's lines from then on (while the loop is paused only pause and resume
+// leave the queue, so it stays bounded). Events of one frame come in
 // the order: the timeline's, the events files' (command-line and line order), live.
 #pragma once
 
 #include <cstdint>
 #include <fstream>
 #include <memory>
+#include <mutex>
 #include <string>
 #include <vector>
 
@@ -23,7 +29,33 @@
 
 namespace sph2d::cli {
 
-/// The events of a run: the schedule known in advance and live standard input.
+/// Live events parsed on other threads (sph2d serve's network threads), waiting for the
+/// loop's next boundary. Bounded: a client that floods it is refused, not queued.
+class EventQueue {
+ public:
+  /// A queue that holds at most `capacity` events not taken yet, and besides them at most
+  /// `capacity` pause and resume events (so that a resume gets in while others fill it).
+  explicit EventQueue(std::size_t capacity = 256) : capacity_(capacity) {}
+  /// Adds `e`; false (nothing added) when `capacity` events of its kind (pause and resume,
+  /// or the others) wait already.
+  bool push(TimedEvent e);
+  /// Removes and returns every event waiting, in the order pushed.
+  std::vector<TimedEvent> take();
+  /// Removes and returns the pause and resume events waiting (in order); the others stay,
+  /// still counting against `capacity` (the loop takes only these while paused).
+  std::vector<TimedEvent> takePauses();
+  /// Events waiting.
+  std::size_t size() const;
+
+ private:
+  mutable std::mutex mutex_;
+  std::size_t capacity_;
+  std::size_t pauses_ = 0;  ///< pause and resume events in events_
+  std::vector<TimedEvent> events_;
+};
+
+/// The events of a run: the schedule known in advance and live input (standard input
+/// or an EventQueue).
 class EventIntake {
  public:
   /// Events for `scene` (which must outlive the intake); `warn` reports skipped lines.
@@ -39,6 +71,8 @@ class EventIntake {
   void openLive(int fd);
   /// Stops reading live events (joins the reader thread).
   void closeLive();
+  /// Takes live events from `queue` too (sph2d serve); live input is open while it is set.
+  void openQueue(std::shared_ptr<EventQueue> queue) { queue_ = std::move(queue); }
   /// True while live input is open or has lines not taken yet.
   bool liveOpen() const;
   /// Removes and returns the scheduled events due at or before `frame`, in order.
@@ -55,14 +89,21 @@ class EventIntake {
   std::size_t skippedSceneEvents() const { return skippedScene_; }
 
  private:
-  void pollLive();
+  void pollLive(bool pausesOnly);
   const SceneDef& scene_;
   WarnFn warn_;
   EventSchedule schedule_;
   std::size_t skippedScene_ = 0;  ///< events files' lines a record took from the timeline
   std::unique_ptr<LiveInput> live_;
+  std::shared_ptr<EventQueue> queue_;
   std::vector<TimedEvent> liveQueue_;  ///< parsed live events not taken yet
 };
+
+/// One live event (a line of `--input -`, a message from the network): parsed and checked
+/// by parseEvent with the stamp optional, as coming from `name` (its `number`th line or
+/// message), source "live", the frame it is due at, and `where` = "name:number". Throws
+/// SceneError naming the key and what is allowed.
+TimedEvent parseLiveEvent(const std::string& text, const std::string& name, int number, const SceneDef& scene);
 
 /// The line --record writes and the manifest lists for event `e` applied at `frame`:
 /// the event stamped with that frame (eventToJson, read back bit for bit).

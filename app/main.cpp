@@ -25,6 +25,8 @@ const char* kMainHelp =
     "  sph2d run SCENE.json [options]   simulate a scene and write PNG frames (a fixed-step game\n"
     "                                   loop: --realtime, --input events, --record)\n"
     "  sph2d info SCENE.json            print what a scene will simulate\n"
+    "  sph2d serve SCENE.json [options] play a scene in a browser: live frames over a WebSocket,\n"
+    "                                   input from the page (http://127.0.0.1:8080/)\n"
     "  sph2d check SCENE.json --against MANIFEST   rerun and compare frame hashes\n"
     "  sph2d render SCENE.json --particles FRAME.csv --out IMAGE.png   re-render exported particles\n"
     "  sph2d bench step [options]       step throughput (particle-steps per second)\n"
@@ -32,6 +34,7 @@ const char* kMainHelp =
     "  sph2d bench accuracy [options]   every solver against experiment and theory: error vs cost\n"
     "  sph2d bench effects [options]    milliseconds per substep with and without each effect\n"
     "  sph2d bench game [options]       the real-time end: the dam break per quality preset, beside LiquidFun\n"
+    "  sph2d bench serve --port P       frames/s and input-to-frame latency a running serve delivers\n"
     "  sph2d --help | COMMAND --help\n"
     "\n"
     "Exit codes: 0 ok, 1 runtime failure (check: frames differ), 2 bad input, 3 simulation stopped by the guard, 130 interrupted.\n";
@@ -51,9 +54,11 @@ int main(int argc, char** argv) {
     if (cmd == "run") return cmdRun(args);
     if (cmd == "info") return cmdInfo(args);
     if (cmd == "check") return cmdCheck(args);
+    if (cmd == "serve") return cmdServe(args);
     if (cmd == "render") return cmdRender(args);
     if (cmd == "bench") {
       if (!args.empty() && args[0] == "step") return cmdBenchStep(std::vector<std::string>(args.begin() + 1, args.end()));
+      if (!args.empty() && args[0] == "serve") return cmdBenchServe(std::vector<std::string>(args.begin() + 1, args.end()));
       if (!args.empty() && args[0] == "game") return cmdBenchGame(std::vector<std::string>(args.begin() + 1, args.end()));
       if (!args.empty() && args[0] == "effects")
         return cmdBenchEffects(std::vector<std::string>(args.begin() + 1, args.end()));
@@ -61,7 +66,7 @@ int main(int argc, char** argv) {
         return cmdBenchAccuracy(std::vector<std::string>(args.begin() + 1, args.end()));
       return cmdBench(args);
     }
-    throw UsageError("unknown command '" + cmd + "'; commands: run, info, check, render, bench (see sph2d --help)");
+    throw UsageError("unknown command '" + cmd + "'; commands: run, info, check, render, bench, serve (see sph2d --help)");
   } catch (const UsageError& e) {
     std::fprintf(stderr, "sph2d: %s\n", e.what());
     return 2;
