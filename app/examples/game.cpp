@@ -4,8 +4,8 @@
 // lives in that world (sph2d::World(scene, b2World&)). The player holds a hose, an
 // emitter that a scripted input sweeps along the top and switches on and off; the
 // water pours down the platforms into a bucket, where a kinematic paddle of the
-// game's stirs it, and the game counts what lands in it and what touches the
-// bumper (World::particlesTouching). Frames are drawn with sph2d::render and written
+// game's stirs it and a dynamic crate floats up as the bucket fills, and the game
+// counts what lands in it and what touches the bumper (World::forEachContact). Frames are drawn with sph2d::render and written
 // as PNG files.
 //
 // Usage: sph2d_example_game [OUT_DIR] [FRAMES]   (default out/example_game, 150)
@@ -58,6 +58,18 @@ b2Body* buildPaddle(b2World& level) {
   return paddle;
 }
 
+// A wooden crate (density 400 kg/m²) dropped into the bucket: the water lifts it.
+b2Body* buildCrate(b2World& level) {
+  b2BodyDef def;
+  def.type = b2_dynamicBody;
+  def.position.Set(3.3f, 0.3f);
+  b2Body* crate = level.CreateBody(&def);
+  b2PolygonShape box;
+  box.SetAsBox(0.12f, 0.08f);
+  crate->CreateFixture(&box, 400.0f);
+  return crate;
+}
+
 // The player, scripted: where the hose is at time t, and whether it sprays.
 struct PlayerInput {
   double x;
@@ -76,6 +88,7 @@ int main(int argc, char** argv) {
   b2World level(b2Vec2(0.0f, -9.81f));
   buildLevel(level);
   b2Body* paddle = buildPaddle(level);
+  const b2Body* crate = buildCrate(level);
 
   // 2. The fluid's settings, in code: no boundaries (the level is the game's), one hose.
   sph2d::SceneDef scene;
@@ -130,8 +143,9 @@ int main(int argc, char** argv) {
         fluid.forEachContact([&](const b2Fixture& fx, const std::vector<std::uint32_t>& ids) {
           if (fx.GetShape()->GetType() == b2Shape::e_circle) onBumper = ids.size();
         });
-        std::printf("t = %.1f s: %zu particles, %zu in the bucket, density at its bottom %.0f kg/m3, %zu on the bumper\n",
-                    fluid.time(), fluid.particleCount(), inBucket, probe.density, onBumper);
+        std::printf("t = %.1f s: %zu particles, %zu in the bucket, density at its bottom %.0f kg/m3, %zu on the bumper, "
+                    "the crate at %.2f m\n",
+                    fluid.time(), fluid.particleCount(), inBucket, probe.density, onBumper, crate->GetPosition().y);
       }
     }
     writer.finish();

@@ -356,3 +356,23 @@ TEST_CASE("moving bodies: a floating crate gives the same bits on 1, 2 and 3 thr
     CHECK_MESSAGE((pose.x == pose0.x && pose.y == pose0.y), "threads " << threads);
   }
 }
+
+TEST_CASE("assets/scenes/floating_crates.json: the light crates float, the heavy one sinks, the paddle pushes the water") {
+  World w(test::scene("floating_crates.json"), WorldOptions{2});
+  std::vector<const b2Body*> dyn;  // scene order: box 500, circle 300, box 800, box 2500
+  for (const b2Body* b = w.box2d().GetBodyList(); b; b = b->GetNext())
+    if (b->GetType() == b2_dynamicBody) dyn.insert(dyn.begin(), b);  // Box2D lists the newest first
+  REQUIRE(dyn.size() == 4);
+  std::size_t entered = 0;
+  for (int f = 0; f < 150; ++f) {
+    w.stepFrame();
+    entered = std::max(entered, insideMoving(w));
+  }
+  for (const b2Body* b : dyn) MESSAGE("crate at (" << b->GetPosition().x << ", " << b->GetPosition().y << ")");
+  CHECK(entered == 0);
+  CHECK(test::outside(w, 0, 0, 4, 2.2) == 0);
+  CHECK(dyn[0]->GetPosition().y > 0.5);  // density 500 and 300: on the surface (0.6 m of water)
+  CHECK(dyn[1]->GetPosition().y > 0.5);
+  CHECK(dyn[3]->GetPosition().y < 0.15);  // density 2500: on the floor
+  CHECK(test::meanSpeed(w) > 0.05);       // the paddle keeps the water moving
+}
