@@ -228,6 +228,7 @@ void World::Impl::collideMoving(StepContext& c) {
   struct Pose {
     double theta0, theta1, c0, s0, c1, s1;  // the rotations at the substep's start and end
     Vec2d o0, o1, com1;
+    double reach2;  // beyond this from com1, a particle's whole path misses the body (squared)
   };
   const std::vector<MovingSolid>& bodies = moving.bodies;
   std::vector<Pose> poses(bodies.size());
@@ -238,6 +239,12 @@ void World::Impl::collideMoving(StepContext& c) {
     bodies[k].pose(tau1, q.theta1, q.o1);
     q.com1 = bodies[k].centreAt(tau1);
     q.c0 = std::cos(q.theta0), q.s0 = std::sin(q.theta0), q.c1 = std::cos(q.theta1), q.s1 = std::sin(q.theta1);
+    // The shapes' reach, plus how far any of the body's points moved over the substep.
+    const Vec2d& lc = bodies[k].localCenter;
+    const Vec2d com0 = q.o0 + Vec2d(q.c0 * lc.x() - q.s0 * lc.y(), q.s0 * lc.x() + q.c0 * lc.y());
+    const double reach = bodies[k].radius + double(c.clearance) + (q.com1 - com0).norm() +
+                         std::fabs(q.theta1 - q.theta0) * bodies[k].radius;
+    q.reach2 = reach * reach;
   }
   const bool anyDynamic = moving.anyDynamic();
   if (anyDynamic) {
@@ -251,8 +258,13 @@ void World::Impl::collideMoving(StepContext& c) {
       for (std::size_t k = 0; k < bodies.size(); ++k) {
         const MovingSolid& m = bodies[k];
         const Pose& q = poses[k];
-        const Vec2d xw(c.P.x[i].x(), c.P.x[i].y());
-        const Vec2d a = toBody(q.c0, q.s0, Vec2d(c.P.xPrev[i].x(), c.P.xPrev[i].y()) - q.o0);
+        const Vec2d xw(c.P.x[i].x(), c.P.x[i].y()), xp(c.P.xPrev[i].x(), c.P.xPrev[i].y());
+        {  // a first cull in the local frame: the path from xp to xw against the swept reach
+          const Vec2d d = xw - xp, e = q.com1 - xp;
+          const double l2 = d.squaredNorm(), u = l2 > 0 ? std::clamp(e.dot(d) / l2, 0.0, 1.0) : 0.0;
+          if ((xp + u * d - q.com1).squaredNorm() > q.reach2) continue;
+        }
+        const Vec2d a = toBody(q.c0, q.s0, xp - q.o0);
         Vec2d b = toBody(q.c1, q.s1, xw - q.o1);
         // Beyond reach: the path from a to b passes farther than the shapes reach.
         const Vec2d ab = b - a, ac = m.localCenter - a;
