@@ -31,7 +31,7 @@ namespace {
 
 constexpr char kMagic[8] = {'S', 'P', 'H', '2', 'D', 'S', 'A', 'V'};
 constexpr std::uint64_t kMaxEmitters = World::Impl::kMaxEmitters;  // a save holding more is not one of ours
-constexpr std::uint32_t kVersion = 2;  // 2: every emitter's whole definition (emitters added at run time)
+constexpr std::uint32_t kVersion = 3;  // 2: every emitter's whole definition (emitters added at run time); 3: bodies' swept poses
 constexpr std::size_t kMaxFields = 64, kMaxName = 128;
 constexpr const char* kUserForce = "user_force";  ///< the effect setUserForces adds
 
@@ -129,6 +129,14 @@ void World::save(std::ostream& out) const {
       o.put(b->GetAngle());
       o.put(b->GetLinearVelocity());
       o.put(b->GetAngularVelocity());
+      // The pose the particles last saw a dynamic body at (moving_solid.hpp), if any.
+      const MovingSolids::LastPose* last = nullptr;
+      for (const MovingSolids::LastPose& l : w.moving.last)
+        if (l.body == b) last = &l;
+      o.put(std::uint8_t(last != nullptr));
+      o.put(last ? last->theta : 0.0);
+      o.put(last ? last->origin.x() : 0.0);
+      o.put(last ? last->origin.y() : 0.0);
     }
   w.solver->saveState(o);
   out.write(reinterpret_cast<const char*>(o.bytes.data()), std::streamsize(o.bytes.size()));
@@ -248,6 +256,8 @@ void World::load(std::istream& input) {
   struct BodyState {
     b2Vec2 p, v;
     float angle, omega;
+    std::uint8_t hasLast;
+    double lastTheta, lastX, lastY;
   };
   std::vector<BodyState> bodyStates(movable.size());
   for (BodyState& b : bodyStates) {
@@ -255,7 +265,12 @@ void World::load(std::istream& input) {
     b.angle = in.get<float>("a body");
     b.v = in.get<b2Vec2>("a body");
     b.omega = in.get<float>("a body");
-    if (!b.p.IsValid() || !b.v.IsValid() || !std::isfinite(b.angle) || !std::isfinite(b.omega))
+    b.hasLast = in.get<std::uint8_t>("a body");
+    b.lastTheta = in.get<double>("a body");
+    b.lastX = in.get<double>("a body");
+    b.lastY = in.get<double>("a body");
+    if (!b.p.IsValid() || !b.v.IsValid() || !std::isfinite(b.angle) || !std::isfinite(b.omega) || b.hasLast > 1 ||
+        !std::isfinite(b.lastTheta) || !std::isfinite(b.lastX) || !std::isfinite(b.lastY))
       throw SaveError("the saved state is malformed: a body's pose or velocity is not finite");
   }
   // The solver's state is the stream's tail. Its own loadState reads all before it assigns;
@@ -296,6 +311,10 @@ void World::load(std::istream& input) {
     movable[k]->SetLinearVelocity(bodyStates[k].v);
     movable[k]->SetAngularVelocity(bodyStates[k].omega);
   }
+  w.moving.last.clear();  // the loaded state's, not those of the World's own last step
+  for (std::size_t k = 0; k < movable.size(); ++k)
+    if (bodyStates[k].hasLast)
+      w.moving.last.push_back({movable[k], bodyStates[k].lastTheta, Vec2d(bodyStates[k].lastX, bodyStates[k].lastY)});
   w.time = time;
   w.frames = frames;
   w.steps = steps;

@@ -7,6 +7,7 @@
 
 #include <cmath>
 #include <map>
+#include <sstream>
 
 #include "support/fixture.hpp"
 
@@ -375,4 +376,24 @@ TEST_CASE("assets/scenes/floating_crates.json: the light crates float, the heavy
   CHECK(dyn[1]->GetPosition().y > 0.5);
   CHECK(dyn[3]->GetPosition().y < 0.15);  // density 2500: on the floor
   CHECK(test::meanSpeed(w) > 0.05);       // the paddle keeps the water moving
+}
+
+TEST_CASE("moving bodies: save, load and step a floating crate: the same state hashes and crate as the World not interrupted") {
+  SceneDef s = crateScene("game", 500, 0.62);
+  s.solver.spacing = 0.02;
+  World a(s, WorldOptions{2});
+  for (int f = 0; f < 20; ++f) a.stepFrame();  // the crate falls in and bobs
+  std::ostringstream out;
+  a.save(out);
+  World b(s, WorldOptions{1});
+  std::istringstream in(out.str());
+  b.load(in);
+  CHECK(b.stateHash() == a.stateHash());
+  for (int f = 0; f < 15; ++f) {
+    a.stepFrame();
+    b.stepFrame();
+    REQUIRE_MESSAGE(b.stateHash() == a.stateHash(), "frame " << f << " after the load");
+    const b2Vec2 pa = dynamicBody(a)->GetPosition(), pb = dynamicBody(b)->GetPosition();
+    REQUIRE_MESSAGE((pa.x == pb.x && pa.y == pb.y), "frame " << f << " after the load");
+  }
 }
