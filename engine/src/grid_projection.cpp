@@ -164,10 +164,26 @@ void GridProjection::markBodies(const StepContext& c) {
     // reach (the grid may hold only part of it): a cell is the body's when its centre lies
     // at least half a cell inside, so the fluid cells around have their centres (where
     // the pressure is) on its surface.
-    const long bI0 = long(std::floor((st.centre.x() - m.radius) / h - 0.5)) - 1;
-    const long bJ0 = long(std::floor((st.centre.y() - m.radius) / h - 0.5)) - 1;
-    const long bn = long(std::ceil((st.centre.x() + m.radius) / h - 0.5)) + 2 - bI0;
-    const long bm = long(std::ceil((st.centre.y() + m.radius) / h - 0.5)) + 2 - bJ0;
+    // Beyond the grid: no cell of it (a far body costs nothing).
+    if (st.centre.x() + m.radius < double(I0_) * h || st.centre.x() - m.radius > double(I0_ + nx_) * h ||
+        st.centre.y() + m.radius < double(J0_) * h || st.centre.y() - m.radius > double(J0_ + ny_) * h) {
+      bodies_.push_back(st);
+      continue;
+    }
+    long bI0 = long(std::floor((st.centre.x() - m.radius) / h - 0.5)) - 1;
+    long bJ0 = long(std::floor((st.centre.y() - m.radius) / h - 0.5)) - 1;
+    long bn = long(std::ceil((st.centre.x() + m.radius) / h - 0.5)) + 2 - bI0;
+    long bm = long(std::ceil((st.centre.y() + m.radius) / h - 0.5)) + 2 - bJ0;
+    // The face correction needs the whole body; one too large to scan every substep is
+    // scanned over the grid only, T left the identity.
+    const bool whole = double(bn) * double(bm) <= std::max(double(1 << 20), 4.0 * double(type_.size()));
+    if (!whole) {
+      const long cI0 = std::max(bI0, I0_ - 1), cJ0 = std::max(bJ0, J0_ - 1);
+      bn = std::min(bI0 + bn, I0_ + nx_ + 1) - cI0;
+      bm = std::min(bJ0 + bm, J0_ + ny_ + 1) - cJ0;
+      bI0 = cI0;
+      bJ0 = cJ0;
+    }
     in.assign(std::size_t(bn * bm), 0);
     for (long J = 1; J + 1 < bm; ++J)
       for (long I = 1; I + 1 < bn; ++I) {
@@ -191,10 +207,10 @@ void GridProjection::markBodies(const StepContext& c) {
       }
     // The faces' moments: for a pressure κ linear in x, the faces' impulse Σ κ(x_c) h g
     // (x_c the fluid cell's centre across the face) is K·∇κ with K = Σ h g x_cᵀ (3 × 2);
-    // the body's own surface gives (−A·I, 0) (A its area; no torque about its centre of
-    // mass, taken as its centroid). The faces miss that by about a cell along each side:
-    // T = [C 0; τᵀ 1] with C K_F = −A I and τᵀ K_F + k_θᵀ = 0 corrects every face's g
-    // (and the flux it carries), so a body floats by Archimedes at any cell size.
+    // the body's own surface gives (−A·I, t*ᵀ) (A its area, t* the torque below). The faces
+    // miss that by about a cell along each side: T = [C 0; τᵀ 1] with C K_F = −A I and
+    // τᵀ K_F + k_θᵀ = t*ᵀ corrects every face's g (and the flux it carries), so a body
+    // floats by Archimedes at any cell size.
     double KF[2][2] = {{0, 0}, {0, 0}}, kt[2] = {0, 0};
     const long di[4] = {-1, 1, 0, 0}, dj[4] = {0, 0, -1, 1};
     for (long J = 1; J + 1 < bm; ++J)
@@ -213,13 +229,19 @@ void GridProjection::markBodies(const StepContext& c) {
           }
         }
       }
+    // The true torque of a linear κ about the centre of mass: A (c_y ∂x κ − c_x ∂y κ), c the
+    // centroid's offset (zero for a uniform body; a heavy keel puts it above: the righting
+    // moment).
+    const double th = m.angleAt(tau), cs = std::cos(th), sn = std::sin(th);
+    const Vec2d cw(cs * m.centroid.x() - sn * m.centroid.y(), sn * m.centroid.x() + cs * m.centroid.y());
+    const double tstar[2] = {m.area * cw.y(), -m.area * cw.x()};
     const double det = KF[0][0] * KF[1][1] - KF[0][1] * KF[1][0];
-    if (std::fabs(det) > 1e-30) {
+    if (whole && std::fabs(det) > 1e-30) {
       const double inv[2][2] = {{KF[1][1] / det, -KF[0][1] / det}, {-KF[1][0] / det, KF[0][0] / det}};
       for (int r = 0; r < 2; ++r)
         for (int q = 0; q < 2; ++q) {
           st.T[r][q] = -m.area * inv[r][q];
-          st.T[2][q] -= kt[r] * inv[r][q];
+          st.T[2][q] += (tstar[r] - kt[r]) * inv[r][q];
         }
     }
     bodies_.push_back(st);

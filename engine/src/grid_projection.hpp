@@ -7,14 +7,20 @@
 // column's long (hydrostatic) mode needs ~(depth/dx)² Jacobi iterations. On a
 // MAC grid of cells a few spacings wide that mode is a small linear system:
 // the particles' velocities go to the grid faces (bilinear weights), cells
-// are solid (inside a collider), fluid (enough particle weight) or air; a
+// are solid (inside a collider), a moving body's (at least half a cell inside
+// a kinematic or dynamic Box2D body), fluid (enough particle weight) or air; a
 // Poisson equation for κ = p/ρ0 makes the grid velocity divergence-free and
 // removes the cells' mean compression over one substep; the change of the
 // face velocities goes back to the particles (a FLIP increment, so nothing is
-// smoothed away). Walls are closed faces (no-through-flow, free slip), air
-// cells hold κ = 0. The pressure acts through a smooth interpolated field,
-// so it adds no stiffness to the particle arrangement (unlike SPH pressure
-// sums under a large uniform pressure).
+// smoothed away). Walls are closed faces (no-through-flow, free slip); a
+// moving body's faces carry its velocity, and a dynamic body's velocity is
+// solved with κ (Batty, Bertails & Bridson 2007, "A fast variational framework
+// for accurate solid-fluid coupling", SIGGRAPH, on voxels, each body's faces
+// corrected to its true area). The free surface is κ = 0 at the air cells'
+// centres, or (`grid_surface`) half a spacing above the highest particle, a
+// ghost-fluid boundary (Gibou, Fedkiw, Cheng & Kang 2002, JCP). The pressure
+// acts through a smooth interpolated field, so it adds no stiffness to the
+// particle arrangement (unlike SPH pressure sums under a large uniform pressure).
 //
 // The compression shift (Kugelstadt, Longva, Thuerey & Bender 2019, "Implicit
 // density projection for volume conserving liquids", IEEE TVCG): the same
@@ -86,9 +92,11 @@ class GridProjection {
     std::vector<Real> r, z, d, q, y;
   };
   int pcg(std::vector<Real>& x, const std::vector<Real>& b, Real tol, Real& res, CgWork& w, bool coupled) const;
-  /// Marks the cells whose centre lies inside a moving body (kBody), static solids excepted.
+  /// Marks the cells whose centre lies at least half a cell inside a moving body (kBody),
+  /// static solids excepted; makes a cell its centre covers less deeply fluid when it holds
+  /// any particle weight; computes each body's face correction T (bodies_).
   void markBodies(const StepContext& c);
-  /// The coupling rows G (one per fluid cell next to a dynamic body's cells).
+  /// The coupling rows G: one per (fluid cell, dynamic body) pair whose faces touch.
   void assembleCoupling();
   /// The velocity along +x (axis 0, u face) or +y (axis 1, v face) that a moving body's
   /// cell imposes on face (i, j): g·(v, ω) with the face's corrected coupling g.

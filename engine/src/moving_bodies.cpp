@@ -6,20 +6,22 @@
 // At the start of each step the World reads every non-static body's pose, velocity,
 // mass and inertia (moving_solid.hpp: a body moves along a piecewise-linear path
 // within the step). Per substep:
-//  - `body_gravity` (first, with a dynamic body): its velocity takes g·dt;
+//  - `body_gravity` (after `emit`, with a dynamic body): its velocity takes g·dt;
 //  - the game solver's grid projection treats the bodies as moving solids and solves
 //    for a dynamic body's velocity together with the pressure (grid_projection.cpp);
-//  - `bodies` (after the static collision): a particle that ends the substep inside a
-//    body's polygon or circle (or within the clearance of it) is put back on the
-//    surface, through the face it came in by (its start position taken in the body's
-//    frame at the substep's start, its end in the frame at the substep's end, so a
-//    body's own motion counts). Against a kinematic body the part of its velocity into
+//  - `bodies` (after the static collision): a particle whose path entered one of a body's
+//    polygons or circles is stopped at the face it entered by (shape by shape, each on
+//    the path the shapes before left), one that started inside or ends within the
+//    clearance is put back on the surface (its start position taken in the body's frame
+//    at the substep's start, its end in the frame at the substep's end, so a body's own
+//    motion counts). Against a kinematic body the part of its velocity into
 //    the body, relative to the body's velocity there, is removed. Against a dynamic
 //    body the two meet as an inelastic contact: the particle (mass m) and the body
 //    (effective mass 1/M_eff = 1/M + (r × n)²/I at the contact) share the relative
 //    normal velocity v_n, the N contacts of the body in the substep splitting its mass
 //    (impulse j = −v_n / (1/m + N/M_eff)): a light body meeting much water takes most
-//    of the change, the water little, and no contact can overshoot. The body takes −j
+//    of the change, the water little, and like contacts together cannot overshoot the
+//    shared velocity (with rotation or mixed normals only nearly). The body takes −j
 //    (and its torque) at the substep's end; the step's sum goes to Box2D, which then
 //    moves the body.
 // Positions are pushed out in parallel (each particle alone); the contacts' impulses
@@ -126,6 +128,61 @@ int solidAt(const MovingSolids& s, double tau, const Vec2d& p) {
   return -1;
 }
 
+namespace {
+
+/// A moving body's area and centroid (body coordinates, offset from its centre of mass):
+/// exact for one shape; for several, which may overlap, their union sampled on a 96 × 96
+/// lattice over their bounds (the grid's face correction scales the pressure to this area).
+void shapeMoments(MovingSolid& m) {
+  Vec2d sum(0, 0);
+  if (m.shapes.size() == 1) {
+    const Collider& c = m.shapes[0];
+    if (c.kind == Collider::Kind::Circle) {
+      m.area = 3.14159265358979323846 * double(c.radius) * double(c.radius);
+      sum = m.area * Vec2d(c.center.x(), c.center.y());
+    } else {
+      for (std::size_t e = 0; e < c.vertices.size(); ++e) {  // counter-clockwise (Box2D)
+        const Vec2d p(c.vertices[e].x(), c.vertices[e].y());
+        const Vec2d q(c.vertices[(e + 1) % c.vertices.size()].x(), c.vertices[(e + 1) % c.vertices.size()].y());
+        const double cross = p.x() * q.y() - q.x() * p.y();
+        m.area += 0.5 * cross;
+        sum += cross / 6.0 * (p + q);
+      }
+    }
+  } else {
+    Vec2d lo(1e300, 1e300), hi(-1e300, -1e300);
+    for (const Collider& c : m.shapes) {
+      const double r = c.kind == Collider::Kind::Circle ? double(c.radius) : 0.0;
+      if (c.kind == Collider::Kind::Circle) {
+        lo = lo.cwiseMin(Vec2d(c.center.x() - r, c.center.y() - r));
+        hi = hi.cwiseMax(Vec2d(c.center.x() + r, c.center.y() + r));
+      }
+      for (const Vec2& p : c.vertices) {
+        lo = lo.cwiseMin(Vec2d(p.x(), p.y()));
+        hi = hi.cwiseMax(Vec2d(p.x(), p.y()));
+      }
+    }
+    constexpr int kSamples = 96;
+    const Vec2d step = (hi - lo) / double(kSamples);
+    const double cell = step.x() * step.y();
+    for (int j = 0; j < kSamples; ++j)
+      for (int i = 0; i < kSamples; ++i) {
+        const Vec2d p = lo + Vec2d((i + 0.5) * step.x(), (j + 0.5) * step.y());
+        for (const Collider& c : m.shapes) {
+          Vec2d n;
+          if (outsideCollider(c, p, p, n) < 0) {
+            m.area += cell;
+            sum += cell * p;
+            break;
+          }
+        }
+      }
+  }
+  m.centroid = m.area > 0 ? Vec2d(sum / m.area - m.localCenter) : Vec2d(0, 0);
+}
+
+}  // namespace
+
 void World::Impl::captureBodies() {
   const bool had = !moving.bodies.empty(), hadDynamic = moving.anyDynamic();
   moving.bodies.clear();
@@ -172,17 +229,11 @@ void World::Impl::captureBodies() {
       m.gravity = Vec2d(g.x, g.y) * double(body->GetGravityScale());
     }
     for (const Collider& c : m.shapes) {
-      if (c.kind == Collider::Kind::Circle) {
+      if (c.kind == Collider::Kind::Circle)
         m.radius = std::max(m.radius, (Vec2d(c.center.x(), c.center.y()) - m.localCenter).norm() + double(c.radius));
-        m.area += 3.14159265358979323846 * double(c.radius) * double(c.radius);
-      }
-      for (std::size_t e = 0; e < c.vertices.size(); ++e) {
-        const Vec2& p = c.vertices[e];
-        const Vec2& q = c.vertices[(e + 1) % c.vertices.size()];
-        m.radius = std::max(m.radius, (Vec2d(p.x(), p.y()) - m.localCenter).norm());
-        m.area += 0.5 * (double(p.x()) * double(q.y()) - double(q.x()) * double(p.y()));  // counter-clockwise (Box2D)
-      }
+      for (const Vec2& p : c.vertices) m.radius = std::max(m.radius, (Vec2d(p.x(), p.y()) - m.localCenter).norm());
     }
+    shapeMoments(m);
     double theta;
     m.pose(0, theta, m.sweptOrigin);
     m.sweptTheta = theta;
@@ -279,8 +330,9 @@ void World::Impl::collideMoving(StepContext& c) {
           double te;
           if (sweptEntry(s, a, b, te, n)) {
             // It entered on the way (and may have crossed it: a fast particle, a thin body):
-            // stopped at the face it entered by, the clearance off it.
-            b = a + te * ab + clearance * n;
+            // stopped at the face it entered by, the clearance off it. The path is the one
+            // left by the shapes before (b moves).
+            b = a + te * (b - a) + clearance * n;
           } else {
             // It started inside, or ends within the clearance outside: back on the surface.
             const double d = outsideCollider(s, a, b, n);

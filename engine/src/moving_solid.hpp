@@ -36,7 +36,8 @@ struct MovingSolid {
   Vec2d drift{0, 0};             ///< position offset that keeps the path continuous across velocity changes
   double turn = 0;               ///< angle offset, likewise
   double radius = 0;             ///< the shapes' reach from the centre of mass [m]
-  double area = 0;               ///< the shapes' area [m²] (overlaps counted twice)
+  double area = 0;               ///< the area of its shapes' union [m²]
+  Vec2d centroid{0, 0};          ///< the union's centroid, body coordinates from the centre of mass
   double invMass = 0;            ///< 1/mass: 0 for a kinematic body (the fluid does not move it)
   double invInertia = 0;         ///< 1/(rotational inertia about the centre of mass), 0 when it cannot turn
   Vec2d gravity{0, 0};           ///< the b2World's gravity times the body's gravity scale (dynamic only)

@@ -325,6 +325,7 @@ void World::load(std::istream& input) {
   w.iterations = iterations;
   w.removed = removed;
   w.scene.gravity = gravity;
+  if (w.ownWorld) w.ownWorld->SetGravity(b2Vec2(float(gravity.x()), float(gravity.y())));
   w.emitters = std::move(emitters);
   // The user-force effect exactly when the saved World had it (setUserForces adds it on the
   // first non-empty list); then the scene's effects as they were switched.

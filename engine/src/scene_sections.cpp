@@ -62,7 +62,7 @@ ShapeDef readFixture(const Reader& r, const json& j, const std::string& path) {
   }
   s.friction = r.number(j, path, "friction", s.friction, 0, 10);
   s.restitution = r.number(j, path, "restitution", s.restitution, 0, 1);
-  s.density = r.number(j, path, "density", s.density, 0, 1e6, true);
+  s.density = r.number(j, path, "density", s.density, 1, 1e6);  // below 1 kg/m² the coupled grid solve is ill-conditioned
   return s;
 }
 

@@ -199,7 +199,11 @@ void World::step(double dt) {
   ++impl_->frames;
 }
 
-void World::setGravity(const Vec2d& g) { impl_->scene.gravity = g; }
+void World::setGravity(const Vec2d& g) {
+  impl_->scene.gravity = g;
+  // The scene's own b2World falls the same way (its dynamic bodies); a game sets its own.
+  if (impl_->ownWorld) impl_->ownWorld->SetGravity(b2Vec2(float(g.x()), float(g.y())));
+}
 
 std::size_t World::addBlock(const FluidBlockDef& block) { return impl_->fillBlock(block, false); }
 

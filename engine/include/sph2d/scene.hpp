@@ -55,8 +55,8 @@ struct BodyDef {
   Type type = Type::Static;
   Vec2d position{0, 0};          ///< body origin in world coordinates [m]
   double angle = 0;              ///< body rotation [rad]
-  Vec2d velocity{0, 0};          ///< kinematic: velocity; dynamic: initial velocity of its origin [m/s]
-  double angularVelocity = 0;    ///< kinematic: [rad/s], about `position` (Box2D turns a kinematic body about its origin); dynamic: initial
+  Vec2d velocity{0, 0};          ///< kinematic: velocity; dynamic: initial velocity of its centre of mass [m/s]
+  double angularVelocity = 0;    ///< kinematic: [rad/s], about `position` (Box2D turns a kinematic body about its origin); dynamic: initial, about its centre of mass
   std::vector<ShapeDef> fixtures;
 };
 

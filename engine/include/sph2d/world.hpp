@@ -162,7 +162,8 @@ class World {
   /// Messages the world wants the user to see (substep cap hits, dropped particles); cleared on read.
   std::vector<std::string> takeWarnings();
 
-  /// Sets gravity [m/s²] from the next substep on (tilting the tank).
+  /// Sets gravity [m/s²] from the next substep on (tilting the tank); the scene's own b2World
+  /// takes it too (its dynamic bodies fall the same way). A game sets its own b2World's.
   void setGravity(const Vec2d& g);
   /// Adds a block of fluid on the lattice of the scene's spacing (particles
   /// inside solids are skipped), row by row from the bottom, until the world holds
