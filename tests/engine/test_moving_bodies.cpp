@@ -365,7 +365,7 @@ TEST_CASE("moving bodies: a floating crate gives the same bits on 1, 2 and 3 thr
   }
 }
 
-TEST_CASE("assets/scenes/floating_crates.json: the light crates float, the heavy one sinks, the paddle pushes the water") {
+TEST_CASE("assets/scenes/floating_crates.json: the light crates float, the heavy one sinks, the turning bar stirs the water") {
   World w(test::scene("floating_crates.json"), WorldOptions{2});
   std::vector<const b2Body*> dyn;  // scene order: box 500, circle 300, box 800, box 2500
   for (const b2Body* b = w.box2d().GetBodyList(); b; b = b->GetNext())
@@ -383,7 +383,7 @@ TEST_CASE("assets/scenes/floating_crates.json: the light crates float, the heavy
   CHECK(dyn[1]->GetPosition().y > 0.5);
   CHECK(dyn[2]->GetPosition().y > 0.3);   // density 800: mostly under, but afloat
   CHECK(dyn[3]->GetPosition().y < 0.15);  // density 2500: on the floor
-  CHECK(test::meanSpeed(w) > 0.05);       // the paddle keeps the water moving
+  CHECK(test::meanSpeed(w) > 0.05);       // the bar keeps the water moving
 }
 
 TEST_CASE("moving bodies: save, load and step a floating crate: the same state hashes and crate as the World not interrupted") {
