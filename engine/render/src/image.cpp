@@ -159,9 +159,24 @@ int drawColorBar(Frame& img, double lo, double hi, const std::string& title, int
   const int titleW = textWidth(title, scale);
   const int th = textHeight(scale);
   const int boxW = std::max(titleW, barW + 2 * scale + labelW) + 2 * scale * 2;
-  const int x0 = img.width - margin - boxW;
-  const int y0 = (img.height - barH) / 2 - th - 3 * scale;
   const int boxH = barH + 2 * th + 8 * scale;
+  // Where it hides the least: of the right and left edges at the middle, top and bottom (in
+  // that order of preference), the place with the fewest drawn pixels under it (solids and
+  // fluid are brighter than the dark background: a channel above 60).
+  const int xs[2] = {img.width - margin - boxW, margin};
+  const int ys[3] = {(img.height - barH) / 2 - th - 3 * scale, margin, img.height - margin - boxH};
+  int x0 = xs[0], y0 = ys[0];
+  long best = -1;
+  for (const int yc : ys)
+    for (const int xc : xs) {
+      long busy = 0;
+      for (int y = std::max(0, yc); y < std::min(img.height, yc + boxH); ++y)
+        for (int x = std::max(0, xc); x < std::min(img.width, xc + boxW); ++x) {
+          const std::uint8_t* q = &img.rgba[(std::size_t(y) * std::size_t(img.width) + std::size_t(x)) * 4];
+          busy += std::max({q[0], q[1], q[2]}) > 60;
+        }
+      if (best < 0 || busy < best) best = busy, x0 = xc, y0 = yc;
+    }
   fillRect(img, x0, y0, x0 + boxW, y0 + boxH, Rgba8{0, 0, 0, 140});
   const Rgba8 white{235, 235, 235, 255};
   drawText(img, x0 + 2 * scale, y0 + 2 * scale, title, scale, white);

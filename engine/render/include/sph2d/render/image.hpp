@@ -52,8 +52,9 @@ std::array<float, 3> colorRamp(float t);
 std::string formatLabel(double v);
 
 /// Draws a vertical colour bar (ramp from `lo` at the bottom to `hi` at the top) with its
-/// numeric range and `title` (e.g. "SPEED M/S") into the right edge of `img`.
-/// Returns the left x of what it drew.
+/// numeric range and `title` (e.g. "SPEED M/S") at the right or left edge of `img`, at
+/// the middle, top or bottom: where it covers the fewest drawn (solid or fluid) pixels,
+/// the right middle when that is clear. Returns the left x of what it drew.
 int drawColorBar(Frame& img, double lo, double hi, const std::string& title, int scale);
 
 /// Copies `src` into `dst` with its top-left corner at (x, y), shrunk by an integer
