@@ -513,3 +513,45 @@ TEST_CASE("liquid depth shading has no vertical seams under a bump and does not 
   MESSAGE("blue 6 px from the wall " << nearWall << ", 40 px from it " << awayFromWall);
   CHECK(std::abs(nearWall - awayFromWall) <= 2);
 }
+
+TEST_CASE("the colour bar goes where it covers no solid or fluid: the right middle when clear, else a clear edge") {
+  // A dark 400 × 300 frame; a grey wall over the right third, then also fluid blue over the
+  // top third of the rest: the bar (ramp ends 128,0,0 and 0,0,128) must land on the dark part.
+  auto frame = [] {
+    Frame f;
+    f.width = 400;
+    f.height = 300;
+    f.rgba.assign(std::size_t(f.width) * std::size_t(f.height) * 4, 0);
+    for (std::size_t i = 0; i < f.rgba.size(); i += 4) f.rgba[i] = 14, f.rgba[i + 1] = 16, f.rgba[i + 2] = 22, f.rgba[i + 3] = 255;
+    return f;
+  };
+  auto paint = [](Frame& f, int x0, int y0, int x1, int y1, std::array<std::uint8_t, 3> c) {
+    for (int y = y0; y < y1; ++y)
+      for (int x = x0; x < x1; ++x)
+        for (int k = 0; k < 3; ++k) f.rgba[(std::size_t(y) * std::size_t(f.width) + std::size_t(x)) * 4 + std::size_t(k)] = c[std::size_t(k)];
+  };
+  auto barOver = [](const Frame& f, int x0, int y0, int x1, int y1) {  // ramp-end pixels in the box
+    int n = 0;
+    for (int y = y0; y < y1; ++y)
+      for (int x = x0; x < x1; ++x) {
+        const std::uint8_t* p = &f.rgba[(std::size_t(y) * std::size_t(f.width) + std::size_t(x)) * 4];
+        n += (p[0] == 128 && p[1] == 0 && p[2] == 0) || (p[0] == 0 && p[1] == 0 && p[2] == 128);
+      }
+    return n;
+  };
+  Frame clear = frame();
+  CHECK(drawColorBar(clear, 0, 1, "SPEED M/S", 1) > 200);  // clear: the right edge
+  Frame wall = frame();
+  paint(wall, 270, 0, 400, 300, {138, 128, 112});
+  const int x = drawColorBar(wall, 0, 1, "SPEED M/S", 1);
+  CHECK(x < 200);                          // moved to the left edge
+  CHECK(barOver(wall, 270, 0, 400, 300) == 0);
+  CHECK(barOver(wall, 0, 0, 270, 300) > 0);
+  Frame both = frame();
+  paint(both, 270, 0, 400, 300, {138, 128, 112});
+  paint(both, 0, 0, 270, 100, {47, 127, 216});  // the bar (half the height and its labels) fits below
+  drawColorBar(both, 0, 1, "SPEED M/S", 1);
+  CHECK(barOver(both, 270, 0, 400, 300) == 0);
+  CHECK(barOver(both, 0, 0, 270, 100) == 0);
+  CHECK(barOver(both, 0, 100, 270, 300) > 0);  // the clear bottom left
+}
