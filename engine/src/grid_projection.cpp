@@ -151,7 +151,7 @@ void GridProjection::markBodies(const StepContext& c) {
   const MovingSolids& S = *c.solids;
   const double tau = c.time - S.time0, h = double(h_);
   bodyOf_.assign(type_.size(), -1);
-  std::vector<std::uint8_t> in;  // the body's cells over its bounding box (one cell of margin)
+  std::vector<std::uint8_t>& in = bodyCells_;  // the body's cells over its bounding box (one cell of margin)
   for (std::size_t b = 0; b < S.bodies.size(); ++b) {
     const MovingSolid& m = S.bodies[b];
     BodyState st;
@@ -578,7 +578,8 @@ void GridProjection::solve(const StepContext& c) {
   if (coupled) {
     // Each dynamic body takes the pressure's impulse J = ρ0 h dt Σ κ G (force p·h per face,
     // along n into the body, and its torque about the centre of mass) at the substep's start.
-    std::vector<double> J(3 * bodies_.size(), 0.0);
+    std::vector<double>& J = bodyImpulse_;
+    J.assign(3 * bodies_.size(), 0.0);
     for (const Coupling& e : coupling_)
       for (int q = 0; q < 3; ++q) J[3 * std::size_t(e.body) + std::size_t(q)] += e.g[q] * double(x[std::size_t(e.unknown)]);
     const double f = double(c.rho0) * double(h_) * double(dt);

@@ -176,6 +176,8 @@ class GridProjection {
   std::vector<Coupling> coupling_;  ///< in unknown order
   double couplingScale_ = 0;        ///< ρ0 h²
   mutable std::vector<double> bodySum_;  ///< apply()'s scratch: Gᵀ·in per body (the main solve only)
+  std::vector<std::uint8_t> bodyCells_;  ///< markBodies' scratch: one body's cells over its box
+  std::vector<double> bodyImpulse_;      ///< solve()'s scratch: each body's impulse Gᵀκ
 };
 
 }  // namespace sph2d

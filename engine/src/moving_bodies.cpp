@@ -276,13 +276,10 @@ void World::Impl::bodyGravity(StepContext& c) {
 void World::Impl::collideMoving(StepContext& c) {
   if (moving.bodies.empty()) return;
   const double tau0 = c.time - moving.time0, tau1 = tau0 + double(c.dt), clearance = double(c.clearance);
-  struct Pose {
-    double theta0, theta1, c0, s0, c1, s1;  // the rotations at the substep's start and end
-    Vec2d o0, o1, com1;
-    double reach2;  // beyond this from com1, a particle's whole path misses the body (squared)
-  };
+  using Pose = BodyPose;
   const std::vector<MovingSolid>& bodies = moving.bodies;
-  std::vector<Pose> poses(bodies.size());
+  std::vector<Pose>& poses = bodyPoses;
+  poses.resize(bodies.size());
   for (std::size_t k = 0; k < bodies.size(); ++k) {
     Pose& q = poses[k];
     q.theta0 = bodies[k].sweptTheta;  // where the particles last saw it
@@ -366,7 +363,8 @@ void World::Impl::collideMoving(StepContext& c) {
   if (!anyDynamic) return;
   // The dynamic bodies' contacts, in slot order: count each body's approaching contacts,
   // then solve each as inelastic with the body's mass split among them.
-  std::vector<int> count(bodies.size(), 0);
+  std::vector<int>& count = contactCount;
+  count.assign(bodies.size(), 0);
   auto approach = [&](std::size_t i, Vec2d& r, double& vn) {
     const MovingSolid& m = bodies[std::size_t(hitBody[i])];
     const Vec2d x(c.P.x[i].x(), c.P.x[i].y());
@@ -379,8 +377,10 @@ void World::Impl::collideMoving(StepContext& c) {
     double vn;
     if (hitBody[i] >= 0 && approach(i, r, vn)) ++count[std::size_t(hitBody[i])];
   }
-  std::vector<Vec2d> J(bodies.size(), Vec2d(0, 0));
-  std::vector<double> L(bodies.size(), 0.0);
+  std::vector<Vec2d>& J = contactImpulse;
+  std::vector<double>& L = contactTorque;
+  J.assign(bodies.size(), Vec2d(0, 0));
+  L.assign(bodies.size(), 0.0);
   const double m0 = double(c.mass);
   for (std::size_t i = 0; i < c.P.size(); ++i) {
     Vec2d r;

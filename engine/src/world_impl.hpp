@@ -98,6 +98,16 @@ struct World::Impl {
   void collideMoving(StepContext& c);
   std::vector<std::int32_t> hitBody;  ///< the bodies stage's scratch: the dynamic body particle i met (−1: none)
   std::vector<Vec2d> hitNormal;       ///< … and the body's outward normal there
+  /// The bodies stage's scratch per body: its pose at the substep's start and end.
+  struct BodyPose {
+    double theta0, theta1, c0, s0, c1, s1;  ///< the rotations at the substep's start and end
+    Vec2d o0, o1, com1;
+    double reach2;  ///< beyond this from com1, a particle's whole path misses the body (squared)
+  };
+  std::vector<BodyPose> bodyPoses;
+  std::vector<int> contactCount;        ///< … its approaching contacts
+  std::vector<Vec2d> contactImpulse;    ///< … the contacts' impulse on it
+  std::vector<double> contactTorque;    ///< … and their angular impulse
 
   /// Changes of the particles made between steps (the API's adds, removals and moves):
   /// with `steps` and the count, what the query grid is valid for.
