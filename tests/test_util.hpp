@@ -1,11 +1,20 @@
 // test_util.hpp — helpers shared by the tests: scene paths and small probes.
 #pragma once
 
+#include <ostream>
 #include <string>
 #include <vector>
 
 #include "sph2d/scene.hpp"
 #include "sph2d/world.hpp"
+
+namespace sph2d {
+/// "(x, y)": a vector in a test's message.
+template <class T>
+std::ostream& operator<<(std::ostream& o, const Vector2<T>& v) {
+  return o << '(' << v.x() << ", " << v.y() << ')';
+}
+}  // namespace sph2d
 
 namespace sph2d::test {
 

@@ -251,11 +251,16 @@ void World::Impl::captureBodies() {
   if (had != !moving.bodies.empty() || hadDynamic != moving.anyDynamic()) buildStages();
 }
 
+// An impulse at most this in each component [N·s per metre of depth] is none: the fluid did not
+// touch the body, and applying it would wake a sleeping body for nothing.
+constexpr double kNegligibleImpulse = 1e-12;
+
 void World::Impl::moveOwnBodies(double dt) {
   moving.last.clear();
   for (const MovingSolid& m : moving.bodies) moving.last.push_back({m.body, m.sweptTheta, m.sweptOrigin});
   for (const MovingSolid& m : moving.bodies) {
-    if (!m.dynamic() || (m.impulse.isZero() && m.angularImpulse == 0)) continue;
+    const bool noImpulse = std::abs(m.impulse.x()) <= kNegligibleImpulse && std::abs(m.impulse.y()) <= kNegligibleImpulse;
+    if (!m.dynamic() || (noImpulse && m.angularImpulse == 0)) continue;
     m.body->ApplyLinearImpulse(b2Vec2(float(m.impulse.x()), float(m.impulse.y())), m.body->GetWorldCenter(), true);
     m.body->ApplyAngularImpulse(float(m.angularImpulse), true);
   }

@@ -21,7 +21,7 @@ using study::makeLattice;
 namespace {
 
 template <class T>
-using Vec = Eigen::Matrix<T, 2, 1, Eigen::DontAlign>;
+using Vec = Vector2<T>;
 
 // Rounding tolerance of a sum of ~30 kernel-weighted terms, relative to its scale.
 template <class T>
@@ -204,7 +204,8 @@ TEST_CASE_TEMPLATE("corrected gradient, divergence and curl are exact for linear
   std::vector<Vec<T>> Av(lat.x.size());
   for (std::size_t i = 0; i < A.size(); ++i) {
     A[i] = T(2) + g.dot(lat.x[i]);
-    Av[i] = B * lat.x[i] + Vec<T>(T(0.5), T(-2));
+    const Vec<T>& x = lat.x[i];
+    Av[i] = Vec<T>(B(0, 0) * x.x() + B(0, 1) * x.y(), B(1, 0) * x.x() + B(1, 1) * x.y()) + Vec<T>(T(0.5), T(-2));
   }
   const double div = B(0, 0) + B(1, 1), curl = B(1, 0) - B(0, 1);
   double worstPlain = 0;
@@ -256,7 +257,7 @@ TEST_CASE_TEMPLATE("difference operators vanish for uniform fields and the symme
   s.build(lat.x.data(), lat.x.size(), k.R);
   const auto view = ParticleView<T>::withMassDensity(lat.x.data(), m.data(), rho.data(), lat.x.size());
   const FieldOperators<K> ops(k, view, s);
-  Eigen::Vector2d sumSym = Eigen::Vector2d::Zero(), sumDiff = Eigen::Vector2d::Zero();
+  Vec2d sumSym = Vec2d::Zero(), sumDiff = Vec2d::Zero();
   double scale = 0;
   for (std::size_t i = 0; i < A.size(); ++i) {
     CHECK(ops.gradient(i, c.data()).norm() == 0);

@@ -22,7 +22,7 @@ double latticeIntegral(const K& k, int cellsPerR) {
   return s * d * d;
 }
 
-using V2d = Eigen::Matrix<double, 2, 1, Eigen::DontAlign>;
+using V2d = Vector2<double>;
 
 }  // namespace
 

@@ -347,7 +347,7 @@ TEST_CASE("a polygon region fills the lattice points inside its outline, concave
   for (std::size_t i = 0; i < w.particleCount(); ++i) {
     const Vec2d x = w.worldPosition(i);
     const bool inL = x.x() > 0 && x.y() > 0 && x.x() < 1 && x.y() < 1 && !(x.x() > 0.5 && x.y() > 0.5);
-    if (!inL) FAIL("a particle outside the L at " << x.transpose());
+    if (!inL) FAIL("a particle outside the L at " << x);
   }
   CHECK(double(countBlockParticles(s)) == double(w.particleCount()));
   // A self-crossing 64-point star (even-odd: its core is outside): the loader's row-by-row

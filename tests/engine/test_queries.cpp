@@ -87,7 +87,7 @@ TEST_CASE("shapes: particlesInShape matches b2Shape::TestPoint over every partic
     const b2Vec2 q(float(p.x()), float(p.y()));
     if (!box.TestPoint(xf, b2Vec2(q.x, q.y)) && !box.TestPoint(xf, b2Vec2(q.x + 1e-5f, q.y)) &&
         !box.TestPoint(xf, b2Vec2(q.x - 1e-5f, q.y)))
-      FAIL("a particle of the box outside it at " << p.transpose());
+      FAIL("a particle of the box outside it at " << p);
   }
   b2CircleShape disc;
   disc.m_p = b2Vec2(0.1f, 0.05f);

@@ -21,7 +21,7 @@ namespace sph2d::study {
 /// A square lattice of particles with uniform volume dx², optionally jittered.
 template <class T>
 struct Lattice {
-  using V = Eigen::Matrix<T, 2, 1, Eigen::DontAlign>;
+  using V = Vector2<T>;
   std::vector<V> x;
   std::vector<T> vol;
   double dx = 0;

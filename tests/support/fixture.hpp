@@ -343,7 +343,8 @@ inline double inertiaAspect(const World& w) {
   Eigen::Matrix2d M = Eigen::Matrix2d::Zero();
   for (std::size_t i = 0; i < w.particleCount(); ++i) {
     const Vec2d d = w.worldPosition(i) - c;
-    M += d * d.transpose();
+    const Eigen::Vector2d e(d.x(), d.y());
+    M += e * e.transpose();
   }
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> es(M);
   return std::sqrt(es.eigenvalues()(1) / es.eigenvalues()(0));

@@ -40,7 +40,7 @@ namespace sph2d {
 /// or masses m_j and densities ρ_j (then V_j = m_j/ρ_j).
 template <class T>
 struct ParticleView {
-  using V = Eigen::Matrix<T, 2, 1, Eigen::DontAlign>;
+  using V = Vector2<T>;
   const V* x = nullptr;        ///< positions [n]
   std::size_t n = 0;           ///< number of particles
   const T* volume = nullptr;   ///< V_j [n], or null when mass and density are given
@@ -98,8 +98,8 @@ class NeighbourSearch {
   /// Calls f(j) for every indexed point j in the 3×3 cells around p (a superset
   /// of the points within radius()), in cell order then index order. A
   /// non-finite p has no candidates.
-  template <class D, class F>
-  void forCandidates(const Eigen::MatrixBase<D>& p, F&& f) const {
+  template <class S, class F>
+  void forCandidates(const Vector2<S>& p, F&& f) const {
     if (sorted_.empty()) return;
     const double px = double(p.x()), py = double(p.y());
     if (!std::isfinite(px) || !std::isfinite(py)) return;
@@ -150,6 +150,8 @@ class FieldOperators {
   using V = typename K::V;             ///< 2D vector of the kernel's scalar
   using T = typename V::Scalar;        ///< float or double
   using M2 = Eigen::Matrix<T, 2, 2>;   ///< 2×2 matrix (fixed size)
+  using E2 = Eigen::Matrix<T, 2, 1>;   ///< V as an Eigen column, for the 2×2 algebra
+  static E2 col(const V& a) { return E2(a.x(), a.y()); }
 
   /// Throws std::invalid_argument when the view is incomplete or the search does
   /// not match it (size, radius < R).
@@ -251,7 +253,7 @@ class FieldOperators {
   bool correctionMatrix(std::size_t i, M2& L) const {
     M2 M = M2::Zero();
     forNeighbours(p_.x[i], [&](std::size_t j, const V& d, T r) {
-      M.noalias() -= (k_.gradient(d, r) * p_.volumeOf(j)) * d.transpose();  // x_j − x_i = −d
+      M.noalias() -= col(k_.gradient(d, r) * p_.volumeOf(j)) * col(d).transpose();  // x_j − x_i = −d
     });
     return invertCorrection(M, L);
   }
@@ -267,12 +269,13 @@ class FieldOperators {
     const T ai = field[i];
     forNeighbours(p_.x[i], [&](std::size_t j, const V& d, T r) {
       const V gw = k_.gradient(d, r) * p_.volumeOf(j);
-      M.noalias() -= gw * d.transpose();
+      M.noalias() -= col(gw) * col(d).transpose();
       g += gw * (field[j] - ai);
     });
     M2 L;
     if (!invertCorrection(M, L)) return g;
-    return V(L * g);
+    const E2 lg = L * col(g);
+    return V(lg(0), lg(1));
   }
 
   /// Divergence, difference form Σ_j V_j (A_j − A_i) · ∇W_ij. Zero for a
@@ -379,8 +382,8 @@ class FieldOperators {
     const V ai = field[i];
     forNeighbours(p_.x[i], [&](std::size_t j, const V& d, T r) {
       const V gw = k_.gradient(d, r) * p_.volumeOf(j);
-      if (corrected) M.noalias() -= gw * d.transpose();
-      J.noalias() += gw * V(field[j] - ai).transpose();
+      if (corrected) M.noalias() -= col(gw) * col(d).transpose();
+      J.noalias() += col(gw) * col(field[j] - ai).transpose();
     });
     M2 L;
     if (corrected && invertCorrection(M, L)) return L * J;

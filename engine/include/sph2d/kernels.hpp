@@ -13,7 +13,6 @@
 // checks ∫W = 1, symmetry and the derivatives against finite differences.
 #pragma once
 
-#include <Eigen/Core>
 #include <algorithm>
 #include <cmath>
 
@@ -23,9 +22,9 @@ namespace sph2d {
 
 /// Gradient helper: dW/dr times the unit vector d/r, zero at r = 0.
 template <class T>
-inline Eigen::Matrix<T, 2, 1, Eigen::DontAlign> radialGradient(const Eigen::Matrix<T, 2, 1, Eigen::DontAlign>& d,
+inline Vector2<T> radialGradient(const Vector2<T>& d,
                                                               T r, T dWdr) {
-  if (!(r > T(0))) return Eigen::Matrix<T, 2, 1, Eigen::DontAlign>::Zero();
+  if (!(r > T(0))) return Vector2<T>::Zero();
   return (d / r) * dWdr;  // unit vector first: no overflow for tiny r
 }
 
@@ -33,7 +32,7 @@ inline Eigen::Matrix<T, 2, 1, Eigen::DontAlign> radialGradient(const Eigen::Matr
 /// Smooth at r = 0; the density kernel of that paper's solver (muller2003).
 template <class T = Real>
 struct Poly6 {
-  using V = Eigen::Matrix<T, 2, 1, Eigen::DontAlign>;
+  using V = Vector2<T>;
   static constexpr bool hasLaplacian = true;
   static constexpr const char* name = "poly6";
   T R, R2, c;
@@ -72,7 +71,7 @@ struct Poly6 {
 /// 2D gradient constant is −30/(π R^5) (not the W constant, a common slip).
 template <class T = Real>
 struct Spiky {
-  using V = Eigen::Matrix<T, 2, 1, Eigen::DontAlign>;
+  using V = Vector2<T>;
   static constexpr bool hasLaplacian = false;  // W'/r is singular at r = 0
   static constexpr const char* name = "spiky";
   T R, c;
@@ -109,7 +108,7 @@ struct Spiky {
 /// caps the viscous coupling of nearly coincident pairs (docs/KERNELS.md).
 template <class T = Real>
 struct ViscosityKernel {
-  using V = Eigen::Matrix<T, 2, 1, Eigen::DontAlign>;
+  using V = Vector2<T>;
   static constexpr bool hasLaplacian = true;
   static constexpr const char* name = "viscosity";
   T R, c, rMin, rTiny;
@@ -155,7 +154,7 @@ struct ViscosityKernel {
 /// W = σ(6q³ − 6q² + 1) for q ≤ ½, 2σ(1 − q)³ for q ≤ 1.
 template <class T = Real>
 struct CubicSpline {
-  using V = Eigen::Matrix<T, 2, 1, Eigen::DontAlign>;
+  using V = Vector2<T>;
   static constexpr bool hasLaplacian = true;
   static constexpr const char* name = "cubic";
   T R, invR, s;
@@ -192,7 +191,7 @@ struct CubicSpline {
 /// Wendland C2 (Wendland 1995), support R: σ = 7/(π R²), W = σ(1 − q)⁴(4q + 1).
 template <class T = Real>
 struct WendlandC2 {
-  using V = Eigen::Matrix<T, 2, 1, Eigen::DontAlign>;
+  using V = Vector2<T>;
   static constexpr bool hasLaplacian = true;
   static constexpr const char* name = "wendland_c2";
   T R, invR, s;
