@@ -115,14 +115,15 @@ int cmdBench(const std::vector<std::string>& args) {
   scene.render.camera.max = Vec2d(4.25, 3.25);
   World world(scene, WorldOptions{1});
   world.takeWarnings();
-  Particles P;
+  ParticleBuffer B;
   const Vec2d o = world.origin();
   std::uint32_t id = 0;
   for (double x = dx / 2; x < 3.0; x += dx)
     for (double y = dx / 2; y < profile(x); y += dx) {
       const double speed = 1.0 + 2.0 * x + 1.5 * y;
-      P.push(Vec2(Real(x - o.x()), Real(y - o.y())), Vec2(Real(speed), Real(-0.3 * y)), id++, Real(1000));
+      B.push(Vec2(Real(x - o.x()), Real(y - o.y())), Vec2(Real(speed), Real(-0.3 * y)), id++, Real(1000));
     }
+  const Particles P = B.view();
   RenderInput in;
   in.particles = &P;
   in.origin = o;

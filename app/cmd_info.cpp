@@ -116,7 +116,7 @@ int cmdInfo(const std::vector<std::string>& args) {
     std::printf("             frame %lld: %s\n", (long long)eventFrame(e, s.fps), describeEvent(e).c_str());
   std::printf("engine       %.1f MB held by the World now (particle arrays %.1f MB; grid, neighbour lists, "
               "boundary samples)\n",
-              double(w.memoryBytes()) / 1e6, double(w.particles().bytes()) / 1e6);
+              double(w.memoryBytes()) / 1e6, double(w.particleBytes()) / 1e6);
   std::printf("image        %dx%d, %s mode\n", s.render.width, s.render.height, s.render.mode.c_str());
   return 0;
 }

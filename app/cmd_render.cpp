@@ -58,11 +58,12 @@ int cmdRender(const std::vector<std::string>& args) {
   World world(scene, WorldOptions{1});  // for its solids, spacing and local origin
   world.takeWarnings();
   const Vec2d o = world.origin();
-  Particles P;
+  ParticleBuffer B;
   for (std::size_t k = 0; k < snap.size(); ++k) {
-    P.push(Vec2(Real(snap.x[k] - o.x()), Real(snap.y[k] - o.y())), Vec2(snap.vx[k], snap.vy[k]), snap.id[k], snap.rho[k]);
-    P.p.back() = snap.p[k];
+    B.push(Vec2(Real(snap.x[k] - o.x()), Real(snap.y[k] - o.y())), Vec2(snap.vx[k], snap.vy[k]), snap.id[k], snap.rho[k]);
+    B.p.back() = snap.p[k];
   }
+  const Particles P = B.view();
   if (opt.colorBy == ColorField::Age && snap.age.empty() && (opt.mode == "particles" || (opt.mode.empty() && scene.render.mode == "particles")))
     throw UsageError(csv + " has no age column, so --color-by age cannot be shown");
   RenderInput in;

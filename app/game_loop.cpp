@@ -116,24 +116,16 @@ bool GameLoop::finishBoundary(bool drop) {
 
 void GameLoop::capture(std::int64_t f) {
   Pending& q = pending_;
-  const Particles& P = world_.particles();
-  q.particles.x = P.x;
-  q.particles.v = P.v;
-  q.particles.rho = P.rho;
-  q.particles.p = P.p;
-  q.particles.id = P.id;
-  q.particles.extraU32.clear();  // the particles' own colours, when something set them
-  if (const std::vector<std::uint32_t>* own = P.findU32(Particles::kColor)) q.particles.fieldU32(Particles::kColor) = *own;
+  q.particles.assign(world_.particles());  // with the ages and the particles' own colours, when there are
+  q.view = q.particles.view();
   q.colliders = world_.colliders();
-  const std::vector<Real>* age = P.find("age");
-  if (age) q.age = *age;
   q.input = RenderInput{};
-  q.input.particles = &q.particles;
+  q.input.particles = &q.view;
   q.input.origin = world_.origin();
   q.input.spacing = world_.spacing();
   q.input.colliders = &q.colliders;
   q.input.moving = world_.movingColliders();  // where the moving bodies are in this frame
-  q.input.age = age ? q.age.data() : nullptr;
+  q.input.age = q.particles.age.empty() ? nullptr : q.particles.age.data();
   q.input.gravity = world_.scene().gravity.norm();
   q.input.frame = world_.frame();
   q.input.time = world_.time();

@@ -143,9 +143,9 @@ class GameLoop {
   struct Pending {
     bool active = false;
     FrameState state;
-    Particles particles;              ///< x, v, rho, p, id (the fields the renderer reads)
+    ParticleBuffer particles;         ///< copies of the fields the renderer reads
+    Particles view;                   ///< particles.view()
     std::vector<Collider> colliders;
-    std::vector<Real> age;
     RenderInput input;
   } pending_;
 };

@@ -24,7 +24,7 @@
 
 #include "grid.hpp"
 #include "sph2d/boundary.hpp"
-#include "sph2d/kernels.hpp"
+#include "kernels.hpp"
 
 class b2World;
 

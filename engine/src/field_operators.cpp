@@ -1,5 +1,5 @@
 // NeighbourSearch::build — the uniform grid of sph2d/field_operators.hpp.
-#include "sph2d/field_operators.hpp"
+#include "field_operators.hpp"
 
 #include <algorithm>
 #include <cmath>

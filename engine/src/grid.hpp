@@ -23,7 +23,7 @@
 #include <vector>
 
 #include "sph2d/math.hpp"
-#include "sph2d/thread_pool.hpp"
+#include "thread_pool.hpp"
 
 namespace sph2d {
 

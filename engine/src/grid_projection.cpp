@@ -20,7 +20,7 @@ GridProjection::GridProjection(Real cellInSpacings, Real fluidFraction, Real com
       shiftDef_(shift) {}
 
 void GridProjection::layout(const StepContext& c) {
-  const Particles& P = c.P;
+  const ParticleStore& P = c.P;
   const std::size_t n = P.size();
   struct Box {
     Real x0, y0, x1, y1;
@@ -298,7 +298,7 @@ void GridProjection::assembleCoupling() {
 }
 
 void GridProjection::transferToGrid(const StepContext& c) {
-  const Particles& P = c.P;
+  const ParticleStore& P = c.P;
   const Real rho0 = c.rho0;
   const int nu = nx_ + 1;
   // Adds the bilinear weights at (fx, fy), in the units of a field `stride` wide, to
@@ -710,7 +710,7 @@ std::size_t GridProjection::transferToParticles(StepContext& c) {
       }
     }
   });
-  Particles& P = c.P;
+  ParticleStore& P = c.P;
   const Real vmax2 = c.maxSpeed * c.maxSpeed;
   if (shifting) shift_.resize(P.size());
   else shift_.clear();

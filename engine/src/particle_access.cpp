@@ -3,7 +3,7 @@
 // after LiquidFun's writable particle buffers (b2ParticleColor, user data) and
 // b2ParticleHandle: slots move (the grid reorders the particles for locality,
 // removals compact them), ids do not. Colour and user data are optional integer
-// fields (Particles::extraU32), allocated by the first set.
+// fields (ParticleStore::extraU32), allocated by the first set.
 //
 // The id index is a vector of (id, slot) sorted by id, searched by bisection. It is
 // never invalidated explicitly: a lookup checks that the slot it found still holds
@@ -23,11 +23,11 @@ namespace {
 
 bool finite(const Vec2d& v) { return std::isfinite(v.x()) && std::isfinite(v.y()); }
 
-constexpr const char* kColorField = Particles::kColor;
-constexpr const char* kUserDataField = Particles::kUserData;
+constexpr const char* kColorField = ParticleStore::kColor;
+constexpr const char* kUserDataField = ParticleStore::kUserData;
 
 /// Writes `value` into integer field `field` (created on first use) for particle `id`.
-bool setU32(World& w, Particles& P, const char* field, std::uint32_t id, std::uint32_t value) {
+bool setU32(World& w, ParticleStore& P, const char* field, std::uint32_t id, std::uint32_t value) {
   const std::size_t i = w.slotOf(id);
   if (i == World::npos) return false;
   P.fieldU32(field)[i] = value;
@@ -35,7 +35,7 @@ bool setU32(World& w, Particles& P, const char* field, std::uint32_t id, std::ui
 }
 
 /// Integer field `field` of particle `id`: 0 without the field or the particle.
-std::uint32_t getU32(const World& w, const Particles& P, const char* field, std::uint32_t id) {
+std::uint32_t getU32(const World& w, const ParticleStore& P, const char* field, std::uint32_t id) {
   const std::vector<std::uint32_t>* f = P.findU32(field);
   if (!f) return 0;
   const std::size_t i = w.slotOf(id);
@@ -43,7 +43,7 @@ std::uint32_t getU32(const World& w, const Particles& P, const char* field, std:
 }
 
 /// Rebuilds the id index of `P`.
-void rebuild(std::vector<std::pair<std::uint32_t, std::uint32_t>>& index, const Particles& P) {
+void rebuild(std::vector<std::pair<std::uint32_t, std::uint32_t>>& index, const ParticleStore& P) {
   index.resize(P.size());
   for (std::size_t i = 0; i < P.size(); ++i) index[i] = {P.id[i], std::uint32_t(i)};
   std::sort(index.begin(), index.end());

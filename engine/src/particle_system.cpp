@@ -1,7 +1,7 @@
 // The World's particle system (the particle-system seed: emitters,
 // lifetimes, forces, integration): fluid blocks and drops on the lattice of
 // the spacing, seeded emitters, lifetimes, sinks and the particle budget.
-// Removal keeps the order of the remaining particles (Particles::compact), and
+// Removal keeps the order of the remaining particles (ParticleStore::compact), and
 // emitters draw from their own SplitMix64 stream, so a run is deterministic.
 #include <algorithm>
 #include <cmath>

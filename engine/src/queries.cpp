@@ -173,7 +173,7 @@ World::FieldSample World::sampleAt(const Vec2d& point) const {
 }
 
 std::uint64_t World::stateHash() const {
-  const Particles& P = impl_->P;
+  const ParticleStore& P = impl_->P;
   std::vector<std::uint32_t> slotOf(impl_->nextId, 0xffffffffu);
   for (std::size_t i = 0; i < P.size(); ++i) slotOf[P.id[i]] = std::uint32_t(i);
   Xxh64 h;
@@ -189,7 +189,7 @@ std::uint64_t World::stateHash() const {
 }
 
 DensityStats World::densityStats() const {
-  const Particles& P = impl_->P;
+  const ParticleStore& P = impl_->P;
   DensityStats s;
   if (P.size() == 0) return s;
   const double rho0 = impl_->scene.solver.restDensity;
@@ -207,7 +207,7 @@ DensityStats World::densityStats() const {
 }
 
 double World::kineticEnergy() const {
-  const Particles& P = impl_->P;
+  const ParticleStore& P = impl_->P;
   double e = 0;
   for (std::size_t i = 0; i < P.size(); ++i) e += 0.5 * double(impl_->mass) * double(P.v[i].squaredNorm());
   return e;
@@ -240,6 +240,8 @@ void World::resetTimings() { impl_->stages.resetTimings(); }
 SolverStats World::solverStats() const { return impl_->solver->stats(); }
 
 std::uint64_t World::solverIterations() const { return impl_->iterations; }
+
+std::size_t World::particleBytes() const { return impl_->P.bytes(); }
 
 std::size_t World::memoryBytes() const {
   const Impl& w = *impl_;

@@ -233,7 +233,7 @@ void World::load(std::istream& input) {
   std::string missing;
   w.P.forEachField([&](const char* name, const auto& vec) {
     const Field* f = find(name);
-    if (!f && Particles::integerField(name)) return;  // a colour or tag set after the save: zeros on load
+    if (!f && ParticleStore::integerField(name)) return;  // a colour or tag set after the save: zeros on load
     if (!f || f->element != sizeof(vec[0])) missing += (missing.empty() ? "" : ", ") + std::string(name);
   });
   if (!missing.empty()) throw SaveError("the saved state is malformed: it lacks the particle fields " + missing);
@@ -294,7 +294,7 @@ void World::load(std::istream& input) {
       vec.resize(static_cast<std::size_t>(n));
       if (n) std::memcpy(static_cast<void*>(vec.data()), f.data.data(), f.data.size());
     });
-    if (!fixed && Particles::integerField(f.name)) {  // colour or user data the save holds and this World lacks
+    if (!fixed && ParticleStore::integerField(f.name)) {  // colour or user data the save holds and this World lacks
       std::vector<std::uint32_t>& vec = w.P.fieldU32(f.name);
       vec.resize(static_cast<std::size_t>(n));
       if (n) std::memcpy(vec.data(), f.data.data(), f.data.size());

@@ -45,13 +45,13 @@ bool reorderThisStep(const StepContext& c) {
   return every > 0 && c.step % std::uint64_t(every) == 0;
 }
 
-void permuteParticles(Particles& P, const std::vector<std::uint32_t>& order, Scratch& s, ThreadPool& pool) {
+void permuteParticles(ParticleStore& P, const std::vector<std::uint32_t>& order, Scratch& s, ThreadPool& pool) {
   P.forEachField([&](const char*, auto& field) { permuteField(field, order, scratchFor(s, field), pool); });
 }
 
 void stageWrap(StepContext& c) {
   if (!c.periodic.any()) return;
-  Particles& P = c.P;
+  ParticleStore& P = c.P;
   const PeriodicBox& box = c.periodic;
   c.pool.parallelFor(P.size(), kStreamBlock, [&](std::size_t b, std::size_t e) {
     for (std::size_t i = b; i < e; ++i) {
@@ -62,7 +62,7 @@ void stageWrap(StepContext& c) {
 }
 
 void stageGrid(StepContext& c, bool reorder) {
-  Particles& P = c.P;
+  ParticleStore& P = c.P;
   if (c.periodic.any()) stageWrap(c);
   c.grid.build(P.x.data(), P.size(), c.R, c.pool, 2, c.periodic.any() ? &c.periodic : nullptr);
   if (!reorder) return;
@@ -74,7 +74,7 @@ void stageGrid(StepContext& c, bool reorder) {
 }
 
 void stageNeighbours(StepContext& c) {
-  Particles& P = c.P;
+  ParticleStore& P = c.P;
   const Grid& g = c.grid;
   const BoundarySet& B = c.boundary;
   NeighbourLists& L = c.nbr;
@@ -129,7 +129,7 @@ void stageNeighbours(StepContext& c) {
 }
 
 std::size_t stageIntegrate(StepContext& c) {
-  Particles& P = c.P;
+  ParticleStore& P = c.P;
   const Real dt = c.dt;
   const Real vmax2 = c.maxSpeed * c.maxSpeed;
   // The displacement clamp: no particle moves more than kMaxMove·R in one
@@ -154,7 +154,7 @@ std::size_t stageIntegrate(StepContext& c) {
 }
 
 std::size_t stageDrift(StepContext& c) {
-  Particles& P = c.P;
+  ParticleStore& P = c.P;
   const Real dt = c.dt, vmax2 = c.maxSpeed * c.maxSpeed;
   return firstBad(c.pool, P.size(), [&](std::size_t b, std::size_t e) {
     std::size_t bad = kNone;
@@ -170,14 +170,14 @@ std::size_t stageDrift(StepContext& c) {
 }
 
 void stageCollide(StepContext& c) {
-  Particles& P = c.P;
+  ParticleStore& P = c.P;
   if (c.boundary.colliders.empty()) return;
   c.pool.parallelFor(P.size(), kBlock, [&](std::size_t b, std::size_t e) {
     for (std::size_t i = b; i < e; ++i) c.boundary.resolve(P.x[i], P.v[i], P.xPrev[i], c.clearance);
   });
 }
 
-Real maxSpeedOf(const Particles& P, ThreadPool& pool) {
+Real maxSpeedOf(const ParticleStore& P, ThreadPool& pool) {
   const Real m2 = pool.reduce(
       P.size(), kStreamBlock, Real(0),
       [&](std::size_t b, std::size_t e) {
@@ -189,7 +189,7 @@ Real maxSpeedOf(const Particles& P, ThreadPool& pool) {
   return std::sqrt(m2);
 }
 
-Real maxAccelOf(const Particles& P, ThreadPool& pool) {
+Real maxAccelOf(const ParticleStore& P, ThreadPool& pool) {
   const Real m2 = pool.reduce(
       P.size(), kStreamBlock, Real(0),
       [&](std::size_t b, std::size_t e) {

@@ -33,9 +33,9 @@ std::size_t stageDrift(StepContext& c);
 /// Swept collision against the Box2D colliders. Reads xPrev; writes x, v.
 void stageCollide(StepContext& c);
 /// Largest speed (deterministic reduction).
-Real maxSpeedOf(const Particles& P, ThreadPool& pool);
+Real maxSpeedOf(const ParticleStore& P, ThreadPool& pool);
 /// Largest acceleration magnitude (deterministic reduction).
-Real maxAccelOf(const Particles& P, ThreadPool& pool);
+Real maxAccelOf(const ParticleStore& P, ThreadPool& pool);
 /// The gravity that builds a hydrostatic pressure: its components along
 /// periodic axes are dropped (a body force along a periodic channel drives
 /// a flow; the pressure does not grow along it).
@@ -52,7 +52,7 @@ inline Vec2 hydrostaticGravity(const StepContext& c) {
 /// is scratch kept by the caller. Needs hydrostaticGravity(c) ≠ 0.
 template <class F>
 void columnDepths(const StepContext& c, std::vector<Real>& top, F f) {
-  const Particles& P = c.P;
+  const ParticleStore& P = c.P;
   const Vec2 gh = hydrostaticGravity(c);
   const Vec2 up = -gh / gh.norm(), across(up.y(), -up.x());
   Real sMin = std::numeric_limits<Real>::infinity(), sMax = -sMin;
@@ -74,6 +74,6 @@ void columnDepths(const StepContext& c, std::vector<Real>& top, F f) {
 }
 
 /// Permutes every particle field into `order` (slot k takes old slot order[k]).
-void permuteParticles(Particles& P, const std::vector<std::uint32_t>& order, Scratch& s, ThreadPool& pool);
+void permuteParticles(ParticleStore& P, const std::vector<std::uint32_t>& order, Scratch& s, ThreadPool& pool);
 
 }  // namespace sph2d

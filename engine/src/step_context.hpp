@@ -20,10 +20,10 @@
 #include "boundary_set.hpp"
 #include "constants.hpp"
 #include "grid.hpp"
-#include "sph2d/kernels.hpp"
-#include "sph2d/particles.hpp"
+#include "kernels.hpp"
+#include "particle_store.hpp"
 #include "sph2d/scene.hpp"
-#include "sph2d/thread_pool.hpp"
+#include "thread_pool.hpp"
 
 namespace sph2d {
 
@@ -64,7 +64,7 @@ struct Scratch {
 
 /// Everything a stage needs for one substep.
 struct StepContext {
-  Particles& P;
+  ParticleStore& P;
   Grid& grid;
   NeighbourLists& nbr;
   const BoundarySet& boundary;

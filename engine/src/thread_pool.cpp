@@ -1,4 +1,4 @@
-#include "sph2d/thread_pool.hpp"
+#include "thread_pool.hpp"
 
 #include <chrono>
 #if defined(__x86_64__) || defined(__i386__)

@@ -261,7 +261,19 @@ std::size_t World::removeParticlesInBox(const Vec2d& lo, const Vec2d& hi) {
   return n;
 }
 
-const Particles& World::particles() const { return impl_->P; }
+Particles World::particles() const {
+  const ParticleStore& S = impl_->P;
+  Particles P;
+  P.x = S.x;
+  P.v = S.v;
+  P.rho = S.rho;
+  P.p = S.p;
+  P.id = S.id;
+  if (const std::vector<Real>* age = S.find("age")) P.age = *age;
+  if (const std::vector<std::uint32_t>* c = S.findU32(ParticleStore::kColor)) P.color = *c;
+  if (const std::vector<std::uint32_t>* u = S.findU32(ParticleStore::kUserData)) P.userData = *u;
+  return P;
+}
 std::size_t World::particleCount() const { return impl_->P.size(); }
 Vec2d World::origin() const { return impl_->origin; }
 Vec2d World::worldPosition(std::size_t i) const {

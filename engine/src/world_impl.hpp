@@ -35,7 +35,7 @@ struct World::Impl {
   std::unique_ptr<b2World> ownWorld;  ///< the scene's bodies (null when a game attached its own)
   b2World* b2 = nullptr;              ///< the b2World the fluid collides with
   Vec2d origin{0, 0};                 ///< local frame offset (world = local + origin)
-  Particles P;
+  ParticleStore P;
   Grid grid;
   NeighbourLists nbr;
   BoundarySet boundary;

@@ -89,13 +89,14 @@ TEST_CASE("liquid frames depend on particle values only, not on storage order, a
   Renderer a(s.render);
   const std::uint64_t h0 = hashOf(a.render(world));
   // The same particles in reversed slots.
-  Particles P = world.particles();
-  Particles R;
+  const Particles P = world.particles();
+  ParticleBuffer R;
   for (std::size_t k = P.size(); k-- > 0;) {
     R.push(P.x[k], P.v[k], P.id[k], P.rho[k]);
     R.p.back() = P.p[k];
   }
-  const std::uint64_t h1 = hashOf(a.render(inputOf(world, R)));
+  const Particles reversed = R.view();
+  const std::uint64_t h1 = hashOf(a.render(inputOf(world, reversed)));
   CHECK(h0 == h1);
   Renderer b(s.render);
   CHECK(hashOf(b.render(world)) == h0);
@@ -111,8 +112,10 @@ TEST_CASE("a liquid frame does not depend on the frames before it (the backgroun
   const SceneDef s = blockScene(160, 120, Vec2d(-0.1, -0.1), Vec2d(0.3, 0.3));
   World world(s, WorldOptions{1});
   // The same block lifted by 0.08 m: its rows of the image are others.
-  Particles up = world.particles();
-  for (auto& x : up.x) x.y() += 0.08f;
+  ParticleBuffer raised;
+  raised.assign(world.particles());
+  for (auto& x : raised.x) x.y() += 0.08f;
+  const Particles up = raised.view();
   Renderer seq(s.render);
   const std::uint64_t first = hashOf(seq.render(world));
   const std::uint64_t lifted = hashOf(seq.render(inputOf(world, up)));
@@ -396,12 +399,13 @@ TEST_CASE("the overlay changes only the pixels of its box in the top-left corner
 
 TEST_CASE("100k particles render: a 2 m x 1 m lattice covers its share of a 960x540 image, both modes") {
   // 100,352 particles at 0.0044 m (about 1.07 px at 240 px/m): sprites of 4.3 px, full-resolution field.
-  Particles P;
+  ParticleBuffer B;
   const double dx = 0.0044;
   std::uint32_t id = 0;
   for (int j = 0; j < 224; ++j)
     for (int i = 0; i < 448; ++i)
-      P.push(Vec2(Real(0.5 + (i + 0.5) * dx), Real(0.5 + (j + 0.5) * dx)), Vec2(Real(i % 7), 0), id++, Real(1000));
+      B.push(Vec2(Real(0.5 + (i + 0.5) * dx), Real(0.5 + (j + 0.5) * dx)), Vec2(Real(i % 7), 0), id++, Real(1000));
+  const Particles P = B.view();
   REQUIRE(P.size() == 100352);
   RenderDef def;
   def.width = 960;
@@ -440,7 +444,8 @@ namespace {
 /// high and 0.2 m wide standing on its surface at x = 0.8 .. 1.0 (a bump), as a square lattice
 /// at rest, seen at 240 px/m (spacing 3 px, like the dam break).
 struct BumpPool {
-  Particles P;
+  ParticleBuffer B;
+  Particles P;  // B.view()
   std::vector<Collider> walls;
   RenderDef def;
   RenderInput in;
@@ -449,10 +454,11 @@ struct BumpPool {
     std::uint32_t id = 0;
     auto fill = [&](double x0, double x1, double y0, double y1) {
       for (double y = y0 + dx / 2; y < y1; y += dx)
-        for (double x = x0 + dx / 2; x < x1; x += dx) P.push(Vec2(Real(x), Real(y)), Vec2(0, 0), id++, Real(1000));
+        for (double x = x0 + dx / 2; x < x1; x += dx) B.push(Vec2(Real(x), Real(y)), Vec2(0, 0), id++, Real(1000));
     };
     fill(0.0, 2.5, 0.0, 0.6);
     fill(0.8, 1.0, 0.6, 0.9);
+    P = B.view();
     Collider wall;  // x −0.1 .. 0, y −0.1 .. 1.2, counter-clockwise
     wall.vertices = {Vec2(-0.1f, -0.1f), Vec2(0.0f, -0.1f), Vec2(0.0f, 1.2f), Vec2(-0.1f, 1.2f)};
     wall.normals = {Vec2(0, -1), Vec2(1, 0), Vec2(0, 1), Vec2(-1, 0)};

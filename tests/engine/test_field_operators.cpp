@@ -10,8 +10,8 @@
 #include <type_traits>
 #include <vector>
 
-#include "sph2d/field_operators.hpp"
-#include "sph2d/kernels.hpp"
+#include "field_operators.hpp"
+#include "kernels.hpp"
 #include "support/field_study.hpp"
 
 using namespace sph2d;

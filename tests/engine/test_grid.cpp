@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "grid.hpp"
-#include "sph2d/thread_pool.hpp"
+#include "thread_pool.hpp"
 
 using namespace sph2d;
 

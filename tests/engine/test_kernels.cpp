@@ -3,7 +3,7 @@
 
 #include <cmath>
 
-#include "sph2d/kernels.hpp"
+#include "kernels.hpp"
 
 using namespace sph2d;
 

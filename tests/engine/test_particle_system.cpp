@@ -69,8 +69,9 @@ TEST_CASE("lifetimes remove exactly the particles older than max_age, and only t
   CHECK(has(w.particleFields(), "age"));
   for (int f = 0; f < 40; ++f) {
     w.stepFrame();
-    const std::vector<Real>& age = *w.particles().find("age");
-    for (Real a : age) CHECK(a <= Real(0.25) + Real(1e-6));
+    const Particles P = w.particles();
+    REQUIRE(P.age.size() == P.size());
+    for (Real a : P.age) CHECK(a <= Real(0.25) + Real(1e-6));
   }
   // At steady state the particles alive are those emitted in the last max_age seconds.
   const double alive = double(w.particleCount());

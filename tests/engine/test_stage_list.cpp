@@ -16,7 +16,7 @@ namespace {
 
 /// The parts a StepContext refers to, empty: the stages under test do not touch them.
 struct Context {
-  Particles P;
+  ParticleStore P;
   Grid grid;
   NeighbourLists nbr;
   BoundarySet boundary;

@@ -102,7 +102,7 @@ namespace {
 
 /// Two particles and the parts a StepContext refers to (no neighbours needed).
 struct TwoParticles {
-  Particles P;
+  ParticleStore P;
   Grid grid;
   NeighbourLists nbr;
   BoundarySet boundary;

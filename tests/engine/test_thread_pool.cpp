@@ -13,7 +13,7 @@
 #include <string>
 #include <vector>
 
-#include "sph2d/thread_pool.hpp"
+#include "thread_pool.hpp"
 
 using namespace sph2d;
 

@@ -16,6 +16,18 @@ foreach(f include/sph2d/world.hpp include/sph2d/render/renderer.hpp lib/cmake/sp
     message(FATAL_ERROR "the install lacks ${f}")
   endif()
 endforeach()
+# The installed headers are the public API alone: none includes Eigen or shows the solver's
+# working fields or the job system.
+file(GLOB_RECURSE installed_headers "${WORK}/prefix/include/sph2d/*.hpp")
+foreach(h IN LISTS installed_headers)
+  file(READ "${h}" text)
+  foreach(internal "#include <Eigen" "xPrev" "invRho" "pOverRho" "ThreadPool" "thread_pool.hpp" "kernels.hpp")
+    string(FIND "${text}" "${internal}" at)
+    if(NOT at EQUAL -1)
+      message(FATAL_ERROR "the installed ${h} shows the engine's internals (${internal})")
+    endif()
+  endforeach()
+endforeach()
 step("configure" ${CMAKE_COMMAND} -S "${CONSUMER}" -B "${WORK}/build" -G "${GENERATOR}"
      -DCMAKE_BUILD_TYPE=Release -DCMAKE_CXX_COMPILER=${CXX} -DCMAKE_PREFIX_PATH=${WORK}/prefix
      -DCMAKE_FIND_USE_PACKAGE_REGISTRY=OFF)
@@ -33,18 +45,23 @@ if(NOT EXISTS "${WORK}/frame.png")
   message(FATAL_ERROR "no frame written")
 endif()
 
-# The engine alone, on a view of the machine without OSMesa and libpng (pkg-config sees
-# no modules, find_package(PNG) is disabled): it configures, builds and runs, and its
-# own source is compiled without our floating-point flags unless it opts in.
+# The engine alone, on a view of the machine without Eigen, OSMesa and libpng (pkg-config
+# sees no modules, find_package(PNG) and find_package(Eigen3) are disabled, and Eigen's
+# headers are not on the default include path): it configures, builds and runs, so the
+# public headers need no Eigen; and its own source is compiled without our floating-point
+# flags unless it opts in.
 set(ENGINE_ONLY "${CONSUMER}/../engine_only")
 set(NO_RENDER_DEPS ${CMAKE_COMMAND} -E env PKG_CONFIG_LIBDIR=${WORK}/no-pkgconfig PKG_CONFIG_PATH=)
-set(NO_RENDER_ARGS -DCMAKE_DISABLE_FIND_PACKAGE_PNG=ON -DCMAKE_PREFIX_PATH=${WORK}/prefix
+set(NO_RENDER_ARGS -DCMAKE_DISABLE_FIND_PACKAGE_PNG=ON -DCMAKE_DISABLE_FIND_PACKAGE_Eigen3=ON -DCMAKE_PREFIX_PATH=${WORK}/prefix
     -DCMAKE_FIND_USE_PACKAGE_REGISTRY=OFF -DCMAKE_CXX_COMPILER=${CXX} -G "${GENERATOR}")
 step("configure engine_only" ${NO_RENDER_DEPS} ${CMAKE_COMMAND} -S "${ENGINE_ONLY}" -B "${WORK}/engine_only"
      -DCMAKE_BUILD_TYPE=Release -DCMAKE_EXPORT_COMPILE_COMMANDS=ON ${NO_RENDER_ARGS})
 file(READ "${WORK}/engine_only/compile_commands.json" commands)
 if(commands MATCHES "ffp-contract")
   message(FATAL_ERROR "sph2d::engine imposed its floating-point flags on the game's source:\n${commands}")
+endif()
+if(commands MATCHES "eigen3")
+  message(FATAL_ERROR "sph2d::engine put Eigen on the game's include path:\n${commands}")
 endif()
 step("build engine_only" ${CMAKE_COMMAND} --build "${WORK}/engine_only")
 step("run engine_only" "${WORK}/engine_only/engine_only")

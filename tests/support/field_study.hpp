@@ -14,7 +14,7 @@
 #include <type_traits>
 #include <vector>
 
-#include "sph2d/field_operators.hpp"
+#include "field_operators.hpp"
 
 namespace sph2d::study {
 

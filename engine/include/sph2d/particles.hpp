@@ -1,141 +1,124 @@
-// sph2d/particles.hpp — structure-of-arrays particle storage.
+// sph2d/particles.hpp — a fluid's particles as read-only arrays.
 //
-// Hot fields (read every substep by the neighbour passes) are contiguous
-// arrays; the order of particles changes when the grid reorders them for
-// locality, so a game holds particles by `id`, which never changes.
+// World::particles() shows the World's own storage without copying: one
+// array per field, indexed by storage slot. Slots change when the grid
+// reorders the particles for locality or some are removed, so a game holds
+// particles by `id`, which never changes (World::slotOf, getParticle). The
+// view is valid until the World steps or its particles change. The solver's
+// working fields stay inside the engine.
+//
+// A program that keeps particles to draw later (on another thread, or read
+// from a file) owns them in a ParticleBuffer and passes its view().
 #pragma once
 
 #include <cstddef>
 #include <cstdint>
-#include <deque>
-#include <string>
-#include <utility>
 #include <vector>
 
 #include "sph2d/math.hpp"
 
 namespace sph2d {
 
-/// All per-particle data of a fluid. Index i is a storage slot; id[i] is stable.
-struct Particles {
-  std::vector<Vec2> x;            ///< position, relative to World::origin() [m]
-  std::vector<Vec2> v;            ///< velocity [m/s]
-  std::vector<Vec2> a;            ///< acceleration of the current substep [m/s²]
-  std::vector<Vec2> xPrev;        ///< position before the last integration (swept collision)
-  std::vector<Real> rho;          ///< density [kg/m³]
-  std::vector<Real> p;            ///< pressure [Pa]
-  std::vector<Real> invRho;       ///< 1/ρ, set by the pressure stage (saves divisions in pair loops)
-  std::vector<Real> pOverRho;     ///< p/ρ, set with p by the solver (every solver)
-  std::vector<std::uint32_t> id;  ///< stable identifier
+/// A read-only array someone else owns: a pointer and a length.
+template <class T>
+class ArrayView {
+ public:
+  /// An empty view.
+  constexpr ArrayView() = default;
+  /// The `size` values at `data`.
+  constexpr ArrayView(const T* data, std::size_t size) : data_(data), size_(size) {}
+  /// The values of `v` (valid while v is neither changed nor destroyed).
+  ArrayView(const std::vector<T>& v) : data_(v.data()), size_(v.size()) {}  // NOLINT: implicit on purpose
 
-  /// Optional per-particle scalar fields, created only by the solver or effect
-  /// that needs them (e.g. "age", "dfsph.kappa"), in creation order. Reordering
-  /// permutes them with the rest; push() gives new particles 0. A deque: creating
-  /// a field never moves the others, so references from field() stay valid.
-  std::deque<std::pair<std::string, std::vector<Real>>> extra;
-  /// Optional per-particle integer fields a game asks for (World::setParticleColor:
-  /// "color", World::setParticleUserData: "user_data"), in creation order; like
-  /// `extra`, permuted with the rest, 0 for new particles.
-  std::deque<std::pair<std::string, std::vector<std::uint32_t>>> extraU32;
+  /// Value i (no bounds check).
+  constexpr const T& operator[](std::size_t i) const { return data_[i]; }
+  /// Number of values.
+  constexpr std::size_t size() const { return size_; }
+  /// True when there are no values.
+  constexpr bool empty() const { return size_ == 0; }
+  /// The first value's address (null when empty and never set).
+  constexpr const T* data() const { return data_; }
+  /// Start of the values.
+  constexpr const T* begin() const { return data_; }
+  /// One past the last value.
+  constexpr const T* end() const { return data_ + size_; }
+
+ private:
+  const T* data_ = nullptr;
+  std::size_t size_ = 0;
+};
+
+/// A fluid's particles, one read-only array per field, indexed by storage slot.
+/// Optional fields are empty when the World has none of them.
+struct Particles {
+  ArrayView<Vec2> x;                  ///< position, relative to World::origin() [m]
+  ArrayView<Vec2> v;                  ///< velocity [m/s]
+  ArrayView<Real> rho;                ///< density [kg/m³]
+  ArrayView<Real> p;                  ///< pressure [Pa]
+  ArrayView<std::uint32_t> id;        ///< stable identifier
+  ArrayView<Real> age;                ///< optional: time since emission [s] (scenes with lifetimes)
+  ArrayView<std::uint32_t> color;     ///< optional: each particle's own colour 0xRRGGBB (World::setParticleColor; 0 = none)
+  ArrayView<std::uint32_t> userData;  ///< optional: the game's value per particle (World::setParticleUserData)
 
   /// Number of particles.
   std::size_t size() const { return x.size(); }
-  /// The optional field `name`, or nullptr when nothing created it.
-  std::vector<Real>* find(const std::string& name) {
-    for (auto& f : extra)
-      if (f.first == name) return &f.second;
-    return nullptr;
-  }
-  /// Const variant of find().
-  const std::vector<Real>* find(const std::string& name) const {
-    for (const auto& f : extra)
-      if (f.first == name) return &f.second;
-    return nullptr;
-  }
-  /// The optional field `name`, created (filled with `init`) on first use.
-  std::vector<Real>& field(const std::string& name, Real init = 0) {
-    if (auto* f = find(name)) return *f;
-    extra.emplace_back(name, std::vector<Real>(size(), init));
-    return extra.back().second;
-  }
-  /// The names of the optional integer fields (a save that holds one makes it one).
-  static constexpr const char* kColor = "color";
-  static constexpr const char* kUserData = "user_data";
-  /// True for the name of an optional integer field.
-  static bool integerField(const std::string& name) { return name == kColor || name == kUserData; }
-  /// The optional integer field `name`, or nullptr when nothing created it.
-  std::vector<std::uint32_t>* findU32(const std::string& name) {
-    for (auto& f : extraU32)
-      if (f.first == name) return &f.second;
-    return nullptr;
-  }
-  /// Const variant of findU32().
-  const std::vector<std::uint32_t>* findU32(const std::string& name) const {
-    for (const auto& f : extraU32)
-      if (f.first == name) return &f.second;
-    return nullptr;
-  }
-  /// The optional integer field `name`, created (filled with 0) on first use.
-  std::vector<std::uint32_t>& fieldU32(const std::string& name) {
-    if (auto* f = findU32(name)) return *f;
-    extraU32.emplace_back(name, std::vector<std::uint32_t>(size(), 0u));
-    return extraU32.back().second;
-  }
-  /// Calls f(name, field) for every per-particle array: the fixed ones, then
-  /// the optional ones in creation order. The one list of fields: storage,
-  /// removal, reordering and memory accounting all go through it.
-  template <class F>
-  void forEachField(F&& f) {
-    f("x", x);
-    f("v", v);
-    f("a", a);
-    f("xPrev", xPrev);
-    f("rho", rho);
-    f("p", p);
-    f("invRho", invRho);
-    f("pOverRho", pOverRho);
-    f("id", id);
-    for (auto& e : extra) f(e.first.c_str(), e.second);
-    for (auto& e : extraU32) f(e.first.c_str(), e.second);
-  }
-  /// Const variant of forEachField().
-  template <class F>
-  void forEachField(F&& f) const {
-    const_cast<Particles*>(this)->forEachField([&](const char* name, const auto& field) { f(name, field); });
-  }
-  /// Appends one particle at rest-density with zero pressure (optional fields 0).
-  void push(const Vec2& pos, const Vec2& vel, std::uint32_t pid, Real rho0) {
+};
+
+/// Particles a program owns: copies of a World's arrays taken between frames (to draw on
+/// another thread), or particles read from a file. view() shows them as Particles.
+struct ParticleBuffer {
+  std::vector<Vec2> x;                  ///< position, in the local frame of the World they came from [m]
+  std::vector<Vec2> v;                  ///< velocity [m/s]
+  std::vector<Real> rho;                ///< density [kg/m³]
+  std::vector<Real> p;                  ///< pressure [Pa]
+  std::vector<std::uint32_t> id;        ///< stable identifier
+  std::vector<Real> age;                ///< optional (empty or one per particle)
+  std::vector<std::uint32_t> color;     ///< optional (empty or one per particle)
+  std::vector<std::uint32_t> userData;  ///< optional (empty or one per particle)
+
+  /// Number of particles.
+  std::size_t size() const { return x.size(); }
+  /// Appends one particle with pressure 0 (and 0 in the optional fields it has).
+  void push(const Vec2& pos, const Vec2& vel, std::uint32_t pid, Real density) {
     x.push_back(pos);
     v.push_back(vel);
-    a.push_back(Vec2::Zero());
-    xPrev.push_back(pos);
-    rho.push_back(rho0);
+    rho.push_back(density);
     p.push_back(0);
-    invRho.push_back(1 / rho0);
-    pOverRho.push_back(0);
     id.push_back(pid);
-    for (auto& f : extra) f.second.push_back(0);
-    for (auto& f : extraU32) f.second.push_back(0);
+    if (!age.empty()) age.push_back(0);
+    if (!color.empty()) color.push_back(0);
+    if (!userData.empty()) userData.push_back(0);
   }
-  /// Removes the particles whose flag in `remove` is non-zero, keeping the
-  /// order of the rest (serial: deterministic). Returns how many were removed.
-  std::size_t compact(const std::vector<unsigned char>& remove) {
-    const std::size_t n = size();
-    std::size_t out = 0;
-    for (std::size_t i = 0; i < n; ++i) {
-      if (remove[i]) continue;
-      if (out != i)
-        forEachField([&](const char*, auto& field) { field[out] = field[i]; });
-      ++out;
-    }
-    forEachField([&](const char*, auto& field) { field.resize(out); });
-    return n - out;
+  /// Replaces the contents with copies of every array of `view` (capacity is kept, so a
+  /// buffer reused frame after frame stops allocating).
+  void assign(const Particles& view) {
+    copy(view.x, x);
+    copy(view.v, v);
+    copy(view.rho, rho);
+    copy(view.p, p);
+    copy(view.id, id);
+    copy(view.age, age);
+    copy(view.color, color);
+    copy(view.userData, userData);
   }
-  /// Bytes held by the particle arrays (capacity, not size).
-  std::size_t bytes() const {
-    std::size_t b = 0;
-    forEachField([&](const char*, const auto& field) { b += field.capacity() * sizeof(field[0]); });
-    return b;
+  /// The buffer as Particles (valid until the buffer changes).
+  Particles view() const {
+    Particles P;
+    P.x = x;
+    P.v = v;
+    P.rho = rho;
+    P.p = p;
+    P.id = id;
+    P.age = age;
+    P.color = color;
+    P.userData = userData;
+    return P;
+  }
+
+ private:
+  template <class T>
+  static void copy(const ArrayView<T>& from, std::vector<T>& to) {
+    to.assign(from.begin(), from.end());
   }
 };
 

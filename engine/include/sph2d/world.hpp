@@ -103,8 +103,9 @@ class World {
   /// Advances one CFL-limited substep (for benchmarks and tests). Throws SimulationError.
   void stepSubstep();
 
-  /// The particles (local frame; add origin() for world coordinates).
-  const Particles& particles() const;
+  /// The particles as read-only arrays by slot (local frame; add origin() for world
+  /// coordinates), valid until the World steps or its particles change. No copy is made.
+  Particles particles() const;
   /// Number of particles.
   std::size_t particleCount() const;
   /// Offset of the local frame in world coordinates [m].
@@ -159,6 +160,8 @@ class World {
   std::size_t neighbourPairs() const;
   /// Bytes the world holds for its particles, grid, neighbour lists and boundary samples.
   std::size_t memoryBytes() const;
+  /// Bytes the particle arrays hold (every field, the solver's working fields included).
+  std::size_t particleBytes() const;
   /// Messages the world wants the user to see (substep cap hits, dropped particles); cleared on read.
   std::vector<std::string> takeWarnings();
 
@@ -324,7 +327,7 @@ class World {
   /// set or an effect is switched.
   std::vector<std::string> stages() const;
 
-  // b2Vec2 overloads: a game passes its Box2D vectors as they are, with no Eigen at the call;
+  // b2Vec2 overloads: a game passes its Box2D vectors as they are, with no conversion at the call;
   // each does exactly what the Vec2d call of the same name does. Templates on the type (only
   // b2Vec2 qualifies), so a braced pair {x, y} still picks the Vec2d call unambiguously.
   template <class T>

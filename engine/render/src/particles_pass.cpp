@@ -34,11 +34,11 @@ class ParticlesPass final : public RenderPass {
       throw std::runtime_error("colour by age needs particle ages, and none were given");
     if (opt_.colorBy == ColorField::Color) {
       // Each particle's own 0xRRGGBB (an integer below 2^24: exact in a float); none: the fluid's.
-      const std::vector<std::uint32_t>* own = P.findU32(Particles::kColor);
+      const std::uint32_t* own = P.color.size() == P.size() ? P.color.data() : nullptr;
       packed_.resize(n * 4);
       for (std::size_t k = 0; k < n; ++k) {
         const std::size_t i = f.order[k];
-        const std::uint32_t c = own && (*own)[i] != 0 ? (*own)[i] & 0xFFFFFFu : kFluidColor;
+        const std::uint32_t c = own && own[i] != 0 ? own[i] & 0xFFFFFFu : kFluidColor;
         packed_[4 * k] = P.x[i].x();
         packed_[4 * k + 1] = P.x[i].y();
         packed_[4 * k + 2] = float(c);

@@ -25,16 +25,16 @@ float smoothstepf(float e0, float e1, float x) {
   return t * t * (3.0f - 2.0f * t);
 }
 
-RenderInput inputOf(const World& world, const Real* age) {
+// `view` is world.particles(), held by the caller for as long as the input is used.
+RenderInput inputOf(const World& world, const Particles& view, const Real* age) {
   RenderInput in;
-  in.particles = &world.particles();
+  in.particles = &view;
   in.origin = world.origin();
   in.spacing = world.spacing();
   in.colliders = &world.colliders();
   in.moving = world.movingColliders();
   // Ages come from the caller, or from the engine's "age" field when the scene has lifetimes.
-  const std::vector<Real>* engineAge = world.particles().find("age");
-  in.age = age ? age : (engineAge ? engineAge->data() : nullptr);
+  in.age = age ? age : (view.age.empty() ? nullptr : view.age.data());
   in.gravity = world.scene().gravity.norm();
   in.frame = world.frame();
   in.time = world.time();
@@ -44,7 +44,8 @@ RenderInput inputOf(const World& world, const Real* age) {
 }  // namespace
 
 std::vector<double> resolveCamera(const RenderDef& def, const World& world) {
-  return resolveCamera(def, inputOf(world, nullptr));
+  const Particles view = world.particles();
+  return resolveCamera(def, inputOf(world, view, nullptr));
 }
 
 struct Renderer::Impl {
@@ -145,7 +146,10 @@ bool Renderer::usedQuads() const { return impl_->pass->usedQuads(); }
 float Renderer::maxPointSize() const { return impl_->sprites.maxPoint(); }
 std::array<double, 2> Renderer::lastRange() const { return impl_->pass->range(); }
 
-const Frame& Renderer::render(const World& world, const Real* age) { return render(inputOf(world, age)); }
+const Frame& Renderer::render(const World& world, const Real* age) {
+  const Particles view = world.particles();
+  return render(inputOf(world, view, age));
+}
 
 const Frame& Renderer::render(const RenderInput& in) {
   Impl& r = *impl_;

@@ -13,7 +13,7 @@ class ForceFields final : public Effect {
   explicit ForceFields(std::vector<ForceFieldDef> f) : fields_(std::move(f)) {}
   const char* name() const override { return "force_fields"; }
   std::size_t apply(StepContext& c) override {
-    Particles& P = c.P;
+    ParticleStore& P = c.P;
     return firstBad(c.pool, P.size(), [&](std::size_t b, std::size_t e) {
       std::size_t bad = kNone;
       for (std::size_t i = b; i < e; ++i) {
@@ -35,7 +35,7 @@ class UserForces final : public Effect {
   explicit UserForces(const std::vector<UserForce>* f) : forces_(f) {}
   const char* name() const override { return "user_force"; }
   std::size_t apply(StepContext& c) override {
-    Particles& P = c.P;
+    ParticleStore& P = c.P;
     return firstBad(c.pool, P.size(), [&](std::size_t b, std::size_t e) {
       std::size_t bad = kNone;
       for (std::size_t i = b; i < e; ++i) {

@@ -47,7 +47,7 @@ class ParticleShifting final : public Effect {
 
   /// Shifts every particle down ∇C in as many passes as D needs (see above).
   std::size_t apply(StepContext& c) override {
-    Particles& P = c.P;
+    ParticleStore& P = c.P;
     if (!(c.dt > 0) || P.size() == 0) return kNone;
     const Real vmax = maxSpeedOf(P, c.pool);
     const Real dPass = Real(0.1) * c.R * c.R;  // the largest stable D of one pass
@@ -66,7 +66,7 @@ class ParticleShifting final : public Effect {
 
   /// One pass: x_i −= D ∇C_i (gathered into shift_, then applied). Returns the first bad slot.
   std::size_t shiftOnce(StepContext& c, Real D) {
-    Particles& P = c.P;
+    ParticleStore& P = c.P;
     const WendlandC2<Real> W(c.R);
     const Real R2 = c.R * c.R;
     const Real gradK = W.gradientScale;  // ∇W = gradK (1 − q)³ d

@@ -67,7 +67,7 @@ class SurfaceTension final : public Effect {
  private:
   /// CSF: colour gradients (pass 1), then curvature and force (pass 2).
   std::size_t applyCsf(StepContext& c) {
-    Particles& P = c.P;
+    ParticleStore& P = c.P;
     P.field("surface_tension.nx");
     P.field("surface_tension.ny");
     std::vector<Real>& nx = *P.find("surface_tension.nx");
@@ -145,7 +145,7 @@ class SurfaceTension final : public Effect {
 
   /// Akinci et al. 2013: normals (pass 1), then pairwise cohesion and curvature forces (pass 2).
   std::size_t applyAkinci(StepContext& c) {
-    Particles& P = c.P;
+    ParticleStore& P = c.P;
     P.field("surface_tension.nx");
     P.field("surface_tension.ny");
     std::vector<Real>& nx = *P.find("surface_tension.nx");

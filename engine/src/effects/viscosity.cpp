@@ -28,7 +28,7 @@ class LaplacianViscosity final : public Effect {
   Real maxTimeStep(const StepContext& c) const override { return Real(0.03) * c.R * c.R / nu_; }
 
   std::size_t apply(StepContext& c) override {
-    Particles& P = c.P;
+    ParticleStore& P = c.P;
     const ViscosityKernel<Real> W(c.R);
     if (c.R != momentR_ || c.dx != momentDx_) {
       const ViscosityKernel<double> Wd(double(c.R));

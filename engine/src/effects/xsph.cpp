@@ -15,7 +15,7 @@ class Xsph final : public Effect {
   explicit Xsph(double c) : c_(Real(c)) {}
   const char* name() const override { return "xsph"; }
   std::size_t apply(StepContext& c) override {
-    Particles& P = c.P;
+    ParticleStore& P = c.P;
     if (!(c.dt > 0)) return kNone;
     const WendlandC2<Real> W(c.R);
     const Real k = c_ / c.dt * Real(2) * c.mass;

@@ -102,7 +102,7 @@ class Dfsph final : public Solver {
   /// (H/dx)² iterations for that (measured: at dx = 5 mm the 2 m dam-break
   /// column crushed its floor rows by 55 % and blew up at t = 0.06 s).
   void hydrostaticWarmStart(StepContext& c, std::vector<Real>& kappa) const {
-    Particles& P = c.P;
+    ParticleStore& P = c.P;
     const Real g = hydrostaticGravity(c).norm();
     if (!(g > 0) || P.size() == 0) return;
     depths(c, [&](std::size_t i, Real depth) {
@@ -170,7 +170,7 @@ class Dfsph final : public Solver {
  private:
   /// ρ, 1/ρ, α, the per-neighbour (slot, m∇W_ij) and per particle Σ_j m∇W_ij + Σ_b ρ0Ψ_b∇W_ib.
   std::size_t densityAndFactor(StepContext& c, const WendlandC2<Real>& W) {
-    Particles& P = c.P;
+    ParticleStore& P = c.P;
     const std::size_t n = P.size();
     const BoundarySet& B = c.boundary;
     const bool walls = !B.samples.empty();
@@ -248,7 +248,7 @@ class Dfsph final : public Solver {
   /// One solve: warm start, then iterations of (B, A) until the mean error is small.
   /// divergence: the divergence-free solve (source Dρ/Dt), else the constant-density solve.
   void solve(StepContext& c, bool divergence) {
-    Particles& P = c.P;
+    ParticleStore& P = c.P;
     const std::size_t n = P.size();
     std::vector<Real>& kappa = *P.find(divergence ? "dfsph.kappa_v" : "dfsph.kappa");
     const Real dt = c.dt;
@@ -301,7 +301,7 @@ class Dfsph final : public Solver {
 
   /// v_i −= dt [Σ_j m (κ_i/ρ_i + κ_j/ρ_j) ∇W_ij + Σ_b ρ0Ψ_b (κ_i/ρ_i) ∇W_ib] with κ = scale·kappa; then kappa = κ.
   void warmStart(StepContext& c, std::vector<Real>& kappa, Real scale) {
-    Particles& P = c.P;
+    ParticleStore& P = c.P;
     const std::size_t n = P.size();
     const Real* IR = P.invRho.data();
     Real* K = kappa.data();
@@ -330,7 +330,7 @@ class Dfsph final : public Solver {
   }
 
   Sums sourcePass(StepContext& c, const std::vector<Real>& kappa, bool divergence, Real shift) {
-    Particles& P = c.P;
+    ParticleStore& P = c.P;
     const NeighbourLists& L = c.nbr;
     const Vec2* V = P.v.data();
     const Real* K = kappa.data();
@@ -385,7 +385,7 @@ class Dfsph final : public Solver {
   /// Pass B: v_i −= dt [Σ_j (q_i + q_j) m∇W_ij + q_i Σ_b ρ0Ψ_b∇W_ib]; κ_i += dk_i
   /// (w ≠ 1: the Chebyshev step from the previous iterate).
   void correctPass(StepContext& c, std::vector<Real>& kappa, Real w = 1) {
-    Particles& P = c.P;
+    ParticleStore& P = c.P;
     const NeighbourLists& L = c.nbr;
     Vec2* V = P.v.data();
     const Real* Q = q_.data();
@@ -425,7 +425,7 @@ class Dfsph final : public Solver {
 
   /// x += dt v (xPrev for the swept collision); p = κρ for readers. Returns the first bad slot.
   std::size_t integrate(StepContext& c) {
-    Particles& P = c.P;
+    ParticleStore& P = c.P;
     const std::vector<Real>& kappa = *P.find("dfsph.kappa");
     const Real dt = c.dt;
     const Real vmax2 = c.maxSpeed * c.maxSpeed;

@@ -19,7 +19,7 @@ namespace sph2d {
 namespace {
 
 std::size_t density(StepContext& c, const Poly6<Real>& W) {
-  Particles& P = c.P;
+  ParticleStore& P = c.P;
   const NeighbourLists& L = c.nbr;
   const BoundarySet& B = c.boundary;
   const bool hasBoundary = !B.samples.empty();
@@ -56,7 +56,7 @@ std::size_t density(StepContext& c, const Poly6<Real>& W) {
 void pressure(StepContext& c) {
   const Real stiffness = Real(c.def.soundSpeed * c.def.soundSpeed);
   const bool clampNegative = c.def.clampNegativePressure;
-  Particles& P = c.P;
+  ParticleStore& P = c.P;
   c.pool.parallelFor(P.size(), 4096, [&](std::size_t b, std::size_t e) {
     for (std::size_t i = b; i < e; ++i) {
       Real p = stiffness * (P.rho[i] - c.rho0);
@@ -69,7 +69,7 @@ void pressure(StepContext& c) {
 }
 
 std::size_t pressureForce(StepContext& c, const Spiky<Real>& spiky) {
-  Particles& P = c.P;
+  ParticleStore& P = c.P;
   const BoundarySet& B = c.boundary;
   const bool hasBoundary = !B.samples.empty();
   const Real R = spiky.R;

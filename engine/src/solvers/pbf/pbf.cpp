@@ -61,7 +61,7 @@ Real Pbf::maxTimeStep(const StepContext& c, Real vmax, Real amax) const {
 }
 
 Real Pbf::robustSpeed(const StepContext& c) const {
-  const Particles& P = c.P;
+  const ParticleStore& P = c.P;
   const std::size_t n = P.size();
   std::vector<Real>& s = speedScratch_;
   s.resize(n);
@@ -80,7 +80,7 @@ std::vector<Stage> Pbf::stages(bool effects) {
     s.push_back(plainStage("neighbours", [](StepContext& c) { stageNeighbours(c); }));
   }
   s.push_back(plainStage("external", [](StepContext& c) {
-    Particles& P = c.P;
+    ParticleStore& P = c.P;
     c.pool.parallelFor(P.size(), kStreamBlock, [&](std::size_t b, std::size_t e) {
       for (std::size_t i = b; i < e; ++i) P.a[i] = c.gravity;
     });
@@ -256,7 +256,7 @@ void Pbf::calibrate(const StepContext& c) {
 }
 
 std::size_t Pbf::predict(StepContext& c, std::vector<Real>& lambda) {
-  Particles& P = c.P;
+  ParticleStore& P = c.P;
   const Real dt = c.dt, vmax2 = c.maxSpeed * c.maxSpeed;
   // The grid projection's compression shift of this substep (positions only).
   const std::vector<Vec2>* shift =
@@ -292,7 +292,7 @@ Real Pbf::pressure(const StepContext& c, const std::vector<Real>* lam, Real pK, 
 }
 
 std::size_t Pbf::finalDensity(StepContext& c, Real dt) {
-  Particles& P = c.P;
+  ParticleStore& P = c.P;
   if (rhoCurrent_) {  // the last constraint pass already summed ρ (and cached W) at these positions
     const std::vector<Real>* lam = P.find("pbf.lambda");
     const Real pK = dt > 0 ? -c.rho0 / (dt * dt) : Real(0);
@@ -355,7 +355,7 @@ std::size_t Pbf::finalDensity(StepContext& c, Real dt) {
 }
 
 std::size_t Pbf::velocity(StepContext& c) {
-  Particles& P = c.P;
+  ParticleStore& P = c.P;
   const Real invDt = Real(1) / c.dt, vmax2 = c.maxSpeed * c.maxSpeed;
   const Vec2* X = P.x.data();
   const Vec2* X0 = P.xPrev.data();

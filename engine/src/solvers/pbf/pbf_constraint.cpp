@@ -103,7 +103,7 @@ static_assert(std::is_same<Real, float>::value, "Lane4 is single precision");
 }  // namespace
 
 std::size_t Pbf::constraint(StepContext& c, const std::vector<Real>& lambda, const std::vector<std::uint32_t>* list) {
-  Particles& P = c.P;
+  ParticleStore& P = c.P;
   const BoundarySet& B = c.boundary;
   const Spiky<Real> S(c.R);
   const Real invR = Real(1) / c.R, wK = S.c * c.R * c.R * c.R, gK = Real(-3) * S.c * c.R * c.R;
@@ -276,7 +276,7 @@ std::size_t Pbf::constraint(StepContext& c, const std::vector<Real>& lambda, con
 }
 
 std::size_t Pbf::correct(StepContext& c, std::vector<Real>& lambda, Real omega, const std::vector<std::uint32_t>* list) {
-  Particles& P = c.P;
+  ParticleStore& P = c.P;
   const Spiky<Real> S(c.R);
   const Real wK = S.c * c.R * c.R * c.R, gK = Real(-3) * S.c * c.R * c.R;
   const Real invVg = Real(1) / -(c.mass / c.rho0 * gK);

@@ -56,7 +56,7 @@ class Wcsph final : public Solver {
     // The Tait sound speed grows with compression: c² = dp/dρ = c0² (ρ/ρ0)^(γ−1).
     // Using the largest density keeps the step stable when an impact compresses
     // the fluid far beyond what c0 was chosen for.
-    const Particles& P = c.P;
+    const ParticleStore& P = c.P;
     const Real rhoMax = c.pool.reduce(
         P.size(), 4096, c.rho0,
         [&](std::size_t b, std::size_t e) {
@@ -80,7 +80,7 @@ class Wcsph final : public Solver {
 
  private:
   std::size_t density(StepContext& c, const WendlandC2<Real>& W) const {
-    Particles& P = c.P;
+    ParticleStore& P = c.P;
     const Vec2* X = P.x.data();
     const Real self = W.value(0);
     const bool walls = !c.boundary.samples.empty();
@@ -112,7 +112,7 @@ class Wcsph final : public Solver {
   }
 
   void pressure(StepContext& c) {
-    Particles& P = c.P;
+    ParticleStore& P = c.P;
     pOverRho2_.resize(P.size());
     const Real B = c.rho0 * c0_ * c0_ / gamma_;
     const bool clamp = c.def.clampNegativePressure;
@@ -139,7 +139,7 @@ class Wcsph final : public Solver {
   }
 
   std::size_t pressureForce(StepContext& c, const WendlandC2<Real>& W) const {
-    Particles& P = c.P;
+    ParticleStore& P = c.P;
     const BoundarySet& B = c.boundary;
     const bool walls = !B.samples.empty();
     const Real R = c.R, h = Real(0.5) * R;
