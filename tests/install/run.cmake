@@ -1,6 +1,7 @@
 # CTest's install/find_package test: install the build into a fresh prefix,
 # configure and build tests/install/consumer against it (find_package(sph2d)),
-# run the program. Arguments: BUILD_DIR, WORK, CONSUMER, CXX, GENERATOR.
+# run the program (a game: a floating crate, a paddle, team colours, a save and a
+# reload, frames drawn into its own OpenGL context). Arguments: BUILD_DIR, WORK, CONSUMER, CXX, GENERATOR.
 file(REMOVE_RECURSE "${WORK}")
 function(step what)
   execute_process(COMMAND ${ARGN} RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
@@ -38,9 +39,15 @@ endif()
 step("build" ${CMAKE_COMMAND} --build "${WORK}/build")
 step("run" "${WORK}/build/consumer" "${WORK}/frame.png")
 message("${STEP_OUT}")
-if(NOT STEP_OUT MATCHES "consumer: [0-9]+ particles, state [0-9a-f]+, water")
-  message(FATAL_ERROR "unexpected output")
-endif()
+# The consumer exits 1 when a check fails; its lines say what it saw.
+foreach(line "consumer: [0-9]+ particles, state [0-9a-f]+, water"
+             "crate at y = [0-9.]+ m after [0-9]+ frames: afloat"
+             "reloaded: state equal to the uninterrupted World's"
+             "drawn into the game's own context .*game state kept")
+  if(NOT STEP_OUT MATCHES "${line}")
+    message(FATAL_ERROR "unexpected output: no line matching '${line}'")
+  endif()
+endforeach()
 if(NOT EXISTS "${WORK}/frame.png")
   message(FATAL_ERROR "no frame written")
 endif()

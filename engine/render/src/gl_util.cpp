@@ -82,7 +82,7 @@ GLuint target(GLenum internal, GLenum format, GLenum type, int w, int h, GLuint&
   glBindFramebuffer(GL_FRAMEBUFFER, fbo);
   glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, tex, 0);
   if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
-    throw std::runtime_error("OSMesa: incomplete framebuffer");
+    throw std::runtime_error("the renderer's own framebuffer is incomplete");
   return fbo;
 }
 

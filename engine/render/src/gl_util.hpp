@@ -1,8 +1,9 @@
 // gl_util.hpp — the OpenGL plumbing every pass needs: shaders from shaders/ (embedded at build
 // time, or read from $SPH2D_SHADER_DIR for shader work), programs, textures and framebuffers.
 //
-// Design: thin free functions over the GL 3.3 core API of the current OSMesa context; they
-// throw std::runtime_error with the shader's log or the object that failed, and hold no state.
+// Design: thin free functions over the GL 3.3 core API of the current context (the Renderer's
+// own OSMesa context, or a game's: gl_state.hpp); they throw std::runtime_error with the
+// shader's log or the object that failed, and hold no state.
 #pragma once
 
 #define GL_GLEXT_PROTOTYPES 1

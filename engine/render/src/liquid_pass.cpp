@@ -46,6 +46,17 @@ class LiquidPass final : public RenderPass {
     drawnRows_ = {0, 1 << 30};  // a new colour target: the whole background at the next frame
   }
 
+  void release() override {
+    for (GLuint p : {splatProg_, compositeProg_})
+      if (p) glDeleteProgram(p);
+    const GLuint textures[2] = {fieldTex_, auxTex_};
+    glDeleteTextures(2, textures);
+    glDeleteFramebuffers(1, &fieldFbo_);
+    glDeleteVertexArrays(1, &tileVao_);
+    glDeleteBuffers(1, &tileVbo_);
+    splatProg_ = compositeProg_ = fieldTex_ = auxTex_ = fieldFbo_ = tileVao_ = tileVbo_ = 0;
+  }
+
   void prepare(const PassFrame& f) override {
     const Particles& P = *f.in.particles;
     const std::size_t n = f.order.size();

@@ -25,6 +25,10 @@ class ParticlesPass final : public RenderPass {
   const char* mode() const override { return "particles"; }
   float spriteDiameter(double spacingPx) const override { return float(std::max(3.0, spacingPx)); }
   std::array<double, 2> range() const override { return range_; }
+  void release() override {
+    if (discProg_) glDeleteProgram(discProg_);
+    discProg_ = 0;
+  }
 
   void prepare(const PassFrame& f) override {
     const RenderInput& in = f.in;

@@ -43,15 +43,22 @@ struct StageTimer {
 /// The colour target the frame is drawn into (the image plus guard bands) and its background.
 struct ColorTarget {
   GLuint fbo = 0, tex = 0;
-  GLuint background = 0;  ///< the background texture, same size
+  GLuint background = 0;     ///< the background texture, same size
+  GLuint backgroundFbo = 0;  ///< its framebuffer
+  bool copyImage = true;     ///< glCopyImageSubData exists (OpenGL 4.3); else rows are blitted (3.3)
   int EW = 0, EH = 0;
   /// Starts the frame: copies the background into the colour target and binds it.
   void startFrame() const { startFrameRows(0, EH); }
   /// Starts the frame when only rows [y0, y1) (window rows, from the world's top) differ from
   /// the background and solids: copies the background over those rows and binds the target.
   void startFrameRows(int y0, int y1) const {
-    if (y1 > y0)
+    if (y1 > y0 && copyImage) {
       glCopyImageSubData(background, GL_TEXTURE_2D, 0, 0, y0, 0, tex, GL_TEXTURE_2D, 0, 0, y0, 0, EW, y1 - y0, 1);
+    } else if (y1 > y0) {  // the same texels, copied by a 1:1 blit (no filtering, no scissor: gl_state.hpp)
+      glBindFramebuffer(GL_READ_FRAMEBUFFER, backgroundFbo);
+      glBindFramebuffer(GL_DRAW_FRAMEBUFFER, fbo);
+      glBlitFramebuffer(0, y0, EW, y1, 0, y0, EW, y1, GL_COLOR_BUFFER_BIT, GL_NEAREST);
+    }
     glBindFramebuffer(GL_FRAMEBUFFER, fbo);
   }
 };
@@ -81,6 +88,8 @@ class RenderPass {
   virtual int spriteShrink(double /*spacingPx*/) const { return 1; }
   /// The targets changed size: drop what depends on it (recreated at the next frame).
   virtual void targetsChanged() {}
+  /// Deletes the pass's GL objects (the context that made them must be current).
+  virtual void release() = 0;
   /// CPU work and uploads before drawing (the upload stage). Throws std::runtime_error.
   virtual void prepare(const PassFrame& f) = 0;
   /// Draws into the colour target, starting it from the background; ends its own stages.

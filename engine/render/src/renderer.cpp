@@ -1,18 +1,25 @@
-// renderer.cpp — the Renderer: one OSMesa context and the frame loop shared by both modes.
+// renderer.cpp — the Renderer: its context (an OSMesa one of its own, or the caller's) and the
+// frame loop shared by both modes and both contexts.
 //
-// Design: per frame, on the thread that created the Renderer: fix the camera (first frame),
-// size the targets' guard band for the sprites (camera.hpp), order the particles by id and
-// weigh them by their age fade (sprites.hpp), let the mode's pass pack and draw them
-// (render_pass.hpp: liquid or particles, chosen once in the constructor), draw the solids on
-// top (scenery.hpp), read the image back with glReadPixels (rows come out top-down: the
-// camera flips y) and draw text on the CPU. Stage times are taken with glFinish between
-// stages only when RenderOptions::profile is set.
+// Design: per frame, on the thread that created the Renderer: set the state the passes rely on
+// (gl_state.hpp), fix the camera (first frame), size the targets' guard band for the sprites
+// (camera.hpp), order the particles by id and weigh them by their age fade (sprites.hpp), let
+// the mode's pass pack and draw them (render_pass.hpp: liquid or particles, chosen once in the
+// constructor), draw the solids on top (scenery.hpp): drawFrame(), into the Renderer's own
+// colour target. Then render() reads the image back with glReadPixels (rows come out top-down:
+// the camera flips y) and draws text on the CPU, and draw() draws the target into the caller's
+// framebuffer (present.hpp). In the caller's context both run inside a GlStateGuard; in the
+// Renderer's own OSMesa context nothing needs restoring. Stage times are taken with glFinish
+// between stages only when RenderOptions::profile is set.
 #include "sph2d/render/renderer.hpp"
 
 #include <algorithm>
 #include <cstdio>
+#include <optional>
 #include <stdexcept>
 
+#include "gl_state.hpp"
+#include "present.hpp"
 #include "render_pass.hpp"
 #include "scenery.hpp"
 #include "sph2d/world.hpp"
@@ -51,11 +58,14 @@ std::vector<double> resolveCamera(const RenderDef& def, const World& world) {
 struct Renderer::Impl {
   RenderDef def;
   RenderOptions opt;
+  bool ownContext = false;                     // an OSMesa context of the Renderer's, else the caller's
   OSMesaContext ctx = nullptr;
   unsigned char dummy[4] = {0, 0, 0, 0};
+  gl::ContextInfo glInfo;
   SpriteBatch sprites;
   Scenery scenery;
   std::unique_ptr<RenderPass> pass;
+  Presenter presenter;                         // the caller's context only
   FrameGeometry geo;
   ColorTarget color;
   double spacingSeen = -1;
@@ -63,11 +73,58 @@ struct Renderer::Impl {
   Frame frame;
   std::vector<std::uint32_t> order, slotOfId;  // slots in id order; scratch
   std::vector<float> weight;                   // age fade per particle, id order
-  std::string rendererName;
   RenderTimings timings;
+
+  ~Impl() {
+    if (ownContext) {
+      if (ctx) OSMesaDestroyContext(ctx);  // with it, every GL object of the passes
+    } else if (glInfo.major > 0 && glGetString(GL_VERSION)) {
+      releaseGl();  // the caller's context (probed: 3.3 or later): the objects made there are ours to delete
+    }
+  }
 
   void makeCurrent() {
     if (!OSMesaMakeCurrent(ctx, dummy, GL_UNSIGNED_BYTE, 1, 1)) throw std::runtime_error("OSMesaMakeCurrent failed");
+  }
+
+  /// The GL objects of the passes, in the current context (probed into glInfo first).
+  void init(const std::string& mode) {
+    color.copyImage = glInfo.copyImage;
+    sprites.init();
+    scenery.init();
+    pass = mode == "liquid" ? makeLiquidPass(def, opt, sprites) : makeParticlesPass(def, opt, sprites);
+    if (!ownContext) presenter.init();
+    frame.width = def.width;
+    frame.height = def.height;
+    gl::throwOnError("while creating the renderer");
+  }
+
+  /// Deletes every GL object made by init() and the frames (the caller's context).
+  void releaseGl() {
+    if (pass) pass->release();
+    scenery.release();
+    sprites.release();
+    presenter.release();
+    glDeleteFramebuffers(1, &color.fbo);
+    glDeleteTextures(1, &color.tex);
+    color.fbo = color.tex = 0;
+  }
+
+  /// Before using the caller's context: one must be current, and no error of the caller's pending
+  /// (glGetError would take it and blame sph2d's calls).
+  static void enterCallerContext(const char* call) {
+    if (!glGetString(GL_VERSION))
+      throw std::runtime_error(std::string("Renderer::") + call +
+                               ": no OpenGL context is current on this thread (make the one the Renderer was "
+                               "created in current)");
+    const GLenum err = glGetError();
+    if (err != GL_NO_ERROR) {
+      char code[16];
+      std::snprintf(code, sizeof code, "0x%x", err);
+      throw std::runtime_error(std::string("Renderer::") + call + ": an OpenGL error (" + code +
+                               ") was pending in the caller's context before the call; sph2d checks its own calls "
+                               "with glGetError, so clear (and handle) the caller's errors first");
+    }
   }
 
   float fade(const RenderInput& in, std::size_t slot) const {
@@ -87,11 +144,63 @@ struct Renderer::Impl {
     geo.setGuard(g, def.width, def.height);
     if (color.fbo) glDeleteFramebuffers(1, &color.fbo);
     color.fbo = gl::target(GL_RGBA8, GL_RGBA, GL_UNSIGNED_BYTE, geo.EW, geo.EH, color.tex);
+    // Only the presentation samples the frame, bilinearly when it scales it (present.frag).
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
     scenery.build(def, geo, in);
     color.background = scenery.background();
+    color.backgroundFbo = scenery.backgroundFbo();
     color.EW = geo.EW;
     color.EH = geo.EH;
     pass->targetsChanged();
+  }
+
+  /// The frame of `in` into the colour target: every pass, in both contexts. Ends the upload,
+  /// splat, composite and solids stages.
+  void drawFrame(const RenderInput& in, StageTimer& timer) {
+    if (!in.particles) throw std::invalid_argument("Renderer: no particles to render");
+    gl::setDrawState(glInfo);
+    const RenderDef& d = def;
+    if (geo.cam.empty()) geo.cam = resolveCamera(d, in);
+    ensureFrame(in);
+
+    const Particles& P = *in.particles;
+    const std::size_t n = P.size();
+    PassFrame f{in, order, weight, geo, geo.pxPerM(d.width), 0, {0, 0}, {0, 0}, color};
+    f.spacingPx = in.spacing * f.pxPerM;
+    geo.ndcTransform(in.origin, f.scale, f.offset);
+
+    // Id order and age fades, then the pass's own packing and uploads.
+    idOrder(P, order, slotOfId);
+    weight.resize(n);
+    for (std::size_t k = 0; k < n; ++k) weight[k] = fade(in, order[k]);
+    pass->prepare(f);
+    glViewport(0, 0, geo.EW, geo.EH);
+    timer.end(timings.upload);
+
+    pass->restoreRows(movingRows);  // where moving bodies were last frame goes back to the background
+    pass->draw(f, timer, timings);
+    const auto rows = pass->changedRows();  // solids on top, where the pass may have drawn over them
+    scenery.drawSolids(d, rows.first, rows.second);
+    movingRows = scenery.drawMoving(d, geo, in);
+    timer.end(timings.solids);
+  }
+
+  /// The image into `frame` (glReadPixels from the colour target, bound by drawFrame), then the
+  /// CPU text. Ends the readback and overlay stages.
+  void readback(const RenderInput& in, StageTimer& timer) {
+    const RenderDef& d = def;
+    frame.rgba.resize(std::size_t(d.width) * d.height * 4);
+    glPixelStorei(GL_PACK_ALIGNMENT, 1);
+    glReadPixels(geo.guard, geo.guard, d.width, d.height, GL_RGBA, GL_UNSIGNED_BYTE, frame.rgba.data());
+    gl::throwOnError("while rendering");
+    timer.end(timings.readback);
+
+    // Text and colour bar on the CPU (bit-identical everywhere).
+    const int textScale = std::max(1, d.height / 270);
+    pass->annotate(frame, textScale);
+    if (opt.overlay) drawOverlay(in, textScale);
+    timer.end(timings.overlay);
   }
 
   /// Frame number, time and particle count in the top-left corner, on a translucent box.
@@ -107,13 +216,23 @@ struct Renderer::Impl {
   }
 };
 
+namespace {
+
+std::string checkedMode(const RenderDef& def, const RenderOptions& options) {
+  const std::string mode = options.mode.empty() ? def.mode : options.mode;
+  if (mode != "liquid" && mode != "particles")
+    throw std::runtime_error("unknown render mode '" + mode + "' (liquid or particles)");
+  return mode;
+}
+
+}  // namespace
+
 Renderer::Renderer(const RenderDef& def, const RenderOptions& options) : impl_(std::make_unique<Impl>()) {
   Impl& r = *impl_;
   r.def = def;
   r.opt = options;
-  const std::string mode = options.mode.empty() ? def.mode : options.mode;
-  if (mode != "liquid" && mode != "particles")
-    throw std::runtime_error("unknown render mode '" + mode + "' (liquid or particles)");
+  r.ownContext = true;
+  const std::string mode = checkedMode(def, options);
   pinRenderEnvironment();
   const int attribs[] = {OSMESA_FORMAT, OSMESA_RGBA, OSMESA_DEPTH_BITS, 0, OSMESA_STENCIL_BITS, 0, OSMESA_ACCUM_BITS, 0,
                          OSMESA_PROFILE, OSMESA_CORE_PROFILE, OSMESA_CONTEXT_MAJOR_VERSION, 3,
@@ -122,29 +241,32 @@ Renderer::Renderer(const RenderDef& def, const RenderOptions& options) : impl_(s
   if (!r.ctx) throw std::runtime_error("OSMesa could not create a 3.3 core-profile context (is libosmesa6 installed?)");
   r.makeCurrent();
   OSMesaPixelStore(OSMESA_Y_UP, 0);
-  const char* ren = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
-  const char* ver = reinterpret_cast<const char*>(glGetString(GL_VERSION));
-  r.rendererName = std::string(ren ? ren : "?") + " / " + (ver ? ver : "?");
-  r.sprites.init();
-  r.scenery.init();
-  r.pass = mode == "liquid" ? makeLiquidPass(def, options, r.sprites) : makeParticlesPass(def, options, r.sprites);
-  r.frame.width = def.width;
-  r.frame.height = def.height;
-  r.frame.rgba.assign(std::size_t(def.width) * def.height * 4, 0);
-  gl::throwOnError("while creating the renderer");
+  r.glInfo = gl::currentContext();
+  r.init(mode);
 }
 
-Renderer::~Renderer() {
-  if (impl_ && impl_->ctx) OSMesaDestroyContext(impl_->ctx);  // with it, every GL object of the passes
+Renderer::Renderer(CurrentGlContext, const RenderDef& def, const RenderOptions& options)
+    : impl_(std::make_unique<Impl>()) {
+  Impl& r = *impl_;
+  r.def = def;
+  r.opt = options;
+  const std::string mode = checkedMode(def, options);
+  Impl::enterCallerContext("Renderer");
+  r.glInfo = gl::currentContext();
+  gl::GlStateGuard saved(r.glInfo);
+  r.init(mode);  // on a throw, ~Impl deletes what was made
 }
 
-std::string Renderer::rendererString() const { return impl_->rendererName; }
+Renderer::~Renderer() = default;
+
+std::string Renderer::rendererString() const { return impl_->glInfo.renderer + " / " + impl_->glInfo.version; }
 std::vector<double> Renderer::cameraRect() const { return impl_->geo.cam; }
 std::string Renderer::mode() const { return impl_->pass->mode(); }
 RenderTimings Renderer::lastTimings() const { return impl_->timings; }
 bool Renderer::usedQuads() const { return impl_->pass->usedQuads(); }
 float Renderer::maxPointSize() const { return impl_->sprites.maxPoint(); }
 std::array<double, 2> Renderer::lastRange() const { return impl_->pass->range(); }
+bool Renderer::usesCurrentContext() const { return !impl_->ownContext; }
 
 const Frame& Renderer::render(const World& world, const Real* age) {
   const Particles view = world.particles();
@@ -158,44 +280,46 @@ const Frame& Renderer::render(const RenderInput& in) {
   timer.profile = r.opt.profile;
   const auto tStart = timer.t;
   r.timings = RenderTimings{};
-  r.makeCurrent();
-  const RenderDef& d = r.def;
-  if (r.geo.cam.empty()) r.geo.cam = resolveCamera(d, in);
-  r.ensureFrame(in);
-
-  const Particles& P = *in.particles;
-  const std::size_t n = P.size();
-  PassFrame f{in, r.order, r.weight, r.geo, r.geo.pxPerM(d.width), 0, {0, 0}, {0, 0}, r.color};
-  f.spacingPx = in.spacing * f.pxPerM;
-  r.geo.ndcTransform(in.origin, f.scale, f.offset);
-
-  // Id order and age fades, then the pass's own packing and uploads.
-  idOrder(P, r.order, r.slotOfId);
-  r.weight.resize(n);
-  for (std::size_t k = 0; k < n; ++k) r.weight[k] = r.fade(in, r.order[k]);
-  r.pass->prepare(f);
-  glViewport(0, 0, r.geo.EW, r.geo.EH);
-  timer.end(r.timings.upload);
-
-  r.pass->restoreRows(r.movingRows);  // where moving bodies were last frame goes back to the background
-  r.pass->draw(f, timer, r.timings);
-  const auto rows = r.pass->changedRows();  // solids on top, where the pass may have drawn over them
-  r.scenery.drawSolids(d, rows.first, rows.second);
-  r.movingRows = r.scenery.drawMoving(d, r.geo, in);
-  timer.end(r.timings.solids);
-
-  glPixelStorei(GL_PACK_ALIGNMENT, 1);
-  glReadPixels(r.geo.guard, r.geo.guard, d.width, d.height, GL_RGBA, GL_UNSIGNED_BYTE, r.frame.rgba.data());
-  gl::throwOnError("while rendering");
-  timer.end(r.timings.readback);
-
-  // Text and colour bar on the CPU (bit-identical everywhere).
-  const int textScale = std::max(1, d.height / 270);
-  r.pass->annotate(r.frame, textScale);
-  if (r.opt.overlay) r.drawOverlay(in, textScale);
-  timer.end(r.timings.overlay);
+  std::optional<gl::GlStateGuard> saved;
+  if (r.ownContext) {
+    r.makeCurrent();
+  } else {
+    Impl::enterCallerContext("render");
+    saved.emplace(r.glInfo);
+  }
+  r.drawFrame(in, timer);
+  r.readback(in, timer);
   r.timings.total = StageTimer::msSince(tStart);
   return r.frame;
+}
+
+void Renderer::draw(const World& world, const GlTarget& target, const Real* age) {
+  const Particles view = world.particles();
+  draw(inputOf(world, view, age), target);
+}
+
+void Renderer::draw(const RenderInput& in, const GlTarget& target) {
+  Impl& r = *impl_;
+  if (r.ownContext)
+    throw std::logic_error(
+        "Renderer::draw: this Renderer has an OSMesa context of its own (render() gives its frames); draw() needs "
+        "one made with sph2d::currentGlContext in the game's OpenGL context");
+  if (!in.particles) throw std::invalid_argument("Renderer::draw: no particles");
+  StageTimer timer;
+  timer.profile = r.opt.profile;
+  const auto tStart = timer.t;
+  r.timings = RenderTimings{};
+  Impl::enterCallerContext("draw");
+  const gl::GlStateGuard saved(r.glInfo);
+  const GLuint fbo = target.framebuffer ? GLuint(*target.framebuffer) : saved.drawFramebuffer();
+  GLint viewport[4];
+  for (int k = 0; k < 4; ++k) viewport[k] = target.viewport ? (*target.viewport)[std::size_t(k)] : saved.viewport()[k];
+  Presenter::check(fbo, viewport);  // before any work
+  r.drawFrame(in, timer);
+  r.presenter.draw(r.color.tex, r.geo.guard, r.def.width, r.def.height, fbo, viewport);
+  gl::throwOnError("while drawing into the caller's framebuffer");
+  timer.end(r.timings.present);
+  r.timings.total = StageTimer::msSince(tStart);
 }
 
 }  // namespace sph2d

@@ -17,6 +17,18 @@ void Scenery::init() {
   glGenBuffers(1, &movingVbo_);
 }
 
+void Scenery::release() {
+  for (GLuint p : {bgProg_, solidProg_})
+    if (p) glDeleteProgram(p);
+  const GLuint arrays[3] = {emptyVao_, solidVao_, movingVao_}, buffers[2] = {solidVbo_, movingVbo_};
+  glDeleteVertexArrays(3, arrays);
+  glDeleteBuffers(2, buffers);
+  glDeleteTextures(1, &bgTex_);
+  glDeleteFramebuffers(1, &bgFbo_);
+  bgProg_ = solidProg_ = emptyVao_ = solidVao_ = movingVao_ = solidVbo_ = movingVbo_ = bgTex_ = bgFbo_ = 0;
+  solidCount_ = 0;
+}
+
 void Scenery::build(const RenderDef& def, const FrameGeometry& geo, const RenderInput& in) {
   buildBackground(def, geo);
   buildSolids(geo, in);

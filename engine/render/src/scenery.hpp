@@ -19,10 +19,14 @@ class Scenery {
  public:
   /// Compiles the programs and creates the buffers in the current context.
   void init();
+  /// Deletes every GL object of the scenery (the context that made them must be current).
+  void release();
   /// (Re)draws the background for targets of `geo` and rebuilds the solids of `in` (local frame).
   void build(const RenderDef& def, const FrameGeometry& geo, const RenderInput& in);
   /// The background texture (RGBA8, the targets' size).
   GLuint background() const { return bgTex_; }
+  /// The framebuffer of the background texture.
+  GLuint backgroundFbo() const { return bgFbo_; }
   /// Draws the solids in `def.solid`'s colour into the bound framebuffer, over the target rows
   /// [rowFirst, rowLast) only (the rest still shows them from an earlier frame).
   void drawSolids(const RenderDef& def, int rowFirst, int rowLast) const;

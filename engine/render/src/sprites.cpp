@@ -60,7 +60,14 @@ void SpriteBatch::init() {
       glVertexAttribPointer(3, 2, GL_FLOAT, GL_FALSE, 0, nullptr);
     }
   }
-  glEnable(GL_PROGRAM_POINT_SIZE);
+  // GL_PROGRAM_POINT_SIZE: set with the rest of the passes' state each frame (gl_state.hpp).
+}
+
+void SpriteBatch::release() {
+  const GLuint buffers[2] = {particleVbo_, cornerVbo_}, arrays[2] = {pointVao_, quadVao_};
+  glDeleteBuffers(2, buffers);
+  glDeleteVertexArrays(2, arrays);
+  particleVbo_ = cornerVbo_ = pointVao_ = quadVao_ = 0;
 }
 
 void SpriteBatch::upload(const std::vector<float>& packed) {

@@ -26,6 +26,8 @@ class SpriteBatch {
  public:
   /// Creates the buffers and vertex arrays in the current context; reads the point-size limit.
   void init();
+  /// Deletes them (the context that made them must be current).
+  void release();
   /// The driver's largest point sprite [px] (255 on llvmpipe).
   float maxPoint() const { return maxPoint_; }
   /// Uploads `packed` (4 floats per particle: x, y, value, weight in the engine's local frame).

@@ -1,4 +1,5 @@
-// sph2d/render/renderer.hpp — off-screen frames of a World through OSMesa.
+// sph2d/render/renderer.hpp — frames of a World through OpenGL 3.3: off screen in an OSMesa
+// context of the Renderer's own (read back as RGBA8 images), or into a game's own context.
 //
 // Passes per frame (GLSL in shaders/, embedded at build time):
 //   liquid mode
@@ -17,8 +18,16 @@
 //                pressure, density, age) on a ramp, plus a colour bar with its range
 //   both
 //     solids     Box2D fixtures with their real shapes
+//   render(): the frame as an image
 //     readback   glReadPixels into RGBA8, rows top-down (the camera flips y)
-//     overlay    optional text (frame, time, particle count), drawn on the CPU
+//     overlay    optional text (frame, time, particle count) and the colour bar, drawn on the CPU
+//   draw() (a Renderer made with CurrentGlContext): the frame into the game's framebuffer
+//     present    the finished frame drawn over the game's viewport (no readback, no CPU text)
+//
+// Both ways share every pass: the OSMesa path is "make an own context, draw the frame into the
+// Renderer's own target, read it back"; the game's path is "draw the frame into the Renderer's
+// own target made in the game's context, draw that into the game's framebuffer", saving and
+// restoring every piece of GL state it changes.
 //
 // Determinism: particles are submitted in id order (additive float blending
 // depends on order), so a frame depends only on the particles' values, not on
@@ -26,7 +35,7 @@
 // are pinned before the first context is made (pinRenderEnvironment()).
 // Sprites wider than the driver's point-size limit (255 px on llvmpipe) are
 // drawn as instanced quads instead, so any zoom renders correctly.
-// The OSMesa context belongs to the thread that created the Renderer.
+// A Renderer belongs to the thread that created it (and its context).
 #pragma once
 
 #include <array>
@@ -86,7 +95,8 @@ struct RenderInput {
   double time = 0;                                 ///< simulated time [s], for the overlay
 };
 
-/// Wall time of the stages of the last render() [ms]; per stage only with RenderOptions::profile.
+/// Wall time of the stages of the last render() or draw() [ms]; per stage only with
+/// RenderOptions::profile.
 struct RenderTimings {
   double upload = 0;     ///< CPU packing (id order, values, aux grid) and buffer uploads
   double splat = 0;      ///< splat (liquid) or discs (particles)
@@ -94,10 +104,29 @@ struct RenderTimings {
   double solids = 0;     ///< Box2D fixtures
   double readback = 0;   ///< glReadPixels (includes the GPU work not yet finished without profile)
   double overlay = 0;    ///< CPU text and colour bar
-  double total = 0;      ///< the whole render()
+  double present = 0;    ///< draw(): the frame into the caller's framebuffer (0 in render())
+  double total = 0;      ///< the whole render() or draw()
 };
 
-/// Renders frames of a World.
+/// The tag of the Renderer that draws into the caller's OpenGL context:
+/// `sph2d::Renderer renderer(sph2d::currentGlContext, scene.render);`
+struct CurrentGlContext {};
+/// The value of the tag.
+inline constexpr CurrentGlContext currentGlContext{};
+
+/// Where Renderer::draw() puts a frame in the caller's OpenGL context.
+struct GlTarget {
+  /// The framebuffer object to draw into, by its GL name (0: the default framebuffer, the
+  /// window); unset: the one bound to GL_DRAW_FRAMEBUFFER when draw() is called.
+  std::optional<unsigned int> framebuffer;
+  /// The rectangle the frame fills: x, y (its lower-left corner, GL's convention), width,
+  /// height [px]; unset: the viewport set when draw() is called. At RenderDef::width × height
+  /// the frame's pixels are copied exactly; at any other size it is scaled (bilinear).
+  std::optional<std::array<int, 4>> viewport;
+};
+
+/// Renders frames of a World: into images through an OSMesa context of its own
+/// (Renderer(def)), or into the game's OpenGL context (Renderer(currentGlContext, def)).
 class Renderer {
  public:
   /// The memory a renderer of `width` × `height` frames holds at most [bytes]: the OSMesa
@@ -106,16 +135,46 @@ class Renderer {
   static double estimateBytes(int width, int height) { return 40e6 + 8.0 * 4.0 * double(width) * double(height); }
   /// Creates the OSMesa context and GL resources for `def`. Throws std::runtime_error.
   explicit Renderer(const RenderDef& def, const RenderOptions& options = {});
+  /// Draws into the OpenGL context current on the calling thread (a game's window or its own
+  /// framebuffers) instead of an OSMesa context of its own: its shaders, buffers and
+  /// intermediate targets (the splat field, the background, the frame) are created in that
+  /// context, and the context's state is left as it was found. The context must be desktop
+  /// OpenGL 3.3 or later (core or compatibility profile) and must be current whenever this
+  /// Renderer is used or destroyed. Sets no Mesa environment (pinRenderEnvironment()): the
+  /// context exists already. Throws std::runtime_error when no context is current, when it is
+  /// OpenGL ES or below 3.3 (naming the version found), or when an OpenGL error of the
+  /// caller's was pending.
+  Renderer(CurrentGlContext, const RenderDef& def, const RenderOptions& options = {});
+  /// Frees the GL resources: with its own context, by destroying it; in the caller's context,
+  /// by deleting them there (skipped when no context is current).
   ~Renderer();
   Renderer(const Renderer&) = delete;
   Renderer& operator=(const Renderer&) = delete;
 
   /// Renders the current state of `world`; `age` (optional) holds one age [s] per particle
   /// slot, by default the world's "age" field when its scene has lifetimes. The frame
-  /// stays valid until the next call. Throws std::runtime_error.
+  /// stays valid until the next call. With its own context, makes that context current on
+  /// this thread (it stays current); in the caller's context, draws with the caller's state
+  /// saved and restored and reads the frame back (the game's framebuffer is not touched).
+  /// Throws std::runtime_error.
   const Frame& render(const World& world, const Real* age = nullptr);
   /// Renders `in`; the camera is fixed by the first call. Throws std::runtime_error.
   const Frame& render(const RenderInput& in);
+  /// Draws the current state of `world` into the caller's framebuffer (a Renderer made with
+  /// CurrentGlContext only: else std::logic_error): the same passes as render(), composited
+  /// opaque (the scene's background included) over `target` (by default the bound draw
+  /// framebuffer and the current viewport), rows the right way up in GL's convention. No
+  /// readback, and no overlay text or colour bar (render() draws those on the CPU). Every piece
+  /// of GL state it changes is restored before it returns, also when it throws (the list is in
+  /// docs/EMBEDDING.md); scissor, blending, depth and stencil tests of the caller do not apply
+  /// to it. Throws std::invalid_argument for an empty viewport or a name that is no framebuffer,
+  /// std::runtime_error when no context is current, the framebuffer is incomplete, a GL error
+  /// of the caller's was pending, or a GL call fails.
+  void draw(const World& world, const GlTarget& target = {}, const Real* age = nullptr);
+  /// Draws `in` into the caller's framebuffer, as draw(world, target).
+  void draw(const RenderInput& in, const GlTarget& target = {});
+  /// True when this Renderer draws into the caller's context (made with CurrentGlContext).
+  bool usesCurrentContext() const;
   /// GL_RENDERER and GL_VERSION of the context, e.g. "llvmpipe (LLVM 15.0.6, 256 bits) / 4.5 (Core Profile) Mesa 22.3.6".
   std::string rendererString() const;
   /// The world rectangle shown (after aspect correction), min x, min y, max x, max y.
