@@ -125,7 +125,7 @@ int cmdBench(const std::vector<std::string>& args) {
     }
   const Particles P = B.view();
   RenderInput in;
-  in.particles = &P;
+  in.particles = P;
   in.origin = o;
   in.spacing = world.spacing();
   in.colliders = &world.colliders();

@@ -67,7 +67,7 @@ int cmdRender(const std::vector<std::string>& args) {
   if (opt.colorBy == ColorField::Age && snap.age.empty() && (opt.mode == "particles" || (opt.mode.empty() && scene.render.mode == "particles")))
     throw UsageError(csv + " has no age column, so --color-by age cannot be shown");
   RenderInput in;
-  in.particles = &P;
+  in.particles = P;
   in.origin = o;
   in.spacing = world.spacing();
   in.colliders = &world.colliders();

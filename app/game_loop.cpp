@@ -117,15 +117,13 @@ bool GameLoop::finishBoundary(bool drop) {
 void GameLoop::capture(std::int64_t f) {
   Pending& q = pending_;
   q.particles.assign(world_.particles());  // with the ages and the particles' own colours, when there are
-  q.view = q.particles.view();
   q.colliders = world_.colliders();
   q.input = RenderInput{};
-  q.input.particles = &q.view;
+  q.input.particles = q.particles.view();
   q.input.origin = world_.origin();
   q.input.spacing = world_.spacing();
   q.input.colliders = &q.colliders;
   q.input.moving = world_.movingColliders();  // where the moving bodies are in this frame
-  q.input.age = q.particles.age.empty() ? nullptr : q.particles.age.data();
   q.input.gravity = world_.scene().gravity.norm();
   q.input.frame = world_.frame();
   q.input.time = world_.time();

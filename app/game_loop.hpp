@@ -144,7 +144,6 @@ class GameLoop {
     bool active = false;
     FrameState state;
     ParticleBuffer particles;         ///< copies of the fields the renderer reads
-    Particles view;                   ///< particles.view()
     std::vector<Collider> colliders;
     RenderInput input;
   } pending_;

@@ -87,6 +87,7 @@ bool World::setParticle(std::uint32_t id, const Vec2d& position, const Vec2d& ve
   w.P.xPrev[i] = p;  // a teleport: the swept collision starts here, not on the old path
   w.P.v[i] = Vec2(Real(velocity.x()), Real(velocity.y()));
   ++w.edits;  // the query grid is stale
+  w.refreshView();
   return true;
 }
 
@@ -116,7 +117,11 @@ std::size_t World::setVelocities(const std::vector<std::uint32_t>& ids, const st
   return found;
 }
 
-bool World::setParticleColor(std::uint32_t id, std::uint32_t rgb) { return setU32(*this, impl_->P, kColorField, id, rgb); }
+bool World::setParticleColor(std::uint32_t id, std::uint32_t rgb) {
+  const bool found = setU32(*this, impl_->P, kColorField, id, rgb);
+  impl_->refreshView();  // the field may be new
+  return found;
+}
 
 std::size_t World::setParticleColors(const std::vector<std::uint32_t>& ids, const std::vector<std::uint32_t>& colors) {
   if (ids.size() != colors.size())
@@ -125,6 +130,7 @@ std::size_t World::setParticleColors(const std::vector<std::uint32_t>& ids, cons
   Impl& w = *impl_;
   rebuild(w.idIndex, w.P);  // once: absent ids then cost a search each, not a rebuild
   std::vector<std::uint32_t>& c = w.P.fieldU32(kColorField);
+  w.refreshView();  // the field may be new
   std::size_t found = 0;
   for (std::size_t k = 0; k < ids.size(); ++k) {
     const std::size_t i = find(w.idIndex, ids[k]);
@@ -138,7 +144,9 @@ std::size_t World::setParticleColors(const std::vector<std::uint32_t>& ids, cons
 std::uint32_t World::particleColor(std::uint32_t id) const { return getU32(*this, impl_->P, kColorField, id); }
 
 bool World::setParticleUserData(std::uint32_t id, std::uint32_t value) {
-  return setU32(*this, impl_->P, kUserDataField, id, value);
+  const bool found = setU32(*this, impl_->P, kUserDataField, id, value);
+  impl_->refreshView();  // the field may be new
+  return found;
 }
 
 std::uint32_t World::particleUserData(std::uint32_t id) const { return getU32(*this, impl_->P, kUserDataField, id); }
@@ -170,6 +178,7 @@ std::vector<std::uint32_t> World::addParticles(const std::vector<Vec2d>& points,
     w.P.push(p, Vec2(Real(v.x()), Real(v.y())), w.nextId++, rho0);
   }
   ++w.edits;  // the query grid is stale
+  w.refreshView();
   if (inside) w.warnings.push_back("addParticles: skipped " + std::to_string(inside) + " points inside solids");
   if (refused) {
     std::ostringstream o;

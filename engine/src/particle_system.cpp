@@ -102,6 +102,7 @@ std::size_t World::Impl::fillBlock(const FluidBlockDef& b, bool hydrostaticStart
     warnings.push_back(o.str());
   }
   ++edits;  // the query grid is stale
+  refreshView();
   return added;
 }
 
@@ -112,6 +113,7 @@ const char* World::Impl::budgetKey() const {
 void World::Impl::removeFlagged() {
   removed += P.compact(dead);
   ++edits;  // the query grid is stale
+  refreshView();
 }
 
 /// Removes the k particles with the smallest ids (the oldest).

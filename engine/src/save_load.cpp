@@ -344,6 +344,7 @@ void World::load(std::istream& input) {
       if (effectNames[k] == e->name()) e->enabled = enabled[k];
   w.buildStages();
   ++w.edits;
+  w.refreshView();
   w.idIndex.clear();
 }
 

@@ -197,6 +197,7 @@ void World::step(double dt) {
   impl_->advance(dt);
   impl_->moveOwnBodies(impl_->time - t0);
   ++impl_->frames;
+  impl_->refreshView();
 }
 
 void World::setGravity(const Vec2d& g) {
@@ -261,18 +262,24 @@ std::size_t World::removeParticlesInBox(const Vec2d& lo, const Vec2d& hi) {
   return n;
 }
 
-Particles World::particles() const {
-  const ParticleStore& S = impl_->P;
-  Particles P;
-  P.x = S.x;
-  P.v = S.v;
-  P.rho = S.rho;
-  P.p = S.p;
-  P.id = S.id;
-  if (const std::vector<Real>* age = S.find("age")) P.age = *age;
-  if (const std::vector<std::uint32_t>* c = S.findU32(ParticleStore::kColor)) P.color = *c;
-  if (const std::vector<std::uint32_t>* u = S.findU32(ParticleStore::kUserData)) P.userData = *u;
-  return P;
+void World::Impl::refreshView() const {
+  Particles& V = view;
+  V.x = P.x;
+  V.v = P.v;
+  V.rho = P.rho;
+  V.p = P.p;
+  V.id = P.id;
+  const std::vector<Real>* age = P.find("age");
+  V.age = age ? ArrayView<Real>(*age) : ArrayView<Real>();
+  const std::vector<std::uint32_t>* c = P.findU32(ParticleStore::kColor);
+  V.color = c ? ArrayView<std::uint32_t>(*c) : ArrayView<std::uint32_t>();
+  const std::vector<std::uint32_t>* u = P.findU32(ParticleStore::kUserData);
+  V.userData = u ? ArrayView<std::uint32_t>(*u) : ArrayView<std::uint32_t>();
+}
+
+const Particles& World::particles() const {
+  impl_->refreshView();
+  return impl_->view;
 }
 std::size_t World::particleCount() const { return impl_->P.size(); }
 Vec2d World::origin() const { return impl_->origin; }
@@ -330,6 +337,7 @@ std::uint64_t World::removedCount() const { return impl_->removed; }
 void World::stepSubstep() {
   impl_->captureBodies();
   impl_->moveOwnBodies(double(impl_->substep(impl_->stableDt())));
+  impl_->refreshView();
 }
 
 std::vector<std::string> World::takeWarnings() {

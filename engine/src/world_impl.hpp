@@ -36,6 +36,11 @@ struct World::Impl {
   b2World* b2 = nullptr;              ///< the b2World the fluid collides with
   Vec2d origin{0, 0};                 ///< local frame offset (world = local + origin)
   ParticleStore P;
+  /// What World::particles() shows: views of P's public arrays, refreshed after every step and
+  /// every change of the particles (refreshView), so a reference a game holds stays current.
+  mutable Particles view;
+  /// Points `view` at P's arrays as they are now (they move when they grow or are reordered).
+  void refreshView() const;
   Grid grid;
   NeighbourLists nbr;
   BoundarySet boundary;

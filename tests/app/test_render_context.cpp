@@ -260,6 +260,11 @@ struct GameObjects {
 /// sRGB, dithering, alpha to coverage, a clip distance, logic op, polygon smoothing, rasterizer
 /// discard, provoking vertex (the last two the renderer never needs to touch).
 void setGameState(const GameObjects& g, bool compatibility = false) {
+  if (compatibility) {  // the stipple pattern first: it is read with the unpack state set below
+    GLubyte stipple[128];
+    for (int k = 0; k < 128; ++k) stipple[k] = GLubyte(k % 8 < 4 ? 0xF0 : 0x0F);  // a checkerboard
+    glPolygonStipple(stipple);
+  }
   glBindFramebuffer(GL_DRAW_FRAMEBUFFER, g.fbo);
   glBindFramebuffer(GL_READ_FRAMEBUFFER, g.readFbo);
   glUseProgram(g.prog);
@@ -310,6 +315,11 @@ void setGameState(const GameObjects& g, bool compatibility = false) {
     glAlphaFunc(GL_GREATER, 0.99f);  // would drop the discs' soft edges
     glDisable(GL_POINT_SPRITE);      // gl_PointCoord would be undefined
     glClampColor(GL_CLAMP_FRAGMENT_COLOR, GL_TRUE);  // the float splat would stop at 1
+    glEnable(GL_POLYGON_STIPPLE);                  // would punch holes in every triangle
+    glPixelTransferf(GL_RED_SCALE, 0.5f);          // would halve the red of every upload
+    glPixelTransferf(GL_GREEN_BIAS, 0.25f);
+    glPixelTransferf(GL_DEPTH_SCALE, 2.0f);
+    glPixelTransferi(GL_INDEX_SHIFT, 1);
   }
   glEnable(GL_RASTERIZER_DISCARD);  // last: nothing at all would be drawn
   REQUIRE(glGetError() == GL_NO_ERROR);
@@ -407,6 +417,11 @@ std::vector<Item> snapshot(bool compatibility = false) {
     floats("alpha test ref", GL_ALPHA_TEST_REF);
     on("point sprite", GL_POINT_SPRITE);
     ints("clamp fragment colour", GL_CLAMP_FRAGMENT_COLOR);
+    on("polygon stipple", GL_POLYGON_STIPPLE);
+    floats("red scale", GL_RED_SCALE);
+    floats("green bias", GL_GREEN_BIAS);
+    floats("depth scale", GL_DEPTH_SCALE);
+    ints("index shift", GL_INDEX_SHIFT);
   }
   REQUIRE(glGetError() == GL_NO_ERROR);
   return s;
@@ -648,7 +663,7 @@ TEST_CASE("render() in the game's context reads back the OSMesa path's frame (ov
   CHECK(renderer.lastTimings().readback > 0);
 }
 
-TEST_CASE("draw() in a compatibility-profile context: the game's alpha test, point sprites off and colour clamping change nothing and are given back") {
+TEST_CASE("draw() in a compatibility-profile context: the game's alpha test, point sprites off, colour clamping, polygon stipple and pixel transfer change nothing and are given back") {
   for (const std::string mode : {"liquid", "particles"}) {
     CAPTURE(mode);
     const SceneDef s = gameScene(mode);
@@ -666,6 +681,9 @@ TEST_CASE("draw() in a compatibility-profile context: the game's alpha test, poi
     renderer.draw(*world, GlTarget{g.fbo, std::array<int, 4>{0, 0, W, H}});
     CHECK(glGetError() == GL_NO_ERROR);
     checkSame(before, snapshot(true));
+    // The game's pixel transfer would change the game's own readback too: plain for reading.
+    glPixelTransferf(GL_RED_SCALE, 1.0f);
+    glPixelTransferf(GL_GREEN_BIAS, 0.0f);
     CHECK(differing(flipRows(g.pixels(), W, H), reference) == 0);
   }
 }
@@ -715,6 +733,64 @@ TEST_CASE("the renderer on the game's context refuses bad use with a clear error
   CHECK_THROWS_WITH_AS(renderer.draw(*world), doctest::Contains("no OpenGL context is current"), std::runtime_error);
   game.makeCurrent();
   glDeleteFramebuffers(1, &empty);
+}
+
+TEST_CASE("draw() into a framebuffer with two colour attachments writes the first and leaves the second as the game drew it") {
+  const SceneDef s = gameScene("liquid");
+  const RenderOptions o = optionsFor("liquid");
+  const auto world = steppedWorld(s, 12);
+  const std::vector<unsigned char> reference = osmesaFrame(*world, s, o);
+  GameContext game;
+  GameObjects g;
+  // A second colour attachment (the game's G-buffer, say), cleared to one colour, both drawn to.
+  GLuint second = 0;
+  glGenTextures(1, &second);
+  glBindTexture(GL_TEXTURE_2D, second);
+  glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, W, H, 0, GL_RGBA, GL_UNSIGNED_BYTE, nullptr);
+  glBindFramebuffer(GL_FRAMEBUFFER, g.fbo);
+  glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT1, GL_TEXTURE_2D, second, 0);
+  const GLenum both[2] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
+  glDrawBuffers(2, both);
+  const GLfloat teal[4] = {0.0f, 0.5f, 0.5f, 1.0f};
+  glClearBufferfv(GL_COLOR, 1, teal);
+  REQUIRE(glCheckFramebufferStatus(GL_FRAMEBUFFER) == GL_FRAMEBUFFER_COMPLETE);
+  auto readSecond = [&] {
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, g.fbo);
+    glReadBuffer(GL_COLOR_ATTACHMENT1);
+    glPixelStorei(GL_PACK_ALIGNMENT, 1);
+    std::vector<unsigned char> p(std::size_t(W) * H * 4);
+    glReadPixels(0, 0, W, H, GL_RGBA, GL_UNSIGNED_BYTE, p.data());
+    glReadBuffer(GL_COLOR_ATTACHMENT0);
+    REQUIRE(glGetError() == GL_NO_ERROR);
+    return p;
+  };
+  const std::vector<unsigned char> secondBefore = readSecond();
+  REQUIRE(secondBefore[1] == 128);  // teal
+  Renderer renderer(currentGlContext, s.render, o);
+  glBindFramebuffer(GL_FRAMEBUFFER, g.fbo);
+  renderer.draw(*world, GlTarget{g.fbo, std::array<int, 4>{0, 0, W, H}});
+  CHECK(glGetError() == GL_NO_ERROR);
+  CHECK(differing(readSecond(), secondBefore) == 0);
+  CHECK(differing(flipRows(g.pixels(), W, H), reference) == 0);
+  glDeleteTextures(1, &second);
+}
+
+TEST_CASE("another context current (an OSMesa renderer's) is refused by draw(), and destroying the game's renderer there leaves that context's objects alone") {
+  const SceneDef s = gameScene("liquid");
+  const auto world = steppedWorld(s, 6);
+  GameContext game;
+  auto mine = std::make_unique<Renderer>(currentGlContext, s.render);
+  Renderer screenshots(s.render);  // an OSMesa renderer: render() leaves its own context current
+  const std::uint64_t first = xxh64(screenshots.render(*world).rgba.data(), screenshots.render(*world).rgba.size());
+  CHECK_THROWS_WITH_AS(mine->draw(*world), doctest::Contains("another OpenGL context is current"), std::runtime_error);
+  mine.reset();  // in the OSMesa renderer's context: must not delete objects by our names there
+  const Frame& again = screenshots.render(*world);
+  CHECK(xxh64(again.rgba.data(), again.rgba.size()) == first);
+  game.makeCurrent();
+  Renderer back(currentGlContext, s.render);
+  GameObjects g;
+  back.draw(*world, GlTarget{g.fbo, std::array<int, 4>{0, 0, W, H}});
+  CHECK(glGetError() == GL_NO_ERROR);
 }
 
 TEST_CASE("a context below OpenGL 3.3 is refused naming the version found") {

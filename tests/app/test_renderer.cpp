@@ -52,7 +52,7 @@ std::uint64_t hashOf(const Frame& f) { return xxh64(f.rgba.data(), f.rgba.size()
 
 RenderInput inputOf(const World& w, const Particles& P) {
   RenderInput in;
-  in.particles = &P;
+  in.particles = P;
   in.origin = w.origin();
   in.spacing = w.spacing();
   in.colliders = &w.colliders();
@@ -414,7 +414,7 @@ TEST_CASE("100k particles render: a 2 m x 1 m lattice covers its share of a 960x
   def.camera.min = Vec2d(0, 0);
   def.camera.max = Vec2d(4, 2.25);
   RenderInput in;
-  in.particles = &P;
+  in.particles = P;
   in.spacing = dx;
   const double block = (448 * dx) * (224 * dx) / (4.0 * 2.25);
   Renderer liquid(def);
@@ -470,7 +470,7 @@ struct BumpPool {
     def.camera.automatic = false;
     def.camera.min = Vec2d(-0.2, -0.1);
     def.camera.max = Vec2d(1.8, 1.025);
-    in.particles = &P;
+    in.particles = P;
     in.spacing = dx;
     in.colliders = &walls;
   }

@@ -21,7 +21,7 @@ namespace sph2d {
 template <class T>
 struct Vector2 {
   using Scalar = T;  ///< the component type
-  T v[2] = {T(0), T(0)};
+  T v[2] = {T(0), T(0)};  ///< x, y
 
   /// The zero vector.
   constexpr Vector2() = default;

@@ -36,6 +36,10 @@ class ArrayView {
   constexpr std::size_t size() const { return size_; }
   /// True when there are no values.
   constexpr bool empty() const { return size_ == 0; }
+  /// The first value (the view must not be empty).
+  constexpr const T& front() const { return data_[0]; }
+  /// The last value (the view must not be empty).
+  constexpr const T& back() const { return data_[size_ - 1]; }
   /// The first value's address (null when empty and never set).
   constexpr const T* data() const { return data_; }
   /// Start of the values.

@@ -104,8 +104,10 @@ class World {
   void stepSubstep();
 
   /// The particles as read-only arrays by slot (local frame; add origin() for world
-  /// coordinates), valid until the World steps or its particles change. No copy is made.
-  Particles particles() const;
+  /// coordinates). No copy is made: the views show the World's own arrays, and the World keeps
+  /// them current after every step and every change of its particles, so the reference stays
+  /// valid for the World's life. (An element read before a step is the value before it.)
+  const Particles& particles() const;
   /// Number of particles.
   std::size_t particleCount() const;
   /// Offset of the local frame in world coordinates [m].

@@ -30,7 +30,7 @@ std::vector<double> resolveCamera(const RenderDef& def, const RenderInput& in) {
         grow(c.lo.x() + o.x(), c.lo.y() + o.y());
         grow(c.hi.x() + o.x(), c.hi.y() + o.y());
       }
-    const Particles& P = *in.particles;
+    const Particles& P = in.particles;
     for (std::size_t i = 0; i < P.size(); ++i) grow(P.x[i].x() + o.x(), P.x[i].y() + o.y());
     if (!any) {
       lo = Vec2d(-1, -1);

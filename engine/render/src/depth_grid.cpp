@@ -54,7 +54,7 @@ void DepthGrid::build(const RenderInput& in, const std::vector<double>& ext, dou
   const double spacingPx = in.spacing * pxPerM;
   const int w = w_, h = h_, cell = cell_;
   cover_.assign(std::size_t(w) * std::size_t(h), 0.0f);
-  const Particles& P = *in.particles;
+  const Particles& P = in.particles;
   const double cellM = cell / pxPerM;
   const double x0 = ext[0] - in.origin.x(), y1 = ext[3] - in.origin.y();
   const float areaShare = float((spacingPx * spacingPx) / (double(cell) * double(cell)));

@@ -25,6 +25,12 @@ const GLenum kOff[] = {GL_DEPTH_TEST,        GL_STENCIL_TEST,      GL_CULL_FACE,
 /// fresh context (llvmpipe does not dither; a driver that does dithers both paths alike).
 const GLenum kOn[] = {GL_PROGRAM_POINT_SIZE, GL_DITHER};
 
+/// Compatibility profile: the pixel-transfer stage scales, biases and maps every texture upload
+/// and readback; the passes need it to pass values through (scale 1, bias 0, no maps).
+const GLenum kTransferScale[] = {GL_RED_SCALE, GL_GREEN_SCALE, GL_BLUE_SCALE, GL_ALPHA_SCALE, GL_DEPTH_SCALE};
+const GLenum kTransferBias[] = {GL_RED_BIAS, GL_GREEN_BIAS, GL_BLUE_BIAS, GL_ALPHA_BIAS, GL_DEPTH_BIAS};
+const GLenum kTransferInt[] = {GL_MAP_COLOR, GL_MAP_STENCIL, GL_INDEX_SHIFT, GL_INDEX_OFFSET};
+
 }  // namespace
 
 ContextInfo currentContext() {
@@ -71,6 +77,10 @@ void setDrawState(const ContextInfo& ctx) {
     glDisable(GL_ALPHA_TEST);    // would drop the discs' soft edges
     glEnable(GL_POINT_SPRITE);   // gl_PointCoord is undefined without it
     glClampColor(GL_CLAMP_FRAGMENT_COLOR, GL_FIXED_ONLY);  // the float splat target must not clamp at 1
+    glDisable(GL_POLYGON_STIPPLE);  // would punch holes in every triangle
+    for (GLenum p : kTransferScale) glPixelTransferf(p, 1.0f);
+    for (GLenum p : kTransferBias) glPixelTransferf(p, 0.0f);
+    for (GLenum p : kTransferInt) glPixelTransferi(p, 0);
   }
   glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
   glBlendEquation(GL_FUNC_ADD);
@@ -111,7 +121,19 @@ GlStateGuard::GlStateGuard(const ContextInfo& ctx) : ctx_(ctx) {
   if (ctx.compatibility) {
     caps_.push_back({GL_ALPHA_TEST, glIsEnabled(GL_ALPHA_TEST)});
     caps_.push_back({GL_POINT_SPRITE, glIsEnabled(GL_POINT_SPRITE)});
+    caps_.push_back({GL_POLYGON_STIPPLE, glIsEnabled(GL_POLYGON_STIPPLE)});
     glGetIntegerv(GL_CLAMP_FRAGMENT_COLOR, &clampFragment_);
+    for (const GLenum* list : {kTransferScale, kTransferBias})
+      for (int k = 0; k < 5; ++k) {
+        GLfloat v = 0;
+        glGetFloatv(list[k], &v);
+        transfer_.emplace_back(list[k], v);
+      }
+    for (GLenum p : kTransferInt) {
+      GLint v = 0;
+      glGetIntegerv(p, &v);
+      transferI_.emplace_back(p, v);
+    }
   }
   const int buffers = ctx.drawBuffers;
   blendOn_.resize(std::size_t(buffers));
@@ -150,6 +172,8 @@ GlStateGuard::GlStateGuard(const ContextInfo& ctx) : ctx_(ctx) {
 GlStateGuard::~GlStateGuard() {
   for (const Cap& c : caps_) (c.on ? glEnable : glDisable)(c.cap);
   if (ctx_.compatibility) glClampColor(GL_CLAMP_FRAGMENT_COLOR, GLenum(clampFragment_));
+  for (const auto& t : transfer_) glPixelTransferf(t.first, t.second);
+  for (const auto& t : transferI_) glPixelTransferi(t.first, t.second);
   for (std::size_t b = 0; b < blendOn_.size(); ++b) {
     (blendOn_[b] ? glEnablei : glDisablei)(GL_BLEND, GLuint(b));
     const GLboolean* m = &colorMask_[4 * b];

@@ -76,6 +76,8 @@ class GlStateGuard {
   GLint polygonMode_[2] = {};
   GLint spriteOrigin_ = 0;
   GLint clampFragment_ = 0;               // compatibility profile only
+  std::vector<std::pair<GLenum, GLfloat>> transfer_;  // compatibility: pixel-transfer scales and biases
+  std::vector<std::pair<GLenum, GLint>> transferI_;   // compatibility: colour/stencil maps, index shift and offset
   std::vector<Cap> caps_;                 // glIsEnabled items
   std::vector<GLboolean> blendOn_;        // GL_BLEND per draw buffer
   std::vector<BlendFunc> blend_;          // per draw buffer (OpenGL 4.0), else one

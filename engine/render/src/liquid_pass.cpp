@@ -58,7 +58,7 @@ class LiquidPass final : public RenderPass {
   }
 
   void prepare(const PassFrame& f) override {
-    const Particles& P = *f.in.particles;
+    const Particles& P = f.in.particles;
     const std::size_t n = f.order.size();
     packed_.resize(n * 4);
     for (std::size_t k = 0; k < n; ++k) {

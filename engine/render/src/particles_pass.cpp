@@ -32,9 +32,9 @@ class ParticlesPass final : public RenderPass {
 
   void prepare(const PassFrame& f) override {
     const RenderInput& in = f.in;
-    const Particles& P = *in.particles;
+    const Particles& P = in.particles;
     const std::size_t n = f.order.size();
-    if (in.age == nullptr && n > 0 && opt_.colorBy == ColorField::Age)
+    if (agesOf(in) == nullptr && n > 0 && opt_.colorBy == ColorField::Age)
       throw std::runtime_error("colour by age needs particle ages, and none were given");
     if (opt_.colorBy == ColorField::Color) {
       // Each particle's own 0xRRGGBB (an integer below 2^24: exact in a float); none: the fluid's.
@@ -100,12 +100,12 @@ class ParticlesPass final : public RenderPass {
 
  private:
   double valueOf(const RenderInput& in, std::size_t i) const {
-    const Particles& P = *in.particles;
+    const Particles& P = in.particles;
     switch (opt_.colorBy) {
       case ColorField::Speed: return double(P.v[i].norm());
       case ColorField::Pressure: return double(P.p[i]);
       case ColorField::Density: return double(P.rho[i]);
-      case ColorField::Age: return in.age ? double(in.age[i]) : 0.0;
+      case ColorField::Age: return agesOf(in) ? double(agesOf(in)[i]) : 0.0;
       case ColorField::Color: return 0.0;
     }
     return 0.0;

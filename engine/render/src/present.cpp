@@ -25,10 +25,7 @@ void Presenter::check(GLuint fbo, const GLint viewport[4]) {
   if (fbo != 0 && !glIsFramebuffer(fbo))
     throw std::invalid_argument("Renderer::draw: " + std::to_string(fbo) +
                                 " is not a framebuffer object of the current context");
-}
-
-void Presenter::draw(GLuint frameTex, int guard, int width, int height, GLuint fbo, const GLint viewport[4]) const {
-  check(fbo, viewport);
+  // Complete? (Binds it for drawing: the caller's state guard puts the binding back.)
   glBindFramebuffer(GL_DRAW_FRAMEBUFFER, fbo);
   const GLenum status = glCheckFramebufferStatus(GL_DRAW_FRAMEBUFFER);
   if (status != GL_FRAMEBUFFER_COMPLETE) {
@@ -37,6 +34,16 @@ void Presenter::draw(GLuint frameTex, int guard, int width, int height, GLuint f
     throw std::runtime_error("Renderer::draw: framebuffer " + std::to_string(fbo) + " is not complete (status " +
                              code + ")");
   }
+}
+
+void Presenter::draw(GLuint frameTex, int guard, int width, int height, GLuint fbo, const GLint viewport[4]) const {
+  check(fbo, viewport);
+  // present.frag writes colour output 0 only: the framebuffer's other draw buffers keep what the
+  // game drew there (their colour masks are the guard's to restore).
+  GLint drawBuffers = 1;
+  glGetIntegerv(GL_MAX_DRAW_BUFFERS, &drawBuffers);
+  glColorMaski(0, GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+  for (GLint b = 1; b < drawBuffers; ++b) glColorMaski(GLuint(b), GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
   glViewport(viewport[0], viewport[1], viewport[2], viewport[3]);
   glUseProgram(prog_);
   glActiveTexture(GL_TEXTURE0);

@@ -32,16 +32,15 @@ float smoothstepf(float e0, float e1, float x) {
   return t * t * (3.0f - 2.0f * t);
 }
 
-// `view` is world.particles(), held by the caller for as long as the input is used.
-RenderInput inputOf(const World& world, const Particles& view, const Real* age) {
+RenderInput inputOf(const World& world, const Real* age) {
   RenderInput in;
-  in.particles = &view;
+  in.particles = world.particles();
   in.origin = world.origin();
   in.spacing = world.spacing();
   in.colliders = &world.colliders();
   in.moving = world.movingColliders();
   // Ages come from the caller, or from the engine's "age" field when the scene has lifetimes.
-  in.age = age ? age : (view.age.empty() ? nullptr : view.age.data());
+  in.age = age;  // null: the World's own ages when its scene has lifetimes (agesOf)
   in.gravity = world.scene().gravity.norm();
   in.frame = world.frame();
   in.time = world.time();
@@ -51,8 +50,7 @@ RenderInput inputOf(const World& world, const Particles& view, const Real* age) 
 }  // namespace
 
 std::vector<double> resolveCamera(const RenderDef& def, const World& world) {
-  const Particles view = world.particles();
-  return resolveCamera(def, inputOf(world, view, nullptr));
+  return resolveCamera(def, inputOf(world, nullptr));
 }
 
 struct Renderer::Impl {
@@ -60,6 +58,10 @@ struct Renderer::Impl {
   RenderOptions opt;
   bool ownContext = false;                     // an OSMesa context of the Renderer's, else the caller's
   OSMesaContext ctx = nullptr;
+  // The caller's context only: OSMesa's current context when the Renderer was made (null for a
+  // game's EGL, GLX or WGL context). Another one current later (e.g. an OSMesa Renderer's, which
+  // render() leaves current) means the wrong context: its object names are not ours.
+  OSMesaContext callerOsmesa = nullptr;
   unsigned char dummy[4] = {0, 0, 0, 0};
   gl::ContextInfo glInfo;
   SpriteBatch sprites;
@@ -78,9 +80,9 @@ struct Renderer::Impl {
   ~Impl() {
     if (ownContext) {
       if (ctx) OSMesaDestroyContext(ctx);  // with it, every GL object of the passes
-    } else if (glInfo.major > 0 && glGetString(GL_VERSION)) {
+    } else if (glInfo.major > 0 && glGetString(GL_VERSION) && OSMesaGetCurrentContext() == callerOsmesa) {
       releaseGl();  // the caller's context (probed: 3.3 or later): the objects made there are ours to delete
-    }
+    }  // another context current: deleting by name would hit its objects; ours are left to the caller's context
   }
 
   void makeCurrent() {
@@ -112,11 +114,15 @@ struct Renderer::Impl {
 
   /// Before using the caller's context: one must be current, and no error of the caller's pending
   /// (glGetError would take it and blame sph2d's calls).
-  static void enterCallerContext(const char* call) {
+  void enterCallerContext(const char* call) const {
     if (!glGetString(GL_VERSION))
       throw std::runtime_error(std::string("Renderer::") + call +
                                ": no OpenGL context is current on this thread (make the one the Renderer was "
                                "created in current)");
+    if (OSMesaGetCurrentContext() != callerOsmesa)
+      throw std::runtime_error(std::string("Renderer::") + call +
+                               ": another OpenGL context is current than the one this Renderer was created in "
+                               "(an OSMesa Renderer's render() leaves its own current); make the game's current");
     const GLenum err = glGetError();
     if (err != GL_NO_ERROR) {
       char code[16];
@@ -127,9 +133,28 @@ struct Renderer::Impl {
     }
   }
 
+  /// Throws std::invalid_argument naming the array whose length is not the particles' count.
+  static void checkParticles(const RenderInput& in) {
+    const Particles& P = in.particles;
+    const std::size_t n = P.size();
+    auto need = [&](const char* name, std::size_t size, bool optional) {
+      if (size == n || (optional && size == 0)) return;
+      throw std::invalid_argument(std::string("Renderer: RenderInput.particles.") + name + " holds " +
+                                  std::to_string(size) + " values for " + std::to_string(n) + " particles" +
+                                  (optional ? " (it must be empty or one per particle)" : ""));
+    };
+    need("v", P.v.size(), false);
+    need("rho", P.rho.size(), false);
+    need("p", P.p.size(), false);
+    need("id", P.id.size(), false);
+    need("age", P.age.size(), true);
+    need("color", P.color.size(), true);
+  }
+
   float fade(const RenderInput& in, std::size_t slot) const {
-    if (!in.age) return 1.0f;
-    const float a = float(in.age[slot]);
+    const Real* age = agesOf(in);
+    if (!age) return 1.0f;
+    const float a = float(age[slot]);
     if (!(opt.ageFadeEnd > opt.ageFadeStart)) return 1.0f;
     return 1.0f - smoothstepf(float(opt.ageFadeStart), float(opt.ageFadeEnd), a);
   }
@@ -158,13 +183,13 @@ struct Renderer::Impl {
   /// The frame of `in` into the colour target: every pass, in both contexts. Ends the upload,
   /// splat, composite and solids stages.
   void drawFrame(const RenderInput& in, StageTimer& timer) {
-    if (!in.particles) throw std::invalid_argument("Renderer: no particles to render");
+    checkParticles(in);
     gl::setDrawState(glInfo);
     const RenderDef& d = def;
     if (geo.cam.empty()) geo.cam = resolveCamera(d, in);
     ensureFrame(in);
 
-    const Particles& P = *in.particles;
+    const Particles& P = in.particles;
     const std::size_t n = P.size();
     PassFrame f{in, order, weight, geo, geo.pxPerM(d.width), 0, {0, 0}, {0, 0}, color};
     f.spacingPx = in.spacing * f.pxPerM;
@@ -208,7 +233,7 @@ struct Renderer::Impl {
     const Rgba8 textColor = toRgba8(opt.text.value_or(std::array<double, 3>{0.92, 0.92, 0.92}));
     char line[128];
     std::snprintf(line, sizeof line, "FRAME %llu  T %.3f S  %zu PARTICLES", static_cast<unsigned long long>(in.frame),
-                  in.time, in.particles->size());
+                  in.time, in.particles.size());
     const int pad = 2 * textScale;
     fillRect(frame, 0, 0, textWidth(line, textScale) + 2 * pad + 2 * textScale,
              textHeight(textScale) + 2 * pad + 2 * textScale, Rgba8{0, 0, 0, 140});
@@ -251,7 +276,8 @@ Renderer::Renderer(CurrentGlContext, const RenderDef& def, const RenderOptions& 
   r.def = def;
   r.opt = options;
   const std::string mode = checkedMode(def, options);
-  Impl::enterCallerContext("Renderer");
+  r.callerOsmesa = OSMesaGetCurrentContext();
+  r.enterCallerContext("Renderer");
   r.glInfo = gl::currentContext();
   gl::GlStateGuard saved(r.glInfo);
   r.init(mode);  // on a throw, ~Impl deletes what was made
@@ -268,14 +294,10 @@ float Renderer::maxPointSize() const { return impl_->sprites.maxPoint(); }
 std::array<double, 2> Renderer::lastRange() const { return impl_->pass->range(); }
 bool Renderer::usesCurrentContext() const { return !impl_->ownContext; }
 
-const Frame& Renderer::render(const World& world, const Real* age) {
-  const Particles view = world.particles();
-  return render(inputOf(world, view, age));
-}
+const Frame& Renderer::render(const World& world, const Real* age) { return render(inputOf(world, age)); }
 
 const Frame& Renderer::render(const RenderInput& in) {
   Impl& r = *impl_;
-  if (!in.particles) throw std::invalid_argument("Renderer::render: no particles");
   StageTimer timer;
   timer.profile = r.opt.profile;
   const auto tStart = timer.t;
@@ -284,7 +306,7 @@ const Frame& Renderer::render(const RenderInput& in) {
   if (r.ownContext) {
     r.makeCurrent();
   } else {
-    Impl::enterCallerContext("render");
+    r.enterCallerContext("render");
     saved.emplace(r.glInfo);
   }
   r.drawFrame(in, timer);
@@ -293,10 +315,7 @@ const Frame& Renderer::render(const RenderInput& in) {
   return r.frame;
 }
 
-void Renderer::draw(const World& world, const GlTarget& target, const Real* age) {
-  const Particles view = world.particles();
-  draw(inputOf(world, view, age), target);
-}
+void Renderer::draw(const World& world, const GlTarget& target, const Real* age) { draw(inputOf(world, age), target); }
 
 void Renderer::draw(const RenderInput& in, const GlTarget& target) {
   Impl& r = *impl_;
@@ -304,12 +323,11 @@ void Renderer::draw(const RenderInput& in, const GlTarget& target) {
     throw std::logic_error(
         "Renderer::draw: this Renderer has an OSMesa context of its own (render() gives its frames); draw() needs "
         "one made with sph2d::currentGlContext in the game's OpenGL context");
-  if (!in.particles) throw std::invalid_argument("Renderer::draw: no particles");
   StageTimer timer;
   timer.profile = r.opt.profile;
   const auto tStart = timer.t;
   r.timings = RenderTimings{};
-  Impl::enterCallerContext("draw");
+  r.enterCallerContext("draw");
   const gl::GlStateGuard saved(r.glInfo);
   const GLuint fbo = target.framebuffer ? GLuint(*target.framebuffer) : saved.drawFramebuffer();
   GLint viewport[4];

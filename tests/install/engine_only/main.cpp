@@ -3,7 +3,15 @@
 // column's centre of mass fell (as it must under gravity), and prints what it saw.
 #include <cstdio>
 
+// Every installed header of the engine, so each is compiled here without Eigen on the path.
+#include "sph2d/boundary.hpp"
+#include "sph2d/events.hpp"
+#include "sph2d/fluid_block.hpp"
 #include "sph2d/hash.hpp"
+#include "sph2d/math.hpp"
+#include "sph2d/particles.hpp"
+#include "sph2d/scene.hpp"
+#include "sph2d/timeline.hpp"
 #include "sph2d/world.hpp"
 
 namespace {

@@ -84,12 +84,12 @@ struct RenderOptions {
 
 /// What to draw. Particles are in the engine's local frame (add `origin` for world coordinates).
 struct RenderInput {
-  const Particles* particles = nullptr;            ///< required
+  Particles particles;                             ///< what to draw: views whose arrays outlive the call (World::particles(), ParticleBuffer::view())
   Vec2d origin{0, 0};                              ///< local frame offset [m]
   double spacing = 0.02;                           ///< particle spacing dx [m]
   const std::vector<Collider>* colliders = nullptr;///< solids in the local frame (may be null)
   std::vector<Collider> moving;                    ///< moving bodies at their pose this frame (local frame), drawn every frame
-  const Real* age = nullptr;                       ///< optional: one age [s] per particle slot
+  const Real* age = nullptr;                       ///< optional: one age [s] per particle slot (null: particles.age when it has one per particle)
   double gravity = 9.81;                           ///< |g| [m/s²], scales the default foam speed
   std::uint64_t frame = 0;                         ///< for the overlay
   double time = 0;                                 ///< simulated time [s], for the overlay
@@ -181,9 +181,9 @@ class Renderer {
   std::vector<double> cameraRect() const;
   /// The mode in use: "liquid" or "particles".
   std::string mode() const;
-  /// Stage times of the last render().
+  /// Stage times of the last render() or draw().
   RenderTimings lastTimings() const;
-  /// True when the last render() drew instanced quads because sprites exceeded the point-size limit.
+  /// True when the last render() or draw() drew instanced quads because sprites exceeded the point-size limit.
   bool usedQuads() const;
   /// The driver's largest point sprite [px] (255 on llvmpipe).
   float maxPointSize() const;
@@ -199,6 +199,13 @@ class Renderer {
 /// The camera of `def` for `world`: its own rectangle, or the solids and fluid
 /// with a margin; widened to the image's aspect ratio.
 std::vector<double> resolveCamera(const RenderDef& def, const World& world);
+/// The ages a frame of `in` uses: in.age, else the particles' own when they have one per
+/// particle, else null.
+inline const Real* agesOf(const RenderInput& in) {
+  if (in.age) return in.age;
+  const Particles& P = in.particles;
+  return P.age.size() == P.size() && P.size() > 0 ? P.age.data() : nullptr;
+}
 /// The camera of `def` for a RenderInput (same rules as above).
 std::vector<double> resolveCamera(const RenderDef& def, const RenderInput& in);
 
