@@ -149,6 +149,21 @@ GLuint compile(GLenum type, const char* src) {
 /// The game's own GL objects: a framebuffer (RGBA8 + depth) of fw × fh px filled with its own
 /// drawing, a second one bound for reading, a program, a vertex array and buffers, textures and a
 /// sampler that filters with mipmaps (a texture without them sampled through it reads black).
+/// RGBA8 pixels of framebuffer `fbo` (0: the window) over x, y, w, h, rows bottom-up as GL
+/// gives them, read with the pack state made plain first.
+std::vector<unsigned char> readRgba(GLuint fbo, int x, int y, int w, int h) {
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, fbo);
+  glBindBuffer(GL_PIXEL_PACK_BUFFER, 0);
+  glPixelStorei(GL_PACK_ALIGNMENT, 1);
+  glPixelStorei(GL_PACK_ROW_LENGTH, 0);
+  glPixelStorei(GL_PACK_SKIP_ROWS, 0);
+  glPixelStorei(GL_PACK_SKIP_PIXELS, 0);
+  std::vector<unsigned char> p(std::size_t(w) * std::size_t(h) * 4);
+  glReadPixels(x, y, w, h, GL_RGBA, GL_UNSIGNED_BYTE, p.data());
+  REQUIRE(glGetError() == GL_NO_ERROR);
+  return p;
+}
+
 struct GameObjects {
   int fw = W, fh = H;
   GLuint fbo = 0, colorTex = 0, depthRb = 0, readFbo = 0, readTex = 0;
@@ -227,18 +242,7 @@ struct GameObjects {
 
   /// The game's colour pixels over x, y, w, h (rows bottom-up, as GL gives them), read with
   /// the game's own pack settings made plain first.
-  std::vector<unsigned char> pixels(int x, int y, int w, int h) const {
-    glBindFramebuffer(GL_READ_FRAMEBUFFER, fbo);
-    glBindBuffer(GL_PIXEL_PACK_BUFFER, 0);
-    glPixelStorei(GL_PACK_ALIGNMENT, 1);
-    glPixelStorei(GL_PACK_ROW_LENGTH, 0);
-    glPixelStorei(GL_PACK_SKIP_ROWS, 0);
-    glPixelStorei(GL_PACK_SKIP_PIXELS, 0);
-    std::vector<unsigned char> p(std::size_t(w) * std::size_t(h) * 4);
-    glReadPixels(x, y, w, h, GL_RGBA, GL_UNSIGNED_BYTE, p.data());
-    REQUIRE(glGetError() == GL_NO_ERROR);
-    return p;
-  }
+  std::vector<unsigned char> pixels(int x, int y, int w, int h) const { return readRgba(fbo, x, y, w, h); }
   std::vector<unsigned char> pixels() const { return pixels(0, 0, fw, fh); }
 
   /// The game's depth buffer, every pixel.
@@ -590,16 +594,7 @@ TEST_CASE("draw() into the default framebuffer (the game's window) at a viewport
   GameContext game(false, WW, WH);
   glClearColor(0.3f, 0.3f, 0.1f, 1.0f);
   glClear(GL_COLOR_BUFFER_BIT);  // the game's drawing in its window
-  auto readWindow = [&](int x, int y, int w, int h) {
-    glBindFramebuffer(GL_READ_FRAMEBUFFER, 0);
-    glBindBuffer(GL_PIXEL_PACK_BUFFER, 0);
-    glPixelStorei(GL_PACK_ALIGNMENT, 1);
-    glPixelStorei(GL_PACK_ROW_LENGTH, 0);
-    std::vector<unsigned char> p(std::size_t(w) * std::size_t(h) * 4);
-    glReadPixels(x, y, w, h, GL_RGBA, GL_UNSIGNED_BYTE, p.data());
-    REQUIRE(glGetError() == GL_NO_ERROR);
-    return p;
-  };
+  auto readWindow = [&](int x, int y, int w, int h) { return readRgba(0, x, y, w, h); };
   const std::vector<unsigned char> gameDrawing = readWindow(0, 0, WW, WH);
   GameObjects g;
   Renderer renderer(currentGlContext, s.render, o);
@@ -757,11 +752,8 @@ TEST_CASE("draw() into a framebuffer with two colour attachments writes the firs
   auto readSecond = [&] {
     glBindFramebuffer(GL_READ_FRAMEBUFFER, g.fbo);
     glReadBuffer(GL_COLOR_ATTACHMENT1);
-    glPixelStorei(GL_PACK_ALIGNMENT, 1);
-    std::vector<unsigned char> p(std::size_t(W) * H * 4);
-    glReadPixels(0, 0, W, H, GL_RGBA, GL_UNSIGNED_BYTE, p.data());
+    std::vector<unsigned char> p = readRgba(g.fbo, 0, 0, W, H);
     glReadBuffer(GL_COLOR_ATTACHMENT0);
-    REQUIRE(glGetError() == GL_NO_ERROR);
     return p;
   };
   const std::vector<unsigned char> secondBefore = readSecond();
