@@ -62,14 +62,26 @@ Real Pbf::maxTimeStep(const StepContext& c, Real vmax, Real amax) const {
 Real Pbf::robustSpeed(const StepContext& c) const {
   const Particles& P = c.P;
   const std::size_t n = P.size();
+  const std::size_t skip = std::min(n - 1, std::size_t(double(quantile_) * double(n)));
+  const std::size_t k = skip + 1;  // the answer is the k-th largest squared speed
+  // Each block selects its k largest (in parallel); the k largest of all are among them,
+  // so the k-th largest of the blocks' is the answer: the value a selection over every
+  // particle finds, for any thread count.
   std::vector<Real>& s = speedScratch_;
   s.resize(n);
   c.pool.parallelFor(n, kStreamBlock, [&](std::size_t b, std::size_t e) {
     for (std::size_t i = b; i < e; ++i) s[i] = P.v[i].squaredNorm();
+    const std::size_t kb = std::min(k, e - b);
+    std::nth_element(s.begin() + std::ptrdiff_t(b), s.begin() + std::ptrdiff_t(e - kb), s.begin() + std::ptrdiff_t(e));
   });
-  const std::size_t skip = std::min(n - 1, std::size_t(double(quantile_) * double(n)));
-  std::nth_element(s.begin(), s.begin() + std::ptrdiff_t(n - 1 - skip), s.end());
-  return std::sqrt(s[n - 1 - skip]);
+  std::vector<Real>& top = speedTop_;
+  top.clear();
+  for (std::size_t b = 0; b < n; b += kStreamBlock) {
+    const std::size_t e = std::min(n, b + kStreamBlock);
+    top.insert(top.end(), s.begin() + std::ptrdiff_t(e - std::min(k, e - b)), s.begin() + std::ptrdiff_t(e));
+  }
+  std::nth_element(top.begin(), top.end() - std::ptrdiff_t(k), top.end());
+  return std::sqrt(top[top.size() - k]);
 }
 
 std::vector<Stage> Pbf::stages(bool effects) {

@@ -178,7 +178,7 @@ class Pbf final : public Solver {
   std::vector<std::uint32_t> lastList_;      ///< the particles the last constraint pass of the local phase wrote Δλ for
   std::vector<std::uint32_t> movedList_;     ///< moved_ listed for the halo pass (sorted)
   static constexpr std::size_t kLocalBlock = 32;  ///< particles per job of a local iteration (few, clustered)
-  mutable std::vector<Real> speedScratch_;
+  mutable std::vector<Real> speedScratch_, speedTop_;  ///< robustSpeed(): squared speeds, each block's largest
   std::unique_ptr<GridProjection> projection_;  ///< the coarse-grid projection (grid_cell > 0)
 
   Real d0_ = 0, eps_ = 0, invWdq_ = 0, sCorrScale_ = 0;
