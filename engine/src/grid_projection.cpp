@@ -4,6 +4,7 @@
 #include "state_io.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -52,25 +53,28 @@ void GridProjection::layout(const StepContext& c) {
     if (double(nx_) * double(ny_) <= budget) break;
     h_ *= Real(std::sqrt(double(nx_) * double(ny_) / budget) * 1.01);
   }
+}
+
+void GridProjection::resetCells() {
+  // The cells' fields and the faces' flags (classify and assemble write them).
   const std::size_t cells = std::size_t(nx_) * std::size_t(ny_);
   type_.assign(cells, kAir);
   w_.assign(cells, 0);
   comp_.assign(cells, 0);
   if (surface_) top_.assign(cells, -std::numeric_limits<Real>::infinity());
-  kappa_.assign(cells, 0);
   index_.assign(cells, -1);
-  u_.assign(std::size_t(nx_ + 1) * ny_, 0);
-  uw_.assign(u_.size(), 0);
-  du_.assign(u_.size(), 0);
-  uNew_.assign(u_.size(), 0);
-  uOpen_.assign(u_.size(), 0);
-  fluidU_.assign(u_.size(), 0);
-  v_.assign(std::size_t(nx_) * (ny_ + 1), 0);
-  vw_.assign(v_.size(), 0);
-  dv_.assign(v_.size(), 0);
-  vNew_.assign(v_.size(), 0);
-  vOpen_.assign(v_.size(), 0);
-  fluidV_.assign(v_.size(), 0);
+  uOpen_.assign(std::size_t(nx_ + 1) * std::size_t(ny_), 0);
+  fluidU_.assign(uOpen_.size(), 0);
+  vOpen_.assign(std::size_t(nx_) * std::size_t(ny_ + 1), 0);
+  fluidV_.assign(vOpen_.size(), 0);
+}
+
+void GridProjection::resetFaces(int axis) {
+  // One axis's face velocities, weights and changes.
+  const std::size_t faces = axis == 0 ? std::size_t(nx_ + 1) * std::size_t(ny_) : std::size_t(nx_) * std::size_t(ny_ + 1);
+  for (std::vector<Real>* f : axis == 0 ? std::array<std::vector<Real>*, 4>{&u_, &uw_, &du_, &uNew_}
+                                        : std::array<std::vector<Real>*, 4>{&v_, &vw_, &dv_, &vNew_})
+    f->assign(faces, 0);
 }
 
 std::uint8_t GridProjection::cacheEntry(const StepContext& c, long I, long J) {
@@ -297,51 +301,61 @@ void GridProjection::assembleCoupling() {
   }
 }
 
-void GridProjection::transferToGrid(const StepContext& c) {
+namespace {
+/// Adds the bilinear weights at (fx, fy), in the units of a field `stride` wide, to
+/// `weight`, and `value` times them to `sum` when given (fx, fy ≥ 0: the grid has a
+/// margin, so truncation is floor).
+inline void splat(Real* sum, std::vector<Real>& weight, int stride, Real fx, Real fy, Real value) {
+  const int i0 = int(fx), j0 = int(fy);
+  const Real tx = fx - Real(i0), ty = fy - Real(j0);
+  const Real wq[4] = {(1 - tx) * (1 - ty), tx * (1 - ty), (1 - tx) * ty, tx * ty};
+  const std::size_t k = std::size_t(j0) * std::size_t(stride) + std::size_t(i0);
+  const std::size_t ks[4] = {k, k + 1, k + std::size_t(stride), k + std::size_t(stride) + 1};
+  for (int q = 0; q < 4; ++q) {
+    if (sum) sum[ks[q]] += wq[q] * value;
+    weight[ks[q]] += wq[q];
+  }
+}
+}  // namespace
+
+void GridProjection::splatCells(const StepContext& c) {
+  // Serial in slot order (the same bits for any thread count).
   const Particles& P = c.P;
   const Real rho0 = c.rho0;
-  const int nu = nx_ + 1;
-  // Adds the bilinear weights at (fx, fy), in the units of a field `stride` wide, to
-  // `weight`, and `value` times them to `sum` when given (fx, fy ≥ 0: the grid has a
-  // margin, so truncation is floor).
-  auto splat = [](Real* sum, std::vector<Real>& weight, int stride, Real fx, Real fy, Real value) {
-    const int i0 = int(fx), j0 = int(fy);
-    const Real tx = fx - Real(i0), ty = fy - Real(j0);
-    const Real wq[4] = {(1 - tx) * (1 - ty), tx * (1 - ty), (1 - tx) * ty, tx * ty};
-    const std::size_t k = std::size_t(j0) * std::size_t(stride) + std::size_t(i0);
-    const std::size_t ks[4] = {k, k + 1, k + std::size_t(stride), k + std::size_t(stride) + 1};
-    for (int q = 0; q < 4; ++q) {
-      if (sum) sum[ks[q]] += wq[q] * value;
-      weight[ks[q]] += wq[q];
-    }
-  };
   // The cells' SPH compression is read only by the compression source.
   Real* comp = rate_ > 0 ? comp_.data() : nullptr;
-  // Three sums, each serial in slot order (the same bits for any thread count), and
-  // independent of each other: the cells, the u faces and the v faces run side by side.
-  c.pool.parallelFor(3, 1, [&](std::size_t b, std::size_t e) {
-    for (std::size_t task = b; task < e; ++task)
-      for (std::size_t p = 0; p < P.size(); ++p) {
-        const Real px = P.x[p].x() * invH_ - Real(I0_), py = P.x[p].y() * invH_ - Real(J0_);
-        if (task == 0) {
-          splat(comp, w_, nx_, px - Real(0.5), py - Real(0.5), P.rho[p] / rho0 - Real(1));  // cell centres
-          if (surface_) {  // the highest particle of each cell (the ghost surface's height)
-            const std::size_t k = std::size_t(int(py)) * std::size_t(nx_) + std::size_t(int(px));
-            top_[k] = std::max(top_[k], P.x[p].y());
-          }
-        }
-        else if (task == 1) splat(u_.data(), uw_, nu, px, py - Real(0.5), P.v[p].x());               // u faces at (i, j + 1/2)
-        else splat(v_.data(), vw_, nx_, px - Real(0.5), py, P.v[p].y());                              // v faces at (i + 1/2, j)
-      }
-  });
-  for (std::size_t k = 0; k < u_.size(); ++k)
-    if (uw_[k] > 0) u_[k] /= uw_[k];
-  for (std::size_t k = 0; k < v_.size(); ++k)
-    if (vw_[k] > 0) v_[k] /= vw_[k];
+  for (std::size_t p = 0; p < P.size(); ++p) {
+    const Real px = P.x[p].x() * invH_ - Real(I0_), py = P.x[p].y() * invH_ - Real(J0_);
+    splat(comp, w_, nx_, px - Real(0.5), py - Real(0.5), P.rho[p] / rho0 - Real(1));  // cell centres
+    if (surface_) {  // the highest particle of each cell (the ghost surface's height)
+      const std::size_t k = std::size_t(int(py)) * std::size_t(nx_) + std::size_t(int(px));
+      top_[k] = std::max(top_[k], P.x[p].y());
+    }
+  }
+}
+
+void GridProjection::splatFaces(const StepContext& c, int axis) {
+  // Serial in slot order (the same bits for any thread count); then the mean velocity.
+  const Particles& P = c.P;
+  std::vector<Real>& f = axis == 0 ? u_ : v_;
+  std::vector<Real>& fw = axis == 0 ? uw_ : vw_;
+  for (std::size_t p = 0; p < P.size(); ++p) {
+    const Real px = P.x[p].x() * invH_ - Real(I0_), py = P.x[p].y() * invH_ - Real(J0_);
+    if (axis == 0) splat(f.data(), fw, nx_ + 1, px, py - Real(0.5), P.v[p].x());  // u faces at (i, j + 1/2)
+    else splat(f.data(), fw, nx_, px - Real(0.5), py, P.v[p].y());                 // v faces at (i + 1/2, j)
+  }
+  for (std::size_t k = 0; k < f.size(); ++k)
+    if (fw[k] > 0) f[k] /= fw[k];
 }
 
 void GridProjection::assemble() {
   const int nu = nx_ + 1;
+  // The faces next to a fluid cell (their change is known; the others are extrapolated).
+  auto isFluid = [&](int i, int j) { return type_[std::size_t(j) * nx_ + i] == kFluid; };
+  for (int j = 0; j < ny_; ++j)
+    for (int i = 1; i < nx_; ++i) fluidU_[std::size_t(j) * nu + i] = isFluid(i - 1, j) || isFluid(i, j);
+  for (int j = 1; j < ny_; ++j)
+    for (int i = 0; i < nx_; ++i) fluidV_[std::size_t(j) * nx_ + i] = isFluid(i, j - 1) || isFluid(i, j);
   cells_.clear();
   for (int j = 0; j < ny_; ++j)
     for (int i = 0; i < nx_; ++i) {
@@ -513,7 +527,12 @@ void GridProjection::solve(const StepContext& c) {
   const std::size_t m = cells_.size();
   stats_ = GridProjectionStats{};
   stats_.fluidCells = int(m);
-  if (m == 0) return;
+  kappa_.assign(type_.size(), 0);  // air and solid cells hold 0
+  const bool shifting = shiftDef_.rate > 0;
+  if (m == 0) {
+    if (shifting) shiftMoves(c);  // none: no fluid cell
+    return;
+  }
   rhs_.assign(m, 0);
   std::vector<Real>& x = x_;  // the unknowns, in cell order (kept: no allocation in the step)
   x.assign(m, 0);
@@ -550,7 +569,6 @@ void GridProjection::solve(const StepContext& c) {
   // the SPH density of a disordered packing reads high, and removing that lifted the water:
   // 1.5 % energy gain at 40k, 2.8 % at 80k). The particles move by −dt²∇φ in
   // transferToParticles, their velocities unchanged.
-  const bool shifting = shiftDef_.rate > 0;
   const Real invFull = Real(1) / (cellRatio_ * cellRatio_);
   if (shifting) {
     rhsS_.resize(m);
@@ -562,8 +580,9 @@ void GridProjection::solve(const StepContext& c) {
     }
   }
   // The two solves share the matrix and nothing else: with two threads they run side by
-  // side, each in cell order on one thread (the same bits for any thread count). The
-  // residual stands for a density change of |r| dt²/h² over the substep.
+  // side, each in cell order on one thread (the same bits for any thread count); the
+  // shift's, the shorter, goes on to its face moves. The residual stands for a density
+  // change of |r| dt²/h² over the substep.
   Real res = 0, resS = 0;
   int itS = 0;
   const Real scale = h_ * h_ / (dt * dt);
@@ -571,8 +590,14 @@ void GridProjection::solve(const StepContext& c) {
   const bool coupled = !coupling_.empty();
   c.pool.parallelFor(shifting ? 2 : 1, 1, [&](std::size_t b, std::size_t e) {
     for (std::size_t k = b; k < e; ++k) {
-      if (k == 0) stats_.iterations = pcg(x, rhs_, tol_ * scale, res, cgMain_, coupled);
-      else itS = pcg(xs_, rhsS_, shiftDef_.tolerance * scale, resS, cgShift_, false);
+      if (k == 0) {
+        stats_.iterations = pcg(x, rhs_, tol_ * scale, res, cgMain_, coupled);
+      } else {
+        itS = pcg(xs_, rhsS_, shiftDef_.tolerance * scale, resS, cgShift_, false);
+        kappaS_.assign(type_.size(), 0);
+        for (std::size_t a = 0; a < m; ++a) kappaS_[std::size_t(cells_[a])] = xs_[a];
+        shiftMoves(c);
+      }
     }
   });
   if (coupled) {
@@ -595,7 +620,6 @@ void GridProjection::solve(const StepContext& c) {
   }
   stats_.iterations += itS;
   stats_.residual = double(res * dt * dt * invH_ * invH_);
-  std::fill(kappa_.begin(), kappa_.end(), Real(0));
   for (std::size_t a = 0; a < m; ++a) kappa_[std::size_t(cells_[a])] = x[a];
   pH_ = h_;
   pI0_ = I0_;
@@ -603,10 +627,6 @@ void GridProjection::solve(const StepContext& c) {
   pnx_ = nx_;
   pny_ = ny_;
   prevKappa_ = kappa_;
-  if (shifting) {
-    kappaS_.assign(kappa_.size(), 0);
-    for (std::size_t a = 0; a < m; ++a) kappaS_[std::size_t(cells_[a])] = xs_[a];
-  }
 }
 
 Vec2 GridProjection::sampleFaces(const std::vector<Real>& u, const std::vector<Real>& v, Real px, Real py) const {
@@ -650,51 +670,72 @@ void GridProjection::extrapolate(std::vector<Real>& d, int w, int h, const std::
     }
 }
 
+void GridProjection::shiftMoves(const StepContext& c) {
+  // The shift's face moves: −dt²∇φ across open faces between fluid and air cells (none
+  // through a wall or a moving body), extrapolated one layer as the velocity change is.
+  const Real dt = c.dt;
+  const int nu = nx_ + 1;
+  const Real k2 = -dt * dt * invH_;
+  auto phi = [&](int i, int j) {  // φ in a fluid cell, 0 elsewhere (air holds 0)
+    return type_[std::size_t(j) * nx_ + i] == kFluid ? kappaS_[std::size_t(j) * nx_ + i] : Real(0);
+  };
+  su_.assign(u_.size(), 0);
+  sv_.assign(v_.size(), 0);
+  for (int j = 0; j < ny_; ++j)
+    for (int i = 1; i < nx_; ++i) {
+      const std::size_t f = std::size_t(j) * nu + i;
+      if (!fluidU_[f]) continue;
+      const std::size_t kl = std::size_t(j) * nx_ + i - 1, kr = kl + 1;
+      const bool solidSide = type_[kl] == kSolid || type_[kr] == kSolid;
+      if (uOpen_[f] && !solidSide && bodyAcross(kl, kr) < 0) su_[f] = k2 * (phi(i, j) - phi(i - 1, j));
+    }
+  extrapolate(su_, nu, ny_, fluidU_);
+  for (int j = 1; j < ny_; ++j)
+    for (int i = 0; i < nx_; ++i) {
+      const std::size_t f = std::size_t(j) * nx_ + i;
+      if (!fluidV_[f]) continue;
+      const std::size_t kd = std::size_t(j - 1) * nx_ + i, ku = kd + std::size_t(nx_);
+      const bool solidSide = type_[kd] == kSolid || type_[ku] == kSolid;
+      // Under the ghost surface the gradient spans θ of a cell (the matrix's 1/θ).
+      const Real span = surface_ && type_[ku] == kAir ? thetaUp_[kd] : Real(1);
+      if (vOpen_[f] && !solidSide && bodyAcross(kd, ku) < 0) sv_[f] = k2 * (phi(i, j) - phi(i, j - 1)) / span;
+    }
+  extrapolate(sv_, nx_, ny_ + 1, fluidV_);
+}
+
 std::size_t GridProjection::transferToParticles(StepContext& c) {
   const Real dt = c.dt;
   const int nu = nx_ + 1;
-  // A cell field's value in a fluid cell, 0 elsewhere (air holds 0; solid faces are not read).
-  auto inFluid = [&](const std::vector<Real>& field, int i, int j) {
-    return type_[std::size_t(j) * nx_ + i] == kFluid ? field[std::size_t(j) * nx_ + i] : Real(0);
+  // κ in a fluid cell, 0 elsewhere (air holds 0; solid faces are not read).
+  auto kap = [&](int i, int j) {
+    return type_[std::size_t(j) * nx_ + i] == kFluid ? kappa_[std::size_t(j) * nx_ + i] : Real(0);
   };
-  auto kap = [&](int i, int j) { return inFluid(kappa_, i, j); };
-  auto isFluid = [&](int i, int j) { return type_[std::size_t(j) * nx_ + i] == kFluid; };
   const bool shifting = shiftDef_.rate > 0;
-  const Real k2 = -dt * dt * invH_;
-  auto phi = [&](int i, int j) { return inFluid(kappaS_, i, j); };
-  if (shifting) {
-    su_.assign(u_.size(), 0);
-    sv_.assign(v_.size(), 0);
-  }
-  // The u faces and the v faces are independent: two tasks, each serial.
+  // The u faces and the v faces are independent: two tasks, each serial. Open faces
+  // next to fluid take the pressure gradient; closed faces next to fluid lose their
+  // normal velocity (the wall).
   c.pool.parallelFor(2, 1, [&](std::size_t b, std::size_t e) {
     for (std::size_t task = b; task < e; ++task) {
       if (task == 0) {
-        // Face changes: open faces next to fluid take the pressure gradient; closed
-        // faces next to fluid lose their normal velocity (the wall).
         for (int j = 0; j < ny_; ++j)
           for (int i = 1; i < nx_; ++i) {
-            if (!isFluid(i - 1, j) && !isFluid(i, j)) continue;
             const std::size_t f = std::size_t(j) * nu + i;
-            fluidU_[f] = 1;
+            if (!fluidU_[f]) continue;
             const std::size_t kl = std::size_t(j) * nx_ + i - 1, kr = kl + 1;
             const bool solidSide = type_[kl] == kSolid || type_[kr] == kSolid;
             const int body = solidSide ? -1 : bodyAcross(kl, kr);
             du_[f] = body >= 0                    ? bodyFaceVelocity(body, 0, i, j) - u_[f]  // a moving body's face
                      : uOpen_[f] && !solidSide ? -dt * (kap(i, j) - kap(i - 1, j)) * invH_
                                                : -u_[f];
-            // The shift's face moves: −dt²∇φ across open faces between fluid and air
-            // cells (none through a wall), extrapolated one layer as the change is.
-            if (shifting && uOpen_[f] && !solidSide && body < 0) su_[f] = k2 * (phi(i, j) - phi(i - 1, j));
           }
         extrapolate(du_, nu, ny_, fluidU_);
-        if (shifting) extrapolate(su_, nu, ny_, fluidU_);
+        if (pic_ > 0)  // the projected face velocities (closed faces: 0)
+          for (std::size_t f = 0; f < u_.size(); ++f) uNew_[f] = u_[f] + du_[f];
       } else {
         for (int j = 1; j < ny_; ++j)
           for (int i = 0; i < nx_; ++i) {
-            if (!isFluid(i, j - 1) && !isFluid(i, j)) continue;
             const std::size_t f = std::size_t(j) * nx_ + i;
-            fluidV_[f] = 1;
+            if (!fluidV_[f]) continue;
             const std::size_t kd = std::size_t(j - 1) * nx_ + i, ku = kd + std::size_t(nx_);
             const bool solidSide = type_[kd] == kSolid || type_[ku] == kSolid;
             const int body = solidSide ? -1 : bodyAcross(kd, ku);
@@ -703,10 +744,10 @@ std::size_t GridProjection::transferToParticles(StepContext& c) {
             dv_[f] = body >= 0                    ? bodyFaceVelocity(body, 1, i, j) - v_[f]
                      : vOpen_[f] && !solidSide ? -dt * (kap(i, j) - kap(i, j - 1)) * invH_ / span
                                                : -v_[f];
-            if (shifting && vOpen_[f] && !solidSide && body < 0) sv_[f] = k2 * (phi(i, j) - phi(i, j - 1)) / span;
           }
         extrapolate(dv_, nx_, ny_ + 1, fluidV_);
-        if (shifting) extrapolate(sv_, nx_, ny_ + 1, fluidV_);
+        if (pic_ > 0)
+          for (std::size_t f = 0; f < v_.size(); ++f) vNew_[f] = v_[f] + dv_[f];
       }
     }
   });
@@ -714,10 +755,6 @@ std::size_t GridProjection::transferToParticles(StepContext& c) {
   const Real vmax2 = c.maxSpeed * c.maxSpeed;
   if (shifting) shift_.resize(P.size());
   else shift_.clear();
-  if (pic_ > 0) {  // the projected face velocities (closed faces: 0)
-    for (std::size_t f = 0; f < u_.size(); ++f) uNew_[f] = u_[f] + du_[f];
-    for (std::size_t f = 0; f < v_.size(); ++f) vNew_[f] = v_[f] + dv_[f];
-  }
   return firstBad(c.pool, P.size(), [&](std::size_t b, std::size_t e) {
     std::size_t bad = kNone;
     for (std::size_t p = b; p < e; ++p) {
@@ -758,9 +795,22 @@ std::size_t GridProjection::project(StepContext& c) {
   if (c.P.size() == 0 || !(c.dt > 0)) return kNone;
   dx_ = c.dx;
   layout(c);
-  transferToGrid(c);
-  classify(c);
-  assemble();
+  // The cells' particle weights decide the cell types and the matrix; the face
+  // velocities are read only by the solve. Three tasks, each serial: the cells with the
+  // classification and the matrix (the longest), the u faces, the v faces.
+  c.pool.parallelFor(3, 1, [&](std::size_t b, std::size_t e) {
+    for (std::size_t task = b; task < e; ++task) {
+      if (task == 0) {
+        resetCells();
+        splatCells(c);
+        classify(c);
+        assemble();
+      } else {
+        resetFaces(int(task) - 1);
+        splatFaces(c, int(task) - 1);
+      }
+    }
+  });
   solve(c);
   return transferToParticles(c);
 }

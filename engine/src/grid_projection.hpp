@@ -29,8 +29,12 @@
 // prediction adds. It removes the compression that large substeps pile up
 // without putting kinetic energy in.
 //
-// Deterministic: particles go to the grid in slot order (one thread), the
-// conjugate-gradient sums are taken in cell order.
+// Deterministic: particles go to the grid in slot order (each field on one
+// thread), the conjugate-gradient sums are taken in cell order. On two threads
+// a projection is four steps of a few tasks each (project()): the cells'
+// weights, their classification and the matrix beside the u and v faces'
+// velocities; the pressure solve beside the shift's solve and face moves; the
+// u beside the v faces' changes; then the particles in blocks.
 #pragma once
 
 #include <cstdint>
@@ -80,9 +84,17 @@ class GridProjection {
 
  private:
   enum : std::uint8_t { kAir = 0, kFluid = 1, kSolid = 2, kBody = 3 };  ///< kBody: inside a moving body (bodyOf_)
+  /// The grid over the particles' box (cells of cellRatio_·dx, larger for spray).
   void layout(const StepContext& c);
+  /// Sizes and clears the cell fields and the face flags (the first task of a projection).
+  void resetCells();
+  /// Sizes and clears one axis's face fields (0: u, 1: v; that axis's splat task).
+  void resetFaces(int axis);
   void classify(const StepContext& c);
-  void transferToGrid(const StepContext& c);
+  /// The particles' weights (and SPH compression, highest particle) to the cells, in slot order.
+  void splatCells(const StepContext& c);
+  /// The particles' velocities to the u (axis 0) or v (axis 1) faces, in slot order.
+  void splatFaces(const StepContext& c, int axis);
   void assemble();
   /// out = A·in; `coupled`: plus the dynamic bodies' response ρ0 h² G M⁻¹ Gᵀ·in.
   void apply(const std::vector<Real>& in, std::vector<Real>& out, bool coupled) const;
@@ -116,6 +128,8 @@ class GridProjection {
 
  private:
   std::size_t transferToParticles(StepContext& c);
+  /// The compression shift's face moves −dt²∇φ (su_, sv_) from the last shift solve.
+  void shiftMoves(const StepContext& c);
   static void extrapolate(std::vector<Real>& d, int w, int h, const std::vector<std::uint8_t>& known);
   /// Cached solid flags of cell (I, J) and blocked flags of its left/bottom faces (anchored indices).
   std::uint8_t cacheEntry(const StepContext& c, long I, long J);
