@@ -365,6 +365,10 @@ void GridProjection::assemble() {
       cells_.push_back(std::int32_t(k));
     }
   const std::size_t m = cells_.size();
+  // Each row's first unknown (rows[ny] = m): the preconditioner's sweeps go row by row.
+  rowStart_.assign(std::size_t(ny_) + 1, std::int32_t(m));
+  for (std::size_t a = m; a-- > 0;) rowStart_[std::size_t(cells_[a] / nx_)] = std::int32_t(a);
+  for (int j = ny_; j-- > 0;) rowStart_[std::size_t(j)] = std::min(rowStart_[std::size_t(j)], rowStart_[std::size_t(j) + 1]);
   diag_.assign(m, 0);
   if (surface_) thetaUp_.assign(type_.size(), Real(1));
   adj_.assign(4 * m, -1);
@@ -421,31 +425,81 @@ void GridProjection::assemble() {
 
 void GridProjection::precondition(const std::vector<Real>& r, std::vector<Real>& z, std::vector<Real>& y) const {
   // z = (L Lᵀ)⁻¹ r with L = MIC(0)'s factor (p = precon_ = 1/diag(L), p2 = p²). Each
-  // substitution is a chain from one cell to the next in cell order: written so that
-  // the chain is one multiply and one add (the rest is computed beside it), and the
-  // left neighbour's value is carried in a register.
+  // substitution is a chain from one cell to the next along a row (a left neighbour is
+  // always the unknown before, a right one the unknown after), fed by the row below
+  // (forward) or above (backward). Each cell's arithmetic is fixed; only the schedule is
+  // free: two rows run side by side, the second a cell or more behind the first, so two
+  // chains are in flight (the chain is one multiply and one add per cell, and with one
+  // row at a time the core waits on it). Each cursor carries its row's last value in a
+  // register. The same bits as one cell after the other.
   const std::size_t m = cells_.size();
   const Real* p = precon_.data();
   const Real* p2 = precon2_.data();
   const std::int32_t* A = adj_.data();
+  const std::int32_t* rows = rowStart_.data();
+  const Real* R = r.data();
   y.resize(m);
+  Real* Y = y.data();
+  Real* Z = z.data();
   // Forward: q = L⁻¹ r, kept as z (= q) and y = q·p (what the right and up cells read).
-  Real yPrev = 0;
-  for (std::size_t a = 0; a < m; ++a) {
+  auto forward = [&](std::int32_t a, Real& yPrev) {
     const std::int32_t l = A[4 * a + 0], d = A[4 * a + 2];
-    const Real t = r[a] + (d >= 0 ? y[std::size_t(d)] : Real(0));
-    const Real yl = l < 0 ? Real(0) : (std::size_t(l) + 1 == a ? yPrev : y[std::size_t(l)]);
-    z[a] = (t + yl) * p[a];
-    yPrev = y[a] = t * p2[a] + yl * p2[a];
+    const Real t = R[a] + (d >= 0 ? Y[d] : Real(0));
+    const Real yl = l < 0 ? Real(0) : yPrev;
+    Z[a] = (t + yl) * p[a];
+    yPrev = Y[a] = t * p2[a] + yl * p2[a];
+  };
+  for (int j = 0; j < ny_; j += 2) {
+    // Row j (cursor a) and row j + 1 (cursor b): b's cell waits for the cell below it.
+    std::int32_t a = rows[j], b = rows[j + 1];
+    const std::int32_t ae = rows[j + 1], be = rows[std::min(j + 2, ny_)];
+    Real ya = 0, yb = 0;
+    while (a < ae) {
+      forward(a++, ya);
+      if (b < be && A[4 * b + 2] < a) forward(b++, yb);  // below: done (or none, −1)
+    }
+    while (b < be) forward(b++, yb);
   }
-  // Backward: z = L⁻ᵀ q.
-  Real zNext = 0;
-  for (std::size_t a = m; a-- > 0;) {
+  // Backward: z = L⁻ᵀ q, from the top row down.
+  auto backward = [&](std::int32_t a, Real& zNext) {
     const std::int32_t rt = A[4 * a + 1], u = A[4 * a + 3];
-    const Real s = z[a] * p[a] + (u >= 0 ? z[std::size_t(u)] : Real(0)) * p2[a];
-    const Real zr = rt < 0 ? Real(0) : (std::size_t(rt) == a + 1 ? zNext : z[std::size_t(rt)]);
-    zNext = z[a] = s + zr * p2[a];
+    const Real s = Z[a] * p[a] + (u >= 0 ? Z[u] : Real(0)) * p2[a];
+    const Real zr = rt < 0 ? Real(0) : zNext;
+    zNext = Z[a] = s + zr * p2[a];
+  };
+  for (int j = ny_ - 1; j >= 0; j -= 2) {
+    // Row j (cursor a, descending) and row j − 1 (cursor b): b's cell waits for the cell above.
+    std::int32_t a = rows[j + 1] - 1, b = rows[j] - 1;
+    const std::int32_t as = rows[j], bs = rows[std::max(j - 1, 0)];
+    Real za = 0, zb = 0;
+    while (a >= as) {
+      backward(a--, za);
+      if (b >= bs && (A[4 * b + 3] < 0 || A[4 * b + 3] > a)) backward(b--, zb);  // above: done, or none
+    }
+    while (b >= bs) backward(b--, zb);
   }
+  (void)m;
+}
+
+double GridProjection::dot(const std::vector<Real>& a, const std::vector<Real>& b) const {
+  double s = 0;  // in cell order
+  for (std::size_t k = 0; k < cells_.size(); ++k) s += double(a[k]) * double(b[k]);
+  return s;
+}
+
+double GridProjection::applyDot(const std::vector<Real>& in, std::vector<Real>& out) const {
+  // apply(in, out, false), and in·out summed in cell order as it goes.
+  const std::size_t m = cells_.size();
+  const std::int32_t* A = adj_.data();
+  double dsum = 0;
+  for (std::size_t a = 0; a < m; ++a) {
+    Real s = diag_[a] * in[a];
+    for (int q = 0; q < 4; ++q)
+      if (A[4 * a + q] >= 0) s -= in[std::size_t(A[4 * a + q])];
+    out[a] = s;
+    dsum += double(in[a]) * double(s);
+  }
+  return dsum;
 }
 
 void GridProjection::apply(const std::vector<Real>& in, std::vector<Real>& out, bool coupled) const {
@@ -500,23 +554,24 @@ int GridProjection::pcg(std::vector<Real>& x, const std::vector<Real>& b, Real t
   int it = 0;
   res = worst();
   while (it < maxIt_ && res > tol && rz > 0) {
-    apply(d_, q_, coupled);
-    double dq = 0;
-    for (std::size_t a = 0; a < m; ++a) dq += double(d_[a]) * double(q_[a]);
+    // q = A d and d·q (in one pass when no body adds to q afterwards), the update of x and
+    // r with the largest |r| in one pass: the same sums in the same order.
+    const double dq = coupled ? (apply(d_, q_, true), dot(d_, q_)) : applyDot(d_, q_);
     if (!(dq > 0)) break;
     const Real alpha = Real(rz / dq);
+    Real mx = 0;
     for (std::size_t a = 0; a < m; ++a) {
       x[a] += alpha * d_[a];
       r_[a] -= alpha * q_[a];
+      mx = std::max(mx, std::fabs(r_[a]));
     }
-    double rzNew = 0;
     precondition(r_, z_, w.y);
-    for (std::size_t a = 0; a < m; ++a) rzNew += double(r_[a]) * double(z_[a]);
+    const double rzNew = dot(r_, z_);
     const Real beta = Real(rzNew / rz);
     rz = rzNew;
     for (std::size_t a = 0; a < m; ++a) d_[a] = z_[a] + beta * d_[a];
     ++it;
-    res = worst();
+    res = mx;
   }
   return it;
 }
@@ -629,25 +684,37 @@ void GridProjection::solve(const StepContext& c) {
   prevKappa_ = kappa_;
 }
 
-Vec2 GridProjection::sampleFaces(const std::vector<Real>& u, const std::vector<Real>& v, Real px, Real py) const {
+GridProjection::FaceWeights GridProjection::faceWeights(Real px, Real py) const {
   // Bilinear over the MAC faces: u at (i, j + 1/2), v at (i + 1/2, j), in cell units of the
   // grid (px, py ≥ 0: the grid has a margin, so truncation is floor).
-  const int nu = nx_ + 1;
-  Real ux, uy;
+  FaceWeights w;
   {
     const Real fx = px, fy = py - Real(0.5);
     const int i0 = int(fx), j0 = int(fy);
     const Real tx = fx - Real(i0), ty = fy - Real(j0);
-    const std::size_t k = std::size_t(j0) * nu + i0;
-    ux = (1 - tx) * (1 - ty) * u[k] + tx * (1 - ty) * u[k + 1] + (1 - tx) * ty * u[k + nu] + tx * ty * u[k + nu + 1];
+    w.ku = std::size_t(j0) * std::size_t(nx_ + 1) + std::size_t(i0);
+    w.u[0] = (1 - tx) * (1 - ty);
+    w.u[1] = tx * (1 - ty);
+    w.u[2] = (1 - tx) * ty;
+    w.u[3] = tx * ty;
   }
   {
     const Real fx = px - Real(0.5), fy = py;
     const int i0 = int(fx), j0 = int(fy);
     const Real tx = fx - Real(i0), ty = fy - Real(j0);
-    const std::size_t k = std::size_t(j0) * nx_ + i0;
-    uy = (1 - tx) * (1 - ty) * v[k] + tx * (1 - ty) * v[k + 1] + (1 - tx) * ty * v[k + nx_] + tx * ty * v[k + nx_ + 1];
+    w.kv = std::size_t(j0) * std::size_t(nx_) + std::size_t(i0);
+    w.v[0] = (1 - tx) * (1 - ty);
+    w.v[1] = tx * (1 - ty);
+    w.v[2] = (1 - tx) * ty;
+    w.v[3] = tx * ty;
   }
+  return w;
+}
+
+Vec2 GridProjection::sampleFaces(const std::vector<Real>& u, const std::vector<Real>& v, const FaceWeights& w) const {
+  const std::size_t nu = std::size_t(nx_ + 1), k = w.ku, kv = w.kv, nv = std::size_t(nx_);
+  const Real ux = w.u[0] * u[k] + w.u[1] * u[k + 1] + w.u[2] * u[k + nu] + w.u[3] * u[k + nu + 1];
+  const Real uy = w.v[0] * v[kv] + w.v[1] * v[kv + 1] + w.v[2] * v[kv + nv] + w.v[3] * v[kv + nv + 1];
   return Vec2(ux, uy);
 }
 
@@ -759,14 +826,15 @@ std::size_t GridProjection::transferToParticles(StepContext& c) {
     std::size_t bad = kNone;
     for (std::size_t p = b; p < e; ++p) {
       const Real px = P.x[p].x() * invH_ - Real(I0_), py = P.x[p].y() * invH_ - Real(J0_);
-      Vec2 vp = P.v[p] + sampleFaces(du_, dv_, px, py);  // FLIP: the change of the grid velocity
+      const FaceWeights w = faceWeights(px, py);  // the same for every face field
+      Vec2 vp = P.v[p] + sampleFaces(du_, dv_, w);  // FLIP: the change of the grid velocity
       if (pic_ > 0) {
         // PIC share: towards the projected grid velocity itself (smooths particle noise).
-        const Vec2 ug = sampleFaces(uNew_, vNew_, px, py);
+        const Vec2 ug = sampleFaces(uNew_, vNew_, w);
         vp += (ug - vp) * pic_;
       }
       P.v[p] = vp;
-      if (shifting) shift_[p] = sampleFaces(su_, sv_, px, py);
+      if (shifting) shift_[p] = sampleFaces(su_, sv_, w);
       if (bad == kNone && (!allFinite(P.v[p]) || P.v[p].squaredNorm() > vmax2)) bad = p;
     }
     return bad;

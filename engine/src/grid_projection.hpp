@@ -98,6 +98,10 @@ class GridProjection {
   void assemble();
   /// out = A·in; `coupled`: plus the dynamic bodies' response ρ0 h² G M⁻¹ Gᵀ·in.
   void apply(const std::vector<Real>& in, std::vector<Real>& out, bool coupled) const;
+  /// apply(in, out, false), returning in·out (summed in cell order, in double).
+  double applyDot(const std::vector<Real>& in, std::vector<Real>& out) const;
+  /// a·b over the unknowns, summed in cell order in double.
+  double dot(const std::vector<Real>& a, const std::vector<Real>& b) const;
   void precondition(const std::vector<Real>& r, std::vector<Real>& z, std::vector<Real>& y) const;
   /// The vectors of one conjugate-gradient solve (two solves may run at once).
   struct CgWork {
@@ -116,8 +120,15 @@ class GridProjection {
   /// The body of whichever of cells k1, k2 is a moving body's (−1: neither).
   int bodyAcross(std::size_t k1, std::size_t k2) const;
   void solve(const StepContext& c);
-  /// Bilinear sample of face fields u, v at (px, py) in cell units of the grid.
-  Vec2 sampleFaces(const std::vector<Real>& u, const std::vector<Real>& v, Real px, Real py) const;
+  /// The bilinear weights of a point on the u and v faces, and the lower left face of each.
+  struct FaceWeights {
+    std::size_t ku, kv;
+    Real u[4], v[4];  ///< (i, j), (i + 1, j), (i, j + 1), (i + 1, j + 1)
+  };
+  /// The weights at (px, py) in cell units of the grid.
+  FaceWeights faceWeights(Real px, Real py) const;
+  /// Bilinear sample of face fields u, v with weights `w`.
+  Vec2 sampleFaces(const std::vector<Real>& u, const std::vector<Real>& v, const FaceWeights& w) const;
 
  public:
   Real pic_ = 0;  ///< share of the projected grid velocity given to the particles (PIC; the rest FLIP)
@@ -158,6 +169,7 @@ class GridProjection {
   std::vector<std::int32_t> cells_;         ///< unknown → cell
   std::vector<std::int32_t> adj_;           ///< per unknown: left, right, down, up unknown (−1: none)
   std::vector<Real> precon_, precon2_;      ///< MIC(0) factor: 1/diag(L), and its square
+  std::vector<std::int32_t> rowStart_;      ///< per grid row: its first unknown (ny + 1 entries, the last m)
   // Warm start: the last substep's κ by anchored cell.
   Real pH_ = 0;  ///< the cell size of prevKappa_
   long pI0_ = 0, pJ0_ = 0;
