@@ -117,13 +117,18 @@ void GridProjection::classify(const StepContext& c) {
     cnx_ = int(nI1 - nI0);
     cny_ = int(nJ1 - nJ0);
   }
+  // Cell (i, j) of the grid (−1 ≤ i ≤ nx, −1 ≤ j ≤ ny) from the cache, computed when not yet known.
+  std::uint8_t* const base = cache_.data() + std::size_t(J0_ - cJ0_) * std::size_t(cnx_) + std::size_t(I0_ - cI0_);
+  auto entry = [&](int i, int j) {
+    const std::uint8_t e = base[std::ptrdiff_t(j) * cnx_ + i];
+    return (e & 1) ? e : cacheEntry(c, I0_ + i, J0_ + j);
+  };
   const Real full = cellRatio_ * cellRatio_;  // particle weight of a full cell
-  for (int j = 0; j < ny_; ++j)
-    for (int i = 0; i < nx_; ++i) {
+  for (int j = 1; j + 1 < ny_; ++j)  // border cells stay air (solid neighbours are marked below)
+    for (int i = 1; i + 1 < nx_; ++i) {
       const std::size_t k = std::size_t(j) * nx_ + i;
-      const bool border = i == 0 || j == 0 || i == nx_ - 1 || j == ny_ - 1;
-      if (!(w_[k] > 0) || border) continue;  // empty and border cells stay air (solid neighbours are marked below)
-      const std::uint8_t e = cacheEntry(c, I0_ + i, J0_ + j);
+      if (!(w_[k] > 0)) continue;  // empty cells stay air
+      const std::uint8_t e = entry(i, j);
       type_[k] = (e & 2) ? kSolid : (w_[k] >= fluidFraction_ * full ? kFluid : kAir);
     }
   markBodies(c);
@@ -132,16 +137,16 @@ void GridProjection::classify(const StepContext& c) {
     for (int i = 0; i < nx_; ++i) {
       const std::size_t k = std::size_t(j) * nx_ + i;
       if (type_[k] != kFluid) continue;
-      const std::uint8_t e = cacheEntry(c, I0_ + i, J0_ + j);
-      const std::uint8_t eR = cacheEntry(c, I0_ + i + 1, J0_ + j);
-      const std::uint8_t eT = cacheEntry(c, I0_ + i, J0_ + j + 1);
+      const std::uint8_t e = entry(i, j);
+      const std::uint8_t eR = entry(i + 1, j);
+      const std::uint8_t eT = entry(i, j + 1);
       uOpen_[std::size_t(j) * (nx_ + 1) + i] = !(e & 4);
       uOpen_[std::size_t(j) * (nx_ + 1) + i + 1] = !(eR & 4);
       vOpen_[std::size_t(j) * nx_ + i] = !(e & 8);
       vOpen_[std::size_t(j + 1) * nx_ + i] = !(eT & 8);
-      if (i > 0 && (cacheEntry(c, I0_ + i - 1, J0_ + j) & 2)) type_[k - 1] = kSolid;
+      if (i > 0 && (entry(i - 1, j) & 2)) type_[k - 1] = kSolid;
       if (i + 1 < nx_ && (eR & 2)) type_[k + 1] = kSolid;
-      if (j > 0 && (cacheEntry(c, I0_ + i, J0_ + j - 1) & 2)) type_[k - nx_] = kSolid;
+      if (j > 0 && (entry(i, j - 1) & 2)) type_[k - nx_] = kSolid;
       if (j + 1 < ny_ && (eT & 2)) type_[k + nx_] = kSolid;
     }
 }
@@ -277,8 +282,8 @@ void GridProjection::assembleCoupling() {
   coupling_.clear();
   if (bodies_.empty()) return;
   const double h = double(h_);
-  for (std::size_t a = 0; a < cells_.size(); ++a) {
-    const int k = cells_[a], i = k % nx_, j = k / nx_;
+  forUnknowns([&](std::size_t a, int i, int j) {
+    const int k = cells_[a];
     const int nb[4] = {k - 1, k + 1, k - nx_, k + nx_};
     const Vec2d normals[4] = {Vec2d(-1, 0), Vec2d(1, 0), Vec2d(0, -1), Vec2d(0, 1)};
     const Vec2d faces[4] = {Vec2d(double(I0_ + i) * h, (double(J0_ + j) + 0.5) * h),
@@ -298,7 +303,7 @@ void GridProjection::assembleCoupling() {
       st.coupling(normals[q], faces[q], g);
       for (int r = 0; r < 3; ++r) coupling_[e].g[r] += g[r];
     }
-  }
+  });
 }
 
 namespace {
@@ -356,24 +361,26 @@ void GridProjection::assemble() {
     for (int i = 1; i < nx_; ++i) fluidU_[std::size_t(j) * nu + i] = isFluid(i - 1, j) || isFluid(i, j);
   for (int j = 1; j < ny_; ++j)
     for (int i = 0; i < nx_; ++i) fluidV_[std::size_t(j) * nx_ + i] = isFluid(i, j - 1) || isFluid(i, j);
+  // The unknowns in cell order, and each row's first (rowStart_[ny] = m): the loops over
+  // unknowns go row by row (no division to find a cell's row).
   cells_.clear();
-  for (int j = 0; j < ny_; ++j)
+  rowStart_.resize(std::size_t(ny_) + 1);
+  for (int j = 0; j < ny_; ++j) {
+    rowStart_[std::size_t(j)] = std::int32_t(cells_.size());
     for (int i = 0; i < nx_; ++i) {
       const std::size_t k = std::size_t(j) * nx_ + i;
       if (type_[k] != kFluid) continue;
       index_[k] = std::int32_t(cells_.size());
       cells_.push_back(std::int32_t(k));
     }
+  }
   const std::size_t m = cells_.size();
-  // Each row's first unknown (rows[ny] = m): the preconditioner's sweeps go row by row.
-  rowStart_.assign(std::size_t(ny_) + 1, std::int32_t(m));
-  for (std::size_t a = m; a-- > 0;) rowStart_[std::size_t(cells_[a] / nx_)] = std::int32_t(a);
-  for (int j = ny_; j-- > 0;) rowStart_[std::size_t(j)] = std::min(rowStart_[std::size_t(j)], rowStart_[std::size_t(j) + 1]);
+  rowStart_[std::size_t(ny_)] = std::int32_t(m);
   diag_.assign(m, 0);
   if (surface_) thetaUp_.assign(type_.size(), Real(1));
   adj_.assign(4 * m, -1);
-  for (std::size_t a = 0; a < m; ++a) {
-    const int k = cells_[a], i = k % nx_, j = k / nx_;
+  forUnknowns([&](std::size_t a, int i, int j) {
+    const int k = cells_[a];
     const bool open[4] = {uOpen_[std::size_t(j) * nu + i] != 0, uOpen_[std::size_t(j) * nu + i + 1] != 0,
                           vOpen_[std::size_t(j) * nx_ + i] != 0, vOpen_[std::size_t(j + 1) * nx_ + i] != 0};
     const int nb[4] = {k - 1, k + 1, k - nx_, k + nx_};
@@ -385,7 +392,7 @@ void GridProjection::assemble() {
         // of the way to the air cell's centre: half a spacing above the highest particle of
         // the two cells (the fill would say it too, but beside a wall or over a compressed
         // layer its reading differs by a tenth of a cell, and that difference drives a flow).
-        const double ya = (double(J0_ + k / nx_) + 0.5) * double(h_);
+        const double ya = (double(J0_ + j) + 0.5) * double(h_);
         const Real ytop = std::max(top_[std::size_t(k)], top_[std::size_t(nb[q])]);
         const Real theta = std::clamp(Real((double(ytop) + 0.5 * double(dx_) - ya) * double(invH_)), kMinSurfaceFraction, Real(1));
         dg += Real(1) / theta;
@@ -396,7 +403,7 @@ void GridProjection::assemble() {
       adj_[4 * a + q] = open[q] ? index_[std::size_t(nb[q])] : -1;  // −1: air, solid or closed
     }
     diag_[a] = dg;
-  }
+  });
   // MIC(0) (Bridson, "Fluid Simulation for Computer Graphics", 2nd ed., fig. 5.7):
   // the incomplete Cholesky factor of the 5-point Laplacian, in cell order.
   const Real tau = Real(0.97), sigma = Real(0.25);
@@ -576,29 +583,21 @@ int GridProjection::pcg(std::vector<Real>& x, const std::vector<Real>& b, Real t
   return it;
 }
 
-void GridProjection::solve(const StepContext& c) {
+void GridProjection::pressureSystem(const StepContext& c) {
   const Real dt = c.dt;
   const int nu = nx_ + 1;
   const std::size_t m = cells_.size();
-  stats_ = GridProjectionStats{};
-  stats_.fluidCells = int(m);
-  kappa_.assign(type_.size(), 0);  // air and solid cells hold 0
-  const bool shifting = shiftDef_.rate > 0;
-  if (m == 0) {
-    if (shifting) shiftMoves(c);  // none: no fluid cell
-    return;
-  }
   rhs_.assign(m, 0);
-  std::vector<Real>& x = x_;  // the unknowns, in cell order (kept: no allocation in the step)
+  std::vector<Real>& x = x_;
   x.assign(m, 0);
   // Warm start from the last substep's κ of the same anchored cells (none when the cells
   // grew to hold spray: the same index is then another place).
   const bool sameCells = h_ == pH_;
-  for (std::size_t a = 0; a < m; ++a) {
-    const int i = cells_[a] % nx_, j = cells_[a] / nx_;
-    const long I = I0_ + i - pI0_, J = J0_ + j - pJ0_;
-    if (sameCells && I >= 0 && J >= 0 && I < pnx_ && J < pny_) x[a] = prevKappa_[std::size_t(J) * pnx_ + std::size_t(I)];
-  }
+  if (sameCells)
+    forUnknowns([&](std::size_t a, int i, int j) {
+      const long I = I0_ + i - pI0_, J = J0_ + j - pJ0_;
+      if (I >= 0 && J >= 0 && I < pnx_ && J < pny_) x[a] = prevKappa_[std::size_t(J) * pnx_ + std::size_t(I)];
+    });
   // A face against a moving body's cell carries the body's velocity there.
   auto uf = [&](int i, int j) {
     const std::size_t k = std::size_t(j) * nx_ + std::size_t(i);
@@ -612,32 +611,49 @@ void GridProjection::solve(const StepContext& c) {
     if (b >= 0) return bodyFaceVelocity(b, 1, i, j);
     return vOpen_[std::size_t(j) * nx_ + i] ? v_[std::size_t(j) * nx_ + i] : Real(0);
   };
-  for (std::size_t a = 0; a < m; ++a) {
-    const int k = cells_[a], i = k % nx_, j = k / nx_;
+  forUnknowns([&](std::size_t a, int i, int j) {
+    const int k = cells_[a];
     const Real div = (uf(i + 1, j) - uf(i, j) + vf(i, j + 1) - vf(i, j)) * invH_;
     const Real comp = std::max(Real(0), comp_[std::size_t(k)] / w_[std::size_t(k)]);
     const Real src = div - rate_ * comp / dt;  // a compressed cell is to expand by rate·comp over the substep
     rhs_[a] = -(h_ * h_ / dt) * src;
-  }
+  });
+}
+
+void GridProjection::shiftSystem(const StepContext& c) {
   // The compression shift's right-hand side: −∇²φ = rate·(comp − above)/dt² per fluid cell,
   // comp = the cell's particle weight over a full cell's, − 1 (a count, as Kugelstadt et al.:
   // the SPH density of a disordered packing reads high, and removing that lifted the water:
   // 1.5 % energy gain at 40k, 2.8 % at 80k). The particles move by −dt²∇φ in
   // transferToParticles, their velocities unchanged.
+  const Real dt = c.dt;
+  const std::size_t m = cells_.size();
   const Real invFull = Real(1) / (cellRatio_ * cellRatio_);
-  if (shifting) {
-    rhsS_.resize(m);
-    xs_.assign(m, 0);
-    for (std::size_t a = 0; a < m; ++a) {
-      const std::size_t k = std::size_t(cells_[a]);
-      const Real comp = std::max(Real(0), w_[k] * invFull - Real(1) - shiftDef_.above);
-      rhsS_[a] = (h_ * h_ / dt) * shiftDef_.rate * comp / dt;
-    }
+  rhsS_.resize(m);
+  xs_.assign(m, 0);
+  for (std::size_t a = 0; a < m; ++a) {
+    const std::size_t k = std::size_t(cells_[a]);
+    const Real comp = std::max(Real(0), w_[k] * invFull - Real(1) - shiftDef_.above);
+    rhsS_[a] = (h_ * h_ / dt) * shiftDef_.rate * comp / dt;
+  }
+}
+
+void GridProjection::solve(const StepContext& c) {
+  const Real dt = c.dt;
+  const std::size_t m = cells_.size();
+  stats_ = GridProjectionStats{};
+  stats_.fluidCells = int(m);
+  kappa_.assign(type_.size(), 0);  // air and solid cells hold 0
+  const bool shifting = shiftDef_.rate > 0;
+  if (m == 0) {
+    if (shifting) shiftMoves(c);  // none: no fluid cell
+    return;
   }
   // The two solves share the matrix and nothing else: with two threads they run side by
-  // side, each in cell order on one thread (the same bits for any thread count); the
-  // shift's, the shorter, goes on to its face moves. The residual stands for a density
-  // change of |r| dt²/h² over the substep.
+  // side, each with its right-hand side first and in cell order on one thread (the same
+  // bits for any thread count); the shift's, the shorter, goes on to its face moves. The
+  // residual stands for a density change of |r| dt²/h² over the substep.
+  std::vector<Real>& x = x_;  // the unknowns, in cell order (kept: no allocation in the step)
   Real res = 0, resS = 0;
   int itS = 0;
   const Real scale = h_ * h_ / (dt * dt);
@@ -646,8 +662,10 @@ void GridProjection::solve(const StepContext& c) {
   c.pool.parallelFor(shifting ? 2 : 1, 1, [&](std::size_t b, std::size_t e) {
     for (std::size_t k = b; k < e; ++k) {
       if (k == 0) {
+        pressureSystem(c);
         stats_.iterations = pcg(x, rhs_, tol_ * scale, res, cgMain_, coupled);
       } else {
+        shiftSystem(c);
         itS = pcg(xs_, rhsS_, shiftDef_.tolerance * scale, resS, cgShift_, false);
         kappaS_.assign(type_.size(), 0);
         for (std::size_t a = 0; a < m; ++a) kappaS_[std::size_t(cells_[a])] = xs_[a];

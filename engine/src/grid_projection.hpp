@@ -119,7 +119,18 @@ class GridProjection {
   Real bodyFaceVelocity(int body, int axis, int i, int j) const;
   /// The body of whichever of cells k1, k2 is a moving body's (−1: neither).
   int bodyAcross(std::size_t k1, std::size_t k2) const;
+  /// The pressure solve's right-hand side (rhs_) and warm start (x_).
+  void pressureSystem(const StepContext& c);
+  /// The compression shift's right-hand side (rhsS_), its unknowns cleared (xs_).
+  void shiftSystem(const StepContext& c);
   void solve(const StepContext& c);
+  /// Calls f(a, i, j) for every unknown a (cell (i, j)), in cell order, row by row.
+  template <class F>
+  void forUnknowns(F f) const {
+    for (int j = 0; j < ny_; ++j)
+      for (std::int32_t a = rowStart_[std::size_t(j)]; a < rowStart_[std::size_t(j) + 1]; ++a)
+        f(std::size_t(a), cells_[std::size_t(a)] - j * nx_, j);
+  }
   /// The bilinear weights of a point on the u and v faces, and the lower left face of each.
   struct FaceWeights {
     std::size_t ku, kv;
