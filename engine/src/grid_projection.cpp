@@ -404,6 +404,8 @@ void GridProjection::assemble() {
     }
     diag_[a] = dg;
   });
+  nbrPad_.resize(adj_.size());
+  for (std::size_t e = 0; e < adj_.size(); ++e) nbrPad_[e] = adj_[e] >= 0 ? adj_[e] : std::int32_t(m);
   // MIC(0) (Bridson, "Fluid Simulation for Computer Graphics", 2nd ed., fig. 5.7):
   // the incomplete Cholesky factor of the 5-point Laplacian, in cell order.
   const Real tau = Real(0.97), sigma = Real(0.25);
@@ -495,16 +497,23 @@ double GridProjection::dot(const std::vector<Real>& a, const std::vector<Real>& 
 }
 
 double GridProjection::applyDot(const std::vector<Real>& in, std::vector<Real>& out) const {
-  // apply(in, out, false), and in·out summed in cell order as it goes.
+  // apply(in, out, false), and in·out summed in cell order as it goes. `in` holds m + 1
+  // values, the last 0: a missing neighbour (nbrPad_ = m) subtracts that 0, as exact as
+  // subtracting none (s − 0 = s), and the loop has no branch to mispredict.
   const std::size_t m = cells_.size();
-  const std::int32_t* A = adj_.data();
+  const std::int32_t* A = nbrPad_.data();
+  const Real* I = in.data();
+  const Real* D = diag_.data();
+  Real* O = out.data();
   double dsum = 0;
   for (std::size_t a = 0; a < m; ++a) {
-    Real s = diag_[a] * in[a];
-    for (int q = 0; q < 4; ++q)
-      if (A[4 * a + q] >= 0) s -= in[std::size_t(A[4 * a + q])];
-    out[a] = s;
-    dsum += double(in[a]) * double(s);
+    Real s = D[a] * I[a];
+    s -= I[A[4 * a + 0]];
+    s -= I[A[4 * a + 1]];
+    s -= I[A[4 * a + 2]];
+    s -= I[A[4 * a + 3]];
+    O[a] = s;
+    dsum += double(I[a]) * double(s);
   }
   return dsum;
 }
@@ -543,7 +552,7 @@ int GridProjection::pcg(std::vector<Real>& x, const std::vector<Real>& b, Real t
   std::vector<Real>&r_ = w.r, &z_ = w.z, &d_ = w.d, &q_ = w.q;
   r_.resize(m);
   z_.resize(m);
-  d_.resize(m);
+  d_.assign(m + 1, 0);  // d[m] = 0 stays: applyDot's missing neighbour
   q_.resize(m);
   apply(x, q_, coupled);
   for (std::size_t a = 0; a < m; ++a) r_[a] = b[a] - q_[a];
@@ -561,19 +570,24 @@ int GridProjection::pcg(std::vector<Real>& x, const std::vector<Real>& b, Real t
   int it = 0;
   res = worst();
   while (it < maxIt_ && res > tol && rz > 0) {
-    // q = A d and d·q (in one pass when no body adds to q afterwards), the update of x and
-    // r with the largest |r| in one pass: the same sums in the same order.
+    // q = A d and d·q (in one pass when no body adds to q afterwards), the update of r
+    // with the largest |r| in one pass: the same sums in the same order.
     const double dq = coupled ? (apply(d_, q_, true), dot(d_, q_)) : applyDot(d_, q_);
     if (!(dq > 0)) break;
     const Real alpha = Real(rz / dq);
     Real mx = 0;
     for (std::size_t a = 0; a < m; ++a) {
-      x[a] += alpha * d_[a];
       r_[a] -= alpha * q_[a];
       mx = std::max(mx, std::fabs(r_[a]));
     }
     precondition(r_, z_, w.y);
-    const double rzNew = dot(r_, z_);
+    // r·z in cell order, and x's update beside it (d is still this iteration's: the same
+    // x; the sum is a chain of additions, and the update fills the core's idle slots).
+    double rzNew = 0;
+    for (std::size_t a = 0; a < m; ++a) {
+      rzNew += double(r_[a]) * double(z_[a]);
+      x[a] += alpha * d_[a];
+    }
     const Real beta = Real(rzNew / rz);
     rz = rzNew;
     for (std::size_t a = 0; a < m; ++a) d_[a] = z_[a] + beta * d_[a];

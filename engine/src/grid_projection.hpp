@@ -179,6 +179,7 @@ class GridProjection {
   std::vector<std::int32_t> index_;         ///< cell → unknown (−1: none)
   std::vector<std::int32_t> cells_;         ///< unknown → cell
   std::vector<std::int32_t> adj_;           ///< per unknown: left, right, down, up unknown (−1: none)
+  std::vector<std::int32_t> nbrPad_;        ///< adj_ with m for none (applyDot reads a 0 there)
   std::vector<Real> precon_, precon2_;      ///< MIC(0) factor: 1/diag(L), and its square
   std::vector<std::int32_t> rowStart_;      ///< per grid row: its first unknown (ny + 1 entries, the last m)
   // Warm start: the last substep's κ by anchored cell.
