@@ -299,7 +299,9 @@ std::size_t Pbf::finalDensity(StepContext& c, Real dt) {
   if (rhoCurrent_) {  // the last constraint pass already summed ρ (and cached W) at these positions
     const std::vector<Real>* lam = P.find("pbf.lambda");
     const Real pK = dt > 0 ? -c.rho0 / (dt * dt) : Real(0);
-    c.pool.parallelFor(P.size(), kStreamBlock, [&](std::size_t b, std::size_t e) {
+    // kBlock, not kStreamBlock: the grid's κ sampled per particle is no streaming pass,
+    // and five blocks of 20k would leave one thread a block behind the other.
+    c.pool.parallelFor(P.size(), kBlock, [&](std::size_t b, std::size_t e) {
       for (std::size_t i = b; i < e; ++i) {
         const Real p = pressure(c, lam, pK, i);
         P.invRho[i] = Real(1) / P.rho[i];
