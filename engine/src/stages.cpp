@@ -27,8 +27,11 @@ constexpr std::uint8_t kBitCount[16] = {0, 1, 1, 2, 1, 2, 2, 3, 1, 2, 2, 3, 2, 3
 /// order: candidates that are slots themselves (the grid's particles in order), no
 /// periodic axis. The same r² as the scalar loop (one IEEE operation a lane, in the same
 /// order), four candidates at a time; writes up to 3 entries past the list's end.
-std::size_t nearInOrder(const Vec2* X, std::size_t n, std::uint32_t kb, std::uint32_t ke, std::size_t i, const Vec2& xi,
-                        Real R2, std::uint32_t* dst, std::size_t used) {
+#if defined(__GNUC__)
+__attribute__((always_inline))  // called per row of cells with a few candidates: the call cost more than the row
+#endif
+inline std::size_t nearInOrder(const Vec2* X, std::size_t n, std::uint32_t kb, std::uint32_t ke, std::size_t i, const Vec2& xi,
+                               Real R2, std::uint32_t* dst, std::size_t used) {
   std::uint32_t k = kb;
 #ifdef SPH2D_SSE2_NEIGHBOURS
   static_assert(sizeof(Vec2) == 2 * sizeof(float), "positions are pairs of floats");
