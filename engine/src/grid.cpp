@@ -78,6 +78,7 @@ void Grid::build(const Vec2* x, std::size_t n, Real support, ThreadPool& pool, i
   }
   const std::size_t cells = std::size_t(nx) * std::size_t(ny);
 
+  inOrder = false;
   cellOf.resize(n);
   pool.parallelFor(n, 4096, [&](std::size_t b, std::size_t e) {
     for (std::size_t i = b; i < e; ++i)

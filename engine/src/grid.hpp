@@ -75,6 +75,7 @@ struct Grid {
   std::vector<std::uint32_t> cellStart;  ///< nx·ny + 1 offsets into sorted
   std::vector<std::uint32_t> sorted;     ///< particle indices in cell order (stable)
   std::vector<std::uint32_t> cellOf;     ///< cell of each particle
+  bool inOrder = false;  ///< sorted[k] == k: the particles were just reordered along the grid (stageGrid)
 
   /// Rebuilds the grid over positions x[0..n) for neighbours within `support`,
   /// with cells of at least support / cellsPerSupport.

@@ -4,6 +4,7 @@
 #include "state_io.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -52,25 +53,28 @@ void GridProjection::layout(const StepContext& c) {
     if (double(nx_) * double(ny_) <= budget) break;
     h_ *= Real(std::sqrt(double(nx_) * double(ny_) / budget) * 1.01);
   }
+}
+
+void GridProjection::resetCells() {
+  // The cells' fields and the faces' flags (classify and assemble write them).
   const std::size_t cells = std::size_t(nx_) * std::size_t(ny_);
   type_.assign(cells, kAir);
   w_.assign(cells, 0);
   comp_.assign(cells, 0);
   if (surface_) top_.assign(cells, -std::numeric_limits<Real>::infinity());
-  kappa_.assign(cells, 0);
   index_.assign(cells, -1);
-  u_.assign(std::size_t(nx_ + 1) * ny_, 0);
-  uw_.assign(u_.size(), 0);
-  du_.assign(u_.size(), 0);
-  uNew_.assign(u_.size(), 0);
-  uOpen_.assign(u_.size(), 0);
-  fluidU_.assign(u_.size(), 0);
-  v_.assign(std::size_t(nx_) * (ny_ + 1), 0);
-  vw_.assign(v_.size(), 0);
-  dv_.assign(v_.size(), 0);
-  vNew_.assign(v_.size(), 0);
-  vOpen_.assign(v_.size(), 0);
-  fluidV_.assign(v_.size(), 0);
+  uOpen_.assign(std::size_t(nx_ + 1) * std::size_t(ny_), 0);
+  fluidU_.assign(uOpen_.size(), 0);
+  vOpen_.assign(std::size_t(nx_) * std::size_t(ny_ + 1), 0);
+  fluidV_.assign(vOpen_.size(), 0);
+}
+
+void GridProjection::resetFaces(int axis) {
+  // One axis's face velocities, weights and changes.
+  const std::size_t faces = axis == 0 ? std::size_t(nx_ + 1) * std::size_t(ny_) : std::size_t(nx_) * std::size_t(ny_ + 1);
+  for (std::vector<Real>* f : axis == 0 ? std::array<std::vector<Real>*, 4>{&u_, &uw_, &du_, &uNew_}
+                                        : std::array<std::vector<Real>*, 4>{&v_, &vw_, &dv_, &vNew_})
+    f->assign(faces, 0);
 }
 
 std::uint8_t GridProjection::cacheEntry(const StepContext& c, long I, long J) {
@@ -113,13 +117,18 @@ void GridProjection::classify(const StepContext& c) {
     cnx_ = int(nI1 - nI0);
     cny_ = int(nJ1 - nJ0);
   }
+  // Cell (i, j) of the grid (−1 ≤ i ≤ nx, −1 ≤ j ≤ ny) from the cache, computed when not yet known.
+  std::uint8_t* const base = cache_.data() + std::size_t(J0_ - cJ0_) * std::size_t(cnx_) + std::size_t(I0_ - cI0_);
+  auto entry = [&](int i, int j) {
+    const std::uint8_t e = base[std::ptrdiff_t(j) * cnx_ + i];
+    return (e & 1) ? e : cacheEntry(c, I0_ + i, J0_ + j);
+  };
   const Real full = cellRatio_ * cellRatio_;  // particle weight of a full cell
-  for (int j = 0; j < ny_; ++j)
-    for (int i = 0; i < nx_; ++i) {
+  for (int j = 1; j + 1 < ny_; ++j)  // border cells stay air (solid neighbours are marked below)
+    for (int i = 1; i + 1 < nx_; ++i) {
       const std::size_t k = std::size_t(j) * nx_ + i;
-      const bool border = i == 0 || j == 0 || i == nx_ - 1 || j == ny_ - 1;
-      if (!(w_[k] > 0) || border) continue;  // empty and border cells stay air (solid neighbours are marked below)
-      const std::uint8_t e = cacheEntry(c, I0_ + i, J0_ + j);
+      if (!(w_[k] > 0)) continue;  // empty cells stay air
+      const std::uint8_t e = entry(i, j);
       type_[k] = (e & 2) ? kSolid : (w_[k] >= fluidFraction_ * full ? kFluid : kAir);
     }
   markBodies(c);
@@ -128,16 +137,16 @@ void GridProjection::classify(const StepContext& c) {
     for (int i = 0; i < nx_; ++i) {
       const std::size_t k = std::size_t(j) * nx_ + i;
       if (type_[k] != kFluid) continue;
-      const std::uint8_t e = cacheEntry(c, I0_ + i, J0_ + j);
-      const std::uint8_t eR = cacheEntry(c, I0_ + i + 1, J0_ + j);
-      const std::uint8_t eT = cacheEntry(c, I0_ + i, J0_ + j + 1);
+      const std::uint8_t e = entry(i, j);
+      const std::uint8_t eR = entry(i + 1, j);
+      const std::uint8_t eT = entry(i, j + 1);
       uOpen_[std::size_t(j) * (nx_ + 1) + i] = !(e & 4);
       uOpen_[std::size_t(j) * (nx_ + 1) + i + 1] = !(eR & 4);
       vOpen_[std::size_t(j) * nx_ + i] = !(e & 8);
       vOpen_[std::size_t(j + 1) * nx_ + i] = !(eT & 8);
-      if (i > 0 && (cacheEntry(c, I0_ + i - 1, J0_ + j) & 2)) type_[k - 1] = kSolid;
+      if (i > 0 && (entry(i - 1, j) & 2)) type_[k - 1] = kSolid;
       if (i + 1 < nx_ && (eR & 2)) type_[k + 1] = kSolid;
-      if (j > 0 && (cacheEntry(c, I0_ + i, J0_ + j - 1) & 2)) type_[k - nx_] = kSolid;
+      if (j > 0 && (entry(i, j - 1) & 2)) type_[k - nx_] = kSolid;
       if (j + 1 < ny_ && (eT & 2)) type_[k + nx_] = kSolid;
     }
 }
@@ -273,8 +282,8 @@ void GridProjection::assembleCoupling() {
   coupling_.clear();
   if (bodies_.empty()) return;
   const double h = double(h_);
-  for (std::size_t a = 0; a < cells_.size(); ++a) {
-    const int k = cells_[a], i = k % nx_, j = k / nx_;
+  forUnknowns([&](std::size_t a, int i, int j) {
+    const int k = cells_[a];
     const int nb[4] = {k - 1, k + 1, k - nx_, k + nx_};
     const Vec2d normals[4] = {Vec2d(-1, 0), Vec2d(1, 0), Vec2d(0, -1), Vec2d(0, 1)};
     const Vec2d faces[4] = {Vec2d(double(I0_ + i) * h, (double(J0_ + j) + 0.5) * h),
@@ -294,68 +303,84 @@ void GridProjection::assembleCoupling() {
       st.coupling(normals[q], faces[q], g);
       for (int r = 0; r < 3; ++r) coupling_[e].g[r] += g[r];
     }
+  });
+}
+
+namespace {
+/// Adds the bilinear weights at (fx, fy), in the units of a field `stride` wide, to
+/// `weight`, and `value` times them to `sum` when given (fx, fy ≥ 0: the grid has a
+/// margin, so truncation is floor).
+inline void splat(Real* sum, std::vector<Real>& weight, int stride, Real fx, Real fy, Real value) {
+  const int i0 = int(fx), j0 = int(fy);
+  const Real tx = fx - Real(i0), ty = fy - Real(j0);
+  const Real wq[4] = {(1 - tx) * (1 - ty), tx * (1 - ty), (1 - tx) * ty, tx * ty};
+  const std::size_t k = std::size_t(j0) * std::size_t(stride) + std::size_t(i0);
+  const std::size_t ks[4] = {k, k + 1, k + std::size_t(stride), k + std::size_t(stride) + 1};
+  for (int q = 0; q < 4; ++q) {
+    if (sum) sum[ks[q]] += wq[q] * value;
+    weight[ks[q]] += wq[q];
+  }
+}
+}  // namespace
+
+void GridProjection::splatCells(const StepContext& c) {
+  // Serial in slot order (the same bits for any thread count).
+  const ParticleStore& P = c.P;
+  const Real rho0 = c.rho0;
+  // The cells' SPH compression is read only by the compression source.
+  Real* comp = rate_ > 0 ? comp_.data() : nullptr;
+  for (std::size_t p = 0; p < P.size(); ++p) {
+    const Real px = P.x[p].x() * invH_ - Real(I0_), py = P.x[p].y() * invH_ - Real(J0_);
+    splat(comp, w_, nx_, px - Real(0.5), py - Real(0.5), P.rho[p] / rho0 - Real(1));  // cell centres
+    if (surface_) {  // the highest particle of each cell (the ghost surface's height)
+      const std::size_t k = std::size_t(int(py)) * std::size_t(nx_) + std::size_t(int(px));
+      top_[k] = std::max(top_[k], P.x[p].y());
+    }
   }
 }
 
-void GridProjection::transferToGrid(const StepContext& c) {
+void GridProjection::splatFaces(const StepContext& c, int axis) {
+  // Serial in slot order (the same bits for any thread count); then the mean velocity.
   const ParticleStore& P = c.P;
-  const Real rho0 = c.rho0;
-  const int nu = nx_ + 1;
-  // Adds the bilinear weights at (fx, fy), in the units of a field `stride` wide, to
-  // `weight`, and `value` times them to `sum` when given (fx, fy ≥ 0: the grid has a
-  // margin, so truncation is floor).
-  auto splat = [](Real* sum, std::vector<Real>& weight, int stride, Real fx, Real fy, Real value) {
-    const int i0 = int(fx), j0 = int(fy);
-    const Real tx = fx - Real(i0), ty = fy - Real(j0);
-    const Real wq[4] = {(1 - tx) * (1 - ty), tx * (1 - ty), (1 - tx) * ty, tx * ty};
-    const std::size_t k = std::size_t(j0) * std::size_t(stride) + std::size_t(i0);
-    const std::size_t ks[4] = {k, k + 1, k + std::size_t(stride), k + std::size_t(stride) + 1};
-    for (int q = 0; q < 4; ++q) {
-      if (sum) sum[ks[q]] += wq[q] * value;
-      weight[ks[q]] += wq[q];
-    }
-  };
-  // The cells' SPH compression is read only by the compression source.
-  Real* comp = rate_ > 0 ? comp_.data() : nullptr;
-  // Three sums, each serial in slot order (the same bits for any thread count), and
-  // independent of each other: the cells, the u faces and the v faces run side by side.
-  c.pool.parallelFor(3, 1, [&](std::size_t b, std::size_t e) {
-    for (std::size_t task = b; task < e; ++task)
-      for (std::size_t p = 0; p < P.size(); ++p) {
-        const Real px = P.x[p].x() * invH_ - Real(I0_), py = P.x[p].y() * invH_ - Real(J0_);
-        if (task == 0) {
-          splat(comp, w_, nx_, px - Real(0.5), py - Real(0.5), P.rho[p] / rho0 - Real(1));  // cell centres
-          if (surface_) {  // the highest particle of each cell (the ghost surface's height)
-            const std::size_t k = std::size_t(int(py)) * std::size_t(nx_) + std::size_t(int(px));
-            top_[k] = std::max(top_[k], P.x[p].y());
-          }
-        }
-        else if (task == 1) splat(u_.data(), uw_, nu, px, py - Real(0.5), P.v[p].x());               // u faces at (i, j + 1/2)
-        else splat(v_.data(), vw_, nx_, px - Real(0.5), py, P.v[p].y());                              // v faces at (i + 1/2, j)
-      }
-  });
-  for (std::size_t k = 0; k < u_.size(); ++k)
-    if (uw_[k] > 0) u_[k] /= uw_[k];
-  for (std::size_t k = 0; k < v_.size(); ++k)
-    if (vw_[k] > 0) v_[k] /= vw_[k];
+  std::vector<Real>& f = axis == 0 ? u_ : v_;
+  std::vector<Real>& fw = axis == 0 ? uw_ : vw_;
+  for (std::size_t p = 0; p < P.size(); ++p) {
+    const Real px = P.x[p].x() * invH_ - Real(I0_), py = P.x[p].y() * invH_ - Real(J0_);
+    if (axis == 0) splat(f.data(), fw, nx_ + 1, px, py - Real(0.5), P.v[p].x());  // u faces at (i, j + 1/2)
+    else splat(f.data(), fw, nx_, px - Real(0.5), py, P.v[p].y());                 // v faces at (i + 1/2, j)
+  }
+  for (std::size_t k = 0; k < f.size(); ++k)
+    if (fw[k] > 0) f[k] /= fw[k];
 }
 
 void GridProjection::assemble() {
   const int nu = nx_ + 1;
-  cells_.clear();
+  // The faces next to a fluid cell (their change is known; the others are extrapolated).
+  auto isFluid = [&](int i, int j) { return type_[std::size_t(j) * nx_ + i] == kFluid; };
   for (int j = 0; j < ny_; ++j)
+    for (int i = 1; i < nx_; ++i) fluidU_[std::size_t(j) * nu + i] = isFluid(i - 1, j) || isFluid(i, j);
+  for (int j = 1; j < ny_; ++j)
+    for (int i = 0; i < nx_; ++i) fluidV_[std::size_t(j) * nx_ + i] = isFluid(i, j - 1) || isFluid(i, j);
+  // The unknowns in cell order, and each row's first (rowStart_[ny] = m): the loops over
+  // unknowns go row by row (no division to find a cell's row).
+  cells_.clear();
+  rowStart_.resize(std::size_t(ny_) + 1);
+  for (int j = 0; j < ny_; ++j) {
+    rowStart_[std::size_t(j)] = std::int32_t(cells_.size());
     for (int i = 0; i < nx_; ++i) {
       const std::size_t k = std::size_t(j) * nx_ + i;
       if (type_[k] != kFluid) continue;
       index_[k] = std::int32_t(cells_.size());
       cells_.push_back(std::int32_t(k));
     }
+  }
   const std::size_t m = cells_.size();
+  rowStart_[std::size_t(ny_)] = std::int32_t(m);
   diag_.assign(m, 0);
   if (surface_) thetaUp_.assign(type_.size(), Real(1));
   adj_.assign(4 * m, -1);
-  for (std::size_t a = 0; a < m; ++a) {
-    const int k = cells_[a], i = k % nx_, j = k / nx_;
+  forUnknowns([&](std::size_t a, int i, int j) {
+    const int k = cells_[a];
     const bool open[4] = {uOpen_[std::size_t(j) * nu + i] != 0, uOpen_[std::size_t(j) * nu + i + 1] != 0,
                           vOpen_[std::size_t(j) * nx_ + i] != 0, vOpen_[std::size_t(j + 1) * nx_ + i] != 0};
     const int nb[4] = {k - 1, k + 1, k - nx_, k + nx_};
@@ -367,7 +392,7 @@ void GridProjection::assemble() {
         // of the way to the air cell's centre: half a spacing above the highest particle of
         // the two cells (the fill would say it too, but beside a wall or over a compressed
         // layer its reading differs by a tenth of a cell, and that difference drives a flow).
-        const double ya = (double(J0_ + k / nx_) + 0.5) * double(h_);
+        const double ya = (double(J0_ + j) + 0.5) * double(h_);
         const Real ytop = std::max(top_[std::size_t(k)], top_[std::size_t(nb[q])]);
         const Real theta = std::clamp(Real((double(ytop) + 0.5 * double(dx_) - ya) * double(invH_)), kMinSurfaceFraction, Real(1));
         dg += Real(1) / theta;
@@ -378,7 +403,9 @@ void GridProjection::assemble() {
       adj_[4 * a + q] = open[q] ? index_[std::size_t(nb[q])] : -1;  // −1: air, solid or closed
     }
     diag_[a] = dg;
-  }
+  });
+  nbrPad_.resize(adj_.size());
+  for (std::size_t e = 0; e < adj_.size(); ++e) nbrPad_[e] = adj_[e] >= 0 ? adj_[e] : std::int32_t(m);
   // MIC(0) (Bridson, "Fluid Simulation for Computer Graphics", 2nd ed., fig. 5.7):
   // the incomplete Cholesky factor of the 5-point Laplacian, in cell order.
   const Real tau = Real(0.97), sigma = Real(0.25);
@@ -407,31 +434,88 @@ void GridProjection::assemble() {
 
 void GridProjection::precondition(const std::vector<Real>& r, std::vector<Real>& z, std::vector<Real>& y) const {
   // z = (L Lᵀ)⁻¹ r with L = MIC(0)'s factor (p = precon_ = 1/diag(L), p2 = p²). Each
-  // substitution is a chain from one cell to the next in cell order: written so that
-  // the chain is one multiply and one add (the rest is computed beside it), and the
-  // left neighbour's value is carried in a register.
+  // substitution is a chain from one cell to the next along a row (a left neighbour is
+  // always the unknown before, a right one the unknown after), fed by the row below
+  // (forward) or above (backward). Each cell's arithmetic is fixed; only the schedule is
+  // free: two rows run side by side, the second a cell or more behind the first, so two
+  // chains are in flight (the chain is one multiply and one add per cell, and with one
+  // row at a time the core waits on it). Each cursor carries its row's last value in a
+  // register. The same bits as one cell after the other.
   const std::size_t m = cells_.size();
   const Real* p = precon_.data();
   const Real* p2 = precon2_.data();
   const std::int32_t* A = adj_.data();
+  const std::int32_t* rows = rowStart_.data();
+  const Real* R = r.data();
   y.resize(m);
+  Real* Y = y.data();
+  Real* Z = z.data();
   // Forward: q = L⁻¹ r, kept as z (= q) and y = q·p (what the right and up cells read).
-  Real yPrev = 0;
-  for (std::size_t a = 0; a < m; ++a) {
+  auto forward = [&](std::int32_t a, Real& yPrev) {
     const std::int32_t l = A[4 * a + 0], d = A[4 * a + 2];
-    const Real t = r[a] + (d >= 0 ? y[std::size_t(d)] : Real(0));
-    const Real yl = l < 0 ? Real(0) : (std::size_t(l) + 1 == a ? yPrev : y[std::size_t(l)]);
-    z[a] = (t + yl) * p[a];
-    yPrev = y[a] = t * p2[a] + yl * p2[a];
+    const Real t = R[a] + (d >= 0 ? Y[d] : Real(0));
+    const Real yl = l < 0 ? Real(0) : yPrev;
+    Z[a] = (t + yl) * p[a];
+    yPrev = Y[a] = t * p2[a] + yl * p2[a];
+  };
+  for (int j = 0; j < ny_; j += 2) {
+    // Row j (cursor a) and row j + 1 (cursor b): b's cell waits for the cell below it.
+    std::int32_t a = rows[j], b = rows[j + 1];
+    const std::int32_t ae = rows[j + 1], be = rows[std::min(j + 2, ny_)];
+    Real ya = 0, yb = 0;
+    while (a < ae) {
+      forward(a++, ya);
+      if (b < be && A[4 * b + 2] < a) forward(b++, yb);  // below: done (or none, −1)
+    }
+    while (b < be) forward(b++, yb);
   }
-  // Backward: z = L⁻ᵀ q.
-  Real zNext = 0;
-  for (std::size_t a = m; a-- > 0;) {
+  // Backward: z = L⁻ᵀ q, from the top row down.
+  auto backward = [&](std::int32_t a, Real& zNext) {
     const std::int32_t rt = A[4 * a + 1], u = A[4 * a + 3];
-    const Real s = z[a] * p[a] + (u >= 0 ? z[std::size_t(u)] : Real(0)) * p2[a];
-    const Real zr = rt < 0 ? Real(0) : (std::size_t(rt) == a + 1 ? zNext : z[std::size_t(rt)]);
-    zNext = z[a] = s + zr * p2[a];
+    const Real s = Z[a] * p[a] + (u >= 0 ? Z[u] : Real(0)) * p2[a];
+    const Real zr = rt < 0 ? Real(0) : zNext;
+    zNext = Z[a] = s + zr * p2[a];
+  };
+  for (int j = ny_ - 1; j >= 0; j -= 2) {
+    // Row j (cursor a, descending) and row j − 1 (cursor b): b's cell waits for the cell above.
+    std::int32_t a = rows[j + 1] - 1, b = rows[j] - 1;
+    const std::int32_t as = rows[j], bs = rows[std::max(j - 1, 0)];
+    Real za = 0, zb = 0;
+    while (a >= as) {
+      backward(a--, za);
+      if (b >= bs && (A[4 * b + 3] < 0 || A[4 * b + 3] > a)) backward(b--, zb);  // above: done, or none
+    }
+    while (b >= bs) backward(b--, zb);
   }
+  (void)m;
+}
+
+double GridProjection::dot(const std::vector<Real>& a, const std::vector<Real>& b) const {
+  double s = 0;  // in cell order
+  for (std::size_t k = 0; k < cells_.size(); ++k) s += double(a[k]) * double(b[k]);
+  return s;
+}
+
+double GridProjection::applyDot(const std::vector<Real>& in, std::vector<Real>& out) const {
+  // apply(in, out, false), and in·out summed in cell order as it goes. `in` holds m + 1
+  // values, the last 0: a missing neighbour (nbrPad_ = m) subtracts that 0, as exact as
+  // subtracting none (s − 0 = s), and the loop has no branch to mispredict.
+  const std::size_t m = cells_.size();
+  const std::int32_t* A = nbrPad_.data();
+  const Real* I = in.data();
+  const Real* D = diag_.data();
+  Real* O = out.data();
+  double dsum = 0;
+  for (std::size_t a = 0; a < m; ++a) {
+    Real s = D[a] * I[a];
+    s -= I[A[4 * a + 0]];
+    s -= I[A[4 * a + 1]];
+    s -= I[A[4 * a + 2]];
+    s -= I[A[4 * a + 3]];
+    O[a] = s;
+    dsum += double(I[a]) * double(s);
+  }
+  return dsum;
 }
 
 void GridProjection::apply(const std::vector<Real>& in, std::vector<Real>& out, bool coupled) const {
@@ -468,7 +552,7 @@ int GridProjection::pcg(std::vector<Real>& x, const std::vector<Real>& b, Real t
   std::vector<Real>&r_ = w.r, &z_ = w.z, &d_ = w.d, &q_ = w.q;
   r_.resize(m);
   z_.resize(m);
-  d_.resize(m);
+  d_.assign(m + 1, 0);  // d[m] = 0 stays: applyDot's missing neighbour
   q_.resize(m);
   apply(x, q_, coupled);
   for (std::size_t a = 0; a < m; ++a) r_[a] = b[a] - q_[a];
@@ -486,45 +570,48 @@ int GridProjection::pcg(std::vector<Real>& x, const std::vector<Real>& b, Real t
   int it = 0;
   res = worst();
   while (it < maxIt_ && res > tol && rz > 0) {
-    apply(d_, q_, coupled);
-    double dq = 0;
-    for (std::size_t a = 0; a < m; ++a) dq += double(d_[a]) * double(q_[a]);
+    // q = A d and d·q (in one pass when no body adds to q afterwards), the update of r
+    // with the largest |r| in one pass: the same sums in the same order.
+    const double dq = coupled ? (apply(d_, q_, true), dot(d_, q_)) : applyDot(d_, q_);
     if (!(dq > 0)) break;
     const Real alpha = Real(rz / dq);
+    Real mx = 0;
     for (std::size_t a = 0; a < m; ++a) {
-      x[a] += alpha * d_[a];
       r_[a] -= alpha * q_[a];
+      mx = std::max(mx, std::fabs(r_[a]));
     }
-    double rzNew = 0;
     precondition(r_, z_, w.y);
-    for (std::size_t a = 0; a < m; ++a) rzNew += double(r_[a]) * double(z_[a]);
+    // r·z in cell order, and x's update beside it (d is still this iteration's: the same
+    // x; the sum is a chain of additions, and the update fills the core's idle slots).
+    double rzNew = 0;
+    for (std::size_t a = 0; a < m; ++a) {
+      rzNew += double(r_[a]) * double(z_[a]);
+      x[a] += alpha * d_[a];
+    }
     const Real beta = Real(rzNew / rz);
     rz = rzNew;
     for (std::size_t a = 0; a < m; ++a) d_[a] = z_[a] + beta * d_[a];
     ++it;
-    res = worst();
+    res = mx;
   }
   return it;
 }
 
-void GridProjection::solve(const StepContext& c) {
+void GridProjection::pressureSystem(const StepContext& c) {
   const Real dt = c.dt;
   const int nu = nx_ + 1;
   const std::size_t m = cells_.size();
-  stats_ = GridProjectionStats{};
-  stats_.fluidCells = int(m);
-  if (m == 0) return;
   rhs_.assign(m, 0);
-  std::vector<Real>& x = x_;  // the unknowns, in cell order (kept: no allocation in the step)
+  std::vector<Real>& x = x_;
   x.assign(m, 0);
   // Warm start from the last substep's κ of the same anchored cells (none when the cells
   // grew to hold spray: the same index is then another place).
   const bool sameCells = h_ == pH_;
-  for (std::size_t a = 0; a < m; ++a) {
-    const int i = cells_[a] % nx_, j = cells_[a] / nx_;
-    const long I = I0_ + i - pI0_, J = J0_ + j - pJ0_;
-    if (sameCells && I >= 0 && J >= 0 && I < pnx_ && J < pny_) x[a] = prevKappa_[std::size_t(J) * pnx_ + std::size_t(I)];
-  }
+  if (sameCells)
+    forUnknowns([&](std::size_t a, int i, int j) {
+      const long I = I0_ + i - pI0_, J = J0_ + j - pJ0_;
+      if (I >= 0 && J >= 0 && I < pnx_ && J < pny_) x[a] = prevKappa_[std::size_t(J) * pnx_ + std::size_t(I)];
+    });
   // A face against a moving body's cell carries the body's velocity there.
   auto uf = [&](int i, int j) {
     const std::size_t k = std::size_t(j) * nx_ + std::size_t(i);
@@ -538,32 +625,49 @@ void GridProjection::solve(const StepContext& c) {
     if (b >= 0) return bodyFaceVelocity(b, 1, i, j);
     return vOpen_[std::size_t(j) * nx_ + i] ? v_[std::size_t(j) * nx_ + i] : Real(0);
   };
-  for (std::size_t a = 0; a < m; ++a) {
-    const int k = cells_[a], i = k % nx_, j = k / nx_;
+  forUnknowns([&](std::size_t a, int i, int j) {
+    const int k = cells_[a];
     const Real div = (uf(i + 1, j) - uf(i, j) + vf(i, j + 1) - vf(i, j)) * invH_;
     const Real comp = std::max(Real(0), comp_[std::size_t(k)] / w_[std::size_t(k)]);
     const Real src = div - rate_ * comp / dt;  // a compressed cell is to expand by rate·comp over the substep
     rhs_[a] = -(h_ * h_ / dt) * src;
-  }
+  });
+}
+
+void GridProjection::shiftSystem(const StepContext& c) {
   // The compression shift's right-hand side: −∇²φ = rate·(comp − above)/dt² per fluid cell,
   // comp = the cell's particle weight over a full cell's, − 1 (a count, as Kugelstadt et al.:
   // the SPH density of a disordered packing reads high, and removing that lifted the water:
   // 1.5 % energy gain at 40k, 2.8 % at 80k). The particles move by −dt²∇φ in
   // transferToParticles, their velocities unchanged.
-  const bool shifting = shiftDef_.rate > 0;
+  const Real dt = c.dt;
+  const std::size_t m = cells_.size();
   const Real invFull = Real(1) / (cellRatio_ * cellRatio_);
-  if (shifting) {
-    rhsS_.resize(m);
-    xs_.assign(m, 0);
-    for (std::size_t a = 0; a < m; ++a) {
-      const std::size_t k = std::size_t(cells_[a]);
-      const Real comp = std::max(Real(0), w_[k] * invFull - Real(1) - shiftDef_.above);
-      rhsS_[a] = (h_ * h_ / dt) * shiftDef_.rate * comp / dt;
-    }
+  rhsS_.resize(m);
+  xs_.assign(m, 0);
+  for (std::size_t a = 0; a < m; ++a) {
+    const std::size_t k = std::size_t(cells_[a]);
+    const Real comp = std::max(Real(0), w_[k] * invFull - Real(1) - shiftDef_.above);
+    rhsS_[a] = (h_ * h_ / dt) * shiftDef_.rate * comp / dt;
+  }
+}
+
+void GridProjection::solve(const StepContext& c) {
+  const Real dt = c.dt;
+  const std::size_t m = cells_.size();
+  stats_ = GridProjectionStats{};
+  stats_.fluidCells = int(m);
+  kappa_.assign(type_.size(), 0);  // air and solid cells hold 0
+  const bool shifting = shiftDef_.rate > 0;
+  if (m == 0) {
+    if (shifting) shiftMoves(c);  // none: no fluid cell
+    return;
   }
   // The two solves share the matrix and nothing else: with two threads they run side by
-  // side, each in cell order on one thread (the same bits for any thread count). The
+  // side, each with its right-hand side first and in cell order on one thread (the same
+  // bits for any thread count); the shift's, the shorter, goes on to its face moves. The
   // residual stands for a density change of |r| dt²/h² over the substep.
+  std::vector<Real>& x = x_;  // the unknowns, in cell order (kept: no allocation in the step)
   Real res = 0, resS = 0;
   int itS = 0;
   const Real scale = h_ * h_ / (dt * dt);
@@ -571,8 +675,16 @@ void GridProjection::solve(const StepContext& c) {
   const bool coupled = !coupling_.empty();
   c.pool.parallelFor(shifting ? 2 : 1, 1, [&](std::size_t b, std::size_t e) {
     for (std::size_t k = b; k < e; ++k) {
-      if (k == 0) stats_.iterations = pcg(x, rhs_, tol_ * scale, res, cgMain_, coupled);
-      else itS = pcg(xs_, rhsS_, shiftDef_.tolerance * scale, resS, cgShift_, false);
+      if (k == 0) {
+        pressureSystem(c);
+        stats_.iterations = pcg(x, rhs_, tol_ * scale, res, cgMain_, coupled);
+      } else {
+        shiftSystem(c);
+        itS = pcg(xs_, rhsS_, shiftDef_.tolerance * scale, resS, cgShift_, false);
+        kappaS_.assign(type_.size(), 0);
+        for (std::size_t a = 0; a < m; ++a) kappaS_[std::size_t(cells_[a])] = xs_[a];
+        shiftMoves(c);
+      }
     }
   });
   if (coupled) {
@@ -595,7 +707,6 @@ void GridProjection::solve(const StepContext& c) {
   }
   stats_.iterations += itS;
   stats_.residual = double(res * dt * dt * invH_ * invH_);
-  std::fill(kappa_.begin(), kappa_.end(), Real(0));
   for (std::size_t a = 0; a < m; ++a) kappa_[std::size_t(cells_[a])] = x[a];
   pH_ = h_;
   pI0_ = I0_;
@@ -603,31 +714,39 @@ void GridProjection::solve(const StepContext& c) {
   pnx_ = nx_;
   pny_ = ny_;
   prevKappa_ = kappa_;
-  if (shifting) {
-    kappaS_.assign(kappa_.size(), 0);
-    for (std::size_t a = 0; a < m; ++a) kappaS_[std::size_t(cells_[a])] = xs_[a];
-  }
 }
 
-Vec2 GridProjection::sampleFaces(const std::vector<Real>& u, const std::vector<Real>& v, Real px, Real py) const {
+GridProjection::FaceWeights GridProjection::faceWeights(Real px, Real py) const {
   // Bilinear over the MAC faces: u at (i, j + 1/2), v at (i + 1/2, j), in cell units of the
   // grid (px, py ≥ 0: the grid has a margin, so truncation is floor).
-  const int nu = nx_ + 1;
-  Real ux, uy;
+  FaceWeights w;
   {
     const Real fx = px, fy = py - Real(0.5);
     const int i0 = int(fx), j0 = int(fy);
     const Real tx = fx - Real(i0), ty = fy - Real(j0);
-    const std::size_t k = std::size_t(j0) * nu + i0;
-    ux = (1 - tx) * (1 - ty) * u[k] + tx * (1 - ty) * u[k + 1] + (1 - tx) * ty * u[k + nu] + tx * ty * u[k + nu + 1];
+    w.ku = std::size_t(j0) * std::size_t(nx_ + 1) + std::size_t(i0);
+    w.u[0] = (1 - tx) * (1 - ty);
+    w.u[1] = tx * (1 - ty);
+    w.u[2] = (1 - tx) * ty;
+    w.u[3] = tx * ty;
   }
   {
     const Real fx = px - Real(0.5), fy = py;
     const int i0 = int(fx), j0 = int(fy);
     const Real tx = fx - Real(i0), ty = fy - Real(j0);
-    const std::size_t k = std::size_t(j0) * nx_ + i0;
-    uy = (1 - tx) * (1 - ty) * v[k] + tx * (1 - ty) * v[k + 1] + (1 - tx) * ty * v[k + nx_] + tx * ty * v[k + nx_ + 1];
+    w.kv = std::size_t(j0) * std::size_t(nx_) + std::size_t(i0);
+    w.v[0] = (1 - tx) * (1 - ty);
+    w.v[1] = tx * (1 - ty);
+    w.v[2] = (1 - tx) * ty;
+    w.v[3] = tx * ty;
   }
+  return w;
+}
+
+Vec2 GridProjection::sampleFaces(const std::vector<Real>& u, const std::vector<Real>& v, const FaceWeights& w) const {
+  const std::size_t nu = std::size_t(nx_ + 1), k = w.ku, kv = w.kv, nv = std::size_t(nx_);
+  const Real ux = w.u[0] * u[k] + w.u[1] * u[k + 1] + w.u[2] * u[k + nu] + w.u[3] * u[k + nu + 1];
+  const Real uy = w.v[0] * v[kv] + w.v[1] * v[kv + 1] + w.v[2] * v[kv + nv] + w.v[3] * v[kv + nv + 1];
   return Vec2(ux, uy);
 }
 
@@ -650,51 +769,72 @@ void GridProjection::extrapolate(std::vector<Real>& d, int w, int h, const std::
     }
 }
 
+void GridProjection::shiftMoves(const StepContext& c) {
+  // The shift's face moves: −dt²∇φ across open faces between fluid and air cells (none
+  // through a wall or a moving body), extrapolated one layer as the velocity change is.
+  const Real dt = c.dt;
+  const int nu = nx_ + 1;
+  const Real k2 = -dt * dt * invH_;
+  auto phi = [&](int i, int j) {  // φ in a fluid cell, 0 elsewhere (air holds 0)
+    return type_[std::size_t(j) * nx_ + i] == kFluid ? kappaS_[std::size_t(j) * nx_ + i] : Real(0);
+  };
+  su_.assign(u_.size(), 0);
+  sv_.assign(v_.size(), 0);
+  for (int j = 0; j < ny_; ++j)
+    for (int i = 1; i < nx_; ++i) {
+      const std::size_t f = std::size_t(j) * nu + i;
+      if (!fluidU_[f]) continue;
+      const std::size_t kl = std::size_t(j) * nx_ + i - 1, kr = kl + 1;
+      const bool solidSide = type_[kl] == kSolid || type_[kr] == kSolid;
+      if (uOpen_[f] && !solidSide && bodyAcross(kl, kr) < 0) su_[f] = k2 * (phi(i, j) - phi(i - 1, j));
+    }
+  extrapolate(su_, nu, ny_, fluidU_);
+  for (int j = 1; j < ny_; ++j)
+    for (int i = 0; i < nx_; ++i) {
+      const std::size_t f = std::size_t(j) * nx_ + i;
+      if (!fluidV_[f]) continue;
+      const std::size_t kd = std::size_t(j - 1) * nx_ + i, ku = kd + std::size_t(nx_);
+      const bool solidSide = type_[kd] == kSolid || type_[ku] == kSolid;
+      // Under the ghost surface the gradient spans θ of a cell (the matrix's 1/θ).
+      const Real span = surface_ && type_[ku] == kAir ? thetaUp_[kd] : Real(1);
+      if (vOpen_[f] && !solidSide && bodyAcross(kd, ku) < 0) sv_[f] = k2 * (phi(i, j) - phi(i, j - 1)) / span;
+    }
+  extrapolate(sv_, nx_, ny_ + 1, fluidV_);
+}
+
 std::size_t GridProjection::transferToParticles(StepContext& c) {
   const Real dt = c.dt;
   const int nu = nx_ + 1;
-  // A cell field's value in a fluid cell, 0 elsewhere (air holds 0; solid faces are not read).
-  auto inFluid = [&](const std::vector<Real>& field, int i, int j) {
-    return type_[std::size_t(j) * nx_ + i] == kFluid ? field[std::size_t(j) * nx_ + i] : Real(0);
+  // κ in a fluid cell, 0 elsewhere (air holds 0; solid faces are not read).
+  auto kap = [&](int i, int j) {
+    return type_[std::size_t(j) * nx_ + i] == kFluid ? kappa_[std::size_t(j) * nx_ + i] : Real(0);
   };
-  auto kap = [&](int i, int j) { return inFluid(kappa_, i, j); };
-  auto isFluid = [&](int i, int j) { return type_[std::size_t(j) * nx_ + i] == kFluid; };
   const bool shifting = shiftDef_.rate > 0;
-  const Real k2 = -dt * dt * invH_;
-  auto phi = [&](int i, int j) { return inFluid(kappaS_, i, j); };
-  if (shifting) {
-    su_.assign(u_.size(), 0);
-    sv_.assign(v_.size(), 0);
-  }
-  // The u faces and the v faces are independent: two tasks, each serial.
+  // The u faces and the v faces are independent: two tasks, each serial. Open faces
+  // next to fluid take the pressure gradient; closed faces next to fluid lose their
+  // normal velocity (the wall).
   c.pool.parallelFor(2, 1, [&](std::size_t b, std::size_t e) {
     for (std::size_t task = b; task < e; ++task) {
       if (task == 0) {
-        // Face changes: open faces next to fluid take the pressure gradient; closed
-        // faces next to fluid lose their normal velocity (the wall).
         for (int j = 0; j < ny_; ++j)
           for (int i = 1; i < nx_; ++i) {
-            if (!isFluid(i - 1, j) && !isFluid(i, j)) continue;
             const std::size_t f = std::size_t(j) * nu + i;
-            fluidU_[f] = 1;
+            if (!fluidU_[f]) continue;
             const std::size_t kl = std::size_t(j) * nx_ + i - 1, kr = kl + 1;
             const bool solidSide = type_[kl] == kSolid || type_[kr] == kSolid;
             const int body = solidSide ? -1 : bodyAcross(kl, kr);
             du_[f] = body >= 0                    ? bodyFaceVelocity(body, 0, i, j) - u_[f]  // a moving body's face
                      : uOpen_[f] && !solidSide ? -dt * (kap(i, j) - kap(i - 1, j)) * invH_
                                                : -u_[f];
-            // The shift's face moves: −dt²∇φ across open faces between fluid and air
-            // cells (none through a wall), extrapolated one layer as the change is.
-            if (shifting && uOpen_[f] && !solidSide && body < 0) su_[f] = k2 * (phi(i, j) - phi(i - 1, j));
           }
         extrapolate(du_, nu, ny_, fluidU_);
-        if (shifting) extrapolate(su_, nu, ny_, fluidU_);
+        if (pic_ > 0)  // the projected face velocities (closed faces: 0)
+          for (std::size_t f = 0; f < u_.size(); ++f) uNew_[f] = u_[f] + du_[f];
       } else {
         for (int j = 1; j < ny_; ++j)
           for (int i = 0; i < nx_; ++i) {
-            if (!isFluid(i, j - 1) && !isFluid(i, j)) continue;
             const std::size_t f = std::size_t(j) * nx_ + i;
-            fluidV_[f] = 1;
+            if (!fluidV_[f]) continue;
             const std::size_t kd = std::size_t(j - 1) * nx_ + i, ku = kd + std::size_t(nx_);
             const bool solidSide = type_[kd] == kSolid || type_[ku] == kSolid;
             const int body = solidSide ? -1 : bodyAcross(kd, ku);
@@ -703,10 +843,10 @@ std::size_t GridProjection::transferToParticles(StepContext& c) {
             dv_[f] = body >= 0                    ? bodyFaceVelocity(body, 1, i, j) - v_[f]
                      : vOpen_[f] && !solidSide ? -dt * (kap(i, j) - kap(i, j - 1)) * invH_ / span
                                                : -v_[f];
-            if (shifting && vOpen_[f] && !solidSide && body < 0) sv_[f] = k2 * (phi(i, j) - phi(i, j - 1)) / span;
           }
         extrapolate(dv_, nx_, ny_ + 1, fluidV_);
-        if (shifting) extrapolate(sv_, nx_, ny_ + 1, fluidV_);
+        if (pic_ > 0)
+          for (std::size_t f = 0; f < v_.size(); ++f) vNew_[f] = v_[f] + dv_[f];
       }
     }
   });
@@ -714,22 +854,19 @@ std::size_t GridProjection::transferToParticles(StepContext& c) {
   const Real vmax2 = c.maxSpeed * c.maxSpeed;
   if (shifting) shift_.resize(P.size());
   else shift_.clear();
-  if (pic_ > 0) {  // the projected face velocities (closed faces: 0)
-    for (std::size_t f = 0; f < u_.size(); ++f) uNew_[f] = u_[f] + du_[f];
-    for (std::size_t f = 0; f < v_.size(); ++f) vNew_[f] = v_[f] + dv_[f];
-  }
   return firstBad(c.pool, P.size(), [&](std::size_t b, std::size_t e) {
     std::size_t bad = kNone;
     for (std::size_t p = b; p < e; ++p) {
       const Real px = P.x[p].x() * invH_ - Real(I0_), py = P.x[p].y() * invH_ - Real(J0_);
-      Vec2 vp = P.v[p] + sampleFaces(du_, dv_, px, py);  // FLIP: the change of the grid velocity
+      const FaceWeights w = faceWeights(px, py);  // the same for every face field
+      Vec2 vp = P.v[p] + sampleFaces(du_, dv_, w);  // FLIP: the change of the grid velocity
       if (pic_ > 0) {
         // PIC share: towards the projected grid velocity itself (smooths particle noise).
-        const Vec2 ug = sampleFaces(uNew_, vNew_, px, py);
+        const Vec2 ug = sampleFaces(uNew_, vNew_, w);
         vp += (ug - vp) * pic_;
       }
       P.v[p] = vp;
-      if (shifting) shift_[p] = sampleFaces(su_, sv_, px, py);
+      if (shifting) shift_[p] = sampleFaces(su_, sv_, w);
       if (bad == kNone && (!allFinite(P.v[p]) || P.v[p].squaredNorm() > vmax2)) bad = p;
     }
     return bad;
@@ -758,9 +895,22 @@ std::size_t GridProjection::project(StepContext& c) {
   if (c.P.size() == 0 || !(c.dt > 0)) return kNone;
   dx_ = c.dx;
   layout(c);
-  transferToGrid(c);
-  classify(c);
-  assemble();
+  // The cells' particle weights decide the cell types and the matrix; the face
+  // velocities are read only by the solve. Three tasks, each serial: the cells with the
+  // classification and the matrix (the longest), the u faces, the v faces.
+  c.pool.parallelFor(3, 1, [&](std::size_t b, std::size_t e) {
+    for (std::size_t task = b; task < e; ++task) {
+      if (task == 0) {
+        resetCells();
+        splatCells(c);
+        classify(c);
+        assemble();
+      } else {
+        resetFaces(int(task) - 1);
+        splatFaces(c, int(task) - 1);
+      }
+    }
+  });
   solve(c);
   return transferToParticles(c);
 }

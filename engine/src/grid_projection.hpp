@@ -29,8 +29,12 @@
 // prediction adds. It removes the compression that large substeps pile up
 // without putting kinetic energy in.
 //
-// Deterministic: particles go to the grid in slot order (one thread), the
-// conjugate-gradient sums are taken in cell order.
+// Deterministic: particles go to the grid in slot order (each field on one
+// thread), the conjugate-gradient sums are taken in cell order. On two threads
+// a projection is four steps of a few tasks each (project()): the cells'
+// weights, their classification and the matrix beside the u and v faces'
+// velocities; the pressure solve beside the shift's solve and face moves; the
+// u beside the v faces' changes; then the particles in blocks.
 #pragma once
 
 #include <cstdint>
@@ -80,12 +84,24 @@ class GridProjection {
 
  private:
   enum : std::uint8_t { kAir = 0, kFluid = 1, kSolid = 2, kBody = 3 };  ///< kBody: inside a moving body (bodyOf_)
+  /// The grid over the particles' box (cells of cellRatio_·dx, larger for spray).
   void layout(const StepContext& c);
+  /// Sizes and clears the cell fields and the face flags (the first task of a projection).
+  void resetCells();
+  /// Sizes and clears one axis's face fields (0: u, 1: v; that axis's splat task).
+  void resetFaces(int axis);
   void classify(const StepContext& c);
-  void transferToGrid(const StepContext& c);
+  /// The particles' weights (and SPH compression, highest particle) to the cells, in slot order.
+  void splatCells(const StepContext& c);
+  /// The particles' velocities to the u (axis 0) or v (axis 1) faces, in slot order.
+  void splatFaces(const StepContext& c, int axis);
   void assemble();
   /// out = A·in; `coupled`: plus the dynamic bodies' response ρ0 h² G M⁻¹ Gᵀ·in.
   void apply(const std::vector<Real>& in, std::vector<Real>& out, bool coupled) const;
+  /// apply(in, out, false), returning in·out (summed in cell order, in double).
+  double applyDot(const std::vector<Real>& in, std::vector<Real>& out) const;
+  /// a·b over the unknowns, summed in cell order in double.
+  double dot(const std::vector<Real>& a, const std::vector<Real>& b) const;
   void precondition(const std::vector<Real>& r, std::vector<Real>& z, std::vector<Real>& y) const;
   /// The vectors of one conjugate-gradient solve (two solves may run at once).
   struct CgWork {
@@ -103,9 +119,27 @@ class GridProjection {
   Real bodyFaceVelocity(int body, int axis, int i, int j) const;
   /// The body of whichever of cells k1, k2 is a moving body's (−1: neither).
   int bodyAcross(std::size_t k1, std::size_t k2) const;
+  /// The pressure solve's right-hand side (rhs_) and warm start (x_).
+  void pressureSystem(const StepContext& c);
+  /// The compression shift's right-hand side (rhsS_), its unknowns cleared (xs_).
+  void shiftSystem(const StepContext& c);
   void solve(const StepContext& c);
-  /// Bilinear sample of face fields u, v at (px, py) in cell units of the grid.
-  Vec2 sampleFaces(const std::vector<Real>& u, const std::vector<Real>& v, Real px, Real py) const;
+  /// Calls f(a, i, j) for every unknown a (cell (i, j)), in cell order, row by row.
+  template <class F>
+  void forUnknowns(F f) const {
+    for (int j = 0; j < ny_; ++j)
+      for (std::int32_t a = rowStart_[std::size_t(j)]; a < rowStart_[std::size_t(j) + 1]; ++a)
+        f(std::size_t(a), cells_[std::size_t(a)] - j * nx_, j);
+  }
+  /// The bilinear weights of a point on the u and v faces, and the lower left face of each.
+  struct FaceWeights {
+    std::size_t ku, kv;
+    Real u[4], v[4];  ///< (i, j), (i + 1, j), (i, j + 1), (i + 1, j + 1)
+  };
+  /// The weights at (px, py) in cell units of the grid.
+  FaceWeights faceWeights(Real px, Real py) const;
+  /// Bilinear sample of face fields u, v with weights `w`.
+  Vec2 sampleFaces(const std::vector<Real>& u, const std::vector<Real>& v, const FaceWeights& w) const;
 
  public:
   Real pic_ = 0;  ///< share of the projected grid velocity given to the particles (PIC; the rest FLIP)
@@ -116,6 +150,8 @@ class GridProjection {
 
  private:
   std::size_t transferToParticles(StepContext& c);
+  /// The compression shift's face moves −dt²∇φ (su_, sv_) from the last shift solve.
+  void shiftMoves(const StepContext& c);
   static void extrapolate(std::vector<Real>& d, int w, int h, const std::vector<std::uint8_t>& known);
   /// Cached solid flags of cell (I, J) and blocked flags of its left/bottom faces (anchored indices).
   std::uint8_t cacheEntry(const StepContext& c, long I, long J);
@@ -143,7 +179,9 @@ class GridProjection {
   std::vector<std::int32_t> index_;         ///< cell → unknown (−1: none)
   std::vector<std::int32_t> cells_;         ///< unknown → cell
   std::vector<std::int32_t> adj_;           ///< per unknown: left, right, down, up unknown (−1: none)
+  std::vector<std::int32_t> nbrPad_;        ///< adj_ with m for none (applyDot reads a 0 there)
   std::vector<Real> precon_, precon2_;      ///< MIC(0) factor: 1/diag(L), and its square
+  std::vector<std::int32_t> rowStart_;      ///< per grid row: its first unknown (ny + 1 entries, the last m)
   // Warm start: the last substep's κ by anchored cell.
   Real pH_ = 0;  ///< the cell size of prevKappa_
   long pI0_ = 0, pJ0_ = 0;

@@ -5,9 +5,61 @@
 #include <algorithm>
 #include <cmath>
 
+#if defined(__SSE2__) && !defined(SPH2D_NO_SIMD)
+#include <emmintrin.h>
+#define SPH2D_SSE2_NEIGHBOURS 1
+#endif
+
 namespace sph2d {
 
 namespace {
+
+#ifdef SPH2D_SSE2_NEIGHBOURS
+/// The lanes of the set bits of a 4-bit mask, in lane order (then 0): four candidates
+/// compacted at once, without branches.
+alignas(16) constexpr std::uint32_t kCompactLanes[16][4] = {
+    {0, 0, 0, 0}, {0, 0, 0, 0}, {1, 0, 0, 0}, {0, 1, 0, 0}, {2, 0, 0, 0}, {0, 2, 0, 0}, {1, 2, 0, 0}, {0, 1, 2, 0},
+    {3, 0, 0, 0}, {0, 3, 0, 0}, {1, 3, 0, 0}, {0, 1, 3, 0}, {2, 3, 0, 0}, {0, 2, 3, 0}, {1, 2, 3, 0}, {0, 1, 2, 3}};
+constexpr std::uint8_t kBitCount[16] = {0, 1, 1, 2, 1, 2, 2, 3, 1, 2, 2, 3, 2, 3, 3, 4};
+#endif
+
+/// Appends to dst[used..] the slots k of [kb, ke), k ≠ i, with |xi − X[k]|² < R2, in
+/// order: candidates that are slots themselves (the grid's particles in order), no
+/// periodic axis. The same r² as the scalar loop (one IEEE operation a lane, in the same
+/// order), four candidates at a time; writes up to 3 entries past the list's end.
+#if defined(__GNUC__)
+__attribute__((always_inline))  // called per row of cells with a few candidates: the call cost more than the row
+#endif
+inline std::size_t nearInOrder(const Vec2* X, std::size_t n, std::uint32_t kb, std::uint32_t ke, std::size_t i, const Vec2& xi,
+                               Real R2, std::uint32_t* dst, std::size_t used) {
+  std::uint32_t k = kb;
+#ifdef SPH2D_SSE2_NEIGHBOURS
+  static_assert(sizeof(Vec2) == 2 * sizeof(float), "positions are pairs of floats");
+  const float* xy = reinterpret_cast<const float*>(X);
+  const __m128 xi4 = _mm_set1_ps(xi.x()), yi4 = _mm_set1_ps(xi.y()), r24 = _mm_set1_ps(R2);
+  for (; k < ke && std::size_t(k) + 4 <= n; k += 4) {  // lanes past ke read real particles, masked off
+    const __m128 a = _mm_loadu_ps(xy + 2 * std::size_t(k)), b = _mm_loadu_ps(xy + 2 * std::size_t(k) + 4);
+    const __m128 dx = _mm_sub_ps(xi4, _mm_shuffle_ps(a, b, _MM_SHUFFLE(2, 0, 2, 0)));
+    const __m128 dy = _mm_sub_ps(yi4, _mm_shuffle_ps(a, b, _MM_SHUFFLE(3, 1, 3, 1)));
+    const __m128 r2 = _mm_add_ps(_mm_mul_ps(dx, dx), _mm_mul_ps(dy, dy));
+    unsigned mask = unsigned(_mm_movemask_ps(_mm_cmplt_ps(r2, r24)));
+    if (ke - k < 4) mask &= (1u << (ke - k)) - 1;
+    if (i >= k && i - k < 4) mask &= ~(1u << (i - k));
+    const __m128i lanes = _mm_load_si128(reinterpret_cast<const __m128i*>(kCompactLanes[mask]));
+    _mm_storeu_si128(reinterpret_cast<__m128i*>(dst + used), _mm_add_epi32(_mm_set1_epi32(int(k)), lanes));
+    used += kBitCount[mask];
+  }
+#else
+  (void)n;
+#endif
+  for (; k < ke; ++k) {
+    const Real dx = xi.x() - X[k].x(), dy = xi.y() - X[k].y();
+    const Real r2 = dx * dx + dy * dy;
+    dst[used] = k;
+    used += std::size_t((r2 < R2) & (k != i));
+  }
+  return used;
+}
 
 template <class T>
 void permuteField(std::vector<T>& field, const std::vector<std::uint32_t>& order, std::vector<T>& scratch,
@@ -71,6 +123,7 @@ void stageGrid(StepContext& c, bool reorder) {
   // After the permutation slot k is the k-th particle in cell order.
   permuteField(c.grid.cellOf, order, c.scratch.u, c.pool);
   for (std::size_t k = 0; k < c.grid.sorted.size(); ++k) c.grid.sorted[k] = std::uint32_t(k);
+  c.grid.inOrder = true;
 }
 
 void stageNeighbours(StepContext& c) {
@@ -89,6 +142,8 @@ void stageNeighbours(StepContext& c) {
   const Real R2 = c.R * c.R;
   const PeriodicBox per = c.periodic;
   const bool walls = !B.samples.empty();
+  // Candidates that are slots (just reordered) and no wrap: four at a time.
+  const bool inOrder = g.inOrder && !per.any() && g.sorted.size() == n;
   c.pool.parallelFor(n, kBlock, [&](std::size_t b, std::size_t e) {
     std::vector<std::uint32_t>& out = L.perBlock[b / kBlock];
     std::vector<std::uint32_t>& bout = L.boundaryPerBlock[b / kBlock];
@@ -98,9 +153,10 @@ void stageNeighbours(StepContext& c) {
       const Vec2 xi = P.x[i];
       L.start[i] = std::uint32_t(used);
       g.forCandidateRanges(xi, [&](std::uint32_t kb, std::uint32_t ke) {
-        // Room for every candidate (written before the test); grown by an eighth, not
-        // doubled: the lists are most of the engine's memory, and a block's need settles.
-        const std::size_t need = used + (ke - kb);
+        // Room for every candidate (written before the test; and 3 more, nearInOrder's
+        // last group); grown by an eighth, not doubled: the lists are most of the
+        // engine's memory, and a block's need settles.
+        const std::size_t need = used + (ke - kb) + 3;
         if (out.size() < need) {
           if (out.capacity() < need) out.reserve(need + need / 8);
           out.resize(need);
@@ -108,6 +164,10 @@ void stageNeighbours(StepContext& c) {
         std::uint32_t* dst = out.data();
         const std::uint32_t* sorted = g.sorted.data();
         const Vec2* X = P.x.data();
+        if (inOrder) {
+          used = nearInOrder(X, n, kb, ke, i, xi, R2, dst, used);
+          return;
+        }
         for (std::uint32_t k = kb; k < ke; ++k) {
           const std::uint32_t j = sorted[k];
           Real dx = xi.x() - X[j].x(), dy = xi.y() - X[j].y();

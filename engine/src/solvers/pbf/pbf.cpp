@@ -8,7 +8,6 @@
 // the registrations of pbf and game: pbf_params.cpp.
 #include <algorithm>
 #include <cmath>
-#include <iterator>
 #include <limits>
 
 #include "solvers/pbf/pbf.hpp"
@@ -63,14 +62,26 @@ Real Pbf::maxTimeStep(const StepContext& c, Real vmax, Real amax) const {
 Real Pbf::robustSpeed(const StepContext& c) const {
   const ParticleStore& P = c.P;
   const std::size_t n = P.size();
+  const std::size_t skip = std::min(n - 1, std::size_t(double(quantile_) * double(n)));
+  const std::size_t k = skip + 1;  // the answer is the k-th largest squared speed
+  // Each block selects its k largest (in parallel); the k largest of all are among them,
+  // so the k-th largest of the blocks' is the answer: the value a selection over every
+  // particle finds, for any thread count.
   std::vector<Real>& s = speedScratch_;
   s.resize(n);
   c.pool.parallelFor(n, kStreamBlock, [&](std::size_t b, std::size_t e) {
     for (std::size_t i = b; i < e; ++i) s[i] = P.v[i].squaredNorm();
+    const std::size_t kb = std::min(k, e - b);
+    std::nth_element(s.begin() + std::ptrdiff_t(b), s.begin() + std::ptrdiff_t(e - kb), s.begin() + std::ptrdiff_t(e));
   });
-  const std::size_t skip = std::min(n - 1, std::size_t(double(quantile_) * double(n)));
-  std::nth_element(s.begin(), s.begin() + std::ptrdiff_t(n - 1 - skip), s.end());
-  return std::sqrt(s[n - 1 - skip]);
+  std::vector<Real>& top = speedTop_;
+  top.clear();
+  for (std::size_t b = 0; b < n; b += kStreamBlock) {
+    const std::size_t e = std::min(n, b + kStreamBlock);
+    top.insert(top.end(), s.begin() + std::ptrdiff_t(e - std::min(k, e - b)), s.begin() + std::ptrdiff_t(e));
+  }
+  std::nth_element(top.begin(), top.end() - std::ptrdiff_t(k), top.end());
+  return std::sqrt(top[top.size() - k]);
 }
 
 std::vector<Stage> Pbf::stages(bool effects) {
@@ -131,7 +142,8 @@ std::size_t Pbf::solve(StepContext& c) {
   // (and their neighbours) take further Jacobi steps; the rest keep their place.
   int local = 0;
   if (localIterations_ > 0 && maxCompression_ > toleranceMax_) {
-    marks_.resize(n);
+    active_.reset(n);
+    moved_.reset(n);
     const Real thr = Real(0.5) * toleranceMax_;
     const bool pending = used < maxIt;  // the last constraint pass's step is not applied yet
     if (!pending) {
@@ -140,7 +152,6 @@ std::size_t Pbf::solve(StepContext& c) {
     }
     const Real limit = c.rho0 * (Real(1) + thr);
     bool first = true;  // every ρ and Δλ is the last full pass's
-    movedList_.clear();
     while (local < localIterations_) {
       for (; local < localIterations_ && maxCompression_ > toleranceMax_; ++local) {
         // Active: compressed above half the tolerance, or next to such a particle.
@@ -150,37 +161,35 @@ std::size_t Pbf::solve(StepContext& c) {
         // list: they and their neighbours (the lists are symmetric) are the new
         // active set, the same set a full scan finds.
         if (first) {
-          std::vector<std::uint8_t>& on = marks_;
+          // A block of kBlock slots owns its words of the set (64 slots each).
+          static_assert(kBlock % 64 == 0, "a job block covers whole words of a SlotSet");
           c.pool.parallelFor(n, kBlock, [&](std::size_t b, std::size_t e) {
-            for (std::size_t i = b; i < e; ++i) {
-              bool a = c.P.rho[i] > limit;
-              const std::uint32_t* nb = c.nbr.of(i);
-              for (std::uint32_t k = 0; k < c.nbr.count[i] && !a; ++k) a = c.P.rho[nb[k]] > limit;
-              on[i] = a;
+            for (std::size_t w0 = b; w0 < e; w0 += 64) {
+              std::uint64_t bits = 0;
+              for (std::size_t i = w0; i < std::min(e, w0 + 64); ++i) {
+                bool a = c.P.rho[i] > limit;
+                const std::uint32_t* nb = c.nbr.of(i);
+                for (std::uint32_t k = 0; k < c.nbr.count[i] && !a; ++k) a = c.P.rho[nb[k]] > limit;
+                if (a) bits |= std::uint64_t(1) << (i - w0);
+                else dLambda_[i] = 0;  // only the listed particles take their step of the full pass
+              }
+              active_.setWord(w0 / 64, bits);
             }
           });
-          activeList_.clear();
-          for (std::size_t i = 0; i < n; ++i) {
-            if (on[i]) activeList_.push_back(std::uint32_t(i));
-            else dLambda_[i] = 0;  // only the listed particles take their step of the full pass
-            on[i] = 0;
-          }
+          active_.summarise();
           first = false;
         } else {
-          neighbourhood(c, lastList_, &limit, activeList_);
+          neighbourhood(c, lastList_, &limit, active_);
           // Off the new list, only the last list's Δλ can be non-zero: those are cleared.
-          for (const std::uint32_t i : activeList_) marks_[i] = 1;
           for (const std::uint32_t i : lastList_)
-            if (!marks_[i]) dLambda_[i] = 0;
-          for (const std::uint32_t i : activeList_) marks_[i] = 0;
+            if (!active_.has(i)) dLambda_[i] = 0;
         }
+        active_.list(activeList_);
+        active_.clear();
         std::size_t bad = correct(c, lambda, Real(1), &activeList_);
         if (bad != kNone) return bad;
-        // Every particle moved in this phase (sorted): its neighbours' ρ changed too.
-        mergeScratch_.clear();
-        std::set_union(movedList_.begin(), movedList_.end(), activeList_.begin(), activeList_.end(),
-                       std::back_inserter(mergeScratch_));
-        movedList_.swap(mergeScratch_);
+        // Every particle moved in this phase: its neighbours' ρ changed too.
+        for (const std::uint32_t i : activeList_) moved_.add(i);
         bad = constraint(c, lambda, &activeList_);
         if (bad != kNone) return bad;
         lastList_.swap(activeList_);
@@ -190,7 +199,10 @@ std::size_t Pbf::solve(StepContext& c) {
       // summed again (the rest kept ρ and W of the last full pass). A neighbour off the
       // lists may have been pushed above the tolerance: then the iterations go on from
       // this halo, whose ρ are all fresh.
-      neighbourhood(c, movedList_, nullptr, activeList_);
+      moved_.list(movedList_);
+      neighbourhood(c, movedList_, nullptr, active_);
+      active_.list(activeList_);
+      active_.clear();
       const std::size_t bad = constraint(c, lambda, &activeList_);
       if (bad != kNone) return bad;
       lastList_.swap(activeList_);
@@ -216,24 +228,15 @@ std::size_t Pbf::solve(StepContext& c) {
 }
 
 void Pbf::neighbourhood(const StepContext& c, const std::vector<std::uint32_t>& list, const Real* limit,
-                        std::vector<std::uint32_t>& out) {
-  // Serial over the list (a local iteration's few particles); sorted afterwards, so
-  // the result does not depend on the order the list was built in.
-  out.clear();
-  auto add = [&](std::uint32_t i) {
-    if (!marks_[i]) {
-      marks_[i] = 1;
-      out.push_back(i);
-    }
-  };
+                        SlotSet& out) const {
+  // Serial over the list (a local iteration's few particles); a set, so the result
+  // does not depend on the order the list was built in.
   for (const std::uint32_t i : list) {
     if (limit && !(c.P.rho[i] > *limit)) continue;
-    add(i);
+    out.add(i);
     const std::uint32_t* nb = c.nbr.of(i);
-    for (std::uint32_t k = 0; k < c.nbr.count[i]; ++k) add(nb[k]);
+    for (std::uint32_t k = 0; k < c.nbr.count[i]; ++k) out.add(nb[k]);
   }
-  std::sort(out.begin(), out.end());
-  for (const std::uint32_t i : out) marks_[i] = 0;
 }
 
 void Pbf::calibrate(const StepContext& c) {
@@ -296,7 +299,9 @@ std::size_t Pbf::finalDensity(StepContext& c, Real dt) {
   if (rhoCurrent_) {  // the last constraint pass already summed ρ (and cached W) at these positions
     const std::vector<Real>* lam = P.find("pbf.lambda");
     const Real pK = dt > 0 ? -c.rho0 / (dt * dt) : Real(0);
-    c.pool.parallelFor(P.size(), kStreamBlock, [&](std::size_t b, std::size_t e) {
+    // kBlock, not kStreamBlock: the grid's κ sampled per particle is no streaming pass,
+    // and five blocks of 20k would leave one thread a block behind the other.
+    c.pool.parallelFor(P.size(), kBlock, [&](std::size_t b, std::size_t e) {
       for (std::size_t i = b; i < e; ++i) {
         const Real p = pressure(c, lam, pK, i);
         P.invRho[i] = Real(1) / P.rho[i];

@@ -69,6 +69,7 @@
 #include <vector>
 
 #include "grid_projection.hpp"
+#include "solvers/pbf/slot_set.hpp"
 #include "solvers/solver.hpp"
 
 namespace sph2d {
@@ -167,18 +168,17 @@ class Pbf final : public Solver {
   Real quantile_, moveCap_;
   int localIterations_;
   bool resolveEach_;
-  /// The particles of `list` (only those with ρ > *limit when given) and their
-  /// neighbours, in slot order, into `out`; costs in proportion to the list, not to
-  /// the particle count (`marks_` is all zero before and after).
+  /// Adds the particles of `list` (only those with ρ > *limit when given) and their
+  /// neighbours to `out`; costs in proportion to the list, not to the particle count.
   void neighbourhood(const StepContext& c, const std::vector<std::uint32_t>& list, const Real* limit,
-                     std::vector<std::uint32_t>& out);
-  std::vector<std::uint8_t> marks_;          ///< per particle, zero between calls
-  std::vector<std::uint32_t> activeList_;    ///< the particles of a local iteration
+                     SlotSet& out) const;
+  SlotSet active_;                           ///< the next local iteration's particles, as they are found
+  SlotSet moved_;                            ///< every particle the local phase moved
+  std::vector<std::uint32_t> activeList_;    ///< the particles of a local iteration (sorted)
   std::vector<std::uint32_t> lastList_;      ///< the particles the last constraint pass of the local phase wrote Δλ for
-  std::vector<std::uint32_t> movedList_;     ///< every particle the local phase moved (sorted)
-  std::vector<std::uint32_t> mergeScratch_;
+  std::vector<std::uint32_t> movedList_;     ///< moved_ listed for the halo pass (sorted)
   static constexpr std::size_t kLocalBlock = 32;  ///< particles per job of a local iteration (few, clustered)
-  mutable std::vector<Real> speedScratch_;
+  mutable std::vector<Real> speedScratch_, speedTop_;  ///< robustSpeed(): squared speeds, each block's largest
   std::unique_ptr<GridProjection> projection_;  ///< the coarse-grid projection (grid_cell > 0)
 
   Real d0_ = 0, eps_ = 0, invWdq_ = 0, sCorrScale_ = 0;

@@ -100,6 +100,24 @@ struct Lane4 {
 };
 static_assert(std::is_same<Real, float>::value, "Lane4 is single precision");
 
+/// std::min(a, b) = (b < a ? b : a) and std::max(a, b) = (a < b ? b : a) of two floats as
+/// one minss(b, a) or maxss(b, a), which return a when either is NaN: the same values,
+/// with no branch on the data (the compiler branched, and compression is no pattern).
+inline float minOf(float a, float b) {
+#if defined(__SSE2__) && !defined(SPH2D_NO_SIMD)
+  return _mm_cvtss_f32(_mm_min_ss(_mm_set_ss(b), _mm_set_ss(a)));
+#else
+  return std::min(a, b);
+#endif
+}
+inline float maxOf(float a, float b) {
+#if defined(__SSE2__) && !defined(SPH2D_NO_SIMD)
+  return _mm_cvtss_f32(_mm_max_ss(_mm_set_ss(b), _mm_set_ss(a)));
+#else
+  return std::max(a, b);
+#endif
+}
+
 }  // namespace
 
 std::size_t Pbf::constraint(StepContext& c, const std::vector<Real>& lambda, const std::vector<std::uint32_t>* list) {
@@ -250,13 +268,15 @@ std::size_t Pbf::constraint(StepContext& c, const std::vector<Real>& lambda, con
       wallGrad_[i] = wall;
       const Real C = rho / c.rho0 - Real(1);
       const Real D = gix * gix + giy * giy + g2;
-      const Real scale = rho > c.rho0 ? c.rho0 / rho : Real(1);
+      // ρ0/ρ when compressed, else 1: min(1, ρ0/ρ) is the same value (ρ ≥ 0; for ρ > ρ0,
+      // ρ0/ρ rounds to 1 at most; for ρ ≤ ρ0, to 1 at least).
+      const Real scale = minOf(Real(1), c.rho0 / rho);
       const Real lOld = lambda[i];
-      const Real lNew = std::min(Real(0), lOld - scale * C / (D + eps_));
+      const Real lNew = minOf(Real(0), lOld - scale * C / (D + eps_));
       dLambda_[i] = lNew - lOld;
       P.rho[i] = rho;
-      err += double(std::max(Real(0), C));
-      worst = std::max(worst, C);
+      err += double(maxOf(Real(0), C));
+      worst = maxOf(worst, C);
       if (bad == kNone && !std::isfinite(lNew)) bad = i;
     }
     blockErr_[b / step] = err;
