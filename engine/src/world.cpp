@@ -183,6 +183,7 @@ void World::init() {
   StepContext c = w.context(0);
   w.solver->prepare(c);
   w.buildStages();
+  w.refreshView();
 }
 
 World::~World() = default;
@@ -262,6 +263,16 @@ std::size_t World::removeParticlesInBox(const Vec2d& lo, const Vec2d& hi) {
   return n;
 }
 
+bool World::Impl::viewCurrent() const {
+  auto same = [](const auto& shown, const auto* vec) {
+    return vec ? shown.data() == vec->data() && shown.size() == vec->size() : shown.empty();
+  };
+  const Particles& V = view;
+  return same(V.x, &P.x) && same(V.v, &P.v) && same(V.rho, &P.rho) && same(V.p, &P.p) && same(V.id, &P.id) &&
+         same(V.age, P.find("age")) && same(V.color, P.findU32(ParticleStore::kColor)) &&
+         same(V.userData, P.findU32(ParticleStore::kUserData));
+}
+
 void World::Impl::refreshView() const {
   Particles& V = view;
   V.x = P.x;
@@ -278,7 +289,9 @@ void World::Impl::refreshView() const {
 }
 
 const Particles& World::particles() const {
-  impl_->refreshView();
+  // Every change of the particles refreshes the view; this is the net for one that did not, and
+  // writes only then (so threads that only read a World may call it side by side).
+  if (!impl_->viewCurrent()) impl_->refreshView();
   return impl_->view;
 }
 std::size_t World::particleCount() const { return impl_->P.size(); }

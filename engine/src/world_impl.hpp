@@ -41,6 +41,8 @@ struct World::Impl {
   mutable Particles view;
   /// Points `view` at P's arrays as they are now (they move when they grow or are reordered).
   void refreshView() const;
+  /// True when `view` shows P's arrays as they are now.
+  bool viewCurrent() const;
   Grid grid;
   NeighbourLists nbr;
   BoundarySet boundary;

@@ -312,7 +312,12 @@ TEST_CASE("particles(): views of the World own arrays, colour and user data appe
     before.assign(P);
   }
   for (int f = 0; f < 10; ++f) w.stepFrame();  // the column falls and spreads
+  // The step itself brought the held views up to date (particles() need not be called again).
+  const Vec2* heldX = held.x.data();
+  const std::uint32_t* heldColor = held.color.data();
   const Particles now = w.particles();
+  CHECK(heldX == held.x.data());
+  CHECK(heldColor == held.color.data());
   // The reference taken before the steps shows the arrays as they are now (the grid reordered
   // them into other storage meanwhile).
   CHECK(held.x.data() == now.x.data());

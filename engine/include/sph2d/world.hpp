@@ -106,8 +106,7 @@ class World {
   /// The particles as read-only arrays by slot (local frame; add origin() for world
   /// coordinates). No copy is made: the views show the World's own arrays, and the World keeps
   /// them current after every step and every change of its particles, so the reference stays
-  /// valid for the World's life. (An element read before a step is the value before it.) The
-  /// call refreshes the views: like a step, not while another thread uses the World.
+  /// valid for the World's life. (An element read before a step is the value before it.)
   const Particles& particles() const;
   /// Number of particles.
   std::size_t particleCount() const;
