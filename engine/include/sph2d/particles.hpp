@@ -4,8 +4,10 @@
 // array per field, indexed by storage slot. Slots change when the grid
 // reorders the particles for locality or some are removed, so a game holds
 // particles by `id`, which never changes (World::slotOf, getParticle). The
-// view is valid until the World steps or its particles change. The solver's
-// working fields stay inside the engine.
+// World keeps its view pointing at its arrays after every step and change, so
+// a reference to it stays good; a copy of the view (a Particles value) shows
+// the arrays of the moment it was taken and goes stale with the next step. The
+// solver's working fields stay inside the engine.
 //
 // A program that keeps particles to draw later (on another thread, or read
 // from a file) owns them in a ParticleBuffer and passes its view().
