@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <sstream>
+#include <type_traits>
 
 #include "world_impl.hpp"
 
@@ -263,30 +264,37 @@ std::size_t World::removeParticlesInBox(const Vec2d& lo, const Vec2d& hi) {
   return n;
 }
 
-bool World::Impl::viewCurrent() const {
-  auto same = [](const auto& shown, const auto* vec) {
-    return vec ? shown.data() == vec->data() && shown.size() == vec->size() : shown.empty();
+namespace {
+
+/// The views of `S`'s public arrays as they are now (the optional ones empty when absent).
+Particles viewOf(const ParticleStore& S) {
+  auto opt = [](const auto* vec) {
+    using T = typename std::remove_pointer_t<decltype(vec)>::value_type;
+    return vec ? ArrayView<T>(*vec) : ArrayView<T>();
   };
-  const Particles& V = view;
-  return same(V.x, &P.x) && same(V.v, &P.v) && same(V.rho, &P.rho) && same(V.p, &P.p) && same(V.id, &P.id) &&
-         same(V.age, P.find("age")) && same(V.color, P.findU32(ParticleStore::kColor)) &&
-         same(V.userData, P.findU32(ParticleStore::kUserData));
+  Particles V;
+  V.x = S.x;
+  V.v = S.v;
+  V.rho = S.rho;
+  V.p = S.p;
+  V.id = S.id;
+  V.age = opt(S.find("age"));
+  V.color = opt(S.findU32(ParticleStore::kColor));
+  V.userData = opt(S.findU32(ParticleStore::kUserData));
+  return V;
 }
 
-void World::Impl::refreshView() const {
-  Particles& V = view;
-  V.x = P.x;
-  V.v = P.v;
-  V.rho = P.rho;
-  V.p = P.p;
-  V.id = P.id;
-  const std::vector<Real>* age = P.find("age");
-  V.age = age ? ArrayView<Real>(*age) : ArrayView<Real>();
-  const std::vector<std::uint32_t>* c = P.findU32(ParticleStore::kColor);
-  V.color = c ? ArrayView<std::uint32_t>(*c) : ArrayView<std::uint32_t>();
-  const std::vector<std::uint32_t>* u = P.findU32(ParticleStore::kUserData);
-  V.userData = u ? ArrayView<std::uint32_t>(*u) : ArrayView<std::uint32_t>();
+}  // namespace
+
+bool World::Impl::viewCurrent() const {
+  const Particles now = viewOf(P);
+  auto same = [](const auto& a, const auto& b) { return a.data() == b.data() && a.size() == b.size(); };
+  return same(view.x, now.x) && same(view.v, now.v) && same(view.rho, now.rho) && same(view.p, now.p) &&
+         same(view.id, now.id) && same(view.age, now.age) && same(view.color, now.color) &&
+         same(view.userData, now.userData);
 }
+
+void World::Impl::refreshView() const { view = viewOf(P); }
 
 const Particles& World::particles() const {
   // Every change of the particles refreshes the view; this is the net for one that did not, and
