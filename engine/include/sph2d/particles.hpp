@@ -31,6 +31,8 @@ class ArrayView {
   constexpr ArrayView(const T* data, std::size_t size) : data_(data), size_(size) {}
   /// The values of `v` (valid while v is neither changed nor destroyed).
   ArrayView(const std::vector<T>& v) : data_(v.data()), size_(v.size()) {}  // NOLINT: implicit on purpose
+  /// Not of a temporary vector: the view would outlive its values.
+  ArrayView(const std::vector<T>&&) = delete;
 
   /// Value i (no bounds check).
   constexpr const T& operator[](std::size_t i) const { return data_[i]; }
@@ -108,7 +110,7 @@ struct ParticleBuffer {
     copy(view.userData, userData);
   }
   /// The buffer as Particles (valid until the buffer changes).
-  Particles view() const {
+  Particles view() const& {
     Particles P;
     P.x = x;
     P.v = v;
@@ -120,6 +122,8 @@ struct ParticleBuffer {
     P.userData = userData;
     return P;
   }
+  /// Not of a temporary buffer: the views would outlive their values.
+  Particles view() const&& = delete;
 
  private:
   template <class T>
