@@ -810,6 +810,16 @@ std::size_t GridProjection::transferToParticles(StepContext& c) {
     return type_[std::size_t(j) * nx_ + i] == kFluid ? kappa_[std::size_t(j) * nx_ + i] : Real(0);
   };
   const bool shifting = shiftDef_.rate > 0;
+  // The static solids' impulse on the fluid (World::wallImpulse, WallImpulse::grid), per axis in
+  // face order within its task: on each face closed by a static solid (a solid cell beside it, or
+  // a wall across it) next to a fluid cell, the cell's pressure ρ0κ over the face's length h for
+  // dt, pushing away from the face; and the normal velocity the face removes, −u_f, times the
+  // particle mass on the face (m × its splat weight). Between fluid cells the pressure gradient
+  // telescopes to these end terms on a grid of uniform mass ρ0h² a face; a moving body's faces
+  // are not static (the body takes their impulse).
+  const bool countWall = c.wall != nullptr;
+  const double wallP = double(c.mass) / (double(c.dx) * double(c.dx)) * double(h_) * double(dt), wallM = double(c.mass);
+  double wallAxis[2] = {0, 0};
   // The u faces and the v faces are independent: two tasks, each serial. Open faces
   // next to fluid take the pressure gradient; closed faces next to fluid lose their
   // normal velocity (the wall).
@@ -826,6 +836,8 @@ std::size_t GridProjection::transferToParticles(StepContext& c) {
             du_[f] = body >= 0                    ? bodyFaceVelocity(body, 0, i, j) - u_[f]  // a moving body's face
                      : uOpen_[f] && !solidSide ? -dt * (kap(i, j) - kap(i - 1, j)) * invH_
                                                : -u_[f];
+            if (countWall && body < 0 && !(uOpen_[f] && !solidSide))
+              wallAxis[0] += wallP * (double(kap(i, j)) - double(kap(i - 1, j))) + wallM * double(uw_[f]) * double(du_[f]);
           }
         extrapolate(du_, nu, ny_, fluidU_);
         if (pic_ > 0)  // the projected face velocities (closed faces: 0)
@@ -843,6 +855,8 @@ std::size_t GridProjection::transferToParticles(StepContext& c) {
             dv_[f] = body >= 0                    ? bodyFaceVelocity(body, 1, i, j) - v_[f]
                      : vOpen_[f] && !solidSide ? -dt * (kap(i, j) - kap(i, j - 1)) * invH_ / span
                                                : -v_[f];
+            if (countWall && body < 0 && !(vOpen_[f] && !solidSide))
+              wallAxis[1] += wallP * (double(kap(i, j)) - double(kap(i, j - 1))) + wallM * double(vw_[f]) * double(dv_[f]);
           }
         extrapolate(dv_, nx_, ny_ + 1, fluidV_);
         if (pic_ > 0)
@@ -850,6 +864,7 @@ std::size_t GridProjection::transferToParticles(StepContext& c) {
       }
     }
   });
+  if (countWall) c.wall->sum.grid += Vec2d(wallAxis[0], wallAxis[1]);
   ParticleStore& P = c.P;
   const Real vmax2 = c.maxSpeed * c.maxSpeed;
   if (shifting) shift_.resize(P.size());

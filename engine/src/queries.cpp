@@ -241,6 +241,10 @@ SolverStats World::solverStats() const { return impl_->solver->stats(); }
 
 std::uint64_t World::solverIterations() const { return impl_->iterations; }
 
+WallImpulse World::wallImpulse() const { return impl_->wall.sum; }
+
+void World::resetWallImpulse() { impl_->wall.sum = WallImpulse{}; }
+
 std::size_t World::particleBytes() const { return impl_->P.bytes(); }
 
 std::size_t World::memoryBytes() const {

@@ -323,6 +323,7 @@ void World::load(std::istream& input) {
   w.lastDt = lastDt;
   w.nextId = nextId;
   w.iterations = iterations;
+  w.wall = WallAccount{};  // World::wallImpulse() counts from the load on
   w.removed = removed;
   w.scene.gravity = gravity;
   if (w.ownWorld) w.ownWorld->SetGravity(b2Vec2(float(gravity.x()), float(gravity.y())));

@@ -232,9 +232,21 @@ std::size_t stageDrift(StepContext& c) {
 void stageCollide(StepContext& c) {
   ParticleStore& P = c.P;
   if (c.boundary.colliders.empty()) return;
-  c.pool.parallelFor(P.size(), kBlock, [&](std::size_t b, std::size_t e) {
-    for (std::size_t i = b; i < e; ++i) c.boundary.resolve(P.x[i], P.v[i], P.xPrev[i], c.clearance);
-  });
+  // The velocity response is the static solids' impulse on the fluid: m·Δv of each contact,
+  // summed per block and the blocks in order (WallImpulse::collision). Δv of two floats in double is exact.
+  const Vec2d dv = c.pool.reduce(
+      P.size(), kBlock, Vec2d(0, 0),
+      [&](std::size_t b, std::size_t e) {
+        Vec2d s(0, 0);
+        for (std::size_t i = b; i < e; ++i) {
+          const Vec2 v0 = P.v[i];
+          if (c.boundary.resolve(P.x[i], P.v[i], P.xPrev[i], c.clearance))
+            s += P.v[i].cast<double>() - v0.cast<double>();
+        }
+        return s;
+      },
+      [](const Vec2d& a, const Vec2d& b) { return Vec2d(a + b); });
+  if (c.wall) c.wall->sum.collision += dv * double(c.mass);
 }
 
 Real maxSpeedOf(const ParticleStore& P, ThreadPool& pool) {

@@ -23,6 +23,7 @@
 #include "kernels.hpp"
 #include "particle_store.hpp"
 #include "sph2d/scene.hpp"
+#include "sph2d/world.hpp"
 #include "thread_pool.hpp"
 
 namespace sph2d {
@@ -62,6 +63,22 @@ struct Scratch {
   std::vector<std::uint32_t> u;
 };
 
+/// World::wallImpulse()'s accumulator. Stages that change particle velocities because of the
+/// static solids add m·Δv to `sum` (each as per-block partials summed in block order, never
+/// atomics); the explicit solvers add their wall force Σ m·a_wall to `force`, which the World
+/// multiplies by the substep actually taken (force_limit may shorten it after the force stage).
+struct WallAccount {
+  WallImpulse sum;
+  Vec2d force{0, 0};  ///< this substep's wall force on the fluid [N per metre of depth]
+};
+
+/// Sums per-block partials in block order (the fixed reduction order of every wall-impulse part).
+inline Vec2d sumInOrder(const std::vector<Vec2d>& parts, std::size_t count) {
+  Vec2d s(0, 0);
+  for (std::size_t k = 0; k < count && k < parts.size(); ++k) s += parts[k];
+  return s;
+}
+
 /// Everything a stage needs for one substep.
 struct StepContext {
   ParticleStore& P;
@@ -85,6 +102,7 @@ struct StepContext {
   PeriodicBox periodic{};       ///< periodic axes: every pair difference takes the nearest image
   std::uint64_t boundaryVersion = 0;  ///< counts the times the colliders were read: changes whenever they are read again
   MovingSolids* solids = nullptr;     ///< the kinematic and dynamic bodies this step (moving_solid.hpp); null when none
+  WallAccount* wall = nullptr;        ///< where stages add the static solids' impulse (null: not counted, e.g. prepare)
 };
 
 /// Lowest slot reported by the blocks (the blocks are in slot order).

@@ -109,8 +109,12 @@ void World::Impl::fail(const std::string& stage, std::size_t slot) {
 
 Real World::Impl::substep(Real dt, bool driftOnly) {
   StepContext c = context(dt);
+  c.wall = &wall;
+  wall.force = Vec2d(0, 0);
   (driftOnly ? drift : stages).run(c, [this](const std::string& stage, std::size_t slot) { fail(stage, slot); });
   dt = c.dt;
+  wall.sum.samples += wall.force * double(dt);  // the explicit solvers' wall force, over the substep taken
+  wall.force = Vec2d(0, 0);
   if (!driftOnly) {
     const SolverStats st = solver->stats();
     iterations += std::uint64_t(st.pressureIterations) + std::uint64_t(st.divergenceIterations);

@@ -60,6 +60,7 @@ struct World::Impl {
   double lastDt = 0;                  ///< the last full substep's length (0 before the first)
   std::uint32_t nextId = 0;
   std::uint64_t iterations = 0;       ///< solver iterations summed over the substeps
+  WallAccount wall;                   ///< World::wallImpulse(): the stages of each substep add to it (substep())
   std::vector<std::string> warnings;
   std::uint64_t boundarySignature = 0;  ///< staticSignature() when the colliders were last read
   std::uint64_t boundaryVersion = 0;    ///< how many times the colliders were read (StepContext::boundaryVersion)

@@ -81,6 +81,30 @@ struct DensityStats {
   double meanDensity = 0;
 };
 
+/// The impulse the static solids gave the fluid [N·s per metre of depth, i.e. kg·m/s in 2D],
+/// split by the stage that applied it. A static solid is a fixture of a static body of the
+/// b2World (World::colliders() and its boundary samples); kinematic and dynamic bodies are
+/// not: what they exchange with the fluid stays inside fluid plus bodies and is not counted.
+/// Each part is the m·Δv the solver gives the particles because of the solids, taken where it
+/// applies it (not inferred from the fluid's momentum). docs/EMBEDDING.md: what each solver
+/// counts, and how closely Δ(momentum) = gravity's impulse + this closes.
+struct WallImpulse {
+  /// The solver's boundary-sample terms: wcsph's wall pressure and wall viscosity (m·a·dt of the
+  /// substep taken), dfsph's wall terms of both velocity solves, pbf's wall share of the density
+  /// solve when its moves become velocity (correction_to_velocity > 0). 0 for muller2003 and game.
+  Vec2d samples{0, 0};
+  /// The game solver's grid projection (pbf with grid_cell > 0): the pressure of the fluid cells
+  /// on their faces closed by a static solid (ρ0 κ h dt), and the normal velocity those faces
+  /// remove (the faces' particle mass times their change). Grid-level figures: the transfer to
+  /// the particles does not conserve momentum exactly.
+  Vec2d grid{0, 0};
+  /// The swept collision with the static colliders (the collide stage, and pbf's own sweeps
+  /// when its moves become velocity): m·Δv of the velocity response.
+  Vec2d collision{0, 0};
+  /// samples + grid + collision.
+  Vec2d total() const { return samples + grid + collision; }
+};
+
 /// The fluid simulation.
 class World {
  public:
@@ -152,6 +176,13 @@ class World {
   double kineticEnergy() const;
   /// Iterations and residuals of the pressure solver in the last substep (explicit solvers: all zero).
   SolverStats solverStats() const;
+  /// The impulse the static solids gave the fluid over every substep since construction, the
+  /// last load() or the last resetWallImpulse() (whichever came last) [N·s per metre of depth].
+  /// With the gravity impulse Σm·g·t it closes the fluid's momentum balance (docs/EMBEDDING.md).
+  /// A diagnostic: keeping it changes nothing in the simulation; not part of save().
+  WallImpulse wallImpulse() const;
+  /// Zeroes wallImpulse() (say, at the start of the interval a game wants to measure).
+  void resetWallImpulse();
   /// Pressure and divergence solve iterations summed over every substep so far.
   std::uint64_t solverIterations() const;
   /// Per-stage wall time and calls since construction (or the last resetTimings()), by stage name in list order.

@@ -177,6 +177,7 @@ class Dfsph final : public Solver {
     const NeighbourLists& L = c.nbr;
     pairs_.resize(L.perBlock.size());
     gradSum_.resize(n);
+    wallGrad_.resize(n);
     alpha_.resize(n);
     dk_.resize(n);
     q_.resize(n);
@@ -235,6 +236,7 @@ class Dfsph final : public Solver {
         }
         const Real tx = gx + gb.x(), ty = gy + gb.y();
         const Real denom = tx * tx + ty * ty + sq;
+        wallGrad_[i] = gb;
         P.rho[i] = rho;
         P.invRho[i] = Real(1) / rho;
         gradSum_[i] = Vec2(tx, ty);
@@ -255,6 +257,10 @@ class Dfsph final : public Solver {
     const double limit =
         divergence ? divTol_ * double(c.rho0) / double(dt) : tol_ * double(c.rho0);  // on the mean residual
     double err = 0;
+    // The walls' share of the velocity change, Σ_i of what pass B gave particle i through its
+    // wall term −dt q_i Σ_b ρ0Ψ_b∇W_ib since the solve began, combined by the same Chebyshev
+    // weights as the velocities (linear in them, so the sum follows the particles' recurrence).
+    Vec2d wall(0, 0);
     {
       // Stored κ_v is κ_v·dt of the previous substep (an impulse); κ is p/ρ.
       const Real scale = divergence ? Real(1) / dt : Real(1);
@@ -262,7 +268,7 @@ class Dfsph final : public Solver {
         vPrev_.resize(n);
         kPrev_.resize(n);
       }
-      warmStart(c, kappa, scale);
+      wall = warmStart(c, kappa, scale);
       err = sourceMean(c, kappa, divergence);
     }
     int it = 0;
@@ -270,6 +276,7 @@ class Dfsph final : public Solver {
       vPrev_.assign(P.v.begin(), P.v.end());
       kPrev_.assign(kappa.begin(), kappa.end());
     }
+    Vec2d wallPrev = wall;  // the wall's Σ Δv at the iterate vPrev_ holds
     Real w = 1;
     int chebStart = kChebDelay;
     double lastErr = err;
@@ -280,13 +287,17 @@ class Dfsph final : public Solver {
         w = it == chebStart ? Real(2) / (Real(2) - cheb_ * cheb_) : Real(4) / (Real(4) - cheb_ * cheb_ * w);
       else
         w = 1;
-      correctPass(c, kappa, w);
+      const Vec2d step = wall + correctPass(c, kappa, w);  // the Jacobi iterate's
+      const Vec2d next = cheb_ > 0 && w != 1 ? Vec2d((step - wallPrev) * double(w) + wallPrev) : step;
+      if (cheb_ > 0) wallPrev = wall;
+      wall = next;
       err = sourceMean(c, kappa, divergence);
       ++it;
       // Safeguard: a residual that grows restarts the acceleration (plain steps first).
       if (cheb_ > 0 && it > chebStart && err > lastErr) chebStart = it + kChebDelay;
       lastErr = err;
     }
+    if (c.wall) c.wall->sum.samples += wall * double(c.mass);
     if (divergence) {
       c.pool.parallelFor(n, 4096, [&](std::size_t b, std::size_t e) {
         for (std::size_t i = b; i < e; ++i) kappa[i] *= dt;
@@ -300,7 +311,8 @@ class Dfsph final : public Solver {
   }
 
   /// v_i −= dt [Σ_j m (κ_i/ρ_i + κ_j/ρ_j) ∇W_ij + Σ_b ρ0Ψ_b (κ_i/ρ_i) ∇W_ib] with κ = scale·kappa; then kappa = κ.
-  void warmStart(StepContext& c, std::vector<Real>& kappa, Real scale) {
+  /// Returns the walls' share Σ_i Δv_i of the velocity change (correctPass).
+  Vec2d warmStart(StepContext& c, std::vector<Real>& kappa, Real scale) {
     ParticleStore& P = c.P;
     const std::size_t n = P.size();
     const Real* IR = P.invRho.data();
@@ -312,7 +324,7 @@ class Dfsph final : public Solver {
         K[i] = 0;  // correctPass adds dk_ back
       }
     });
-    correctPass(c, kappa);
+    return correctPass(c, kappa);
   }
 
   /// Pass A: the source of every particle, its κ increment (dk_, and dk_/ρ in q_)
@@ -383,18 +395,23 @@ class Dfsph final : public Solver {
   }
 
   /// Pass B: v_i −= dt [Σ_j (q_i + q_j) m∇W_ij + q_i Σ_b ρ0Ψ_b∇W_ib]; κ_i += dk_i
-  /// (w ≠ 1: the Chebyshev step from the previous iterate).
-  void correctPass(StepContext& c, std::vector<Real>& kappa, Real w = 1) {
+  /// (w ≠ 1: the Chebyshev step from the previous iterate). Returns the walls' share of the
+  /// Jacobi step, Σ_i −dt q_i Σ_b ρ0Ψ_b∇W_ib, summed per block and the blocks in order.
+  Vec2d correctPass(StepContext& c, std::vector<Real>& kappa, Real w = 1) {
     ParticleStore& P = c.P;
     const NeighbourLists& L = c.nbr;
     Vec2* V = P.v.data();
     const Real* Q = q_.data();
     const Real dt = c.dt;
     const Real kMin = kMin_;
+    const std::size_t blocks = (P.size() + kBlock - 1) / kBlock;
+    wallBlock_.assign(blocks, Vec2d(0, 0));
     c.pool.parallelFor(P.size(), kBlock, [&](std::size_t b, std::size_t e) {
       const std::vector<Pair>& G = pairs_[b / kBlock];
+      Vec2d wallSum(0, 0);
       for (std::size_t i = b; i < e; ++i) {
         const Real qi = Q[i];
+        wallSum -= wallGrad_[i].cast<double>() * (double(dt) * double(qi));
         const std::uint32_t cnt = L.count[i];
         const Pair* Gi = G.data() + L.start[i];
         // Σ_j (q_i + q_j) m∇W_ij + q_i Σ_b ρ0Ψ_b∇W_ib = q_i gradSum + Σ_j q_j m∇W_ij.
@@ -420,7 +437,9 @@ class Dfsph final : public Solver {
           kappa[i] = kJ;
         }
       }
+      wallBlock_[b / kBlock] = wallSum;
     });
+    return sumInOrder(wallBlock_, blocks);
   }
 
   /// x += dt v (xPrev for the swept collision); p = κρ for readers. Returns the first bad slot.
@@ -462,6 +481,8 @@ class Dfsph final : public Solver {
   };
   std::vector<std::vector<Pair>> pairs_;  ///< per neighbour entry, block by block (as NeighbourLists)
   std::vector<Vec2> gradSum_;             ///< Σ_j m∇W_ij + Σ_b ρ0Ψ_b∇W_ib per particle
+  std::vector<Vec2> wallGrad_;            ///< its wall part Σ_b ρ0Ψ_b∇W_ib (World::wallImpulse)
+  std::vector<Vec2d> wallBlock_;          ///< correctPass(): the walls' Σ Δv per block of kBlock
   std::vector<Real> alpha_;              ///< the DFSPH factor α_i
   std::vector<Real> dk_;                 ///< this iteration's κ increment
   std::vector<Real> q_;                  ///< dk_/ρ

@@ -265,8 +265,13 @@ std::size_t Pbf::predict(StepContext& c, std::vector<Real>& lambda) {
   const std::vector<Vec2>* shift =
       projection_ && projection_->shift().size() == P.size() ? &projection_->shift() : nullptr;
   const Real capSpeed = moveCap_ > 0 ? moveCap_ * maxMove_ * c.R / dt : Real(0), capSpeed2 = capSpeed * capSpeed;
-  return firstBad(c.pool, P.size(), [&](std::size_t b, std::size_t e) {
+  // With correction_to_velocity > 0 the sweep's push becomes velocity: the walls' share (pbf.hpp, wallMove_).
+  const bool countWall = c.wall && toVelocity_ > 0;
+  const std::size_t blocks = (P.size() + kBlock - 1) / kBlock;
+  if (countWall) wallBlock_.assign(2 * blocks, Vec2d(0, 0));
+  const std::size_t first = firstBad(c.pool, P.size(), [&](std::size_t b, std::size_t e) {
     std::size_t bad = kNone;
+    Vec2d push(0, 0);
     for (std::size_t i = b; i < e; ++i) {
       Vec2 v = P.v[i] + P.a[i] * dt;
       if (capSpeed2 > 0) {
@@ -277,15 +282,36 @@ std::size_t Pbf::predict(StepContext& c, std::vector<Real>& lambda) {
       Vec2 x = x0 + v * dt;
       if (shift) x += (*shift)[i];
       Vec2 vd = v;  // resolve()'s velocity response is not used: v follows from the positions
-      c.boundary.resolve(x, vd, x0, c.clearance);
+      const Vec2 xFree = x;
+      if (c.boundary.resolve(x, vd, x0, c.clearance) && countWall) push += x.cast<double>() - xFree.cast<double>();
       P.xPrev[i] = x0;
       P.v[i] = v;
       P.x[i] = x;
       lambda[i] = 0;
       if (bad == kNone && (!allFinite(x) || !allFinite(v) || v.squaredNorm() > vmax2)) bad = i;
     }
+    if (countWall) wallBlock_[2 * (b / kBlock) + 1] = push;
     return bad;
   });
+  for (Vec2d& m : wallMove_) m = Vec2d(0, 0);
+  if (countWall) addWallMoves(blocks, Real(1), false);
+  return first;
+}
+
+void Pbf::addWallMoves(std::size_t blocks, Real omega, bool rotate) {
+  Vec2d part[2] = {Vec2d(0, 0), Vec2d(0, 0)};
+  for (std::size_t k = 0; k < blocks; ++k) {
+    part[0] += wallBlock_[2 * k];
+    part[1] += wallBlock_[2 * k + 1];
+  }
+  for (int q = 0; q < 2; ++q) {
+    // Chebyshev (omega ≠ 1): x = x_old + (x_k + d − x_old)·ω, then the sweep's push.
+    const Vec2d combined = omega != Real(1) ? Vec2d(wallMovePrev_[q] + (wallMove_[q] + (q == 0 ? part[0] : Vec2d(0, 0)) - wallMovePrev_[q]) * double(omega))
+                                            : Vec2d(wallMove_[q] + (q == 0 ? part[0] : Vec2d(0, 0)));
+    const Vec2d next = combined + (q == 1 ? part[1] : Vec2d(0, 0));
+    if (rotate) wallMovePrev_[q] = wallMove_[q];
+    wallMove_[q] = next;
+  }
 }
 
 Real Pbf::pressure(const StepContext& c, const std::vector<Real>* lam, Real pK, std::size_t i) const {
@@ -408,6 +434,12 @@ std::size_t Pbf::velocity(StepContext& c) {
     return bad;
   });
   P.v.swap(vNew_);
+  // The walls' share of the move becomes velocity as the move does: kc·D/dt (XSPH then mixes
+  // velocities among the particles, which keeps their sum up to the density ratio).
+  if (c.wall && kc > 0) {
+    c.wall->sum.samples += wallMove_[0] * (double(c.mass) * double(kc) / double(c.dt));
+    c.wall->sum.collision += wallMove_[1] * (double(c.mass) * double(kc) / double(c.dt));
+  }
   return first;
 }
 

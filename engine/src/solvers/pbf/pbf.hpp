@@ -197,6 +197,17 @@ class Pbf final : public Solver {
   static_assert(sizeof(Grad) == 2 * sizeof(Real), "a Grad is two packed reals (the constraint stores four pairs at a time)");
   std::vector<std::vector<Grad>> gradCache_;  ///< per pair G_ij = (m/ρ0)∇W_ij of the last constraint pass
   std::vector<Vec2> xNew_, vNew_, xOld_;
+  // World::wallImpulse when the moves become velocity (correction_to_velocity > 0; game: 0, so
+  // none): Σ_i of the walls' share D_i of particle i's move this substep, [0] the density solve's
+  // wall term Δλ_i Σ_b Ψ_b∇W_ib, [1] the sweeps' pushes out of the solids. Each follows the
+  // positions' Chebyshev recurrence (linear, one ω for every particle, so the sums do too);
+  // velocity() turns them into m·kc·D/dt.
+  Vec2d wallMove_[2] = {Vec2d(0, 0), Vec2d(0, 0)};
+  Vec2d wallMovePrev_[2] = {Vec2d(0, 0), Vec2d(0, 0)};  ///< … at the iterate xOld_ holds
+  std::vector<Vec2d> wallBlock_;  ///< per block: (wall term, push) partials of the last pass
+  /// Adds the last pass's partials (wallBlock_, `blocks` of them) to wallMove_ through the
+  /// Chebyshev weight `omega`; `rotate`: the pass rotated the position buffers (a full pass).
+  void addWallMoves(std::size_t blocks, Real omega, bool rotate);
 };
 
 }  // namespace sph2d

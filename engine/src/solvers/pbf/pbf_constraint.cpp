@@ -308,8 +308,13 @@ std::size_t Pbf::correct(StepContext& c, std::vector<Real>& lambda, Real omega, 
   xNew_.resize(P.size());
   const std::size_t count = list ? list->size() : P.size();
   const std::size_t step = list ? kLocalBlock : kBlock;
+  // The walls' share of the moves, when they become velocity (pbf.hpp, wallMove_).
+  const bool countWall = c.wall && toVelocity_ > 0;
+  const std::size_t blocks = (count + step - 1) / step;
+  if (countWall) wallBlock_.assign(2 * blocks, Vec2d(0, 0));
   const std::size_t first = c.pool.reduce(count, step, kNone, [&](std::size_t b, std::size_t e) {
     std::size_t bad = kNone;
+    Vec2d wallD(0, 0), push(0, 0);
     for (std::size_t idx = b; idx < e; ++idx) {
       const std::size_t i = list ? (*list)[idx] : idx;
       const std::uint32_t cnt = c.nbr.count[i];
@@ -332,7 +337,9 @@ std::size_t Pbf::correct(StepContext& c, std::vector<Real>& lambda, Real omega, 
         tx += f * gc[k].x;
         ty += f * gc[k].y;
       }
-      const Vec2 d = Vec2(tx, ty) + wallGrad_[i] * li;
+      const Vec2 dWall = wallGrad_[i] * li;
+      const Vec2 d = Vec2(tx, ty) + dWall;
+      if (countWall) wallD += dWall.cast<double>();
       const Vec2 x0 = P.x[i];
       Vec2 x = x0 + d;
       const Real lk = lambda[i];
@@ -345,13 +352,19 @@ std::size_t Pbf::correct(StepContext& c, std::vector<Real>& lambda, Real omega, 
       lOld_[i] = lk;
       if (resolveEach_ && c.nbr.boundaryCount[i]) {
         Vec2 vd = Vec2::Zero();
-        c.boundary.resolve(x, vd, x0, c.clearance);
+        const Vec2 xFree = x;
+        if (c.boundary.resolve(x, vd, x0, c.clearance) && countWall) push += x.cast<double>() - xFree.cast<double>();
       }
       (list ? P.x[i] : xNew_[i]) = x;
       if (bad == kNone && !allFinite(x)) bad = i;
     }
+    if (countWall) {
+      wallBlock_[2 * (b / step)] = wallD;
+      wallBlock_[2 * (b / step) + 1] = push;
+    }
     return bad;
   }, [](std::size_t a, std::size_t b2) { return std::min(a, b2); });
+  if (countWall) addWallMoves(blocks, cheb ? omega : Real(1), !list);
   rhoCurrent_ = false;
   if (list) return first;
   // x^{k−1} ← x^k, x^k ← x^{k+1}: buffers rotate, nothing is copied.

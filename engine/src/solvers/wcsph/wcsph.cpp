@@ -138,7 +138,7 @@ class Wcsph final : public Solver {
     });
   }
 
-  std::size_t pressureForce(StepContext& c, const WendlandC2<Real>& W) const {
+  std::size_t pressureForce(StepContext& c, const WendlandC2<Real>& W) {
     ParticleStore& P = c.P;
     const BoundarySet& B = c.boundary;
     const bool walls = !B.samples.empty();
@@ -155,8 +155,11 @@ class Wcsph final : public Solver {
     const Vec2* V = P.v.data();
     const Real* IR = P.invRho.data();
     const Real* POR2 = pOverRho2_.data();
-    return firstBad(c.pool, P.size(), [&](std::size_t b, std::size_t e) {
+    const std::size_t blocks = (P.size() + kBlock - 1) / kBlock;
+    wallBlock_.assign(blocks, Vec2d(0, 0));
+    const std::size_t first = firstBad(c.pool, P.size(), [&](std::size_t b, std::size_t e) {
       std::size_t bad = kNone;
+      Vec2d wallAcc(0, 0);  // Σ a_wall over the block's particles
       for (std::size_t i = b; i < e; ++i) {
         const Real vix = V[i].x(), viy = V[i].y();
         const Real pri = POR2[i], iri = IR[i];
@@ -203,21 +206,30 @@ class Wcsph final : public Solver {
             const Real vdotx = vix * d.x() + viy * d.y();
             if (vdotx < 0) gv += d * (gw * (h * vdotx / (rr + eta2)));
           }
-          acc -= gb * (c.rho0 * pScale);
-          acc += gv * (c.rho0 * avK * Real(2) / (rhoi + c.rho0));
+          const Vec2 aPressure = gb * (c.rho0 * pScale), aViscous = gv * (c.rho0 * avK * Real(2) / (rhoi + c.rho0));
+          acc -= aPressure;
+          acc += aViscous;
+          wallAcc += aViscous.cast<double>() - aPressure.cast<double>();  // this particle's wall acceleration
         }
         acc += c.gravity;
         P.a[i] = acc;
         if (!allFinite(acc) && bad == kNone) bad = i;
       }
+      wallBlock_[b / kBlock] = wallAcc;
       return bad;
     });
+    // The walls' force on the fluid, Σ m a_wall in block order; the World multiplies it by the
+    // substep integrate takes (force_limit may still shorten it).
+    if (c.wall) c.wall->force += sumInOrder(wallBlock_, blocks) * double(c.mass);
+    return first;
   }
 
   Real gamma_, alpha_, c0_;
   /// p/ρ² per particle, written by the pressure stage for the pressure force of the
   /// same substep (no reordering between them).
   std::vector<Real> pOverRho2_;
+  /// Per block of kBlock particles, Σ of the wall acceleration (the walls' force, summed in block order).
+  std::vector<Vec2d> wallBlock_;
 };
 
 }  // namespace
