@@ -13,7 +13,14 @@
 #include <algorithm>
 #include <cmath>
 
+#include "constants.hpp"
+#include "effects/effect.hpp"
 #include "solvers/solver.hpp"
+
+#if defined(__SSE2__) && !defined(SPH2D_NO_SIMD)
+#include <xmmintrin.h>
+#define SPH2D_SSE2_PAIRS 1
+#endif
 
 namespace sph2d {
 namespace {
@@ -68,41 +75,162 @@ void pressure(StepContext& c) {
   });
 }
 
-std::size_t pressureForce(StepContext& c, const Spiky<Real>& spiky) {
+// The pressure force's pair loop, with the viscosity folded in (stepper.cpp,
+// Solver::foldViscosity): the viscosity effect's own pass recomputed r and 1/r of
+// every pair; here one square root and one division serve both. The per-pair terms
+// are computed four pairs at a time (SSE2: element-wise IEEE operations only, the
+// same operations in the same order as the scalar expressions) and then added to
+// the sums one pair at a time in list order, so the bits are those of the scalar
+// loops. The four sums (pressure x, y; viscosity x, y) are the lanes of one register.
+
+/// The constants of one pair term: the spiky gradient and, with the viscosity, its Laplacian.
+struct PairConstants {
+  Real R, spikyK, halfMass, coincident2;
+  // ViscosityKernel::laplacianR2's constants, computed as it computes them.
+  Real vR2, vR3, lapK, rMin, rMin2, invRMin;
+};
+
+/// The four contributions of pair (i, j) in scalar code: out = {fpx, fpy, fvx, fvy}
+/// increments (the reference the SIMD lanes reproduce; also coincident pairs and the tail).
+template <bool Visc>
+inline void pairTermScalar(const StepContext& c, const PairConstants& k, std::size_t i, std::uint32_t j, Real pi, Real vix,
+                           Real viy, Real out[4]) {
+  const Real* IR = c.P.invRho.data();
+  const Real* POR = c.P.pOverRho.data();
+  Real dx, dy, r2;
+  pairDelta(c, i, j, dx, dy, r2);  // coincident pairs: a fixed, antisymmetric direction
+  // One square root and one division per pair.
+  const Real sq = std::sqrt(r2);
+  const Real invr = Real(1) / sq;
+  const Real r = r2 * invr;
+  const Real a = k.R - r;
+  const Real irj = IR[j];
+  // Spiky gradient dW/dr · d/r, dW/dr = −3c(R − r)², times m (p_i + p_j)/(2 ρ_j).
+  const Real wp = k.spikyK * a * a * invr * (k.halfMass * (pi * irj + POR[j]));
+  out[0] = dx * wp;
+  out[1] = dy * wp;
+  if (Visc) {
+    // ViscosityKernel::laplacianR2 of the pair's own r² (the tie-break only gives a
+    // coincident pair a direction; its r² is below rMin², where q = rMin).
+    const Vec2* X = c.P.x.data();
+    Real ex = X[i].x() - X[j].x(), ey = X[i].y() - X[j].y();
+    c.periodic.nearest(ex, ey);
+    const Real r2v = ex * ex + ey * ey;
+    Real lap = 0;
+    if (!(r2v >= k.vR2)) {
+      const bool big = r2v > k.rMin2;  // then r2v == r2 (not coincident): sq, invr are its own
+      const Real q = big ? sq : k.rMin;
+      const Real iq = big ? invr : k.invRMin;
+      lap = k.lapK * (k.R - q) * (k.vR3 + k.vR2 * q + k.R * q * q + Real(9) * q * q * q) * iq * iq * iq;
+    }
+    const Real w = lap * irj;
+    const Vec2* V = c.P.v.data();
+    out[2] = (V[j].x() - vix) * w;
+    out[3] = (V[j].y() - viy) * w;
+  } else {
+    out[2] = out[3] = 0;
+  }
+}
+
+template <bool Visc>
+std::size_t pressureForce(StepContext& c, const Spiky<Real>& spiky, const ViscosityTerm& vt) {
   ParticleStore& P = c.P;
   const BoundarySet& B = c.boundary;
   const bool hasBoundary = !B.samples.empty();
-  const Real R = spiky.R;
-  const Real spikyK = Real(-3) * spiky.c;  // dW/dr = −3c(R − r)²
-  const Real halfMass = Real(0.5) * c.mass;
+  PairConstants k{};
+  k.R = spiky.R;
+  k.spikyK = Real(-3) * spiky.c;  // dW/dr = −3c(R − r)²
+  k.halfMass = Real(0.5) * c.mass;
+  k.coincident2 = kCoincident2 * (c.R * c.R);
+  const ViscosityKernel<Real>& W = vt.W;
+  if (Visc) {
+    k.vR2 = W.R * W.R;
+    k.vR3 = k.vR2 * W.R;
+    k.lapK = Real(5) / (Real(3) * kPi<Real> * k.vR2 * k.vR3);
+    k.rMin = W.rMin;
+    k.rMin2 = W.rMin * W.rMin;
+    k.invRMin = Real(1) / W.rMin;
+  }
+  const bool simd = !c.periodic.any();
   const Real* IR = P.invRho.data();
   const Real* POR = P.pOverRho.data();
+  const Vec2* X = P.x.data();
+  const Vec2* V = P.v.data();
   return firstBad(c.pool, P.size(), [&](std::size_t b, std::size_t e) {
     std::size_t bad = kNone;
     for (std::size_t i = b; i < e; ++i) {
-      const Vec2 xi = P.x[i];
+      const Vec2 xi = X[i];
       const Real pi = P.p[i];
-      // Σ m (p_i + p_j)/(2 ρ_j) ∇W (force density, Müller eq. 10), accumulated
-      // in scalars from raw arrays so the loop keeps everything in registers.
-      Real fpx = 0, fpy = 0;
+      const Real vix = V[i].x(), viy = V[i].y();
+      // Σ m (p_i + p_j)/(2 ρ_j) ∇W (force density, Müller eq. 10) and Σ (v_j − v_i) ∇²W / ρ_j.
       const std::uint32_t* nb = c.nbr.of(i);
       const std::uint32_t cnt = c.nbr.count[i];
-      for (std::uint32_t k = 0; k < cnt; ++k) {
-        const std::uint32_t j = nb[k];
-        Real dx, dy, r2;
-        pairDelta(c, i, j, dx, dy, r2);  // coincident pairs: a fixed, antisymmetric direction
-        // One square root and one division per pair.
-        const Real invr = Real(1) / std::sqrt(r2);
-        const Real r = r2 * invr;
-        const Real a = R - r;
-        const Real irj = IR[j];
-        // Spiky gradient dW/dr · d/r, dW/dr = −3c(R − r)², times m (p_i + p_j)/(2 ρ_j).
-        const Real wp = spikyK * a * a * invr * (halfMass * (pi * irj + POR[j]));
-        fpx += dx * wp;
-        fpy += dy * wp;
+      std::uint32_t kk = 0;
+      alignas(16) Real sums[4] = {0, 0, 0, 0};
+#ifdef SPH2D_SSE2_PAIRS
+      if (simd) {
+        __m128 acc = _mm_setzero_ps();
+        const __m128 xi4 = _mm_set1_ps(xi.x()), yi4 = _mm_set1_ps(xi.y());
+        const __m128 R4 = _mm_set1_ps(k.R), K4 = _mm_set1_ps(k.spikyK), hm4 = _mm_set1_ps(k.halfMass);
+        const __m128 pi4 = _mm_set1_ps(pi), one = _mm_set1_ps(Real(1)), thr = _mm_set1_ps(k.coincident2);
+        for (; kk + 4 <= cnt; kk += 4) {
+          const std::uint32_t j0 = nb[kk], j1 = nb[kk + 1], j2 = nb[kk + 2], j3 = nb[kk + 3];
+          const __m128 xj = _mm_setr_ps(X[j0].x(), X[j1].x(), X[j2].x(), X[j3].x());
+          const __m128 yj = _mm_setr_ps(X[j0].y(), X[j1].y(), X[j2].y(), X[j3].y());
+          const __m128 dx = _mm_sub_ps(xi4, xj), dy = _mm_sub_ps(yi4, yj);
+          const __m128 r2 = _mm_add_ps(_mm_mul_ps(dx, dx), _mm_mul_ps(dy, dy));
+          if (_mm_movemask_ps(_mm_cmplt_ps(r2, thr))) {  // a coincident pair (rare): the scalar terms
+            for (std::uint32_t q = kk; q < kk + 4; ++q) {
+              alignas(16) Real t[4];
+              pairTermScalar<Visc>(c, k, i, nb[q], pi, vix, viy, t);
+              acc = _mm_add_ps(acc, _mm_load_ps(t));
+            }
+            continue;
+          }
+          const __m128 irj = _mm_setr_ps(IR[j0], IR[j1], IR[j2], IR[j3]);
+          const __m128 porj = _mm_setr_ps(POR[j0], POR[j1], POR[j2], POR[j3]);
+          const __m128 sq = _mm_sqrt_ps(r2);
+          const __m128 invr = _mm_div_ps(one, sq);
+          const __m128 a = _mm_sub_ps(R4, _mm_mul_ps(r2, invr));
+          const __m128 wp = _mm_mul_ps(_mm_mul_ps(_mm_mul_ps(_mm_mul_ps(K4, a), a), invr),
+                                       _mm_mul_ps(hm4, _mm_add_ps(_mm_mul_ps(pi4, irj), porj)));
+          __m128 t0 = _mm_mul_ps(dx, wp), t1 = _mm_mul_ps(dy, wp), t2 = _mm_setzero_ps(), t3 = _mm_setzero_ps();
+          if (Visc) {
+            const __m128 vR2 = _mm_set1_ps(k.vR2);
+            const __m128 big = _mm_cmpgt_ps(r2, _mm_set1_ps(k.rMin2));
+            const __m128 q = _mm_or_ps(_mm_and_ps(big, sq), _mm_andnot_ps(big, _mm_set1_ps(k.rMin)));
+            const __m128 iq = _mm_or_ps(_mm_and_ps(big, invr), _mm_andnot_ps(big, _mm_set1_ps(k.invRMin)));
+            const __m128 qq = _mm_mul_ps(q, q);
+            const __m128 poly = _mm_add_ps(
+                _mm_add_ps(_mm_add_ps(_mm_set1_ps(k.vR3), _mm_mul_ps(vR2, q)), _mm_mul_ps(_mm_mul_ps(R4, q), q)),
+                _mm_mul_ps(_mm_mul_ps(_mm_mul_ps(_mm_set1_ps(Real(9)), q), q), q));
+            (void)qq;
+            __m128 lap = _mm_mul_ps(_mm_mul_ps(_mm_set1_ps(k.lapK), _mm_sub_ps(R4, q)), poly);
+            lap = _mm_mul_ps(_mm_mul_ps(_mm_mul_ps(lap, iq), iq), iq);
+            lap = _mm_and_ps(_mm_cmpnge_ps(r2, vR2), lap);  // r² ≥ R²: 0
+            const __m128 w = _mm_mul_ps(lap, irj);
+            const __m128 vxj = _mm_setr_ps(V[j0].x(), V[j1].x(), V[j2].x(), V[j3].x());
+            const __m128 vyj = _mm_setr_ps(V[j0].y(), V[j1].y(), V[j2].y(), V[j3].y());
+            t2 = _mm_mul_ps(_mm_sub_ps(vxj, _mm_set1_ps(vix)), w);
+            t3 = _mm_mul_ps(_mm_sub_ps(vyj, _mm_set1_ps(viy)), w);
+          }
+          _MM_TRANSPOSE4_PS(t0, t1, t2, t3);  // now t_l = {fpx, fpy, fvx, fvy} of pair kk + l
+          acc = _mm_add_ps(acc, t0);
+          acc = _mm_add_ps(acc, t1);
+          acc = _mm_add_ps(acc, t2);
+          acc = _mm_add_ps(acc, t3);
+        }
+        _mm_store_ps(sums, acc);
       }
-      const Vec2 fp(fpx, fpy);
-      const Real invRhoi = P.invRho[i];
+#endif
+      (void)simd;
+      for (; kk < cnt; ++kk) {
+        Real t[4];
+        pairTermScalar<Visc>(c, k, i, nb[kk], pi, vix, viy, t);
+        for (int l = 0; l < 4; ++l) sums[l] += t[l];
+      }
+      const Vec2 fp(sums[0], sums[1]);
+      const Real invRhoi = IR[i];
       Vec2 acc = -fp * invRhoi;
       if (hasBoundary) {
         // Boundary samples as frozen fluid of mass ρ0·Ψ_b that carries no
@@ -119,13 +247,28 @@ std::size_t pressureForce(StepContext& c, const Spiky<Real>& spiky) {
         // most compressed particle: about 4 % instead of 2–3.5 %).
         Vec2 gb = Vec2::Zero();
         const std::uint32_t* bl = c.nbr.boundaryOf(i);
-        for (std::uint32_t k = 0; k < c.nbr.boundaryCount[i]; ++k) {
-          const Vec2 d = xi - B.samples[bl[k]];
-          gb += spiky.gradient(d, std::sqrt(d.squaredNorm())) * B.volume[bl[k]];
+        for (std::uint32_t q = 0; q < c.nbr.boundaryCount[i]; ++q) {
+          const Vec2 d = xi - B.samples[bl[q]];
+          gb += spiky.gradient(d, std::sqrt(d.squaredNorm())) * B.volume[bl[q]];
         }
         acc -= gb * (Real(0.5) * pi * invRhoi);
       }
       acc += c.gravity;
+      if (Visc) {
+        // The viscosity effect's acceleration (viscosity.cpp), added after gravity as its stage added it.
+        Vec2 av = Vec2(sums[2], sums[3]) * (vt.muMass * invRhoi);
+        if (vt.walls) {
+          Real sum = 0;  // Σ_b Ψ_b ∇²W_ib
+          const std::uint32_t* bl = c.nbr.boundaryOf(i);
+          for (std::uint32_t q = 0; q < c.nbr.boundaryCount[i]; ++q) {
+            const std::uint32_t s = bl[q];
+            sum += B.volume[s] * W.laplacianR2((xi - B.samples[s]).squaredNorm());
+          }
+          av -= Vec2(vix, viy) * (vt.wallFactor * invRhoi * sum);
+        }
+        if (!allFinite(av) && bad == kNone) bad = i;
+        acc += av;
+      }
       P.a[i] = acc;
       if (!allFinite(acc) && bad == kNone) bad = i;
     }
@@ -156,14 +299,30 @@ class Muller2003 final : public Solver {
     return dt;
   }
 
-  /// grid → neighbours → density (poly6) → pressure → pressure_force (spiky) → effects → force_limit → integrate.
+  /// Folds the Laplacian viscosity into the pressure force's pair loop.
+  bool foldViscosity(Effect* viscosity) override {
+    viscosity_ = viscosity;
+    return viscosity != nullptr;
+  }
+
+  /// grid → neighbours → density (poly6) → pressure → pressure_force (spiky) → effects → force_limit → integrate;
+  /// with a folded viscosity, pressure_force+viscosity and the effects without it.
   std::vector<Stage> stages(bool) override {
-    return explicitStages([](StepContext& c) { return density(c, Poly6<Real>(c.R)); }, pressure,
-                          [](StepContext& c) { return pressureForce(c, Spiky<Real>(c.R)); });
+    std::vector<Stage> s = explicitStages([](StepContext& c) { return density(c, Poly6<Real>(c.R)); }, pressure,
+                                          [](StepContext& c) { return pressureForce<false>(c, Spiky<Real>(c.R), ViscosityTerm{}); });
+    if (Effect* v = viscosity_) {
+      for (Stage& st : s)
+        if (st.name == "pressure_force") {
+          st.name = "pressure_force+viscosity";
+          st.run = [v](StepContext& c) { return pressureForce<true>(c, Spiky<Real>(c.R), v->viscosityTerm(c)); };
+        }
+    }
+    return s;
   }
 
  private:
   double c_;
+  Effect* viscosity_ = nullptr;  ///< the folded viscosity effect (foldViscosity), or null
 };
 
 }  // namespace
