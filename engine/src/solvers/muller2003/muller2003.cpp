@@ -18,12 +18,26 @@
 #include "solvers/solver.hpp"
 
 #if defined(__SSE2__) && !defined(SPH2D_NO_SIMD)
-#include <xmmintrin.h>
+#include <emmintrin.h>
 #define SPH2D_SSE2_PAIRS 1
 #endif
 
 namespace sph2d {
 namespace {
+
+#ifdef SPH2D_SSE2_PAIRS
+/// Positions (or velocities) of four particles as their x and y lanes: one 8-byte load each.
+inline void gather4(const Vec2* X, std::uint32_t j0, std::uint32_t j1, std::uint32_t j2, std::uint32_t j3, __m128& xs,
+                    __m128& ys) {
+  static_assert(sizeof(Vec2) == 2 * sizeof(float), "a Vec2 is two floats");
+  const __m128 a = _mm_loadh_pi(_mm_castpd_ps(_mm_load_sd(reinterpret_cast<const double*>(X + j0))),
+                                reinterpret_cast<const __m64*>(X + j1));
+  const __m128 b = _mm_loadh_pi(_mm_castpd_ps(_mm_load_sd(reinterpret_cast<const double*>(X + j2))),
+                                reinterpret_cast<const __m64*>(X + j3));
+  xs = _mm_shuffle_ps(a, b, _MM_SHUFFLE(2, 0, 2, 0));
+  ys = _mm_shuffle_ps(a, b, _MM_SHUFFLE(3, 1, 3, 1));
+}
+#endif
 
 std::size_t density(StepContext& c, const Poly6<Real>& W) {
   ParticleStore& P = c.P;
@@ -31,6 +45,12 @@ std::size_t density(StepContext& c, const Poly6<Real>& W) {
   const BoundarySet& B = c.boundary;
   const bool hasBoundary = !B.samples.empty();
   const Real self = W.valueR2(0);
+  const bool simd = !c.periodic.any();
+#ifdef SPH2D_SSE2_PAIRS
+  const __m128 R24 = _mm_set1_ps(W.R2), c4 = _mm_set1_ps(W.c);
+#else
+  (void)simd;
+#endif
   return firstBad(c.pool, P.size(), [&](std::size_t b, std::size_t e) {
     std::size_t bad = kNone;
     for (std::size_t i = b; i < e; ++i) {
@@ -39,7 +59,31 @@ std::size_t density(StepContext& c, const Poly6<Real>& W) {
       const std::uint32_t cnt = L.count[i];
       Real sum = self;
       const Vec2* X = P.x.data();
-      for (std::uint32_t k = 0; k < cnt; ++k) {
+      std::uint32_t k = 0;
+#ifdef SPH2D_SSE2_PAIRS
+      if (simd) {
+        // Four kernel values at a time (the scalar expressions, lane-wise), added in list order.
+        const __m128 xi4 = _mm_set1_ps(xi.x()), yi4 = _mm_set1_ps(xi.y());
+        for (; k < cnt; k += 4) {
+          // The last group may be partial: its missing lanes repeat the last neighbour and are not added.
+          const std::uint32_t last = cnt - 1, n = std::min<std::uint32_t>(4, cnt - k);
+          __m128 xj, yj;
+          gather4(X, nb[k], nb[std::min(k + 1, last)], nb[std::min(k + 2, last)], nb[std::min(k + 3, last)], xj, yj);
+          const __m128 dx = _mm_sub_ps(xi4, xj), dy = _mm_sub_ps(yi4, yj);
+          const __m128 r2 = _mm_add_ps(_mm_mul_ps(dx, dx), _mm_mul_ps(dy, dy));
+          const __m128 a = _mm_sub_ps(R24, r2);
+          __m128 w = _mm_mul_ps(_mm_mul_ps(_mm_mul_ps(c4, a), a), a);
+          w = _mm_and_ps(_mm_cmpnge_ps(r2, R24), w);  // valueR2: 0 for r² ≥ R²
+          alignas(16) Real t[4];
+          _mm_store_ps(t, w);
+          sum += t[0];
+          if (n > 1) sum += t[1];
+          if (n > 2) sum += t[2];
+          if (n > 3) sum += t[3];
+        }
+      }
+#endif
+      for (; k < cnt; ++k) {
         const Vec2 xj = X[nb[k]];
         Real dx = xi.x() - xj.x(), dy = xi.y() - xj.y();
         c.periodic.nearest(dx, dy);
@@ -49,8 +93,8 @@ std::size_t density(StepContext& c, const Poly6<Real>& W) {
       if (hasBoundary) {
         Real bs = 0;
         const std::uint32_t* bl = L.boundaryOf(i);
-        for (std::uint32_t k = 0; k < L.boundaryCount[i]; ++k)
-          bs += B.volume[bl[k]] * W.valueR2((xi - B.samples[bl[k]]).squaredNorm());
+        for (std::uint32_t q = 0; q < L.boundaryCount[i]; ++q)
+          bs += B.volume[bl[q]] * W.valueR2((xi - B.samples[bl[q]]).squaredNorm());
         rho += c.rho0 * bs;
       }
       P.rho[i] = rho;
@@ -158,6 +202,13 @@ std::size_t pressureForce(StepContext& c, const Spiky<Real>& spiky, const Viscos
   const Vec2* V = P.v.data();
   return firstBad(c.pool, P.size(), [&](std::size_t b, std::size_t e) {
     std::size_t bad = kNone;
+#ifdef SPH2D_SSE2_PAIRS
+    const struct {
+      __m128 R, spikyK, halfMass, one, thr, vR2, vR3, lapK, rMin, rMin2, invRMin, nine;
+    } K4 = {_mm_set1_ps(k.R),    _mm_set1_ps(k.spikyK), _mm_set1_ps(k.halfMass), _mm_set1_ps(Real(1)),
+            _mm_set1_ps(k.coincident2), _mm_set1_ps(k.vR2), _mm_set1_ps(k.vR3), _mm_set1_ps(k.lapK),
+            _mm_set1_ps(k.rMin), _mm_set1_ps(k.rMin2), _mm_set1_ps(k.invRMin), _mm_set1_ps(Real(9))};
+#endif
     for (std::size_t i = b; i < e; ++i) {
       const Vec2 xi = X[i];
       const Real pi = P.p[i];
@@ -170,55 +221,63 @@ std::size_t pressureForce(StepContext& c, const Spiky<Real>& spiky, const Viscos
 #ifdef SPH2D_SSE2_PAIRS
       if (simd) {
         __m128 acc = _mm_setzero_ps();
-        const __m128 xi4 = _mm_set1_ps(xi.x()), yi4 = _mm_set1_ps(xi.y());
-        const __m128 R4 = _mm_set1_ps(k.R), K4 = _mm_set1_ps(k.spikyK), hm4 = _mm_set1_ps(k.halfMass);
-        const __m128 pi4 = _mm_set1_ps(pi), one = _mm_set1_ps(Real(1)), thr = _mm_set1_ps(k.coincident2);
-        for (; kk + 4 <= cnt; kk += 4) {
-          const std::uint32_t j0 = nb[kk], j1 = nb[kk + 1], j2 = nb[kk + 2], j3 = nb[kk + 3];
-          const __m128 xj = _mm_setr_ps(X[j0].x(), X[j1].x(), X[j2].x(), X[j3].x());
-          const __m128 yj = _mm_setr_ps(X[j0].y(), X[j1].y(), X[j2].y(), X[j3].y());
+        const __m128 xi4 = _mm_set1_ps(xi.x()), yi4 = _mm_set1_ps(xi.y()), pi4 = _mm_set1_ps(pi);
+        const __m128 vix4 = _mm_set1_ps(vix), viy4 = _mm_set1_ps(viy);
+        // Adds the terms of pairs kk.. kk + n − 1 (n ≤ 4; missing lanes repeat the last one and are not added).
+        auto group = [&](std::uint32_t j0, std::uint32_t j1, std::uint32_t j2, std::uint32_t j3, std::uint32_t n) {
+          __m128 xj, yj;
+          gather4(X, j0, j1, j2, j3, xj, yj);
           const __m128 dx = _mm_sub_ps(xi4, xj), dy = _mm_sub_ps(yi4, yj);
           const __m128 r2 = _mm_add_ps(_mm_mul_ps(dx, dx), _mm_mul_ps(dy, dy));
-          if (_mm_movemask_ps(_mm_cmplt_ps(r2, thr))) {  // a coincident pair (rare): the scalar terms
-            for (std::uint32_t q = kk; q < kk + 4; ++q) {
+          if (__builtin_expect(_mm_movemask_ps(_mm_cmplt_ps(r2, K4.thr)) & ((1 << n) - 1), 0)) {
+            // A coincident pair (rare): the scalar terms.
+            for (std::uint32_t q = kk; q < kk + n; ++q) {
               alignas(16) Real t[4];
               pairTermScalar<Visc>(c, k, i, nb[q], pi, vix, viy, t);
               acc = _mm_add_ps(acc, _mm_load_ps(t));
             }
-            continue;
+            return;
           }
           const __m128 irj = _mm_setr_ps(IR[j0], IR[j1], IR[j2], IR[j3]);
           const __m128 porj = _mm_setr_ps(POR[j0], POR[j1], POR[j2], POR[j3]);
           const __m128 sq = _mm_sqrt_ps(r2);
-          const __m128 invr = _mm_div_ps(one, sq);
-          const __m128 a = _mm_sub_ps(R4, _mm_mul_ps(r2, invr));
-          const __m128 wp = _mm_mul_ps(_mm_mul_ps(_mm_mul_ps(_mm_mul_ps(K4, a), a), invr),
-                                       _mm_mul_ps(hm4, _mm_add_ps(_mm_mul_ps(pi4, irj), porj)));
+          const __m128 invr = _mm_div_ps(K4.one, sq);
+          const __m128 a = _mm_sub_ps(K4.R, _mm_mul_ps(r2, invr));
+          const __m128 wp = _mm_mul_ps(_mm_mul_ps(_mm_mul_ps(_mm_mul_ps(K4.spikyK, a), a), invr),
+                                       _mm_mul_ps(K4.halfMass, _mm_add_ps(_mm_mul_ps(pi4, irj), porj)));
           __m128 t0 = _mm_mul_ps(dx, wp), t1 = _mm_mul_ps(dy, wp), t2 = _mm_setzero_ps(), t3 = _mm_setzero_ps();
           if (Visc) {
-            const __m128 vR2 = _mm_set1_ps(k.vR2);
-            const __m128 big = _mm_cmpgt_ps(r2, _mm_set1_ps(k.rMin2));
-            const __m128 q = _mm_or_ps(_mm_and_ps(big, sq), _mm_andnot_ps(big, _mm_set1_ps(k.rMin)));
-            const __m128 iq = _mm_or_ps(_mm_and_ps(big, invr), _mm_andnot_ps(big, _mm_set1_ps(k.invRMin)));
-            const __m128 qq = _mm_mul_ps(q, q);
+            const __m128 big = _mm_cmpgt_ps(r2, K4.rMin2);
+            const __m128 q = _mm_or_ps(_mm_and_ps(big, sq), _mm_andnot_ps(big, K4.rMin));
+            const __m128 iq = _mm_or_ps(_mm_and_ps(big, invr), _mm_andnot_ps(big, K4.invRMin));
             const __m128 poly = _mm_add_ps(
-                _mm_add_ps(_mm_add_ps(_mm_set1_ps(k.vR3), _mm_mul_ps(vR2, q)), _mm_mul_ps(_mm_mul_ps(R4, q), q)),
-                _mm_mul_ps(_mm_mul_ps(_mm_mul_ps(_mm_set1_ps(Real(9)), q), q), q));
-            (void)qq;
-            __m128 lap = _mm_mul_ps(_mm_mul_ps(_mm_set1_ps(k.lapK), _mm_sub_ps(R4, q)), poly);
+                _mm_add_ps(_mm_add_ps(K4.vR3, _mm_mul_ps(K4.vR2, q)), _mm_mul_ps(_mm_mul_ps(K4.R, q), q)),
+                _mm_mul_ps(_mm_mul_ps(_mm_mul_ps(K4.nine, q), q), q));
+            __m128 lap = _mm_mul_ps(_mm_mul_ps(K4.lapK, _mm_sub_ps(K4.R, q)), poly);
             lap = _mm_mul_ps(_mm_mul_ps(_mm_mul_ps(lap, iq), iq), iq);
-            lap = _mm_and_ps(_mm_cmpnge_ps(r2, vR2), lap);  // r² ≥ R²: 0
+            lap = _mm_and_ps(_mm_cmpnge_ps(r2, K4.vR2), lap);  // r² ≥ R²: 0
             const __m128 w = _mm_mul_ps(lap, irj);
-            const __m128 vxj = _mm_setr_ps(V[j0].x(), V[j1].x(), V[j2].x(), V[j3].x());
-            const __m128 vyj = _mm_setr_ps(V[j0].y(), V[j1].y(), V[j2].y(), V[j3].y());
-            t2 = _mm_mul_ps(_mm_sub_ps(vxj, _mm_set1_ps(vix)), w);
-            t3 = _mm_mul_ps(_mm_sub_ps(vyj, _mm_set1_ps(viy)), w);
+            __m128 vxj, vyj;
+            gather4(V, j0, j1, j2, j3, vxj, vyj);
+            t2 = _mm_mul_ps(_mm_sub_ps(vxj, vix4), w);
+            t3 = _mm_mul_ps(_mm_sub_ps(vyj, viy4), w);
           }
           _MM_TRANSPOSE4_PS(t0, t1, t2, t3);  // now t_l = {fpx, fpy, fvx, fvy} of pair kk + l
           acc = _mm_add_ps(acc, t0);
-          acc = _mm_add_ps(acc, t1);
-          acc = _mm_add_ps(acc, t2);
-          acc = _mm_add_ps(acc, t3);
+          if (n == 4) {
+            acc = _mm_add_ps(acc, t1);
+            acc = _mm_add_ps(acc, t2);
+            acc = _mm_add_ps(acc, t3);
+          } else {
+            if (n > 1) acc = _mm_add_ps(acc, t1);
+            if (n > 2) acc = _mm_add_ps(acc, t2);
+          }
+        };
+        for (; kk + 4 <= cnt; kk += 4) group(nb[kk], nb[kk + 1], nb[kk + 2], nb[kk + 3], 4);
+        if (kk < cnt) {
+          const std::uint32_t last = nb[cnt - 1], n = cnt - kk;
+          group(nb[kk], n > 1 ? nb[kk + 1] : last, n > 2 ? nb[kk + 2] : last, last, n);
+          kk = cnt;
         }
         _mm_store_ps(sums, acc);
       }
