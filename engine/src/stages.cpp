@@ -48,8 +48,9 @@ inline std::size_t nearInOrder(const Vec2* X, std::size_t n, std::uint32_t kb, s
     const __m128 dy = _mm_sub_ps(yi4, _mm_shuffle_ps(a, b, _MM_SHUFFLE(3, 1, 3, 1)));
     const __m128 r2 = _mm_add_ps(_mm_mul_ps(dx, dx), _mm_mul_ps(dy, dy));
     unsigned mask = unsigned(_mm_movemask_ps(_mm_cmplt_ps(r2, r24)));
-    if (ke - k < 4) mask &= (1u << (ke - k)) - 1;
-    if (i >= k && i - k < 4) mask &= ~(1u << (i - k));
+    mask &= (1u << std::min<std::uint32_t>(ke - k, 4)) - 1;  // no branches on the row's length
+    const std::size_t self = i - k;                             // wraps around when i < k
+    mask &= ~(unsigned(self < 4) << (self & 3));
     const __m128i lanes = _mm_load_si128(reinterpret_cast<const __m128i*>(kCompactLanes[mask]));
     _mm_storeu_si128(reinterpret_cast<__m128i*>(dst + used), _mm_add_epi32(_mm_set1_epi32(int(k)), lanes));
     used += kBitCount[mask];
@@ -103,20 +104,22 @@ __attribute__((target("avx512f,popcnt"))) std::size_t nearAllInOrder16(const Gri
     }
     std::uint32_t* dst = out.data();
     for (std::uint32_t k = kb; k < ke; k += 16) {
+      // Masks without branches (the row lengths vary: a branch on them mispredicts).
       const std::uint32_t m = std::min<std::uint32_t>(16, ke - k);
-      const __mmask16 lanes = __mmask16(m == 16 ? 0xFFFFu : (1u << m) - 1);
-      const __mmask16 lo = __mmask16(m >= 8 ? 0xFFFFu : (1u << (2 * m)) - 1);
-      const __mmask16 hi = __mmask16(m == 16 ? 0xFFFFu : m > 8 ? (1u << (2 * (m - 8))) - 1 : 0u);
+      const __mmask16 lanes = __mmask16((1u << m) - 1);
+      const std::uint64_t floats = (std::uint64_t(1) << (2 * m)) - 1;  // the 2m floats of the m candidates
+      const __mmask16 lo = __mmask16(floats & 0xFFFF), hi = __mmask16(floats >> 16);
       const __m512 a = _mm512_maskz_loadu_ps(lo, xy + 2 * std::size_t(k));
       const __m512 b = _mm512_maskz_loadu_ps(hi, xy + 2 * std::size_t(k) + 16);
       const __m512 dx = _mm512_sub_ps(xi16, _mm512_permutex2var_ps(a, evens, b));
       const __m512 dy = _mm512_sub_ps(yi16, _mm512_permutex2var_ps(a, odds, b));
       const __m512 r2 = _mm512_add_ps(_mm512_mul_ps(dx, dx), _mm512_mul_ps(dy, dy));
       unsigned keep = unsigned(_mm512_mask_cmp_ps_mask(lanes, r2, r216, _CMP_LT_OQ));
-      if (i >= k && i - k < 16) keep &= ~(1u << (i - k));
+      const std::size_t self = i - k;  // wraps around when i < k
+      keep &= ~(unsigned(self < 16) << (self & 15));
       const __m512i ids = _mm512_maskz_compress_epi32(__mmask16(keep), _mm512_add_epi32(_mm512_set1_epi32(int(k)), iota));
       const unsigned got = unsigned(__builtin_popcount(keep));
-      _mm512_mask_storeu_epi32(dst + used, __mmask16(got == 16 ? 0xFFFFu : (1u << got) - 1), ids);
+      _mm512_mask_storeu_epi32(dst + used, __mmask16((1u << got) - 1), ids);
       used += got;
     }
   }
