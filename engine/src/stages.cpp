@@ -3,11 +3,16 @@
 #include "stages.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 
 #if defined(__SSE2__) && !defined(SPH2D_NO_SIMD)
 #include <emmintrin.h>
 #define SPH2D_SSE2_NEIGHBOURS 1
+#endif
+#if defined(__GNUC__) && defined(__x86_64__) && !defined(SPH2D_NO_SIMD)
+#include <immintrin.h>
+#define SPH2D_AVX512_NEIGHBOURS 1
 #endif
 
 namespace sph2d {
@@ -43,8 +48,9 @@ inline std::size_t nearInOrder(const Vec2* X, std::size_t n, std::uint32_t kb, s
     const __m128 dy = _mm_sub_ps(yi4, _mm_shuffle_ps(a, b, _MM_SHUFFLE(3, 1, 3, 1)));
     const __m128 r2 = _mm_add_ps(_mm_mul_ps(dx, dx), _mm_mul_ps(dy, dy));
     unsigned mask = unsigned(_mm_movemask_ps(_mm_cmplt_ps(r2, r24)));
-    if (ke - k < 4) mask &= (1u << (ke - k)) - 1;
-    if (i >= k && i - k < 4) mask &= ~(1u << (i - k));
+    mask &= (1u << std::min<std::uint32_t>(ke - k, 4)) - 1;  // no branches on the row's length
+    const std::size_t self = i - k;                             // wraps around when i < k
+    mask &= ~(unsigned(self < 4) << (self & 3));
     const __m128i lanes = _mm_load_si128(reinterpret_cast<const __m128i*>(kCompactLanes[mask]));
     _mm_storeu_si128(reinterpret_cast<__m128i*>(dst + used), _mm_add_epi32(_mm_set1_epi32(int(k)), lanes));
     used += kBitCount[mask];
@@ -61,6 +67,66 @@ inline std::size_t nearInOrder(const Vec2* X, std::size_t n, std::uint32_t kb, s
   return used;
 }
 
+std::atomic<bool> gBaselineSimd{false};
+
+#ifdef SPH2D_AVX512_NEIGHBOURS
+/// True when this CPU runs the AVX-512 candidate filter (checked once).
+bool haveAvx512() {
+  static const bool yes = __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("popcnt");
+  return yes;
+}
+
+/// The fluid neighbours of slot i among the grid's candidates that are slots themselves
+/// (no periodic axis), appended to out from `used`: nearInOrder sixteen candidates at a
+/// time (AVX-512F, chosen at run time). The same r² per lane as the scalar and SSE2
+/// loops (one IEEE operation a lane, in the same order), so the same lists. Masked loads
+/// and stores: nothing is read past the positions or written past the kept entries.
+__attribute__((target("avx512f,popcnt"))) std::size_t nearAllInOrder16(const Grid& g, const Vec2* X, std::size_t i,
+                                                                       const Vec2& xi, Real R2,
+                                                                       std::vector<std::uint32_t>& out, std::size_t used) {
+  const float* xy = reinterpret_cast<const float*>(X);
+  const __m512 xi16 = _mm512_set1_ps(xi.x()), yi16 = _mm512_set1_ps(xi.y()), r216 = _mm512_set1_ps(R2);
+  const __m512i evens = _mm512_setr_epi32(0, 2, 4, 6, 8, 10, 12, 14, 16, 18, 20, 22, 24, 26, 28, 30);
+  const __m512i odds = _mm512_setr_epi32(1, 3, 5, 7, 9, 11, 13, 15, 17, 19, 21, 23, 25, 27, 29, 31);
+  const __m512i iota = _mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
+  // Grid::forCandidateRanges without a periodic axis, written out (a lambda would not
+  // carry this function's target).
+  const int cx = Grid::coord(xi.x(), g.lo.x(), g.invCell, g.nx), cy = Grid::coord(xi.y(), g.lo.y(), g.invCellY, g.ny);
+  const int x0 = std::max(cx - g.reach, 0), x1 = std::min(cx + g.reach, g.nx - 1);
+  const int y0 = std::max(cy - g.reach, 0), y1 = std::min(cy + g.reach, g.ny - 1);
+  for (int y = y0; y <= y1; ++y) {
+    const std::uint32_t kb = g.cellStart[std::size_t(y) * g.nx + x0], ke = g.cellStart[std::size_t(y) * g.nx + x1 + 1];
+    if (!(kb < ke)) continue;
+    const std::size_t need = used + (ke - kb) + 3;  // as stageNeighbours reserves for nearInOrder
+    if (out.size() < need) {
+      if (out.capacity() < need) out.reserve(need + need / 8);
+      out.resize(need);
+    }
+    std::uint32_t* dst = out.data();
+    for (std::uint32_t k = kb; k < ke; k += 16) {
+      // Masks without branches (the row lengths vary: a branch on them mispredicts).
+      const std::uint32_t m = std::min<std::uint32_t>(16, ke - k);
+      const __mmask16 lanes = __mmask16((1u << m) - 1);
+      const std::uint64_t floats = (std::uint64_t(1) << (2 * m)) - 1;  // the 2m floats of the m candidates
+      const __mmask16 lo = __mmask16(floats & 0xFFFF), hi = __mmask16(floats >> 16);
+      const __m512 a = _mm512_maskz_loadu_ps(lo, xy + 2 * std::size_t(k));
+      const __m512 b = _mm512_maskz_loadu_ps(hi, xy + 2 * std::size_t(k) + 16);
+      const __m512 dx = _mm512_sub_ps(xi16, _mm512_permutex2var_ps(a, evens, b));
+      const __m512 dy = _mm512_sub_ps(yi16, _mm512_permutex2var_ps(a, odds, b));
+      const __m512 r2 = _mm512_add_ps(_mm512_mul_ps(dx, dx), _mm512_mul_ps(dy, dy));
+      unsigned keep = unsigned(_mm512_mask_cmp_ps_mask(lanes, r2, r216, _CMP_LT_OQ));
+      const std::size_t self = i - k;  // wraps around when i < k
+      keep &= ~(unsigned(self < 16) << (self & 15));
+      const __m512i ids = _mm512_maskz_compress_epi32(__mmask16(keep), _mm512_add_epi32(_mm512_set1_epi32(int(k)), iota));
+      const unsigned got = unsigned(__builtin_popcount(keep));
+      _mm512_mask_storeu_epi32(dst + used, __mmask16((1u << got) - 1), ids);
+      used += got;
+    }
+  }
+  return used;
+}
+#endif
+
 template <class T>
 void permuteField(std::vector<T>& field, const std::vector<std::uint32_t>& order, std::vector<T>& scratch,
                   ThreadPool& pool) {
@@ -76,6 +142,9 @@ std::vector<Real>& scratchFor(Scratch& s, const std::vector<Real>&) { return s.r
 std::vector<std::uint32_t>& scratchFor(Scratch& s, const std::vector<std::uint32_t>&) { return s.u; }
 
 }  // namespace
+
+void setBaselineSimdOnly(bool on) { gBaselineSimd.store(on); }
+bool baselineSimdOnly() { return gBaselineSimd.load(std::memory_order_relaxed); }
 
 std::size_t firstBad(ThreadPool& pool, std::size_t n, const std::function<std::size_t(std::size_t, std::size_t)>& fn) {
   return pool.reduce(n, kBlock, kNone, fn, [](std::size_t a, std::size_t b) { return std::min(a, b); });
@@ -144,6 +213,9 @@ void stageNeighbours(StepContext& c) {
   const bool walls = !B.samples.empty();
   // Candidates that are slots (just reordered) and no wrap: four at a time.
   const bool inOrder = g.inOrder && !per.any() && g.sorted.size() == n;
+#ifdef SPH2D_AVX512_NEIGHBOURS
+  const bool wide = !baselineSimdOnly() && haveAvx512();
+#endif
   c.pool.parallelFor(n, kBlock, [&](std::size_t b, std::size_t e) {
     std::vector<std::uint32_t>& out = L.perBlock[b / kBlock];
     std::vector<std::uint32_t>& bout = L.boundaryPerBlock[b / kBlock];
@@ -152,6 +224,11 @@ void stageNeighbours(StepContext& c) {
     for (std::size_t i = b; i < e; ++i) {
       const Vec2 xi = P.x[i];
       L.start[i] = std::uint32_t(used);
+#ifdef SPH2D_AVX512_NEIGHBOURS
+      if (inOrder && wide) {
+        used = nearAllInOrder16(g, P.x.data(), i, xi, R2, out, used);
+      } else
+#endif
       g.forCandidateRanges(xi, [&](std::uint32_t kb, std::uint32_t ke) {
         // Room for every candidate (written before the test; and 3 more, nearInOrder's
         // last group); grown by an eighth, not doubled: the lists are most of the

@@ -13,6 +13,13 @@
 
 namespace sph2d {
 
+/// With `on`, the pair loops use only the baseline SIMD (SSE2) even where the CPU has
+/// wider vectors (chosen at run time: AVX-512). Every path gives the same bits; tests
+/// switch this to compare them on one machine. Process-wide; off by default.
+void setBaselineSimdOnly(bool on);
+/// Whether setBaselineSimdOnly(true) is in force.
+bool baselineSimdOnly();
+
 /// True when this substep reorders particle storage along the grid (every solver.reorder_interval substeps).
 bool reorderThisStep(const StepContext& c);
 /// Neighbour grid (counting sort, cells of R/2) and, when `reorder`, every particle array permuted into cell order.

@@ -7,7 +7,11 @@
 // acceleration (for the next substep's force limit), the swept collision with
 // the Box2D solids, the periodic wrap, lifetimes and sinks. A stage exists
 // only when the scene needs it. The list is rebuilt when a user force is
-// first set or an effect is switched on or off.
+// first set or an effect is switched on or off. One fold: when the first
+// enabled effect is the Laplacian viscosity and the solver computes it in its
+// own pressure-force pair loop (muller2003: one pass over the neighbours
+// instead of two, the same bits), that stage is "pressure_force+viscosity" and
+// the effect has no stage of its own (Solver::foldViscosity).
 //
 // The time-step policy is the World's alone: the solver and the enabled
 // effects report their limits; a frame is split into equal substeps no longer
@@ -54,7 +58,13 @@ void World::Impl::buildStages() {
   if (!emitters.empty()) stages.add(plainStage("emit", [this](StepContext& c) { emit(c.dt); }));
   if (moving.anyDynamic()) stages.add(plainStage("body_gravity", [this](StepContext& c) { bodyGravity(c); }));
   bool anyEffect = false;
-  for (const auto& e : effects) anyEffect = anyEffect || e->enabled;
+  Effect* first = nullptr;  // the first enabled effect: the solver may fold it into its pressure force
+  for (const auto& e : effects) {
+    if (e->enabled && !first) first = e.get();
+    anyEffect = anyEffect || e->enabled;
+  }
+  Effect* folded = first && first->foldable() && solver->foldViscosity(first) ? first : nullptr;
+  if (!folded) solver->foldViscosity(nullptr);
   bool marker = false;
   for (Stage& s : solver->stages(anyEffect)) {
     if (!s.effectsMarker) {
@@ -63,7 +73,7 @@ void World::Impl::buildStages() {
     }
     marker = true;
     for (const auto& e : effects) {
-      if (!e->enabled) continue;
+      if (!e->enabled || e.get() == folded) continue;
       Effect* fx = e.get();
       stages.add(Stage{fx->name(), [fx](StepContext& c) { return fx->apply(c); }});
     }

@@ -26,8 +26,9 @@ using test::maxSpeed;
 TEST_CASE("the stage list exists from construction: the solver's stages, the effects at its marker, then collision") {
   const SceneDef s = test::scene("tests/resting_column.json");  // muller2003 with viscosity
   World w(s, WorldOptions{1});
-  const std::vector<std::string> expected = {"grid",      "neighbours", "density",          "pressure", "pressure_force",
-                                             "viscosity", "force_limit", "integrate", "max_acceleration", "collide"};
+  // muller2003 folds the viscosity (the first effect) into its pressure force's pair loop.
+  const std::vector<std::string> expected = {"grid",        "neighbours", "density",          "pressure", "pressure_force+viscosity",
+                                             "force_limit", "integrate",  "max_acceleration", "collide"};
   CHECK(w.stages() == expected);
   w.stepFrame();
   CHECK(w.stages() == expected);  // running it does not change it
@@ -54,9 +55,31 @@ TEST_CASE("switching an effect or adding a user force rebuilds the list, and a s
   // Effects run in the registry's order, user forces last, all before integrate.
   const auto st = w.stages();
   const auto at = [&](const std::string& n) { return std::find(st.begin(), st.end(), n) - st.begin(); };
-  CHECK(at("viscosity") < at("xsph"));
+  CHECK(at("pressure_force+viscosity") < at("xsph"));  // muller2003 folds the viscosity (the first effect)
   CHECK(at("xsph") < at("user_force"));
   CHECK(at("user_force") < at("integrate"));
+}
+
+TEST_CASE("muller2003 folds the viscosity into its pressure force only while it is the first enabled effect") {
+  SceneDef s = test::scene("tests/resting_column.json");  // muller2003 with viscosity
+  World w(s, WorldOptions{1});
+  auto has = [&](const std::string& n) {
+    const auto st = w.stages();
+    return std::find(st.begin(), st.end(), n) != st.end();
+  };
+  CHECK(has("pressure_force+viscosity"));
+  CHECK_FALSE(has("viscosity"));
+  w.setEffectEnabled("viscosity", false);
+  CHECK(has("pressure_force"));
+  CHECK_FALSE(has("pressure_force+viscosity"));
+  w.stepFrame();
+  CHECK(callsOf(w, "pressure_force+viscosity") == 0);
+  SceneDef ws = s;  // a solver that does not fold keeps the effect's own stage
+  ws.solver.type = "wcsph";
+  ws.solver.params.clear();
+  World v(ws, WorldOptions{1});
+  const auto st = v.stages();
+  CHECK(std::find(st.begin(), st.end(), "viscosity") != st.end());
 }
 
 namespace {
@@ -94,7 +117,7 @@ TEST_CASE("the guard stops a run at the first non-finite value and names stage a
     w.stepFrame();
     FAIL("expected SimulationError");
   } catch (const SimulationError& e) {
-    CHECK(e.stage == "pressure_force");  // gravity is added there: the first stage to see the NaN
+    CHECK(e.stage == "pressure_force+viscosity");  // gravity is added there: the first stage to see the NaN
     CHECK(e.step == 0);
     CHECK(std::string(e.what()).find("particle id") != std::string::npos);
   }

@@ -19,10 +19,22 @@
 #include <memory>
 #include <vector>
 
+#include "kernels.hpp"
 #include "sph2d/world.hpp"
 #include "stages.hpp"
 
 namespace sph2d {
+
+/// The Laplacian viscosity's constants for one substep (viscosity.cpp): per fluid pair
+/// a_i += muMass·IR_i Σ_j (v_j − v_i) ∇²W(r_ij) IR_j; with walls,
+/// a_i −= v_i·(wallFactor·IR_i·Σ_b Ψ_b ∇²W_ib). A solver that folds the viscosity into
+/// its own pair loop (Solver::foldViscosity) computes exactly this.
+struct ViscosityTerm {
+  ViscosityKernel<Real> W{Real(1)};
+  Real muMass = 0;      ///< ν·s·ρ0·m (s: 1 / the Laplacian's lattice moment)
+  Real wallFactor = 0;  ///< 2·ν·s·ρ0
+  bool walls = false;   ///< no-slip walls with boundary samples
+};
 
 class Effect {
  public:
@@ -35,6 +47,14 @@ class Effect {
   virtual const char* limitKey() const { return name(); }
   /// False while an input event has switched the effect off (it then runs no stage).
   bool enabled = true;
+  /// True for the Laplacian viscosity, which an explicit solver may fold into its
+  /// pressure-force pair loop (stepper.cpp; the effect then runs no stage of its own).
+  virtual bool foldable() const { return false; }
+  /// The constants of a foldable effect for this substep (others: never called).
+  virtual ViscosityTerm viscosityTerm(const StepContext& c) {
+    (void)c;
+    return {};
+  }
   /// Largest stable time step this effect allows.
   virtual Real maxTimeStep(const StepContext& c) const {
     (void)c;

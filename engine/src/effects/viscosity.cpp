@@ -27,9 +27,9 @@ class LaplacianViscosity final : public Effect {
 
   Real maxTimeStep(const StepContext& c) const override { return Real(0.03) * c.R * c.R / nu_; }
 
-  std::size_t apply(StepContext& c) override {
-    ParticleStore& P = c.P;
-    const ViscosityKernel<Real> W(c.R);
+  bool foldable() const override { return true; }
+
+  ViscosityTerm viscosityTerm(const StepContext& c) override {
     if (c.R != momentR_ || c.dx != momentDx_) {
       const ViscosityKernel<double> Wd(double(c.R));
       const double m = latticeLaplacianMoment([&](double r) { return Wd.laplacian(r); }, Wd.R, double(c.dx));
@@ -38,12 +38,24 @@ class LaplacianViscosity final : public Effect {
       momentDx_ = c.dx;
     }
     const Real nuS = nu_ * scale_;
-    const Real muMass = nuS * c.rho0 * c.mass;
+    ViscosityTerm t;
+    t.W = ViscosityKernel<Real>(c.R);
+    t.muMass = nuS * c.rho0 * c.mass;
+    t.wallFactor = Real(2) * nuS * c.rho0;
+    t.walls = noSlip_ && !c.boundary.samples.empty();
+    return t;
+  }
+
+  std::size_t apply(StepContext& c) override {
+    ParticleStore& P = c.P;
+    const ViscosityTerm t = viscosityTerm(c);
+    const ViscosityKernel<Real>& W = t.W;
+    const Real muMass = t.muMass;
     const Vec2* X = P.x.data();
     const Vec2* V = P.v.data();
     const Real* IR = P.invRho.data();
     const BoundarySet& B = c.boundary;
-    const bool walls = noSlip_ && !B.samples.empty();
+    const bool walls = t.walls;
     return firstBad(c.pool, P.size(), [&](std::size_t b, std::size_t e) {
       std::size_t bad = kNone;
       for (std::size_t i = b; i < e; ++i) {
@@ -69,7 +81,7 @@ class LaplacianViscosity final : public Effect {
             const std::uint32_t s = bl[k];
             sum += B.volume[s] * W.laplacianR2((xi - B.samples[s]).squaredNorm());
           }
-          acc -= Vec2(vix, viy) * (Real(2) * nuS * c.rho0 * IR[i] * sum);
+          acc -= Vec2(vix, viy) * (t.wallFactor * IR[i] * sum);
         }
         P.a[i] += acc;
         if (!allFinite(acc) && bad == kNone) bad = i;

@@ -22,6 +22,7 @@ namespace sph2d {
 
 class StateOut;
 class StateIn;
+class Effect;
 
 class Solver {
  public:
@@ -52,6 +53,14 @@ class Solver {
   /// then need neighbours of the current positions first). The stages may
   /// keep pointers to the solver; the World rebuilds the list when effects change.
   virtual std::vector<Stage> stages(bool effects) = 0;
+  /// Offers the scene's Laplacian viscosity (Effect::foldable, the first enabled effect;
+  /// null: none) to compute inside the solver's own pair loop. True: the next stages()
+  /// computes it (its pressure-force stage is named "pressure_force+viscosity") and
+  /// the effect runs no stage of its own. The default folds nothing.
+  virtual bool foldViscosity(Effect* viscosity) {
+    (void)viscosity;
+    return false;
+  }
   /// Iterations and residuals of the last substep (explicit solvers: all zero).
   virtual SolverStats stats() const { return {}; }
   /// Writes what the solver carries from one substep to the next outside the particle

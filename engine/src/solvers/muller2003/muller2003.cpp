@@ -13,10 +13,35 @@
 #include <algorithm>
 #include <cmath>
 
+#include "constants.hpp"
+#include "effects/effect.hpp"
 #include "solvers/solver.hpp"
+
+#if defined(__SSE2__) && !defined(SPH2D_NO_SIMD)
+#include <emmintrin.h>
+#define SPH2D_SSE2_PAIRS 1
+#endif
+#if defined(SPH2D_SSE2_PAIRS) && defined(__GNUC__) && defined(__x86_64__)
+#include <immintrin.h>
+#define SPH2D_AVX2_PAIRS 1
+#endif
 
 namespace sph2d {
 namespace {
+
+#ifdef SPH2D_SSE2_PAIRS
+/// Positions (or velocities) of four particles as their x and y lanes: one 8-byte load each.
+inline void gather4(const Vec2* X, std::uint32_t j0, std::uint32_t j1, std::uint32_t j2, std::uint32_t j3, __m128& xs,
+                    __m128& ys) {
+  static_assert(sizeof(Vec2) == 2 * sizeof(float), "a Vec2 is two floats");
+  const __m128 a = _mm_loadh_pi(_mm_castpd_ps(_mm_load_sd(reinterpret_cast<const double*>(X + j0))),
+                                reinterpret_cast<const __m64*>(X + j1));
+  const __m128 b = _mm_loadh_pi(_mm_castpd_ps(_mm_load_sd(reinterpret_cast<const double*>(X + j2))),
+                                reinterpret_cast<const __m64*>(X + j3));
+  xs = _mm_shuffle_ps(a, b, _MM_SHUFFLE(2, 0, 2, 0));
+  ys = _mm_shuffle_ps(a, b, _MM_SHUFFLE(3, 1, 3, 1));
+}
+#endif
 
 std::size_t density(StepContext& c, const Poly6<Real>& W) {
   ParticleStore& P = c.P;
@@ -24,6 +49,12 @@ std::size_t density(StepContext& c, const Poly6<Real>& W) {
   const BoundarySet& B = c.boundary;
   const bool hasBoundary = !B.samples.empty();
   const Real self = W.valueR2(0);
+  const bool simd = !c.periodic.any();
+#ifdef SPH2D_SSE2_PAIRS
+  const __m128 R24 = _mm_set1_ps(W.R2), c4 = _mm_set1_ps(W.c);
+#else
+  (void)simd;
+#endif
   return firstBad(c.pool, P.size(), [&](std::size_t b, std::size_t e) {
     std::size_t bad = kNone;
     for (std::size_t i = b; i < e; ++i) {
@@ -32,7 +63,31 @@ std::size_t density(StepContext& c, const Poly6<Real>& W) {
       const std::uint32_t cnt = L.count[i];
       Real sum = self;
       const Vec2* X = P.x.data();
-      for (std::uint32_t k = 0; k < cnt; ++k) {
+      std::uint32_t k = 0;
+#ifdef SPH2D_SSE2_PAIRS
+      if (simd) {
+        // Four kernel values at a time (the scalar expressions, lane-wise), added in list order.
+        const __m128 xi4 = _mm_set1_ps(xi.x()), yi4 = _mm_set1_ps(xi.y());
+        for (; k < cnt; k += 4) {
+          // The last group may be partial: its missing lanes repeat the last neighbour and are not added.
+          const std::uint32_t last = cnt - 1, n = std::min<std::uint32_t>(4, cnt - k);
+          __m128 xj, yj;
+          gather4(X, nb[k], nb[std::min(k + 1, last)], nb[std::min(k + 2, last)], nb[std::min(k + 3, last)], xj, yj);
+          const __m128 dx = _mm_sub_ps(xi4, xj), dy = _mm_sub_ps(yi4, yj);
+          const __m128 r2 = _mm_add_ps(_mm_mul_ps(dx, dx), _mm_mul_ps(dy, dy));
+          const __m128 a = _mm_sub_ps(R24, r2);
+          __m128 w = _mm_mul_ps(_mm_mul_ps(_mm_mul_ps(c4, a), a), a);
+          w = _mm_and_ps(_mm_cmpnge_ps(r2, R24), w);  // valueR2: 0 for r² ≥ R²
+          alignas(16) Real t[4];
+          _mm_store_ps(t, w);
+          sum += t[0];
+          if (n > 1) sum += t[1];
+          if (n > 2) sum += t[2];
+          if (n > 3) sum += t[3];
+        }
+      }
+#endif
+      for (; k < cnt; ++k) {
         const Vec2 xj = X[nb[k]];
         Real dx = xi.x() - xj.x(), dy = xi.y() - xj.y();
         c.periodic.nearest(dx, dy);
@@ -42,8 +97,8 @@ std::size_t density(StepContext& c, const Poly6<Real>& W) {
       if (hasBoundary) {
         Real bs = 0;
         const std::uint32_t* bl = L.boundaryOf(i);
-        for (std::uint32_t k = 0; k < L.boundaryCount[i]; ++k)
-          bs += B.volume[bl[k]] * W.valueR2((xi - B.samples[bl[k]]).squaredNorm());
+        for (std::uint32_t q = 0; q < L.boundaryCount[i]; ++q)
+          bs += B.volume[bl[q]] * W.valueR2((xi - B.samples[bl[q]]).squaredNorm());
         rho += c.rho0 * bs;
       }
       P.rho[i] = rho;
@@ -68,41 +123,276 @@ void pressure(StepContext& c) {
   });
 }
 
-std::size_t pressureForce(StepContext& c, const Spiky<Real>& spiky) {
+// The pressure force's pair loop, with the viscosity folded in (stepper.cpp,
+// Solver::foldViscosity): the viscosity effect's own pass recomputed r and 1/r of
+// every pair; here one square root and one division serve both. The per-pair terms
+// are computed four pairs at a time (SSE2: element-wise IEEE operations only, the
+// same operations in the same order as the scalar expressions) and then added to
+// the sums one pair at a time in list order, so the bits are those of the scalar
+// loops. The four sums (pressure x, y; viscosity x, y) are the lanes of one register.
+
+/// The constants of one pair term: the spiky gradient and, with the viscosity, its Laplacian.
+struct PairConstants {
+  Real R, spikyK, halfMass, coincident2;
+  // ViscosityKernel::laplacianR2's constants, computed as it computes them.
+  Real vR2, vR3, lapK, rMin, rMin2, invRMin;
+};
+
+/// The four contributions of pair (i, j) in scalar code: out = {fpx, fpy, fvx, fvy}
+/// increments (the reference the SIMD lanes reproduce; also coincident pairs and the tail).
+template <bool Visc>
+inline void pairTermScalar(const StepContext& c, const PairConstants& k, std::size_t i, std::uint32_t j, Real pi, Real vix,
+                           Real viy, Real out[4]) {
+  const Real* IR = c.P.invRho.data();
+  const Real* POR = c.P.pOverRho.data();
+  Real dx, dy, r2;
+  pairDelta(c, i, j, dx, dy, r2);  // coincident pairs: a fixed, antisymmetric direction
+  // One square root and one division per pair.
+  const Real sq = std::sqrt(r2);
+  const Real invr = Real(1) / sq;
+  const Real r = r2 * invr;
+  const Real a = k.R - r;
+  const Real irj = IR[j];
+  // Spiky gradient dW/dr · d/r, dW/dr = −3c(R − r)², times m (p_i + p_j)/(2 ρ_j).
+  const Real wp = k.spikyK * a * a * invr * (k.halfMass * (pi * irj + POR[j]));
+  out[0] = dx * wp;
+  out[1] = dy * wp;
+  if (Visc) {
+    // ViscosityKernel::laplacianR2 of the pair's own r² (the tie-break only gives a
+    // coincident pair a direction; its r² is below rMin², where q = rMin).
+    const Vec2* X = c.P.x.data();
+    Real ex = X[i].x() - X[j].x(), ey = X[i].y() - X[j].y();
+    c.periodic.nearest(ex, ey);
+    const Real r2v = ex * ex + ey * ey;
+    Real lap = 0;
+    if (!(r2v >= k.vR2)) {
+      const bool big = r2v > k.rMin2;  // then r2v == r2 (not coincident): sq, invr are its own
+      const Real q = big ? sq : k.rMin;
+      const Real iq = big ? invr : k.invRMin;
+      lap = k.lapK * (k.R - q) * (k.vR3 + k.vR2 * q + k.R * q * q + Real(9) * q * q * q) * iq * iq * iq;
+    }
+    const Real w = lap * irj;
+    const Vec2* V = c.P.v.data();
+    out[2] = (V[j].x() - vix) * w;
+    out[3] = (V[j].y() - viy) * w;
+  } else {
+    out[2] = out[3] = 0;
+  }
+}
+
+#ifdef SPH2D_AVX2_PAIRS
+/// True when this CPU runs the AVX2 pair loop (checked once) and the baseline is not forced (stages.hpp).
+bool useAvx2() {
+  static const bool have = __builtin_cpu_supports("avx2");
+  return have && !baselineSimdOnly();
+}
+
+/// The pair sums {fpx, fpy, fvx, fvy} of slot i, eight pairs at a time (AVX2, chosen at
+/// run time): the SSE2 loop's operations lane for lane, the gathers by index, the terms
+/// added in list order; no periodic axis.
+template <bool Visc>
+__attribute__((target("avx2"))) void pairSums8(const StepContext& c, const PairConstants& k, std::size_t i,
+                                               const std::uint32_t* nb, std::uint32_t cnt, Real pi, Real vix, Real viy,
+                                               Real* sums) {
+  const float* IR = c.P.invRho.data();
+  const float* POR = c.P.pOverRho.data();
+  const Vec2 xi = c.P.x[i];
+  const __m256 xi8 = _mm256_set1_ps(xi.x()), yi8 = _mm256_set1_ps(xi.y()), pi8 = _mm256_set1_ps(pi);
+  const __m256 vix8 = _mm256_set1_ps(vix), viy8 = _mm256_set1_ps(viy);
+  const __m256 R8 = _mm256_set1_ps(k.R), spikyK = _mm256_set1_ps(k.spikyK), halfMass = _mm256_set1_ps(k.halfMass);
+  const __m256 one = _mm256_set1_ps(Real(1)), thr = _mm256_set1_ps(k.coincident2);
+  // Gathers by plain loads (the hardware gathers were slower on the EPYC measured).
+  auto gather8 = [](const Vec2* base, const std::uint32_t* j, __m256& xs, __m256& ys) __attribute__((target("avx2"))) {
+    __m128 p0, p1, p2, p3;  // (x y) of j0 j1 | j2 j3 | j4 j5 | j6 j7
+    gather4(base, j[0], j[1], j[2], j[3], p0, p1);
+    gather4(base, j[4], j[5], j[6], j[7], p2, p3);
+    xs = _mm256_insertf128_ps(_mm256_castps128_ps256(p0), p2, 1);
+    ys = _mm256_insertf128_ps(_mm256_castps128_ps256(p1), p3, 1);
+  };
+  __m128 acc = _mm_setzero_ps();
+  for (std::uint32_t kk = 0; kk < cnt; kk += 8) {
+    const std::uint32_t n = std::min<std::uint32_t>(8, cnt - kk);
+    std::uint32_t j[8];
+    for (std::uint32_t l = 0; l < 8; ++l) j[l] = nb[std::min(kk + l, cnt - 1)];  // missing lanes repeat the last (not added)
+    __m256 xj, yj;
+    gather8(c.P.x.data(), j, xj, yj);
+    const __m256 dx = _mm256_sub_ps(xi8, xj), dy = _mm256_sub_ps(yi8, yj);
+    const __m256 r2 = _mm256_add_ps(_mm256_mul_ps(dx, dx), _mm256_mul_ps(dy, dy));
+    if (__builtin_expect(_mm256_movemask_ps(_mm256_cmp_ps(r2, thr, _CMP_LT_OQ)) & ((1 << n) - 1), 0)) {
+      for (std::uint32_t q = kk; q < kk + n; ++q) {  // a coincident pair (rare): the scalar terms
+        alignas(16) Real t[4];
+        pairTermScalar<Visc>(c, k, i, nb[q], pi, vix, viy, t);
+        acc = _mm_add_ps(acc, _mm_load_ps(t));
+      }
+      continue;
+    }
+    const __m256 irj = _mm256_setr_ps(IR[j[0]], IR[j[1]], IR[j[2]], IR[j[3]], IR[j[4]], IR[j[5]], IR[j[6]], IR[j[7]]);
+    const __m256 porj =
+        _mm256_setr_ps(POR[j[0]], POR[j[1]], POR[j[2]], POR[j[3]], POR[j[4]], POR[j[5]], POR[j[6]], POR[j[7]]);
+    const __m256 sq = _mm256_sqrt_ps(r2);
+    const __m256 invr = _mm256_div_ps(one, sq);
+    const __m256 a = _mm256_sub_ps(R8, _mm256_mul_ps(r2, invr));
+    const __m256 wp = _mm256_mul_ps(_mm256_mul_ps(_mm256_mul_ps(_mm256_mul_ps(spikyK, a), a), invr),
+                                    _mm256_mul_ps(halfMass, _mm256_add_ps(_mm256_mul_ps(pi8, irj), porj)));
+    __m256 t0 = _mm256_mul_ps(dx, wp), t1 = _mm256_mul_ps(dy, wp), t2 = _mm256_setzero_ps(), t3 = _mm256_setzero_ps();
+    if (Visc) {
+      const __m256 vR2 = _mm256_set1_ps(k.vR2);
+      const __m256 big = _mm256_cmp_ps(r2, _mm256_set1_ps(k.rMin2), _CMP_GT_OQ);
+      const __m256 q = _mm256_blendv_ps(_mm256_set1_ps(k.rMin), sq, big);
+      const __m256 iq = _mm256_blendv_ps(_mm256_set1_ps(k.invRMin), invr, big);
+      const __m256 poly = _mm256_add_ps(
+          _mm256_add_ps(_mm256_add_ps(_mm256_set1_ps(k.vR3), _mm256_mul_ps(vR2, q)), _mm256_mul_ps(_mm256_mul_ps(R8, q), q)),
+          _mm256_mul_ps(_mm256_mul_ps(_mm256_mul_ps(_mm256_set1_ps(Real(9)), q), q), q));
+      __m256 lap = _mm256_mul_ps(_mm256_mul_ps(_mm256_set1_ps(k.lapK), _mm256_sub_ps(R8, q)), poly);
+      lap = _mm256_mul_ps(_mm256_mul_ps(_mm256_mul_ps(lap, iq), iq), iq);
+      lap = _mm256_and_ps(_mm256_cmp_ps(r2, vR2, _CMP_NGE_UQ), lap);  // r² ≥ R²: 0
+      const __m256 w = _mm256_mul_ps(lap, irj);
+      __m256 vxj, vyj;
+      gather8(c.P.v.data(), j, vxj, vyj);
+      t2 = _mm256_mul_ps(_mm256_sub_ps(vxj, vix8), w);
+      t3 = _mm256_mul_ps(_mm256_sub_ps(vyj, viy8), w);
+    }
+    // Rows {fpx, fpy, fvx, fvy} of pairs kk..kk+3 (low halves) and kk+4..kk+7 (high halves), added in order.
+    __m128 a0 = _mm256_castps256_ps128(t0), a1 = _mm256_castps256_ps128(t1), a2 = _mm256_castps256_ps128(t2),
+           a3 = _mm256_castps256_ps128(t3);
+    _MM_TRANSPOSE4_PS(a0, a1, a2, a3);
+    __m128 b0 = _mm256_extractf128_ps(t0, 1), b1 = _mm256_extractf128_ps(t1, 1), b2 = _mm256_extractf128_ps(t2, 1),
+           b3 = _mm256_extractf128_ps(t3, 1);
+    _MM_TRANSPOSE4_PS(b0, b1, b2, b3);
+    const __m128 rows[8] = {a0, a1, a2, a3, b0, b1, b2, b3};
+    if (n == 8) {
+      for (int l = 0; l < 8; ++l) acc = _mm_add_ps(acc, rows[l]);
+    } else {
+      for (std::uint32_t l = 0; l < n; ++l) acc = _mm_add_ps(acc, rows[l]);
+    }
+  }
+  _mm_store_ps(sums, acc);
+}
+#endif
+
+template <bool Visc>
+std::size_t pressureForce(StepContext& c, const Spiky<Real>& spiky, const ViscosityTerm& vt) {
   ParticleStore& P = c.P;
   const BoundarySet& B = c.boundary;
   const bool hasBoundary = !B.samples.empty();
-  const Real R = spiky.R;
-  const Real spikyK = Real(-3) * spiky.c;  // dW/dr = −3c(R − r)²
-  const Real halfMass = Real(0.5) * c.mass;
+  PairConstants k{};
+  k.R = spiky.R;
+  k.spikyK = Real(-3) * spiky.c;  // dW/dr = −3c(R − r)²
+  k.halfMass = Real(0.5) * c.mass;
+  k.coincident2 = kCoincident2 * (c.R * c.R);
+  const ViscosityKernel<Real>& W = vt.W;
+  if (Visc) {
+    k.vR2 = W.R * W.R;
+    k.vR3 = k.vR2 * W.R;
+    k.lapK = Real(5) / (Real(3) * kPi<Real> * k.vR2 * k.vR3);
+    k.rMin = W.rMin;
+    k.rMin2 = W.rMin * W.rMin;
+    k.invRMin = Real(1) / W.rMin;
+  }
+  const bool simd = !c.periodic.any();
+#ifdef SPH2D_AVX2_PAIRS
+  const bool wide = useAvx2();
+#endif
   const Real* IR = P.invRho.data();
   const Real* POR = P.pOverRho.data();
+  const Vec2* X = P.x.data();
+  const Vec2* V = P.v.data();
   return firstBad(c.pool, P.size(), [&](std::size_t b, std::size_t e) {
     std::size_t bad = kNone;
+#ifdef SPH2D_SSE2_PAIRS
+    const struct {
+      __m128 R, spikyK, halfMass, one, thr, vR2, vR3, lapK, rMin, rMin2, invRMin, nine;
+    } K4 = {_mm_set1_ps(k.R),    _mm_set1_ps(k.spikyK), _mm_set1_ps(k.halfMass), _mm_set1_ps(Real(1)),
+            _mm_set1_ps(k.coincident2), _mm_set1_ps(k.vR2), _mm_set1_ps(k.vR3), _mm_set1_ps(k.lapK),
+            _mm_set1_ps(k.rMin), _mm_set1_ps(k.rMin2), _mm_set1_ps(k.invRMin), _mm_set1_ps(Real(9))};
+#endif
     for (std::size_t i = b; i < e; ++i) {
-      const Vec2 xi = P.x[i];
+      const Vec2 xi = X[i];
       const Real pi = P.p[i];
-      // Σ m (p_i + p_j)/(2 ρ_j) ∇W (force density, Müller eq. 10), accumulated
-      // in scalars from raw arrays so the loop keeps everything in registers.
-      Real fpx = 0, fpy = 0;
+      const Real vix = V[i].x(), viy = V[i].y();
+      // Σ m (p_i + p_j)/(2 ρ_j) ∇W (force density, Müller eq. 10) and Σ (v_j − v_i) ∇²W / ρ_j.
       const std::uint32_t* nb = c.nbr.of(i);
       const std::uint32_t cnt = c.nbr.count[i];
-      for (std::uint32_t k = 0; k < cnt; ++k) {
-        const std::uint32_t j = nb[k];
-        Real dx, dy, r2;
-        pairDelta(c, i, j, dx, dy, r2);  // coincident pairs: a fixed, antisymmetric direction
-        // One square root and one division per pair.
-        const Real invr = Real(1) / std::sqrt(r2);
-        const Real r = r2 * invr;
-        const Real a = R - r;
-        const Real irj = IR[j];
-        // Spiky gradient dW/dr · d/r, dW/dr = −3c(R − r)², times m (p_i + p_j)/(2 ρ_j).
-        const Real wp = spikyK * a * a * invr * (halfMass * (pi * irj + POR[j]));
-        fpx += dx * wp;
-        fpy += dy * wp;
+      std::uint32_t kk = 0;
+      alignas(16) Real sums[4] = {0, 0, 0, 0};
+#ifdef SPH2D_AVX2_PAIRS
+      if (simd && wide) {
+        pairSums8<Visc>(c, k, i, nb, cnt, pi, vix, viy, sums);
+        kk = cnt;
+      } else
+#endif
+#ifdef SPH2D_SSE2_PAIRS
+      if (simd) {
+        __m128 acc = _mm_setzero_ps();
+        const __m128 xi4 = _mm_set1_ps(xi.x()), yi4 = _mm_set1_ps(xi.y()), pi4 = _mm_set1_ps(pi);
+        const __m128 vix4 = _mm_set1_ps(vix), viy4 = _mm_set1_ps(viy);
+        // Adds the terms of pairs kk.. kk + n − 1 (n ≤ 4; missing lanes repeat the last one and are not added).
+        auto group = [&](std::uint32_t j0, std::uint32_t j1, std::uint32_t j2, std::uint32_t j3, std::uint32_t n) {
+          __m128 xj, yj;
+          gather4(X, j0, j1, j2, j3, xj, yj);
+          const __m128 dx = _mm_sub_ps(xi4, xj), dy = _mm_sub_ps(yi4, yj);
+          const __m128 r2 = _mm_add_ps(_mm_mul_ps(dx, dx), _mm_mul_ps(dy, dy));
+          if (__builtin_expect(_mm_movemask_ps(_mm_cmplt_ps(r2, K4.thr)) & ((1 << n) - 1), 0)) {
+            // A coincident pair (rare): the scalar terms.
+            for (std::uint32_t q = kk; q < kk + n; ++q) {
+              alignas(16) Real t[4];
+              pairTermScalar<Visc>(c, k, i, nb[q], pi, vix, viy, t);
+              acc = _mm_add_ps(acc, _mm_load_ps(t));
+            }
+            return;
+          }
+          const __m128 irj = _mm_setr_ps(IR[j0], IR[j1], IR[j2], IR[j3]);
+          const __m128 porj = _mm_setr_ps(POR[j0], POR[j1], POR[j2], POR[j3]);
+          const __m128 sq = _mm_sqrt_ps(r2);
+          const __m128 invr = _mm_div_ps(K4.one, sq);
+          const __m128 a = _mm_sub_ps(K4.R, _mm_mul_ps(r2, invr));
+          const __m128 wp = _mm_mul_ps(_mm_mul_ps(_mm_mul_ps(_mm_mul_ps(K4.spikyK, a), a), invr),
+                                       _mm_mul_ps(K4.halfMass, _mm_add_ps(_mm_mul_ps(pi4, irj), porj)));
+          __m128 t0 = _mm_mul_ps(dx, wp), t1 = _mm_mul_ps(dy, wp), t2 = _mm_setzero_ps(), t3 = _mm_setzero_ps();
+          if (Visc) {
+            const __m128 big = _mm_cmpgt_ps(r2, K4.rMin2);
+            const __m128 q = _mm_or_ps(_mm_and_ps(big, sq), _mm_andnot_ps(big, K4.rMin));
+            const __m128 iq = _mm_or_ps(_mm_and_ps(big, invr), _mm_andnot_ps(big, K4.invRMin));
+            const __m128 poly = _mm_add_ps(
+                _mm_add_ps(_mm_add_ps(K4.vR3, _mm_mul_ps(K4.vR2, q)), _mm_mul_ps(_mm_mul_ps(K4.R, q), q)),
+                _mm_mul_ps(_mm_mul_ps(_mm_mul_ps(K4.nine, q), q), q));
+            __m128 lap = _mm_mul_ps(_mm_mul_ps(K4.lapK, _mm_sub_ps(K4.R, q)), poly);
+            lap = _mm_mul_ps(_mm_mul_ps(_mm_mul_ps(lap, iq), iq), iq);
+            lap = _mm_and_ps(_mm_cmpnge_ps(r2, K4.vR2), lap);  // r² ≥ R²: 0
+            const __m128 w = _mm_mul_ps(lap, irj);
+            __m128 vxj, vyj;
+            gather4(V, j0, j1, j2, j3, vxj, vyj);
+            t2 = _mm_mul_ps(_mm_sub_ps(vxj, vix4), w);
+            t3 = _mm_mul_ps(_mm_sub_ps(vyj, viy4), w);
+          }
+          _MM_TRANSPOSE4_PS(t0, t1, t2, t3);  // now t_l = {fpx, fpy, fvx, fvy} of pair kk + l
+          acc = _mm_add_ps(acc, t0);
+          if (n == 4) {
+            acc = _mm_add_ps(acc, t1);
+            acc = _mm_add_ps(acc, t2);
+            acc = _mm_add_ps(acc, t3);
+          } else {
+            if (n > 1) acc = _mm_add_ps(acc, t1);
+            if (n > 2) acc = _mm_add_ps(acc, t2);
+          }
+        };
+        for (; kk + 4 <= cnt; kk += 4) group(nb[kk], nb[kk + 1], nb[kk + 2], nb[kk + 3], 4);
+        if (kk < cnt) {
+          const std::uint32_t last = nb[cnt - 1], n = cnt - kk;
+          group(nb[kk], n > 1 ? nb[kk + 1] : last, n > 2 ? nb[kk + 2] : last, last, n);
+          kk = cnt;
+        }
+        _mm_store_ps(sums, acc);
       }
-      const Vec2 fp(fpx, fpy);
-      const Real invRhoi = P.invRho[i];
+#endif
+      (void)simd;
+      for (; kk < cnt; ++kk) {
+        Real t[4];
+        pairTermScalar<Visc>(c, k, i, nb[kk], pi, vix, viy, t);
+        for (int l = 0; l < 4; ++l) sums[l] += t[l];
+      }
+      const Vec2 fp(sums[0], sums[1]);
+      const Real invRhoi = IR[i];
       Vec2 acc = -fp * invRhoi;
       if (hasBoundary) {
         // Boundary samples as frozen fluid of mass ρ0·Ψ_b that carries no
@@ -119,13 +409,28 @@ std::size_t pressureForce(StepContext& c, const Spiky<Real>& spiky) {
         // most compressed particle: about 4 % instead of 2–3.5 %).
         Vec2 gb = Vec2::Zero();
         const std::uint32_t* bl = c.nbr.boundaryOf(i);
-        for (std::uint32_t k = 0; k < c.nbr.boundaryCount[i]; ++k) {
-          const Vec2 d = xi - B.samples[bl[k]];
-          gb += spiky.gradient(d, std::sqrt(d.squaredNorm())) * B.volume[bl[k]];
+        for (std::uint32_t q = 0; q < c.nbr.boundaryCount[i]; ++q) {
+          const Vec2 d = xi - B.samples[bl[q]];
+          gb += spiky.gradient(d, std::sqrt(d.squaredNorm())) * B.volume[bl[q]];
         }
         acc -= gb * (Real(0.5) * pi * invRhoi);
       }
       acc += c.gravity;
+      if (Visc) {
+        // The viscosity effect's acceleration (viscosity.cpp), added after gravity as its stage added it.
+        Vec2 av = Vec2(sums[2], sums[3]) * (vt.muMass * invRhoi);
+        if (vt.walls) {
+          Real sum = 0;  // Σ_b Ψ_b ∇²W_ib
+          const std::uint32_t* bl = c.nbr.boundaryOf(i);
+          for (std::uint32_t q = 0; q < c.nbr.boundaryCount[i]; ++q) {
+            const std::uint32_t s = bl[q];
+            sum += B.volume[s] * W.laplacianR2((xi - B.samples[s]).squaredNorm());
+          }
+          av -= Vec2(vix, viy) * (vt.wallFactor * invRhoi * sum);
+        }
+        if (!allFinite(av) && bad == kNone) bad = i;
+        acc += av;
+      }
       P.a[i] = acc;
       if (!allFinite(acc) && bad == kNone) bad = i;
     }
@@ -156,14 +461,30 @@ class Muller2003 final : public Solver {
     return dt;
   }
 
-  /// grid → neighbours → density (poly6) → pressure → pressure_force (spiky) → effects → force_limit → integrate.
+  /// Folds the Laplacian viscosity into the pressure force's pair loop.
+  bool foldViscosity(Effect* viscosity) override {
+    viscosity_ = viscosity;
+    return viscosity != nullptr;
+  }
+
+  /// grid → neighbours → density (poly6) → pressure → pressure_force (spiky) → effects → force_limit → integrate;
+  /// with a folded viscosity, pressure_force+viscosity and the effects without it.
   std::vector<Stage> stages(bool) override {
-    return explicitStages([](StepContext& c) { return density(c, Poly6<Real>(c.R)); }, pressure,
-                          [](StepContext& c) { return pressureForce(c, Spiky<Real>(c.R)); });
+    std::vector<Stage> s = explicitStages([](StepContext& c) { return density(c, Poly6<Real>(c.R)); }, pressure,
+                                          [](StepContext& c) { return pressureForce<false>(c, Spiky<Real>(c.R), ViscosityTerm{}); });
+    if (Effect* v = viscosity_) {
+      for (Stage& st : s)
+        if (st.name == "pressure_force") {
+          st.name = "pressure_force+viscosity";
+          st.run = [v](StepContext& c) { return pressureForce<true>(c, Spiky<Real>(c.R), v->viscosityTerm(c)); };
+        }
+    }
+    return s;
   }
 
  private:
   double c_;
+  Effect* viscosity_ = nullptr;  ///< the folded viscosity effect (foldViscosity), or null
 };
 
 }  // namespace
