@@ -55,15 +55,25 @@ LoopEnd GameLoop::run() {
       continue;
     }
     clock_.tick(wallNow());
+    double startAt = 0;  // wall time at which the next step may start (0: at once)
     if (!clock_.due()) {
-      if (!renderPending()) return LoopEnd::Ended;  // show the frame before waiting for the clock
-      // Ahead of the wall clock: sleep (in short slices, so Ctrl-C stays prompt).
-      std::this_thread::sleep_for(std::chrono::duration<double>(std::min(clock_.untilDue(), 0.02)));
-      continue;
+      if (pending_.active && f + 1 < settings_.frames) {
+        // Ahead of the wall clock with a frame to draw: draw it now, and let the next step
+        // start on the other thread when it falls due, so that drawing and stepping overlap
+        // (drawn first and then stepped, a heavy frame's two halves added up past 1/fps).
+        startAt = wallNow() + clock_.untilDue();
+        clock_.tick(startAt);
+      } else {
+        if (!renderPending()) return LoopEnd::Ended;  // show the frame before waiting for the clock
+        // Ahead of the wall clock: sleep (in short slices, so Ctrl-C stays prompt).
+        std::this_thread::sleep_for(std::chrono::duration<double>(std::min(clock_.untilDue(), 0.02)));
+        continue;
+      }
     }
     steps = 0;
     while (stepDue()) {
-      if (!stepAndRender()) return LoopEnd::Ended;
+      if (!stepAndRender(startAt)) return LoopEnd::Ended;
+      startAt = 0;
       ++f;
       ++steps;
       clock_.consume();
@@ -140,8 +150,11 @@ bool GameLoop::renderPending() {
   return observer_.frame(pending_.state, image);
 }
 
-bool GameLoop::stepAndRender() {
-  auto step = [this] {
+bool GameLoop::stepAndRender(double startAt) {
+  auto step = [this, startAt] {
+    // Real time: wait (in short slices, so a stop stays prompt) until the step is due.
+    for (double left = startAt - wallNow(); left > 0 && !stopRequested(); left = startAt - wallNow())
+      std::this_thread::sleep_for(std::chrono::duration<double>(std::min(left, 0.005)));
     const auto s0 = std::chrono::steady_clock::now();
     world_.stepFrame();
     status_.simSeconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - s0).count();

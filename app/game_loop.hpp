@@ -2,10 +2,12 @@
 //
 //   boundary 0: apply events ─> observer.boundary ─> render if kept ─> observer.frame
 //   then, while frames remain:  [paused? hold]  [real time: wait until a frame is due]
-//     World::stepFrame  ‖  render the snapshot ─> observer.frame   (two threads, joined)
+//     World::stepFrame  ‖  render the snapshot ─> observer.frame   (two threads, joined;
+//                          in real time the render starts at once, the step when it is due)
 //       ─> apply events due at the new boundary ─> observer.boundary
 //       ─> snapshot if kept (unless the loop is behind the wall clock: dropped)
-//   a snapshot still pending is rendered before a pause, a wait for the clock and the end.
+//   a snapshot still pending is rendered before a pause, a wait for the clock with no step
+//   left to take, and the end.
 //
 // Rendering overlaps the next step: the renderer draws a copy of what it reads
 // (positions, velocities, density, pressure, ids, ages, colliders) on the thread
@@ -126,9 +128,10 @@ class GameLoop {
   void capture(std::int64_t f);
   /// Renders the pending frame and hands it to the observer. False: the observer ended the loop.
   bool renderPending();
-  /// One World::stepFrame, with the pending frame rendered on this thread meanwhile.
+  /// One World::stepFrame, started at wall time `startAt` (seconds since the loop began; at
+  /// once when it has passed), with the pending frame rendered on this thread meanwhile.
   /// False: the observer ended the loop.
-  bool stepAndRender();
+  bool stepAndRender(double startAt);
 
   World& world_;
   EventIntake& input_;
