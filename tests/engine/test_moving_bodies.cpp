@@ -461,7 +461,13 @@ struct TankBalance {
 /// between crate and walls enters the balance.
 TankBalance tankBalance(const std::string& solver, bool slosh, bool crate, int threads = 2) {
   const double W = 2.0, depth = 0.4, U = slosh ? 0.4 : 0.0;
-  SceneDef s = test::tank(solver, W, 1.0, 0.02);
+  // "NAME+no_slip": the solver with solver.no_slip (the viscosity effect's wall term).
+  const bool noSlip = solver.size() > 8 && solver.compare(solver.size() - 8, 8, "+no_slip") == 0;
+  SceneDef s = test::tank(noSlip ? solver.substr(0, solver.size() - 8) : solver, W, 1.0, 0.02);
+  if (noSlip) {
+    REQUIRE(s.solver.viscosity > 0);
+    s.solver.noSlip = true;
+  }
   s.blocks.push_back(test::block({0, 0}, {W, depth}));
   if (crate) {
     BodyDef b;
@@ -529,8 +535,10 @@ TEST_CASE("moving bodies: over a second of a crate in a sloshing tank, the chang
   // solvers count each wall term where they apply it and close to rounding (≤ 1e-8 of |gravity|
   // for wcsph and dfsph, 5e-6 for pbf, whose XSPH sum is not exactly antisymmetric): they are
   // held to 1e-6 and 1e-4, so that a lost part shows (wcsph's collision, 4e-6 of it, is the
-  // smallest). docs/STABILITY.md, "Momentum balance", has the figures.
-  for (const std::string solver : {"game", "wcsph", "dfsph", "pbf"}) {
+  // smallest). muller2003 counts its wall pressure and, with no_slip, the viscosity's wall term
+  // (folded into its pressure force; wcsph+no_slip: the viscosity effect's own stage).
+  // docs/STABILITY.md, "Momentum balance", has the figures.
+  for (const std::string solver : {"game", "wcsph", "dfsph", "pbf", "muller2003", "muller2003+no_slip", "wcsph+no_slip"}) {
     INFO(solver);
     const TankBalance b = tankBalance(solver, true, true);
     const Vec2d r = b.residual(), w = b.wall.total();

@@ -91,7 +91,8 @@ struct DensityStats {
 struct WallImpulse {
   /// The solver's boundary-sample terms: wcsph's wall pressure and wall viscosity (m·a·dt of the
   /// substep taken), dfsph's wall terms of both velocity solves, pbf's wall share of the density
-  /// solve when its moves become velocity (correction_to_velocity > 0). 0 for muller2003 and game.
+  /// solve when its moves become velocity (correction_to_velocity > 0), muller2003's wall pressure,
+  /// and with solver.no_slip the viscosity's wall term (every solver). 0 for the game solver.
   Vec2d samples{0, 0};
   /// The game solver's grid projection (pbf with grid_cell > 0): the pressure of the fluid cells
   /// on their faces closed by a static solid (ρ0 κ h dt), and the normal velocity those faces

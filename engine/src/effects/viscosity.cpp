@@ -56,8 +56,13 @@ class LaplacianViscosity final : public Effect {
     const Real* IR = P.invRho.data();
     const BoundarySet& B = c.boundary;
     const bool walls = t.walls;
-    return firstBad(c.pool, P.size(), [&](std::size_t b, std::size_t e) {
+    // With the walls: their force on the fluid (World::wallImpulse), Σ m a_wall per block, the blocks in order.
+    const bool count = walls && c.wall;
+    const std::size_t blocks = (P.size() + kBlock - 1) / kBlock;
+    if (count) wallBlock_.assign(blocks, Vec2d(0, 0));
+    const std::size_t first = firstBad(c.pool, P.size(), [&](std::size_t b, std::size_t e) {
       std::size_t bad = kNone;
+      Vec2d wallAcc(0, 0);
       for (std::size_t i = b; i < e; ++i) {
         const Real xix = X[i].x(), xiy = X[i].y(), vix = V[i].x(), viy = V[i].y();
         Real fx = 0, fy = 0;
@@ -81,19 +86,25 @@ class LaplacianViscosity final : public Effect {
             const std::uint32_t s = bl[k];
             sum += B.volume[s] * W.laplacianR2((xi - B.samples[s]).squaredNorm());
           }
-          acc -= Vec2(vix, viy) * (t.wallFactor * IR[i] * sum);
+          const Vec2 aWall = Vec2(vix, viy) * (t.wallFactor * IR[i] * sum);
+          acc -= aWall;
+          wallAcc -= aWall.cast<double>();
         }
         P.a[i] += acc;
         if (!allFinite(acc) && bad == kNone) bad = i;
       }
+      if (count) wallBlock_[b / kBlock] = wallAcc;
       return bad;
     });
+    if (count) c.wall->force += sumInOrder(wallBlock_, blocks) * double(c.mass);
+    return first;
   }
 
  private:
   Real nu_;
   bool noSlip_;
   Real scale_ = 1, momentR_ = -1, momentDx_ = -1;  ///< 1 / lattice moment, for (R, dx)
+  std::vector<Vec2d> wallBlock_;  ///< with the walls: per block of kBlock particles, Σ of their acceleration
 };
 
 }  // namespace

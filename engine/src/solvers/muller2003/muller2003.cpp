@@ -271,7 +271,8 @@ __attribute__((target("avx2"))) void pairSums8(const StepContext& c, const PairC
 #endif
 
 template <bool Visc>
-std::size_t pressureForce(StepContext& c, const Spiky<Real>& spiky, const ViscosityTerm& vt) {
+std::size_t pressureForce(StepContext& c, const Spiky<Real>& spiky, const ViscosityTerm& vt,
+                          std::vector<Vec2d>& wallBlock) {
   ParticleStore& P = c.P;
   const BoundarySet& B = c.boundary;
   const bool hasBoundary = !B.samples.empty();
@@ -297,8 +298,12 @@ std::size_t pressureForce(StepContext& c, const Spiky<Real>& spiky, const Viscos
   const Real* POR = P.pOverRho.data();
   const Vec2* X = P.x.data();
   const Vec2* V = P.v.data();
-  return firstBad(c.pool, P.size(), [&](std::size_t b, std::size_t e) {
+  // The walls' force on the fluid (World::wallImpulse), Σ m a_wall per block, the blocks in order.
+  const std::size_t blocks = (P.size() + kBlock - 1) / kBlock;
+  if (c.wall) wallBlock.assign(blocks, Vec2d(0, 0));
+  const std::size_t first = firstBad(c.pool, P.size(), [&](std::size_t b, std::size_t e) {
     std::size_t bad = kNone;
+    Vec2d wallAcc(0, 0);  // Σ a_wall over the block's particles
 #ifdef SPH2D_SSE2_PAIRS
     const struct {
       __m128 R, spikyK, halfMass, one, thr, vR2, vR3, lapK, rMin, rMin2, invRMin, nine;
@@ -413,7 +418,9 @@ std::size_t pressureForce(StepContext& c, const Spiky<Real>& spiky, const Viscos
           const Vec2 d = xi - B.samples[bl[q]];
           gb += spiky.gradient(d, std::sqrt(d.squaredNorm())) * B.volume[bl[q]];
         }
-        acc -= gb * (Real(0.5) * pi * invRhoi);
+        const Vec2 aWall = gb * (Real(0.5) * pi * invRhoi);
+        acc -= aWall;
+        wallAcc -= aWall.cast<double>();
       }
       acc += c.gravity;
       if (Visc) {
@@ -426,7 +433,9 @@ std::size_t pressureForce(StepContext& c, const Spiky<Real>& spiky, const Viscos
             const std::uint32_t s = bl[q];
             sum += B.volume[s] * W.laplacianR2((xi - B.samples[s]).squaredNorm());
           }
-          av -= Vec2(vix, viy) * (vt.wallFactor * invRhoi * sum);
+          const Vec2 aWall = Vec2(vix, viy) * (vt.wallFactor * invRhoi * sum);
+          av -= aWall;
+          wallAcc -= aWall.cast<double>();
         }
         if (!allFinite(av) && bad == kNone) bad = i;
         acc += av;
@@ -434,8 +443,12 @@ std::size_t pressureForce(StepContext& c, const Spiky<Real>& spiky, const Viscos
       P.a[i] = acc;
       if (!allFinite(acc) && bad == kNone) bad = i;
     }
+    if (c.wall) wallBlock[b / kBlock] = wallAcc;
     return bad;
   });
+  // The World multiplies it by the substep integrate takes (force_limit may still shorten it).
+  if (c.wall) c.wall->force += sumInOrder(wallBlock, blocks) * double(c.mass);
+  return first;
 }
 
 class Muller2003 final : public Solver {
@@ -471,12 +484,16 @@ class Muller2003 final : public Solver {
   /// with a folded viscosity, pressure_force+viscosity and the effects without it.
   std::vector<Stage> stages(bool) override {
     std::vector<Stage> s = explicitStages([](StepContext& c) { return density(c, Poly6<Real>(c.R)); }, pressure,
-                                          [](StepContext& c) { return pressureForce<false>(c, Spiky<Real>(c.R), ViscosityTerm{}); });
+                                          [this](StepContext& c) {
+                                            return pressureForce<false>(c, Spiky<Real>(c.R), ViscosityTerm{}, wallBlock_);
+                                          });
     if (Effect* v = viscosity_) {
       for (Stage& st : s)
         if (st.name == "pressure_force") {
           st.name = "pressure_force+viscosity";
-          st.run = [v](StepContext& c) { return pressureForce<true>(c, Spiky<Real>(c.R), v->viscosityTerm(c)); };
+          st.run = [this, v](StepContext& c) {
+            return pressureForce<true>(c, Spiky<Real>(c.R), v->viscosityTerm(c), wallBlock_);
+          };
         }
     }
     return s;
@@ -485,6 +502,7 @@ class Muller2003 final : public Solver {
  private:
   double c_;
   Effect* viscosity_ = nullptr;  ///< the folded viscosity effect (foldViscosity), or null
+  std::vector<Vec2d> wallBlock_;  ///< per block of kBlock particles, Σ of the walls' acceleration
 };
 
 }  // namespace
