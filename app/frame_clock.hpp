@@ -35,7 +35,7 @@ class FrameClock {
       return;
     }
     acc_ += std::max(0.0, now - last_);
-    last_ = now;
+    last_ = std::max(last_, now);  // the loop may tick ahead (a step scheduled for its due time)
   }
   /// True while a whole frame is due.
   bool due() const { return acc_ >= dt_ * (1 - 1e-9); }

@@ -57,22 +57,23 @@ LoopEnd GameLoop::run() {
     clock_.tick(wallNow());
     double startAt = 0;  // wall time at which the next step may start (0: at once)
     if (!clock_.due()) {
-      if (pending_.active && f + 1 < settings_.frames) {
+      if (pending_.active) {
         // Ahead of the wall clock with a frame to draw: draw it now, and let the next step
         // start on the other thread when it falls due, so that drawing and stepping overlap
         // (drawn first and then stepped, a heavy frame's two halves added up past 1/fps).
         startAt = wallNow() + clock_.untilDue();
         clock_.tick(startAt);
       } else {
-        if (!renderPending()) return LoopEnd::Ended;  // show the frame before waiting for the clock
-        // Ahead of the wall clock: sleep (in short slices, so Ctrl-C stays prompt).
+        // Ahead of the wall clock with nothing to draw: sleep (in short slices, so Ctrl-C stays prompt).
         std::this_thread::sleep_for(std::chrono::duration<double>(std::min(clock_.untilDue(), 0.02)));
         continue;
       }
     }
     steps = 0;
     while (stepDue()) {
-      if (!stepAndRender(startAt)) return LoopEnd::Ended;
+      const StepOutcome o = stepAndRender(startAt);
+      if (o == StepOutcome::Ended) return LoopEnd::Ended;
+      if (o == StepOutcome::Stopped) return LoopEnd::Interrupted;  // the frame is drawn, the step not taken
       startAt = 0;
       ++f;
       ++steps;
@@ -150,18 +151,24 @@ bool GameLoop::renderPending() {
   return observer_.frame(pending_.state, image);
 }
 
-bool GameLoop::stepAndRender(double startAt) {
-  auto step = [this, startAt] {
-    // Real time: wait (in short slices, so a stop stays prompt) until the step is due.
-    for (double left = startAt - wallNow(); left > 0 && !stopRequested(); left = startAt - wallNow())
+GameLoop::StepOutcome GameLoop::stepAndRender(double startAt) {
+  std::atomic<bool> abandon{false};  // the render ended the loop (or threw): a waiting step is not taken
+  bool stepped = false;
+  auto step = [&] {
+    // Real time: wait (in short slices, so a stop stays prompt) until the step is due; a stop
+    // or an ended loop meanwhile leaves it untaken.
+    for (double left = startAt - wallNow(); left > 0; left = startAt - wallNow()) {
+      if (stopRequested() || abandon.load()) return;
       std::this_thread::sleep_for(std::chrono::duration<double>(std::min(left, 0.005)));
+    }
     const auto s0 = std::chrono::steady_clock::now();
     world_.stepFrame();
     status_.simSeconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - s0).count();
+    stepped = true;
   };
   if (!pending_.active) {
     step();
-    return true;
+    return stepped ? StepOutcome::Stepped : StepOutcome::Stopped;
   }
   // The World steps on a second thread; the renderer stays on this one (its GL
   // context's). Both are joined before anything else touches the World.
@@ -179,10 +186,12 @@ bool GameLoop::stepAndRender(double startAt) {
   } catch (...) {
     renderError = std::current_exception();
   }
+  if (!more || renderError) abandon = true;
   stepper.join();
   if (stepError) std::rethrow_exception(stepError);
   if (renderError) std::rethrow_exception(renderError);
-  return more;
+  if (!more) return StepOutcome::Ended;
+  return stepped ? StepOutcome::Stepped : StepOutcome::Stopped;
 }
 
 // Paused at boundary f (already rendered): waits for a resume, or the pause's own seconds

@@ -6,8 +6,7 @@
 //                          in real time the render starts at once, the step when it is due)
 //       ─> apply events due at the new boundary ─> observer.boundary
 //       ─> snapshot if kept (unless the loop is behind the wall clock: dropped)
-//   a snapshot still pending is rendered before a pause, a wait for the clock with no step
-//   left to take, and the end.
+//   a snapshot still pending is rendered before a pause, at a stop and at the end.
 //
 // Rendering overlaps the next step: the renderer draws a copy of what it reads
 // (positions, velocities, density, pressure, ids, ages, colliders) on the thread
@@ -128,10 +127,15 @@ class GameLoop {
   void capture(std::int64_t f);
   /// Renders the pending frame and hands it to the observer. False: the observer ended the loop.
   bool renderPending();
-  /// One World::stepFrame, started at wall time `startAt` (seconds since the loop began; at
-  /// once when it has passed), with the pending frame rendered on this thread meanwhile.
-  /// False: the observer ended the loop.
-  bool stepAndRender(double startAt);
+  /// What stepAndRender did.
+  enum class StepOutcome {
+    Stepped,  ///< the World stepped one frame (and the pending frame, if any, was drawn)
+    Ended,    ///< the observer ended the loop
+    Stopped,  ///< the stop flag was set while the step waited for its time: not taken
+  };
+  /// One World::stepFrame, started at wall time `startAt` (wallNow()'s seconds; at once when it
+  /// has passed), with the pending frame rendered on this thread meanwhile.
+  StepOutcome stepAndRender(double startAt);
 
   World& world_;
   EventIntake& input_;

@@ -6,7 +6,8 @@
 # per round, the load average before it, the frames dropped (stepped but not rendered, to keep
 # up) and late (the simulation fell behind the wall clock), the wall, simulation and rendering
 # seconds, and which frames were dropped; then the rounds as CSV. With OTHER=path/to/sph2d it
-# alternates that binary with this build's (A B A B ...), so that two builds meet the same load.
+# alternates that binary with this build's (A B, B A, ...), so that two builds meet the same load
+# (paths without spaces).
 # A benchmark, not a test: the machine is shared, and a busy machine drops frames that a quiet
 # one does not (the load average says which it was).
 #
@@ -23,7 +24,10 @@ csv="binary,round,load1,dropped,late,wall_s,simulation_s,rendering_s"
 i=0
 while [ "$i" -lt "$rounds" ]; do
   i=$((i + 1))
-  for bin in "$app" ${OTHER:+"$OTHER"}; do
+  # With OTHER, the order alternates (A B, B A, ...) so that a load trend within a round favours neither.
+  order="$app ${OTHER:-}"
+  [ -n "${OTHER:-}" ] && [ $((i % 2)) -eq 0 ] && order="$OTHER $app"
+  for bin in $order; do
     load=$(cut -d' ' -f1 /proc/loadavg)
     rm -rf "$work/out"
     "$bin" run "$scene" --realtime --quiet --out "$work/out" > "$work/log" 2>&1 || { cat "$work/log"; exit 1; }

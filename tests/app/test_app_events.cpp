@@ -292,6 +292,23 @@ TEST_CASE("the frame clock steps whole frames, waits when ahead and forgets the 
   CHECK(c.late() == 5);
   CHECK(c.behindSeconds() == doctest::Approx(0.5));
   CHECK_FALSE(c.due());
+  // The loop may tick ahead (a step scheduled for its due time); a tick behind that adds
+  // nothing and does not move the clock back, so the span is never counted twice.
+  FrameClock a(0.1, true, 4);
+  a.resync(20.0);
+  a.tick(20.04);
+  a.tick(20.04 + a.untilDue());  // ahead: the step is due at 20.1
+  CHECK(a.due());
+  a.consume();
+  a.tick(20.08);  // behind the tick ahead
+  CHECK(a.untilDue() == doctest::Approx(0.1));
+  a.tick(20.19);  // 0.09 s after 20.1, not 0.11 s after 20.08
+  CHECK_FALSE(a.due());
+  CHECK(a.untilDue() == doctest::Approx(0.01));
+  a.tick(20.2);
+  CHECK(a.due());
+  a.consume();
+  CHECK_FALSE(a.due());
   FrameClock h(0.1, false, 4);  // headless: one frame per tick, never a wait
   h.resync(0);
   h.tick(0);

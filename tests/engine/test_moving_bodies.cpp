@@ -570,7 +570,7 @@ TEST_CASE("moving bodies: water at rest in a tank: over a second the walls' impu
 }
 
 TEST_CASE("moving bodies: the walls' impulse on a sloshing tank with a crate has the same bits on 1, 2 and 3 threads") {
-  for (const std::string solver : {"game", "wcsph"}) {
+  for (const std::string solver : {"game", "wcsph", "dfsph", "pbf", "muller2003+no_slip"}) {
     INFO(solver);
     const TankBalance ref = tankBalance(solver, true, true, 1);
     for (int threads = 2; threads <= 3; ++threads) {

@@ -92,7 +92,8 @@ struct WallImpulse {
   /// The solver's boundary-sample terms: wcsph's wall pressure and wall viscosity (m·a·dt of the
   /// substep taken), dfsph's wall terms of both velocity solves, pbf's wall share of the density
   /// solve when its moves become velocity (correction_to_velocity > 0), muller2003's wall pressure,
-  /// and with solver.no_slip the viscosity's wall term (every solver). 0 for the game solver.
+  /// and with solver.no_slip the viscosity's wall term (every solver). 0 for the game solver
+  /// unless no_slip.
   Vec2d samples{0, 0};
   /// The game solver's grid projection (pbf with grid_cell > 0): the pressure of the fluid cells
   /// on their faces closed by a static solid (ρ0 κ h dt), and the normal velocity those faces
@@ -179,7 +180,9 @@ class World {
   SolverStats solverStats() const;
   /// The impulse the static solids gave the fluid over every substep since construction, the
   /// last load() or the last resetWallImpulse() (whichever came last) [N·s per metre of depth].
-  /// With the gravity impulse Σm·g·t it closes the fluid's momentum balance (docs/EMBEDDING.md).
+  /// With the gravity impulse Σm·g·t it closes the fluid's momentum balance (docs/EMBEDDING.md)
+  /// while nothing else acts on the fluid: no force fields, user forces, emitters, sinks,
+  /// lifetimes or particle edits, and no moving bodies (their exchange is the bodies' own).
   /// A diagnostic: keeping it changes nothing in the simulation; not part of save().
   WallImpulse wallImpulse() const;
   /// Zeroes wallImpulse() (say, at the start of the interval a game wants to measure).
