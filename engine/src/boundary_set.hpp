@@ -18,6 +18,8 @@
 // follows the fixture's restitution and Coulomb friction.
 #pragma once
 
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -52,6 +54,27 @@ struct BoundarySet {
   Real binSize = 1, invBin = 1;
   int bnx = 0, bny = 0;
   std::vector<std::uint32_t> binStart, binItems;
+  /// clearOf's map: cells of a quarter bin over the colliders' bounds widened by two cells on
+  /// every side (nearNx × nearNy from nearLo), a cell 1 when some collider's bounding box
+  /// touches the 3×3 cells around it (closed, with a margin).
+  std::vector<std::uint8_t> nearMap;
+  Vec2 nearLo = Vec2::Zero();
+  Real nearInv = 1;
+  int nearNx = 0, nearNy = 0;
+
+  /// True when resolve(x, v, xOld, clearance) provably finds no candidate collider (and so
+  /// changes nothing and returns false): the move plus the clearance is at most half a
+  /// cell of nearMap, so resolve's swept box lies in the 3×3 cells around x's cell, and no
+  /// collider's bounding box touches them. False means "call resolve" (also for positions
+  /// off the map and non-finite ones).
+  bool clearOf(const Vec2& x, const Vec2& xOld, Real clearance) const {
+    if (bnx == 0) return true;  // resolve's own first test
+    const Real d = std::max(std::abs(x.x() - xOld.x()), std::abs(x.y() - xOld.y())) + clearance;
+    if (!(d * nearInv <= Real(0.5))) return false;
+    const Real tx = (x.x() - nearLo.x()) * nearInv, ty = (x.y() - nearLo.y()) * nearInv;
+    if (!(tx >= 0 && tx < Real(nearNx) && ty >= 0 && ty < Real(nearNy))) return false;
+    return nearMap[std::size_t(ty) * std::size_t(nearNx) + std::size_t(tx)] == 0;
+  }
 
   /// Collects every static fixture of `world` as colliders in the frame shifted by −origin.
   void collect(b2World& world, const Vec2d& origin);

@@ -316,6 +316,8 @@ void stageCollide(StepContext& c) {
       [&](std::size_t b, std::size_t e) {
         Vec2d s(0, 0);
         for (std::size_t i = b; i < e; ++i) {
+          // Most particles are far from every solid: resolve would find no candidate there.
+          if (c.boundary.clearOf(P.x[i], P.xPrev[i], c.clearance)) continue;
           const Vec2 v0 = P.v[i];
           if (c.boundary.resolve(P.x[i], P.v[i], P.xPrev[i], c.clearance))
             s += P.v[i].cast<double>() - v0.cast<double>();
