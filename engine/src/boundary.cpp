@@ -362,6 +362,17 @@ void BoundarySet::sample(Real dx, Real depth, ThreadPool& pool) {
     sideOffset.resize(out);
   }
   sampleGrid.build(samples.data(), samples.size(), depth, pool);
+  // noSamplesNear's map: each occupied cell marks the block of cells whose queries visit it.
+  const Grid& g = sampleGrid;
+  sampleNear.assign(std::size_t(g.nx) * std::size_t(g.ny), 0);
+  for (int y = 0; y < g.ny; ++y)
+    for (int x = 0; x < g.nx; ++x) {
+      const std::size_t c = std::size_t(y) * g.nx + x;
+      if (!(g.cellStart[c] < g.cellStart[c + 1])) continue;
+      for (int v = std::max(y - g.reach, 0); v <= std::min(y + g.reach, g.ny - 1); ++v)
+        for (int u = std::max(x - g.reach, 0); u <= std::min(x + g.reach, g.nx - 1); ++u)
+          sampleNear[std::size_t(v) * g.nx + u] = 1;
+    }
 }
 
 void BoundarySet::buildBins(Real hint) {

@@ -42,6 +42,18 @@ struct BoundarySet {
   std::vector<Vec2> sideNormal;
   std::vector<Real> sideOffset;
   Grid sampleGrid;
+  /// Per cell of sampleGrid: 1 when a cell of the (2·reach + 1)² block around it holds a
+  /// sample (noSamplesNear's map).
+  std::vector<std::uint8_t> sampleNear;
+
+  /// True when sampleGrid.forCandidates(x, f) would call f for nothing: no cell it visits
+  /// around x holds a sample (the same cell of x as the query's, no periodic axis).
+  bool noSamplesNear(const Vec2& x) const {
+    const Grid& g = sampleGrid;
+    if (g.wrapX || g.wrapY || sampleNear.size() != std::size_t(g.nx) * std::size_t(g.ny)) return false;
+    const int cx = Grid::coord(x.x(), g.lo.x(), g.invCell, g.nx), cy = Grid::coord(x.y(), g.lo.y(), g.invCellY, g.ny);
+    return sampleNear[std::size_t(cy) * std::size_t(g.nx) + std::size_t(cx)] == 0;
+  }
 
   /// True when sample k is visible from position x (always, unless it belongs to a segment's far side).
   bool visible(std::size_t k, const Vec2& x) const {

@@ -260,7 +260,7 @@ void stageNeighbours(StepContext& c) {
       });
       L.count[i] = std::uint32_t(used - L.start[i]);
       L.boundaryStart[i] = std::uint32_t(bout.size());
-      if (walls)
+      if (walls && !B.noSamplesNear(xi))  // most particles are far from every wall
         B.sampleGrid.forCandidates(xi, [&](std::uint32_t s) {
           if ((xi - B.samples[s]).squaredNorm() < R2 && B.visible(s, xi)) bout.push_back(s);
         });
