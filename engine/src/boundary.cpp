@@ -362,11 +362,24 @@ void BoundarySet::sample(Real dx, Real depth, ThreadPool& pool) {
     sideOffset.resize(out);
   }
   sampleGrid.build(samples.data(), samples.size(), depth, pool);
+  // noSamplesNear's map: each occupied cell marks the block of cells whose queries visit it.
+  const Grid& g = sampleGrid;
+  sampleNear.assign(std::size_t(g.nx) * std::size_t(g.ny), 0);
+  for (int y = 0; y < g.ny; ++y)
+    for (int x = 0; x < g.nx; ++x) {
+      const std::size_t c = std::size_t(y) * g.nx + x;
+      if (!(g.cellStart[c] < g.cellStart[c + 1])) continue;
+      for (int v = std::max(y - g.reach, 0); v <= std::min(y + g.reach, g.ny - 1); ++v)
+        for (int u = std::max(x - g.reach, 0); u <= std::min(x + g.reach, g.nx - 1); ++u)
+          sampleNear[std::size_t(v) * g.nx + u] = 1;
+    }
 }
 
 void BoundarySet::buildBins(Real hint) {
   binStart.clear();
   binItems.clear();
+  nearMap.clear();
+  nearNx = nearNy = 0;
   if (colliders.empty()) {
     bnx = bny = 0;
     return;
@@ -395,6 +408,30 @@ void BoundarySet::buildBins(Real hint) {
   for (const auto& b : bins) {
     binItems.insert(binItems.end(), b.begin(), b.end());
     binStart.push_back(std::uint32_t(binItems.size()));
+  }
+  // clearOf's map (in double, with a margin of a hundredth of a cell: it may only err
+  // towards marking a cell).
+  const double f = double(binSize) / 4;
+  nearInv = Real(1.0 / f);
+  const double f1 = 1.0 / double(nearInv);  // the cell the particles' coordinates see
+  nearLo = Vec2(Real(double(lo.x()) - 2 * f1), Real(double(lo.y()) - 2 * f1));
+  nearNx = int(std::floor(double(ext.x()) / f1)) + 5;
+  nearNy = int(std::floor(double(ext.y()) / f1)) + 5;
+  nearMap.assign(std::size_t(nearNx) * std::size_t(nearNy), 0);
+  const double margin = 0.01 * f1;
+  for (const Collider& c : colliders) {
+    // Cells u whose block [u − 1, u + 2)·f1 (closed, widened by the margin) meets [c.lo, c.hi].
+    const auto range = [&](double clo, double chi, double origin, int count, int& u0, int& u1) {
+      u0 = int(std::floor((clo - margin - origin) / f1)) - 1;
+      u1 = int(std::floor((chi + margin - origin) / f1)) + 1;
+      u0 = std::max(u0, 0);
+      u1 = std::min(u1, count - 1);
+    };
+    int x0, x1, y0, y1;
+    range(c.lo.x(), c.hi.x(), nearLo.x(), nearNx, x0, x1);
+    range(c.lo.y(), c.hi.y(), nearLo.y(), nearNy, y0, y1);
+    for (int y = y0; y <= y1; ++y)
+      for (int x = x0; x <= x1; ++x) nearMap[std::size_t(y) * nearNx + x] = 1;
   }
 }
 

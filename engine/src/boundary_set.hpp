@@ -18,6 +18,8 @@
 // follows the fixture's restitution and Coulomb friction.
 #pragma once
 
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -40,6 +42,18 @@ struct BoundarySet {
   std::vector<Vec2> sideNormal;
   std::vector<Real> sideOffset;
   Grid sampleGrid;
+  /// Per cell of sampleGrid: 1 when a cell of the (2·reach + 1)² block around it holds a
+  /// sample (noSamplesNear's map).
+  std::vector<std::uint8_t> sampleNear;
+
+  /// True when sampleGrid.forCandidates(x, f) would call f for nothing: no cell it visits
+  /// around x holds a sample (the same cell of x as the query's, no periodic axis).
+  bool noSamplesNear(const Vec2& x) const {
+    const Grid& g = sampleGrid;
+    if (g.wrapX || g.wrapY || sampleNear.size() != std::size_t(g.nx) * std::size_t(g.ny)) return false;
+    const int cx = Grid::coord(x.x(), g.lo.x(), g.invCell, g.nx), cy = Grid::coord(x.y(), g.lo.y(), g.invCellY, g.ny);
+    return sampleNear[std::size_t(cy) * std::size_t(g.nx) + std::size_t(cx)] == 0;
+  }
 
   /// True when sample k is visible from position x (always, unless it belongs to a segment's far side).
   bool visible(std::size_t k, const Vec2& x) const {
@@ -52,6 +66,27 @@ struct BoundarySet {
   Real binSize = 1, invBin = 1;
   int bnx = 0, bny = 0;
   std::vector<std::uint32_t> binStart, binItems;
+  /// clearOf's map: cells of a quarter bin over the colliders' bounds widened by two cells on
+  /// every side (nearNx × nearNy from nearLo), a cell 1 when some collider's bounding box
+  /// touches the 3×3 cells around it (closed, with a margin).
+  std::vector<std::uint8_t> nearMap;
+  Vec2 nearLo = Vec2::Zero();
+  Real nearInv = 1;
+  int nearNx = 0, nearNy = 0;
+
+  /// True when resolve(x, v, xOld, clearance) provably finds no candidate collider (and so
+  /// changes nothing and returns false): the move plus the clearance is at most half a
+  /// cell of nearMap, so resolve's swept box lies in the 3×3 cells around x's cell, and no
+  /// collider's bounding box touches them. False means "call resolve" (also for positions
+  /// off the map and non-finite ones).
+  bool clearOf(const Vec2& x, const Vec2& xOld, Real clearance) const {
+    if (bnx == 0) return true;  // resolve's own first test
+    const Real d = std::max(std::abs(x.x() - xOld.x()), std::abs(x.y() - xOld.y())) + clearance;
+    if (!(d * nearInv <= Real(0.5))) return false;
+    const Real tx = (x.x() - nearLo.x()) * nearInv, ty = (x.y() - nearLo.y()) * nearInv;
+    if (!(tx >= 0 && tx < Real(nearNx) && ty >= 0 && ty < Real(nearNy))) return false;
+    return nearMap[std::size_t(ty) * std::size_t(nearNx) + std::size_t(tx)] == 0;
+  }
 
   /// Collects every static fixture of `world` as colliders in the frame shifted by −origin.
   void collect(b2World& world, const Vec2d& origin);

@@ -51,13 +51,13 @@ class ThreadPool {
 
  private:
   void workerLoop();
-  void runBlocks();
+  void runBlocks(bool front);
 
   std::vector<std::thread> workers_;
   std::mutex mutex_;
   std::condition_variable wake_;
   std::atomic<unsigned long long> epoch_{0};
-  std::atomic<std::uint64_t> ticket_{0};  ///< the job's block count (high bits) and next block (low 24 bits)
+  std::atomic<std::uint64_t> ticket_{0};  ///< the job's unclaimed blocks: first (low 32 bits), one past the last (high 32)
   std::atomic<std::size_t> done_{0};      ///< blocks of the job finished
   std::atomic<bool> stop_{false};
   const std::function<void(std::size_t, std::size_t)>* fn_ = nullptr;
