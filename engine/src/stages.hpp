@@ -14,7 +14,8 @@
 namespace sph2d {
 
 /// With `on`, the pair loops use only the baseline SIMD (SSE2) even where the CPU has
-/// wider vectors (chosen at run time: AVX-512). Every path gives the same bits; tests
+/// wider vectors (chosen at run time: the neighbour filters' AVX-512, muller2003's AVX2 pair
+/// loop). Every path gives the same bits; tests
 /// switch this to compare them on one machine. Process-wide; off by default.
 void setBaselineSimdOnly(bool on);
 /// Whether setBaselineSimdOnly(true) is in force.

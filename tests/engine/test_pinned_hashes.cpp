@@ -79,12 +79,14 @@ TEST_CASE("pinned state hashes: every solver on the standard scenes, for 1, 2 an
 TEST_CASE("pinned state hashes: the same on the baseline SIMD path (SSE2) as on the CPU's widest") {
   // The pair loops choose wider vectors at run time where the CPU has them
   // (stages.hpp, setBaselineSimdOnly); every path must give the pinned bits.
-  setBaselineSimdOnly(true);
+  struct BaselineOnly {  // restored even when a run throws
+    BaselineOnly() { setBaselineSimdOnly(true); }
+    ~BaselineOnly() { setBaselineSimdOnly(false); }
+  } baseline;
   for (const Pinned& p : kPinned) {
     const std::uint64_t h = run(p, 2);
     CAPTURE(p.scene);
     CAPTURE(p.solver);
     CHECK(h == p.hash);
   }
-  setBaselineSimdOnly(false);
 }
