@@ -58,9 +58,11 @@ struct Renderer::Impl {
   RenderOptions opt;
   bool ownContext = false;                     // an OSMesa context of the Renderer's, else the caller's
   OSMesaContext ctx = nullptr;
-  // The caller's context only: OSMesa's current context when the Renderer was made (null for a
-  // game's EGL, GLX or WGL context). Another one current later (e.g. an OSMesa Renderer's, which
-  // render() leaves current) means the wrong context: its object names are not ours.
+  // The caller's context only: OSMesa's current context when the Renderer was made. For a game's
+  // EGL or GLX context on Mesa it is not null: OSMesa reads Mesa's shared dispatch, which gives
+  // the same pointer for the same context (tests/egl); a driver that is not Mesa's OSMesa cannot
+  // see (docs/EMBEDDING.md). Another one current later (e.g. an OSMesa Renderer's, which render()
+  // leaves current) means the wrong context: its object names are not ours.
   OSMesaContext callerOsmesa = nullptr;
   unsigned char dummy[4] = {0, 0, 0, 0};
   gl::ContextInfo glInfo;
@@ -122,7 +124,9 @@ struct Renderer::Impl {
     if (OSMesaGetCurrentContext() != callerOsmesa)
       throw std::runtime_error(std::string("Renderer::") + call +
                                ": another OpenGL context is current than the one this Renderer was created in "
-                               "(an OSMesa Renderer's render() leaves its own current); make the game's current");
+                               "(an OSMesa Renderer's render() leaves its own current); make the game's current (with EGL, "
+                               "eglMakeCurrent(display, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT) first: Mesa's "
+                               "EGL skips making current the context it believes is current already)");
     const GLenum err = glGetError();
     if (err != GL_NO_ERROR) {
       char code[16];
