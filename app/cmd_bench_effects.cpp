@@ -19,6 +19,7 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <map>
 #include <memory>
 #include <sstream>
 #include <stdexcept>
@@ -67,7 +68,32 @@ struct Row {
   Config cfg;
   std::unique_ptr<World> world;
   std::vector<double> ms, ratio, effectMs, share;
+  std::map<std::string, double> stageSec;  ///< this round's seconds per stage
+  double wallSec = 0;                      ///< this round's wall time
+  std::string foldedInto;                  ///< the solver stage an effect of the configuration runs inside ("": none)
 };
+
+/// The seconds of configuration r's own effect stages in one round. An effect folded into a
+/// solver's stage ("X+E", e.g. muller2003's pressure_force+viscosity) has no timer of its own:
+/// its time is that stage's minus the stage X of `none` in the same round.
+double effectSeconds(Row& r, const Row& none) {
+  double sec = 0;
+  for (const auto& [name, t] : r.stageSec) {
+    if (std::find(r.cfg.stages.begin(), r.cfg.stages.end(), name) != r.cfg.stages.end()) {
+      sec += t;
+      continue;
+    }
+    const auto plus = name.find('+');
+    if (plus == std::string::npos) continue;
+    const std::string base = name.substr(0, plus), effect = name.substr(plus + 1);
+    if (std::find(r.cfg.stages.begin(), r.cfg.stages.end(), effect) == r.cfg.stages.end()) continue;
+    const auto it = none.stageSec.find(base);
+    if (it == none.stageSec.end()) continue;
+    sec += t - it->second;
+    r.foldedInto = name;
+  }
+  return sec;
+}
 
 double median(std::vector<double> v) {
   if (v.empty()) return 0;
@@ -234,11 +260,15 @@ int cmdBenchEffects(const std::vector<std::string>& args) {
       for (int i = 0; i < steps; ++i) r.world->stepSubstep();
       const double sec = now() - t0, wallSec = wallSeconds() - w0;
       msThisRound[idx] = 1e3 * sec / steps;
-      double effectSec = 0;
-      for (const StageTiming& t : r.world->timings())
-        if (std::find(r.cfg.stages.begin(), r.cfg.stages.end(), t.name) != r.cfg.stages.end()) effectSec += t.seconds;
+      r.stageSec.clear();
+      for (const StageTiming& t : r.world->timings()) r.stageSec[t.name] += t.seconds;
+      r.wallSec = wallSec;
+    }
+    for (std::size_t k = 0; k < rows.size(); ++k) {
+      Row& r = rows[k];
+      const double effectSec = effectSeconds(r, rows[0]);
       r.effectMs.push_back(1e3 * effectSec / steps);
-      r.share.push_back(effectSec / wallSec);  // both wall: the stage timers use the wall clock
+      r.share.push_back(effectSec / r.wallSec);  // both wall: the stage timers use the wall clock
     }
     for (std::size_t k = 0; k < rows.size(); ++k) {
       rows[k].ms.push_back(msThisRound[k]);
@@ -263,6 +293,11 @@ int cmdBenchEffects(const std::vector<std::string>& args) {
   std::printf("(ms/substep and 'vs none' are medians over rounds, 'vs none' taken within each round; 'best' is the\n"
               " fastest round; 'effect ms' is the wall time of the effect's own stages per substep, 'share' its part of\n"
               " the round's wall time; 'substep ms' is the longest stable substep at the end: viscosity limits it)\n");
+  for (const Row& r : rows)
+    if (!r.foldedInto.empty())
+      std::printf("(%s: an effect runs inside the solver stage %s; its 'effect ms' is that stage's time minus the\n"
+                  " same stage's time in none, round by round)\n",
+                  r.cfg.name.c_str(), r.foldedInto.c_str());
   if (!csvPath.empty()) {
     const std::filesystem::path out(csvPath);
     if (out.has_parent_path()) std::filesystem::create_directories(out.parent_path());

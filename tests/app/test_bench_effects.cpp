@@ -37,10 +37,17 @@ TEST_CASE("bench effects with a tiny dam break writes the CSV with one row per c
     for (std::size_t k = 6; k < f.size(); ++k) {
       CAPTURE(line);
       CHECK(std::isfinite(std::stod(f[k])));
-      CHECK(std::stod(f[k]) >= 0);
+      // A folded effect's time (columns 9, 10) is a difference of two timers: noise may take it below 0.
+      const bool folded = (f[0] == "viscosity" || f[0] == "all") && (k == 9 || k == 10);
+      if (!folded) CHECK(std::stod(f[k]) >= 0);
     }
     if (f[0] == "none") CHECK(std::stod(f[8]) == 1.0);
+    // muller2003 folds the viscosity into its pressure force (stage pressure_force+viscosity): the
+    // effect's time is taken as that stage's minus none's pressure_force, not the 0 of a stage
+    // that no longer runs.
+    if (f[0] == "viscosity") CHECK(std::stod(f[9]) != 0.0);
   }
+  CHECK(r.out.find("runs inside the solver stage pressure_force+viscosity") != std::string::npos);
   CHECK(names == std::vector<std::string>{"none", "none_again", "viscosity", "xsph", "force_field", "csf", "akinci", "lifetime",
                                            "sink", "user_force", "all"});
 }
