@@ -5,7 +5,19 @@
 //
 // At the start of each step the World reads every non-static body's pose, velocity,
 // mass and inertia (moving_solid.hpp: a body moves along a piecewise-linear path
-// within the step). Per substep:
+// within the step), and its shapes as the fluid meets them: a polygon with Box2D's skin
+// (b2_polygonRadius, 1 cm: withSkin, faces moved out, corners mitred), a circle as it is
+// (its radius is its skin). Box2D rests a polygon on another at about two skins less the
+// slop, core to core: seen without its skin, a crate on the floor left a 1.5 cm gap that
+// the fluid entered and was squeezed in. Everything that reads a body's shape (the
+// collision below, the grid's body cells and faces, the body's area and centroid, its
+// reach, movingColliders() for drawing) reads these. Static bodies' shapes stay cores
+// (boundary.cpp; their skins would move every tank's walls and water level): a skinned
+// crate resting on a core floor leaves 0.5 cm, room for a particle kept the clearance
+// (0.25 spacing) off both only at a spacing of 1 cm or less, and then for one layer, which
+// is not squeezed. Box2D's mass is the core's: the fluid displaces the larger skinned
+// shape, so a polygon body floats a little higher than its density alone says.
+// Per substep:
 //  - `body_gravity` (after `emit`, with a dynamic body): its velocity takes g·dt;
 //  - the game solver's grid projection treats the bodies as moving solids and solves
 //    for a dynamic body's velocity together with the pressure (grid_projection.cpp);
@@ -14,8 +26,14 @@
 //    the path the shapes before left), one that started inside or ends within the
 //    clearance is put back on the surface (its start position taken in the body's frame
 //    at the substep's start, its end in the frame at the substep's end, so a body's own
-//    motion counts). Against a kinematic body the part of its velocity into
-//    the body, relative to the body's velocity there, is removed. Against a dynamic
+//    motion counts). Where that push would put it into a static solid (a gap thinner than
+//    the clearance on both sides, or a body that overlaps a static solid within the step:
+//    the fluid's step has no contact between them), it goes only onto the body's surface,
+//    or, where that is inside the static solid too, stays where the static collision put it
+//    and is squeezed out along the body's face a spacing a substep: never into a static
+//    solid, at worst for a few frames within a landing body. Against a kinematic body the
+//    part of its velocity into the body, relative to the body's velocity there, is
+//    removed. Against a dynamic
 //    body the two meet as an inelastic contact: the particle (mass m) and the body
 //    (effective mass 1/M_eff = 1/M + (r × n)²/I at the contact) share the relative
 //    normal velocity v_n, the N contacts of the body in the substep splitting its mass
@@ -37,6 +55,24 @@ namespace {
 Vec2d rot(double theta, const Vec2d& p) {
   const double c = std::cos(theta), s = std::sin(theta);
   return Vec2d(c * p.x() - s * p.y(), s * p.x() + c * p.y());
+}
+
+/// The way out for a particle at `p` (body coordinates, on or in polygon `k`) squeezed along
+/// the face it is nearest: the unit vector along the face towards its nearer end. False for a
+/// circle (no face to run along).
+bool squeezeDirection(const Collider& k, const Vec2d& p, Vec2d& t) {
+  if (k.kind != Collider::Kind::Polygon) return false;
+  const std::size_t m = k.vertices.size();
+  std::size_t f = 0;
+  double best = -1e300;
+  for (std::size_t e = 0; e < m; ++e) {
+    const double s = Vec2d(k.normals[e].x(), k.normals[e].y()).dot(p - Vec2d(k.vertices[e].x(), k.vertices[e].y()));
+    if (s > best) best = s, f = e;
+  }
+  const Vec2d v0(k.vertices[f].x(), k.vertices[f].y()), v1(k.vertices[(f + 1) % m].x(), k.vertices[(f + 1) % m].y());
+  t = (v1 - v0).normalized();
+  if ((p - v0).dot(t) <= 0.5 * (v1 - v0).norm()) t = -t;
+  return true;
 }
 
 }  // namespace
@@ -130,6 +166,38 @@ int solidAt(const MovingSolids& s, double tau, const Vec2d& p) {
 
 namespace {
 
+/// Box2D's polygon `poly` as the fluid meets it, into `c` (body coordinates): its core with
+/// Box2D's skin (m_radius, b2_polygonRadius = 1 cm), where Box2D's own contacts put it. The
+/// skinned polygon is the core's Minkowski sum with a disc of the skin's radius (rounded
+/// corners); the fluid gets a simpler polygon: every face moved out along its normal by the
+/// skin, the corners mitred (each new vertex where the two moved faces meet), so the
+/// collision code keeps reading a convex polygon by its faces' planes, and every face lies
+/// exactly where Box2D's skin has it. A corner sharper than a right angle (its normals
+/// turning by more than 90°) is bevelled: a face of the mean normal, also the skin off the
+/// core's corner, splits the turn in two, so no mitre reaches past √2 skins (a box's corner
+/// is mitred: √2 skins out, against the rounded corner's one).
+void withSkin(const b2PolygonShape& poly, Collider& c) {
+  const double r = double(poly.m_radius);
+  const int n = poly.m_count;
+  auto at = [&](int i) { return Vec2d(poly.m_vertices[(i + n) % n].x, poly.m_vertices[(i + n) % n].y); };
+  auto normal = [&](int i) { return Vec2d(poly.m_normals[(i + n) % n].x, poly.m_normals[(i + n) % n].y); };
+  auto add = [&](const Vec2d& v, const Vec2d& na, const Vec2d& nb) {  // faces na (in) and nb (out) at core vertex v
+    const Vec2d p = v + r / (1.0 + na.dot(nb)) * (na + nb);       // on both moved faces: nₐ·(p − v) = n_b·(p − v) = r
+    c.vertices.push_back(Vec2(Real(p.x()), Real(p.y())));
+    c.normals.push_back(Vec2(Real(nb.x()), Real(nb.y())));
+  };
+  for (int i = 0; i < n; ++i) {  // vertex i starts face i (from vertex i to i + 1)
+    const Vec2d v = at(i), na = normal(i - 1), nb = normal(i);
+    if (na.dot(nb) < 0) {
+      const Vec2d bevel = (na + nb).normalized();
+      add(v, na, bevel);
+      add(v, bevel, nb);
+    } else {
+      add(v, na, nb);
+    }
+  }
+}
+
 /// A moving body's area and centroid (body coordinates, offset from its centre of mass):
 /// exact for one shape; for several, which may overlap, their union sampled on a 96 × 96
 /// lattice over their bounds (the grid's face correction scales the pressure to this area).
@@ -196,12 +264,8 @@ void World::Impl::captureBodies() {
       const b2Shape* shape = fx->GetShape();
       Collider c;
       if (shape->GetType() == b2Shape::e_polygon) {
-        const auto* poly = static_cast<const b2PolygonShape*>(shape);
         c.kind = Collider::Kind::Polygon;
-        for (int i = 0; i < poly->m_count; ++i) {
-          c.vertices.push_back(Vec2(poly->m_vertices[i].x, poly->m_vertices[i].y));
-          c.normals.push_back(Vec2(poly->m_normals[i].x, poly->m_normals[i].y));
-        }
+        withSkin(*static_cast<const b2PolygonShape*>(shape), c);
       } else if (shape->GetType() == b2Shape::e_circle) {
         const auto* circle = static_cast<const b2CircleShape*>(shape);
         c.kind = Collider::Kind::Circle;
@@ -318,15 +382,15 @@ void World::Impl::collideMoving(StepContext& c) {
           if ((xp + u * d - q.com1).squaredNorm() > q.reach2) continue;
         }
         const Vec2d a = toBody(q.c0, q.s0, xp - q.o0);
-        Vec2d b = toBody(q.c1, q.s1, xw - q.o1);
-        // Beyond reach: the path from a to b passes farther than the shapes reach.
-        const Vec2d ab = b - a, ac = m.localCenter - a;
+        const Vec2d bEnd = toBody(q.c1, q.s1, xw - q.o1);
+        // Beyond reach: the path from a to bEnd passes farther than the shapes reach.
+        const Vec2d ab = bEnd - a, ac = m.localCenter - a;
         const double len2 = ab.squaredNorm();
         const double t = len2 > 0 ? std::clamp(ac.dot(ab) / len2, 0.0, 1.0) : 0.0;
         const double reach = m.radius + clearance;
         if ((a + t * ab - m.localCenter).squaredNorm() > reach * reach) continue;
+        Vec2d nb(0, 0), b = bEnd;
         bool hit = false;
-        Vec2d nb(0, 0);
         for (const Collider& s : m.shapes) {
           Vec2d n;
           double te;
@@ -345,7 +409,49 @@ void World::Impl::collideMoving(StepContext& c) {
           hit = true;
         }
         if (!hit) continue;
-        const Vec2d x = q.o1 + Vec2d(q.c1 * b.x() - q.s1 * b.y(), q.s1 * b.x() + q.c1 * b.y());
+        auto toLocal = [&](const Vec2d& p) { return q.o1 + Vec2d(q.c1 * p.x() - q.s1 * p.y(), q.s1 * p.x() + q.c1 * p.y()); };
+        Vec2d x = toLocal(b);
+        {
+          // Pushed into a static solid: the particle is in a gap between the body and a static
+          // solid thinner than the clearance on both sides (beside or under a crate resting on
+          // the floor or against a wall: its skin leaves 0.5 cm or less), or where the two
+          // overlap within the step (the fluid's step has no contact between them: a crate
+          // landing on the floor sinks into it until Box2D's next step). First it is put only
+          // on the body's surface (its skin, outside its core), along the face nearest its end
+          // point and not stopped where it entered (which would pin it, and every particle
+          // after it, at one point): it moves along the gap. Where that is inside the static
+          // solid too, it stays where the static collision left it and is squeezed out along
+          // the body's face: one spacing a substep towards the face's nearer end (or the
+          // farther, where a static solid is in the way; or not at all). All the particles
+          // there move alike, so none lands on another. Never into a static solid.
+          const Vec2 from = c.P.x[i];
+          auto intoStatic = [&](const Vec2d& p) {
+            const Vec2 to(Real(p.x()), Real(p.y()));
+            return !c.boundary.clearOf(to, from, 0) && c.boundary.blocks(from, to);
+          };
+          if (intoStatic(x)) {
+            b = bEnd;
+            const Collider* last = nullptr;
+            for (const Collider& s : m.shapes) {
+              Vec2d n;
+              const double d = outsideCollider(s, a, b, n);
+              if (d >= 0) continue;
+              b -= d * n;
+              nb = n;
+              last = &s;
+            }
+            x = toLocal(b);
+            if (intoStatic(x)) {
+              x = xw;
+              Vec2d way;
+              if (last && squeezeDirection(*last, b, way)) {
+                const Vec2d tw = double(c.dx) * Vec2d(q.c1 * way.x() - q.s1 * way.y(), q.s1 * way.x() + q.c1 * way.y());
+                if (!intoStatic(xw + tw)) x = xw + tw;
+                else if (!intoStatic(xw - tw)) x = xw - tw;
+              }
+            }
+          }
+        }
         const Vec2d n(q.c1 * nb.x() - q.s1 * nb.y(), q.s1 * nb.x() + q.c1 * nb.y());
         c.P.x[i] = Vec2(Real(x.x()), Real(x.y()));
         if (m.dynamic()) {  // the contact is solved below, with the body's other contacts

@@ -105,9 +105,11 @@ std::vector<std::uint32_t> World::particlesTouching(const b2Fixture& fixture) co
     const Vec2d lo(box.lowerBound.x - reach, box.lowerBound.y - reach), hi(box.upperBound.x + reach, box.upperBound.y + reach);
     b2DistanceProxy part;
     part.Set(&shape, child);
-    // Box2D's polygons carry a skin (b2_polygonRadius) the fluid does not see: distances are
-    // to the core shape, less a circle's own radius.
-    const double radius = shape.GetType() == b2Shape::e_circle ? double(shape.m_radius) : 0.0;
+    // Distances are to the core shape, less the radius the fluid meets it at: a circle's own, a
+    // moving body's polygon's skin (b2_polygonRadius: moving_bodies.cpp); a static body's
+    // polygons, edges and chains are seen without their skin.
+    const bool skinned = shape.GetType() == b2Shape::e_polygon && fixture.GetBody()->GetType() != b2_staticBody;
+    const double radius = shape.GetType() == b2Shape::e_circle || skinned ? double(shape.m_radius) : 0.0;
     const std::vector<std::size_t> near = collect(w, lo, hi, [&](std::size_t i) {
       const Vec2d p = worldPosition(i);
       const b2Vec2 q(float(p.x()), float(p.y()));

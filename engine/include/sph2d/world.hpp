@@ -218,9 +218,10 @@ class World {
   /// Removes the particles inside the box [lo, hi] (world coordinates). Returns how many.
   std::size_t removeParticlesInBox(const Vec2d& lo, const Vec2d& hi);
 
-  /// The shapes of the moving (kinematic and dynamic) bodies at their current pose, in the
-  /// local frame like colliders() (polygons and circles; for drawing). They push the fluid;
-  /// the fluid does not push them yet.
+  /// The shapes of the moving (kinematic and dynamic) bodies at their current pose as the fluid
+  /// meets them, in the local frame like colliders() (polygons with Box2D's skin, faces moved
+  /// out by b2_polygonRadius and corners mitred; circles as they are; for drawing). They push
+  /// the fluid, and the fluid pushes the dynamic ones.
   std::vector<Collider> movingColliders() const;
   /// Writes the World's whole changing state (particles with every field, time and
   /// counters, emitters with their random streams, gravity, user forces, switched
@@ -314,7 +315,8 @@ class World {
   FieldSample sampleAt(const Vec2d& point) const;
   /// The ids of the particles touching `fixture` now (between frames: at the end of the last
   /// one): their centres within one spacing of its surface, or inside it; in slot order. Any
-  /// fixture of the b2World the fluid sees, static or moving, at the body's current pose.
+  /// fixture of the b2World the fluid sees, static or moving, at the body's current pose; the
+  /// surface where the fluid meets it (a moving body's polygon with Box2D's skin).
   std::vector<std::uint32_t> particlesTouching(const b2Fixture& fixture) const;
   /// Calls f(fixture, ids) for every fixture of box2d() that particles touch now, with their
   /// ids as particlesTouching() gives them; bodies and fixtures in Box2D's list order. The
