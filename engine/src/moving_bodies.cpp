@@ -10,13 +10,15 @@
 // (its radius is its skin). Box2D rests a polygon on another at about two skins less the
 // slop, core to core: seen without its skin, a crate on the floor left a 1.5 cm gap that
 // the fluid entered and was squeezed in. Everything that reads a body's shape (the
-// collision below, the grid's body cells and faces, the body's area and centroid, its
-// reach, movingColliders() for drawing) reads these. Static bodies' shapes stay cores
-// (boundary.cpp; their skins would move every tank's walls and water level): a skinned
+// collision below, the grid's body cells and faces, its reach, movingColliders() for
+// drawing) reads these; the body's area and centroid are its fixtures' (below). Static
+// bodies' shapes stay cores (boundary.cpp; their skins would move every tank's walls and
+// water level): a skinned
 // crate resting on a core floor leaves 0.5 cm, room for a particle kept the clearance
 // (0.25 spacing) off both only at a spacing of 1 cm or less, and then for one layer, which
-// is not squeezed. Box2D's mass is the core's: the fluid displaces the larger skinned
-// shape, so a polygon body floats a little higher than its density alone says.
+// is not squeezed. Box2D's mass is the core's, and so is the area the grid's buoyancy is
+// scaled to (shapeMoments of the cores): the skin keeps water out without making a body
+// lighter than its density says (density 1000 stays neutral).
 // Per substep:
 //  - `body_gravity` (after `emit`, with a dynamic body): its velocity takes g·dt;
 //  - the game solver's grid projection treats the bodies as moving solids and solves
@@ -198,13 +200,16 @@ void withSkin(const b2PolygonShape& poly, Collider& c) {
   }
 }
 
-/// A moving body's area and centroid (body coordinates, offset from its centre of mass):
-/// exact for one shape; for several, which may overlap, their union sampled on a 96 × 96
-/// lattice over their bounds (the grid's face correction scales the pressure to this area).
-void shapeMoments(MovingSolid& m) {
+/// A moving body's area and centroid (body coordinates, offset from its centre of mass) from
+/// `shapes`: exact for one shape; for several, which may overlap, their union sampled on a
+/// 96 × 96 lattice over their bounds (the grid's face correction scales the pressure to this
+/// area). Given the fixtures' cores, as Box2D weighs them, not the skinned shapes the fluid is
+/// kept out of: so a body floats by Archimedes for its fixtures (density 1000 is neutral),
+/// the skin only closing the gaps Box2D leaves between resting bodies.
+void shapeMoments(MovingSolid& m, const std::vector<Collider>& shapes) {
   Vec2d sum(0, 0);
-  if (m.shapes.size() == 1) {
-    const Collider& c = m.shapes[0];
+  if (shapes.size() == 1) {
+    const Collider& c = shapes[0];
     if (c.kind == Collider::Kind::Circle) {
       m.area = 3.14159265358979323846 * double(c.radius) * double(c.radius);
       sum = m.area * Vec2d(c.center.x(), c.center.y());
@@ -219,7 +224,7 @@ void shapeMoments(MovingSolid& m) {
     }
   } else {
     Vec2d lo(1e300, 1e300), hi(-1e300, -1e300);
-    for (const Collider& c : m.shapes) {
+    for (const Collider& c : shapes) {
       const double r = c.kind == Collider::Kind::Circle ? double(c.radius) : 0.0;
       if (c.kind == Collider::Kind::Circle) {
         lo = lo.cwiseMin(Vec2d(c.center.x() - r, c.center.y() - r));
@@ -236,7 +241,7 @@ void shapeMoments(MovingSolid& m) {
     for (int j = 0; j < kSamples; ++j)
       for (int i = 0; i < kSamples; ++i) {
         const Vec2d p = lo + Vec2d((i + 0.5) * step.x(), (j + 0.5) * step.y());
-        for (const Collider& c : m.shapes) {
+        for (const Collider& c : shapes) {
           Vec2d n;
           if (outsideCollider(c, p, p, n) < 0) {
             m.area += cell;
@@ -260,12 +265,21 @@ void World::Impl::captureBodies() {
     if (body->GetType() == b2_staticBody) continue;
     MovingSolid m;
     m.body = body;
+    std::vector<Collider> cores;  // the fixtures as Box2D weighs them (shapeMoments)
     for (b2Fixture* fx = body->GetFixtureList(); fx; fx = fx->GetNext()) {
       const b2Shape* shape = fx->GetShape();
       Collider c;
       if (shape->GetType() == b2Shape::e_polygon) {
+        const auto* poly = static_cast<const b2PolygonShape*>(shape);
+        Collider core;
+        core.kind = Collider::Kind::Polygon;
+        for (int i = 0; i < poly->m_count; ++i) {
+          core.vertices.push_back(Vec2(poly->m_vertices[i].x, poly->m_vertices[i].y));
+          core.normals.push_back(Vec2(poly->m_normals[i].x, poly->m_normals[i].y));
+        }
+        cores.push_back(std::move(core));
         c.kind = Collider::Kind::Polygon;
-        withSkin(*static_cast<const b2PolygonShape*>(shape), c);
+        withSkin(*poly, c);
       } else if (shape->GetType() == b2Shape::e_circle) {
         const auto* circle = static_cast<const b2CircleShape*>(shape);
         c.kind = Collider::Kind::Circle;
@@ -275,6 +289,7 @@ void World::Impl::captureBodies() {
       } else {
         continue;  // edges and chains enclose nothing
       }
+      if (c.kind == Collider::Kind::Circle) cores.push_back(c);
       m.shapes.push_back(std::move(c));
     }
     if (m.shapes.empty()) continue;
@@ -297,7 +312,7 @@ void World::Impl::captureBodies() {
         m.radius = std::max(m.radius, (Vec2d(c.center.x(), c.center.y()) - m.localCenter).norm() + double(c.radius));
       for (const Vec2& p : c.vertices) m.radius = std::max(m.radius, (Vec2d(p.x(), p.y()) - m.localCenter).norm());
     }
-    shapeMoments(m);
+    shapeMoments(m, cores);
     double theta;
     m.pose(0, theta, m.sweptOrigin);
     m.sweptTheta = theta;
