@@ -265,7 +265,6 @@ void World::Impl::captureBodies() {
     if (body->GetType() == b2_staticBody) continue;
     MovingSolid m;
     m.body = body;
-    std::vector<Collider> cores;  // the fixtures as Box2D weighs them (shapeMoments)
     for (b2Fixture* fx = body->GetFixtureList(); fx; fx = fx->GetNext()) {
       const b2Shape* shape = fx->GetShape();
       Collider c;
@@ -277,7 +276,7 @@ void World::Impl::captureBodies() {
           core.vertices.push_back(Vec2(poly->m_vertices[i].x, poly->m_vertices[i].y));
           core.normals.push_back(Vec2(poly->m_normals[i].x, poly->m_normals[i].y));
         }
-        cores.push_back(std::move(core));
+        m.cores.push_back(std::move(core));
         c.kind = Collider::Kind::Polygon;
         withSkin(*poly, c);
       } else if (shape->GetType() == b2Shape::e_circle) {
@@ -289,7 +288,7 @@ void World::Impl::captureBodies() {
       } else {
         continue;  // edges and chains enclose nothing
       }
-      if (c.kind == Collider::Kind::Circle) cores.push_back(c);
+      if (c.kind == Collider::Kind::Circle) m.cores.push_back(c);
       m.shapes.push_back(std::move(c));
     }
     if (m.shapes.empty()) continue;
@@ -312,7 +311,7 @@ void World::Impl::captureBodies() {
         m.radius = std::max(m.radius, (Vec2d(c.center.x(), c.center.y()) - m.localCenter).norm() + double(c.radius));
       for (const Vec2& p : c.vertices) m.radius = std::max(m.radius, (Vec2d(p.x(), p.y()) - m.localCenter).norm());
     }
-    shapeMoments(m, cores);
+    shapeMoments(m, m.cores);
     double theta;
     m.pose(0, theta, m.sweptOrigin);
     m.sweptTheta = theta;
