@@ -8,6 +8,7 @@
 #include <box2d/box2d.h>
 
 #include <cmath>
+#include <map>
 
 #include "support/fixture.hpp"
 
@@ -119,4 +120,48 @@ TEST_CASE("body samples: a neutrally buoyant muller2003 crate stays within 3 cm 
 
 TEST_CASE("body samples: a floating crate gives the same bits on 1 2 and 3 threads crate included (wcsph and muller2003)") {
   for (const char* solver : {"wcsph", "muller2003"}) sameBitsOnThreads(solver);
+}
+
+TEST_CASE("body samples: beside a kinematic box at rest each particle has the density it has beside the same box static to 1 % (wcsph and muller2003)") {
+  // A 0.4 m × 0.12 m box in a 2 m × 0.6 m block of water at rest (no gravity: the lattice stays
+  // square, half a spacing off every face), once static (the static solids' samples), once
+  // kinematic at rest (its own samples, sampled in its frame and placed at its pose). After a
+  // substep each particle within 2 spacings of the box has the same density in both, to 1 %
+  // (measured 0.23 % with wcsph, 0.89 % with muller2003, beside the corners at x = 1.2: the
+  // sampler splits the samples on a corner's diagonal between its two faces by a rounding that
+  // differs between the body's frame and the local one). Without samples on the moving box
+  // they differed by up to 25 % (wcsph) and 31 % (muller2003).
+  for (const char* solver : {"wcsph", "muller2003"}) {
+    std::map<std::uint32_t, double> rho[2];
+    for (int kinematic = 0; kinematic < 2; ++kinematic) {
+      SceneDef s = test::tank(solver, 2.0, 1.0, 0.02);
+      s.gravity = Vec2d(0, 0);
+      s.blocks.push_back(test::block({0, 0}, {2.0, 0.6}));
+      BodyDef box;
+      box.type = kinematic ? BodyDef::Type::Kinematic : BodyDef::Type::Static;
+      box.position = Vec2d(1.0, 0.3);
+      box.fixtures.push_back(test::boxShape({0, 0}, {0.2, 0.06}));
+      s.bodies.push_back(box);
+      World w(s, WorldOptions{2});
+      w.stepSubstep();
+      const double d = 2 * double(w.spacing());  // the rows at 0.5 and 1.5 spacings
+      for (std::size_t i = 0; i < w.particleCount(); ++i) {
+        const Vec2d x = w.worldPosition(i);
+        const double ex = std::fabs(x.x() - 1.0) - 0.2, ey = std::fabs(x.y() - 0.3) - 0.06;
+        if (std::max(ex, ey) > 0 && ex < d && ey < d) rho[kinematic][w.particles().id[i]] = double(w.particles().rho[i]);
+      }
+    }
+    REQUIRE(rho[0].size() > 20);
+    CHECK(rho[1].size() == rho[0].size());
+    double worst = 0, lowest = 1e300;
+    for (const auto& [id, r] : rho[0]) {
+      const auto k = rho[1].find(id);
+      REQUIRE(k != rho[1].end());
+      worst = std::max(worst, std::fabs(k->second - r) / r);
+      lowest = std::min(lowest, r);
+    }
+    MESSAGE(solver << ": " << rho[0].size() << " particles beside the box, the least density " << lowest
+                   << " kg/m³, the largest relative difference kinematic against static " << worst);
+    CHECK(worst <= 0.01);
+  }
 }
