@@ -1,5 +1,5 @@
 #!/bin/sh
-# What five dynamic bodies cost the game solver at 20k particles (issue 16: "the cost per
+# What five dynamic bodies cost a solver (the game solver unless QUALITY says) at 20k particles (issue 16: "the cost per
 # frame with 5 bodies at 20k particles").
 #
 # Makes two scenes from assets/scenes/dam_break.json with spacing 0.01 (about 20,000
@@ -10,12 +10,15 @@
 # run's wall time per frame and, per pair, what the crates added. A benchmark, not a test:
 # the machine is shared, so only the interleaved difference means much.
 #
-# Usage: benchmarks/bodies_cost.sh [PAIRS] [FRAMES] [THREADS]   (defaults 3, 120, 2)
+# QUALITY picks the solver by solver.quality (game, balanced: wcsph, accurate: dfsph).
+#
+# Usage: benchmarks/bodies_cost.sh [PAIRS] [FRAMES] [THREADS] [QUALITY]   (defaults 3, 120, 2, game)
 set -eu
 root=$(cd "$(dirname "$0")/.." && pwd)
 pairs=${1:-3}
 frames=${2:-120}
 threads=${3:-2}
+quality=${4:-game}
 app=$root/build/app/sph2d
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
@@ -23,6 +26,7 @@ trap 'rm -rf "$work"' EXIT
 
 duration=$(awk -v f="$frames" 'BEGIN { printf "%.6f", f / 60 }')
 sed -e 's/"spacing": 0.014/"spacing": 0.01/' -e "s/\"duration\": 4.0/\"duration\": $duration/" \
+  -e "s/\"quality\": \"game\"/\"quality\": \"$quality\"/" \
   "$root/assets/scenes/dam_break.json" > "$work/plain.json"
 # The crates go in after the static tank (its closing "] }" line, then "],").
 awk '
@@ -46,7 +50,7 @@ run() {  # prints wall ms per frame of scene $1
   awk -v s="$start" -v e="$end" -v f="$frames" 'BEGIN { printf "%.2f", 1000 * (e - s) / f }'
 }
 
-echo "dam break at spacing 0.01, $frames frames, $threads threads: wall ms per frame"
+echo "dam break ($quality) at spacing 0.01, $frames frames, $threads threads: wall ms per frame"
 echo "pair  plain  crates  added"
 i=1
 while [ "$i" -le "$pairs" ]; do

@@ -268,7 +268,10 @@ Real BoundarySet::insideDepth(const Vec2& p) const {
   return depth;
 }
 
-void BoundarySet::sample(Real dx, Real depth, ThreadPool& pool) {
+void colliderBounds(Collider& c) { finishBounds(c); }
+
+void sampleColliders(const std::vector<Collider>& colliders, Real dx, Real depth, std::vector<Vec2>& samples,
+                     std::vector<Real>& volume, std::vector<Vec2>& sideNormal, std::vector<Real>& sideOffset) {
   samples.clear();
   volume.clear();
   sideNormal.clear();
@@ -361,6 +364,10 @@ void BoundarySet::sample(Real dx, Real depth, ThreadPool& pool) {
     sideNormal.resize(out);
     sideOffset.resize(out);
   }
+}
+
+void BoundarySet::sample(Real dx, Real depth, ThreadPool& pool) {
+  sampleColliders(colliders, dx, depth, samples, volume, sideNormal, sideOffset);
   sampleGrid.build(samples.data(), samples.size(), depth, pool);
   // noSamplesNear's map: each occupied cell marks the block of cells whose queries visit it.
   const Grid& g = sampleGrid;

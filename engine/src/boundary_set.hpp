@@ -32,6 +32,17 @@ class b2World;
 
 namespace sph2d {
 
+/// Fills `colliders` (each with its bounds, colliderBounds) with layers of boundary samples at
+/// spacing dx down to depth `depth` (the layering and volumes described above; a sample inside
+/// an earlier solid collider is left out): positions, volumes Ψ_b and, for a two-sided
+/// segment's samples, the side they are visible from (BoundarySet's fields of those names).
+/// BoundarySet::sample for the static solids; body_samples.cpp for each moving body, in its frame.
+void sampleColliders(const std::vector<Collider>& colliders, Real dx, Real depth, std::vector<Vec2>& samples,
+                     std::vector<Real>& volume, std::vector<Vec2>& sideNormal, std::vector<Real>& sideOffset);
+
+/// Sets c.lo and c.hi, the bounds of a polygon's vertices or of a circle.
+void colliderBounds(Collider& c);
+
 struct BoundarySet {
   std::vector<Collider> colliders;
   std::vector<Vec2> samples;   ///< boundary sample positions (local frame)

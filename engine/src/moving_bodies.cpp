@@ -7,7 +7,8 @@
 // mass and inertia (moving_solid.hpp: a body moves along a piecewise-linear path
 // within the step), and its shapes as the fluid meets them: a polygon with Box2D's skin
 // (b2_polygonRadius, 1 cm: withSkin, faces moved out, corners mitred), a circle as it is
-// (its radius is its skin). Box2D rests a polygon on another at about two skins less the
+// (its radius is its skin); for a solver that samples moving bodies (body_samples.hpp:
+// wcsph, muller2003) the fixtures themselves, which its samples stand for. Box2D rests a polygon on another at about two skins less the
 // slop, core to core: seen without its skin, a crate on the floor left a 1.5 cm gap that
 // the fluid entered and was squeezed in. Everything that reads a body's shape (the
 // collision below, the grid's body cells and faces, its reach, movingColliders() for
@@ -261,6 +262,10 @@ void World::Impl::captureBodies() {
   moving.bodies.clear();
   moving.time0 = time;
   const b2Vec2 g = b2->GetGravity();
+  // A solver that samples the moving bodies (Solver::movingSamples: wcsph, muller2003) meets
+  // them at their fixtures, as its samples stand for them: their pressure keeps the water out
+  // of the gaps Box2D leaves, as at a static wall. The others meet a polygon at its skin.
+  const bool skinned = !(solver && solver->movingSamples());
   for (b2Body* body = b2->GetBodyList(); body; body = body->GetNext()) {
     if (body->GetType() == b2_staticBody) continue;
     MovingSolid m;
@@ -276,9 +281,13 @@ void World::Impl::captureBodies() {
           core.vertices.push_back(Vec2(poly->m_vertices[i].x, poly->m_vertices[i].y));
           core.normals.push_back(Vec2(poly->m_normals[i].x, poly->m_normals[i].y));
         }
+        if (skinned) {
+          c.kind = Collider::Kind::Polygon;
+          withSkin(*poly, c);
+        } else {
+          c = core;
+        }
         m.cores.push_back(std::move(core));
-        c.kind = Collider::Kind::Polygon;
-        withSkin(*poly, c);
       } else if (shape->GetType() == b2Shape::e_circle) {
         const auto* circle = static_cast<const b2CircleShape*>(shape);
         c.kind = Collider::Kind::Circle;

@@ -73,6 +73,7 @@ std::size_t World::Impl::fillBlock(const FluidBlockDef& b, bool hydrostaticStart
       if (disc && !((pw - b.center).squaredNorm() <= b.radius * b.radius)) continue;
       if (b.shape == FluidBlockDef::Shape::Polygon && !FluidBlockDef::insideRow(crossings, pw.x())) continue;
       const Vec2 p = Vec2(Real(pw.x() - origin.x()), Real(pw.y() - origin.y()));
+      if (nearMovingSamples(p) && !insideMoving(p)) continue;  // on a moving body's samples: left out, no warning
       if (boundary.insideDepth(p) > 0 || insideMoving(p)) {
         dlo = dropped ? dlo.cwiseMin(pw) : pw;
         dhi = dropped ? dhi.cwiseMax(pw) : pw;

@@ -2,6 +2,8 @@
 // integration, collision, the periodic wrap, and the deterministic reductions.
 #include "stages.hpp"
 
+#include "body_samples.hpp"
+
 #include <algorithm>
 #include <atomic>
 #include <cmath>
@@ -215,6 +217,12 @@ void stageNeighbours(StepContext& c) {
   const Real R2 = c.R * c.R;
   const PeriodicBox per = c.periodic;
   const bool walls = !B.samples.empty();
+  const BodySamples* moving = c.bodySamples && c.bodySamples->active() ? c.bodySamples : nullptr;
+  if (moving) {
+    L.movingPerBlock.resize(blocks);
+    L.movingStart.resize(n);
+    L.movingCount.resize(n);
+  }
   // Candidates that are slots (just reordered) and no wrap: four at a time.
   const bool inOrder = g.inOrder && !per.any() && g.sorted.size() == n;
 #ifdef SPH2D_AVX512_NEIGHBOURS
@@ -265,6 +273,24 @@ void stageNeighbours(StepContext& c) {
           if ((xi - B.samples[s]).squaredNorm() < R2 && B.visible(s, xi)) bout.push_back(s);
         });
       L.boundaryCount[i] = std::uint32_t(bout.size() - L.boundaryStart[i]);
+      if (moving) {
+        // The moving bodies' samples within R: body by body, each searched in its own
+        // frame's grid, the distance tested in the local frame.
+        std::vector<std::uint32_t>& mout = L.movingPerBlock[b / kBlock];
+        if (i == b) mout.clear();
+        L.movingStart[i] = std::uint32_t(mout.size());
+        for (const BodySamples::Placed& q : moving->placed) {
+          const Real ex = xi.x() - q.com.x(), ey = xi.y() - q.com.y();
+          if (!(ex * ex + ey * ey < q.reach2)) continue;
+          const double px = double(xi.x()) - q.origin.x(), py = double(xi.y()) - q.origin.y();
+          const Vec2 pb(Real(q.c * px + q.s * py), Real(-q.s * px + q.c * py));
+          const Vec2* xs = moving->x.data() + q.first;
+          q.sampled->grid.forCandidates(pb, [&](std::uint32_t s) {
+            if ((xi - xs[s]).squaredNorm() < R2) mout.push_back(q.first + s);
+          });
+        }
+        L.movingCount[i] = std::uint32_t(mout.size() - L.movingStart[i]);
+      }
     }
   });
 }

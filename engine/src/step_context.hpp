@@ -29,6 +29,7 @@
 namespace sph2d {
 
 struct MovingSolids;
+struct BodySamples;
 
 constexpr std::size_t kNone = std::numeric_limits<std::size_t>::max();  ///< "no bad particle"
 
@@ -42,12 +43,17 @@ struct NeighbourLists {
   std::vector<std::vector<std::uint32_t>> boundaryPerBlock;  ///< boundary sample indices, block by block
   std::vector<std::uint32_t> boundaryStart;          ///< offset of particle i's boundary list in its block
   std::vector<std::uint32_t> boundaryCount;          ///< number of boundary samples near particle i
+  std::vector<std::vector<std::uint32_t>> movingPerBlock;  ///< moving bodies' samples (BodySamples), block by block
+  std::vector<std::uint32_t> movingStart;            ///< offset of particle i's moving-sample list in its block
+  std::vector<std::uint32_t> movingCount;            ///< number of moving bodies' samples near particle i
   /// First fluid neighbour slot of particle i.
   const std::uint32_t* of(std::size_t i) const { return perBlock[i / kBlock].data() + start[i]; }
   /// First boundary sample index near particle i.
   const std::uint32_t* boundaryOf(std::size_t i) const {
     return boundaryPerBlock[i / kBlock].data() + boundaryStart[i];
   }
+  /// First moving bodies' sample index near particle i (only while BodySamples::active()).
+  const std::uint32_t* movingOf(std::size_t i) const { return movingPerBlock[i / kBlock].data() + movingStart[i]; }
   /// Total fluid pairs (each counted from both sides).
   std::size_t pairs() const {
     std::size_t n = 0;
@@ -103,6 +109,10 @@ struct StepContext {
   std::uint64_t boundaryVersion = 0;  ///< counts the times the colliders were read: changes whenever they are read again
   MovingSolids* solids = nullptr;     ///< the kinematic and dynamic bodies this step (moving_solid.hpp); null when none
   WallAccount* wall = nullptr;        ///< where stages add the static solids' impulse (null: not counted, e.g. prepare)
+  /// The moving bodies' boundary samples (body_samples.hpp), for a solver that takes them
+  /// (Solver::movingSamples) in a scene with moving bodies; else null. The neighbour lists
+  /// hold them only while bodySamples->active().
+  BodySamples* bodySamples = nullptr;
 };
 
 /// Lowest slot reported by the blocks (the blocks are in slot order).

@@ -50,6 +50,7 @@ StepContext World::Impl::context(Real dt) {
   c.periodic = periodic;
   c.boundaryVersion = boundaryVersion;
   c.solids = moving.bodies.empty() ? nullptr : &moving;
+  if (bodySamplesOn()) c.bodySamples = &bodySamples;
   return c;
 }
 
@@ -57,6 +58,7 @@ void World::Impl::buildStages() {
   stages.clear();
   if (!emitters.empty()) stages.add(plainStage("emit", [this](StepContext& c) { emit(c.dt); }));
   if (moving.anyDynamic()) stages.add(plainStage("body_gravity", [this](StepContext& c) { bodyGravity(c); }));
+  if (bodySamplesOn()) stages.add(plainStage("body_samples", [this](StepContext& c) { bodySamples.place(c, moving); }));
   bool anyEffect = false;
   Effect* first = nullptr;  // the first enabled effect: the solver may fold it into its pressure force
   for (const auto& e : effects) {
@@ -81,6 +83,7 @@ void World::Impl::buildStages() {
   if (!marker)
     throw std::logic_error(std::string("solver ") + solver->name() + " has no effects marker in its stages");
   stages.add(plainStage("max_acceleration", [this](StepContext& c) { lastAccel = maxAccelOf(c.P, c.pool); }));
+  if (bodySamplesOn()) stages.add(plainStage("body_forces", [this](StepContext& c) { bodySamples.react(c, moving); }));
   addParticleSystemStages(stages);
 
   drift.clear();

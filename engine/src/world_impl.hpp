@@ -20,6 +20,7 @@
 #include <utility>
 #include <vector>
 
+#include "body_samples.hpp"
 #include "effects/effect.hpp"
 #include "moving_solid.hpp"
 #include "solvers/solver.hpp"
@@ -116,6 +117,15 @@ struct World::Impl {
   std::vector<int> contactCount;        ///< … its approaching contacts
   std::vector<Vec2d> contactImpulse;    ///< … the contacts' impulse on it
   std::vector<double> contactTorque;    ///< … and their angular impulse
+
+  /// The moving bodies' boundary samples (body_samples.hpp), when the solver takes them.
+  BodySamples bodySamples;
+  /// True when the substep places moving bodies' samples: some moving body, and a solver that takes them.
+  bool bodySamplesOn() const { return !moving.bodies.empty() && solver && solver->movingSamples(); }
+  /// With moving bodies' samples (bodySamplesOn), true when local point p lies within 0.4
+  /// spacing outside a moving body at the current pose: a particle there would overlap the
+  /// samples' first layer (dx/2 deep), so a fluid block leaves it out (body_samples.cpp).
+  bool nearMovingSamples(const Vec2& p) const;
 
   /// Changes of the particles made between steps (the API's adds, removals and moves):
   /// with `steps` and the count, what the query grid is valid for.

@@ -270,7 +270,7 @@ TEST_CASE("moving bodies: water thrown at a free crate in zero gravity keeps the
     // The game solver's pressure reaches the crate on the grid, whose faces are corrected to
     // give a body its true area (markBodies): first order in the cell size, so the balance
     // is 2.4 % with the crate 10 × 15 cells (spacing 0.01) and 5.6 % at 5 × 7.5 (0.02).
-    // wcsph's contacts exchange exactly opposite impulses.
+    // wcsph's contacts and its moving samples (body_samples.hpp) exchange exactly opposite impulses.
     const double dx = 0.01;
     SceneDef s = test::tank(solver, 4.0, 4.0, dx);
     s.gravity = Vec2d(0, 0);

@@ -9,10 +9,12 @@
 // momentum, velocityVariance, layerVelocityDifference, centroid,
 // minPairDistance(Periodic), inertiaAspect, cornerRatio, surfaceHeight,
 // PressureProbe (fitLine). Flows:
-// wallScene, periodicShearLayer, freeMovingBlock (momentumOver).
+// wallScene, periodicShearLayer, freeMovingBlock (momentumOver). Floating bodies:
+// crateScene, dynamicBody, crateSurface, bottomOf, insideMovingCount.
 #pragma once
 
 #include <Eigen/Eigenvalues>
+#include <box2d/box2d.h>
 
 #include <algorithm>
 #include <cmath>
@@ -363,6 +365,74 @@ inline double cornerRatio(const World& w) {
     far[std::size_t(k)] = std::max(far[std::size_t(k)], d.norm());
   }
   return *std::max_element(far.begin(), far.end()) / *std::min_element(far.begin(), far.end());
+}
+
+// --- floating bodies ---------------------------------------------------------
+
+/// A 2 m × 1 m tank with 0.6 m of still water (spacing 0.01) and a dynamic crate, 0.6 m × 0.2 m
+/// of density `density` kg/m², its centre at height `y`, solver `solver`.
+inline SceneDef crateScene(const std::string& solver, double density, double y) {
+  SceneDef s = tank(solver, 2.0, 1.0, 0.01);
+  s.blocks.push_back(block({0, 0}, {2.0, 0.6}));
+  BodyDef crate;
+  crate.type = BodyDef::Type::Dynamic;
+  crate.position = Vec2d(1.0, y);
+  ShapeDef box = boxShape({0, 0}, {0.3, 0.1});
+  box.density = density;
+  crate.fixtures.push_back(box);
+  s.bodies.push_back(crate);
+  return s;
+}
+
+/// The world's first dynamic body (null: none).
+inline const b2Body* dynamicBody(const World& w) {
+  for (const b2Body* b = w.box2d().GetBodyList(); b; b = b->GetNext())
+    if (b->GetType() == b2_dynamicBody) return b;
+  return nullptr;
+}
+
+/// The water's surface height in [x0, x1]: over columns three spacings wide (so that a
+/// column always holds a surface particle), the mean of the highest particle's centre,
+/// plus half a spacing.
+inline double crateSurface(const World& w, double x0, double x1) {
+  const double dx = double(w.spacing()), bin = 3 * dx;
+  const int n = int(std::floor((x1 - x0) / bin));
+  std::vector<double> top(std::size_t(n), -1e300);
+  for (std::size_t i = 0; i < w.particleCount(); ++i) {
+    const Vec2d q = w.worldPosition(i);
+    const int k = int(std::floor((q.x() - x0) / bin));
+    if (k >= 0 && k < n) top[std::size_t(k)] = std::max(top[std::size_t(k)], q.y());
+  }
+  double sum = 0;
+  for (double t : top) sum += t;
+  return sum / n + 0.5 * dx;
+}
+
+/// The lowest point of a body of polygons (world coordinates).
+inline double bottomOf(const b2Body* b) {
+  double lo = 1e300;
+  for (const b2Fixture* f = b->GetFixtureList(); f; f = f->GetNext()) {
+    const auto* poly = static_cast<const b2PolygonShape*>(f->GetShape());
+    for (int i = 0; i < poly->m_count; ++i) lo = std::min(lo, double(b2Mul(b->GetTransform(), poly->m_vertices[i]).y));
+  }
+  return lo;
+}
+
+/// Particles deeper than 0.1 spacing inside any moving body.
+inline std::size_t insideMovingCount(const World& w) {
+  std::size_t n = 0;
+  const std::vector<Collider> shapes = w.movingColliders();
+  for (std::size_t i = 0; i < w.particleCount(); ++i) {
+    const Vec2 x = w.particles().x[i];
+    for (const Collider& c : shapes) {
+      Real depth = 1e30f;
+      if (c.kind == Collider::Kind::Circle) depth = c.radius - (x - c.center).norm();
+      else
+        for (std::size_t f = 0; f < c.vertices.size(); ++f) depth = std::min(depth, -c.normals[f].dot(x - c.vertices[f]));
+      if (depth > Real(0.1) * w.spacing()) ++n;
+    }
+  }
+  return n;
 }
 
 }  // namespace sph2d::test

@@ -61,6 +61,13 @@ class Solver {
     (void)viscosity;
     return false;
   }
+  /// True when the solver takes the moving bodies' boundary samples (body_samples.hpp): it
+  /// counts them in its density and wall terms (with their velocity) while
+  /// StepContext::bodySamples is active, and adds the force they exert on each particle to
+  /// BodySamples::perBlock; the World then places them each substep and gives each dynamic
+  /// body the opposite. False (the default): the bodies meet the fluid by the `bodies`
+  /// stage's contacts alone (and the game solver's grid).
+  virtual bool movingSamples() const { return false; }
   /// Iterations and residuals of the last substep (explicit solvers: all zero).
   virtual SolverStats stats() const { return {}; }
   /// Writes what the solver carries from one substep to the next outside the particle

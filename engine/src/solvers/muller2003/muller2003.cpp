@@ -4,7 +4,9 @@
 // m (p_i + p_j)/(2ρ_j) ∇W, gravity, the scene's effects (viscosity: the
 // viscosity-kernel Laplacian), symplectic Euler. Walls: the boundary samples
 // act as frozen fluid in the density, and push with the particle's own
-// pressure only (the single term; see pressureForce).
+// pressure only (the single term; see pressureForce). A moving body's samples
+// (body_samples.hpp) are such walls too, moving with the body (the no-slip wall
+// term takes the sample's velocity); their force on the fluid goes back to the body.
 //
 // Measured property (docs/SCENES.md): the density and gradient kernels differ,
 // so the pressure force is not the gradient of an energy, and the symmetric
@@ -13,6 +15,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "body_samples.hpp"
 #include "constants.hpp"
 #include "effects/effect.hpp"
 #include "solvers/solver.hpp"
@@ -48,6 +51,7 @@ std::size_t density(StepContext& c, const Poly6<Real>& W) {
   const NeighbourLists& L = c.nbr;
   const BoundarySet& B = c.boundary;
   const bool hasBoundary = !B.samples.empty();
+  const BodySamples* moving = c.bodySamples && c.bodySamples->active() ? c.bodySamples : nullptr;
   const Real self = W.valueR2(0);
   const bool simd = !c.periodic.any();
 #ifdef SPH2D_SSE2_PAIRS
@@ -100,6 +104,13 @@ std::size_t density(StepContext& c, const Poly6<Real>& W) {
         for (std::uint32_t q = 0; q < L.boundaryCount[i]; ++q)
           bs += B.volume[bl[q]] * W.valueR2((xi - B.samples[bl[q]]).squaredNorm());
         rho += c.rho0 * bs;
+      }
+      if (moving) {
+        Real ms = 0;
+        const std::uint32_t* ml = L.movingOf(i);
+        for (std::uint32_t q = 0; q < L.movingCount[i]; ++q)
+          ms += moving->volume[ml[q]] * W.valueR2((xi - moving->x[ml[q]]).squaredNorm());
+        rho += c.rho0 * ms;
       }
       P.rho[i] = rho;
       if (!std::isfinite(rho) && bad == kNone) bad = i;
@@ -276,6 +287,7 @@ std::size_t pressureForce(StepContext& c, const Spiky<Real>& spiky, const Viscos
   ParticleStore& P = c.P;
   const BoundarySet& B = c.boundary;
   const bool hasBoundary = !B.samples.empty();
+  BodySamples* moving = c.bodySamples && c.bodySamples->active() ? c.bodySamples : nullptr;
   PairConstants k{};
   k.R = spiky.R;
   k.spikyK = Real(-3) * spiky.c;  // dW/dr = −3c(R − r)²
@@ -440,6 +452,38 @@ std::size_t pressureForce(StepContext& c, const Spiky<Real>& spiky, const Viscos
         if (!allFinite(av) && bad == kNone) bad = i;
         acc += av;
       }
+      if (moving && c.nbr.movingCount[i] > 0) {
+        // The moving bodies' samples: the same wall terms (the no-slip term with the sample's
+        // velocity), body by body; each body's share of the acceleration is its reaction.
+        const std::uint32_t* ml = c.nbr.movingOf(i);
+        const std::uint32_t mc = c.nbr.movingCount[i];
+        const Real pK = Real(0.5) * pi * invRhoi;
+        for (std::uint32_t q = 0; q < mc;) {
+          const std::uint32_t body = moving->body[ml[q]];
+          Vec2 gb = Vec2::Zero(), lv = Vec2::Zero();
+          Real tb = 0, tv = 0;  // Σ arm × (the pair's term), for the torque
+          for (; q < mc && moving->body[ml[q]] == body; ++q) {
+            const std::uint32_t s = ml[q];
+            const Vec2 d = xi - moving->x[s];
+            const Real rr = d.squaredNorm();
+            const Vec2 g = spiky.gradient(d, std::sqrt(rr)) * moving->volume[s];
+            gb += g;
+            const Vec2& arm = moving->arm[s];
+            tb += arm.x() * g.y() - arm.y() * g.x();
+            if (Visc && vt.walls) {
+              const Vec2 u = (Vec2(vix, viy) - moving->v[s]) * (moving->volume[s] * W.laplacianR2(rr));
+              lv += u;
+              tv += arm.x() * u.y() - arm.y() * u.x();
+            }
+          }
+          const Real vK = Visc && vt.walls ? vt.wallFactor * invRhoi : Real(0);
+          const Vec2 aBody = -(gb * pK) - lv * vK;
+          acc += aBody;
+          if (moving->placed[body].dynamic)
+            moving->addReaction(b / kBlock, body, aBody.cast<double>() * double(c.mass),
+                                -(double(tb) * double(pK) + double(tv) * double(vK)) * double(c.mass));
+        }
+      }
       P.a[i] = acc;
       if (!allFinite(acc) && bad == kNone) bad = i;
     }
@@ -459,6 +503,9 @@ class Muller2003 final : public Solver {
   double hydrostaticFactor() const override { return 2.0 / (c_ * c_); }
 
   double densityKernel(double r, double R) const override { return Poly6<double>(R).value(r); }
+
+  /// The moving bodies' samples are walls like the static ones (body_samples.hpp).
+  bool movingSamples() const override { return true; }
 
   void prepare(StepContext& c) override {
     stageGrid(c, false);

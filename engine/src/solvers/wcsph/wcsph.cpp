@@ -27,6 +27,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "body_samples.hpp"
 #include "solvers/solver.hpp"
 
 namespace sph2d {
@@ -44,6 +45,10 @@ class Wcsph final : public Solver {
   double hydrostaticFactor() const override { return 1.0 / (double(c0_) * double(c0_)); }
 
   double densityKernel(double r, double R) const override { return WendlandC2<double>(R).value(r); }
+
+  // The moving bodies' samples are walls like the static ones, moving with their body (its
+  // velocity in the wall viscosity); their force on the fluid goes back to the body.
+  bool movingSamples() const override { return true; }
 
   void prepare(StepContext& c) override {
     stageGrid(c, false);
@@ -84,6 +89,7 @@ class Wcsph final : public Solver {
     const Vec2* X = P.x.data();
     const Real self = W.value(0);
     const bool walls = !c.boundary.samples.empty();
+    const BodySamples* moving = c.bodySamples && c.bodySamples->active() ? c.bodySamples : nullptr;
     return firstBad(c.pool, P.size(), [&](std::size_t b, std::size_t e) {
       std::size_t bad = kNone;
       for (std::size_t i = b; i < e; ++i) {
@@ -102,6 +108,13 @@ class Wcsph final : public Solver {
           const std::uint32_t* bl = c.nbr.boundaryOf(i);
           for (std::uint32_t k = 0; k < c.nbr.boundaryCount[i]; ++k)
             s += c.boundary.volume[bl[k]] * W.value(std::sqrt((xi - c.boundary.samples[bl[k]]).squaredNorm()));
+          rho += c.rho0 * s;
+        }
+        if (moving) {
+          Real s = 0;
+          const std::uint32_t* ml = c.nbr.movingOf(i);
+          for (std::uint32_t k = 0; k < c.nbr.movingCount[i]; ++k)
+            s += moving->volume[ml[k]] * W.value(std::sqrt((xi - moving->x[ml[k]]).squaredNorm()));
           rho += c.rho0 * s;
         }
         P.rho[i] = rho;
@@ -142,6 +155,7 @@ class Wcsph final : public Solver {
     ParticleStore& P = c.P;
     const BoundarySet& B = c.boundary;
     const bool walls = !B.samples.empty();
+    BodySamples* moving = c.bodySamples && c.bodySamples->active() ? c.bodySamples : nullptr;
     const Real R = c.R, h = Real(0.5) * R;
     // ∇W = gradK (1 − q)³ d, with the pressure term renormalised by the lattice
     // gradient moment (kernels.hpp) so a hydrostatic column gets ρ g per metre.
@@ -210,6 +224,45 @@ class Wcsph final : public Solver {
           acc -= aPressure;
           acc += aViscous;
           wallAcc += aViscous.cast<double>() - aPressure.cast<double>();  // this particle's wall acceleration
+        }
+        if (moving && c.nbr.movingCount[i] > 0) {
+          // The moving bodies' samples: the same terms, the viscosity with the sample's
+          // velocity; body by body (the list holds each body's samples together), each body's
+          // share of the acceleration is also its reaction (body_samples.hpp).
+          const Real pi = P.p[i], rhoi = P.rho[i];
+          const Real pressK = c.rho0 * pScale, viscK = c.rho0 * avK * Real(2) / (rhoi + c.rho0);
+          const std::uint32_t* ml = c.nbr.movingOf(i);
+          const std::uint32_t mc = c.nbr.movingCount[i];
+          for (std::uint32_t k = 0; k < mc;) {
+            const std::uint32_t body = moving->body[ml[k]];
+            Vec2 gb = Vec2::Zero(), gv = Vec2::Zero();
+            Real tb = 0, tv = 0;  // Σ arm × (the pair's term), for the torque
+            for (; k < mc && moving->body[ml[k]] == body; ++k) {
+              const std::uint32_t s = ml[k];
+              const Vec2 d = X[i] - moving->x[s];
+              const Real rr = d.squaredNorm();
+              const Real q = std::sqrt(rr) * W.invR;
+              const Real a = Real(1) - q;
+              const Real gw = gradK * a * a * a * moving->volume[s];
+              const Real pb = std::max(Real(0), pi - rhoi * c.gravity.dot(d));
+              const Vec2 fp = d * (gw * (pri + pb / (c.rho0 * c.rho0)));
+              gb += fp;
+              const Vec2& arm = moving->arm[s];
+              tb += arm.x() * fp.y() - arm.y() * fp.x();
+              const Vec2 vr = V[i] - moving->v[s];
+              const Real vdotx = vr.x() * d.x() + vr.y() * d.y();
+              if (vdotx < 0) {
+                const Vec2 fv = d * (gw * (h * vdotx / (rr + eta2)));
+                gv += fv;
+                tv += arm.x() * fv.y() - arm.y() * fv.x();
+              }
+            }
+            const Vec2 aBody = gv * viscK - gb * pressK;
+            acc += aBody;
+            if (moving->placed[body].dynamic)
+              moving->addReaction(b / kBlock, body, aBody.cast<double>() * double(c.mass),
+                                  (double(tv) * double(viscK) - double(tb) * double(pressK)) * double(c.mass));
+          }
         }
         acc += c.gravity;
         P.a[i] = acc;
