@@ -29,24 +29,9 @@ SceneDef paddleScene(const std::string& solver) {
   return s;
 }
 
-/// Particles deeper than 0.1 spacing inside any moving body as the fluid meets it (a polygon
-/// with Box2D's skin: World::movingColliders()), those with y below `floorBand` not counted.
-std::size_t insideMoving(const World& w, double floorBand = -1e300) {
-  std::size_t n = 0;
-  const std::vector<Collider> shapes = w.movingColliders();
-  for (std::size_t i = 0; i < w.particleCount(); ++i) {
-    const Vec2 x = w.particles().x[i];
-    if (w.worldPosition(i).y() < floorBand) continue;
-    for (const Collider& c : shapes) {
-      Real depth = 1e30f;
-      if (c.kind == Collider::Kind::Circle) depth = c.radius - (x - c.center).norm();
-      else
-        for (std::size_t f = 0; f < c.vertices.size(); ++f) depth = std::min(depth, -c.normals[f].dot(x - c.vertices[f]));
-      if (depth > Real(0.1) * w.spacing()) ++n;
-    }
-  }
-  return n;
-}
+/// Particles deeper than 0.1 spacing inside any moving body, those below `floorBand` not
+/// counted (fixture.hpp's insideMovingCount).
+std::size_t insideMoving(const World& w, double floorBand = -1e300) { return test::insideMovingCount(w, floorBand); }
 
 }  // namespace
 
@@ -175,29 +160,11 @@ SceneDef crateScene(const std::string& solver, double density, double y) {
   return s;
 }
 
-/// The world's one dynamic body.
-const b2Body* dynamicBody(const World& w) {
-  for (const b2Body* b = w.box2d().GetBodyList(); b; b = b->GetNext())
-    if (b->GetType() == b2_dynamicBody) return b;
-  return nullptr;
-}
-
-/// The water's surface height in [x0, x1]: over columns three spacings wide (so that a
-/// column always holds a surface particle), the mean of the highest particle's centre,
-/// plus half a spacing.
-double surfaceIn(const World& w, double x0, double x1) {
-  const double dx = double(w.spacing()), bin = 3 * dx;
-  const int n = int(std::floor((x1 - x0) / bin));
-  std::vector<double> top(std::size_t(n), -1e300);
-  for (std::size_t i = 0; i < w.particleCount(); ++i) {
-    const Vec2d q = w.worldPosition(i);
-    const int k = int(std::floor((q.x() - x0) / bin));
-    if (k >= 0 && k < n) top[std::size_t(k)] = std::max(top[std::size_t(k)], q.y());
-  }
-  double sum = 0;
-  for (double t : top) sum += t;
-  return sum / n + 0.5 * dx;
-}
+// The crate helpers shared with test_body_samples.cpp (tests/support/fixture.hpp).
+using test::bottomOf;
+using test::dynamicBody;
+/// The water's surface height in [x0, x1] (fixture.hpp's crateSurface).
+double surfaceIn(const World& w, double x0, double x1) { return test::crateSurface(w, x0, x1); }
 
 /// Archimedes' draught of a box crate h tall of density `density` floating in water of density
 /// 1000 (kg/m²; the scenes' rest density): its fixture, as Box2D weighs it, under water by
@@ -205,16 +172,6 @@ double surfaceIn(const World& w, double x0, double x1) {
 /// the pressure on it to the fixture's area (moving_bodies.cpp shapeMoments), so the skin closes
 /// the gaps Box2D leaves under resting bodies without making a body lighter than its density.
 double archimedesDraught(double density, double h) { return h * density / 1000.0; }
-
-/// The lowest point of a body of polygons (world coordinates).
-double bottomOf(const b2Body* b) {
-  double lo = 1e300;
-  for (const b2Fixture* f = b->GetFixtureList(); f; f = f->GetNext()) {
-    const auto* poly = static_cast<const b2PolygonShape*>(f->GetShape());
-    for (int i = 0; i < poly->m_count; ++i) lo = std::min(lo, double(b2Mul(b->GetTransform(), poly->m_vertices[i]).y));
-  }
-  return lo;
-}
 
 }  // namespace
 

@@ -418,12 +418,14 @@ inline double bottomOf(const b2Body* b) {
   return lo;
 }
 
-/// Particles deeper than 0.1 spacing inside any moving body.
-inline std::size_t insideMovingCount(const World& w) {
+/// Particles deeper than 0.1 spacing inside any moving body (as the fluid meets it:
+/// World::movingColliders()), those with y below `floorBand` not counted.
+inline std::size_t insideMovingCount(const World& w, double floorBand = -1e300) {
   std::size_t n = 0;
   const std::vector<Collider> shapes = w.movingColliders();
   for (std::size_t i = 0; i < w.particleCount(); ++i) {
     const Vec2 x = w.particles().x[i];
+    if (w.worldPosition(i).y() < floorBand) continue;
     for (const Collider& c : shapes) {
       Real depth = 1e30f;
       if (c.kind == Collider::Kind::Circle) depth = c.radius - (x - c.center).norm();
