@@ -106,9 +106,11 @@ std::vector<std::uint32_t> World::particlesTouching(const b2Fixture& fixture) co
     b2DistanceProxy part;
     part.Set(&shape, child);
     // Distances are to the core shape, less the radius the fluid meets it at: a circle's own, a
-    // moving body's polygon's skin (b2_polygonRadius: moving_bodies.cpp); a static body's
-    // polygons, edges and chains are seen without their skin.
-    const bool skinned = shape.GetType() == b2Shape::e_polygon && fixture.GetBody()->GetType() != b2_staticBody;
+    // moving body's polygon's skin (b2_polygonRadius: moving_bodies.cpp) unless the solver
+    // samples moving bodies and meets their fixtures; a static body's polygons, edges and
+    // chains are seen without their skin.
+    const bool skinned = shape.GetType() == b2Shape::e_polygon && fixture.GetBody()->GetType() != b2_staticBody &&
+                         !w.solver->movingSamples();
     const double radius = shape.GetType() == b2Shape::e_circle || skinned ? double(shape.m_radius) : 0.0;
     const std::vector<std::size_t> near = collect(w, lo, hi, [&](std::size_t i) {
       const Vec2d p = worldPosition(i);

@@ -239,3 +239,37 @@ TEST_CASE("queries: particlesTouching finds the particles within one spacing of 
   CHECK(sawPole);
   CHECK_FALSE(sawCeiling);
 }
+
+TEST_CASE("queries: particlesTouching a kinematic box measures from where the fluid meets it: the skin for the game solver, the fixture for wcsph") {
+  // A 0.3 m × 0.1 m kinematic box at rest in the water. The game solver meets a moving polygon
+  // at Box2D's skin (1 cm out), wcsph at the fixture itself (its moving samples stand for it):
+  // the particles touching it are those within one spacing of that surface.
+  for (const char* solver : {"game", "wcsph"}) {
+    INFO(solver);
+    SceneDef s = test::tank(solver, 1.0, 1.0, 0.02);
+    s.blocks.push_back(test::block({0, 0}, {1, 0.5}));
+    BodyDef box;
+    box.type = BodyDef::Type::Kinematic;
+    box.position = Vec2d(0.5, 0.25);
+    box.fixtures.push_back(test::boxShape({0, 0}, {0.15, 0.05}));
+    s.bodies.push_back(box);
+    World w(s, WorldOptions{2});
+    for (int f = 0; f < 10; ++f) w.stepFrame();
+    const double dx = double(w.spacing()), skin = std::string(solver) == "game" ? double(b2_polygonRadius) : 0.0;
+    const b2Fixture* fixture = nullptr;
+    for (const b2Body* b = w.box2d().GetBodyList(); b; b = b->GetNext())
+      if (b->GetType() == b2_kinematicBody) fixture = b->GetFixtureList();
+    REQUIRE(fixture);
+    // Against a scan: the distance from the box's fixture (0.3 × 0.1 at (0.5, 0.25)), less the skin.
+    std::vector<std::uint32_t> scan;
+    for (std::size_t i = 0; i < w.particleCount(); ++i) {
+      const Vec2d p = w.worldPosition(i);
+      const double ox = std::max(0.0, std::fabs(p.x() - 0.5) - 0.15), oy = std::max(0.0, std::fabs(p.y() - 0.25) - 0.05);
+      if (std::sqrt(ox * ox + oy * oy) - skin <= dx) scan.push_back(w.particles().id[i]);
+    }
+    const std::vector<std::uint32_t> touching = w.particlesTouching(*fixture);
+    MESSAGE(solver << ": " << touching.size() << " particles touch the box");
+    CHECK(touching.size() >= std::size_t(0.6 / dx));  // a layer around it
+    CHECK(touching == scan);
+  }
+}

@@ -316,7 +316,8 @@ class World {
   /// The ids of the particles touching `fixture` now (between frames: at the end of the last
   /// one): their centres within one spacing of its surface, or inside it; in slot order. Any
   /// fixture of the b2World the fluid sees, static or moving, at the body's current pose; the
-  /// surface where the fluid meets it (a moving body's polygon with Box2D's skin).
+  /// surface where the fluid meets it (a moving body's polygon with Box2D's skin, or its
+  /// fixture for a solver that samples moving bodies: wcsph, muller2003).
   std::vector<std::uint32_t> particlesTouching(const b2Fixture& fixture) const;
   /// Calls f(fixture, ids) for every fixture of box2d() that particles touch now, with their
   /// ids as particlesTouching() gives them; bodies and fixtures in Box2D's list order. The
