@@ -58,11 +58,7 @@ void BodySamples::place(StepContext& c, const MovingSolids& solids) {
     found->used = true;
   }
   // Bodies gone (or resampled) are dropped from the cache; the rest keep their samples.
-  std::vector<Sampled> kept;
-  kept.reserve(cache.size());
-  for (Sampled& s : cache)
-    if (s.used) kept.push_back(std::move(s));
-  cache.swap(kept);
+  cache.erase(std::remove_if(cache.begin(), cache.end(), [](const Sampled& s) { return !s.used; }), cache.end());
   for (std::size_t k = 0; k < solids.bodies.size(); ++k) {
     const MovingSolid& m = solids.bodies[k];
     const Sampled* sp = nullptr;
@@ -104,14 +100,17 @@ void BodySamples::place(StepContext& c, const MovingSolids& solids) {
 void BodySamples::react(StepContext& c, MovingSolids& solids) {
   if (!active()) return;
   const double tau0 = c.time - solids.time0, dt = double(c.dt);
-  std::vector<Vec2d> force(placed.size(), Vec2d(0, 0));
-  std::vector<double> torque(placed.size(), 0.0);
-  std::vector<bool> touched(placed.size(), false);
+  force_.assign(placed.size(), Vec2d(0, 0));
+  torque_.assign(placed.size(), 0.0);
+  touched_.assign(placed.size(), 0);
+  std::vector<Vec2d>& force = force_;
+  std::vector<double>& torque = torque_;
+  std::vector<std::uint8_t>& touched = touched_;
   for (const std::vector<Reaction>& block : perBlock)
     for (const Reaction& r : block) {
       force[r.body] += r.force;
       torque[r.body] += r.torque;
-      touched[r.body] = true;
+      touched[r.body] = 1;
     }
   for (std::size_t k = 0; k < placed.size() && k < solids.bodies.size(); ++k) {
     MovingSolid& m = solids.bodies[k];

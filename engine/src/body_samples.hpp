@@ -78,6 +78,13 @@ struct BodySamples {
   };
   std::vector<std::vector<Reaction>> perBlock;  ///< per block of kBlock particles, bodies in first-met order
 
+ private:
+  std::vector<Vec2d> force_;           ///< react()'s scratch per body: Σ of the blocks' forces
+  std::vector<double> torque_;         ///< … and torques
+  std::vector<std::uint8_t> touched_;  ///< … and whether any block met the body
+
+ public:
+
   /// True between the `body_samples` and `body_forces` stages of a substep: the samples
   /// are placed, and the neighbour lists hold them.
   bool active() const { return !placed.empty(); }
