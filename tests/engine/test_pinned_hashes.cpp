@@ -29,15 +29,15 @@ struct Pinned {
 // To regenerate after a change that moves bits on purpose: run the test, copy
 // the "actual" values it prints, and say why in the commit message.
 const Pinned kPinned[] = {
-    {"tests/small_dam_break.json", "muller2003", 30, false, 0x6bee05716112ca6cULL},
+    {"tests/small_dam_break.json", "muller2003", 30, false, 0x6aec7dfdff7df099ULL},
     {"tests/small_dam_break.json", "wcsph", 30, false, 0x2ade8288374787cdULL},
-    {"tests/small_dam_break.json", "pbf", 30, false, 0xfba956fc0dfcb1f0ULL},
+    {"tests/small_dam_break.json", "pbf", 30, false, 0xf550fd66b4baad4bULL},
     {"tests/small_dam_break.json", "dfsph", 30, false, 0xada4a0ec2734e326ULL},
     {"tests/small_dam_break.json", "game", 30, false, 0x36af8b0c84c4d7dbULL},
-    {"tests/every_stage.json", "muller2003", 20, true, 0x1071278408b8c4e6ULL},
-    {"tests/every_stage.json", "wcsph", 20, true, 0x6765038e71549caaULL},
-    {"tests/every_stage.json", "pbf", 20, true, 0xa86098640c4c80a2ULL},
-    {"tests/every_stage.json", "dfsph", 20, true, 0xf49c189bb01820abULL},
+    {"tests/every_stage.json", "muller2003", 20, true, 0x00be3e92d1d11a1bULL},
+    {"tests/every_stage.json", "wcsph", 20, true, 0x10c6e2c443a7b508ULL},
+    {"tests/every_stage.json", "pbf", 20, true, 0x83d2cefd08507ea1ULL},
+    {"tests/every_stage.json", "dfsph", 20, true, 0xcf47063c723a351eULL},
     {"tests/every_stage.json", "game", 20, true, 0x62b36fec1da00ffdULL},
     {"validation/poiseuille.json", "wcsph", 20, false, 0x377f8c008f15fca1ULL},
     {"validation/poiseuille.json", "dfsph", 20, false, 0x365aeeeb32a9c100ULL},

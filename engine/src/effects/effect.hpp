@@ -34,6 +34,9 @@ struct ViscosityTerm {
   Real muMass = 0;      ///< ν·s·ρ0·m (s: 1 / the Laplacian's lattice moment)
   Real wallFactor = 0;  ///< 2·ν·s·ρ0
   bool walls = false;   ///< no-slip walls with boundary samples
+  /// The largest ∇²W a pair (or a wall sample) takes this substep: dt·μm·∇²W/ρ0² ≤
+  /// kViscousPairShare (constants.hpp), so that no pair overshoots at any dt.
+  Real lapMax = std::numeric_limits<Real>::infinity();
 };
 
 class Effect {

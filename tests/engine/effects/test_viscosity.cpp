@@ -58,6 +58,40 @@ TEST_CASE("viscosity conserves linear momentum to rounding (no walls, no gravity
   CHECK(r.finite);
 }
 
+TEST_CASE("viscosity: two particles pressed to 0.1 R with opposite velocities neither swap nor grow their shear, at the solvers' own substeps") {
+  // The Laplacian's coupling grows as 1/r³: at 0.1 R the game solver's substep (1/120 s,
+  // ν = 0.001 m²/s) would take 3.5 times the pair's relative velocity away per substep, so
+  // that it reverses and grows sixfold (the 20k game dam break ran away so at 0.72 s).
+  // The cap on ∇²W (ViscosityTerm::lapMax) leaves at most a quarter of it per substep.
+  // Two lone particles in zero gravity: no pressure, only the viscosity (and XSPH, which
+  // also only mixes) acts on the shear. muller2003 with a slow sound speed takes substeps
+  // long enough to need the cap too (its folded pair loop).
+  for (const char* solver : {"game", "pbf", "muller2003"}) {
+    INFO(solver);
+    SceneDef s;
+    s.solver.type = solver;
+    s.solver.spacing = 0.01;
+    s.solver.viscosity = 0.001;
+    if (std::string(solver) == "muller2003") s.solver.soundSpeed = 0.5;
+    s.gravity = Vec2d(0, 0);
+    World w(s, WorldOptions{2});
+    const double R = double(w.support()), U = 1.0;
+    const std::vector<std::uint32_t> ids = w.addParticles({Vec2d(1, 1), Vec2d(1 + 0.1 * R, 1)}, {Vec2d(0, U), Vec2d(0, -U)});
+    REQUIRE(ids.size() == 2);
+    for (int f = 0; f < 3; ++f) {
+      w.stepFrame();
+      Vec2d x0, v0, x1, v1;
+      REQUIRE(w.getParticle(ids[0], x0, v0));
+      REQUIRE(w.getParticle(ids[1], x1, v1));
+      const double shear = v0.y() - v1.y();
+      MESSAGE(solver << ", frame " << f + 1 << ": shear " << shear << " m/s (start " << 2 * U << "), pair at " << (x1 - x0).norm() / R << " R");
+      CHECK(shear > 0);          // not reversed
+      CHECK(shear <= 2 * U);     // not grown
+      CHECK(std::fabs(v0.y() + v1.y()) <= 1e-4 * U);  // momentum (pbf's velocities are position differences over dt: float rounding)
+    }
+  }
+}
+
 TEST_CASE("start-up Poiseuille flow (viscosity, no-slip walls) follows the series at every tabulated time and reaches the steady parabola, for every solver") {
   const auto table = validation::readReferenceCsv(test::asset("reference/channel_flow_transient.csv"));
   for (const std::string solver : {"muller2003", "wcsph", "dfsph", "pbf"}) {

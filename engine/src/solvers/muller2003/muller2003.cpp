@@ -146,7 +146,7 @@ void pressure(StepContext& c) {
 struct PairConstants {
   Real R, spikyK, halfMass, coincident2;
   // ViscosityKernel::laplacianR2's constants, computed as it computes them.
-  Real vR2, vR3, lapK, rMin, rMin2, invRMin;
+  Real vR2, vR3, lapMax, lapK, rMin, rMin2, invRMin;  // lapMax: ViscosityTerm::lapMax
 };
 
 /// The four contributions of pair (i, j) in scalar code: out = {fpx, fpy, fvx, fvy}
@@ -180,7 +180,7 @@ inline void pairTermScalar(const StepContext& c, const PairConstants& k, std::si
       const bool big = r2v > k.rMin2;  // then r2v == r2 (not coincident): sq, invr are its own
       const Real q = big ? sq : k.rMin;
       const Real iq = big ? invr : k.invRMin;
-      lap = k.lapK * (k.R - q) * (k.vR3 + k.vR2 * q + k.R * q * q + Real(9) * q * q * q) * iq * iq * iq;
+      lap = std::min(k.lapK * (k.R - q) * (k.vR3 + k.vR2 * q + k.R * q * q + Real(9) * q * q * q) * iq * iq * iq, k.lapMax);
     }
     const Real w = lap * irj;
     const Vec2* V = c.P.v.data();
@@ -256,6 +256,7 @@ __attribute__((target("avx2"))) void pairSums8(const StepContext& c, const PairC
           _mm256_mul_ps(_mm256_mul_ps(_mm256_mul_ps(_mm256_set1_ps(Real(9)), q), q), q));
       __m256 lap = _mm256_mul_ps(_mm256_mul_ps(_mm256_set1_ps(k.lapK), _mm256_sub_ps(R8, q)), poly);
       lap = _mm256_mul_ps(_mm256_mul_ps(_mm256_mul_ps(lap, iq), iq), iq);
+      lap = _mm256_min_ps(lap, _mm256_set1_ps(k.lapMax));  // the stability cap (std::min's value for finite lanes)
       lap = _mm256_and_ps(_mm256_cmp_ps(r2, vR2, _CMP_NGE_UQ), lap);  // r² ≥ R²: 0
       const __m256 w = _mm256_mul_ps(lap, irj);
       __m256 vxj, vyj;
@@ -301,6 +302,7 @@ std::size_t pressureForce(StepContext& c, const Spiky<Real>& spiky, const Viscos
     k.rMin = W.rMin;
     k.rMin2 = W.rMin * W.rMin;
     k.invRMin = Real(1) / W.rMin;
+    k.lapMax = vt.lapMax;
   }
   const bool simd = !c.periodic.any();
 #ifdef SPH2D_AVX2_PAIRS
@@ -318,10 +320,11 @@ std::size_t pressureForce(StepContext& c, const Spiky<Real>& spiky, const Viscos
     Vec2d wallAcc(0, 0);  // Σ a_wall over the block's particles
 #ifdef SPH2D_SSE2_PAIRS
     const struct {
-      __m128 R, spikyK, halfMass, one, thr, vR2, vR3, lapK, rMin, rMin2, invRMin, nine;
+      __m128 R, spikyK, halfMass, one, thr, vR2, vR3, lapK, rMin, rMin2, invRMin, nine, lapMax;
     } K4 = {_mm_set1_ps(k.R),    _mm_set1_ps(k.spikyK), _mm_set1_ps(k.halfMass), _mm_set1_ps(Real(1)),
             _mm_set1_ps(k.coincident2), _mm_set1_ps(k.vR2), _mm_set1_ps(k.vR3), _mm_set1_ps(k.lapK),
-            _mm_set1_ps(k.rMin), _mm_set1_ps(k.rMin2), _mm_set1_ps(k.invRMin), _mm_set1_ps(Real(9))};
+            _mm_set1_ps(k.rMin), _mm_set1_ps(k.rMin2), _mm_set1_ps(k.invRMin), _mm_set1_ps(Real(9)),
+            _mm_set1_ps(k.lapMax)};
 #endif
     for (std::size_t i = b; i < e; ++i) {
       const Vec2 xi = X[i];
@@ -375,6 +378,7 @@ std::size_t pressureForce(StepContext& c, const Spiky<Real>& spiky, const Viscos
                 _mm_mul_ps(_mm_mul_ps(_mm_mul_ps(K4.nine, q), q), q));
             __m128 lap = _mm_mul_ps(_mm_mul_ps(K4.lapK, _mm_sub_ps(K4.R, q)), poly);
             lap = _mm_mul_ps(_mm_mul_ps(_mm_mul_ps(lap, iq), iq), iq);
+            lap = _mm_min_ps(lap, K4.lapMax);  // the stability cap (std::min's value for finite lanes)
             lap = _mm_and_ps(_mm_cmpnge_ps(r2, K4.vR2), lap);  // r² ≥ R²: 0
             const __m128 w = _mm_mul_ps(lap, irj);
             __m128 vxj, vyj;
@@ -443,7 +447,7 @@ std::size_t pressureForce(StepContext& c, const Spiky<Real>& spiky, const Viscos
           const std::uint32_t* bl = c.nbr.boundaryOf(i);
           for (std::uint32_t q = 0; q < c.nbr.boundaryCount[i]; ++q) {
             const std::uint32_t s = bl[q];
-            sum += B.volume[s] * W.laplacianR2((xi - B.samples[s]).squaredNorm());
+            sum += B.volume[s] * std::min(W.laplacianR2((xi - B.samples[s]).squaredNorm()), vt.lapMax);
           }
           const Vec2 aWall = Vec2(vix, viy) * (vt.wallFactor * invRhoi * sum);
           av -= aWall;
@@ -471,7 +475,7 @@ std::size_t pressureForce(StepContext& c, const Spiky<Real>& spiky, const Viscos
             const Vec2& arm = moving->arm[s];
             tb += arm.x() * g.y() - arm.y() * g.x();
             if (Visc && vt.walls) {
-              const Vec2 u = (Vec2(vix, viy) - moving->v[s]) * (moving->volume[s] * W.laplacianR2(rr));
+              const Vec2 u = (Vec2(vix, viy) - moving->v[s]) * (moving->volume[s] * std::min(W.laplacianR2(rr), vt.lapMax));
               lv += u;
               tv += arm.x() * u.y() - arm.y() * u.x();
             }
