@@ -19,11 +19,14 @@
 // With solver.no_slip, the walls' boundary samples take part as fluid at rest
 // (v_b = 0, density ρ0, volume Ψ_b): a_i += ν ρ0/ρ_i Σ_b Ψ_b (0 − v_i) ∇²W_ib,
 // the no-slip wall of Morris, Fox & Zhu 1997 with the wall velocity in place
-// of their mirrored one. Without it (the default) walls are free-slip and only
+// of their mirrored one. A moving body's samples (body_samples.hpp, for the solvers
+// that take them) are such a wall moving with the sample's velocity v_b, and the
+// body takes minus the force they exert (its viscous drag, Akinci et al. 2012). Without it (the default) walls are free-slip and only
 // the collision stage's Coulomb friction acts on the fluid at the wall.
 #include <algorithm>
 #include <cmath>
 
+#include "body_samples.hpp"
 #include "effects/effect.hpp"
 
 namespace sph2d {
@@ -68,6 +71,7 @@ class LaplacianViscosity final : public Effect {
     const Real* IR = P.invRho.data();
     const BoundarySet& B = c.boundary;
     const bool walls = t.walls;
+    BodySamples* moving = noSlip_ && c.bodySamples && c.bodySamples->active() ? c.bodySamples : nullptr;
     // With the walls: their force on the fluid (World::wallImpulse), Σ m a_wall per block, the blocks in order.
     const bool count = walls && c.wall;
     const std::size_t blocks = (P.size() + kBlock - 1) / kBlock;
@@ -101,6 +105,32 @@ class LaplacianViscosity final : public Effect {
           const Vec2 aWall = Vec2(vix, viy) * (t.wallFactor * IR[i] * sum);
           acc -= aWall;
           wallAcc -= aWall.cast<double>();
+        }
+        if (moving && c.nbr.movingCount[i] > 0) {
+          // The moving bodies' samples, body by body: the wall term with the sample's
+          // velocity; each body's share is its reaction (a force and a torque about its
+          // centre of mass), as in the solvers' own wall terms.
+          const Vec2 xi = X[i];
+          const std::uint32_t* ml = c.nbr.movingOf(i);
+          const std::uint32_t mc = c.nbr.movingCount[i];
+          const Real vK = t.wallFactor * IR[i];
+          for (std::uint32_t q = 0; q < mc;) {
+            const std::uint32_t body = moving->body[ml[q]];
+            Vec2 lv = Vec2::Zero();
+            Real tv = 0;  // Σ arm × the pair's term
+            for (; q < mc && moving->body[ml[q]] == body; ++q) {
+              const std::uint32_t s = ml[q];
+              const Real rr = (xi - moving->x[s]).squaredNorm();
+              const Vec2 u = (Vec2(vix, viy) - moving->v[s]) * (moving->volume[s] * std::min(W.laplacianR2(rr), t.lapMax));
+              lv += u;
+              const Vec2& arm = moving->arm[s];
+              tv += arm.x() * u.y() - arm.y() * u.x();
+            }
+            const Vec2 aBody = -lv * vK;
+            acc += aBody;
+            if (moving->placed[body].dynamic)
+              moving->addReaction(b / kBlock, body, aBody.cast<double>() * double(c.mass), -double(tv) * double(vK) * double(c.mass));
+          }
         }
         P.a[i] += acc;
         if (!allFinite(acc) && bad == kNone) bad = i;

@@ -92,6 +92,45 @@ TEST_CASE("viscosity: two particles pressed to 0.1 R with opposite velocities ne
   }
 }
 
+TEST_CASE("viscosity: with no_slip a kinematic plate sliding along itself drags the water beside it as Stokes' first problem says (wcsph)") {
+  // A 1.6 m × 0.04 m plate in still water (no gravity) set sliding along itself at U: the
+  // water beside it follows u(y, t) = U erfc(y / (2 sqrt(ν t))) (Stokes 1851). Only the
+  // no-slip wall term acts on the sliding shear (wcsph's artificial viscosity takes only
+  // approaching pairs), so this needs the moving body's samples in it.
+  const double U = 0.2, nu = 0.02, dx = 0.02;
+  SceneDef s = test::tank("wcsph", 2.0, 1.0, dx);
+  s.gravity = Vec2d(0, 0);
+  s.solver.viscosity = nu;
+  s.solver.noSlip = true;
+  s.blocks.push_back(test::block({0, 0}, {2.0, 0.8}));
+  BodyDef plate;
+  plate.type = BodyDef::Type::Kinematic;
+  plate.position = Vec2d(1.0, 0.4);
+  plate.velocity = Vec2d(U, 0);
+  plate.fixtures.push_back(test::boxShape({0, 0}, {0.8, 0.02}));
+  s.bodies.push_back(plate);
+  World w(s, WorldOptions{2});
+  for (int f = 0; f < 6; ++f) w.stepFrame();
+  const double t = w.time(), top = 0.42;
+  for (int layer = 0; layer < 3; ++layer) {
+    double sum = 0, ysum = 0;
+    int n = 0;
+    for (std::size_t i = 0; i < w.particleCount(); ++i) {
+      const Vec2d x = w.worldPosition(i);
+      const double y = x.y() - top;
+      if (std::fabs(x.x() - 1.0 - U * t) < 0.4 && y >= layer * dx && y < (layer + 1) * dx) {
+        sum += double(w.particles().v[i].x());
+        ysum += y;
+        ++n;
+      }
+    }
+    REQUIRE(n > 10);
+    const double u = sum / n, y = ysum / n, exact = U * std::erfc(y / (2 * std::sqrt(nu * t)));
+    MESSAGE("layer " << layer << " (" << n << " particles, mean distance " << y << " m): u = " << u << " m/s, Stokes " << exact);
+    CHECK(u == doctest::Approx(exact).epsilon(0.05));
+  }
+}
+
 TEST_CASE("start-up Poiseuille flow (viscosity, no-slip walls) follows the series at every tabulated time and reaches the steady parabola, for every solver") {
   const auto table = validation::readReferenceCsv(test::asset("reference/channel_flow_transient.csv"));
   for (const std::string solver : {"muller2003", "wcsph", "dfsph", "pbf"}) {
