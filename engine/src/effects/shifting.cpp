@@ -20,7 +20,8 @@
 // substeps (3 a frame) the Taylor–Green vortex got a fifth of wcsph's
 // shifting, its particles paired in the vortex cores and it blew up at
 // t ≈ 0.6 s; with the passes its decay rate is within 2 % of the analytic one.
-// Walls count in ∇C, so particles are not shifted into them. At a free
+// Walls count in ∇C, so particles are not shifted into them; so do a moving body's
+// samples (body_samples.hpp, for the solvers that take them), where they are this substep. At a free
 // surface ∇C points into the fluid; there (C_i below 0.95 of a full lattice's)
 // only the component along the surface is kept (Lind's surface treatment).
 // Velocities are not interpolated to the new positions (the shift is a small
@@ -34,6 +35,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "body_samples.hpp"
 #include "effects/effect.hpp"
 
 namespace sph2d {
@@ -75,6 +77,7 @@ class ParticleShifting final : public Effect {
     const Real surfaceC = Real(0.95);
     const BoundarySet& B = c.boundary;
     const bool walls = !B.samples.empty();
+    const BodySamples* moving = c.bodySamples && c.bodySamples->active() ? c.bodySamples : nullptr;
     const PeriodicBox per = c.periodic;
     const Vec2* X = P.x.data();
     const Real* IR = P.invRho.data();
@@ -110,6 +113,20 @@ class ParticleShifting final : public Effect {
             gx += g * d.x();
             gy += g * d.y();
             C += B.volume[s] * W.value(r);
+          }
+        }
+        if (moving) {
+          const std::uint32_t* ml = c.nbr.movingOf(i);
+          for (std::uint32_t k = 0; k < c.nbr.movingCount[i]; ++k) {
+            const std::uint32_t s = ml[k];
+            const Vec2 d = xi - moving->x[s];
+            const Real r2 = d.squaredNorm();
+            if (r2 >= R2) continue;  // a later pass: the sample has left the support since the lists were built
+            const Real r = std::sqrt(r2), a = Real(1) - r * W.invR;
+            const Real g = moving->volume[s] * gradK * a * a * a;
+            gx += g * d.x();
+            gy += g * d.y();
+            C += moving->volume[s] * W.value(r);
           }
         }
         Vec2 s(-D * gx, -D * gy);
