@@ -55,10 +55,11 @@ constexpr Real kMaxMove = Real(0.5);
 /// pressure is ~0 either way) and slow the conjugate gradients.
 constexpr Real kMinSurfaceFraction = Real(0.1);
 
-/// The Laplacian viscosity removes at most this share of a pair's relative velocity per
-/// substep (ViscosityTerm::lapMax): ∇²W grows as 1/r³, and two particles pressed together
-/// would otherwise overshoot and run away. Lattice pairs at the viscous time-step limit
-/// take at most 0.061, so flows the limit resolves never meet the cap.
+/// The Laplacian viscosity's coupling of one pair over a substep, dt·μm·∇²W/(ρ_i ρ_j), is at
+/// most this (ViscosityTerm::pairCap), so the pair's relative velocity loses at most a quarter
+/// a substep: ∇²W grows as 1/r³, and two particles pressed together would otherwise overshoot
+/// and run away. Lattice pairs at the viscous time-step limit take at most 0.061, so flows
+/// the limit resolves never meet the cap.
 constexpr Real kViscousPairShare = Real(0.125);
 
 /// A step() shorter than this fraction of the last substep only drifts (no

@@ -29,15 +29,15 @@ struct Pinned {
 // To regenerate after a change that moves bits on purpose: run the test, copy
 // the "actual" values it prints, and say why in the commit message.
 const Pinned kPinned[] = {
-    {"tests/small_dam_break.json", "muller2003", 30, false, 0x6aec7dfdff7df099ULL},
+    {"tests/small_dam_break.json", "muller2003", 30, false, 0xc5c0f32815bbfbd5ULL},
     {"tests/small_dam_break.json", "wcsph", 30, false, 0x2ade8288374787cdULL},
-    {"tests/small_dam_break.json", "pbf", 30, false, 0xf550fd66b4baad4bULL},
-    {"tests/small_dam_break.json", "dfsph", 30, false, 0xada4a0ec2734e326ULL},
+    {"tests/small_dam_break.json", "pbf", 30, false, 0x5a0e709326b133fdULL},
+    {"tests/small_dam_break.json", "dfsph", 30, false, 0xa9a801ef350459c4ULL},
     {"tests/small_dam_break.json", "game", 30, false, 0x36af8b0c84c4d7dbULL},
-    {"tests/every_stage.json", "muller2003", 20, true, 0x00be3e92d1d11a1bULL},
-    {"tests/every_stage.json", "wcsph", 20, true, 0x10c6e2c443a7b508ULL},
-    {"tests/every_stage.json", "pbf", 20, true, 0x83d2cefd08507ea1ULL},
-    {"tests/every_stage.json", "dfsph", 20, true, 0xcf47063c723a351eULL},
+    {"tests/every_stage.json", "muller2003", 20, true, 0xc33307cfe1e579d2ULL},
+    {"tests/every_stage.json", "wcsph", 20, true, 0x3409da5f258e0471ULL},
+    {"tests/every_stage.json", "pbf", 20, true, 0x65d70f9da35c9e0cULL},
+    {"tests/every_stage.json", "dfsph", 20, true, 0xf5529c33dc53c12bULL},
     {"tests/every_stage.json", "game", 20, true, 0x62b36fec1da00ffdULL},
     {"validation/poiseuille.json", "wcsph", 20, false, 0x377f8c008f15fca1ULL},
     {"validation/poiseuille.json", "dfsph", 20, false, 0x365aeeeb32a9c100ULL},

@@ -68,7 +68,11 @@ using test::minPairDistance;
 /// density where they overlap; every added particle coincides with one of the
 /// block's): within 1 s the compression is gone (the most compressed particle under
 /// 5 %), the coincident pairs have parted (the closest pair farther than 0.1 dx;
-/// measured 0.17 dx for muller2003, 0.37 for pbf, 0.19 for dfsph), nothing escapes.
+/// measured 0.37 for pbf, 0.19 for dfsph), nothing escapes. muller2003: farther than
+/// 0.05 dx. Its closest pair parts to 0.080 dx within 12 frames and then rests at
+/// 0.088 dx: below ρ0 its clamped pressure pushes no pair apart. It read 0.17 dx before
+/// the viscosity's per-pair cap (viscosity.cpp), when the viscous coupling of the pressed
+/// pair overshot every substep (dt·coupling 0.8) and kept it jittering.
 ///
 /// Wendland's |∇W| = |gradK|(1 − q)³ r vanishes as r → 0, so pairDelta's tie-break
 /// direction alone (1e-6 R long) gives a coincident pair a direction without a
@@ -99,7 +103,7 @@ void overlapSeparates(const std::string& solver) {
   CHECK(test::allFiniteState(w));
   CHECK(outside(w, 1, 1) == 0);
   CHECK(d.maxError < 0.05);
-  CHECK(d1 > 0.1 * s.solver.spacing);
+  CHECK(d1 > (solver == "muller2003" ? 0.05 : 0.1) * s.solver.spacing);
 }
 
 }  // namespace

@@ -34,9 +34,11 @@ struct ViscosityTerm {
   Real muMass = 0;      ///< ν·s·ρ0·m (s: 1 / the Laplacian's lattice moment)
   Real wallFactor = 0;  ///< 2·ν·s·ρ0
   bool walls = false;   ///< no-slip walls with boundary samples
-  /// The largest ∇²W a pair (or a wall sample) takes this substep: dt·μm·∇²W/ρ0² ≤
-  /// kViscousPairShare (constants.hpp), so that no pair overshoots at any dt.
-  Real lapMax = std::numeric_limits<Real>::infinity();
+  bool noSlip = false;  ///< solver.no_slip: the walls' and the moving bodies' samples take part
+  /// kViscousPairShare / (dt·μm) (constants.hpp): pair (i, j) takes min(∇²W_ij/ρ_j, pairCap·ρ_i),
+  /// so that dt·μm·∇²W_ij/(ρ_i ρ_j) ≤ kViscousPairShare (symmetric: momentum is kept), and a
+  /// wall sample min(∇²W_ib, pairCap·ρ_i·ρ0); no pair overshoots at any dt or density.
+  Real pairCap = std::numeric_limits<Real>::infinity();
 };
 
 class Effect {

@@ -7,12 +7,14 @@
 // shear flow feels ν and not 0.83 ν (measured on start-up Poiseuille flow).
 // Time-step limit: dt ≤ 0.03 R²/ν (explicit diffusion). That limit is for pairs at
 // the lattice's distances: ∇²W grows as 1/r³, so a pair pressed to 0.1 R (two particles
-// put against a corner) needs a hundred times less. Each pair's ∇²W is therefore capped
-// (ViscosityTerm::lapMax) so that dt·μm·∇²W/ρ0² ≤ kViscousPairShare = 1/8: the pair loses
-// at most a quarter of its relative velocity per substep instead of overshooting. At the
-// time-step limit a lattice neighbour takes at most 0.061 and the lattice's row sums 0.42
-// (R = 2.5 dx), so resolved flows never meet the cap, and a particle with four capped
-// pairs besides still takes a convex combination of its neighbours' velocities. Without
+// put against a corner) needs a hundred times less. Each pair's coupling is therefore capped
+// (ViscosityTerm::pairCap) so that dt·μm·∇²W_ij/(ρ_i ρ_j) ≤ kViscousPairShare = 1/8 (μm =
+// ν_s ρ0 m, ν_s = ν over the lattice moment): the pair loses at most a quarter of its
+// relative velocity per substep instead of overshooting, at any density (a lone pair in
+// a splash reads far below ρ0). At the time-step limit a lattice neighbour takes at most
+// 0.061 and the lattice's row sums 0.42 (R = 2.5 dx), so resolved flows never meet the cap,
+// and a particle with four capped pairs besides still takes a convex combination of its
+// neighbours' velocities. Without
 // it the game preset's 20k dam break with ν = 0.001 m²/s ran away at the far corner
 // after 0.72 s (two particles 3 mm apart at ±240 m/s).
 //
@@ -56,8 +58,8 @@ class LaplacianViscosity final : public Effect {
     t.muMass = nuS * c.rho0 * c.mass;
     t.wallFactor = Real(2) * nuS * c.rho0;
     t.walls = noSlip_ && !c.boundary.samples.empty();
-    if (c.dt > 0 && t.muMass > 0)
-      t.lapMax = kViscousPairShare * c.rho0 * c.rho0 / (c.dt * t.muMass);
+    t.noSlip = noSlip_;
+    if (c.dt > 0 && t.muMass > 0) t.pairCap = kViscousPairShare / (c.dt * t.muMass);
     return t;
   }
 
@@ -71,7 +73,7 @@ class LaplacianViscosity final : public Effect {
     const Real* IR = P.invRho.data();
     const BoundarySet& B = c.boundary;
     const bool walls = t.walls;
-    BodySamples* moving = noSlip_ && c.bodySamples && c.bodySamples->active() ? c.bodySamples : nullptr;
+    BodySamples* moving = t.noSlip && c.bodySamples && c.bodySamples->active() ? c.bodySamples : nullptr;
     // With the walls: their force on the fluid (World::wallImpulse), Σ m a_wall per block, the blocks in order.
     const bool count = walls && c.wall;
     const std::size_t blocks = (P.size() + kBlock - 1) / kBlock;
@@ -82,6 +84,8 @@ class LaplacianViscosity final : public Effect {
       for (std::size_t i = b; i < e; ++i) {
         const Real xix = X[i].x(), xiy = X[i].y(), vix = V[i].x(), viy = V[i].y();
         Real fx = 0, fy = 0;
+        const Real capI = t.pairCap / IR[i];          // ViscosityTerm::pairCap · ρ_i
+        const Real capWall = capI * c.rho0;          // … · ρ0, for a wall sample's ∇²W
         const std::uint32_t* nb = c.nbr.of(i);
         const std::uint32_t cnt = c.nbr.count[i];
         for (std::uint32_t k = 0; k < cnt; ++k) {
@@ -89,7 +93,7 @@ class LaplacianViscosity final : public Effect {
           Real dx = xix - X[j].x(), dy = xiy - X[j].y();
           c.periodic.nearest(dx, dy);
           const Real r2 = dx * dx + dy * dy;
-          const Real w = std::min(W.laplacianR2(r2), t.lapMax) * IR[j];
+          const Real w = std::min(W.laplacianR2(r2) * IR[j], capI);
           fx += (V[j].x() - vix) * w;
           fy += (V[j].y() - viy) * w;
         }
@@ -100,7 +104,7 @@ class LaplacianViscosity final : public Effect {
           const std::uint32_t* bl = c.nbr.boundaryOf(i);
           for (std::uint32_t k = 0; k < c.nbr.boundaryCount[i]; ++k) {
             const std::uint32_t s = bl[k];
-            sum += B.volume[s] * std::min(W.laplacianR2((xi - B.samples[s]).squaredNorm()), t.lapMax);
+            sum += B.volume[s] * std::min(W.laplacianR2((xi - B.samples[s]).squaredNorm()), capWall);
           }
           const Vec2 aWall = Vec2(vix, viy) * (t.wallFactor * IR[i] * sum);
           acc -= aWall;
@@ -121,7 +125,7 @@ class LaplacianViscosity final : public Effect {
             for (; q < mc && moving->body[ml[q]] == body; ++q) {
               const std::uint32_t s = ml[q];
               const Real rr = (xi - moving->x[s]).squaredNorm();
-              const Vec2 u = (Vec2(vix, viy) - moving->v[s]) * (moving->volume[s] * std::min(W.laplacianR2(rr), t.lapMax));
+              const Vec2 u = (Vec2(vix, viy) - moving->v[s]) * (moving->volume[s] * std::min(W.laplacianR2(rr), capWall));
               lv += u;
               const Vec2& arm = moving->arm[s];
               tv += arm.x() * u.y() - arm.y() * u.x();

@@ -146,7 +146,7 @@ void pressure(StepContext& c) {
 struct PairConstants {
   Real R, spikyK, halfMass, coincident2;
   // ViscosityKernel::laplacianR2's constants, computed as it computes them.
-  Real vR2, vR3, lapMax, lapK, rMin, rMin2, invRMin;  // lapMax: ViscosityTerm::lapMax
+  Real vR2, vR3, pairCap, lapK, rMin, rMin2, invRMin;  // pairCap: ViscosityTerm::pairCap
 };
 
 /// The four contributions of pair (i, j) in scalar code: out = {fpx, fpy, fvx, fvy}
@@ -180,9 +180,9 @@ inline void pairTermScalar(const StepContext& c, const PairConstants& k, std::si
       const bool big = r2v > k.rMin2;  // then r2v == r2 (not coincident): sq, invr are its own
       const Real q = big ? sq : k.rMin;
       const Real iq = big ? invr : k.invRMin;
-      lap = std::min(k.lapK * (k.R - q) * (k.vR3 + k.vR2 * q + k.R * q * q + Real(9) * q * q * q) * iq * iq * iq, k.lapMax);
+      lap = k.lapK * (k.R - q) * (k.vR3 + k.vR2 * q + k.R * q * q + Real(9) * q * q * q) * iq * iq * iq;
     }
-    const Real w = lap * irj;
+    const Real w = std::min(lap * irj, k.pairCap / IR[i]);  // the stability cap (ViscosityTerm::pairCap)
     const Vec2* V = c.P.v.data();
     out[2] = (V[j].x() - vix) * w;
     out[3] = (V[j].y() - viy) * w;
@@ -256,9 +256,9 @@ __attribute__((target("avx2"))) void pairSums8(const StepContext& c, const PairC
           _mm256_mul_ps(_mm256_mul_ps(_mm256_mul_ps(_mm256_set1_ps(Real(9)), q), q), q));
       __m256 lap = _mm256_mul_ps(_mm256_mul_ps(_mm256_set1_ps(k.lapK), _mm256_sub_ps(R8, q)), poly);
       lap = _mm256_mul_ps(_mm256_mul_ps(_mm256_mul_ps(lap, iq), iq), iq);
-      lap = _mm256_min_ps(lap, _mm256_set1_ps(k.lapMax));  // the stability cap (std::min's value for finite lanes)
       lap = _mm256_and_ps(_mm256_cmp_ps(r2, vR2, _CMP_NGE_UQ), lap);  // r² ≥ R²: 0
-      const __m256 w = _mm256_mul_ps(lap, irj);
+      // The stability cap (ViscosityTerm::pairCap · ρ_i): std::min's value for finite lanes.
+      const __m256 w = _mm256_min_ps(_mm256_mul_ps(lap, irj), _mm256_set1_ps(k.pairCap / IR[i]));
       __m256 vxj, vyj;
       gather8(c.P.v.data(), j, vxj, vyj);
       t2 = _mm256_mul_ps(_mm256_sub_ps(vxj, vix8), w);
@@ -302,7 +302,7 @@ std::size_t pressureForce(StepContext& c, const Spiky<Real>& spiky, const Viscos
     k.rMin = W.rMin;
     k.rMin2 = W.rMin * W.rMin;
     k.invRMin = Real(1) / W.rMin;
-    k.lapMax = vt.lapMax;
+    k.pairCap = vt.pairCap;
   }
   const bool simd = !c.periodic.any();
 #ifdef SPH2D_AVX2_PAIRS
@@ -320,11 +320,10 @@ std::size_t pressureForce(StepContext& c, const Spiky<Real>& spiky, const Viscos
     Vec2d wallAcc(0, 0);  // Σ a_wall over the block's particles
 #ifdef SPH2D_SSE2_PAIRS
     const struct {
-      __m128 R, spikyK, halfMass, one, thr, vR2, vR3, lapK, rMin, rMin2, invRMin, nine, lapMax;
+      __m128 R, spikyK, halfMass, one, thr, vR2, vR3, lapK, rMin, rMin2, invRMin, nine;
     } K4 = {_mm_set1_ps(k.R),    _mm_set1_ps(k.spikyK), _mm_set1_ps(k.halfMass), _mm_set1_ps(Real(1)),
             _mm_set1_ps(k.coincident2), _mm_set1_ps(k.vR2), _mm_set1_ps(k.vR3), _mm_set1_ps(k.lapK),
-            _mm_set1_ps(k.rMin), _mm_set1_ps(k.rMin2), _mm_set1_ps(k.invRMin), _mm_set1_ps(Real(9)),
-            _mm_set1_ps(k.lapMax)};
+            _mm_set1_ps(k.rMin), _mm_set1_ps(k.rMin2), _mm_set1_ps(k.invRMin), _mm_set1_ps(Real(9))};
 #endif
     for (std::size_t i = b; i < e; ++i) {
       const Vec2 xi = X[i];
@@ -346,6 +345,7 @@ std::size_t pressureForce(StepContext& c, const Spiky<Real>& spiky, const Viscos
         __m128 acc = _mm_setzero_ps();
         const __m128 xi4 = _mm_set1_ps(xi.x()), yi4 = _mm_set1_ps(xi.y()), pi4 = _mm_set1_ps(pi);
         const __m128 vix4 = _mm_set1_ps(vix), viy4 = _mm_set1_ps(viy);
+        const __m128 capI4 = _mm_set1_ps(k.pairCap / IR[i]);  // ViscosityTerm::pairCap · ρ_i
         // Adds the terms of pairs kk.. kk + n − 1 (n ≤ 4; missing lanes repeat the last one and are not added).
         auto group = [&](std::uint32_t j0, std::uint32_t j1, std::uint32_t j2, std::uint32_t j3, std::uint32_t n) {
           __m128 xj, yj;
@@ -378,9 +378,8 @@ std::size_t pressureForce(StepContext& c, const Spiky<Real>& spiky, const Viscos
                 _mm_mul_ps(_mm_mul_ps(_mm_mul_ps(K4.nine, q), q), q));
             __m128 lap = _mm_mul_ps(_mm_mul_ps(K4.lapK, _mm_sub_ps(K4.R, q)), poly);
             lap = _mm_mul_ps(_mm_mul_ps(_mm_mul_ps(lap, iq), iq), iq);
-            lap = _mm_min_ps(lap, K4.lapMax);  // the stability cap (std::min's value for finite lanes)
             lap = _mm_and_ps(_mm_cmpnge_ps(r2, K4.vR2), lap);  // r² ≥ R²: 0
-            const __m128 w = _mm_mul_ps(lap, irj);
+            const __m128 w = _mm_min_ps(_mm_mul_ps(lap, irj), capI4);  // the stability cap (std::min's value for finite lanes)
             __m128 vxj, vyj;
             gather4(V, j0, j1, j2, j3, vxj, vyj);
             t2 = _mm_mul_ps(_mm_sub_ps(vxj, vix4), w);
@@ -414,6 +413,7 @@ std::size_t pressureForce(StepContext& c, const Spiky<Real>& spiky, const Viscos
       }
       const Vec2 fp(sums[0], sums[1]);
       const Real invRhoi = IR[i];
+      const Real capWall = vt.pairCap / invRhoi * c.rho0;  // a wall sample's ∇²W at most (ViscosityTerm::pairCap)
       Vec2 acc = -fp * invRhoi;
       if (hasBoundary) {
         // Boundary samples as frozen fluid of mass ρ0·Ψ_b that carries no
@@ -447,7 +447,7 @@ std::size_t pressureForce(StepContext& c, const Spiky<Real>& spiky, const Viscos
           const std::uint32_t* bl = c.nbr.boundaryOf(i);
           for (std::uint32_t q = 0; q < c.nbr.boundaryCount[i]; ++q) {
             const std::uint32_t s = bl[q];
-            sum += B.volume[s] * std::min(W.laplacianR2((xi - B.samples[s]).squaredNorm()), vt.lapMax);
+            sum += B.volume[s] * std::min(W.laplacianR2((xi - B.samples[s]).squaredNorm()), capWall);
           }
           const Vec2 aWall = Vec2(vix, viy) * (vt.wallFactor * invRhoi * sum);
           av -= aWall;
@@ -474,13 +474,13 @@ std::size_t pressureForce(StepContext& c, const Spiky<Real>& spiky, const Viscos
             gb += g;
             const Vec2& arm = moving->arm[s];
             tb += arm.x() * g.y() - arm.y() * g.x();
-            if (Visc && vt.walls) {
-              const Vec2 u = (Vec2(vix, viy) - moving->v[s]) * (moving->volume[s] * std::min(W.laplacianR2(rr), vt.lapMax));
+            if (Visc && vt.noSlip) {
+              const Vec2 u = (Vec2(vix, viy) - moving->v[s]) * (moving->volume[s] * std::min(W.laplacianR2(rr), capWall));
               lv += u;
               tv += arm.x() * u.y() - arm.y() * u.x();
             }
           }
-          const Real vK = Visc && vt.walls ? vt.wallFactor * invRhoi : Real(0);
+          const Real vK = Visc && vt.noSlip ? vt.wallFactor * invRhoi : Real(0);
           const Vec2 aBody = -(gb * pK) - lv * vK;
           acc += aBody;
           if (moving->placed[body].dynamic)
