@@ -222,12 +222,13 @@ TEST_CASE("moving bodies: in the game solver a crate of density 500 floats at Ar
 TEST_CASE("moving bodies: water thrown at a free crate in zero gravity keeps the momentum of water and crate together") {
   // No gravity, nothing reaches the walls: the only impulse is between the water and the
   // crate (pressure on the grid and contacts), so their momenta must sum to the start's.
-  for (const char* solver : {"game", "wcsph"}) {
+  for (const char* solver : {"game", "wcsph", "dfsph"}) {
     INFO(solver);
     // The game solver's pressure reaches the crate on the grid, whose faces are corrected to
     // give a body its true area (markBodies): first order in the cell size, so the balance
     // is 2.4 % with the crate 10 × 15 cells (spacing 0.01) and 5.6 % at 5 × 7.5 (0.02).
-    // wcsph's contacts and its moving samples (body_samples.hpp) exchange exactly opposite impulses.
+    // wcsph's and dfsph's contacts and moving samples (body_samples.hpp) exchange exactly
+    // opposite impulses (dfsph: each solve's wall terms of the crate's samples, summed).
     const double dx = 0.01;
     SceneDef s = test::tank(solver, 4.0, 4.0, dx);
     s.gravity = Vec2d(0, 0);
@@ -250,7 +251,7 @@ TEST_CASE("moving bodies: water thrown at a free crate in zero gravity keeps the
     const Vec2d p0 = test::momentum(w) + bodyMomentum();
     for (int f = 0; f < 36; ++f) w.stepFrame();  // 0.6 s: the drop meets the crate at about 0.15 s
     const Vec2d pBody = bodyMomentum(), p1 = test::momentum(w) + pBody;
-    MESSAGE(solver << ": momentum of water and crate from (" << p0.x() << ", " << p0.y() << ") to (" << p1.x() << ", "
+    MESSAGE(std::string(solver) << ": momentum of water and crate from (" << p0.x() << ", " << p0.y() << ") to (" << p1.x() << ", "
                    << p1.y() << ") kg m/s; the crate's " << pBody.x() << " kg m/s");
     CHECK(test::outside(w, 0.3, 0.3, 3.7, 3.7) == 0);  // nothing reached the walls
     CHECK(pBody.x() > 0.05 * p0.x());                   // the water threw the crate
