@@ -248,7 +248,7 @@ class Dfsph final : public Solver {
     // neighbourhood gives about (ρ0/R)²).
     const Real eps = Real(1e-6) * (c.rho0 / R) * (c.rho0 / R);
     const Vec2* X = P.x.data();
-    const std::size_t bad = firstBad(c.pool, n, [&](std::size_t b, std::size_t e) {
+    const std::size_t firstBadSlot = firstBad(c.pool, n, [&](std::size_t b, std::size_t e) {
       std::size_t bad = kNone;
       std::vector<Pair>& G = pairs_[b / kBlock];
       G.resize(L.perBlock[b / kBlock].size());
@@ -338,7 +338,7 @@ class Dfsph final : public Solver {
       return bad;
     });
     if (moving_) lumpBodies(c);
-    return bad;
+    return firstBadSlot;
   }
 
   /// A dynamic body moves with what all its neighbours push it by at once, which a particle's
@@ -533,9 +533,9 @@ class Dfsph final : public Solver {
             if (P.rho[i] > kneeRho) dk *= kneeRho * P.invRho[i];
             // Complementarity residual: where κ_i > 0 the constraint is active and
             // any deviation counts; where κ_i = 0 only compression does.
-            const double e = double(K[i] > 0 || !unilateral ? std::fabs(src) : std::max(src, Real(0)));
-            errSum += e;
-            if (movSrc && movCount_[i] > 0) bodyErr += e, bodyN += 1;
+            const double err = double(K[i] > 0 || !unilateral ? std::fabs(src) : std::max(src, Real(0)));
+            errSum += err;
+            if (movSrc && movCount_[i] > 0) bodyErr += err, bodyN += 1;
             dk = std::max(dk, kMin - K[i]);  // κ stays ≥ 0: no tension at the free surface
             dk_[i] = dk;
             q_[i] = dk * P.invRho[i];
