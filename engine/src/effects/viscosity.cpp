@@ -14,17 +14,17 @@
 // a splash reads far below ρ0). At the time-step limit a lattice neighbour takes at most
 // 0.061 and the lattice's row sums 0.42 (R = 2.5 dx), so resolved flows never meet the cap,
 // and a particle with four capped pairs besides still takes a convex combination of its
-// neighbours' velocities. Without
-// it the game preset's 20k dam break with ν = 0.001 m²/s ran away at the far corner
-// after 0.72 s (two particles 3 mm apart at ±240 m/s).
+// neighbours' velocities. Without it the game preset's 20k dam break with ν = 0.001 m²/s
+// ran away at the far corner after 0.72 s (two particles 3 mm apart at ±240 m/s).
 //
 // With solver.no_slip, the walls' boundary samples take part as fluid at rest
 // (v_b = 0, density ρ0, volume Ψ_b): a_i += ν ρ0/ρ_i Σ_b Ψ_b (0 − v_i) ∇²W_ib,
 // the no-slip wall of Morris, Fox & Zhu 1997 with the wall velocity in place
 // of their mirrored one. A moving body's samples (body_samples.hpp, for the solvers
 // that take them) are such a wall moving with the sample's velocity v_b, and the
-// body takes minus the force they exert (its viscous drag, Akinci et al. 2012). Without it (the default) walls are free-slip and only
-// the collision stage's Coulomb friction acts on the fluid at the wall.
+// body takes minus the force they exert (its viscous drag, Akinci et al. 2012).
+// Without no_slip (the default) walls are free-slip and only the collision stage's
+// Coulomb friction acts on the fluid at the wall.
 #include <algorithm>
 #include <cmath>
 
