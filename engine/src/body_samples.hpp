@@ -85,6 +85,21 @@ struct BodySamples {
 
  public:
 
+  /// Calls f(k, first, last) for each body k's run [first, last) of a particle's list of moving
+  /// samples ml[0, count) (nbr.movingOf: the neighbours stage lists each body's samples together),
+  /// in list order.
+  template <class F>
+  void forEachBody(const std::uint32_t* ml, std::uint32_t count, F&& f) const {
+    for (std::uint32_t q = 0; q < count;) {
+      const std::uint32_t k = body[ml[q]], first = q;
+      while (q < count && body[ml[q]] == k) ++q;
+      f(k, ml + first, ml + q);
+    }
+  }
+
+  /// The torque arm × f about a body's centre of mass (2D cross product).
+  static Real torque(const Vec2& arm, const Vec2& f) { return arm.x() * f.y() - arm.y() * f.x(); }
+
   /// True between the `body_samples` and `body_forces` stages of a substep: the samples
   /// are placed, and the neighbour lists hold them.
   bool active() const { return !placed.empty(); }

@@ -150,15 +150,7 @@ TEST_CASE("body samples: beside a kinematic box at rest each particle has the de
   for (const char* solver : {"wcsph", "muller2003", "dfsph"}) {
     std::map<std::uint32_t, double> rho[2];
     for (int kinematic = 0; kinematic < 2; ++kinematic) {
-      SceneDef s = test::tank(solver, 2.0, 1.0, 0.02);
-      s.gravity = Vec2d(0, 0);
-      s.blocks.push_back(test::block({0, 0}, {2.0, 0.6}));
-      BodyDef box;
-      box.type = kinematic ? BodyDef::Type::Kinematic : BodyDef::Type::Static;
-      box.position = Vec2d(1.0, 0.3);
-      box.fixtures.push_back(test::boxShape({0, 0}, {0.2, 0.06}));
-      s.bodies.push_back(box);
-      World w(s, WorldOptions{2});
+      World w(test::boxInWater(solver, kinematic != 0), WorldOptions{2});
       w.stepSubstep();
       const double d = 2 * double(w.spacing());  // the rows at 0.5 and 1.5 spacings
       for (std::size_t i = 0; i < w.particleCount(); ++i) {

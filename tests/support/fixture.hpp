@@ -384,6 +384,21 @@ inline SceneDef crateScene(const std::string& solver, double density, double y) 
   return s;
 }
 
+/// A 2 m × 1 m tank (spacing 0.02, no gravity) holding water [0, 2] × [0, 0.6] moving at
+/// `velocity`, and a 0.4 m × 0.12 m box centred at (1, 0.3): static, or kinematic at rest (the
+/// same box sampled as a moving body). Water within 0.2 + 2 spacings of its centre in x is beside it.
+inline SceneDef boxInWater(const std::string& solver, bool kinematic, const Vec2d& velocity = Vec2d(0, 0)) {
+  SceneDef s = tank(solver, 2.0, 1.0, 0.02);
+  s.gravity = Vec2d(0, 0);
+  s.blocks.push_back(block({0, 0}, {2.0, 0.6}, velocity));
+  BodyDef box;
+  box.type = kinematic ? BodyDef::Type::Kinematic : BodyDef::Type::Static;
+  box.position = Vec2d(1.0, 0.3);
+  box.fixtures.push_back(boxShape({0, 0}, {0.2, 0.06}));
+  s.bodies.push_back(box);
+  return s;
+}
+
 /// The world's first dynamic body (null: none).
 inline const b2Body* dynamicBody(const World& w) {
   for (const b2Body* b = w.box2d().GetBodyList(); b; b = b->GetNext())

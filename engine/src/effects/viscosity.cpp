@@ -118,23 +118,21 @@ class LaplacianViscosity final : public Effect {
           const std::uint32_t* ml = c.nbr.movingOf(i);
           const std::uint32_t mc = c.nbr.movingCount[i];
           const Real vK = t.wallFactor * IR[i];
-          for (std::uint32_t q = 0; q < mc;) {
-            const std::uint32_t body = moving->body[ml[q]];
+          moving->forEachBody(ml, mc, [&](std::uint32_t body, const std::uint32_t* run, const std::uint32_t* runEnd) {
             Vec2 lv = Vec2::Zero();
             Real tv = 0;  // Σ arm × the pair's term
-            for (; q < mc && moving->body[ml[q]] == body; ++q) {
-              const std::uint32_t s = ml[q];
+            for (const std::uint32_t* p = run; p != runEnd; ++p) {
+              const std::uint32_t s = *p;
               const Real rr = (xi - moving->x[s]).squaredNorm();
               const Vec2 u = (Vec2(vix, viy) - moving->v[s]) * (moving->volume[s] * std::min(W.laplacianR2(rr), capWall));
               lv += u;
-              const Vec2& arm = moving->arm[s];
-              tv += arm.x() * u.y() - arm.y() * u.x();
+              tv += BodySamples::torque(moving->arm[s], u);
             }
             const Vec2 aBody = -lv * vK;
             acc += aBody;
             if (moving->placed[body].dynamic)
               moving->addReaction(b / kBlock, body, aBody.cast<double>() * double(c.mass), -double(tv) * double(vK) * double(c.mass));
-          }
+          });
         }
         P.a[i] += acc;
         if (!allFinite(acc) && bad == kNone) bad = i;

@@ -50,16 +50,9 @@ TEST_CASE("particle shifting beside a kinematic box at rest moves each particle 
   std::map<std::uint32_t, Vec2d> at[2];
   double dx = 0;
   for (int kinematic = 0; kinematic < 2; ++kinematic) {
-    SceneDef s = test::tank("wcsph", 2.0, 1.0, 0.02);
-    s.gravity = Vec2d(0, 0);
+    SceneDef s = test::boxInWater("wcsph", kinematic != 0, Vec2d(0.3, 0));
     s.effects.shifting = true;
     s.effects.shiftingStrength = 8;
-    s.blocks.push_back(test::block({0, 0}, {2.0, 0.6}, {0.3, 0}));
-    BodyDef box;
-    box.type = kinematic ? BodyDef::Type::Kinematic : BodyDef::Type::Static;
-    box.position = Vec2d(1.0, 0.3);
-    box.fixtures.push_back(test::boxShape({0, 0}, {0.2, 0.06}));
-    s.bodies.push_back(box);
     World w(s, WorldOptions{2});
     const std::vector<std::string> fx = w.effects();
     REQUIRE(std::find(fx.begin(), fx.end(), "shifting") != fx.end());

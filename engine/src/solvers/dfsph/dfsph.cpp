@@ -302,12 +302,11 @@ class Dfsph final : public Solver {
           const std::uint32_t* ml = L.movingOf(i);
           const std::uint32_t mc = L.movingCount[i];
           Real vol = 0, src = 0;
-          for (std::uint32_t k = 0; k < mc;) {
-            const std::uint32_t body = moving->body[ml[k]];
+          moving->forEachBody(ml, mc, [&](std::uint32_t body, const std::uint32_t* run, const std::uint32_t* runEnd) {
             Vec2 gk = Vec2::Zero();
             Real tk = 0;
-            for (; k < mc && moving->body[ml[k]] == body; ++k) {
-              const std::uint32_t s = ml[k];
+            for (const std::uint32_t* p = run; p != runEnd; ++p) {
+              const std::uint32_t s = *p;
               const Vec2 d = xi - moving->x[s];
               const Real q = std::sqrt(d.squaredNorm()) * W.invR;
               const Real a = Real(1) - q;
@@ -315,12 +314,11 @@ class Dfsph final : public Solver {
               const Vec2 g = d * (c.rho0 * gradK * a * a * a * moving->volume[s]);
               gk += g;
               src += g.x() * moving->v[s].x() + g.y() * moving->v[s].y();
-              const Vec2& arm = moving->arm[s];
-              tk += arm.x() * g.y() - arm.y() * g.x();
+              tk += BodySamples::torque(moving->arm[s], g);
             }
             gm += gk;
             if (moving->placed[body].dynamic) T.push_back(MovTerm{body, gk.x(), gk.y(), tk});
-          }
+          });
           movCount_[i] = std::uint32_t(T.size() - movStart_[i]);
           movSrc_[i] = src;
           rho += c.rho0 * vol;

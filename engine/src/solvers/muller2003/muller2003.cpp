@@ -462,22 +462,20 @@ std::size_t pressureForce(StepContext& c, const Spiky<Real>& spiky, const Viscos
         const std::uint32_t* ml = c.nbr.movingOf(i);
         const std::uint32_t mc = c.nbr.movingCount[i];
         const Real pK = Real(0.5) * pi * invRhoi;
-        for (std::uint32_t q = 0; q < mc;) {
-          const std::uint32_t body = moving->body[ml[q]];
+        moving->forEachBody(ml, mc, [&](std::uint32_t body, const std::uint32_t* run, const std::uint32_t* runEnd) {
           Vec2 gb = Vec2::Zero(), lv = Vec2::Zero();
           Real tb = 0, tv = 0;  // Σ arm × (the pair's term), for the torque
-          for (; q < mc && moving->body[ml[q]] == body; ++q) {
-            const std::uint32_t s = ml[q];
+          for (const std::uint32_t* p = run; p != runEnd; ++p) {
+            const std::uint32_t s = *p;
             const Vec2 d = xi - moving->x[s];
             const Real rr = d.squaredNorm();
             const Vec2 g = spiky.gradient(d, std::sqrt(rr)) * moving->volume[s];
             gb += g;
-            const Vec2& arm = moving->arm[s];
-            tb += arm.x() * g.y() - arm.y() * g.x();
+            tb += BodySamples::torque(moving->arm[s], g);
             if (Visc && vt.noSlip) {
               const Vec2 u = (Vec2(vix, viy) - moving->v[s]) * (moving->volume[s] * std::min(W.laplacianR2(rr), capWall));
               lv += u;
-              tv += arm.x() * u.y() - arm.y() * u.x();
+              tv += BodySamples::torque(moving->arm[s], u);
             }
           }
           const Real vK = Visc && vt.noSlip ? vt.wallFactor * invRhoi : Real(0);
@@ -486,7 +484,7 @@ std::size_t pressureForce(StepContext& c, const Spiky<Real>& spiky, const Viscos
           if (moving->placed[body].dynamic)
             moving->addReaction(b / kBlock, body, aBody.cast<double>() * double(c.mass),
                                 -(double(tb) * double(pK) + double(tv) * double(vK)) * double(c.mass));
-        }
+        });
       }
       P.a[i] = acc;
       if (!allFinite(acc) && bad == kNone) bad = i;

@@ -233,12 +233,11 @@ class Wcsph final : public Solver {
           const Real pressK = c.rho0 * pScale, viscK = c.rho0 * avK * Real(2) / (rhoi + c.rho0);
           const std::uint32_t* ml = c.nbr.movingOf(i);
           const std::uint32_t mc = c.nbr.movingCount[i];
-          for (std::uint32_t k = 0; k < mc;) {
-            const std::uint32_t body = moving->body[ml[k]];
+          moving->forEachBody(ml, mc, [&](std::uint32_t body, const std::uint32_t* run, const std::uint32_t* runEnd) {
             Vec2 gb = Vec2::Zero(), gv = Vec2::Zero();
             Real tb = 0, tv = 0;  // Σ arm × (the pair's term), for the torque
-            for (; k < mc && moving->body[ml[k]] == body; ++k) {
-              const std::uint32_t s = ml[k];
+            for (const std::uint32_t* p = run; p != runEnd; ++p) {
+              const std::uint32_t s = *p;
               const Vec2 d = X[i] - moving->x[s];
               const Real rr = d.squaredNorm();
               const Real q = std::sqrt(rr) * W.invR;
@@ -247,14 +246,13 @@ class Wcsph final : public Solver {
               const Real pb = std::max(Real(0), pi - rhoi * c.gravity.dot(d));
               const Vec2 fp = d * (gw * (pri + pb / (c.rho0 * c.rho0)));
               gb += fp;
-              const Vec2& arm = moving->arm[s];
-              tb += arm.x() * fp.y() - arm.y() * fp.x();
+              tb += BodySamples::torque(moving->arm[s], fp);
               const Vec2 vr = V[i] - moving->v[s];
               const Real vdotx = vr.x() * d.x() + vr.y() * d.y();
               if (vdotx < 0) {
                 const Vec2 fv = d * (gw * (h * vdotx / (rr + eta2)));
                 gv += fv;
-                tv += arm.x() * fv.y() - arm.y() * fv.x();
+                tv += BodySamples::torque(moving->arm[s], fv);
               }
             }
             const Vec2 aBody = gv * viscK - gb * pressK;
@@ -262,7 +260,7 @@ class Wcsph final : public Solver {
             if (moving->placed[body].dynamic)
               moving->addReaction(b / kBlock, body, aBody.cast<double>() * double(c.mass),
                                   (double(tv) * double(viscK) - double(tb) * double(pressK)) * double(c.mass));
-          }
+          });
         }
         acc += c.gravity;
         P.a[i] = acc;
