@@ -22,6 +22,10 @@
 // lighter than its density says (density 1000 stays neutral).
 // Per substep:
 //  - `body_gravity` (after `emit`, with a dynamic body): its velocity takes g·dt;
+//  - `body_jump` (with a solver that samples the bodies): where a body is not where the fluid
+//    last saw it, the `bodies` push-out below for particles standing still, before the solver
+//    counts them (with these solvers the scene's own b2World steps with every substep:
+//    World::Impl::bodiesFollow);
 //  - the game solver's grid projection treats the bodies as moving solids and solves
 //    for a dynamic body's velocity together with the pressure (grid_projection.cpp);
 //  - `bodies` (after the static collision): a particle whose path entered one of a body's
@@ -338,6 +342,10 @@ void World::Impl::captureBodies() {
   if (had != !moving.bodies.empty() || hadDynamic != moving.anyDynamic()) buildStages();
 }
 
+// A body whose pose at a substep's start differs from where the fluid last saw it by less than
+// this share of the clearance did not jump: Box2D's float poses round to about a micrometre.
+constexpr double kJumpShare = 1e-3;
+
 // An impulse at most this in each component [N·s per metre of depth] is none: the fluid did not
 // touch the body, and applying it would wake a sleeping body for nothing.
 constexpr double kNegligibleImpulse = 1e-12;
@@ -365,9 +373,10 @@ void World::Impl::bodyGravity(StepContext& c) {
     if (m.dynamic()) m.changeVelocity(tau0, m.gravity * double(c.dt), 0);
 }
 
-void World::Impl::collideMoving(StepContext& c) {
+void World::Impl::collideMoving(StepContext& c, bool atStart) {
   if (moving.bodies.empty()) return;
-  const double tau0 = c.time - moving.time0, tau1 = tau0 + double(c.dt), clearance = double(c.clearance);
+  const double tau0 = c.time - moving.time0, tau1 = atStart ? tau0 : tau0 + double(c.dt),
+               clearance = double(c.clearance);
   using Pose = BodyPose;
   const std::vector<MovingSolid>& bodies = moving.bodies;
   std::vector<Pose>& poses = bodyPoses;
@@ -386,6 +395,14 @@ void World::Impl::collideMoving(StepContext& c) {
                          std::fabs(q.theta1 - q.theta0) * bodies[k].radius;
     q.reach2 = reach * reach;
   }
+  if (atStart) {  // only where a body is not where the fluid last saw it (beyond float rounding)
+    const double tol = kJumpShare * clearance;
+    bool jumped = false;
+    for (std::size_t k = 0; k < bodies.size(); ++k)
+      jumped = jumped || (poses[k].o1 - poses[k].o0).norm() > tol ||
+               std::fabs(poses[k].theta1 - poses[k].theta0) * bodies[k].radius > tol;
+    if (!jumped) return;
+  }
   const bool anyDynamic = moving.anyDynamic();
   if (anyDynamic) {
     hitBody.assign(c.P.size(), -1);
@@ -398,7 +415,8 @@ void World::Impl::collideMoving(StepContext& c) {
       for (std::size_t k = 0; k < bodies.size(); ++k) {
         const MovingSolid& m = bodies[k];
         const Pose& q = poses[k];
-        const Vec2d xw(c.P.x[i].x(), c.P.x[i].y()), xp(c.P.xPrev[i].x(), c.P.xPrev[i].y());
+        const Vec2d xw(c.P.x[i].x(), c.P.x[i].y());
+        const Vec2d xp = atStart ? xw : Vec2d(c.P.xPrev[i].x(), c.P.xPrev[i].y());
         {  // a first cull in the local frame: the path from xp to xw against the swept reach
           const Vec2d d = xw - xp, e = q.com1 - xp;
           const double l2 = d.squaredNorm(), u = l2 > 0 ? std::clamp(e.dot(d) / l2, 0.0, 1.0) : 0.0;

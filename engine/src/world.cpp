@@ -196,8 +196,9 @@ void World::step(double dt) {
   if (impl_->staticSignature() != impl_->boundarySignature) refreshBoundaries();
   impl_->captureBodies();  // the moving bodies' pose and velocity for this step
   const double t0 = impl_->time;
+  const bool everySubstep = impl_->bodiesEverySubstep();  // then advance() stepped the bodies
   impl_->advance(dt);
-  impl_->moveOwnBodies(impl_->time - t0);
+  if (!everySubstep) impl_->moveOwnBodies(impl_->time - t0);
   ++impl_->frames;
   impl_->refreshView();
 }

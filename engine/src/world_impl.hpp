@@ -104,7 +104,11 @@ struct World::Impl {
   /// The `bodies` stage: particles that entered a moving body during the substep are put
   /// back on its surface, their velocity into it replaced by the body's (free slip); with a
   /// dynamic body they meet as an inelastic contact, and the body takes the impulse.
-  void collideMoving(StepContext& c);
+  /// atStart (the `body_jump` stage): the same for the particles, standing still, that a
+  /// body's move from where the fluid last saw it to its pose at the substep's start swept
+  /// over (Box2D's step moves a dynamic body off the path the fluid's substeps assumed);
+  /// nothing when no body jumped.
+  void collideMoving(StepContext& c, bool atStart = false);
   std::vector<std::int32_t> hitBody;  ///< the bodies stage's scratch: the dynamic body particle i met (−1: none)
   std::vector<Vec2d> hitNormal;       ///< … and the body's outward normal there
   /// The bodies stage's scratch per body: its pose at the substep's start and end.
@@ -182,6 +186,14 @@ struct World::Impl {
   Real substep(Real dt, bool driftOnly = false);
   /// Advances frameDt in equal substeps within the limits (the frame's split is the World's alone).
   void advance(double frameDt);
+  /// True when the scene's own b2World steps with every substep instead of once a frame:
+  /// it has a dynamic body and the solver samples the moving bodies (those solvers take
+  /// many substeps a frame, and a body–body contact resolved once a frame moved a crate by
+  /// up to 5 cm off the path the fluid's substeps had assumed).
+  bool bodiesEverySubstep() const { return ownWorld && moving.anyDynamic() && bodySamplesOn(); }
+  /// After a substep of `taken` seconds: with bodiesEverySubstep(), steps the scene's b2World by
+  /// it and reads the bodies again.
+  void bodiesFollow(Real taken);
   /// Throws the SimulationError naming the stage, the particle and its values.
   [[noreturn]] void fail(const std::string& stage, std::size_t slot);
 

@@ -124,7 +124,9 @@ class World {
 
   /// Advances one frame (1/fps seconds) in CFL substeps. Throws SimulationError.
   void stepFrame();
-  /// Advances `dt` seconds in CFL substeps. Throws SimulationError.
+  /// Advances `dt` seconds in CFL substeps. The scene's own b2World (not a game's) steps once by
+  /// `dt` after them, or with every substep when a dynamic body meets a solver that samples the
+  /// moving bodies (wcsph, muller2003, dfsph). Throws SimulationError.
   void step(double dt);
   /// Advances one CFL-limited substep (for benchmarks and tests). Throws SimulationError.
   void stepSubstep();

@@ -71,13 +71,17 @@
 // Measured (crate 0.6 m × 0.2 m, density 500, spacing 0.01): taking the reaction only after
 // the solve, the body light against the water it moves (added mass), each substep's impulse
 // overshot and the crate floated at 0.078 m (Archimedes 0.1). Two more terms make the coupled
-// Jacobi iteration converge: a particle beside body k adds the body's row of the coupled
-// system, lumped, m (G_ik·Σ_j G_jk / M_k + T_ik Σ_j T_jk / I_k), to α_i's denominator
-// (lumpBodies: each particle's step allows for the body giving way to all of them at once);
+// Jacobi iteration converge: a particle beside body k adds a bound on the body's row of the
+// coupled system, m (|G_ik| Σ_j |G_jk| / M_k + |T_ik| Σ_j |T_jk| / I_k), to α_i's denominator
+// (lumpBodies: each particle's step allows for the body giving way to all of them at once; the
+// absolute values keep the bound where particles push the body from opposite sides: with the
+// signed row, G_ik·Σ_j G_jk, those pushes cancelled, and the divergence solve of a crate wedged
+// against the tank's wall diverged, its residual doubling every two iterations);
 // and each solve also iterates until the mean residual of the particles beside a dynamic
 // body meets the tolerance (the body's mode is global, the mean over all particles hides
 // it). Measured with these: draught 0.0959 m over the third second (0.0942 without the
-// lumping, 0.0933 without either; 0.0976 with the Box2D skin alone and no samples).
+// lumping, 0.0933 without either; 0.0976 with the Box2D skin alone and no samples); 0.0952 m
+// with the bound and Box2D stepping with the substeps (docs/SCENES.md).
 //
 // Parameters (solver.*): tolerance, divergence_tolerance, max_iterations,
 // min_iterations, relaxation, chebyshev_rho, velocity_cfl, divergence_solve. stats()
@@ -340,17 +344,17 @@ class Dfsph final : public Solver {
   }
 
   /// A dynamic body moves with what all its neighbours push it by at once, which a particle's
-  /// Jacobi step alone does not see: the factor of a particle beside body k takes the body's
-  /// row of the coupled system lumped, m (G_ik·Σ_j G_jk / M_k + T_ik Σ_j T_jk / I_k), into its
-  /// denominator (sums in block order).
+  /// Jacobi step alone does not see: the factor of a particle beside body k takes a bound on the
+  /// body's row of the coupled system, m (|G_ik| Σ_j |G_jk| / M_k + |T_ik| Σ_j |T_jk| / I_k), into
+  /// its denominator (sums in block order).
   void lumpBodies(StepContext& c) {
     const std::size_t K = invMass_.size();
-    sumG_.assign(K, Vec2d(0, 0));
+    sumG_.assign(K, 0.0);
     sumT_.assign(K, 0.0);
     for (const std::vector<MovTerm>& T : movTerms_)
       for (const MovTerm& t : T) {
-        sumG_[t.body] += Vec2d(double(t.gx), double(t.gy));
-        sumT_[t.body] += double(t.t);
+        sumG_[t.body] += std::hypot(double(t.gx), double(t.gy));
+        sumT_[t.body] += std::fabs(double(t.t));
       }
     const double m = double(c.mass);
     c.pool.parallelFor(c.P.size(), kBlock, [&](std::size_t b, std::size_t e) {
@@ -359,8 +363,8 @@ class Dfsph final : public Solver {
         double extra = 0;
         for (std::uint32_t k = movStart_[i], ke = k + movCount_[i]; k < ke; ++k) {
           const MovTerm& t = T[k];
-          extra += m * (invMass_[t.body] * (double(t.gx) * sumG_[t.body].x() + double(t.gy) * sumG_[t.body].y()) +
-                        invInertia_[t.body] * double(t.t) * sumT_[t.body]);
+          extra += m * (invMass_[t.body] * std::hypot(double(t.gx), double(t.gy)) * sumG_[t.body] +
+                        invInertia_[t.body] * std::fabs(double(t.t)) * sumT_[t.body]);
         }
         if (extra > 0 && alpha_[i] > 0) {
           const double rho = double(c.P.rho[i]), a = double(alpha_[i]);
@@ -702,8 +706,8 @@ class Dfsph final : public Solver {
   std::vector<double> invMass_, invInertia_;  ///< per placed body (0: kinematic)
   std::vector<Vec2d> dv_, dvBase_;        ///< per body: ΔV so far in the substep, and before this solve
   std::vector<double> dw_, dwBase_;       ///< … and Δω
-  std::vector<Vec2d> sumG_;               ///< lumpBodies(): Σ_i G_ik per body
-  std::vector<double> sumT_;              ///< … and Σ_i T_ik
+  std::vector<double> sumG_;              ///< lumpBodies(): Σ_i |G_ik| per body
+  std::vector<double> sumT_;              ///< … and Σ_i |T_ik|
   std::vector<Vec2d> blockG_;             ///< per block and body: Σ_i Q_i G_ik (block-major)
   std::vector<double> blockT_;            ///< … and Σ_i Q_i T_ik
   std::vector<Real> alpha_;              ///< the DFSPH factor α_i
