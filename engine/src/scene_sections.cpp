@@ -317,20 +317,13 @@ void readSolver(const Reader& r, const json& root, SceneDef& s) {
   const std::string p = "solver";
   r.requireObject(j, p);
   SolverDef& d = s.solver;
-  d.type = r.string(j, p, "type", d.type, solverNames());
-  // A preset instead of a solver, chosen from docs/ACCURACY.md's measurements.
-  if (j.contains("quality")) {
-    if (j.contains("type")) r.fail(Reader::sub(p, "quality"), "give either solver.type or solver.quality, not both");
-    const std::string q = r.string(j, p, "quality", "balanced", qualityPresets());
-    const SolverDef preset = qualityPreset(q);
-    d.type = preset.type;
-    d.viscosity = preset.viscosity;
-    d.supportRatio = preset.supportRatio;
-    d.params = preset.params;
-  }
-  // The shared keys the solver tunes (e.g. the game solver's viscosity) take its
-  // values unless the scene gives them.
-  tuneSolverDefaults(d);
+  // The named solver's own defaults (the shared keys it tunes, e.g. the game solver's viscosity,
+  // and its parameters), or a preset's, chosen from docs/ACCURACY.md's measurements; a scene
+  // that names neither is real time: the game preset (issue 15).
+  if (j.contains("quality") && j.contains("type"))
+    r.fail(Reader::sub(p, "quality"), "give either solver.type or solver.quality, not both");
+  if (j.contains("type")) d = solverDefaults(r.string(j, p, "type", "game", solverNames()));
+  else d = qualityPreset(r.string(j, p, "quality", "game", qualityPresets()));
   std::vector<std::string> keys = {"type", "quality", "spacing", "support_ratio", "rest_density", "sound_speed", "viscosity", "no_slip", "cfl",
                                    "max_substeps", "clamp_negative_pressure", "reorder_interval", "max_speed"};
   for (const SolverParam& sp : solverParams(d.type)) keys.push_back(sp.key);

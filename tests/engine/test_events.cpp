@@ -17,7 +17,7 @@ namespace {
 
 const char* kTank = R"({
   "name": "tank", "fps": 60,
-  "solver": { "spacing": 0.05 },
+  "solver": { "type": "muller2003", "spacing": 0.05 },
   "boundaries": [ { "fixtures": [ { "shape": "box", "center": [1, -0.1], "half_size": [1.2, 0.1] } ] } ],
   "fluid": [ { "min": [0, 0], "max": [0.5, 0.5] } ],
   "effects": { "xsph": { "c": 0.1 },

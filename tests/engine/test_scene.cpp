@@ -1,9 +1,13 @@
 // Scene loading: good scenes load, bad ones name file, line, column, key and what is allowed.
 #include <doctest/doctest.h>
 
+#include <algorithm>
 #include <string>
+#include <vector>
 
 #include "sph2d/scene.hpp"
+#include "sph2d/world.hpp"
+#include "support/fixture.hpp"
 #include "test_util.hpp"
 
 using namespace sph2d;
@@ -119,4 +123,32 @@ TEST_CASE("solver.quality presets pick a solver, and cannot be combined with sol
   } catch (const SceneError& e) {
     CHECK(e.message.find("game, balanced, accurate") != std::string::npos);
   }
+}
+
+TEST_CASE("a scene or a program that names no solver is real time (the game preset), and a named solver starts from its own defaults") {
+  // Issue 15: "real time by default". The game preset's values (its viscosity 0, support 2 and
+  // its parameters), not muller2003's as before 24 Nov.
+  const SolverDef game = qualityPreset("game");
+  for (const SolverDef& d : {SceneDef().solver, parseScene("{}", "none.json").solver,
+                             parseScene("{\"solver\": {\"spacing\": 0.03}}", "spacing.json").solver}) {
+    CHECK(d.type == "game");
+    CHECK(d.viscosity == game.viscosity);
+    CHECK(d.supportRatio == game.supportRatio);
+    CHECK(d.params == game.params);
+  }
+  // Naming a type gives that solver's defaults, not the game preset's with another name.
+  const SolverDef named = parseScene("{\"solver\": {\"type\": \"muller2003\"}}", "m.json").solver;
+  const SolverDef muller = solverDefaults("muller2003");
+  CHECK(named.type == "muller2003");
+  CHECK(named.viscosity == muller.viscosity);
+  CHECK(named.supportRatio == muller.supportRatio);
+  CHECK(named.params == muller.params);
+  // And the World built from a default SceneDef runs the game solver's stages.
+  SceneDef s;
+  s.solver.spacing = 0.05;
+  s.bodies.push_back(test::tankWalls(1.0, 1.0));
+  s.blocks.push_back(test::block({0, 0}, {0.5, 0.5}));
+  const World w(s, WorldOptions{1});
+  const std::vector<std::string> st = w.stages();
+  CHECK(std::find(st.begin(), st.end(), "grid_projection") != st.end());
 }

@@ -181,6 +181,7 @@ TEST_CASE("the particle budget counts the blocks' lattice and the solids' sample
   // Samples: a 4 m box at 1e-5 m needs about 4.8 million, over the 4 million allowed
   // to any scene, within a max_particles of 5 million.
   SceneDef solid;
+  solid.solver = solverDefaults("muller2003");  // support 2.5 spacings: three layers of samples
   solid.solver.spacing = 1e-5;
   BodyDef body;
   ShapeDef box;

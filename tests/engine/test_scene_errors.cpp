@@ -136,7 +136,7 @@ TEST_CASE("bad input: a spacing too small for the budget is refused with the par
   CHECK(has(e, "spacing 1e-300 fills the fluid blocks with too many particles, more than max_particles = 4000000"));
 
   // Boundary samples cost memory like particles: a 4 m box at 1e-5 m needs about 4.8 million.
-  e = errorOf("{\"solver\": {\"spacing\": 1e-5}, \"boundaries\": [{\"fixtures\": [{\"shape\": \"box\", \"half_size\": [2, 2]}]}]}");
+  e = errorOf("{\"solver\": {\"type\": \"muller2003\", \"spacing\": 1e-5}, \"boundaries\": [{\"fixtures\": [{\"shape\": \"box\", \"half_size\": [2, 2]}]}]}");
   CHECK(e.key == "solver.spacing");
   CHECK(has(e, "spacing 1e-05 lines the solids with about 4800000 boundary samples, more than max(max_particles, 4000000) = 4000000"));
 }

@@ -40,14 +40,15 @@ std::string failure(const std::string& text, SceneDef& s, Fn read) {
 TEST_CASE("readSolver fills every parameter the solver declares, with or without a solver key") {
   for (const std::string& type : solverNames()) {
     INFO(type);
-    // No solver key: the type the SceneDef holds (muller2003 unless set) gets its defaults.
+    // No solver key: the game preset with its defaults, whatever the SceneDef held (a scene
+    // that names no solver is real time).
     const Doc d("{}");
     SceneDef s;
-    s.solver.type = type;
+    s.solver = solverDefaults(type);
     readSolver(d.r, d.doc.root, s);
-    CHECK(s.solver.type == type);
-    CHECK(s.solver.params.size() == solverParams(type).size());
-    for (const SolverParam& sp : solverParams(type)) CHECK(s.solver.param(sp.key) == sp.def);
+    CHECK(s.solver.type == "game");
+    CHECK(s.solver.params.size() == solverParams("game").size());
+    for (const SolverParam& sp : solverParams("game")) CHECK(s.solver.param(sp.key) == sp.def);
   }
   CHECK(solverParams("pbf").size() > 0);  // so that the loop above checks something
   for (const std::string& type : solverNames()) {

@@ -129,7 +129,7 @@ inline SceneDef wallScene(double spacing, const std::string& solver = "wcsph") {
 /// wcsph at dx = 0.04, ν = 0, no effects (the pairwise-momentum tests add theirs).
 inline SceneDef freeMovingBlock() {
   SceneDef s;
-  s.solver.type = "wcsph";
+  s.solver = solverDefaults("wcsph");
   s.solver.spacing = 0.04;
   s.solver.viscosity = 0.0;
   s.gravity = Vec2d(0, 0);

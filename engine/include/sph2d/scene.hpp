@@ -199,7 +199,11 @@ struct SceneDef {
   std::string name = "scene";
   std::string path;                 ///< file it came from ("" when built in code)
   Vec2d gravity{0, -9.81};
-  SolverDef solver;
+  /// Real time unless the program names another: the game preset (qualityPreset("game")). To
+  /// name a solver, start from its own defaults (`solver = solverDefaults("wcsph")` or
+  /// `qualityPreset("accurate")`), not by changing `solver.type` alone: the game's viscosity,
+  /// support and parameters would stay.
+  SolverDef solver = qualityPreset("game");
   std::vector<BodyDef> bodies;
   std::vector<FluidBlockDef> blocks;
   PeriodicDef periodic;             ///< periodic axes (none by default)

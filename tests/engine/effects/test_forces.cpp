@@ -17,7 +17,7 @@ bool has(const std::vector<std::string>& v, const std::string& s) { return std::
 
 TEST_CASE("a region-limited force field accelerates only the particles inside it") {
   SceneDef s;
-  s.solver.type = "wcsph";
+  s.solver = solverDefaults("wcsph");
   s.solver.spacing = 0.05;
   s.solver.viscosity = 0;
   s.gravity = Vec2d(0, 0);
@@ -83,7 +83,7 @@ TEST_CASE("a force field everywhere alone accelerates a free block's mean veloci
   // Zero gravity, no walls: pressure forces are pairwise and cancel, so the mean
   // velocity is exactly the field's a·t. Measured: (1.500000, −0.500002) m/s at 0.5 s.
   SceneDef s;
-  s.solver.type = "wcsph";
+  s.solver = solverDefaults("wcsph");
   s.solver.spacing = 0.05;
   s.solver.viscosity = 0;
   s.gravity = Vec2d(0, 0);

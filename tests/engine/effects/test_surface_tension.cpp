@@ -42,7 +42,7 @@ constexpr double kPiD = test::kPi;
 /// Free fluid in zero gravity: wcsph at dx = 0.005 m, c = 5 m/s, ν = 0.01 m²/s.
 SceneDef freeFluid(const std::string& model, double strength) {
   SceneDef s;
-  s.solver.type = "wcsph";
+  s.solver = solverDefaults("wcsph");
   s.solver.spacing = 0.005;
   s.solver.soundSpeed = 5;
   s.solver.viscosity = 0.01;

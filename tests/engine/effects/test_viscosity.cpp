@@ -76,7 +76,7 @@ TEST_CASE("viscosity: two particles pressed to 0.1 R with opposite velocities ne
     const char* solver = k.solver;
     INFO(solver << ", support ratio " << k.supportRatio);
     SceneDef s;
-    s.solver.type = solver;
+    s.solver = solverDefaults(solver);
     s.solver.spacing = 0.01;
     s.solver.viscosity = 0.001;
     if (k.supportRatio > 0) s.solver.supportRatio = k.supportRatio;
