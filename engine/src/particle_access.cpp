@@ -11,6 +11,7 @@
 // remember to mark it stale, and a World whose game never asks holds no index.
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <sstream>
 #include <stdexcept>
 
@@ -115,6 +116,49 @@ std::size_t World::setVelocities(const std::vector<std::uint32_t>& ids, const st
     ++found;
   }
   return found;
+}
+
+std::size_t World::getParticles(const std::vector<std::uint32_t>& ids, std::vector<Vec2d>& positions,
+                                std::vector<Vec2d>& velocities) const {
+  const Impl& w = *impl_;
+  rebuild(w.idIndex, w.P);  // once: absent ids then cost a search each, not a rebuild
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  positions.assign(ids.size(), Vec2d(nan, nan));
+  velocities.assign(ids.size(), Vec2d(nan, nan));
+  std::size_t found = 0;
+  for (std::size_t k = 0; k < ids.size(); ++k) {
+    const std::size_t i = find(w.idIndex, ids[k]);
+    if (i == npos) continue;
+    positions[k] = worldPosition(i);
+    velocities[k] = Vec2d(w.P.v[i].x(), w.P.v[i].y());
+    ++found;
+  }
+  return found;
+}
+
+std::size_t World::setPositions(const std::vector<std::uint32_t>& ids, const std::vector<Vec2d>& positions) {
+  if (ids.size() != positions.size())
+    throw std::invalid_argument("setPositions: " + std::to_string(ids.size()) + " ids but " +
+                                std::to_string(positions.size()) + " positions");
+  for (const Vec2d& p : positions)
+    if (!finite(p)) throw std::invalid_argument("setPositions: every position must be finite");
+  Impl& w = *impl_;
+  rebuild(w.idIndex, w.P);
+  std::size_t moved = 0;
+  for (std::size_t k = 0; k < ids.size(); ++k) {
+    const std::size_t i = find(w.idIndex, ids[k]);
+    if (i == npos) continue;
+    const Vec2 p(Real(positions[k].x() - w.origin.x()), Real(positions[k].y() - w.origin.y()));
+    if (w.boundary.insideDepth(p) > 0) continue;
+    w.P.x[i] = p;
+    w.P.xPrev[i] = p;  // a teleport, as setParticle
+    ++moved;
+  }
+  if (moved) {
+    ++w.edits;  // the query grid is stale
+    w.refreshView();
+  }
+  return moved;
 }
 
 bool World::setParticleColor(std::uint32_t id, std::uint32_t rgb) {

@@ -104,6 +104,46 @@ TEST_CASE("particle access: setParticle teleports a particle over a wall, and a 
   CHECK(x.x() < 1.0);
 }
 
+TEST_CASE("particle access: getParticles reads many ids as getParticle does one, and setPositions teleports many, refusing solids") {
+  SceneDef s = test::tank("wcsph", 1.0, 1.0, 0.02);
+  s.bodies[0].fixtures.push_back(test::boxShape({0.5, 0.5}, {0.05, 0.5}));  // a wall at x in [0.45, 0.55]
+  s.blocks.push_back(test::block({0, 0}, {0.2, 0.2}));
+  World w(s, WorldOptions{2});
+  for (int f = 0; f < 3; ++f) w.stepFrame();  // moving, and reordered by the grid
+  const std::uint32_t absent = 1000000;
+  std::vector<std::uint32_t> ids = {w.particles().id[5], absent, w.particles().id[0], w.particles().id[17]};
+  std::vector<Vec2d> x, v;
+  CHECK(w.getParticles(ids, x, v) == 3);
+  REQUIRE(x.size() == ids.size());
+  REQUIRE(v.size() == ids.size());
+  for (std::size_t k = 0; k < ids.size(); ++k) {
+    Vec2d xk, vk;
+    if (!w.getParticle(ids[k], xk, vk)) {
+      CHECK(std::isnan(x[k].x()));
+      CHECK(std::isnan(v[k].y()));
+      continue;
+    }
+    CHECK(x[k] == xk);
+    CHECK(v[k] == vk);
+  }
+  // Three moves: one into the right compartment, one into the wall (refused), one for an absent id.
+  const std::vector<std::uint32_t> movers = {ids[0], ids[2], absent};
+  const std::vector<Vec2d> to = {Vec2d(0.8, 0.3), Vec2d(0.5, 0.3), Vec2d(0.8, 0.5)};
+  CHECK_THROWS_AS(w.setPositions(movers, {Vec2d(0.8, 0.3)}), std::invalid_argument);
+  CHECK_THROWS_AS(w.setPositions(movers, {Vec2d(0.8, 0.3), Vec2d(std::nan(""), 0), Vec2d(0.8, 0.5)}), std::invalid_argument);
+  std::vector<Vec2d> before, vBefore;
+  w.getParticles(movers, before, vBefore);
+  CHECK(w.setPositions(movers, to) == 1);
+  w.getParticles(movers, x, v);
+  CHECK((x[0] - to[0]).norm() < 1e-6);  // stored in float, relative to the World's origin
+  CHECK(v[0] == vBefore[0]);            // the velocity is kept
+  CHECK(x[1] == before[1]);   // refused inside the wall
+  for (int f = 0; f < 30; ++f) w.stepFrame();
+  w.getParticles(movers, x, v);
+  MESSAGE("the moved particle after 0.5 s at " << x[0].x() << ", " << x[0].y());
+  CHECK(x[0].x() > 0.55);  // it stays on its side of the wall: the teleport started its swept path there
+}
+
 TEST_CASE("particle access: addParticles places particles that fall freely, skips solids and holds the budget") {
   SceneDef s = test::tank("wcsph", 1.0, 2.0, 0.02);
   s.blocks.push_back(test::block({0, 0}, {1.0, 0.1}));

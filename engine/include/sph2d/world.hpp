@@ -260,6 +260,17 @@ class World {
   /// ids a particle has (the rest are skipped). Throws std::invalid_argument when the
   /// lengths differ or a velocity is not finite (then nothing is changed).
   std::size_t setVelocities(const std::vector<std::uint32_t>& ids, const std::vector<Vec2d>& velocities);
+  /// Bulk read: positions[k] (world coordinates) and velocities[k] of particle ids[k]; both
+  /// vectors are resized to ids.size(), and an id no particle has gets NaN in both. Returns
+  /// how many of the ids a particle has. One id-index rebuild at most, then O(log n) an id.
+  std::size_t getParticles(const std::vector<std::uint32_t>& ids, std::vector<Vec2d>& positions,
+                           std::vector<Vec2d>& velocities) const;
+  /// Bulk teleport: particle ids[k] moves to positions[k] (world coordinates), its velocity
+  /// kept, as setParticle does (the next swept collision starts there). Ids no particle has,
+  /// and positions inside a solid, are skipped. Returns how many particles moved. Throws
+  /// std::invalid_argument when the lengths differ or a position is not finite (then nothing
+  /// is changed).
+  std::size_t setPositions(const std::vector<std::uint32_t>& ids, const std::vector<Vec2d>& positions);
   /// Adds one particle at each of `points` (world coordinates, any arrangement; the
   /// caller keeps them about a spacing apart) moving at velocities[k] (`velocities`
   /// empty: at rest). Points inside solids are skipped, and the particle budget holds as
