@@ -113,8 +113,9 @@ class World {
   /// Builds the world of a scene: its own b2World, the fluid blocks, the solver.
   explicit World(const SceneDef& scene, const WorldOptions& options = {});
   /// Builds the fluid of `scene` in a b2World the game owns: every static
-  /// fixture of `gameWorld` is solid to the fluid. The World never steps,
-  /// changes or destroys `gameWorld` (it must outlive the World); the scene's
+  /// fixture of `gameWorld` is solid to the fluid. The World never steps or destroys
+  /// `gameWorld` (it must outlive the World) and changes it only by the fluid's impulse on
+  /// its dynamic bodies (ApplyLinearImpulse / ApplyAngularImpulse after each step); the scene's
   /// own `boundaries` are ignored, with a warning. Static bodies the game adds,
   /// moves or removes later are picked up at the next frame.
   World(const SceneDef& scene, b2World& gameWorld, const WorldOptions& options = {});
