@@ -56,7 +56,37 @@ std::size_t find(const std::vector<std::pair<std::uint32_t, std::uint32_t>>& ind
   return it != index.end() && it->first == id ? std::size_t(it->second) : World::npos;
 }
 
+/// The bulk calls' argument check: as many values as ids.
+template <class T>
+void checkLengths(const char* call, const std::vector<std::uint32_t>& ids, const std::vector<T>& values, const char* what) {
+  if (ids.size() != values.size())
+    throw std::invalid_argument(std::string(call) + ": " + std::to_string(ids.size()) + " ids but " +
+                                std::to_string(values.size()) + " " + what);
+}
+
+/// Calls f(k, slot) for each ids[k] a particle has, the id index rebuilt once first (absent ids
+/// then cost a search each, not a rebuild); returns how many calls returned true.
+template <class F>
+std::size_t forEachId(std::vector<std::pair<std::uint32_t, std::uint32_t>>& index, const ParticleStore& P,
+                      const std::vector<std::uint32_t>& ids, F&& f) {
+  rebuild(index, P);
+  std::size_t n = 0;
+  for (std::size_t k = 0; k < ids.size(); ++k) {
+    const std::size_t i = find(index, ids[k]);
+    if (i != World::npos && f(k, i)) ++n;
+  }
+  return n;
+}
+
 }  // namespace
+
+bool World::Impl::teleport(std::size_t i, const Vec2d& position) {
+  const Vec2 p(Real(position.x() - origin.x()), Real(position.y() - origin.y()));
+  if (boundary.insideDepth(p) > 0) return false;
+  P.x[i] = p;
+  P.xPrev[i] = p;  // a teleport: the swept collision starts here, not on the old path
+  return true;
+}
 
 std::size_t World::slotOf(std::uint32_t id) const {
   const Impl& w = *impl_;
@@ -81,11 +111,7 @@ bool World::setParticle(std::uint32_t id, const Vec2d& position, const Vec2d& ve
     throw std::invalid_argument("setParticle: the position and the velocity must be finite");
   Impl& w = *impl_;
   const std::size_t i = slotOf(id);
-  if (i == npos) return false;
-  const Vec2 p(Real(position.x() - w.origin.x()), Real(position.y() - w.origin.y()));
-  if (w.boundary.insideDepth(p) > 0) return false;
-  w.P.x[i] = p;
-  w.P.xPrev[i] = p;  // a teleport: the swept collision starts here, not on the old path
+  if (i == npos || !w.teleport(i, position)) return false;
   w.P.v[i] = Vec2(Real(velocity.x()), Real(velocity.y()));
   ++w.edits;  // the query grid is stale
   w.refreshView();
@@ -101,59 +127,36 @@ bool World::setParticleVelocity(std::uint32_t id, const Vec2d& velocity) {
 }
 
 std::size_t World::setVelocities(const std::vector<std::uint32_t>& ids, const std::vector<Vec2d>& velocities) {
-  if (ids.size() != velocities.size())
-    throw std::invalid_argument("setVelocities: " + std::to_string(ids.size()) + " ids but " +
-                                std::to_string(velocities.size()) + " velocities");
+  checkLengths("setVelocities", ids, velocities, "velocities");
   for (const Vec2d& v : velocities)
     if (!finite(v)) throw std::invalid_argument("setVelocities: every velocity must be finite");
   Impl& w = *impl_;
-  rebuild(w.idIndex, w.P);  // once: absent ids then cost a search each, not a rebuild
-  std::size_t found = 0;
-  for (std::size_t k = 0; k < ids.size(); ++k) {
-    const std::size_t i = find(w.idIndex, ids[k]);
-    if (i == npos) continue;
+  return forEachId(w.idIndex, w.P, ids, [&](std::size_t k, std::size_t i) {
     w.P.v[i] = Vec2(Real(velocities[k].x()), Real(velocities[k].y()));
-    ++found;
-  }
-  return found;
+    return true;
+  });
 }
 
 std::size_t World::getParticles(const std::vector<std::uint32_t>& ids, std::vector<Vec2d>& positions,
                                 std::vector<Vec2d>& velocities) const {
   const Impl& w = *impl_;
-  rebuild(w.idIndex, w.P);  // once: absent ids then cost a search each, not a rebuild
   const double nan = std::numeric_limits<double>::quiet_NaN();
   positions.assign(ids.size(), Vec2d(nan, nan));
   velocities.assign(ids.size(), Vec2d(nan, nan));
-  std::size_t found = 0;
-  for (std::size_t k = 0; k < ids.size(); ++k) {
-    const std::size_t i = find(w.idIndex, ids[k]);
-    if (i == npos) continue;
+  return forEachId(w.idIndex, w.P, ids, [&](std::size_t k, std::size_t i) {
     positions[k] = worldPosition(i);
     velocities[k] = Vec2d(w.P.v[i].x(), w.P.v[i].y());
-    ++found;
-  }
-  return found;
+    return true;
+  });
 }
 
 std::size_t World::setPositions(const std::vector<std::uint32_t>& ids, const std::vector<Vec2d>& positions) {
-  if (ids.size() != positions.size())
-    throw std::invalid_argument("setPositions: " + std::to_string(ids.size()) + " ids but " +
-                                std::to_string(positions.size()) + " positions");
+  checkLengths("setPositions", ids, positions, "positions");
   for (const Vec2d& p : positions)
     if (!finite(p)) throw std::invalid_argument("setPositions: every position must be finite");
   Impl& w = *impl_;
-  rebuild(w.idIndex, w.P);
-  std::size_t moved = 0;
-  for (std::size_t k = 0; k < ids.size(); ++k) {
-    const std::size_t i = find(w.idIndex, ids[k]);
-    if (i == npos) continue;
-    const Vec2 p(Real(positions[k].x() - w.origin.x()), Real(positions[k].y() - w.origin.y()));
-    if (w.boundary.insideDepth(p) > 0) continue;
-    w.P.x[i] = p;
-    w.P.xPrev[i] = p;  // a teleport, as setParticle
-    ++moved;
-  }
+  const std::size_t moved =
+      forEachId(w.idIndex, w.P, ids, [&](std::size_t k, std::size_t i) { return w.teleport(i, positions[k]); });
   if (moved) {
     ++w.edits;  // the query grid is stale
     w.refreshView();
@@ -168,21 +171,14 @@ bool World::setParticleColor(std::uint32_t id, std::uint32_t rgb) {
 }
 
 std::size_t World::setParticleColors(const std::vector<std::uint32_t>& ids, const std::vector<std::uint32_t>& colors) {
-  if (ids.size() != colors.size())
-    throw std::invalid_argument("setParticleColors: " + std::to_string(ids.size()) + " ids but " +
-                                std::to_string(colors.size()) + " colours");
+  checkLengths("setParticleColors", ids, colors, "colours");
   Impl& w = *impl_;
-  rebuild(w.idIndex, w.P);  // once: absent ids then cost a search each, not a rebuild
   std::vector<std::uint32_t>& c = w.P.fieldU32(kColorField);
   w.refreshView();  // the field may be new
-  std::size_t found = 0;
-  for (std::size_t k = 0; k < ids.size(); ++k) {
-    const std::size_t i = find(w.idIndex, ids[k]);
-    if (i == npos) continue;
+  return forEachId(w.idIndex, w.P, ids, [&](std::size_t k, std::size_t i) {
     c[i] = colors[k];
-    ++found;
-  }
-  return found;
+    return true;
+  });
 }
 
 std::uint32_t World::particleColor(std::uint32_t id) const { return getU32(*this, impl_->P, kColorField, id); }

@@ -86,6 +86,9 @@ struct World::Impl {
   /// (id, slot) of every particle sorted by id: World::slotOf's index, rebuilt when a lookup
   /// finds it stale (particle_access.cpp). Mutable: a lookup on a const World refreshes it.
   mutable std::vector<std::pair<std::uint32_t, std::uint32_t>> idIndex;
+  /// Moves particle slot i to `position` (world coordinates) as a teleport (xPrev too);
+  /// false, changing nothing, when the position is inside a solid (setParticle, setPositions).
+  bool teleport(std::size_t i, const Vec2d& position);
   // Moving bodies (moving_bodies.cpp, moving_solid.hpp): the kinematic and dynamic bodies
   // of the b2World, captured at the start of each step with their pose and velocity; the
   // `bodies` stage pushes the fluid out of them and, for a dynamic body, takes the
