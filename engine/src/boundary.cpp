@@ -188,10 +188,10 @@ bool segmentPush(const Collider& c, Vec2& x, const Vec2& xOld, Real clearance, V
 
 }  // namespace
 
-void BoundarySet::collect(b2World& world, const Vec2d& origin) {
+void BoundarySet::collect(b2World& world, const Vec2d& origin, const std::vector<const void*>& skip) {
   colliders.clear();
   for (b2Body* body = world.GetBodyList(); body; body = body->GetNext()) {
-    if (body->GetType() != b2_staticBody) continue;
+    if (body->GetType() != b2_staticBody || std::find(skip.begin(), skip.end(), body) != skip.end()) continue;
     const b2Transform& xf = body->GetTransform();
     for (b2Fixture* fx = body->GetFixtureList(); fx; fx = fx->GetNext()) {
       Collider base;

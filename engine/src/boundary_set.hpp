@@ -99,8 +99,9 @@ struct BoundarySet {
     return nearMap[std::size_t(ty) * std::size_t(nearNx) + std::size_t(tx)] == 0;
   }
 
-  /// Collects every static fixture of `world` as colliders in the frame shifted by −origin.
-  void collect(b2World& world, const Vec2d& origin);
+  /// Collects every static fixture of `world` as colliders in the frame shifted by −origin,
+  /// the bodies in `skip` left out.
+  void collect(b2World& world, const Vec2d& origin, const std::vector<const void*>& skip = {});
   /// Fills every collider with layers of samples at spacing dx down to depth `depth`.
   void sample(Real dx, Real depth, ThreadPool& pool);
   /// Builds the collider bins.

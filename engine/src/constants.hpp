@@ -45,6 +45,13 @@ constexpr Real kForceCfl = Real(0.25);
 /// sees a full neighbourhood, and a resting particle does not touch the surface.
 constexpr Real kClearance = Real(0.25);
 
+/// The fastest a static body that the game moves (SetTransform between frames) may go and
+/// still be a sliding wall, a kinematic body for the step [m/s]: a door or a piston a game
+/// slides is slower. A faster move is a teleport: the static solids take the body where it
+/// is now, and the particles it lands on are dropped (pushing them out of a 0.6 m box set on
+/// water threw particles at 50–100 m/s).
+constexpr Real kStaticPushSpeed = Real(10);
+
 /// Integration moves no particle more than kMaxMove·R in one substep: a force
 /// that jumps within a substep (a new overlap) cannot fling a particle across
 /// the neighbour search radius before the next step's limits see it.

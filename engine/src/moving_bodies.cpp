@@ -271,7 +271,11 @@ void World::Impl::captureBodies() {
   // of the gaps Box2D leaves, as at a static wall. The others meet a polygon at its skin.
   const bool skinned = !(solver && solver->movingSamples());
   for (b2Body* body = b2->GetBodyList(); body; body = body->GetNext()) {
-    if (body->GetType() == b2_staticBody) continue;
+    // A static body the game slid moves as a kinematic one through the step (box2d_bridge.cpp).
+    const SlidingStatic* slide = nullptr;
+    for (const SlidingStatic& s : sliding)
+      if (s.body == body) slide = &s;
+    if (body->GetType() == b2_staticBody && !slide) continue;
     MovingSolid m;
     m.body = body;
     for (b2Fixture* fx = body->GetFixtureList(); fx; fx = fx->GetNext()) {
@@ -285,7 +289,7 @@ void World::Impl::captureBodies() {
           core.vertices.push_back(Vec2(poly->m_vertices[i].x, poly->m_vertices[i].y));
           core.normals.push_back(Vec2(poly->m_normals[i].x, poly->m_normals[i].y));
         }
-        if (skinned) {
+        if (skinned && !slide) {  // the static solids are their cores, sliding or not
           c.kind = Collider::Kind::Polygon;
           withSkin(*poly, c);
         } else {
@@ -311,6 +315,14 @@ void World::Impl::captureBodies() {
     m.angle0 = body->GetAngle();
     m.v = Vec2d(v.x, v.y);
     m.omega = body->GetAngularVelocity();
+    if (slide) {  // its path from the pose the game moved it from (a static body's centre is its origin)
+      const double tau = time - slide->t0;
+      m.com0 = slide->p0 + slide->v * tau - origin;
+      m.localCenter = Vec2d(0, 0);
+      m.angle0 = slide->angle0 + slide->omega * tau;
+      m.v = slide->v;
+      m.omega = slide->omega;
+    }
     if (body->GetType() == b2_dynamicBody && body->GetMass() > 0) {
       const double bodyMass = body->GetMass();
       m.invMass = 1.0 / bodyMass;

@@ -159,6 +159,7 @@ void World::init() {
     w.periodic.ly = pd.y ? Real(pd.max.y() - pd.min.y()) : Real(0);
   }
   w.rebuildBoundary();
+  w.recordStaticPoses();
   w.captureBodies();
   // Fluid blocks on a square lattice; particles inside solids (moving ones too) are dropped.
   for (const FluidBlockDef& b : scene.blocks) w.fillBlock(b, true);
@@ -192,8 +193,9 @@ World::~World() = default;
 void World::stepFrame() { step(1.0 / impl_->scene.fps); }
 
 void World::step(double dt) {
-  // A game may edit its level between frames: re-read the static fixtures when they changed.
-  if (impl_->staticSignature() != impl_->boundarySignature) refreshBoundaries();
+  // A game may edit its level between frames: a static body it slid moves through this step
+  // as a kinematic one; other changes are re-read (the water they cover pushed out).
+  impl_->readStatics(dt);
   impl_->captureBodies();  // the moving bodies' pose and velocity for this step
   const double t0 = impl_->time;
   const bool everySubstep = impl_->bodiesEverySubstep();  // then advance() stepped the bodies

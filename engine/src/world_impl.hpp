@@ -222,10 +222,33 @@ struct World::Impl {
   void removeOldest(std::size_t k);
 
   // box2d_bridge.cpp
-  /// XXH64 of the static fixtures' identities and transforms: changes when the game edits its level.
+  /// A static body the game moved (SetTransform) since the last step, no faster than
+  /// kStaticPushSpeed: through this step it moves as a kinematic body from its old pose to
+  /// its new one (the water sees a moving wall), and it rejoins the static solids when it stops.
+  struct SlidingStatic {
+    b2Body* body = nullptr;
+    Vec2d p0{0, 0};     ///< its origin at time t0 (world)
+    double angle0 = 0;  ///< its angle at t0 [rad]
+    Vec2d v{0, 0};      ///< its velocity over the step [m/s]
+    double omega = 0;   ///< its angular velocity over the step [rad/s]
+    double t0 = 0;      ///< the step's start
+  };
+  std::vector<SlidingStatic> sliding;
+  /// The static bodies' poses at the last step's start (or the last re-read), by body.
+  std::vector<std::pair<const void*, b2Transform>> staticPoses;
+  /// XXH64 of the static fixtures' identities and transforms, the sliding ones left out:
+  /// changes when the game edits its level.
   std::uint64_t staticSignature() const;
-  /// Reads the colliders and boundary samples from the b2World again.
+  /// Reads the colliders and boundary samples from the b2World's static bodies again, the
+  /// sliding ones left out.
   void rebuildBoundary();
+  /// At a step of `dt`: finds the sliding static bodies, then re-reads the static solids when
+  /// they changed (dropBuried), and records the static poses.
+  void readStatics(double dt);
+  /// After rebuildBoundary: drops the particles now inside a static solid, with a warning.
+  void dropBuried();
+  /// Records every static body's pose (staticPoses).
+  void recordStaticPoses();
 };
 
 /// A b2World with the scene's gravity and static bodies (box2d_bridge.cpp).

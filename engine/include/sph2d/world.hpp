@@ -337,7 +337,14 @@ class World {
   /// ids as particlesTouching() gives them; bodies and fixtures in Box2D's list order. The
   /// game's contact listener for the fluid (a button the water reaches, a fire it puts out).
   void forEachContact(const std::function<void(const b2Fixture&, const std::vector<std::uint32_t>&)>& f) const;
-  /// Re-reads the static fixtures of the b2World now (stepFrame does it when they change).
+  /// Re-reads the static fixtures of the b2World now, every static body where it is (step
+  /// and stepFrame do it when they changed, sliding a moved one instead: below). Particles
+  /// a static solid now covers are removed, with a warning (takeWarnings).
+  ///
+  /// A static body the game moves with SetTransform between steps, at no more than 10 m/s
+  /// at any point, is a sliding wall: through the next step it moves from its old pose to
+  /// its new one as a kinematic body would, pushing the water ahead of it, and it is a
+  /// static solid again from the first step it did not move. A faster move is a teleport.
   void refreshBoundaries();
 
   /// Replaces the user forces (push/pull at points). The user_force stage
