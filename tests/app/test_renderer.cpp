@@ -6,6 +6,8 @@
 #include <cmath>
 #include <cstdlib>
 
+#include <box2d/box2d.h>
+
 #include "sph2d/hash.hpp"
 #include "sph2d/render/image.hpp"
 #include "sph2d/render/renderer.hpp"
@@ -560,4 +562,87 @@ TEST_CASE("the colour bar goes where it covers no solid or fluid: the right midd
   CHECK(barOver(both, 270, 0, 400, 300) == 0);
   CHECK(barOver(both, 0, 0, 270, 100) == 0);
   CHECK(barOver(both, 0, 100, 270, 300) > 0);  // the clear bottom left
+}
+
+TEST_CASE("static solids a game moves are drawn where they are: a teleported wall, a slid one at rest") {
+  // A game's level: a tank and a static shelf above the water. The game teleports the shelf,
+  // then slides it back and stops it (a sliding static body is drawn as a moving one while
+  // it moves, and is a static solid again once it rests). At each point the frame of the
+  // renderer that drew every earlier frame equals a fresh renderer's, and the shelf's colour
+  // is where the shelf is and gone from where it was.
+  for (const char* mode : {"liquid", "particles"}) {
+    INFO(mode);
+    b2World level(b2Vec2(0, -9.81f));
+    auto addBox = [&](float cx, float cy, float hx, float hy) {
+      b2BodyDef bd;
+      bd.position.Set(cx, cy);
+      b2Body* body = level.CreateBody(&bd);
+      b2PolygonShape box;
+      box.SetAsBox(hx, hy);
+      body->CreateFixture(&box, 0);
+      return body;
+    };
+    addBox(1, -0.1f, 1.2f, 0.1f);
+    addBox(-0.1f, 0.5f, 0.1f, 0.7f);
+    addBox(2.1f, 0.5f, 0.1f, 0.7f);
+    b2Body* shelf = addBox(0.4f, 0.7f, 0.08f, 0.15f);
+    SceneDef s;
+    s.solver.spacing = 0.04;
+    FluidBlockDef water;
+    water.min = Vec2d(0, 0);
+    water.max = Vec2d(2, 0.3);
+    s.blocks.push_back(water);
+    s.render.mode = mode;
+    s.render.width = 200;
+    s.render.height = 120;
+    s.render.camera.min = Vec2d(-0.2, -0.2);
+    s.render.camera.max = Vec2d(2.2, 1.2);
+    World world(s, level, WorldOptions{1});
+    Renderer seq(s.render);
+    const std::array<std::uint8_t, 3> solid{std::uint8_t(std::lround(s.render.solid[0] * 255)),
+                                            std::uint8_t(std::lround(s.render.solid[1] * 255)),
+                                            std::uint8_t(std::lround(s.render.solid[2] * 255))};
+    auto solidAround = [&](const Frame& f, double wx, double wy) {
+      const auto cam = seq.cameraRect();
+      const int cx = int((wx - cam[0]) / (cam[2] - cam[0]) * f.width), cy = int((cam[3] - wy) / (cam[3] - cam[1]) * f.height);
+      int n = 0;
+      for (int y = cy - 3; y <= cy + 3; ++y)
+        for (int x = cx - 2; x <= cx + 2; ++x) {
+          const std::uint8_t* p = &f.rgba[(std::size_t(y) * std::size_t(f.width) + std::size_t(x)) * 4];
+          n += p[0] == solid[0] && p[1] == solid[1] && p[2] == solid[2];
+        }
+      return n;
+    };
+    auto sameAsFresh = [&](const Frame& f) {
+      Renderer fresh(s.render);
+      return hashOf(fresh.render(world)) == hashOf(f);
+    };
+    for (int f = 0; f < 5; ++f) {
+      seq.render(world);
+      world.stepFrame();
+    }
+    CHECK(solidAround(seq.render(world), 0.4, 0.7) == 35);
+    // Teleported 1 m (no water up there): a static solid at once.
+    shelf->SetTransform(b2Vec2(1.4f, 0.7f), 0);
+    world.stepFrame();
+    CHECK(world.colliders().size() == 4);
+    const Frame& a = seq.render(world);
+    CHECK(solidAround(a, 1.4, 0.7) == 35);
+    CHECK(solidAround(a, 0.4, 0.7) == 0);
+    CHECK(sameAsFresh(a));
+    // Slid back 0.3 m at 1.2 m/s, then at rest for two frames.
+    for (int f = 1; f <= 15; ++f) {
+      shelf->SetTransform(b2Vec2(1.4f - 0.02f * float(f), 0.7f), 0);
+      world.stepFrame();
+      seq.render(world);
+    }
+    CHECK(world.movingColliders().size() == 1);
+    for (int f = 0; f < 2; ++f) world.stepFrame();
+    CHECK(world.colliders().size() == 4);
+    CHECK(world.movingColliders().empty());
+    const Frame& b = seq.render(world);
+    CHECK(solidAround(b, 1.1, 0.7) == 35);
+    CHECK(solidAround(b, 1.4, 0.7) == 0);
+    CHECK(sameAsFresh(b));
+  }
 }

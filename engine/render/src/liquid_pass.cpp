@@ -46,6 +46,11 @@ class LiquidPass final : public RenderPass {
     drawnRows_ = {0, 1 << 30};  // a new colour target: the whole background at the next frame
   }
 
+  void solidsChanged() override {
+    grid_.solidsChanged();      // the depth grid's solid mask
+    drawnRows_ = {0, 1 << 30};  // the old solids go back to the background everywhere
+  }
+
   void release() override {
     for (GLuint p : {splatProg_, compositeProg_})
       if (p) glDeleteProgram(p);

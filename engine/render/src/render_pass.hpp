@@ -88,6 +88,9 @@ class RenderPass {
   virtual int spriteShrink(double /*spacingPx*/) const { return 1; }
   /// The targets changed size: drop what depends on it (recreated at the next frame).
   virtual void targetsChanged() {}
+  /// The static solids changed (a game edited its level): what depends on them is rebuilt,
+  /// and the next draw() starts the whole target from the background.
+  virtual void solidsChanged() {}
   /// Deletes the pass's GL objects (the context that made them must be current).
   virtual void release() = 0;
   /// CPU work and uploads before drawing (the upload stage). Throws std::runtime_error.

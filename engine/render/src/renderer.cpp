@@ -22,6 +22,7 @@
 #include "present.hpp"
 #include "render_pass.hpp"
 #include "scenery.hpp"
+#include "sph2d/hash.hpp"
 #include "sph2d/world.hpp"
 
 namespace sph2d {
@@ -73,6 +74,7 @@ struct Renderer::Impl {
   FrameGeometry geo;
   ColorTarget color;
   double spacingSeen = -1;
+  std::uint64_t solidsSeen = 0;          // solidsHash of the static solids the scenery holds
   std::pair<int, int> movingRows{0, 0};  // target rows the moving bodies covered in the last frame
   Frame frame;
   std::vector<std::uint32_t> order, slotOfId;  // slots in id order; scratch
@@ -163,6 +165,20 @@ struct Renderer::Impl {
     return 1.0f - smoothstepf(float(opt.ageFadeStart), float(opt.ageFadeEnd), a);
   }
 
+  /// XXH64 of the static solids of `in` (their kinds and geometry), 0 for none.
+  static std::uint64_t solidsHash(const RenderInput& in) {
+    if (!in.colliders || in.colliders->empty()) return 0;
+    Xxh64 h;
+    for (const Collider& c : *in.colliders) {
+      const int kind = int(c.kind);
+      h.update(&kind, sizeof kind);
+      if (!c.vertices.empty()) h.update(c.vertices.data(), c.vertices.size() * sizeof(Vec2));
+      h.update(&c.center, sizeof c.center);
+      h.update(&c.radius, sizeof c.radius);
+    }
+    return h.digest() | 1;  // never 0
+  }
+
   /// Sizes the guard band for the sprites of `in` and (re)creates what depends on it.
   void ensureFrame(const RenderInput& in) {
     if (in.spacing == spacingSeen) return;
@@ -177,6 +193,7 @@ struct Renderer::Impl {
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
     scenery.build(def, geo, in);
+    solidsSeen = solidsHash(in);
     color.background = scenery.background();
     color.backgroundFbo = scenery.backgroundFbo();
     color.EW = geo.EW;
@@ -192,6 +209,13 @@ struct Renderer::Impl {
     const RenderDef& d = def;
     if (geo.cam.empty()) geo.cam = resolveCamera(d, in);
     ensureFrame(in);
+    // A game edited its level (a static body added, removed, or at rest after sliding): the
+    // solids are drawn again where they are, and where they were goes back to the background.
+    if (const std::uint64_t h = solidsHash(in); h != solidsSeen) {
+      solidsSeen = h;
+      scenery.rebuildSolids(geo, in);
+      pass->solidsChanged();
+    }
 
     const Particles& P = in.particles;
     const std::size_t n = P.size();

@@ -97,7 +97,7 @@ std::vector<float> solidTriangles(const FrameGeometry& geo, const Vec2d& o, cons
 }
 
 void Scenery::buildSolids(const FrameGeometry& geo, const RenderInput& in) {
-  // The camera is fixed for a run: built once per target.
+  // The camera is fixed for a run: built once per target, and again when the solids change.
   const std::vector<float> tri = in.colliders ? solidTriangles(geo, in.origin, *in.colliders) : std::vector<float>();
   solidCount_ = GLsizei(tri.size() / 2);
   glBindVertexArray(solidVao_);

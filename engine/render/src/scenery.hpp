@@ -4,7 +4,8 @@
 // target size into a texture; each frame starts as a copy of it, and the liquid composite reads
 // it, so both agree to the bit. The solids are the World's colliders as triangles in the
 // targets' NDC, built once per camera: polygons as fans, circles as 64-gons, segments (edges,
-// chain links, zero thickness) as 3 px wide quads. Both are rebuilt when the guard band changes.
+// chain links, zero thickness) as 3 px wide quads. Both are rebuilt when the guard band changes,
+// the solids alone when they change (a game edits its level: Renderer compares a hash of them).
 // Moving bodies are the exception: their triangles are built and drawn every frame.
 #pragma once
 
@@ -23,6 +24,8 @@ class Scenery {
   void release();
   /// (Re)draws the background for targets of `geo` and rebuilds the solids of `in` (local frame).
   void build(const RenderDef& def, const FrameGeometry& geo, const RenderInput& in);
+  /// Rebuilds the solids of `in` only (the static solids changed; the background stays).
+  void rebuildSolids(const FrameGeometry& geo, const RenderInput& in) { buildSolids(geo, in); }
   /// The background texture (RGBA8, the targets' size).
   GLuint background() const { return bgTex_; }
   /// The framebuffer of the background texture.
