@@ -1,12 +1,12 @@
 // app/examples/game.cpp — a tiny game on sph2d, as a tutorial (docs/EMBEDDING.md).
 //
 // The game owns a Box2D world whose static platforms it builds in code; the fluid
-// lives in that world (sph2d::World(scene, b2World&)). The player holds a hose, an
-// emitter that a scripted input sweeps along the top and switches on and off; the
-// water pours down the platforms into a bucket, where a kinematic paddle of the
-// game's stirs it and a dynamic crate floats up as the bucket fills, and the game
-// counts what lands in it and what touches the bumper (World::forEachContact). Frames are drawn with sph2d::render and written
-// as PNG files.
+// lives in that world (sph2d::World(scene, b2World&)). A bucket holds a pool where two
+// dynamic crates float and a kinematic paddle of the game's stirs the water. The player
+// holds a hose, an emitter that a scripted input sweeps along the top and switches on
+// and off; its water pours down the platforms to a drain on the floor (a sink), and the
+// game counts what is in the bucket and what touches the bumper (World::forEachContact).
+// Frames are drawn with sph2d::render and written as PNG files.
 //
 // Usage: sph2d_example_game [OUT_DIR] [FRAMES]   (default out/example_game, 150)
 #include <box2d/box2d.h>
@@ -36,7 +36,7 @@ void buildLevel(b2World& level) {
   add(2.2f, 0.1f, 2.0f, -0.1f, 0.0f);    // floor
   add(0.1f, 1.7f, -0.1f, 1.5f, 0.0f);    // left wall
   add(0.1f, 1.7f, 4.1f, 1.5f, 0.0f);     // right wall
-  add(0.05f, 0.3f, 3.0f, 0.3f, 0.0f);    // the bucket's left side (the bucket: x 3..4, floor)
+  add(0.05f, 0.45f, 3.0f, 0.45f, 0.0f);  // the bucket's left side (the bucket: x 3..4, floor)
   add(1.0f, 0.04f, 1.1f, 2.2f, -0.25f);  // platforms, tilted so water runs from one to the next
   add(1.0f, 0.04f, 2.8f, 1.5f, 0.25f);
   add(0.9f, 0.04f, 1.3f, 0.8f, -0.2f);
@@ -50,23 +50,24 @@ void buildLevel(b2World& level) {
 b2Body* buildPaddle(b2World& level) {
   b2BodyDef def;
   def.type = b2_kinematicBody;
-  def.position.Set(3.5f, 0.2f);
+  def.position.Set(3.5f, 0.09f);  // under the pool's surface: it stirs the water, the water the crates
   b2Body* paddle = level.CreateBody(&def);
   b2PolygonShape blade;
-  blade.SetAsBox(0.04f, 0.18f);
+  blade.SetAsBox(0.04f, 0.07f);
   paddle->CreateFixture(&blade, 0.0f);
   return paddle;
 }
 
-// A wooden crate (density 400 kg/m²) dropped into the bucket: the water lifts it.
-b2Body* buildCrate(b2World& level) {
+// Two crates dropped into the bucket's pool: a light one (pine, density 400 kg/m²) and a
+// heavier one (oak, 700 kg/m²): the water holds both up, the oak one deeper.
+b2Body* buildCrate(b2World& level, float x, float density) {
   b2BodyDef def;
   def.type = b2_dynamicBody;
-  def.position.Set(3.3f, 0.3f);
+  def.position.Set(x, 0.45f);
   b2Body* crate = level.CreateBody(&def);
   b2PolygonShape box;
-  box.SetAsBox(0.12f, 0.08f);
-  crate->CreateFixture(&box, 400.0f);
+  box.SetAsBox(0.1f, 0.08f);
+  crate->CreateFixture(&box, density);
   return crate;
 }
 
@@ -88,12 +89,19 @@ int main(int argc, char** argv) {
   b2World level(b2Vec2(0.0f, -9.81f));
   buildLevel(level);
   b2Body* paddle = buildPaddle(level);
-  const b2Body* crate = buildCrate(level);
+  const b2Body* pine = buildCrate(level, 3.25f, 400.0f);
+  const b2Body* oak = buildCrate(level, 3.8f, 700.0f);
 
-  // 2. The fluid's settings, in code: no boundaries (the level is the game's), one hose.
+  // 2. The fluid's settings, in code: no boundaries (the level is the game's), a pool in
+  // the bucket, one hose, and a drain on the floor left of the bucket.
   sph2d::SceneDef scene;
   scene.fps = 30;
   scene.solver.spacing = 0.03;
+  sph2d::FluidBlockDef pool;
+  pool.min = {3.05, 0.0};
+  pool.max = {4.0, 0.25};
+  scene.blocks.push_back(pool);
+  scene.effects.sinks.push_back(sph2d::RegionDef{{0.0, 0.0}, {2.9, 0.06}});
   sph2d::EmitterDef hose;
   hose.position = {0.5, 2.9};
   hose.direction = {0.3, -1};
@@ -112,7 +120,7 @@ int main(int argc, char** argv) {
     sph2d::World fluid(scene, level, sph2d::WorldOptions{2});
     sph2d::Renderer renderer(scene.render);
     sph2d::FrameWriter writer(out);
-    const sph2d::Vec2d bucketLo(3.05, 0.0), bucketHi(4.0, 0.6);
+    const sph2d::Vec2d bucketLo(3.05, 0.0), bucketHi(4.0, 0.9);
 
     for (int f = 0; f < frames; ++f) {
       // 4. Input between frames: move the hose, switch it on or off.
@@ -144,8 +152,9 @@ int main(int argc, char** argv) {
           if (fx.GetShape()->GetType() == b2Shape::e_circle) onBumper = ids.size();
         });
         std::printf("t = %.1f s: %zu particles, %zu in the bucket, density at its bottom %.0f kg/m3, %zu on the bumper, "
-                    "the crate at %.2f m\n",
-                    fluid.time(), fluid.particleCount(), inBucket, probe.density, onBumper, crate->GetPosition().y);
+                    "crates at (%.2f, %.2f) m and (%.2f, %.2f) m\n",
+                    fluid.time(), fluid.particleCount(), inBucket, probe.density, onBumper, pine->GetPosition().x,
+                    pine->GetPosition().y, oak->GetPosition().x, oak->GetPosition().y);
       }
     }
     writer.finish();

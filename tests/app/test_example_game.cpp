@@ -1,7 +1,8 @@
 // app/examples/game.cpp, the embedding tutorial's program, builds and runs: its
-// frames exist, are whole and show water.
+// its crates float on the bucket's pool, and its frames exist, are whole and show water.
 #include <doctest/doctest.h>
 
+#include <cstdio>
 #include <set>
 #include <string>
 #include <vector>
@@ -12,24 +13,40 @@
 using namespace sph2d::apptest;
 
 #ifdef SPH2D_EXAMPLE_GAME_EXE
-TEST_CASE("the example game runs and writes non-blank frames") {
+TEST_CASE("the example game runs, its crates float, and it writes non-blank frames") {
   const std::string dir = freshDir("example_game");
   const std::string log = dir + ".log";
-  const int status = std::system((std::string("\"") + SPH2D_EXAMPLE_GAME_EXE + "\" " + q(dir) + " 30 > " + q(log) + " 2>&1").c_str());
+  const int status = std::system((std::string("\"") + SPH2D_EXAMPLE_GAME_EXE + "\" " + q(dir) + " 150 > " + q(log) + " 2>&1").c_str());
   const std::string out = readText(log);
   INFO(out);
   REQUIRE(status == 0);
-  CHECK(out.find("t = 1.0 s: 258 particles") != std::string::npos);  // 30 frames of the hose at 2400 particles/s, 90 % on
-  CHECK(out.find("30 frames in") != std::string::npos);
-  CHECK(out.find(", 0 on the bumper, the crate at ") != std::string::npos);  // no water reaches the bumper within 1 s
+  // The bucket's pool (224 particles beside the paddle) and 1 s of the hose (258: 266 a second, 90 % on).
+  CHECK(out.find("t = 1.0 s: 482 particles") != std::string::npos);
+  CHECK(out.find("150 frames in") != std::string::npos);
+  CHECK(out.find(", 0 on the bumper, crates at ") != std::string::npos);  // no water reaches the bumper within 1 s
+  // Both crates float in the bucket (x 3.05..4) from the first second to the last: resting on
+  // its floor they would stand at 0.09 m.
+  std::size_t lines = 0;
+  for (std::size_t at = out.find("crates at "); at != std::string::npos; at = out.find("crates at ", at + 1)) {
+    double x[2] = {0, 0}, y[2] = {0, 0};
+    REQUIRE(std::sscanf(out.c_str() + at, "crates at (%lf, %lf) m and (%lf, %lf) m", &x[0], &y[0], &x[1], &y[1]) == 4);
+    for (int k = 0; k < 2; ++k) {
+      CHECK(x[k] > 3.05);
+      CHECK(x[k] < 4.0);
+      CHECK(y[k] > 0.2);
+      CHECK(y[k] < 1.0);
+    }
+    ++lines;
+  }
+  CHECK(lines == 5);
   const auto pngs = filesEnding(dir, ".png");
-  REQUIRE(pngs.size() == 30);
+  REQUIRE(pngs.size() == 150);
   CHECK(pngs.front() == "frame_00000.png");
-  CHECK(pngs.back() == "frame_00029.png");
+  CHECK(pngs.back() == "frame_00149.png");
   CHECK_FALSE(anyTemporary(dir));
   int w = 0, h = 0;
   std::vector<std::uint8_t> rgba;
-  sph2d::readPng(dir + "/frame_00029.png", w, h, rgba);
+  sph2d::readPng(dir + "/frame_00149.png", w, h, rgba);
   CHECK(w == 320);
   CHECK(h == 240);
   std::size_t water = 0, solid = 0;
@@ -39,7 +56,7 @@ TEST_CASE("the example game runs and writes non-blank frames") {
     if (rgba[p] > 120 && rgba[p] < 160 && rgba[p + 2] < rgba[p]) ++solid;  // the level's grey-brown
     colours.insert(std::uint32_t(rgba[p]) << 16 | std::uint32_t(rgba[p + 1]) << 8 | rgba[p + 2]);
   }
-  MESSAGE("frame 29: water " << water << " px, solids " << solid << " px, " << colours.size() << " colours");
+  MESSAGE("frame 149: water " << water << " px, solids " << solid << " px, " << colours.size() << " colours");
   CHECK(water > 300);
   CHECK(solid > 3000);
   CHECK(colours.size() > 50);
