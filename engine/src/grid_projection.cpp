@@ -645,10 +645,19 @@ void GridProjection::shiftSystem(const StepContext& c) {
   const Real invFull = Real(1) / (cellRatio_ * cellRatio_);
   rhsS_.resize(m);
   xs_.assign(m, 0);
+  const std::size_t nx = std::size_t(nx_);
   for (std::size_t a = 0; a < m; ++a) {
     const std::size_t k = std::size_t(cells_[a]);
-    const Real comp = std::max(Real(0), w_[k] * invFull - Real(1) - shiftDef_.above);
-    rhsS_[a] = (h_ * h_ / dt) * shiftDef_.rate * comp / dt;
+    const Real excess = w_[k] * invFull - Real(1);
+    const Real comp = std::max(Real(0), excess - shiftDef_.above);
+    Real src = shiftDef_.rate * comp;
+    if (shiftDef_.fill > 0 && excess < -shiftDef_.above) {
+      const std::size_t i = k % nx, j = k / nx;
+      const bool interior = i > 0 && j > 0 && i + 1 < nx && j + 1 < std::size_t(ny_) && type_[k - 1] == kFluid &&
+                            type_[k + 1] == kFluid && type_[k - nx] == kFluid && type_[k + nx] == kFluid;
+      if (interior) src = shiftDef_.fill * (excess + shiftDef_.above);  // negative: the cell draws particles in
+    }
+    rhsS_[a] = (h_ * h_ / dt) * src / dt;
   }
 }
 
@@ -658,7 +667,7 @@ void GridProjection::solve(const StepContext& c) {
   stats_ = GridProjectionStats{};
   stats_.fluidCells = int(m);
   kappa_.assign(type_.size(), 0);  // air and solid cells hold 0
-  const bool shifting = shiftDef_.rate > 0;
+  const bool shifting = shiftDef_.on();
   if (m == 0) {
     if (shifting) shiftMoves(c);  // none: no fluid cell
     return;
@@ -809,7 +818,7 @@ std::size_t GridProjection::transferToParticles(StepContext& c) {
   auto kap = [&](int i, int j) {
     return type_[std::size_t(j) * nx_ + i] == kFluid ? kappa_[std::size_t(j) * nx_ + i] : Real(0);
   };
-  const bool shifting = shiftDef_.rate > 0;
+  const bool shifting = shiftDef_.on();
   // The static solids' impulse on the fluid (World::wallImpulse, WallImpulse::grid), per axis in
   // face order within its task: on each face closed by a static solid (a solid cell beside it, or
   // a wall across it) next to a fluid cell, the cell's pressure ρ0κ over the face's length h for

@@ -27,7 +27,9 @@
 // Poisson matrix solved once more with the cells' compression (particle weight
 // over a full cell's) as the source; its gradient is a move of positions, not of velocities, which the
 // prediction adds. It removes the compression that large substeps pile up
-// without putting kinetic energy in.
+// without putting kinetic energy in. With GridShift::fill the source also holds
+// the deficit of interior cells (Kugelstadt et al. correct both signs): air that
+// the projection would keep in a cell rises out of the water.
 //
 // Deterministic: particles go to the grid in slot order (each field on one
 // thread), the conjugate-gradient sums are taken in cell order. On two threads
@@ -54,6 +56,13 @@ struct GridShift {
   Real rate = 0;   ///< share of a cell's compression (particle weight over a full cell's, − 1, above `above`) removed per substep
   Real above = 0;  ///< compression a cell keeps (left to the particle solve)
   Real tolerance = 0.01;  ///< the solve stops when its largest residual stands for this density change
+  /// Share of an interior cell's deficit (1 − its particle weight over a full cell's, above
+  /// `above`) closed per substep: air the water holds (a pocket, a porous layer) is moved up
+  /// and out through the free surface. Interior: its four neighbours are fluid cells (a cell
+  /// at the surface or cut by a wall is short of particles by its nature).
+  Real fill = 0;
+  /// True when the shift moves particles at all.
+  bool on() const { return rate > 0 || fill > 0; }
 };
 
 /// What one projection did.

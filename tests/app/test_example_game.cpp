@@ -25,7 +25,8 @@ TEST_CASE("the example game runs, its crates float, and it writes non-blank fram
   CHECK(out.find("150 frames in") != std::string::npos);
   CHECK(out.find(", 0 on the bumper, crates at ") != std::string::npos);  // no water reaches the bumper within 1 s
   // Both crates float in the bucket (x 3.05..4) from the first second to the last: resting on
-  // its floor they would stand at 0.09 m.
+  // its floor they would stand at 0.09 m; on the pool at rest (0.21 m) Archimedes puts them
+  // at 0.23 and 0.18 m.
   std::size_t lines = 0;
   for (std::size_t at = out.find("crates at "); at != std::string::npos; at = out.find("crates at ", at + 1)) {
     double x[2] = {0, 0}, y[2] = {0, 0};
@@ -33,7 +34,7 @@ TEST_CASE("the example game runs, its crates float, and it writes non-blank fram
     for (int k = 0; k < 2; ++k) {
       CHECK(x[k] > 3.05);
       CHECK(x[k] < 4.0);
-      CHECK(y[k] > 0.2);
+      CHECK(y[k] > 0.13);
       CHECK(y[k] < 1.0);
     }
     ++lines;

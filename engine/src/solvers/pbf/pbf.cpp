@@ -37,7 +37,7 @@ Pbf::Pbf(const SolverDef& d)
                                                    Real(d.param("grid_compression_rate")), Real(d.param("grid_tolerance")),
                                                    int(std::lround(d.param("grid_max_iterations"))),
                                                    GridShift{Real(d.param("grid_shift")), Real(d.param("grid_shift_above")),
-                                                             Real(d.param("grid_shift_tolerance"))});
+                                                             Real(d.param("grid_shift_tolerance")), Real(d.param("grid_fill"))});
   if (projection_) projection_->pic_ = Real(d.param("grid_pic"));
   if (projection_) projection_->surface_ = d.param("grid_surface") > 0;
 }

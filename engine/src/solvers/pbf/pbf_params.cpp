@@ -39,6 +39,8 @@ std::vector<SolverParam> pbfParams(bool game) {
        "share of a grid cell's compression (particle weight over a full cell's, − 1, above grid_shift_above) removed per substep by moving its particles (positions only; Kugelstadt et al. 2019)"},
       {"grid_shift_above", 0.005, 0, 1,
        "the compression a cell keeps from the shift (left to the density solve)"},
+      {"grid_fill", g(0, 0.5), 0, 1,
+       "share of an interior grid cell's deficit (1 − particle weight over a full cell's, above grid_shift_above) closed per substep by the shift's moves: air pockets rise out (interior: four fluid neighbours)"},
       {"grid_shift_tolerance", 0.01, 1e-7, 1, "the shift's solve: the density change its largest residual may stand for (a correction: looser than grid_tolerance)"},
       {"grid_surface", g(0, 1), 0, 1,
        "1: the grid's free surface lies half a spacing above the highest particle (ghost fluid, Gibou et al. 2002: a floating body's draught by Archimedes), 0: at the air cells' centres"},
@@ -55,6 +57,9 @@ std::pair<std::string, std::string> pbfCheck(const SolverDef& d) {
   if (d.param("grid_cell") > 0 && d.param("grid_shift") > 0 && d.param("correction_to_velocity") > 0)
     return {"solver.grid_shift",
             "the grid's compression shift needs correction_to_velocity 0 (it would become velocity): set one of them to 0"};
+  if (d.param("grid_cell") > 0 && d.param("grid_fill") > 0 && d.param("correction_to_velocity") > 0)
+    return {"solver.grid_fill",
+            "the grid's fill shift needs correction_to_velocity 0 (it would become velocity): set one of them to 0"};
   return {};
 }
 }  // namespace
