@@ -74,6 +74,7 @@ std::size_t World::Impl::fillBlock(const FluidBlockDef& b, bool hydrostaticStart
       if (b.shape == FluidBlockDef::Shape::Polygon && !FluidBlockDef::insideRow(crossings, pw.x())) continue;
       const Vec2 p = Vec2(Real(pw.x() - origin.x()), Real(pw.y() - origin.y()));
       if (nearMovingSamples(p) && !insideMoving(p)) continue;  // on a moving body's samples: left out, no warning
+      if (onStaticSurface(p)) continue;  // within the clearance of a static solid: left out, no warning
       if (boundary.insideDepth(p) > 0 || insideMoving(p)) {
         dlo = dropped ? dlo.cwiseMin(pw) : pw;
         dhi = dropped ? dhi.cwiseMax(pw) : pw;
@@ -105,6 +106,12 @@ std::size_t World::Impl::fillBlock(const FluidBlockDef& b, bool hydrostaticStart
   ++edits;  // the query grid is stale
   refreshView();
   return added;
+}
+
+bool World::Impl::onStaticSurface(const Vec2& p) const {
+  if (boundary.insideDepth(p) > 0) return false;  // inside: dropped, with the warning
+  Vec2 q = p, v(0, 0);
+  return boundary.resolve(q, v, p, Real(0.4) * dx);  // true when it would be pushed off a surface
 }
 
 const char* World::Impl::budgetKey() const {

@@ -359,6 +359,7 @@ std::uint64_t World::emittedCount(std::size_t index) const { return impl_->emitt
 std::uint64_t World::removedCount() const { return impl_->removed; }
 
 void World::stepSubstep() {
+  impl_->readStatics(0);  // the level's edits (a moved static body is re-read where it is: no step to slide it over)
   impl_->captureBodies();
   impl_->moveOwnBodies(double(impl_->substep(impl_->stableDt())));
   impl_->refreshView();

@@ -133,6 +133,11 @@ struct World::Impl {
   /// spacing outside a moving body at the current pose: a particle there would overlap the
   /// samples' first layer (dx/2 deep), so a fluid block leaves it out (body_samples.cpp).
   bool nearMovingSamples(const Vec2& p) const;
+  /// True when local point p lies outside every static solid but within 0.4 spacing of one's
+  /// surface: a particle there would overlap its samples' first layer (dx/2 deep), so a fluid
+  /// block leaves it out, as beside a moving body (a lattice row on a wall's face started at
+  /// 1.6 ρ0 and threw a particle at 11 m/s; particle_system.cpp).
+  bool onStaticSurface(const Vec2& p) const;
 
   /// Changes of the particles made between steps (the API's adds, removals and moves):
   /// with `steps` and the count, what the query grid is valid for.
