@@ -190,6 +190,7 @@ bool segmentPush(const Collider& c, Vec2& x, const Vec2& xOld, Real clearance, V
 
 void BoundarySet::collect(b2World& world, const Vec2d& origin, const std::vector<const void*>& skip) {
   colliders.clear();
+  colliderFixture.clear();
   for (b2Body* body = world.GetBodyList(); body; body = body->GetNext()) {
     if (body->GetType() != b2_staticBody || std::find(skip.begin(), skip.end(), body) != skip.end()) continue;
     const b2Transform& xf = body->GetTransform();
@@ -249,6 +250,7 @@ void BoundarySet::collect(b2World& world, const Vec2d& origin, const std::vector
         }
         default: break;
       }
+      colliderFixture.resize(colliders.size(), fx);
     }
   }
 }

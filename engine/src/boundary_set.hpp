@@ -45,6 +45,7 @@ void colliderBounds(Collider& c);
 
 struct BoundarySet {
   std::vector<Collider> colliders;
+  std::vector<const void*> colliderFixture;  ///< the b2Fixture each collider came from (collect)
   std::vector<Vec2> samples;   ///< boundary sample positions (local frame)
   std::vector<Real> volume;    ///< Ψ_b [m²]: the area the sample stands for
   /// For samples of a two-sided segment: the segment's unit normal n and offset
@@ -99,6 +100,32 @@ struct BoundarySet {
     return nearMap[std::size_t(ty) * std::size_t(nearNx) + std::size_t(tx)] == 0;
   }
 
+  /// Calls f(k) once for every collider k whose bounding box, grown by `reach`, holds x (the
+  /// bins around x; in bin order, then the bin's order).
+  template <class F>
+  void forCollidersNear(const Vec2& x, Real reach, F&& f) const {
+    if (bnx == 0) return;
+    const int x0 = std::max(0, int(std::floor((x.x() - reach - binLo.x()) * invBin)));
+    const int x1 = std::min(bnx - 1, int(std::floor((x.x() + reach - binLo.x()) * invBin)));
+    const int y0 = std::max(0, int(std::floor((x.y() - reach - binLo.y()) * invBin)));
+    const int y1 = std::min(bny - 1, int(std::floor((x.y() + reach - binLo.y()) * invBin)));
+    std::uint32_t seen[16];
+    int ns = 0;
+    for (int y = y0; y <= y1; ++y)
+      for (int xx = x0; xx <= x1; ++xx) {
+        const std::size_t bin = std::size_t(y) * std::size_t(bnx) + std::size_t(xx);
+        for (std::uint32_t q = binStart[bin]; q < binStart[bin + 1]; ++q) {
+          const std::uint32_t k = binItems[q];
+          const Collider& c = colliders[k];
+          if (x.x() < c.lo.x() - reach || x.y() < c.lo.y() - reach || x.x() > c.hi.x() + reach || x.y() > c.hi.y() + reach) continue;
+          bool dup = false;
+          for (int s = 0; s < ns && !dup; ++s) dup = seen[s] == k;
+          if (dup) continue;
+          if (ns < 16) seen[ns++] = k;  // past 16 a collider may be called twice: its repeats are removed later
+          f(k);
+        }
+      }
+  }
   /// Collects every static fixture of `world` as colliders in the frame shifted by −origin,
   /// the bodies in `skip` left out.
   void collect(b2World& world, const Vec2d& origin, const std::vector<const void*>& skip = {});

@@ -307,6 +307,7 @@ void World::Impl::captureBodies() {
       }
       if (c.kind == Collider::Kind::Circle) m.cores.push_back(c);
       m.shapes.push_back(std::move(c));
+      m.fixtures.push_back(fx);
     }
     if (m.shapes.empty()) continue;
     const b2Vec2 com = body->GetWorldCenter(), lc = body->GetLocalCenter(), v = body->GetLinearVelocity();

@@ -28,6 +28,7 @@ namespace sph2d {
 struct MovingSolid {
   b2Body* body = nullptr;
   std::vector<Collider> shapes;  ///< polygons (with Box2D's skin) and circles in body coordinates: where the fluid meets the body
+  std::vector<const void*> fixtures;  ///< the b2Fixture of each of `shapes`
   std::vector<Collider> cores;   ///< the fixtures as Box2D weighs them (polygons without the skin), body coordinates
   Vec2d com0{0, 0};              ///< centre of mass at the step's start (World's local frame)
   Vec2d localCenter{0, 0};       ///< centre of mass in body coordinates

@@ -133,7 +133,19 @@ std::vector<std::uint32_t> World::particlesTouching(const b2Fixture& fixture) co
     });
     for (const std::size_t i : near) ids.push_back(w.P.id[i]);
   }
-  if (shape.GetChildCount() > 1) {  // a chain: a particle near two links once, in slot order
+  // With contact tracking, also those that touched it at the end of a substep of the last
+  // step (and are still there: not removed since).
+  bool merged = false;
+  if (w.contactsOn) {
+    const auto key = std::uintptr_t(static_cast<const void*>(&fixture));
+    const std::pair<std::uintptr_t, std::uint32_t> lo{key, 0}, hi{key, 0xffffffffu};
+    const auto b = std::lower_bound(w.frameContacts.begin(), w.frameContacts.end(), lo);
+    const auto e = std::upper_bound(b, w.frameContacts.end(), hi);
+    for (auto it = b; it != e; ++it)
+      if (slotOf(it->second) != npos) ids.push_back(it->second);
+    merged = b != e;
+  }
+  if (shape.GetChildCount() > 1 || merged) {  // a particle found twice (two links, or now and before) once, in slot order
     std::vector<std::pair<std::size_t, std::uint32_t>> bySlot;
     for (const std::uint32_t id : ids) bySlot.push_back({slotOf(id), id});
     std::sort(bySlot.begin(), bySlot.end());

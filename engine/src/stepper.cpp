@@ -103,6 +103,7 @@ void World::Impl::addParticleSystemStages(StageList& list) {
   if (periodic.any()) list.add(plainStage("wrap", [](StepContext& c) { stageWrap(c); }));
   if (scene.effects.lifetime) list.add(plainStage("lifetimes", [this](StepContext& c) { lifetimes(c.dt); }));
   if (!scene.effects.sinks.empty()) list.add(plainStage("sinks", [this](StepContext&) { sinks(); }));
+  if (contactsOn) list.add(plainStage("contacts", [this](StepContext& c) { recordContacts(c); }));
 }
 
 Real World::Impl::stableDt() {

@@ -196,11 +196,13 @@ void World::step(double dt) {
   // A game may edit its level between frames: a static body it slid moves through this step
   // as a kinematic one; other changes are re-read (the water they cover pushed out).
   impl_->readStatics(dt);
+  impl_->frameContacts.clear();  // the contacts stage's record is this step's
   impl_->captureBodies();  // the moving bodies' pose and velocity for this step
   const double t0 = impl_->time;
   const bool everySubstep = impl_->bodiesEverySubstep();  // then advance() stepped the bodies
   impl_->advance(dt);
   if (!everySubstep) impl_->moveOwnBodies(impl_->time - t0);
+  if (impl_->contactsOn) impl_->finishContacts();
   ++impl_->frames;
   impl_->refreshView();
 }
@@ -360,8 +362,10 @@ std::uint64_t World::removedCount() const { return impl_->removed; }
 
 void World::stepSubstep() {
   impl_->readStatics(0);  // the level's edits (a moved static body is re-read where it is: no step to slide it over)
+  impl_->frameContacts.clear();
   impl_->captureBodies();
   impl_->moveOwnBodies(double(impl_->substep(impl_->stableDt())));
+  if (impl_->contactsOn) impl_->finishContacts();
   impl_->refreshView();
 }
 

@@ -254,6 +254,17 @@ struct World::Impl {
   void dropBuried();
   /// Records every static body's pose (staticPoses).
   void recordStaticPoses();
+
+  // contacts.cpp (World::setContactTracking)
+  bool contactsOn = false;  ///< the `contacts` stage runs
+  /// (fixture, particle id) of every contact at the end of a substep of the current (or last)
+  /// step, sorted by fixture then id after the step (finishContacts).
+  std::vector<std::pair<std::uintptr_t, std::uint32_t>> frameContacts;  ///< the fixture by its address
+  std::vector<std::vector<std::pair<std::uintptr_t, std::uint32_t>>> contactBlocks;  ///< the stage's per-block scratch
+  /// The `contacts` stage: the particles within one spacing of each fixture now, into frameContacts.
+  void recordContacts(StepContext& c);
+  /// Sorts frameContacts and removes repeats (after a step).
+  void finishContacts();
 };
 
 /// A b2World with the scene's gravity and static bodies (box2d_bridge.cpp).

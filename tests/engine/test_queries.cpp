@@ -240,6 +240,72 @@ TEST_CASE("queries: particlesTouching finds the particles within one spacing of 
   CHECK_FALSE(sawCeiling);
 }
 
+TEST_CASE("queries: with contact tracking a particle that passed a fixture during the step is reported, without it only those touching at its end") {
+  // One particle shot at 8 m/s along a line 1 cm above a circle (r = 0.05 m at (0.5, 0.3)),
+  // static or a kinematic body at rest: within one frame (wcsph: many substeps) it passes the
+  // circle and ends 5 cm beyond it. The snapshot at the frame's end misses it; the contacts
+  // stage, which looks at the end of every substep, records it, for that step only.
+  for (const bool kinematic : {false, true}) {
+  INFO(std::string(kinematic ? "kinematic" : "static"));
+  auto run = [kinematic](bool tracking, std::vector<std::uint32_t>& touching, std::vector<std::uint32_t>& after,
+                double& endGap, std::uint32_t& id, int& visits, bool& stagePresent) {
+    SceneDef s = test::tank("wcsph", 1.0, 1.0, 0.02);
+    BodyDef pole;
+    ShapeDef c;
+    c.type = ShapeDef::Type::Circle;
+    c.center = Vec2d(0.5, 0.3);
+    c.radius = 0.05;
+    if (kinematic) {
+      pole.type = BodyDef::Type::Kinematic;
+      pole.position = c.center;
+      c.center = Vec2d(0, 0);
+    }
+    pole.fixtures.push_back(c);
+    s.bodies.push_back(pole);
+    World w(s, WorldOptions{2});
+    w.setContactTracking(tracking);
+    CHECK(w.contactTracking() == tracking);
+    const auto names = w.stages();
+    stagePresent = std::find(names.begin(), names.end(), "contacts") != names.end();
+    const b2Fixture* circle = nullptr;
+    for (const b2Body* b = w.box2d().GetBodyList(); b; b = b->GetNext())
+      for (const b2Fixture* fx = b->GetFixtureList(); fx; fx = fx->GetNext())
+        if (fx->GetShape()->GetType() == b2Shape::e_circle) circle = fx;
+    REQUIRE(circle);
+    const auto ids = w.addParticles({Vec2d(0.45, 0.36)}, {Vec2d(8, 0)});
+    REQUIRE(ids.size() == 1);
+    id = ids[0];
+    w.stepFrame();
+    REQUIRE(w.substeps() > 5);
+    endGap = (w.worldPosition(0) - Vec2d(0.5, 0.3)).norm() - 0.05;
+    touching = w.particlesTouching(*circle);
+    visits = 0;
+    w.forEachContact([&](const b2Fixture& fx, const std::vector<std::uint32_t>& l) {
+      if (&fx == circle) visits += l == touching;
+    });
+    w.stepFrame();  // on, far from the circle: this step's record is empty
+    after = w.particlesTouching(*circle);
+  };
+  std::vector<std::uint32_t> offNow, offAfter, onNow, onAfter;
+  double gapOff = 0, gapOn = 0;
+  std::uint32_t idOff = 0, idOn = 0;
+  int visitsOff = 0, visitsOn = 0;
+  bool stageOff = true, stageOn = false;
+  run(false, offNow, offAfter, gapOff, idOff, visitsOff, stageOff);
+  run(true, onNow, onAfter, gapOn, idOn, visitsOn, stageOn);
+  MESSAGE("the particle ends the frame " << gapOn << " m from the circle");
+  CHECK(gapOff == gapOn);         // tracking changes nothing of the motion
+  CHECK(gapOn > 0.04);            // it passed and left (the reach is one spacing, 0.02 m)
+  CHECK(offNow.empty());          // the snapshot misses it
+  CHECK(visitsOff == 0);
+  CHECK(onNow == std::vector<std::uint32_t>{idOn});  // the stage saw it pass
+  CHECK(visitsOn == 1);
+  CHECK(onAfter.empty());
+  CHECK_FALSE(stageOff);
+  CHECK(stageOn);
+  }
+}
+
 TEST_CASE("queries: particlesTouching a kinematic box measures from where the fluid meets it: the skin for the game solver, the fixture for wcsph") {
   // A 0.3 m × 0.1 m kinematic box at rest in the water. The game solver meets a moving polygon
   // at Box2D's skin (1 cm out), wcsph at the fixture itself (its moving samples stand for it):

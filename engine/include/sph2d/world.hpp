@@ -331,12 +331,22 @@ class World {
   /// one): their centres within one spacing of its surface, or inside it; in slot order. Any
   /// fixture of the b2World the fluid sees, static or moving, at the body's current pose; the
   /// surface where the fluid meets it (a moving body's polygon with Box2D's skin, or its
-  /// fixture for a solver that samples moving bodies: wcsph, muller2003).
+  /// fixture for a solver that samples moving bodies: wcsph, muller2003). With contact
+  /// tracking on (setContactTracking), also every particle still in the World that touched it
+  /// at the end of a substep of the last step.
   std::vector<std::uint32_t> particlesTouching(const b2Fixture& fixture) const;
   /// Calls f(fixture, ids) for every fixture of box2d() that particles touch now, with their
   /// ids as particlesTouching() gives them; bodies and fixtures in Box2D's list order. The
   /// game's contact listener for the fluid (a button the water reaches, a fire it puts out).
   void forEachContact(const std::function<void(const b2Fixture&, const std::vector<std::uint32_t>&)>& f) const;
+  /// Turns on (or off) the `contacts` stage: at the end of every substep it records which
+  /// particles touch which fixture, so that particlesTouching() and forEachContact() also
+  /// report the particles that touched a fixture during the last step and left it before its
+  /// end (a splash that hit a button and bounced off; a jet through a sensor), not only those
+  /// touching it at the step's end. Off by default: the stage exists only while it is on.
+  void setContactTracking(bool on);
+  /// True while contact tracking is on (setContactTracking).
+  bool contactTracking() const;
   /// Re-reads the static fixtures of the b2World now, every static body where it is (step
   /// and stepFrame do it when they changed, sliding a moved one instead: below). Particles
   /// a static solid now covers are removed, with a warning (takeWarnings).

@@ -1,0 +1,93 @@
+// contacts.cpp — the `contacts` stage: which particles touch which fixture during a step
+// (World::setContactTracking), LiquidFun's particle-body contacts gathered at the end of
+// every substep rather than only read at the step's end, so that a splash that hit a
+// fixture and left it within one step is still reported. A particle touches a fixture when
+// its centre lies within one spacing of the surface the fluid meets there, or inside it (as
+// World::particlesTouching measures now): a static collider, or a moving body's shape at
+// its pose at the substep's end. Each block lists its contacts in slot order and the
+// blocks are joined in block order: the same list for any thread count.
+#include <algorithm>
+
+#include "constants.hpp"
+#include "world_impl.hpp"
+
+namespace sph2d {
+
+namespace {
+/// Distance of p outside static collider k (≤ 0 inside; a polygon's largest face separation,
+/// which is the distance except off a corner, where it is less).
+Real outsideStatic(const Collider& k, const Vec2& p) {
+  switch (k.kind) {
+    case Collider::Kind::Polygon: {
+      Real s = -1e30f;
+      for (std::size_t f = 0; f < k.vertices.size(); ++f) s = std::max(s, k.normals[f].dot(p - k.vertices[f]));
+      return s;
+    }
+    case Collider::Kind::Circle: return (p - k.center).norm() - k.radius;
+    case Collider::Kind::Segment: {
+      const Vec2 a = k.vertices[0], e = k.vertices[1] - a;
+      const Real len2 = e.squaredNorm();
+      const Real t = len2 > 0 ? std::clamp((p - a).dot(e) / len2, Real(0), Real(1)) : Real(0);
+      return (p - (a + e * t)).norm();
+    }
+  }
+  return 1e30f;
+}
+}  // namespace
+
+void World::Impl::recordContacts(StepContext& c) {
+  const std::size_t n = P.size(), blocks = (n + kBlock - 1) / kBlock;
+  contactBlocks.resize(blocks);
+  const Real reach = dx;
+  const double tau = c.time - moving.time0 + double(c.dt);  // the moving bodies at the substep's end
+  struct Placed {
+    double theta;
+    Vec2d o, centre;
+  };
+  std::vector<Placed> placed(moving.bodies.size());
+  for (std::size_t k = 0; k < placed.size(); ++k) {
+    moving.bodies[k].pose(tau, placed[k].theta, placed[k].o);
+    placed[k].centre = moving.bodies[k].centreAt(tau);
+  }
+  c.pool.parallelFor(n, kBlock, [&](std::size_t b, std::size_t e) {
+    auto& out = contactBlocks[b / kBlock];
+    out.clear();
+    for (std::size_t i = b; i < e; ++i) {
+      const Vec2 x = P.x[i];
+      if (!boundary.clearOf(x, x, reach))
+        boundary.forCollidersNear(x, reach, [&](std::uint32_t k) {
+          if (outsideStatic(boundary.colliders[k], x) <= reach) out.emplace_back(std::uintptr_t(boundary.colliderFixture[k]), P.id[i]);
+        });
+      for (std::size_t k = 0; k < placed.size(); ++k) {
+        const MovingSolid& m = moving.bodies[k];
+        const Vec2d p(x.x(), x.y());
+        const double r = m.radius + double(reach);
+        if ((p - placed[k].centre).squaredNorm() > r * r) continue;
+        const double cs = std::cos(placed[k].theta), sn = std::sin(placed[k].theta);
+        const Vec2d d = p - placed[k].o, q(cs * d.x() + sn * d.y(), -sn * d.x() + cs * d.y());  // body frame
+        for (std::size_t s = 0; s < m.shapes.size(); ++s) {
+          Vec2d normal;
+          if (outsideCollider(m.shapes[s], q, q, normal) <= double(reach)) out.emplace_back(std::uintptr_t(m.fixtures[s]), P.id[i]);
+        }
+      }
+    }
+  });
+  for (std::size_t k = 0; k < blocks; ++k) frameContacts.insert(frameContacts.end(), contactBlocks[k].begin(), contactBlocks[k].end());
+}
+
+void World::Impl::finishContacts() {
+  std::sort(frameContacts.begin(), frameContacts.end());  // by fixture, then id: each fixture's ids together
+  frameContacts.erase(std::unique(frameContacts.begin(), frameContacts.end()), frameContacts.end());
+}
+
+void World::setContactTracking(bool on) {
+  Impl& w = *impl_;
+  if (w.contactsOn == on) return;
+  w.contactsOn = on;
+  w.frameContacts.clear();
+  w.buildStages();
+}
+
+bool World::contactTracking() const { return impl_->contactsOn; }
+
+}  // namespace sph2d
