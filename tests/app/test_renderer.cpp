@@ -52,6 +52,21 @@ double waterShare(const Frame& f) {
 
 std::uint64_t hashOf(const Frame& f) { return xxh64(f.rgba.data(), f.rgba.size()); }
 
+/// Pixels of `def`'s solid colour in the 5 × 7 box around world point (wx, wy) of frame f,
+/// seen through camera rectangle `cam` (Renderer::cameraRect: aspect-fitted).
+int solidAround(const Frame& f, const RenderDef& def, const std::vector<double>& cam, double wx, double wy) {
+  const std::array<std::uint8_t, 3> solid{std::uint8_t(std::lround(def.solid[0] * 255)), std::uint8_t(std::lround(def.solid[1] * 255)),
+                                          std::uint8_t(std::lround(def.solid[2] * 255))};
+  const int cx = int((wx - cam[0]) / (cam[2] - cam[0]) * f.width), cy = int((cam[3] - wy) / (cam[3] - cam[1]) * f.height);
+  int n = 0;
+  for (int y = cy - 3; y <= cy + 3; ++y)
+    for (int x = cx - 2; x <= cx + 2; ++x) {
+      const std::uint8_t* p = &f.rgba[(std::size_t(y) * std::size_t(f.width) + std::size_t(x)) * 4];
+      n += p[0] == solid[0] && p[1] == solid[1] && p[2] == solid[2];
+    }
+  return n;
+}
+
 RenderInput inputOf(const World& w, const Particles& P) {
   RenderInput in;
   in.particles = P;
@@ -167,21 +182,7 @@ TEST_CASE("moving bodies are drawn where they are in each frame, with no trace w
   }
   const Frame& a = seq.render(world);
   const std::uint64_t sequential = hashOf(a);
-  const std::array<std::uint8_t, 3> solid{std::uint8_t(std::lround(s.render.solid[0] * 255)),
-                                          std::uint8_t(std::lround(s.render.solid[1] * 255)),
-                                          std::uint8_t(std::lround(s.render.solid[2] * 255))};
-  // Pixels of the solid colour around a world point (the camera is aspect-fitted: use its rect).
-  const auto cam = seq.cameraRect();
-  auto solidAround = [&](const Frame& f, double wx, double wy) {
-    const int cx = int((wx - cam[0]) / (cam[2] - cam[0]) * f.width), cy = int((cam[3] - wy) / (cam[3] - cam[1]) * f.height);
-    int n = 0;
-    for (int y = cy - 3; y <= cy + 3; ++y)
-      for (int x = cx - 2; x <= cx + 2; ++x) {
-        const std::uint8_t* p = &f.rgba[(std::size_t(y) * std::size_t(f.width) + std::size_t(x)) * 4];
-        n += p[0] == solid[0] && p[1] == solid[1] && p[2] == solid[2];
-      }
-    return n;
-  };
+  auto solidAround = [&](const Frame& f, double wx, double wy) { return ::solidAround(f, s.render, seq.cameraRect(), wx, wy); };
   CHECK(solidAround(a, 0.9, 0.7) == 35);  // the paddle now (it moved 0.5 m)
   CHECK(solidAround(a, 0.4, 0.7) == 0);   // nothing left where it started
   Renderer fresh(s.render);
@@ -573,7 +574,7 @@ TEST_CASE("static solids a game moves are drawn where they are: a teleported wal
   for (const char* mode : {"liquid", "particles"}) {
     INFO(mode);
     b2World level(b2Vec2(0, -9.81f));
-    auto addBox = [&](float cx, float cy, float hx, float hy) {
+    auto addBox = [&](float cx, float cy, float hx, float hy) {  // static boxes of the game's level
       b2BodyDef bd;
       bd.position.Set(cx, cy);
       b2Body* body = level.CreateBody(&bd);
@@ -599,20 +600,7 @@ TEST_CASE("static solids a game moves are drawn where they are: a teleported wal
     s.render.camera.max = Vec2d(2.2, 1.2);
     World world(s, level, WorldOptions{1});
     Renderer seq(s.render);
-    const std::array<std::uint8_t, 3> solid{std::uint8_t(std::lround(s.render.solid[0] * 255)),
-                                            std::uint8_t(std::lround(s.render.solid[1] * 255)),
-                                            std::uint8_t(std::lround(s.render.solid[2] * 255))};
-    auto solidAround = [&](const Frame& f, double wx, double wy) {
-      const auto cam = seq.cameraRect();
-      const int cx = int((wx - cam[0]) / (cam[2] - cam[0]) * f.width), cy = int((cam[3] - wy) / (cam[3] - cam[1]) * f.height);
-      int n = 0;
-      for (int y = cy - 3; y <= cy + 3; ++y)
-        for (int x = cx - 2; x <= cx + 2; ++x) {
-          const std::uint8_t* p = &f.rgba[(std::size_t(y) * std::size_t(f.width) + std::size_t(x)) * 4];
-          n += p[0] == solid[0] && p[1] == solid[1] && p[2] == solid[2];
-        }
-      return n;
-    };
+    auto solidAround = [&](const Frame& f, double wx, double wy) { return ::solidAround(f, s.render, seq.cameraRect(), wx, wy); };
     auto sameAsFresh = [&](const Frame& f) {
       Renderer fresh(s.render);
       return hashOf(fresh.render(world)) == hashOf(f);

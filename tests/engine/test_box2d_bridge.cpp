@@ -35,15 +35,7 @@ TEST_CASE("the walls are real Box2D fixtures of the world's b2World") {
 
 TEST_CASE("a game-owned b2World: the fluid collides with its level, and the game's world is unchanged") {
   b2World game(b2Vec2(0, -9.81f));
-  auto addBox = [&](float cx, float cy, float hx, float hy, float angle) {
-    b2BodyDef bd;
-    bd.position.Set(cx, cy);
-    bd.angle = angle;
-    b2Body* body = game.CreateBody(&bd);
-    b2PolygonShape box;
-    box.SetAsBox(hx, hy);
-    body->CreateFixture(&box, 0);
-  };
+  auto addBox = [&](float cx, float cy, float hx, float hy, float angle) { test::addStaticBox(game, cx, cy, hx, hy, angle); };
   addBox(2, -0.2f, 2.4f, 0.2f, 0);    // floor
   addBox(-0.2f, 2, 0.2f, 2.4f, 0);    // walls
   addBox(4.2f, 2, 0.2f, 2.4f, 0);
@@ -117,15 +109,7 @@ TEST_CASE("a static body the game slides through still water at 1 m/s pushes it 
     // users do. The water ahead is pushed at the door's speed, nothing enters the door and
     // every particle stays in the game.
     b2World game(b2Vec2(0, -9.81f));
-    auto addBox = [&](float cx, float cy, float hx, float hy) {
-      b2BodyDef bd;
-      bd.position.Set(cx, cy);
-      b2Body* body = game.CreateBody(&bd);
-      b2PolygonShape box;
-      box.SetAsBox(hx, hy);
-      body->CreateFixture(&box, 0);
-      return body;
-    };
+    auto addBox = [&](float cx, float cy, float hx, float hy) { return test::addStaticBox(game, cx, cy, hx, hy); };
     addBox(1, -0.2f, 1.4f, 0.2f);  // floor and walls of a 2 m × 1 m tank
     addBox(-0.2f, 0.5f, 0.2f, 0.9f);
     addBox(2.2f, 0.5f, 0.2f, 0.9f);
@@ -151,18 +135,10 @@ TEST_CASE("a static body the game slides through still water at 1 m/s pushes it 
     CHECK(w.colliders().size() == 3);        // while it slides, the door is no static solid…
     CHECK(w.movingColliders().size() == 1);  // …but a moving one
     const double front = door->GetPosition().x + 0.03;
-    double sum = 0;
-    int n = 0;
-    for (std::size_t i = 0; i < w.particleCount(); ++i) {
-      const Vec2d x = w.worldPosition(i);
-      if (x.x() > front && x.x() < front + 0.06 && x.y() > 0.1 && x.y() < 0.35) {
-        sum += double(w.particles().v[i].x());
-        ++n;
-      }
-    }
-    REQUIRE(n > 10);
-    MESSAGE(std::string(solver) << ": " << n << " particles just ahead of the door, mean vx " << sum / n << " m/s");
-    CHECK(sum / n >= 0.5);
+    const test::MeanVx ahead = test::meanVxIn(w, front, front + 0.06, 0.1, 0.35);
+    REQUIRE(ahead.count > 10);
+    MESSAGE(std::string(solver) << ": " << ahead.count << " particles just ahead of the door, mean vx " << ahead.mean << " m/s");
+    CHECK(ahead.mean >= 0.5);
     // Nothing leaves the tank, over its walls or above its 1 m (the level has no lid). Until
     // the fluid blocks left out lattice points on a static face (25 Nov), wcsph threw the row
     // under the door's foot out at 11 m/s as the door started, and one particle above 2.8 m.

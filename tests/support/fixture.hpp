@@ -139,6 +139,37 @@ inline SceneDef freeMovingBlock() {
 
 // --- measurements --------------------------------------------------------------
 
+/// A static box body of a game's own b2World, centre (cx, cy), half sizes (hx, hy), turned by `angle`.
+inline b2Body* addStaticBox(b2World& world, float cx, float cy, float hx, float hy, float angle = 0) {
+  b2BodyDef bd;
+  bd.position.Set(cx, cy);
+  bd.angle = angle;
+  b2Body* body = world.CreateBody(&bd);
+  b2PolygonShape box;
+  box.SetAsBox(hx, hy);
+  body->CreateFixture(&box, 0);
+  return body;
+}
+
+/// Mean vx of the particles in [x0, x1] × [y0, y1] (world coordinates) and how many there are.
+struct MeanVx {
+  double mean = 0;
+  int count = 0;
+};
+inline MeanVx meanVxIn(const World& w, double x0, double x1, double y0, double y1) {
+  MeanVx r;
+  double sum = 0;
+  for (std::size_t i = 0; i < w.particleCount(); ++i) {
+    const Vec2d x = w.worldPosition(i);
+    if (x.x() > x0 && x.x() < x1 && x.y() > y0 && x.y() < y1) {
+      sum += double(w.particles().v[i].x());
+      ++r.count;
+    }
+  }
+  r.mean = r.count ? sum / r.count : 0;
+  return r;
+}
+
 /// Particles outside the rectangle [x0, x1] × [y0, y1] (world frame; the edges count as inside).
 inline std::size_t outside(const World& w, double x0, double y0, double x1, double y1) {
   std::size_t n = 0;
