@@ -105,10 +105,13 @@ struct BoundarySet {
   template <class F>
   void forCollidersNear(const Vec2& x, Real reach, F&& f) const {
     if (bnx == 0) return;
-    const int x0 = std::max(0, int(std::floor((x.x() - reach - binLo.x()) * invBin)));
-    const int x1 = std::min(bnx - 1, int(std::floor((x.x() + reach - binLo.x()) * invBin)));
-    const int y0 = std::max(0, int(std::floor((x.y() - reach - binLo.y()) * invBin)));
-    const int y1 = std::min(bny - 1, int(std::floor((x.y() + reach - binLo.y()) * invBin)));
+    // Bin coordinates clamped in double before the cast (a far spray particle, or NaN: no bin).
+    const auto bin = [&](Real v, Real lo, int count) {
+      const double t = std::floor((double(v) - double(lo)) * double(invBin));
+      return t >= 0 ? int(std::min(t, double(count))) : -1;
+    };
+    const int x0 = std::max(0, bin(x.x() - reach, binLo.x(), bnx)), x1 = std::min(bnx - 1, bin(x.x() + reach, binLo.x(), bnx));
+    const int y0 = std::max(0, bin(x.y() - reach, binLo.y(), bny)), y1 = std::min(bny - 1, bin(x.y() + reach, binLo.y(), bny));
     std::uint32_t seen[16];
     int ns = 0;
     for (int y = y0; y <= y1; ++y)

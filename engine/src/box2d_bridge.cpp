@@ -154,17 +154,14 @@ void World::Impl::readStatics(double dt) {
     if (!(next < staticPoses.size() && staticPoses[next].first == body))
       for (next = 0; next < staticPoses.size() && staticPoses[next].first != body;) ++next;
     if (next == staticPoses.size()) continue;  // a new body
-    {
-      const b2Transform was = staticPoses[next++].second;
-      if (was.p.x == now.p.x && was.p.y == now.p.y && was.q.s == now.q.s && was.q.c == now.q.c) break;
-      const double a0 = std::atan2(double(was.q.s), double(was.q.c));
-      const double turn = std::remainder(std::atan2(double(now.q.s), double(now.q.c)) - a0, 2 * kPi<double>);
-      const Vec2d move(double(now.p.x) - was.p.x, double(now.p.y) - was.p.y);
-      // Faster than a game slides a door: a teleport (the static solids take it where it is).
-      if ((move.norm() + std::abs(turn) * reach(*body)) / dt > double(kStaticPushSpeed)) break;
-      sliding.push_back({body, Vec2d(was.p.x, was.p.y), a0, move / dt, turn / dt, time});
-      break;
-    }
+    const b2Transform was = staticPoses[next++].second;
+    if (was.p.x == now.p.x && was.p.y == now.p.y && was.q.s == now.q.s && was.q.c == now.q.c) continue;
+    const double a0 = std::atan2(double(was.q.s), double(was.q.c));
+    const double turn = std::remainder(std::atan2(double(now.q.s), double(now.q.c)) - a0, 2 * kPi<double>);
+    const Vec2d move(double(now.p.x) - was.p.x, double(now.p.y) - was.p.y);
+    // Faster than a game slides a door: a teleport (the static solids take it where it is).
+    if ((move.norm() + std::abs(turn) * reach(*body)) / dt > double(kStaticPushSpeed)) continue;
+    sliding.push_back({body, Vec2d(was.p.x, was.p.y), a0, move / dt, turn / dt, time});
   }
   if (staticSignature() != boundarySignature) {
     rebuildBoundary();
