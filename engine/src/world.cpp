@@ -194,7 +194,7 @@ void World::stepFrame() { step(1.0 / impl_->scene.fps); }
 
 void World::step(double dt) {
   // A game may edit its level between frames: a static body it slid moves through this step
-  // as a kinematic one; other changes are re-read (the water they cover pushed out).
+  // as a kinematic one; other changes are re-read (the particles a new solid covers dropped).
   impl_->readStatics(dt);
   impl_->frameContacts.clear();  // the contacts stage's record is this step's
   impl_->captureBodies();  // the moving bodies' pose and velocity for this step
