@@ -255,17 +255,29 @@ void BoundarySet::collect(b2World& world, const Vec2d& origin, const std::vector
   }
 }
 
+Real colliderSeparation(const Collider& c, const Vec2& p) {
+  switch (c.kind) {
+    case Collider::Kind::Polygon: {
+      Real s = -std::numeric_limits<Real>::infinity();
+      for (std::size_t k = 0; k < c.vertices.size(); ++k) s = std::max(s, c.normals[k].dot(p - c.vertices[k]));
+      return s;
+    }
+    case Collider::Kind::Circle: return (p - c.center).norm() - c.radius;
+    case Collider::Kind::Segment: {
+      const Vec2 a = c.vertices[0], e = c.vertices[1] - a;
+      const Real len2 = e.squaredNorm();
+      const Real t = len2 > 0 ? std::clamp((p - a).dot(e) / len2, Real(0), Real(1)) : Real(0);
+      return (p - (a + e * t)).norm();
+    }
+  }
+  return std::numeric_limits<Real>::infinity();
+}
+
 Real BoundarySet::insideDepth(const Vec2& p) const {
   Real depth = 0;
   for (const Collider& c : colliders) {
     if (p.x() < c.lo.x() || p.y() < c.lo.y() || p.x() > c.hi.x() || p.y() > c.hi.y()) continue;
-    if (c.kind == Collider::Kind::Polygon) {
-      Real s = -std::numeric_limits<Real>::infinity();
-      for (std::size_t k = 0; k < c.vertices.size(); ++k) s = std::max(s, c.normals[k].dot(p - c.vertices[k]));
-      depth = std::max(depth, -s);
-    } else if (c.kind == Collider::Kind::Circle) {
-      depth = std::max(depth, c.radius - (p - c.center).norm());
-    }
+    if (c.kind != Collider::Kind::Segment) depth = std::max(depth, -colliderSeparation(c, p));
   }
   return depth;
 }

@@ -43,6 +43,11 @@ void sampleColliders(const std::vector<Collider>& colliders, Real dx, Real depth
 /// Sets c.lo and c.hi, the bounds of a polygon's vertices or of a circle.
 void colliderBounds(Collider& c);
 
+/// How far p lies outside collider c (≤ 0 inside a polygon or circle): a polygon's largest
+/// face separation (the distance, except off a corner, where it is less), a circle's distance
+/// from its rim, a segment's distance from p.
+Real colliderSeparation(const Collider& c, const Vec2& p);
+
 struct BoundarySet {
   std::vector<Collider> colliders;
   std::vector<const void*> colliderFixture;  ///< the b2Fixture each collider came from (collect)

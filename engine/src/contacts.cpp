@@ -7,44 +7,20 @@
 // its pose at the substep's end. Each block lists its contacts in slot order and the
 // blocks are joined in block order: the same list for any thread count.
 #include <algorithm>
+#include <cmath>
 
 #include "constants.hpp"
 #include "world_impl.hpp"
 
 namespace sph2d {
 
-namespace {
-/// Distance of p outside static collider k (≤ 0 inside; a polygon's largest face separation,
-/// which is the distance except off a corner, where it is less).
-Real outsideStatic(const Collider& k, const Vec2& p) {
-  switch (k.kind) {
-    case Collider::Kind::Polygon: {
-      Real s = -1e30f;
-      for (std::size_t f = 0; f < k.vertices.size(); ++f) s = std::max(s, k.normals[f].dot(p - k.vertices[f]));
-      return s;
-    }
-    case Collider::Kind::Circle: return (p - k.center).norm() - k.radius;
-    case Collider::Kind::Segment: {
-      const Vec2 a = k.vertices[0], e = k.vertices[1] - a;
-      const Real len2 = e.squaredNorm();
-      const Real t = len2 > 0 ? std::clamp((p - a).dot(e) / len2, Real(0), Real(1)) : Real(0);
-      return (p - (a + e * t)).norm();
-    }
-  }
-  return 1e30f;
-}
-}  // namespace
-
 void World::Impl::recordContacts(StepContext& c) {
   const std::size_t n = P.size(), blocks = (n + kBlock - 1) / kBlock;
   contactBlocks.resize(blocks);
   const Real reach = dx;
   const double tau = c.time - moving.time0 + double(c.dt);  // the moving bodies at the substep's end
-  struct Placed {
-    double theta;
-    Vec2d o, centre;
-  };
-  std::vector<Placed> placed(moving.bodies.size());
+  std::vector<ContactPose>& placed = contactPoses;  // kept: no allocation in the step
+  placed.resize(moving.bodies.size());
   for (std::size_t k = 0; k < placed.size(); ++k) {
     moving.bodies[k].pose(tau, placed[k].theta, placed[k].o);
     placed[k].centre = moving.bodies[k].centreAt(tau);
@@ -56,7 +32,7 @@ void World::Impl::recordContacts(StepContext& c) {
       const Vec2 x = P.x[i];
       if (!boundary.clearOf(x, x, reach))
         boundary.forCollidersNear(x, reach, [&](std::uint32_t k) {
-          if (outsideStatic(boundary.colliders[k], x) <= reach) out.emplace_back(std::uintptr_t(boundary.colliderFixture[k]), P.id[i]);
+          if (colliderSeparation(boundary.colliders[k], x) <= reach) out.emplace_back(std::uintptr_t(boundary.colliderFixture[k]), P.id[i]);
         });
       for (std::size_t k = 0; k < placed.size(); ++k) {
         const MovingSolid& m = moving.bodies[k];

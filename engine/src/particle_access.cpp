@@ -64,6 +64,12 @@ void checkLengths(const char* call, const std::vector<std::uint32_t>& ids, const
                                 std::to_string(values.size()) + " " + what);
 }
 
+/// The bulk calls' other argument check: every value finite ("<call>: every <what> must be finite").
+void checkFinite(const char* call, const std::vector<Vec2d>& values, const char* what) {
+  for (const Vec2d& v : values)
+    if (!finite(v)) throw std::invalid_argument(std::string(call) + ": every " + what + " must be finite");
+}
+
 /// Calls f(k, slot) for each ids[k] a particle has, the id index rebuilt once first (absent ids
 /// then cost a search each, not a rebuild); returns how many calls returned true.
 template <class F>
@@ -128,8 +134,7 @@ bool World::setParticleVelocity(std::uint32_t id, const Vec2d& velocity) {
 
 std::size_t World::setVelocities(const std::vector<std::uint32_t>& ids, const std::vector<Vec2d>& velocities) {
   checkLengths("setVelocities", ids, velocities, "velocities");
-  for (const Vec2d& v : velocities)
-    if (!finite(v)) throw std::invalid_argument("setVelocities: every velocity must be finite");
+  checkFinite("setVelocities", velocities, "velocity");
   Impl& w = *impl_;
   return forEachId(w.idIndex, w.P, ids, [&](std::size_t k, std::size_t i) {
     w.P.v[i] = Vec2(Real(velocities[k].x()), Real(velocities[k].y()));
@@ -152,8 +157,7 @@ std::size_t World::getParticles(const std::vector<std::uint32_t>& ids, std::vect
 
 std::size_t World::setPositions(const std::vector<std::uint32_t>& ids, const std::vector<Vec2d>& positions) {
   checkLengths("setPositions", ids, positions, "positions");
-  for (const Vec2d& p : positions)
-    if (!finite(p)) throw std::invalid_argument("setPositions: every position must be finite");
+  checkFinite("setPositions", positions, "position");
   Impl& w = *impl_;
   const std::size_t moved =
       forEachId(w.idIndex, w.P, ids, [&](std::size_t k, std::size_t i) { return w.teleport(i, positions[k]); });
@@ -195,10 +199,8 @@ std::vector<std::uint32_t> World::addParticles(const std::vector<Vec2d>& points,
   if (!velocities.empty() && velocities.size() != points.size())
     throw std::invalid_argument("addParticles: " + std::to_string(points.size()) + " points but " +
                                 std::to_string(velocities.size()) + " velocities");
-  for (const Vec2d& p : points)
-    if (!finite(p)) throw std::invalid_argument("addParticles: every point must be finite");
-  for (const Vec2d& v : velocities)
-    if (!finite(v)) throw std::invalid_argument("addParticles: every velocity must be finite");
+  checkFinite("addParticles", points, "point");
+  checkFinite("addParticles", velocities, "velocity");
   Impl& w = *impl_;
   const Real rho0 = Real(w.scene.solver.restDensity);
   std::vector<std::uint32_t> ids;

@@ -261,6 +261,12 @@ struct World::Impl {
   /// step, sorted by fixture then id after the step (finishContacts).
   std::vector<std::pair<std::uintptr_t, std::uint32_t>> frameContacts;  ///< the fixture by its address
   std::vector<std::vector<std::pair<std::uintptr_t, std::uint32_t>>> contactBlocks;  ///< the stage's per-block scratch
+  /// A moving body as the contacts stage sees it: its pose and centre at the substep's end.
+  struct ContactPose {
+    double theta = 0;
+    Vec2d o{0, 0}, centre{0, 0};
+  };
+  std::vector<ContactPose> contactPoses;  ///< the stage's scratch, one per moving body
   /// The `contacts` stage: the particles within one spacing of each fixture now, into frameContacts.
   void recordContacts(StepContext& c);
   /// Sorts frameContacts and removes repeats (after a step).

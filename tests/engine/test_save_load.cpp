@@ -147,6 +147,17 @@ TEST_CASE("save and load: crates resting on each other and on the floor follow t
     std::istringstream in(saved(a));
     b.load(in);
     REQUIRE(b.stateHash() == a.stateHash());
+    // The crates come back exactly where and as fast as they were saved (not where the scene put them).
+    int crates = 0;
+    for (const b2Body *qa = a.box2d().GetBodyList(), *qb = b.box2d().GetBodyList(); qa && qb;
+         qa = qa->GetNext(), qb = qb->GetNext()) {
+      if (qa->GetType() != b2_dynamicBody) continue;
+      ++crates;
+      CHECK(qb->GetPosition() == qa->GetPosition());
+      CHECK(qb->GetAngle() == qa->GetAngle());
+      CHECK(qb->GetLinearVelocity() == qa->GetLinearVelocity());
+    }
+    CHECK(crates == 3);
     a.stepFrame();
     b.stepFrame();
     // The game solver's first step after the load is the same bits (Box2D steps after the
