@@ -33,18 +33,20 @@ constexpr std::uint8_t kBitCount[16] = {0, 1, 1, 2, 1, 2, 2, 3, 1, 2, 2, 3, 2, 3
 /// Appends to dst[used..] the slots k of [kb, ke), k ≠ i, with |xi − X[k]|² < R2, in
 /// order: candidates that are slots themselves (the grid's particles in order), no
 /// periodic axis. The same r² as the scalar loop (one IEEE operation a lane, in the same
-/// order), four candidates at a time; writes up to 3 entries past the list's end.
+/// order), four candidates at a time unless not `vector` (setScalarPairLoops); writes up to 3
+/// entries past the list's end.
 #if defined(__GNUC__)
 __attribute__((always_inline))  // called per row of cells with a few candidates: the call cost more than the row
 #endif
 inline std::size_t nearInOrder(const Vec2* X, std::size_t n, std::uint32_t kb, std::uint32_t ke, std::size_t i, const Vec2& xi,
-                               Real R2, std::uint32_t* dst, std::size_t used) {
+                               Real R2, std::uint32_t* dst, std::size_t used, bool vector) {
   std::uint32_t k = kb;
 #ifdef SPH2D_SSE2_NEIGHBOURS
+  const std::uint32_t kv = vector ? ke : kb;  // without `vector`, the scalar loop takes every candidate
   static_assert(sizeof(Vec2) == 2 * sizeof(float), "positions are pairs of floats");
   const float* xy = reinterpret_cast<const float*>(X);
   const __m128 xi4 = _mm_set1_ps(xi.x()), yi4 = _mm_set1_ps(xi.y()), r24 = _mm_set1_ps(R2);
-  for (; k < ke && std::size_t(k) + 4 <= n; k += 4) {  // lanes past ke read real particles, masked off
+  for (; k < kv && std::size_t(k) + 4 <= n; k += 4) {  // lanes past ke read real particles, masked off
     const __m128 a = _mm_loadu_ps(xy + 2 * std::size_t(k)), b = _mm_loadu_ps(xy + 2 * std::size_t(k) + 4);
     const __m128 dx = _mm_sub_ps(xi4, _mm_shuffle_ps(a, b, _MM_SHUFFLE(2, 0, 2, 0)));
     const __m128 dy = _mm_sub_ps(yi4, _mm_shuffle_ps(a, b, _MM_SHUFFLE(3, 1, 3, 1)));
@@ -59,6 +61,7 @@ inline std::size_t nearInOrder(const Vec2* X, std::size_t n, std::uint32_t kb, s
   }
 #else
   (void)n;
+  (void)vector;
 #endif
   for (; k < ke; ++k) {
     const Real dx = xi.x() - X[k].x(), dy = xi.y() - X[k].y();
@@ -70,6 +73,7 @@ inline std::size_t nearInOrder(const Vec2* X, std::size_t n, std::uint32_t kb, s
 }
 
 std::atomic<bool> gBaselineSimd{false};
+std::atomic<bool> gScalarPairs{false};
 
 #ifdef SPH2D_AVX512_NEIGHBOURS
 /// True when this CPU runs the AVX-512 candidate filter (checked once).
@@ -151,6 +155,8 @@ std::vector<std::uint32_t>& scratchFor(Scratch& s, const std::vector<std::uint32
 
 void setBaselineSimdOnly(bool on) { gBaselineSimd.store(on); }
 bool baselineSimdOnly() { return gBaselineSimd.load(std::memory_order_relaxed); }
+void setScalarPairLoops(bool on) { gScalarPairs.store(on); }
+bool scalarPairLoops() { return gScalarPairs.load(std::memory_order_relaxed); }
 
 std::size_t firstBad(ThreadPool& pool, std::size_t n, const std::function<std::size_t(std::size_t, std::size_t)>& fn) {
   return pool.reduce(n, kBlock, kNone, fn, [](std::size_t a, std::size_t b) { return std::min(a, b); });
@@ -226,8 +232,9 @@ void stageNeighbours(StepContext& c) {
   // Candidates that are slots (just reordered) and no wrap: four at a time.
   const bool inOrder = g.inOrder && !per.any() && g.sorted.size() == n;
 #ifdef SPH2D_AVX512_NEIGHBOURS
-  const bool wide = !baselineSimdOnly() && haveAvx512();
+  const bool wide = !baselineSimdOnly() && !scalarPairLoops() && haveAvx512();
 #endif
+  const bool vector = !scalarPairLoops();
   c.pool.parallelFor(n, kBlock, [&](std::size_t b, std::size_t e) {
     std::vector<std::uint32_t>& out = L.perBlock[b / kBlock];
     std::vector<std::uint32_t>& bout = L.boundaryPerBlock[b / kBlock];
@@ -254,7 +261,7 @@ void stageNeighbours(StepContext& c) {
         const std::uint32_t* sorted = g.sorted.data();
         const Vec2* X = P.x.data();
         if (inOrder) {
-          used = nearInOrder(X, n, kb, ke, i, xi, R2, dst, used);
+          used = nearInOrder(X, n, kb, ke, i, xi, R2, dst, used, vector);
           return;
         }
         for (std::uint32_t k = kb; k < ke; ++k) {

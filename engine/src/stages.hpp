@@ -20,6 +20,12 @@ namespace sph2d {
 void setBaselineSimdOnly(bool on);
 /// Whether setBaselineSimdOnly(true) is in force.
 bool baselineSimdOnly();
+/// With `on`, the pair loops with a scalar reference (the neighbour filter, muller2003's
+/// density and pressure force) run it instead of SIMD, as in a periodic scene. The same
+/// bits again; tests switch this to compare. Process-wide; off by default.
+void setScalarPairLoops(bool on);
+/// Whether setScalarPairLoops(true) is in force.
+bool scalarPairLoops();
 
 /// True when this substep reorders particle storage along the grid (every solver.reorder_interval substeps).
 bool reorderThisStep(const StepContext& c);

@@ -44,6 +44,77 @@ inline void gather4(const Vec2* X, std::uint32_t j0, std::uint32_t j1, std::uint
   xs = _mm_shuffle_ps(a, b, _MM_SHUFFLE(2, 0, 2, 0));
   ys = _mm_shuffle_ps(a, b, _MM_SHUFFLE(3, 1, 3, 1));
 }
+
+/// All lanes, or the first n of a group of four (n < 4): the live lanes of a last, partial group.
+alignas(16) constexpr std::uint32_t kLive4[5][4] = {
+    {0, 0, 0, 0}, {~0u, 0, 0, 0}, {~0u, ~0u, 0, 0}, {~0u, ~0u, ~0u, 0}, {~0u, ~0u, ~0u, ~0u}};
+#endif
+
+#ifdef SPH2D_AVX2_PAIRS
+/// True when this CPU runs the AVX2 pair loops (checked once) and the baseline is not forced (stages.hpp).
+bool useAvx2() {
+  static const bool have = __builtin_cpu_supports("avx2");
+  return have && !baselineSimdOnly();
+}
+
+/// Positions (or velocities) of the eight particles j[0..7] as their x and y lanes.
+__attribute__((target("avx2"))) inline void gather8(const Vec2* base, const std::uint32_t* j, __m256& xs, __m256& ys) {
+  __m128 p0, p1, p2, p3;  // x and y of j0..j3, then of j4..j7
+  gather4(base, j[0], j[1], j[2], j[3], p0, p1);
+  gather4(base, j[4], j[5], j[6], j[7], p2, p3);
+  xs = _mm256_insertf128_ps(_mm256_castps128_ps256(p0), p2, 1);
+  ys = _mm256_insertf128_ps(_mm256_castps128_ps256(p1), p3, 1);
+}
+#endif
+
+/// The lanes of the pair sums: the terms of pair k of a list go to partial sum k mod
+/// kSumLanes, and the lanes are added in one fixed tree (laneTotal). Every path (scalar,
+/// SSE2, AVX2) adds the same terms to the same lanes in the same order, so the bits are
+/// the same on any CPU and for any thread count; eight chains instead of one let the
+/// vector loops run at their throughput rather than at the latency of one add.
+constexpr std::uint32_t kSumLanes = 8;
+
+/// Σ of eight partial sums in the fixed tree ((s0+s4) + (s2+s6)) + ((s1+s5) + (s3+s7)).
+inline Real laneTotal(const Real s[kSumLanes]) {
+  const Real a0 = s[0] + s[4], a1 = s[1] + s[5], a2 = s[2] + s[6], a3 = s[3] + s[7];
+  return (a0 + a2) + (a1 + a3);
+}
+
+#ifdef SPH2D_SSE2_PAIRS
+/// laneTotal of one sum whose lanes 0–3 are lo and 4–7 hi.
+inline Real laneTotal1(__m128 lo, __m128 hi) {
+  const __m128 a = _mm_add_ps(lo, hi);                // a_q = s_q + s_{q+4}
+  const __m128 b = _mm_add_ps(a, _mm_movehl_ps(a, a));  // a0 + a2, a1 + a3
+  return _mm_cvtss_f32(_mm_add_ss(b, _mm_shuffle_ps(b, b, _MM_SHUFFLE(1, 1, 1, 1))));
+}
+#endif
+
+#ifdef SPH2D_AVX2_PAIRS
+/// Σ_j W(|x_i − x_j|) over slot i's list, eight pairs at a time (AVX2, chosen at run time):
+/// the scalar valueR2 lane for lane, pair k in lane k mod 8 (kSumLanes); no periodic axis.
+__attribute__((target("avx2"))) Real densitySum8(const Vec2* X, const Vec2& xi, const std::uint32_t* nb, std::uint32_t cnt,
+                                                 const Poly6<Real>& W) {
+  const __m256 xi8 = _mm256_set1_ps(xi.x()), yi8 = _mm256_set1_ps(xi.y());
+  const __m256 R28 = _mm256_set1_ps(W.R2), c8 = _mm256_set1_ps(W.c);
+  const __m256i iota = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
+  __m256 s = _mm256_setzero_ps();
+  for (std::uint32_t k = 0; k < cnt; k += 8) {
+    const std::uint32_t n = std::min<std::uint32_t>(8, cnt - k);
+    std::uint32_t j[8];
+    for (std::uint32_t l = 0; l < 8; ++l) j[l] = nb[std::min(k + l, cnt - 1)];  // missing lanes repeat the last (zeroed)
+    __m256 xj, yj;
+    gather8(X, j, xj, yj);
+    const __m256 dx = _mm256_sub_ps(xi8, xj), dy = _mm256_sub_ps(yi8, yj);
+    const __m256 r2 = _mm256_add_ps(_mm256_mul_ps(dx, dx), _mm256_mul_ps(dy, dy));
+    const __m256 a = _mm256_sub_ps(R28, r2);
+    __m256 w = _mm256_mul_ps(_mm256_mul_ps(_mm256_mul_ps(c8, a), a), a);
+    w = _mm256_and_ps(_mm256_cmp_ps(r2, R28, _CMP_NGE_UQ), w);  // valueR2: 0 for r² ≥ R²
+    // Missing lanes add +0, which leaves a sum unchanged: a sum that starts at +0 is never −0.
+    w = _mm256_and_ps(w, _mm256_castsi256_ps(_mm256_cmpgt_epi32(_mm256_set1_epi32(int(n)), iota)));
+    s = _mm256_add_ps(s, w);
+  }
+  return laneTotal1(_mm256_castps256_ps128(s), _mm256_extractf128_ps(s, 1));
+}
 #endif
 
 std::size_t density(StepContext& c, const Poly6<Real>& W) {
@@ -53,7 +124,10 @@ std::size_t density(StepContext& c, const Poly6<Real>& W) {
   const bool hasBoundary = !B.samples.empty();
   const BodySamples* moving = c.bodySamples && c.bodySamples->active() ? c.bodySamples : nullptr;
   const Real self = W.valueR2(0);
-  const bool simd = !c.periodic.any();
+  const bool simd = !c.periodic.any() && !scalarPairLoops();
+#ifdef SPH2D_AVX2_PAIRS
+  const bool wide = useAvx2();
+#endif
 #ifdef SPH2D_SSE2_PAIRS
   const __m128 R24 = _mm_set1_ps(W.R2), c4 = _mm_set1_ps(W.c);
 #else
@@ -65,15 +139,20 @@ std::size_t density(StepContext& c, const Poly6<Real>& W) {
       const Vec2 xi = P.x[i];
       const std::uint32_t* nb = L.of(i);
       const std::uint32_t cnt = L.count[i];
-      Real sum = self;
       const Vec2* X = P.x.data();
-      std::uint32_t k = 0;
+      Real total;  // Σ_j W_ij, pair k in lane k mod 8 (kSumLanes)
+#ifdef SPH2D_AVX2_PAIRS
+      if (simd && wide) {
+        total = densitySum8(X, xi, nb, cnt, W);
+      } else
+#endif
 #ifdef SPH2D_SSE2_PAIRS
       if (simd) {
-        // Four kernel values at a time (the scalar expressions, lane-wise), added in list order.
+        // Four kernel values at a time (the scalar expressions, lane-wise); lanes 0–3 in lo, 4–7 in hi.
         const __m128 xi4 = _mm_set1_ps(xi.x()), yi4 = _mm_set1_ps(xi.y());
-        for (; k < cnt; k += 4) {
-          // The last group may be partial: its missing lanes repeat the last neighbour and are not added.
+        __m128 lo = _mm_setzero_ps(), hi = _mm_setzero_ps();
+        for (std::uint32_t k = 0; k < cnt; k += 4) {
+          // The last group may be partial: its missing lanes repeat the last neighbour and add +0.
           const std::uint32_t last = cnt - 1, n = std::min<std::uint32_t>(4, cnt - k);
           __m128 xj, yj;
           gather4(X, nb[k], nb[std::min(k + 1, last)], nb[std::min(k + 2, last)], nb[std::min(k + 3, last)], xj, yj);
@@ -82,21 +161,24 @@ std::size_t density(StepContext& c, const Poly6<Real>& W) {
           const __m128 a = _mm_sub_ps(R24, r2);
           __m128 w = _mm_mul_ps(_mm_mul_ps(_mm_mul_ps(c4, a), a), a);
           w = _mm_and_ps(_mm_cmpnge_ps(r2, R24), w);  // valueR2: 0 for r² ≥ R²
-          alignas(16) Real t[4];
-          _mm_store_ps(t, w);
-          sum += t[0];
-          if (n > 1) sum += t[1];
-          if (n > 2) sum += t[2];
-          if (n > 3) sum += t[3];
+          w = _mm_and_ps(w, _mm_load_ps(reinterpret_cast<const float*>(kLive4[n])));
+          if (k & 4) hi = _mm_add_ps(hi, w);
+          else lo = _mm_add_ps(lo, w);
         }
-      }
+        total = laneTotal1(lo, hi);
+      } else
 #endif
-      for (; k < cnt; ++k) {
-        const Vec2 xj = X[nb[k]];
-        Real dx = xi.x() - xj.x(), dy = xi.y() - xj.y();
-        c.periodic.nearest(dx, dy);
-        sum += W.valueR2(dx * dx + dy * dy);
+      {
+        Real lanes[kSumLanes] = {};
+        for (std::uint32_t k = 0; k < cnt; ++k) {
+          const Vec2 xj = X[nb[k]];
+          Real dx = xi.x() - xj.x(), dy = xi.y() - xj.y();
+          c.periodic.nearest(dx, dy);
+          lanes[k % kSumLanes] += W.valueR2(dx * dx + dy * dy);
+        }
+        total = laneTotal(lanes);
       }
+      const Real sum = self + total;
       Real rho = c.mass * sum;
       if (hasBoundary) {
         Real bs = 0;
@@ -137,10 +219,11 @@ void pressure(StepContext& c) {
 // The pressure force's pair loop, with the viscosity folded in (stepper.cpp,
 // Solver::foldViscosity): the viscosity effect's own pass recomputed r and 1/r of
 // every pair; here one square root and one division serve both. The per-pair terms
-// are computed four pairs at a time (SSE2: element-wise IEEE operations only, the
-// same operations in the same order as the scalar expressions) and then added to
-// the sums one pair at a time in list order, so the bits are those of the scalar
-// loops. The four sums (pressure x, y; viscosity x, y) are the lanes of one register.
+// are computed four (SSE2) or eight (AVX2) pairs at a time: element-wise IEEE
+// operations only, the same operations in the same order as the scalar expressions.
+// Each of the four sums (pressure x, y; viscosity x, y) is kept in eight partial sums,
+// pair k of the list in partial sum k mod 8, added in a fixed tree at the end
+// (kSumLanes, laneTotal): the scalar loop does the same, so every path gives the same bits.
 
 /// The constants of one pair term: the spiky gradient and, with the viscosity, its Laplacian.
 struct PairConstants {
@@ -191,16 +274,33 @@ inline void pairTermScalar(const StepContext& c, const PairConstants& k, std::si
   }
 }
 
-#ifdef SPH2D_AVX2_PAIRS
-/// True when this CPU runs the AVX2 pair loop (checked once) and the baseline is not forced (stages.hpp).
-bool useAvx2() {
-  static const bool have = __builtin_cpu_supports("avx2");
-  return have && !baselineSimdOnly();
+/// The pair sums {fpx, fpy, fvx, fvy} of slot i in scalar code, lane by lane (the
+/// reference the SIMD loops reproduce; also the periodic path).
+template <bool Visc>
+void pairSumsScalar(const StepContext& c, const PairConstants& k, std::size_t i, const std::uint32_t* nb,
+                    std::uint32_t cnt, Real pi, Real vix, Real viy, Real sums[4]) {
+  Real lanes[4][kSumLanes] = {};
+  for (std::uint32_t q = 0; q < cnt; ++q) {
+    Real t[4];
+    pairTermScalar<Visc>(c, k, i, nb[q], pi, vix, viy, t);
+    for (int l = 0; l < 4; ++l) lanes[l][q % kSumLanes] += t[l];
+  }
+  for (int l = 0; l < 4; ++l) sums[l] = laneTotal(lanes[l]);
 }
 
+#ifdef SPH2D_SSE2_PAIRS
+/// laneTotal of four sums at once: lo holds lanes 0–3 and hi lanes 4–7 of {fpx, fpy, fvx, fvy}.
+inline void laneTotals4(__m128 lo[4], const __m128 hi[4], Real* sums) {
+  for (int l = 0; l < 4; ++l) lo[l] = _mm_add_ps(lo[l], hi[l]);  // a_q = s_q + s_{q+4}
+  _MM_TRANSPOSE4_PS(lo[0], lo[1], lo[2], lo[3]);                // row q = a_q of the four sums
+  _mm_store_ps(sums, _mm_add_ps(_mm_add_ps(lo[0], lo[2]), _mm_add_ps(lo[1], lo[3])));
+}
+#endif
+
+#ifdef SPH2D_AVX2_PAIRS
 /// The pair sums {fpx, fpy, fvx, fvy} of slot i, eight pairs at a time (AVX2, chosen at
-/// run time): the SSE2 loop's operations lane for lane, the gathers by index, the terms
-/// added in list order; no periodic axis.
+/// run time): the scalar terms' operations lane for lane, the gathers by index, pair k
+/// in lane k mod 8 (kSumLanes); no periodic axis.
 template <bool Visc>
 __attribute__((target("avx2"))) void pairSums8(const StepContext& c, const PairConstants& k, std::size_t i,
                                                const std::uint32_t* nb, std::uint32_t cnt, Real pi, Real vix, Real viy,
@@ -212,29 +312,28 @@ __attribute__((target("avx2"))) void pairSums8(const StepContext& c, const PairC
   const __m256 vix8 = _mm256_set1_ps(vix), viy8 = _mm256_set1_ps(viy);
   const __m256 R8 = _mm256_set1_ps(k.R), spikyK = _mm256_set1_ps(k.spikyK), halfMass = _mm256_set1_ps(k.halfMass);
   const __m256 one = _mm256_set1_ps(Real(1)), thr = _mm256_set1_ps(k.coincident2);
+  const __m256i iota = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
   // Gathers by plain loads (the hardware gathers were slower on the EPYC measured).
-  auto gather8 = [](const Vec2* base, const std::uint32_t* j, __m256& xs, __m256& ys) __attribute__((target("avx2"))) {
-    __m128 p0, p1, p2, p3;  // (x y) of j0 j1 | j2 j3 | j4 j5 | j6 j7
-    gather4(base, j[0], j[1], j[2], j[3], p0, p1);
-    gather4(base, j[4], j[5], j[6], j[7], p2, p3);
-    xs = _mm256_insertf128_ps(_mm256_castps128_ps256(p0), p2, 1);
-    ys = _mm256_insertf128_ps(_mm256_castps128_ps256(p1), p3, 1);
-  };
-  __m128 acc = _mm_setzero_ps();
+  __m256 s0 = _mm256_setzero_ps(), s1 = s0, s2 = s0, s3 = s0;  // lanes of fpx, fpy, fvx, fvy
   for (std::uint32_t kk = 0; kk < cnt; kk += 8) {
     const std::uint32_t n = std::min<std::uint32_t>(8, cnt - kk);
     std::uint32_t j[8];
-    for (std::uint32_t l = 0; l < 8; ++l) j[l] = nb[std::min(kk + l, cnt - 1)];  // missing lanes repeat the last (not added)
+    for (std::uint32_t l = 0; l < 8; ++l) j[l] = nb[std::min(kk + l, cnt - 1)];  // missing lanes repeat the last (zeroed)
     __m256 xj, yj;
     gather8(c.P.x.data(), j, xj, yj);
     const __m256 dx = _mm256_sub_ps(xi8, xj), dy = _mm256_sub_ps(yi8, yj);
     const __m256 r2 = _mm256_add_ps(_mm256_mul_ps(dx, dx), _mm256_mul_ps(dy, dy));
     if (__builtin_expect(_mm256_movemask_ps(_mm256_cmp_ps(r2, thr, _CMP_LT_OQ)) & ((1 << n) - 1), 0)) {
-      for (std::uint32_t q = kk; q < kk + n; ++q) {  // a coincident pair (rare): the scalar terms
-        alignas(16) Real t[4];
-        pairTermScalar<Visc>(c, k, i, nb[q], pi, vix, viy, t);
-        acc = _mm_add_ps(acc, _mm_load_ps(t));
+      alignas(32) Real t[4][8] = {};  // a coincident pair (rare): the scalar terms, in their lanes
+      for (std::uint32_t q = 0; q < n; ++q) {
+        Real tq[4];
+        pairTermScalar<Visc>(c, k, i, nb[kk + q], pi, vix, viy, tq);
+        for (int l = 0; l < 4; ++l) t[l][q] = tq[l];
       }
+      s0 = _mm256_add_ps(s0, _mm256_load_ps(t[0]));
+      s1 = _mm256_add_ps(s1, _mm256_load_ps(t[1]));
+      s2 = _mm256_add_ps(s2, _mm256_load_ps(t[2]));
+      s3 = _mm256_add_ps(s3, _mm256_load_ps(t[3]));
       continue;
     }
     const __m256 irj = _mm256_setr_ps(IR[j[0]], IR[j[1]], IR[j[2]], IR[j[3]], IR[j[4]], IR[j[5]], IR[j[6]], IR[j[7]]);
@@ -264,21 +363,24 @@ __attribute__((target("avx2"))) void pairSums8(const StepContext& c, const PairC
       t2 = _mm256_mul_ps(_mm256_sub_ps(vxj, vix8), w);
       t3 = _mm256_mul_ps(_mm256_sub_ps(vyj, viy8), w);
     }
-    // Rows {fpx, fpy, fvx, fvy} of pairs kk..kk+3 (low halves) and kk+4..kk+7 (high halves), added in order.
-    __m128 a0 = _mm256_castps256_ps128(t0), a1 = _mm256_castps256_ps128(t1), a2 = _mm256_castps256_ps128(t2),
-           a3 = _mm256_castps256_ps128(t3);
-    _MM_TRANSPOSE4_PS(a0, a1, a2, a3);
-    __m128 b0 = _mm256_extractf128_ps(t0, 1), b1 = _mm256_extractf128_ps(t1, 1), b2 = _mm256_extractf128_ps(t2, 1),
-           b3 = _mm256_extractf128_ps(t3, 1);
-    _MM_TRANSPOSE4_PS(b0, b1, b2, b3);
-    const __m128 rows[8] = {a0, a1, a2, a3, b0, b1, b2, b3};
-    if (n == 8) {
-      for (int l = 0; l < 8; ++l) acc = _mm_add_ps(acc, rows[l]);
-    } else {
-      for (std::uint32_t l = 0; l < n; ++l) acc = _mm_add_ps(acc, rows[l]);
+    if (n < 8) {
+      // Missing lanes add +0, which leaves a sum unchanged: a sum that starts at +0 is never −0.
+      const __m256 live = _mm256_castsi256_ps(_mm256_cmpgt_epi32(_mm256_set1_epi32(int(n)), iota));
+      t0 = _mm256_and_ps(t0, live);
+      t1 = _mm256_and_ps(t1, live);
+      t2 = _mm256_and_ps(t2, live);
+      t3 = _mm256_and_ps(t3, live);
     }
+    s0 = _mm256_add_ps(s0, t0);
+    s1 = _mm256_add_ps(s1, t1);
+    s2 = _mm256_add_ps(s2, t2);
+    s3 = _mm256_add_ps(s3, t3);
   }
-  _mm_store_ps(sums, acc);
+  __m128 lo[4] = {_mm256_castps256_ps128(s0), _mm256_castps256_ps128(s1), _mm256_castps256_ps128(s2),
+                  _mm256_castps256_ps128(s3)};
+  const __m128 hi[4] = {_mm256_extractf128_ps(s0, 1), _mm256_extractf128_ps(s1, 1), _mm256_extractf128_ps(s2, 1),
+                        _mm256_extractf128_ps(s3, 1)};
+  laneTotals4(lo, hi, sums);
 }
 #endif
 
@@ -304,7 +406,7 @@ std::size_t pressureForce(StepContext& c, const Spiky<Real>& spiky, const Viscos
     k.invRMin = Real(1) / W.rMin;
     k.pairCap = vt.pairCap;
   }
-  const bool simd = !c.periodic.any();
+  const bool simd = !c.periodic.any() && !scalarPairLoops();
 #ifdef SPH2D_AVX2_PAIRS
   const bool wide = useAvx2();
 #endif
@@ -342,23 +444,30 @@ std::size_t pressureForce(StepContext& c, const Spiky<Real>& spiky, const Viscos
 #endif
 #ifdef SPH2D_SSE2_PAIRS
       if (simd) {
-        __m128 acc = _mm_setzero_ps();
+        // Pair k in lane k mod 8 (kSumLanes): lanes 0–3 in lo, 4–7 in hi.
+        __m128 lo[4] = {_mm_setzero_ps(), _mm_setzero_ps(), _mm_setzero_ps(), _mm_setzero_ps()};
+        __m128 hi[4] = {lo[0], lo[0], lo[0], lo[0]};
         const __m128 xi4 = _mm_set1_ps(xi.x()), yi4 = _mm_set1_ps(xi.y()), pi4 = _mm_set1_ps(pi);
         const __m128 vix4 = _mm_set1_ps(vix), viy4 = _mm_set1_ps(viy);
         const __m128 capI4 = _mm_set1_ps(k.pairCap / IR[i]);  // ViscosityTerm::pairCap · ρ_i
-        // Adds the terms of pairs kk.. kk + n − 1 (n ≤ 4; missing lanes repeat the last one and are not added).
-        auto group = [&](std::uint32_t j0, std::uint32_t j1, std::uint32_t j2, std::uint32_t j3, std::uint32_t n) {
+        // Adds the terms of pairs at.. at + n − 1 (n ≤ 4) to s; missing lanes repeat the last
+        // pair and add +0, which leaves a sum unchanged (a sum that starts at +0 is never −0).
+        auto group = [&](std::uint32_t at, std::uint32_t n, __m128 s[4]) {
+          const std::uint32_t last = nb[cnt - 1];
+          const std::uint32_t j0 = nb[at], j1 = n > 1 ? nb[at + 1] : last, j2 = n > 2 ? nb[at + 2] : last,
+                              j3 = n > 3 ? nb[at + 3] : last;
           __m128 xj, yj;
           gather4(X, j0, j1, j2, j3, xj, yj);
           const __m128 dx = _mm_sub_ps(xi4, xj), dy = _mm_sub_ps(yi4, yj);
           const __m128 r2 = _mm_add_ps(_mm_mul_ps(dx, dx), _mm_mul_ps(dy, dy));
           if (__builtin_expect(_mm_movemask_ps(_mm_cmplt_ps(r2, K4.thr)) & ((1 << n) - 1), 0)) {
-            // A coincident pair (rare): the scalar terms.
-            for (std::uint32_t q = kk; q < kk + n; ++q) {
-              alignas(16) Real t[4];
-              pairTermScalar<Visc>(c, k, i, nb[q], pi, vix, viy, t);
-              acc = _mm_add_ps(acc, _mm_load_ps(t));
+            alignas(16) Real t[4][4] = {};  // a coincident pair (rare): the scalar terms, in their lanes
+            for (std::uint32_t q = 0; q < n; ++q) {
+              Real tq[4];
+              pairTermScalar<Visc>(c, k, i, nb[at + q], pi, vix, viy, tq);
+              for (int l = 0; l < 4; ++l) t[l][q] = tq[l];
             }
+            for (int l = 0; l < 4; ++l) s[l] = _mm_add_ps(s[l], _mm_load_ps(t[l]));
             return;
           }
           const __m128 irj = _mm_setr_ps(IR[j0], IR[j1], IR[j2], IR[j3]);
@@ -368,7 +477,7 @@ std::size_t pressureForce(StepContext& c, const Spiky<Real>& spiky, const Viscos
           const __m128 a = _mm_sub_ps(K4.R, _mm_mul_ps(r2, invr));
           const __m128 wp = _mm_mul_ps(_mm_mul_ps(_mm_mul_ps(_mm_mul_ps(K4.spikyK, a), a), invr),
                                        _mm_mul_ps(K4.halfMass, _mm_add_ps(_mm_mul_ps(pi4, irj), porj)));
-          __m128 t0 = _mm_mul_ps(dx, wp), t1 = _mm_mul_ps(dy, wp), t2 = _mm_setzero_ps(), t3 = _mm_setzero_ps();
+          __m128 t[4] = {_mm_mul_ps(dx, wp), _mm_mul_ps(dy, wp), _mm_setzero_ps(), _mm_setzero_ps()};
           if (Visc) {
             const __m128 big = _mm_cmpgt_ps(r2, K4.rMin2);
             const __m128 q = _mm_or_ps(_mm_and_ps(big, sq), _mm_andnot_ps(big, K4.rMin));
@@ -382,35 +491,22 @@ std::size_t pressureForce(StepContext& c, const Spiky<Real>& spiky, const Viscos
             const __m128 w = _mm_min_ps(_mm_mul_ps(lap, irj), capI4);  // the stability cap (std::min's value for finite lanes)
             __m128 vxj, vyj;
             gather4(V, j0, j1, j2, j3, vxj, vyj);
-            t2 = _mm_mul_ps(_mm_sub_ps(vxj, vix4), w);
-            t3 = _mm_mul_ps(_mm_sub_ps(vyj, viy4), w);
+            t[2] = _mm_mul_ps(_mm_sub_ps(vxj, vix4), w);
+            t[3] = _mm_mul_ps(_mm_sub_ps(vyj, viy4), w);
           }
-          _MM_TRANSPOSE4_PS(t0, t1, t2, t3);  // now t_l = {fpx, fpy, fvx, fvy} of pair kk + l
-          acc = _mm_add_ps(acc, t0);
-          if (n == 4) {
-            acc = _mm_add_ps(acc, t1);
-            acc = _mm_add_ps(acc, t2);
-            acc = _mm_add_ps(acc, t3);
-          } else {
-            if (n > 1) acc = _mm_add_ps(acc, t1);
-            if (n > 2) acc = _mm_add_ps(acc, t2);
+          if (n < 4) {
+            const __m128 live = _mm_load_ps(reinterpret_cast<const float*>(kLive4[n]));
+            for (int l = 0; l < 4; ++l) t[l] = _mm_and_ps(t[l], live);
           }
+          for (int l = 0; l < 4; ++l) s[l] = _mm_add_ps(s[l], t[l]);
         };
-        for (; kk + 4 <= cnt; kk += 4) group(nb[kk], nb[kk + 1], nb[kk + 2], nb[kk + 3], 4);
-        if (kk < cnt) {
-          const std::uint32_t last = nb[cnt - 1], n = cnt - kk;
-          group(nb[kk], n > 1 ? nb[kk + 1] : last, n > 2 ? nb[kk + 2] : last, last, n);
-          kk = cnt;
-        }
-        _mm_store_ps(sums, acc);
+        for (; kk < cnt; kk += 4) group(kk, std::min<std::uint32_t>(4, cnt - kk), (kk & 4) ? hi : lo);
+        kk = cnt;
+        laneTotals4(lo, hi, sums);
       }
 #endif
       (void)simd;
-      for (; kk < cnt; ++kk) {
-        Real t[4];
-        pairTermScalar<Visc>(c, k, i, nb[kk], pi, vix, viy, t);
-        for (int l = 0; l < 4; ++l) sums[l] += t[l];
-      }
+      if (kk < cnt) pairSumsScalar<Visc>(c, k, i, nb, cnt, pi, vix, viy, sums);
       const Vec2 fp(sums[0], sums[1]);
       const Real invRhoi = IR[i];
       const Real capWall = vt.pairCap / invRhoi * c.rho0;  // a wall sample's ∇²W at most (ViscosityTerm::pairCap)
