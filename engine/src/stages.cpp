@@ -82,24 +82,51 @@ bool haveAvx512() {
   return yes;
 }
 
+/// The cell of a position without a periodic axis, as Grid::forCandidateRanges finds it.
+inline void cellOfPoint(const Grid& g, const Vec2& x, int& cx, int& cy) {
+  cx = Grid::coord(x.x(), g.lo.x(), g.invCell, g.nx);
+  cy = Grid::coord(x.y(), g.lo.y(), g.invCellY, g.ny);
+}
+
+/// Entries of nearInOrder16's staging buffer: a query's candidates, plus one vector's overrun.
+constexpr std::size_t kStageEntries = 512;
+
 /// The fluid neighbours of slot i among the grid's candidates that are slots themselves
 /// (no periodic axis), appended to out from `used`: nearInOrder sixteen candidates at a
 /// time (AVX-512F, chosen at run time). The same r² per lane as the scalar and SSE2
 /// loops (one IEEE operation a lane, in the same order), so the same lists. Masked loads
 /// and stores: nothing is read past the positions or written past the kept entries.
-__attribute__((target("avx512f,popcnt"))) std::size_t nearAllInOrder16(const Grid& g, const Vec2* X, std::size_t i,
-                                                                       const Vec2& xi, Real R2,
-                                                                       std::vector<std::uint32_t>& out, std::size_t used) {
+/// With Two, slot i + 1 lies in the same cell, so its candidate rows are i's: each row's
+/// candidates are loaded once and tested for both. i + 1's kept slots are stored as whole
+/// vectors into a buffer on the stack (the lanes past them are overwritten or dropped) and
+/// follow i's list, which ends at *mid, at the end. `used` becomes the end of the last
+/// list. False, with nothing written, when Two and the rows hold more candidates than the
+/// buffer (a pile-up: the caller then searches for i alone); always true without Two.
+template <bool Two>
+__attribute__((target("avx512f,popcnt"))) bool nearInOrder16(const Grid& g, const Vec2* X, std::size_t i, Real R2,
+                                                             std::vector<std::uint32_t>& out, std::size_t& used,
+                                                             std::size_t* mid) {
   const float* xy = reinterpret_cast<const float*>(X);
+  const Vec2 xi = X[i], xn = X[i + (Two ? 1 : 0)];
   const __m512 xi16 = _mm512_set1_ps(xi.x()), yi16 = _mm512_set1_ps(xi.y()), r216 = _mm512_set1_ps(R2);
+  const __m512 xn16 = _mm512_set1_ps(xn.x()), yn16 = _mm512_set1_ps(xn.y());
   const __m512i evens = _mm512_setr_epi32(0, 2, 4, 6, 8, 10, 12, 14, 16, 18, 20, 22, 24, 26, 28, 30);
   const __m512i odds = _mm512_setr_epi32(1, 3, 5, 7, 9, 11, 13, 15, 17, 19, 21, 23, 25, 27, 29, 31);
   const __m512i iota = _mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
   // Grid::forCandidateRanges without a periodic axis, written out (a lambda would not
   // carry this function's target).
-  const int cx = Grid::coord(xi.x(), g.lo.x(), g.invCell, g.nx), cy = Grid::coord(xi.y(), g.lo.y(), g.invCellY, g.ny);
+  int cx, cy;
+  cellOfPoint(g, xi, cx, cy);
   const int x0 = std::max(cx - g.reach, 0), x1 = std::min(cx + g.reach, g.nx - 1);
   const int y0 = std::max(cy - g.reach, 0), y1 = std::min(cy + g.reach, g.ny - 1);
+  if (Two) {
+    std::size_t total = 0;
+    for (int y = y0; y <= y1; ++y)
+      total += g.cellStart[std::size_t(y) * g.nx + x1 + 1] - g.cellStart[std::size_t(y) * g.nx + x0];
+    if (total + 16 > kStageEntries) return false;
+  }
+  alignas(64) std::uint32_t bufN[Two ? kStageEntries : 1];
+  std::size_t gotN = 0;
   for (int y = y0; y <= y1; ++y) {
     const std::uint32_t kb = g.cellStart[std::size_t(y) * g.nx + x0], ke = g.cellStart[std::size_t(y) * g.nx + x1 + 1];
     if (!(kb < ke)) continue;
@@ -117,19 +144,42 @@ __attribute__((target("avx512f,popcnt"))) std::size_t nearAllInOrder16(const Gri
       const __mmask16 lo = __mmask16(floats & 0xFFFF), hi = __mmask16(floats >> 16);
       const __m512 a = _mm512_maskz_loadu_ps(lo, xy + 2 * std::size_t(k));
       const __m512 b = _mm512_maskz_loadu_ps(hi, xy + 2 * std::size_t(k) + 16);
-      const __m512 dx = _mm512_sub_ps(xi16, _mm512_permutex2var_ps(a, evens, b));
-      const __m512 dy = _mm512_sub_ps(yi16, _mm512_permutex2var_ps(a, odds, b));
-      const __m512 r2 = _mm512_add_ps(_mm512_mul_ps(dx, dx), _mm512_mul_ps(dy, dy));
-      unsigned keep = unsigned(_mm512_mask_cmp_ps_mask(lanes, r2, r216, _CMP_LT_OQ));
-      const std::size_t self = i - k;  // wraps around when i < k
-      keep &= ~(unsigned(self < 16) << (self & 15));
-      const __m512i ids = _mm512_maskz_compress_epi32(__mmask16(keep), _mm512_add_epi32(_mm512_set1_epi32(int(k)), iota));
+      const __m512 xs = _mm512_permutex2var_ps(a, evens, b), ys = _mm512_permutex2var_ps(a, odds, b);
+      const __m512i ks = _mm512_add_epi32(_mm512_set1_epi32(int(k)), iota);
+      // The kept lanes of slot `slot` at (px, py): within R, not the slot itself.
+      const auto keepOf = [&](__m512 px, __m512 py, std::size_t slot) __attribute__((always_inline, target("avx512f"))) {
+        const __m512 dx = _mm512_sub_ps(px, xs), dy = _mm512_sub_ps(py, ys);
+        const __m512 r2 = _mm512_add_ps(_mm512_mul_ps(dx, dx), _mm512_mul_ps(dy, dy));
+        const unsigned keep = unsigned(_mm512_mask_cmp_ps_mask(lanes, r2, r216, _CMP_LT_OQ));
+        const std::size_t self = slot - k;  // wraps around when slot < k
+        return keep & ~(unsigned(self < 16) << (self & 15));
+      };
+      const unsigned keep = keepOf(xi16, yi16, i);
       const unsigned got = unsigned(__builtin_popcount(keep));
-      _mm512_mask_storeu_epi32(dst + used, __mmask16((1u << got) - 1), ids);
+      _mm512_mask_storeu_epi32(dst + used, __mmask16((1u << got) - 1), _mm512_maskz_compress_epi32(__mmask16(keep), ks));
       used += got;
+      if (Two) {
+        const unsigned keepN = keepOf(xn16, yn16, i + 1);
+        _mm512_storeu_si512(bufN + gotN, _mm512_maskz_compress_epi32(__mmask16(keepN), ks));
+        gotN += unsigned(__builtin_popcount(keepN));
+      }
     }
   }
-  return used;
+  if (!Two) return true;
+  *mid = used;
+  const std::size_t need = used + gotN + 3;
+  if (out.size() < need) {
+    if (out.capacity() < need) out.reserve(need + need / 8);
+    out.resize(need);
+  }
+  std::uint32_t* dst = out.data() + used;
+  for (std::size_t k = 0; k < gotN; k += 16) {  // sixteen at a time, the last ones masked
+    const std::size_t left = gotN - k;
+    const __mmask16 part = left >= 16 ? __mmask16(0xFFFF) : __mmask16((1u << left) - 1);
+    _mm512_mask_storeu_epi32(dst + k, part, _mm512_load_si512(bufN + k));
+  }
+  used += gotN;
+  return true;
 }
 #endif
 
@@ -240,40 +290,59 @@ void stageNeighbours(StepContext& c) {
     std::vector<std::uint32_t>& bout = L.boundaryPerBlock[b / kBlock];
     bout.clear();
     std::size_t used = 0;
+    std::size_t listed = b;  // slots below this have their fluid lists (i + 1 of a pair searched with i)
     for (std::size_t i = b; i < e; ++i) {
       const Vec2 xi = P.x[i];
-      L.start[i] = std::uint32_t(used);
+      if (i >= listed) {
+        L.start[i] = std::uint32_t(used);
+        listed = i + 1;
 #ifdef SPH2D_AVX512_NEIGHBOURS
-      if (inOrder && wide) {
-        used = nearAllInOrder16(g, P.x.data(), i, xi, R2, out, used);
-      } else
+        if (inOrder && wide) {
+          int cx, cy, nx = -1, ny = -1;
+          cellOfPoint(g, xi, cx, cy);
+          if (i + 1 < e) cellOfPoint(g, P.x[i + 1], nx, ny);
+          std::size_t mid = 0;
+          if (nx == cx && ny == cy && nearInOrder16<true>(g, P.x.data(), i, R2, out, used, &mid)) {
+            // The same cell: the same candidates, loaded once for both.
+            L.count[i] = std::uint32_t(mid - L.start[i]);
+            L.start[i + 1] = std::uint32_t(mid);
+            L.count[i + 1] = std::uint32_t(used - mid);
+            listed = i + 2;
+          } else {
+            nearInOrder16<false>(g, P.x.data(), i, R2, out, used, nullptr);  // one slot: always true
+            L.count[i] = std::uint32_t(used - L.start[i]);
+          }
+        } else
 #endif
-      g.forCandidateRanges(xi, [&](std::uint32_t kb, std::uint32_t ke) {
-        // Room for every candidate (written before the test; and 3 more, nearInOrder's
-        // last group); grown by an eighth, not doubled: the lists are most of the
-        // engine's memory, and a block's need settles.
-        const std::size_t need = used + (ke - kb) + 3;
-        if (out.size() < need) {
-          if (out.capacity() < need) out.reserve(need + need / 8);
-          out.resize(need);
+        {
+          g.forCandidateRanges(xi, [&](std::uint32_t kb, std::uint32_t ke) {
+            // Room for every candidate (written before the test; and 3 more, nearInOrder's
+            // last group); grown by an eighth, not doubled: the lists are most of the
+            // engine's memory, and a block's need settles.
+            const std::size_t need = used + (ke - kb) + 3;
+            if (out.size() < need) {
+              if (out.capacity() < need) out.reserve(need + need / 8);
+              out.resize(need);
+            }
+            std::uint32_t* dst = out.data();
+            const std::uint32_t* sorted = g.sorted.data();
+            const Vec2* X = P.x.data();
+            if (inOrder) {
+              used = nearInOrder(X, n, kb, ke, i, xi, R2, dst, used, vector);
+              return;
+            }
+            for (std::uint32_t k = kb; k < ke; ++k) {
+              const std::uint32_t j = sorted[k];
+              Real dx = xi.x() - X[j].x(), dy = xi.y() - X[j].y();
+              per.nearest(dx, dy);
+              const Real r2 = dx * dx + dy * dy;
+              dst[used] = j;  // written always, kept only when inside: no branch
+              used += std::size_t((r2 < R2) & (j != i));
+            }
+          });
+          L.count[i] = std::uint32_t(used - L.start[i]);
         }
-        std::uint32_t* dst = out.data();
-        const std::uint32_t* sorted = g.sorted.data();
-        const Vec2* X = P.x.data();
-        if (inOrder) {
-          used = nearInOrder(X, n, kb, ke, i, xi, R2, dst, used, vector);
-          return;
-        }
-        for (std::uint32_t k = kb; k < ke; ++k) {
-          const std::uint32_t j = sorted[k];
-          Real dx = xi.x() - X[j].x(), dy = xi.y() - X[j].y();
-          per.nearest(dx, dy);
-          const Real r2 = dx * dx + dy * dy;
-          dst[used] = j;  // written always, kept only when inside: no branch
-          used += std::size_t((r2 < R2) & (j != i));
-        }
-      });
-      L.count[i] = std::uint32_t(used - L.start[i]);
+      }
       L.boundaryStart[i] = std::uint32_t(bout.size());
       if (walls && !B.noSamplesNear(xi))  // most particles are far from every wall
         B.sampleGrid.forCandidates(xi, [&](std::uint32_t s) {
