@@ -339,8 +339,18 @@ __attribute__((target("avx2"))) void pairSums8(const StepContext& c, const PairC
     const __m256 irj = _mm256_setr_ps(IR[j[0]], IR[j[1]], IR[j[2]], IR[j[3]], IR[j[4]], IR[j[5]], IR[j[6]], IR[j[7]]);
     const __m256 porj =
         _mm256_setr_ps(POR[j[0]], POR[j[1]], POR[j[2]], POR[j[3]], POR[j[4]], POR[j[5]], POR[j[6]], POR[j[7]]);
-    const __m256 sq = _mm256_sqrt_ps(r2);
-    const __m256 invr = _mm256_div_ps(one, sq);
+    __m256 sq, invr;
+    if (n <= 4) {
+      // A short last group: the square roots and divisions of its four lanes only (the
+      // divider bounds this loop; a lane's result is the same at either width, the upper
+      // lanes are 0 and masked off below).
+      const __m128 sq4 = _mm_sqrt_ps(_mm256_castps256_ps128(r2));
+      sq = _mm256_zextps128_ps256(sq4);
+      invr = _mm256_zextps128_ps256(_mm_div_ps(_mm_set1_ps(Real(1)), sq4));
+    } else {
+      sq = _mm256_sqrt_ps(r2);
+      invr = _mm256_div_ps(one, sq);
+    }
     const __m256 a = _mm256_sub_ps(R8, _mm256_mul_ps(r2, invr));
     const __m256 wp = _mm256_mul_ps(_mm256_mul_ps(_mm256_mul_ps(_mm256_mul_ps(spikyK, a), a), invr),
                                     _mm256_mul_ps(halfMass, _mm256_add_ps(_mm256_mul_ps(pi8, irj), porj)));
