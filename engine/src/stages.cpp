@@ -90,21 +90,25 @@ inline void cellOfPoint(const Grid& g, const Vec2& x, int& cx, int& cy) {
 
 /// Entries of nearInOrder16's staging buffer: a query's candidates, plus one vector's overrun.
 constexpr std::size_t kStageEntries = 512;
+/// Two slots are searched together when the second's cell is at most this many cells right
+/// of the first's in the same row: their rows then share all but this many columns.
+constexpr int kPairShift = 2;
 
 /// The fluid neighbours of slot i among the grid's candidates that are slots themselves
 /// (no periodic axis), appended to out from `used`: nearInOrder sixteen candidates at a
 /// time (AVX-512F, chosen at run time). The same r² per lane as the scalar and SSE2
 /// loops (one IEEE operation a lane, in the same order), so the same lists. Masked loads
 /// and stores: nothing is read past the positions or written past the kept entries.
-/// With Two, slot i + 1 lies in the same cell, so its candidate rows are i's: each row's
-/// candidates are loaded once and tested for both. i + 1's kept slots are stored as whole
+/// With Two, slot i + 1 lies in the same row of cells, `shift` cells right of i's (0: the
+/// same cell), so their candidate rows overlap: each row's candidates are loaded once over
+/// both slots' columns and tested for both. i + 1's kept slots are stored as whole
 /// vectors into a buffer on the stack (the lanes past them are overwritten or dropped) and
 /// follow i's list, which ends at *mid, at the end. `used` becomes the end of the last
 /// list. False, with nothing written, when Two and the rows hold more candidates than the
 /// buffer (a pile-up: the caller then searches for i alone); always true without Two.
 template <bool Two>
-__attribute__((target("avx512f,popcnt"))) bool nearInOrder16(const Grid& g, const Vec2* X, std::size_t i, Real R2,
-                                                             std::vector<std::uint32_t>& out, std::size_t& used,
+__attribute__((target("avx512f,popcnt"))) bool nearInOrder16(const Grid& g, const Vec2* X, std::size_t i, int shift,
+                                                             Real R2, std::vector<std::uint32_t>& out, std::size_t& used,
                                                              std::size_t* mid) {
   const float* xy = reinterpret_cast<const float*>(X);
   const Vec2 xi = X[i], xn = X[i + (Two ? 1 : 0)];
@@ -115,22 +119,30 @@ __attribute__((target("avx512f,popcnt"))) bool nearInOrder16(const Grid& g, cons
   const __m512i iota = _mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
   // Grid::forCandidateRanges without a periodic axis, written out (a lambda would not
   // carry this function's target).
+  // Slot i + 1 is `shift` cells to the right of i in the same row of cells: the rows hold
+  // i's columns x0..x1 and its columns nx0..nx1; each row is read over both, and each slot
+  // keeps only candidates of its own columns (so its list is the one search's exactly).
   int cx, cy;
   cellOfPoint(g, xi, cx, cy);
   const int x0 = std::max(cx - g.reach, 0), x1 = std::min(cx + g.reach, g.nx - 1);
+  const int nx0 = std::max(cx + shift - g.reach, 0), nx1 = std::min(cx + shift + g.reach, g.nx - 1);
   const int y0 = std::max(cy - g.reach, 0), y1 = std::min(cy + g.reach, g.ny - 1);
   if (Two) {
     std::size_t total = 0;
     for (int y = y0; y <= y1; ++y)
-      total += g.cellStart[std::size_t(y) * g.nx + x1 + 1] - g.cellStart[std::size_t(y) * g.nx + x0];
+      total += g.cellStart[std::size_t(y) * g.nx + nx1 + 1] - g.cellStart[std::size_t(y) * g.nx + x0];
     if (total + 16 > kStageEntries) return false;
   }
+  // The first n lanes (n clamped to 0..16).
+  const auto below = [](std::int64_t n) { return n <= 0 ? 0u : n >= 16 ? 0xFFFFu : (1u << n) - 1; };
   alignas(64) std::uint32_t bufN[Two ? kStageEntries : 1];
   std::size_t gotN = 0;
   for (int y = y0; y <= y1; ++y) {
-    const std::uint32_t kb = g.cellStart[std::size_t(y) * g.nx + x0], ke = g.cellStart[std::size_t(y) * g.nx + x1 + 1];
+    const std::size_t row = std::size_t(y) * g.nx;
+    const std::uint32_t kb = g.cellStart[row + x0], ie = g.cellStart[row + x1 + 1];
+    const std::uint32_t nb = Two ? g.cellStart[row + nx0] : kb, ke = Two ? g.cellStart[row + nx1 + 1] : ie;
     if (!(kb < ke)) continue;
-    const std::size_t need = used + (ke - kb) + 3;  // as stageNeighbours reserves for nearInOrder
+    const std::size_t need = used + (ie - kb) + 3;  // as stageNeighbours reserves for nearInOrder
     if (out.size() < need) {
       if (out.capacity() < need) out.reserve(need + need / 8);
       out.resize(need);
@@ -140,6 +152,8 @@ __attribute__((target("avx512f,popcnt"))) bool nearInOrder16(const Grid& g, cons
       // Masks without branches (the row lengths vary: a branch on them mispredicts).
       const std::uint32_t m = std::min<std::uint32_t>(16, ke - k);
       const __mmask16 lanes = __mmask16((1u << m) - 1);
+      const __mmask16 mineI = __mmask16(lanes & below(std::int64_t(ie) - k));   // i's columns
+      const __mmask16 mineN = __mmask16(lanes & ~below(std::int64_t(nb) - k));  // i + 1's columns
       const std::uint64_t floats = (std::uint64_t(1) << (2 * m)) - 1;  // the 2m floats of the m candidates
       const __mmask16 lo = __mmask16(floats & 0xFFFF), hi = __mmask16(floats >> 16);
       const __m512 a = _mm512_maskz_loadu_ps(lo, xy + 2 * std::size_t(k));
@@ -147,19 +161,20 @@ __attribute__((target("avx512f,popcnt"))) bool nearInOrder16(const Grid& g, cons
       const __m512 xs = _mm512_permutex2var_ps(a, evens, b), ys = _mm512_permutex2var_ps(a, odds, b);
       const __m512i ks = _mm512_add_epi32(_mm512_set1_epi32(int(k)), iota);
       // The kept lanes of slot `slot` at (px, py): within R, not the slot itself.
-      const auto keepOf = [&](__m512 px, __m512 py, std::size_t slot) __attribute__((always_inline, target("avx512f"))) {
+      const auto keepOf = [&](__m512 px, __m512 py, std::size_t slot, __mmask16 mine)
+                              __attribute__((always_inline, target("avx512f"))) {
         const __m512 dx = _mm512_sub_ps(px, xs), dy = _mm512_sub_ps(py, ys);
         const __m512 r2 = _mm512_add_ps(_mm512_mul_ps(dx, dx), _mm512_mul_ps(dy, dy));
-        const unsigned keep = unsigned(_mm512_mask_cmp_ps_mask(lanes, r2, r216, _CMP_LT_OQ));
+        const unsigned keep = unsigned(_mm512_mask_cmp_ps_mask(mine, r2, r216, _CMP_LT_OQ));
         const std::size_t self = slot - k;  // wraps around when slot < k
         return keep & ~(unsigned(self < 16) << (self & 15));
       };
-      const unsigned keep = keepOf(xi16, yi16, i);
+      const unsigned keep = keepOf(xi16, yi16, i, mineI);
       const unsigned got = unsigned(__builtin_popcount(keep));
       _mm512_mask_storeu_epi32(dst + used, __mmask16((1u << got) - 1), _mm512_maskz_compress_epi32(__mmask16(keep), ks));
       used += got;
       if (Two) {
-        const unsigned keepN = keepOf(xn16, yn16, i + 1);
+        const unsigned keepN = keepOf(xn16, yn16, i + 1, mineN);
         _mm512_storeu_si512(bufN + gotN, _mm512_maskz_compress_epi32(__mmask16(keepN), ks));
         gotN += unsigned(__builtin_popcount(keepN));
       }
@@ -302,14 +317,15 @@ void stageNeighbours(StepContext& c) {
           cellOfPoint(g, xi, cx, cy);
           if (i + 1 < e) cellOfPoint(g, P.x[i + 1], nx, ny);
           std::size_t mid = 0;
-          if (nx == cx && ny == cy && nearInOrder16<true>(g, P.x.data(), i, R2, out, used, &mid)) {
-            // The same cell: the same candidates, loaded once for both.
+          if (ny == cy && nx >= cx && nx - cx <= kPairShift &&
+              nearInOrder16<true>(g, P.x.data(), i, nx - cx, R2, out, used, &mid)) {
+            // Near in one row of cells: the shared candidates loaded once for both.
             L.count[i] = std::uint32_t(mid - L.start[i]);
             L.start[i + 1] = std::uint32_t(mid);
             L.count[i + 1] = std::uint32_t(used - mid);
             listed = i + 2;
           } else {
-            nearInOrder16<false>(g, P.x.data(), i, R2, out, used, nullptr);  // one slot: always true
+            nearInOrder16<false>(g, P.x.data(), i, 0, R2, out, used, nullptr);  // one slot: always true
             L.count[i] = std::uint32_t(used - L.start[i]);
           }
         } else
