@@ -140,7 +140,7 @@ __attribute__((target("avx512f,popcnt"))) bool nearInOrder16(const Grid& g, cons
   for (int y = y0; y <= y1; ++y) {
     const std::size_t row = std::size_t(y) * g.nx;
     const std::uint32_t kb = g.cellStart[row + x0], ie = g.cellStart[row + x1 + 1];
-    const std::uint32_t nb = Two ? g.cellStart[row + nx0] : kb, ke = Two ? g.cellStart[row + nx1 + 1] : ie;
+    const std::uint32_t nbeg = Two ? g.cellStart[row + nx0] : kb, ke = Two ? g.cellStart[row + nx1 + 1] : ie;
     if (!(kb < ke)) continue;
     const std::size_t need = used + (ie - kb) + 3;  // as stageNeighbours reserves for nearInOrder
     if (out.size() < need) {
@@ -153,7 +153,7 @@ __attribute__((target("avx512f,popcnt"))) bool nearInOrder16(const Grid& g, cons
       const std::uint32_t m = std::min<std::uint32_t>(16, ke - k);
       const __mmask16 lanes = __mmask16((1u << m) - 1);
       const __mmask16 mineI = __mmask16(lanes & below(std::int64_t(ie) - k));   // i's columns
-      const __mmask16 mineN = __mmask16(lanes & ~below(std::int64_t(nb) - k));  // i + 1's columns
+      const __mmask16 mineN = __mmask16(lanes & ~below(std::int64_t(nbeg) - k));  // i + 1's columns
       const std::uint64_t floats = (std::uint64_t(1) << (2 * m)) - 1;  // the 2m floats of the m candidates
       const __mmask16 lo = __mmask16(floats & 0xFFFF), hi = __mmask16(floats >> 16);
       const __m512 a = _mm512_maskz_loadu_ps(lo, xy + 2 * std::size_t(k));

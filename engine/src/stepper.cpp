@@ -10,7 +10,8 @@
 // first set or an effect is switched on or off. One fold: when the first
 // enabled effect is the Laplacian viscosity and the solver computes it in its
 // own pressure-force pair loop (muller2003: one pass over the neighbours
-// instead of two, the same bits), that stage is "pressure_force+viscosity" and
+// instead of two, the same terms; its sums in eight partial sums, the effect's
+// pass in list order, so they differ by rounding), that stage is "pressure_force+viscosity" and
 // the effect has no stage of its own (Solver::foldViscosity).
 //
 // The time-step policy is the World's alone: the solver and the enabled
