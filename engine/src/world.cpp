@@ -93,6 +93,25 @@ void World::Impl::warnLowSoundSpeed() {
   warnings.push_back(o.str());
 }
 
+/// Moving bodies are not wrapped across a periodic seam (Box2D's bodies know no period, and a
+/// particle meets a body's samples and skin only directly, not through the nearest image).
+/// One warning names the scene's first moving body and the seam.
+void World::Impl::warnMovingBodiesInPeriodic() {
+  if (!scene.periodic.any()) return;
+  for (std::size_t k = 0; k < scene.bodies.size(); ++k) {
+    if (scene.bodies[k].type == BodyDef::Type::Static) continue;
+    std::ostringstream o;
+    o << "boundaries[" << k << "] is " << (scene.bodies[k].type == BodyDef::Type::Kinematic ? "kinematic" : "dynamic")
+      << " in a periodic scene: moving bodies do not wrap at the periodic seam (";
+    if (scene.periodic.x) o << "x = " << scene.periodic.min.x() << " and " << scene.periodic.max.x();
+    if (scene.periodic.x && scene.periodic.y) o << "; ";
+    if (scene.periodic.y) o << "y = " << scene.periodic.min.y() << " and " << scene.periodic.max.y();
+    o << "), and water across the seam does not meet them: keep them more than a support radius from it";
+    warnings.push_back(o.str());
+    return;
+  }
+}
+
 void World::init() {
   Impl& w = *impl_;
   // A scene built in code may leave solver parameters out: give them their defaults.
@@ -114,6 +133,7 @@ void World::init() {
   w.budget = scene.effects.budget > 0 ? scene.effects.budget : scene.maxParticles;
   if (scene.effects.lifetime) w.P.field("age");
   w.warnLowSoundSpeed();
+  w.warnMovingBodiesInPeriodic();
 
   // Local frame: the centre of the scene's box, rounded to 64 m, so that
   // scenes far from the origin keep float precision.

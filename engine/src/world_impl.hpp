@@ -213,6 +213,8 @@ struct World::Impl {
   /// Warns once when a weakly compressible solver's sound speed is below 10 × the fastest
   /// speed the scene sets (blocks, emitters, timeline events).
   void warnLowSoundSpeed();
+  /// A warning when the scene has moving bodies and a periodic axis (they do not wrap).
+  void warnMovingBodiesInPeriodic();
   /// The scene key that sets the particle budget.
   const char* budgetKey() const;
   /// The emit stage: every enabled emitter's particles due by the end of the substep.

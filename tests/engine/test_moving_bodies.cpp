@@ -452,6 +452,32 @@ TEST_CASE("moving bodies: a crate built of two overlapping boxes floats as deep 
   CHECK(std::fabs(draught - expected) <= 0.1 * expected);
 }
 
+TEST_CASE("moving bodies: a periodic scene with a moving body loads with one warning naming the body and the seam") {
+  // Moving bodies do not wrap at a periodic seam (docs/SCENES.md, periodic); the user is told.
+  const char* text = R"({"solver": {"quality": "game", "spacing": 0.04}, "periodic": {"x": [0, 2]},
+      "boundaries": [{"fixtures": [{"shape": "box", "center": [1, -0.2], "half_size": [2, 0.2]}]},
+                     {"type": "TYPE", "position": [1, 0.5], "fixtures": [{"shape": "box", "half_size": [0.1, 0.2]TAIL}]}],
+      "fluid": [{"min": [0, 0], "max": [2, 0.4]}]})";
+  auto warningsFor = [&](const std::string& type, const std::string& tail) {
+    std::string t = text;
+    t.replace(t.find("TYPE"), 4, type);
+    t.replace(t.find("TAIL"), 4, tail);
+    World w(parseScene(t, "periodic.json"));
+    std::vector<std::string> seam;
+    for (const std::string& m : w.takeWarnings())
+      if (m.find("periodic seam") != std::string::npos) seam.push_back(m);
+    return seam;
+  };
+  for (const auto& [type, tail] : {std::pair<std::string, std::string>{"kinematic", ""}, {"dynamic", R"(, "density": 500)"}}) {
+    CAPTURE(type);
+    const std::vector<std::string> seam = warningsFor(type, tail);
+    REQUIRE(seam.size() == 1);
+    CHECK(seam[0].find("boundaries[1] is " + type) != std::string::npos);
+    CHECK(seam[0].find("x = 0 and 2") != std::string::npos);
+  }
+  CHECK(warningsFor("static", "").empty());
+}
+
 TEST_CASE("moving bodies: setGravity turns the scene's own b2World's gravity too") {
   World w(crateScene("game", 500, 0.62));
   w.setGravity(Vec2d(-2.0, -9.0));
