@@ -95,7 +95,8 @@ void World::Impl::warnLowSoundSpeed() {
 
 /// Moving bodies are not wrapped across a periodic seam (Box2D's bodies know no period, and a
 /// particle meets a body's samples and skin only directly, not through the nearest image).
-/// One warning names the scene's first moving body and the seam.
+/// One warning names the scene's first moving body and the seam (or, with a game's b2World,
+/// says it has one when the World is built).
 void World::Impl::warnMovingBodiesInPeriodic() {
   if (!scene.periodic.any()) return;
   for (std::size_t k = 0; k < scene.bodies.size(); ++k) {
@@ -110,6 +111,14 @@ void World::Impl::warnMovingBodiesInPeriodic() {
     warnings.push_back(o.str());
     return;
   }
+  if (ownWorld) return;
+  for (const b2Body* b = b2->GetBodyList(); b; b = b->GetNext())  // a game's b2World, as it is now
+    if (b->GetType() != b2_staticBody) {
+      warnings.push_back(std::string("the game's b2World has a ") + (b->GetType() == b2_kinematicBody ? "kinematic" : "dynamic") +
+                         " body and the scene a periodic axis: moving bodies do not wrap at the periodic seam, and "
+                         "water across the seam does not meet them: keep them more than a support radius from it");
+      return;
+    }
 }
 
 void World::init() {

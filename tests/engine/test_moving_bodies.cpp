@@ -476,6 +476,19 @@ TEST_CASE("moving bodies: a periodic scene with a moving body loads with one war
     CHECK(seam[0].find("x = 0 and 2") != std::string::npos);
   }
   CHECK(warningsFor("static", "").empty());
+  // A game's b2World with a kinematic body, the scene periodic with no bodies of its own.
+  b2World game(b2Vec2(0, -9.81f));
+  b2BodyDef bd;
+  bd.type = b2_kinematicBody;
+  bd.position.Set(1, 0.5f);
+  b2PolygonShape box;
+  box.SetAsBox(0.1f, 0.2f);
+  game.CreateBody(&bd)->CreateFixture(&box, 0);
+  World w(parseScene(R"({"solver": {"quality": "game", "spacing": 0.04}, "periodic": {"x": [0, 2]},
+      "fluid": [{"min": [0, 0], "max": [2, 0.4]}]})", "periodic.json"), game);
+  int seam = 0;
+  for (const std::string& m : w.takeWarnings()) seam += m.find("game's b2World has a kinematic body") != std::string::npos;
+  CHECK(seam == 1);
 }
 
 TEST_CASE("moving bodies: setGravity turns the scene's own b2World's gravity too") {
