@@ -142,7 +142,7 @@ TEST_CASE("integration is symplectic Euler (v += a dt, then x += v dt) and moves
   CHECK(stageIntegrate(g.c) == 1);
 }
 
-TEST_CASE("neighbour lists: every path (AVX-512 with two slots of one cell searched together, SSE2, scalar) finds exactly the particles within R, in slot order") {
+TEST_CASE("neighbour lists: every path (AVX-512 with two near slots of one row of cells searched together, SSE2, scalar) finds exactly the particles within R, in slot order") {
   // A lattice, a pile-up too dense for the AVX-512 path's buffer (two slots of one cell there
   // are searched one at a time), and a few isolated particles with no neighbour.
   ParticleStore P;
