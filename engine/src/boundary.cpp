@@ -473,37 +473,44 @@ bool BoundarySet::blocks(const Vec2& a, const Vec2& b) const {
   return false;
 }
 
-bool BoundarySet::resolve(Vec2& x, Vec2& v, const Vec2& xOld, Real clearance) const {
-  if (bnx == 0) return false;
-  // Swept box of the move, grown by the clearance, in bin coordinates.
-  const Vec2 lo = x.cwiseMin(xOld) - Vec2(clearance, clearance);
-  const Vec2 hi = x.cwiseMax(xOld) + Vec2(clearance, clearance);
+std::size_t BoundarySet::collidersMeeting(const Vec2& lo, const Vec2& hi, std::uint32_t* out, std::size_t cap,
+                                          bool& overflow) const {
+  overflow = false;
+  if (bnx == 0) return 0;
+  // The box in bin coordinates.
   const Real fx0 = std::floor((lo.x() - binLo.x()) * invBin), fx1 = std::floor((hi.x() - binLo.x()) * invBin);
   const Real fy0 = std::floor((lo.y() - binLo.y()) * invBin), fy1 = std::floor((hi.y() - binLo.y()) * invBin);
-  if (fx1 < 0 || fy1 < 0 || fx0 > Real(bnx - 1) || fy0 > Real(bny - 1)) return false;
+  if (!(fx0 <= fx1 && fy0 <= fy1)) return 0;  // not finite
+  if (fx1 < 0 || fy1 < 0 || fx0 > Real(bnx - 1) || fy0 > Real(bny - 1)) return 0;
   const int x0 = int(std::max(fx0, Real(0))), x1 = int(std::min(fx1, Real(bnx - 1)));
   const int y0 = int(std::max(fy0, Real(0))), y1 = int(std::min(fy1, Real(bny - 1)));
-
-  std::uint32_t cand[64];
-  int nc = 0;
-  bool overflow = false;
-  for (int y = y0; y <= y1 && !overflow; ++y)
-    for (int xx = x0; xx <= x1 && !overflow; ++xx) {
+  std::size_t n = 0;
+  for (int y = y0; y <= y1; ++y)
+    for (int xx = x0; xx <= x1; ++xx) {
       const std::size_t bin = std::size_t(y) * bnx + xx;
       for (std::uint32_t k = binStart[bin]; k < binStart[bin + 1]; ++k) {
         const std::uint32_t id = binItems[k];
         const Collider& c = colliders[id];
         if (c.hi.x() < lo.x() || c.hi.y() < lo.y() || c.lo.x() > hi.x() || c.lo.y() > hi.y()) continue;
-        bool dup = false;
-        for (int q = 0; q < nc; ++q) dup = dup || cand[q] == id;
-        if (dup) continue;
-        if (nc == 64) {
+        if (std::find(out, out + n, id) != out + n) continue;
+        if (n == cap) {
           overflow = true;
-          break;
+          return n;
         }
-        cand[nc++] = id;
+        out[n++] = id;
       }
     }
+  return n;
+}
+
+bool BoundarySet::resolve(Vec2& x, Vec2& v, const Vec2& xOld, Real clearance) const {
+  // Swept box of the move, grown by the clearance.
+  const Vec2 lo = x.cwiseMin(xOld) - Vec2(clearance, clearance);
+  const Vec2 hi = x.cwiseMax(xOld) + Vec2(clearance, clearance);
+  std::uint32_t cand[64];
+  bool overflow = false;
+  const int nc = int(collidersMeeting(lo, hi, cand, 64, overflow));
+  if (nc == 0) return false;
   std::sort(cand, cand + nc);  // fixed resolution order: collider index
 
   bool contact = false;

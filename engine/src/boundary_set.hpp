@@ -105,34 +105,24 @@ struct BoundarySet {
     return nearMap[std::size_t(ty) * std::size_t(nearNx) + std::size_t(tx)] == 0;
   }
 
-  /// Calls f(k) once for every collider k whose bounding box, grown by `reach`, holds x (the
-  /// bins around x; in bin order, then the bin's order).
+  /// The colliders whose bounding box meets the box [lo, hi], each once, into out[0, cap)
+  /// in bin order (the bins the box covers): returns how many. `overflow` is set when more
+  /// than cap meet it (those are left out). No bin for a non-finite box: 0.
+  std::size_t collidersMeeting(const Vec2& lo, const Vec2& hi, std::uint32_t* out, std::size_t cap, bool& overflow) const;
+  /// Calls f(k) once for every collider k whose bounding box, grown by `reach`, holds x.
   template <class F>
   void forCollidersNear(const Vec2& x, Real reach, F&& f) const {
-    if (bnx == 0) return;
-    // Bin coordinates clamped in double before the cast (a far spray particle, or NaN: no bin).
-    const auto bin = [&](Real v, Real lo, int count) {
-      const double t = std::floor((double(v) - double(lo)) * double(invBin));
-      return t >= 0 ? int(std::min(t, double(count))) : -1;
-    };
-    const int x0 = std::max(0, bin(x.x() - reach, binLo.x(), bnx)), x1 = std::min(bnx - 1, bin(x.x() + reach, binLo.x(), bnx));
-    const int y0 = std::max(0, bin(x.y() - reach, binLo.y(), bny)), y1 = std::min(bny - 1, bin(x.y() + reach, binLo.y(), bny));
-    std::uint32_t seen[16];
-    int ns = 0;
-    for (int y = y0; y <= y1; ++y)
-      for (int xx = x0; xx <= x1; ++xx) {
-        const std::size_t bin = std::size_t(y) * std::size_t(bnx) + std::size_t(xx);
-        for (std::uint32_t q = binStart[bin]; q < binStart[bin + 1]; ++q) {
-          const std::uint32_t k = binItems[q];
-          const Collider& c = colliders[k];
-          if (x.x() < c.lo.x() - reach || x.y() < c.lo.y() - reach || x.x() > c.hi.x() + reach || x.y() > c.hi.y() + reach) continue;
-          bool dup = false;
-          for (int s = 0; s < ns && !dup; ++s) dup = seen[s] == k;
-          if (dup) continue;
-          if (ns < 16) seen[ns++] = k;  // past 16 a collider may be called twice: its repeats are removed later
-          f(k);
-        }
-      }
+    std::uint32_t ids[64];
+    bool overflow = false;
+    const Vec2 lo = x - Vec2(reach, reach), hi = x + Vec2(reach, reach);
+    const std::size_t n = collidersMeeting(lo, hi, ids, 64, overflow);
+    for (std::size_t q = 0; q < n; ++q) f(ids[q]);
+    if (!overflow) return;
+    for (std::uint32_t k = 0; k < colliders.size(); ++k) {  // more than 64 (a dense level): the rest, by a scan
+      const Collider& c = colliders[k];
+      if (c.hi.x() < lo.x() || c.hi.y() < lo.y() || c.lo.x() > hi.x() || c.lo.y() > hi.y()) continue;
+      if (std::find(ids, ids + n, k) == ids + n) f(k);
+    }
   }
   /// Collects every static fixture of `world` as colliders in the frame shifted by −origin,
   /// the bodies in `skip` left out.

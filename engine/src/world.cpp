@@ -99,15 +99,18 @@ void World::Impl::warnLowSoundSpeed() {
 /// says it has one when the World is built).
 void World::Impl::warnMovingBodiesInPeriodic() {
   if (!scene.periodic.any()) return;
+  const char* what =
+      "moving bodies do not wrap at the periodic seam, and water across the seam does not meet them: keep them "
+      "more than a support radius from it";
   for (std::size_t k = 0; k < scene.bodies.size(); ++k) {
     if (scene.bodies[k].type == BodyDef::Type::Static) continue;
     std::ostringstream o;
     o << "boundaries[" << k << "] is " << (scene.bodies[k].type == BodyDef::Type::Kinematic ? "kinematic" : "dynamic")
-      << " in a periodic scene: moving bodies do not wrap at the periodic seam (";
+      << " in a periodic scene (seam at ";
     if (scene.periodic.x) o << "x = " << scene.periodic.min.x() << " and " << scene.periodic.max.x();
     if (scene.periodic.x && scene.periodic.y) o << "; ";
     if (scene.periodic.y) o << "y = " << scene.periodic.min.y() << " and " << scene.periodic.max.y();
-    o << "), and water across the seam does not meet them: keep them more than a support radius from it";
+    o << "): " << what;
     warnings.push_back(o.str());
     return;
   }
@@ -115,8 +118,7 @@ void World::Impl::warnMovingBodiesInPeriodic() {
   for (const b2Body* b = b2->GetBodyList(); b; b = b->GetNext())  // a game's b2World, as it is now
     if (b->GetType() != b2_staticBody) {
       warnings.push_back(std::string("the game's b2World has a ") + (b->GetType() == b2_kinematicBody ? "kinematic" : "dynamic") +
-                         " body and the scene a periodic axis: moving bodies do not wrap at the periodic seam, and "
-                         "water across the seam does not meet them: keep them more than a support radius from it");
+                         " body and the scene a periodic axis: " + what);
       return;
     }
 }
