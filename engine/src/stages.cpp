@@ -243,8 +243,15 @@ bool reorderThisStep(const StepContext& c) {
   return every > 0 && c.step % std::uint64_t(every) == 0;
 }
 
-void permuteParticles(ParticleStore& P, const std::vector<std::uint32_t>& order, Scratch& s, ThreadPool& pool) {
-  P.forEachField([&](const char*, auto& field) { permuteField(field, order, scratchFor(s, field), pool); });
+void permuteParticles(ParticleStore& P, const std::vector<std::uint32_t>& order, Scratch& s, ThreadPool& pool,
+                      unsigned rewritten) {
+  const void* skip[] = {rewritten & kRewritesA ? &P.a : nullptr, rewritten & kRewritesXPrev ? &P.xPrev : nullptr,
+                        rewritten & kRewritesRho ? &P.rho : nullptr, rewritten & kRewritesInvRho ? &P.invRho : nullptr,
+                        rewritten & kRewritesPOverRho ? &P.pOverRho : nullptr};
+  P.forEachField([&](const char*, auto& field) {
+    if (std::find(std::begin(skip), std::end(skip), static_cast<const void*>(&field)) == std::end(skip))
+      permuteField(field, order, scratchFor(s, field), pool);
+  });
 }
 
 void stageWrap(StepContext& c) {
@@ -259,13 +266,13 @@ void stageWrap(StepContext& c) {
   });
 }
 
-void stageGrid(StepContext& c, bool reorder) {
+void stageGrid(StepContext& c, bool reorder, unsigned rewritten) {
   ParticleStore& P = c.P;
   if (c.periodic.any()) stageWrap(c);
   c.grid.build(P.x.data(), P.size(), c.R, c.pool, 2, c.periodic.any() ? &c.periodic : nullptr);
   if (!reorder) return;
   const std::vector<std::uint32_t>& order = c.grid.sorted;
-  permuteParticles(P, order, c.scratch, c.pool);
+  permuteParticles(P, order, c.scratch, c.pool, rewritten);
   // After the permutation slot k is the k-th particle in cell order.
   permuteField(c.grid.cellOf, order, c.scratch.u, c.pool);
   for (std::size_t k = 0; k < c.grid.sorted.size(); ++k) c.grid.sorted[k] = std::uint32_t(k);

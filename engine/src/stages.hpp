@@ -29,9 +29,20 @@ bool scalarPairLoops();
 
 /// True when this substep reorders particle storage along the grid (every solver.reorder_interval substeps).
 bool reorderThisStep(const StepContext& c);
-/// Neighbour grid (counting sort, cells of R/2) and, when `reorder`, every particle array permuted into cell order.
-/// In a periodic scene it first wraps every position into the box (stageWrap).
-void stageGrid(StepContext& c, bool reorder);
+/// Particle fields a solver's substep writes for every particle, after the grid and before
+/// any stage reads them: stageGrid's reordering need not carry their old values.
+enum RewrittenFields : unsigned {
+  kRewritesA = 1u << 0,         ///< a: the pressure force sets it (effects add to it after)
+  kRewritesXPrev = 1u << 1,     ///< xPrev: integrate sets it to x before moving x
+  kRewritesRho = 1u << 2,       ///< rho: the density stage sums it
+  kRewritesInvRho = 1u << 3,    ///< invRho: the pressure stage
+  kRewritesPOverRho = 1u << 4,  ///< pOverRho: the pressure stage
+};
+/// Neighbour grid (counting sort, cells of R/2) and, when `reorder`, every particle array permuted
+/// into cell order but the fields in `rewritten` (RewrittenFields), which keep stale values at
+/// their slots until the substep writes them. In a periodic scene it first wraps every position
+/// into the box (stageWrap).
+void stageGrid(StepContext& c, bool reorder, unsigned rewritten = 0);
 /// Moves particles that left the periodic box to their image inside it (x and
 /// xPrev shift together, so the swept collision sees the true move). Reads and writes x, xPrev.
 void stageWrap(StepContext& c);
@@ -87,7 +98,9 @@ void columnDepths(const StepContext& c, std::vector<Real>& top, F f) {
   for (std::size_t i = 0; i < P.size(); ++i) f(i, top[strip(P.x[i])] - up.dot(P.x[i]));
 }
 
-/// Permutes every particle field into `order` (slot k takes old slot order[k]).
-void permuteParticles(ParticleStore& P, const std::vector<std::uint32_t>& order, Scratch& s, ThreadPool& pool);
+/// Permutes every particle field into `order` (slot k takes old slot order[k]), but the
+/// fields in `rewritten` (RewrittenFields), which are left as they are.
+void permuteParticles(ParticleStore& P, const std::vector<std::uint32_t>& order, Scratch& s, ThreadPool& pool,
+                      unsigned rewritten = 0);
 
 }  // namespace sph2d

@@ -32,7 +32,10 @@ void limitStepByForce(StepContext& c) {
 }  // namespace
 
 std::vector<Stage> explicitStages(Stage::Fn density, std::function<void(StepContext&)> pressure, Stage::Fn pressureForce) {
-  return {plainStage("grid", [](StepContext& c) { stageGrid(c, reorderThisStep(c)); }),
+  // Density, pressure, the pressure force and integrate write these for every particle before
+  // anything reads them (p stays: a bad density reports each particle's last pressure).
+  constexpr unsigned kRewritten = kRewritesRho | kRewritesInvRho | kRewritesPOverRho | kRewritesA | kRewritesXPrev;
+  return {plainStage("grid", [](StepContext& c) { stageGrid(c, reorderThisStep(c), kRewritten); }),
           plainStage("neighbours", [](StepContext& c) { stageNeighbours(c); }),
           Stage{"density", std::move(density)},
           plainStage("pressure", std::move(pressure)),
