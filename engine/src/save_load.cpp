@@ -31,7 +31,9 @@ namespace {
 
 constexpr char kMagic[8] = {'S', 'P', 'H', '2', 'D', 'S', 'A', 'V'};
 constexpr std::uint64_t kMaxEmitters = World::Impl::kMaxEmitters;  // a save holding more is not one of ours
-constexpr std::uint32_t kVersion = 3;  // 2: every emitter's whole definition (emitters added at run time); 3: bodies' swept poses
+// 2: every emitter's whole definition (emitters added at run time); 3: bodies' swept poses;
+// 4: the swept poses of a game's b2World's bodies too.
+constexpr std::uint32_t kVersion = 4;
 constexpr std::size_t kMaxFields = 64, kMaxName = 128;
 constexpr const char* kUserForce = "user_force";  ///< the effect setUserForces adds
 
@@ -117,18 +119,24 @@ void World::save(std::ostream& out) const {
     o.put(std::uint32_t(sizeof(f[0])));
     o.putBytes(f.data(), f.size() * sizeof(f[0]));
   });
-  // The scene's own moving bodies (a game saves its own b2World).
+  // The moving bodies of the b2World the fluid meets, in its body list's order: the scene's
+  // own with their pose and velocity; a game's without (the game saves its own b2World and
+  // rebuilds it with its bodies in the same order), but with where the particles last saw
+  // them, which the World holds.
   std::uint64_t bodies = 0;
-  if (w.ownWorld)
-    for (b2Body* b = w.ownWorld->GetBodyList(); b; b = b->GetNext()) bodies += b->GetType() != b2_staticBody;
+  if (w.b2)
+    for (b2Body* b = w.b2->GetBodyList(); b; b = b->GetNext()) bodies += b->GetType() != b2_staticBody;
   o.put(bodies);
-  if (w.ownWorld)
-    for (b2Body* b = w.ownWorld->GetBodyList(); b; b = b->GetNext()) {
+  o.put(std::uint8_t(w.ownWorld != nullptr));
+  if (w.b2)
+    for (b2Body* b = w.b2->GetBodyList(); b; b = b->GetNext()) {
       if (b->GetType() == b2_staticBody) continue;
-      o.put(b->GetPosition());
-      o.put(b->GetAngle());
-      o.put(b->GetLinearVelocity());
-      o.put(b->GetAngularVelocity());
+      if (w.ownWorld) {
+        o.put(b->GetPosition());
+        o.put(b->GetAngle());
+        o.put(b->GetLinearVelocity());
+        o.put(b->GetAngularVelocity());
+      }
       // The pose the particles last saw a dynamic body at (moving_solid.hpp), if any.
       const MovingSolids::LastPose* last = nullptr;
       for (const MovingSolids::LastPose& l : w.moving.last)
@@ -248,23 +256,31 @@ void World::load(std::istream& input) {
   if (std::adjacent_find(ids.begin(), ids.end()) != ids.end() || (!ids.empty() && ids.back() >= nextId))
     throw SaveError("the saved state is malformed: particle ids repeat or reach the next id");
   std::vector<b2Body*> movable;
-  if (w.ownWorld)
-    for (b2Body* b = w.ownWorld->GetBodyList(); b; b = b->GetNext())
+  if (w.b2)
+    for (b2Body* b = w.b2->GetBodyList(); b; b = b->GetNext())
       if (b->GetType() != b2_staticBody) movable.push_back(b);
-  if (in.get<std::uint64_t>("the bodies") != movable.size())
-    throw SaveError("the saved state is malformed: its moving bodies are not the scene's " + std::to_string(movable.size()));
+  const std::uint64_t savedBodies = in.get<std::uint64_t>("the bodies");
+  const std::uint8_t savedOwn = in.get<std::uint8_t>("the bodies");
+  if (savedOwn != std::uint8_t(w.ownWorld != nullptr))
+    throw SaveError(savedOwn ? "the saved state holds the scene's own bodies, but this World meets a game's b2World"
+                             : "the saved state was taken with a game's b2World, but this World has the scene's own");
+  if (savedBodies != movable.size())
+    throw SaveError("the saved state has " + std::to_string(savedBodies) + " moving bodies, but " +
+                    (w.ownWorld ? "the scene has " : "the game's b2World has ") + std::to_string(movable.size()));
   struct BodyState {
-    b2Vec2 p, v;
-    float angle, omega;
-    std::uint8_t hasLast;
-    double lastTheta, lastX, lastY;
+    b2Vec2 p = b2Vec2(0, 0), v = b2Vec2(0, 0);  // a game's bodies: not in the save
+    float angle = 0, omega = 0;
+    std::uint8_t hasLast = 0;
+    double lastTheta = 0, lastX = 0, lastY = 0;
   };
   std::vector<BodyState> bodyStates(movable.size());
   for (BodyState& b : bodyStates) {
-    b.p = in.get<b2Vec2>("a body");
-    b.angle = in.get<float>("a body");
-    b.v = in.get<b2Vec2>("a body");
-    b.omega = in.get<float>("a body");
+    if (savedOwn) {
+      b.p = in.get<b2Vec2>("a body");
+      b.angle = in.get<float>("a body");
+      b.v = in.get<b2Vec2>("a body");
+      b.omega = in.get<float>("a body");
+    }
     b.hasLast = in.get<std::uint8_t>("a body");
     b.lastTheta = in.get<double>("a body");
     b.lastX = in.get<double>("a body");
@@ -306,7 +322,7 @@ void World::load(std::istream& input) {
   }
   for (auto& e : w.P.extraU32)  // integer fields the save lacks: none set at the time of the save
     if (!find(e.first)) e.second.assign(static_cast<std::size_t>(n), 0u);
-  for (std::size_t k = 0; k < movable.size(); ++k) {
+  for (std::size_t k = 0; k < movable.size() && savedOwn; ++k) {
     movable[k]->SetTransform(bodyStates[k].p, bodyStates[k].angle);
     movable[k]->SetLinearVelocity(bodyStates[k].v);
     movable[k]->SetAngularVelocity(bodyStates[k].omega);
