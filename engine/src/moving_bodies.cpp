@@ -38,7 +38,11 @@
 //    the fluid's step has no contact between them), it goes only onto the body's surface,
 //    or, where that is inside the static solid too, stays where the static collision put it
 //    and is squeezed out along the body's face a spacing a substep: never into a static
-//    solid, at worst for a few frames within a landing body. Against a kinematic body the
+//    solid, at worst for a few frames within a landing body. Skins that overlap (a crate
+//    resting on another, two fixtures of one body) can leave a particle pushed out of a
+//    later body inside an earlier one: it is put on that one's surface again, or, where
+//    that is inside another body too (the overlap has no point outside both), squeezed
+//    along the face a spacing a substep. Against a kinematic body the
 //    part of its velocity into the body, relative to the body's velocity there, is
 //    removed. Against a dynamic
 //    body the two meet as an inelastic contact: the particle (mass m) and the body
@@ -423,8 +427,49 @@ void World::Impl::collideMoving(StepContext& c, bool atStart) {
   }
   // Body frame from the local frame: rotate by −θ about the body origin.
   auto toBody = [](double co, double si, const Vec2d& p) { return Vec2d(co * p.x() + si * p.y(), -si * p.x() + co * p.y()); };
+  // A particle body k has just put at x (local) with world normal n: a dynamic body's contact
+  // is solved below with its other contacts; a kinematic one carries the particle along.
+  auto settle = [&](std::size_t i, std::size_t k, const Vec2d& x, const Vec2d& n) {
+    const MovingSolid& m = bodies[k];
+    if (m.dynamic()) {
+      hitBody[i] = std::int32_t(k);
+      hitNormal[i] = n;
+      return;
+    }
+    const Vec2d r = x - poses[k].com1, vb = m.v + m.omega * Vec2d(-r.y(), r.x());
+    Vec2d v(c.P.v[i].x(), c.P.v[i].y());
+    const double vn = (v - vb).dot(n);
+    if (vn < 0) v -= vn * n;  // no velocity into the body
+    c.P.v[i] = Vec2(Real(v.x()), Real(v.y()));
+  };
+  // The first body whose shapes contain local point x at the substep's end (deeper than a
+  // micrometre: a point put on a surface stays on it), with the shape, x in its frame, the
+  // face's depth (negative) and outward normal there.
+  struct Inside {
+    std::size_t k;
+    const Collider* shape;
+    Vec2d at, n;
+    double d;
+  };
+  auto insideAny = [&](const Vec2d& x, Inside& in) {
+    for (std::size_t k = 0; k < bodies.size(); ++k) {
+      const Pose& q = poses[k];
+      if ((x - q.com1).squaredNorm() > q.reach2) continue;
+      const Vec2d at = toBody(q.c1, q.s1, x - q.o1);
+      for (const Collider& s : bodies[k].shapes) {
+        Vec2d n;
+        const double d = outsideCollider(s, at, at, n);
+        if (d < -1e-6) {
+          in = Inside{k, &s, at, n, d};
+          return true;
+        }
+      }
+    }
+    return false;
+  };
   c.pool.parallelFor(c.P.size(), kStreamBlock, [&](std::size_t b0, std::size_t e0) {
     for (std::size_t i = b0; i < e0; ++i) {
+      bool moved = false;
       for (std::size_t k = 0; k < bodies.size(); ++k) {
         const MovingSolid& m = bodies[k];
         const Pose& q = poses[k];
@@ -508,17 +553,32 @@ void World::Impl::collideMoving(StepContext& c, bool atStart) {
         }
         const Vec2d n(q.c1 * nb.x() - q.s1 * nb.y(), q.s1 * nb.x() + q.c1 * nb.y());
         c.P.x[i] = Vec2(Real(x.x()), Real(x.y()));
-        if (m.dynamic()) {  // the contact is solved below, with the body's other contacts
-          hitBody[i] = std::int32_t(k);
-          hitNormal[i] = n;
-          continue;
-        }
-        const Vec2d r = x - q.com1, vb = m.v + m.omega * Vec2d(-r.y(), r.x());
-        Vec2d v(c.P.v[i].x(), c.P.v[i].y());
-        const double vn = (v - vb).dot(n);
-        if (vn < 0) v -= vn * n;  // no velocity into the body: it carries the particle along
-        c.P.v[i] = Vec2(Real(v.x()), Real(v.y()));
+        settle(i, k, x, n);
+        moved = true;
       }
+      // Skins that overlap: a crate resting on another (Box2D keeps their cores about 1.5 cm
+      // apart, the game solver's skins are 1 cm each), or two fixtures of one body. A later
+      // body's push can end inside one handled before it. Put on that body's surface once
+      // more; where that is inside another body too, the particle is in the overlap, where no
+      // point is outside both: it is squeezed along the face, one spacing a substep towards
+      // the face's nearer end, where the gap opens (as beside a static solid above).
+      Inside in;
+      const Vec2 from = c.P.x[i];
+      if (!moved || !insideAny(Vec2d(from.x(), from.y()), in)) continue;
+      const Pose& q = poses[in.k];
+      auto toLocal = [&](const Vec2d& p) { return q.o1 + Vec2d(q.c1 * p.x() - q.s1 * p.y(), q.s1 * p.x() + q.c1 * p.y()); };
+      auto turn = [&](const Vec2d& p) { return Vec2d(q.c1 * p.x() - q.s1 * p.y(), q.s1 * p.x() + q.c1 * p.y()); };
+      Vec2d x = toLocal(in.at + (clearance - in.d) * in.n);
+      Inside other;
+      if (insideAny(x, other)) {
+        Vec2d way;
+        if (!squeezeDirection(*in.shape, in.at, way)) continue;
+        x = Vec2d(from.x(), from.y()) + double(c.dx) * turn(way);
+      }
+      const Vec2 to(Real(x.x()), Real(x.y()));
+      if (!c.boundary.clearOf(to, from, 0) && c.boundary.blocks(from, to)) continue;  // never into a static solid
+      c.P.x[i] = to;
+      settle(i, in.k, x, turn(in.n));
     }
   });
   for (std::size_t k = 0; k < bodies.size(); ++k) {
