@@ -318,6 +318,30 @@ TEST_CASE("particle access: the b2Vec2 overloads do what the Vec2d calls do, and
   CHECK(b.particlesInBox(b2Vec2(0.0f, 0.0f), b2Vec2(0.1875f, 0.1875f)) == a.particlesInBox({0.0, 0.0}, {0.1875, 0.1875}));
   CHECK(b.sampleAt(b2Vec2(0.125f, 0.125f)).density == a.sampleAt({0.125, 0.125}).density);
   CHECK(b.particlesInRadius(b2Vec2(0.125f, 0.1875f), 0.1).size() > 10);
+  // The bulk calls, the box removal and the shape fill.
+  const std::vector<std::uint32_t> ids = {a.particles().id[5], a.particles().id[6], 999999};
+  a.setVelocities(ids, std::vector<Vec2d>{{0.5, 0.25}, {-0.5, 0.0}, {0.0, 0.0}});
+  CHECK(b.setVelocities(ids, std::vector<b2Vec2>{b2Vec2(0.5f, 0.25f), b2Vec2(-0.5f, 0.0f), b2Vec2(0.0f, 0.0f)}) == 2);
+  a.setPositions(ids, std::vector<Vec2d>{{0.75, 0.5}, {0.75, 0.5625}, {0.0, 0.0}});
+  CHECK(b.setPositions(ids, std::vector<b2Vec2>{b2Vec2(0.75f, 0.5f), b2Vec2(0.75f, 0.5625f), b2Vec2(0.0f, 0.0f)}) == 2);
+  CHECK(b.removeParticlesInBox(b2Vec2(0.0f, 0.0f), b2Vec2(0.125f, 0.125f)) ==
+        a.removeParticlesInBox({0.0, 0.0}, {0.125, 0.125}));
+  CHECK(a.removedCount() > 0);
+  b2CircleShape disc;
+  disc.m_radius = 0.0625f;
+  b2Transform at;
+  at.Set(b2Vec2(0.75f, 0.25f), 0.0f);
+  CHECK(b.addShape(disc, at, b2Vec2(0.0f, -0.5f)) == a.addShape(disc, at, {0.0, -0.5}));
+  a.stepFrame();
+  b.stepFrame();
+  CHECK(a.stateHash() == b.stateHash());
+  std::vector<Vec2d> pa2, va2;
+  std::vector<b2Vec2> pb2, vb2;
+  CHECK(b.getParticles(ids, pb2, vb2) == a.getParticles(ids, pa2, va2));
+  REQUIRE(pb2.size() == 3);
+  CHECK(pb2[0].x == float(pa2[0].x()));
+  CHECK(vb2[1].y == float(va2[1].y()));
+  CHECK(std::isnan(pb2[2].x));
 }
 
 TEST_CASE("particles(): views of the World own arrays, colour and user data appear once set, a ParticleBuffer copy keeps a frame") {

@@ -433,10 +433,7 @@ class World {
   /// addParticles at b2Vec2 points (velocities empty: at rest).
   template <class B2, IfB2<B2> = 0>
   std::vector<std::uint32_t> addParticles(const std::vector<B2>& points, const std::vector<B2>& velocities) {
-    std::vector<Vec2d> p, v;
-    for (const B2& q : points) p.emplace_back(q.x, q.y);
-    for (const B2& q : velocities) v.emplace_back(q.x, q.y);
-    return addParticles(p, v);
+    return addParticles(toVec2d(points), toVec2d(velocities));
   }
   /// particlesInRadius about a b2Vec2.
   template <class B2, IfB2<B2> = 0>
@@ -456,10 +453,51 @@ class World {
   void moveEmitter(std::size_t index, const B2& position, const B2& direction) {
     moveEmitter(index, Vec2d(position.x, position.y), Vec2d(direction.x, direction.y));
   }
+  /// removeParticlesInBox between b2Vec2 corners.
+  template <class B2, IfB2<B2> = 0>
+  std::size_t removeParticlesInBox(const B2& lo, const B2& hi) {
+    return removeParticlesInBox(Vec2d(lo.x, lo.y), Vec2d(hi.x, hi.y));
+  }
+  /// addShape moving at a b2Vec2 velocity.
+  template <class B2, IfB2<B2> = 0>
+  std::size_t addShape(const b2Shape& shape, const b2Transform& xf, const B2& velocity) {
+    return addShape(shape, xf, Vec2d(velocity.x, velocity.y));
+  }
+  /// setVelocities from b2Vec2s.
+  template <class B2, IfB2<B2> = 0>
+  std::size_t setVelocities(const std::vector<std::uint32_t>& ids, const std::vector<B2>& velocities) {
+    return setVelocities(ids, toVec2d(velocities));
+  }
+  /// setPositions from b2Vec2s (world coordinates).
+  template <class B2, IfB2<B2> = 0>
+  std::size_t setPositions(const std::vector<std::uint32_t>& ids, const std::vector<B2>& positions) {
+    return setPositions(ids, toVec2d(positions));
+  }
+  /// getParticles into b2Vec2s (world coordinates; an id no particle has gets NaN in both).
+  template <class B2, IfB2<B2> = 0>
+  std::size_t getParticles(const std::vector<std::uint32_t>& ids, std::vector<B2>& positions,
+                           std::vector<B2>& velocities) const {
+    std::vector<Vec2d> p, v;
+    const std::size_t found = getParticles(ids, p, v);
+    positions.resize(p.size());
+    velocities.resize(v.size());
+    for (std::size_t k = 0; k < p.size(); ++k) {
+      positions[k].Set(float(p[k].x()), float(p[k].y()));
+      velocities[k].Set(float(v[k].x()), float(v[k].y()));
+    }
+    return found;
+  }
 
   struct Impl;
 
  private:
+  template <class B2>
+  static std::vector<Vec2d> toVec2d(const std::vector<B2>& in) {
+    std::vector<Vec2d> out;
+    out.reserve(in.size());
+    for (const B2& q : in) out.emplace_back(q.x, q.y);
+    return out;
+  }
   void init();
   std::unique_ptr<Impl> impl_;
 };
