@@ -5,7 +5,7 @@
 // context: an OSMesa 3.3 core context the game makes itself (a window library's context in a
 // real game), its own framebuffer, split screen: the liquid view on the left, the team colours
 // on the right (sph2d::Renderer(sph2d::currentGlContext, ...).draw()).
-// Prints what it measured; exits 0 only when the crate floats, the reload steps on to the
+// Prints what it measured; exits 0 only when the crate floats, the paddle stirs the water, the reload steps on to the
 // uninterrupted World's state hash, both views show what they should and the game's GL state
 // is as it left it. Writes the game's framebuffer to OUT.png.
 #define GL_GLEXT_PROTOTYPES 1
@@ -127,6 +127,12 @@ int main(int argc, char** argv) {
   const b2Body* crate = crateOf(reloaded);
   const double crateY = crate ? double(crate->GetPosition().y) : -1;
   const bool afloat = crateY > 0.3;  // resting on the floor it would be at 0.08 m
+  // The paddle (turning about (0.45, 0.25) m, its tips at 0.45 m/s) stirs the water around it.
+  double stirred = 0;
+  const std::vector<std::size_t> around = reloaded.particlesInRadius(b2Vec2(0.45f, 0.25f), 0.2);
+  for (const std::size_t i : around) stirred += double(reloaded.particles().v[i].norm());
+  stirred = around.empty() ? 0 : stirred / double(around.size());
+  const bool pushed = around.size() > 50 && stirred > 0.1;
   std::size_t dyed = 0;  // the colours came back with the save
   for (std::size_t i = 0; i < reloaded.particleCount(); ++i) {
     const std::uint32_t id = reloaded.particles().id[i];
@@ -201,12 +207,14 @@ int main(int argc, char** argv) {
   std::printf("consumer: %zu particles, state %s, water %.1f %% of the liquid view (%dx%d)\n",
               reloaded.particleCount(), sph2d::hex64(reloaded.stateHash()).c_str(), 100.0 * waterShare, kViewW, kViewH);
   std::printf("consumer: crate at y = %.3f m after %d frames: %s\n", crateY, kFrames, afloat ? "afloat" : "NOT afloat");
+  std::printf("consumer: the paddle stirs the %zu particles within 0.2 m of its axis at a mean %.3f m/s: %s\n",
+              around.size(), stirred, pushed ? "pushed" : "NOT pushed");
   std::printf("consumer: saved at frame %d and reloaded: state %s the uninterrupted World's; %zu of %zu particles keep their team colour\n",
               kSaveAt, sameState ? "equal to" : "DIFFERENT from", dyed, reloaded.particleCount());
   std::printf("consumer: drawn into the game's own context (%s): team pixels red %zu, yellow %zu; game state %s\n",
               renderer.c_str(), red, yellow, stateKept ? "kept" : "CHANGED");
   std::printf("consumer: %.2f s\n", seconds);
-  const bool ok = afloat && sameState && dyed == reloaded.particleCount() && waterShare > 0.1 && red > 100 &&
+  const bool ok = afloat && pushed && sameState && dyed == reloaded.particleCount() && waterShare > 0.1 && red > 100 &&
                   yellow > 100 && stateKept;
   return ok ? 0 : 1;
 }
