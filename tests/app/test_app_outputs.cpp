@@ -395,6 +395,45 @@ TEST_CASE("--export csv writes bodies_NNNNN.csv with each kinematic body's pose 
   CHECK(b[1][6] == doctest::Approx(2.0));
 }
 
+TEST_CASE("--export csv writes the dynamic crates of floating_crates.json too, each row's velocity that of its x, y") {
+  // Every frame kept: a row's (vx, vy) is the velocity of the point (x, y) (the body origin),
+  // so it matches the origin's move over the frame (Box2D moves a body by its new velocity:
+  // x(n+1) = x(n) + dt v(n+1), the rotation's part included up to its second order).
+  const std::string dir = freshDir("export_crates");
+  REQUIRE(run("run " + q(asset("scenes/floating_crates.json")) + " --frames 40 --quiet --export csv --out " + q(dir)).code == 0);
+  auto rows = [&](int frame) {
+    char name[32];
+    std::snprintf(name, sizeof name, "bodies_%05d.csv", frame);
+    std::vector<std::vector<double>> out;
+    std::istringstream in(readText(dir + "/" + name));
+    std::string line;
+    std::getline(in, line);
+    std::getline(in, line);
+    while (std::getline(in, line)) {
+      std::vector<double> r;
+      std::istringstream cells(line);
+      std::string c;
+      while (std::getline(cells, c, ',')) r.push_back(std::stod(c));
+      out.push_back(r);
+    }
+    return out;
+  };
+  const auto a = rows(38), b = rows(39);
+  REQUIRE(a.size() == 5);  // the turning bar and four crates, boundaries[1..5]
+  REQUIRE(b.size() == 5);
+  const double dt = 1.0 / 60;
+  int checked = 0;
+  for (std::size_t k = 0; k < b.size(); ++k) {
+    INFO("body " << b[k][0]);
+    CHECK(b[k][0] == double(k + 1));
+    const double vx = (b[k][1] - a[k][1]) / dt, vy = (b[k][2] - a[k][2]) / dt;
+    CHECK(std::abs(vx - b[k][4]) < 0.01 + 0.02 * std::abs(b[k][4]));
+    CHECK(std::abs(vy - b[k][5]) < 0.01 + 0.02 * std::abs(b[k][5]));
+    checked += std::abs(b[k][4]) + std::abs(b[k][5]) > 0.01;
+  }
+  CHECK(checked >= 3);  // most bodies are moving at 0.65 s
+}
+
 TEST_CASE("--export csv and vtk write each kept frame's particles in id order, world coordinates") {
   const std::string dir = freshDir("export_csv"), vdir = freshDir("export_vtk"), adir = freshDir("export_vtka");
   REQUIRE(run("run " + q(kSmall) + " --frames 5 --every 4 --quiet --export csv --out " + q(dir)).code == 0);

@@ -78,7 +78,9 @@ ParticleSnapshot snapshotOf(const World& world, const Real* age) {
   for (std::size_t k = 0; k < bodies.size(); ++k) {
     const b2Body* b = bodies[k];
     if (b->GetType() == b2_staticBody) continue;
-    const b2Vec2 p = b->GetPosition(), v = b->GetLinearVelocity();
+    // The origin's own velocity (Box2D's linear velocity is its centre of mass's): the row's
+    // x, y and vx, vy are one point's position and velocity.
+    const b2Vec2 p = b->GetPosition(), v = b->GetLinearVelocityFromWorldPoint(p);
     s.bodies.push_back(BodySnapshot{int(k), p.x, p.y, b->GetAngle(), v.x, v.y, b->GetAngularVelocity()});
   }
   return s;

@@ -26,7 +26,7 @@ class World;
 struct BodySnapshot {
   int body = 0;                   ///< its index among all bodies of the b2World in creation order (a scene's: boundaries[] index)
   double x = 0, y = 0, angle = 0; ///< the body origin [m] and angle [rad]
-  double vx = 0, vy = 0, omega = 0;  ///< velocity of its centre of mass [m/s], angular velocity [rad/s]
+  double vx = 0, vy = 0, omega = 0;  ///< velocity of its origin [m/s] (of x, y), angular velocity [rad/s]
 };
 
 struct ParticleSnapshot {
