@@ -36,7 +36,7 @@ std::size_t insideMoving(const World& w, double floorBand = -1e300) { return tes
 }  // namespace
 
 TEST_CASE("moving bodies: a kinematic paddle at 1 m/s pushes the water ahead of it and is never entered") {
-  for (const char* solver : {"game", "wcsph"}) {
+  for (const char* solver : {"game", "wcsph", "muller2003", "pbf", "dfsph"}) {
     INFO(solver);
     World w(paddleScene(solver), WorldOptions{2});
     REQUIRE(w.movingColliders().size() == 1);
@@ -251,65 +251,74 @@ TEST_CASE("moving bodies: water thrown at a free crate in zero gravity keeps the
   }
 }
 
-TEST_CASE("moving bodies: a 50 m/s jet against a game's dynamic box never passes through it") {
-  // The game's own b2World: a 2 m × 1 m tank and a 0.1 m × 0.4 m box of density 3000 on its
-  // floor (upright: fixed rotation, so that "through it" stays well defined while the jet
-  // shoves it along). The box is thinner than a jet particle's move in a substep.
-  b2World level(b2Vec2(0, -9.81f));
-  b2BodyDef wallsDef;
-  b2Body* walls = level.CreateBody(&wallsDef);
-  for (const auto& [c, h] : {std::pair<b2Vec2, b2Vec2>{{1.0f, -0.1f}, {1.2f, 0.1f}}, {{1.0f, 1.1f}, {1.2f, 0.1f}},
-                             {{-0.1f, 0.5f}, {0.1f, 0.7f}}, {{2.1f, 0.5f}, {0.1f, 0.7f}}}) {
-    b2PolygonShape box;
-    box.SetAsBox(h.x, h.y, c, 0);
-    walls->CreateFixture(&box, 0);
-  }
-  b2BodyDef boxDef;
-  boxDef.type = b2_dynamicBody;
-  boxDef.fixedRotation = true;
-  boxDef.position.Set(1.2f, 0.2f);
-  b2Body* box = level.CreateBody(&boxDef);
-  b2PolygonShape shape;
-  shape.SetAsBox(0.05f, 0.2f);
-  box->CreateFixture(&shape, 3000.0f);
-  SceneDef s;
-  s.solver = solverDefaults("game");
-  s.solver.spacing = 0.02;
-  EmitterDef jet;
-  jet.position = Vec2d(0.1, 0.2);
-  jet.direction = Vec2d(1, 0);
-  jet.speed = 50;
-  jet.rate = 1000;
-  jet.stop = 0.3;
-  s.effects.emitters.push_back(jet);
-  World w(s, level, WorldOptions{2});
-  std::size_t entered = 0, crossed = 0;
-  std::map<std::uint32_t, Vec2d> last;  // each particle's position at the last frame
-  double frontPrev = 1.15;
-  for (int f = 0; f < 30; ++f) {
-    w.stepFrame();
-    level.Step(1.0f / 60, 8, 3);
-    entered = std::max(entered, insideMoving(w));
-    const double front = double(box->GetPosition().x) - 0.05, back = double(box->GetPosition().x) + 0.05;
-    // Through the box: in front of it at the last frame, behind it now, and low enough both
-    // times (under its top by 0.1 m) that the way over it is longer than a frame allows. Not
-    // under it: Box2D rests a polygon on its skin (b2_polygonRadius, 1 cm) over the floor,
-    // and a particle on the floor may pass that gap.
-    for (std::size_t i = 0; i < w.particleCount(); ++i) {
-      const Vec2d x = w.worldPosition(i);
-      const auto it = last.find(w.particles().id[i]);
-      auto through = [](double y) { return y > 0.03 && y < 0.3; };
-      if (it != last.end() && it->second.x() < frontPrev && x.x() > back && through(it->second.y()) && through(x.y())) ++crossed;
-      last[w.particles().id[i]] = x;
+TEST_CASE("moving bodies: a 50 m/s jet against a game's dynamic box never passes through it, every solver but muller2003") {
+  // muller2003 is not in the list: it fails this test (found 25 Nov, not yet fixed). When the jet
+  // has shoved the box against the far wall (frame 7), 11 particles end in the 1.4 cm gap Box2D
+  // leaves between the box and the wall (muller2003 meets the box at its core, without the
+  // skin). The likely cause, not yet confirmed: within the frame the box's predicted path runs
+  // into the wall, and when the game's Box2D step stops it there, the particles it had pushed
+  // are behind it.
+  for (const char* solver : {"game", "wcsph", "pbf", "dfsph"}) {
+    INFO(solver);
+    // The game's own b2World: a 2 m × 1 m tank and a 0.1 m × 0.4 m box of density 3000 on its
+    // floor (upright: fixed rotation, so that "through it" stays well defined while the jet
+    // shoves it along). The box is thinner than a jet particle's move in a substep.
+    b2World level(b2Vec2(0, -9.81f));
+    b2BodyDef wallsDef;
+    b2Body* walls = level.CreateBody(&wallsDef);
+    for (const auto& [c, h] : {std::pair<b2Vec2, b2Vec2>{{1.0f, -0.1f}, {1.2f, 0.1f}}, {{1.0f, 1.1f}, {1.2f, 0.1f}},
+                               {{-0.1f, 0.5f}, {0.1f, 0.7f}}, {{2.1f, 0.5f}, {0.1f, 0.7f}}}) {
+      b2PolygonShape box;
+      box.SetAsBox(h.x, h.y, c, 0);
+      walls->CreateFixture(&box, 0);
     }
-    frontPrev = front;
+    b2BodyDef boxDef;
+    boxDef.type = b2_dynamicBody;
+    boxDef.fixedRotation = true;
+    boxDef.position.Set(1.2f, 0.2f);
+    b2Body* box = level.CreateBody(&boxDef);
+    b2PolygonShape shape;
+    shape.SetAsBox(0.05f, 0.2f);
+    box->CreateFixture(&shape, 3000.0f);
+    SceneDef s;
+    s.solver = solverDefaults(solver);
+    s.solver.spacing = 0.02;
+    EmitterDef jet;
+    jet.position = Vec2d(0.1, 0.2);
+    jet.direction = Vec2d(1, 0);
+    jet.speed = 50;
+    jet.rate = 1000;
+    jet.stop = 0.3;
+    s.effects.emitters.push_back(jet);
+    World w(s, level, WorldOptions{2});
+    std::size_t entered = 0, crossed = 0;
+    std::map<std::uint32_t, Vec2d> last;  // each particle's position at the last frame
+    double frontPrev = 1.15;
+    for (int f = 0; f < 30; ++f) {
+      w.stepFrame();
+      level.Step(1.0f / 60, 8, 3);
+      entered = std::max(entered, insideMoving(w));
+      const double front = double(box->GetPosition().x) - 0.05, back = double(box->GetPosition().x) + 0.05;
+      // Through the box: in front of it at the last frame, behind it now, and low enough both
+      // times (under its top by 0.1 m) that the way over it is longer than a frame allows. Not
+      // under it: Box2D rests a polygon on its skin (b2_polygonRadius, 1 cm) over the floor,
+      // and a particle on the floor may pass that gap.
+      for (std::size_t i = 0; i < w.particleCount(); ++i) {
+        const Vec2d x = w.worldPosition(i);
+        const auto it = last.find(w.particles().id[i]);
+        auto through = [](double y) { return y > 0.03 && y < 0.3; };
+        if (it != last.end() && it->second.x() < frontPrev && x.x() > back && through(it->second.y()) && through(x.y())) ++crossed;
+        last[w.particles().id[i]] = x;
+      }
+      frontPrev = front;
+    }
+    MESSAGE(w.particleCount() << " jet particles; the box shoved from x = 1.2 to " << box->GetPosition().x << " m");
+    CHECK(w.particleCount() == 300);
+    CHECK(box->GetPosition().x > 1.25);  // the water pushed it
+    CHECK(entered == 0);
+    CHECK(crossed == 0);
+    CHECK(test::outside(w, 2.0, 1.0) == 0);
   }
-  MESSAGE(w.particleCount() << " jet particles; the box shoved from x = 1.2 to " << box->GetPosition().x << " m");
-  CHECK(w.particleCount() == 300);
-  CHECK(box->GetPosition().x > 1.25);  // the water pushed it
-  CHECK(entered == 0);
-  CHECK(crossed == 0);
-  CHECK(test::outside(w, 2.0, 1.0) == 0);
 }
 
 TEST_CASE("moving bodies: a crate resting on the floor leaves no water under it, and none squeezed there, in the game solver") {
@@ -402,18 +411,21 @@ TEST_CASE("moving bodies: crates stacked on each other in a game's b2World never
   CHECK(double(light->GetPosition().y) > 0.25);  // still resting across the heavy ones
 }
 
-TEST_CASE("moving bodies: a floating crate gives the same bits on 1, 2 and 3 threads, crate included") {
-  std::uint64_t first = 0;
-  b2Vec2 pose0(0, 0);
-  for (int threads = 1; threads <= 3; ++threads) {
-    SceneDef s = crateScene("game", 500, 0.62);
-    s.solver.spacing = 0.02;
-    World w(s, WorldOptions{threads});
-    for (int f = 0; f < 30; ++f) w.stepFrame();
-    const b2Vec2 pose = dynamicBody(w)->GetPosition();
-    if (threads == 1) first = w.stateHash(), pose0 = pose;
-    CHECK_MESSAGE(w.stateHash() == first, "threads " << threads);
-    CHECK_MESSAGE((pose.x == pose0.x && pose.y == pose0.y), "threads " << threads);
+TEST_CASE("moving bodies: a floating crate gives the same bits on 1, 2 and 3 threads, crate included, every solver") {
+  for (const char* solver : {"game", "wcsph", "muller2003", "pbf", "dfsph"}) {
+    INFO(solver);
+    std::uint64_t first = 0;
+    b2Vec2 pose0(0, 0);
+    for (int threads = 1; threads <= 3; ++threads) {
+      SceneDef s = crateScene(solver, 500, 0.62);
+      s.solver.spacing = 0.02;
+      World w(s, WorldOptions{threads});
+      for (int f = 0; f < 30; ++f) w.stepFrame();
+      const b2Vec2 pose = dynamicBody(w)->GetPosition();
+      if (threads == 1) first = w.stateHash(), pose0 = pose;
+      CHECK_MESSAGE(w.stateHash() == first, "threads " << threads);
+      CHECK_MESSAGE((pose.x == pose0.x && pose.y == pose0.y), "threads " << threads);
+    }
   }
 }
 
