@@ -22,6 +22,9 @@
 // lighter than its density says (density 1000 stays neutral).
 // Per substep:
 //  - `body_gravity` (after `emit`, with a dynamic body): its velocity takes g·dt;
+//  - `body_walls` (after it): where its shapes would overlap a static fixture by the substep's
+//    end deeper than Box2D's contact distance, its velocity into the fixture is removed
+//    (Box2D's contacts act only when Box2D next steps it);
 //  - `body_jump` (with a solver that samples the bodies): where a body is not where the fluid
 //    last saw it, the `bodies` push-out below for particles standing still, before the solver
 //    counts them (with these solvers the scene's own b2World steps with every substep:
@@ -355,7 +358,7 @@ void World::Impl::captureBodies() {
       }
     moving.bodies.push_back(std::move(m));
   }
-  // The `bodies` stage exists only with moving bodies, `body_gravity` only with a dynamic one.
+  // The `bodies` stage exists only with moving bodies, `body_gravity` and `body_walls` only with a dynamic one.
   if (had != !moving.bodies.empty() || hadDynamic != moving.anyDynamic()) buildStages();
 }
 
@@ -388,6 +391,112 @@ void World::Impl::bodyGravity(StepContext& c) {
   const double tau0 = c.time - moving.time0;
   for (MovingSolid& m : moving.bodies)
     if (m.dynamic()) m.changeVelocity(tau0, m.gravity * double(c.dt), 0);
+}
+
+namespace {
+
+// Overlap of the skins deeper than this is a body running into a static solid, not resting on
+// it: Box2D keeps resting shapes at about b2_linearSlop (0.5 cm) into each other's skins, and
+// a resting crate sinks a further g·dt²/2 (1.4 mm) within a frame before Box2D steps it.
+constexpr double kRunInto = 3 * b2_linearSlop;
+
+/// Box2D's manifold of shape a (placed by xa) against child `child` of static shape b (placed
+/// by xb), its normal from a to b; false for a pair Box2D has no collide function for here.
+bool collideWithStatic(const b2Shape* a, const b2Transform& xa, const b2Shape* b, int child, const b2Transform& xb,
+                       b2WorldManifold& out, int& points) {
+  b2Manifold m;
+  m.pointCount = 0;
+  const bool aPoly = a->GetType() == b2Shape::e_polygon, aCircle = a->GetType() == b2Shape::e_circle;
+  if (!aPoly && !aCircle) return false;
+  bool flip = false;
+  b2EdgeShape edge;
+  const b2Shape* other = b;
+  if (b->GetType() == b2Shape::e_chain) {
+    static_cast<const b2ChainShape*>(b)->GetChildEdge(&edge, child);
+    other = &edge;
+  }
+  switch (other->GetType()) {
+    case b2Shape::e_polygon:
+      if (aPoly) {
+        b2CollidePolygons(&m, static_cast<const b2PolygonShape*>(a), xa, static_cast<const b2PolygonShape*>(other), xb);
+      } else {
+        b2CollidePolygonAndCircle(&m, static_cast<const b2PolygonShape*>(other), xb, static_cast<const b2CircleShape*>(a), xa);
+        flip = true;
+      }
+      break;
+    case b2Shape::e_circle:
+      if (aPoly)
+        b2CollidePolygonAndCircle(&m, static_cast<const b2PolygonShape*>(a), xa, static_cast<const b2CircleShape*>(other), xb);
+      else
+        b2CollideCircles(&m, static_cast<const b2CircleShape*>(a), xa, static_cast<const b2CircleShape*>(other), xb);
+      break;
+    case b2Shape::e_edge:
+      if (aPoly)
+        b2CollideEdgeAndPolygon(&m, static_cast<const b2EdgeShape*>(other), xb, static_cast<const b2PolygonShape*>(a), xa);
+      else
+        b2CollideEdgeAndCircle(&m, static_cast<const b2EdgeShape*>(other), xb, static_cast<const b2CircleShape*>(a), xa);
+      flip = true;
+      break;
+    default:
+      return false;
+  }
+  points = m.pointCount;
+  if (points == 0) return true;
+  if (flip) {
+    out.Initialize(&m, xb, other->m_radius, xa, a->m_radius);
+    out.normal = -out.normal;
+  } else {
+    out.Initialize(&m, xa, a->m_radius, xb, other->m_radius);
+  }
+  return true;
+}
+
+}  // namespace
+
+void World::Impl::bodyWalls(StepContext& c) {
+  // A dynamic body moves through a step along its velocity (moving_solid.hpp); Box2D's contacts
+  // act on it only when Box2D next steps it (once a frame in a game's b2World, and in the
+  // scene's own with the game solver and pbf). Flung at a wall, it would run into the wall for
+  // the rest of the frame, taking the particles it meets with it, and Box2D would then put it
+  // back in front of the wall with those particles behind it (a 50 m/s jet's box with
+  // muller2003: 11 particles a frame). So at each substep's start, its pose at the substep's
+  // end is tested against the static fixtures with Box2D's own collide functions; where the
+  // skins would overlap deeper than kRunInto, the part of its velocity into the fixture (its
+  // centre of mass's, along the contact normal) is removed, as Box2D's inelastic contact would.
+  const double tau0 = c.time - moving.time0, tau1 = tau0 + double(c.dt);
+  for (MovingSolid& m : moving.bodies) {
+    if (!m.dynamic()) continue;
+    double theta;
+    Vec2d o;
+    m.pose(tau1, theta, o);
+    const b2Transform xa(b2Vec2(float(o.x() + origin.x()), float(o.y() + origin.y())), b2Rot(float(theta)));
+    for (const b2Fixture* fa = m.body->GetFixtureList(); fa; fa = fa->GetNext()) {
+      if (fa->IsSensor()) continue;
+      b2AABB boxA;
+      fa->GetShape()->ComputeAABB(&boxA, xa, 0);
+      for (const b2Body* sb = b2->GetBodyList(); sb; sb = sb->GetNext()) {
+        if (sb->GetType() != b2_staticBody) continue;
+        for (const b2Fixture* fb = sb->GetFixtureList(); fb; fb = fb->GetNext()) {
+          if (fb->IsSensor()) continue;
+          const b2Shape* shape = fb->GetShape();
+          for (int child = 0; child < shape->GetChildCount(); ++child) {
+            b2AABB boxB;
+            shape->ComputeAABB(&boxB, sb->GetTransform(), child);
+            if (!b2TestOverlap(boxA, boxB)) continue;
+            b2WorldManifold wm;
+            int points = 0;
+            if (!collideWithStatic(fa->GetShape(), xa, shape, child, sb->GetTransform(), wm, points) || points == 0) continue;
+            double deepest = 0;
+            for (int k = 0; k < points; ++k) deepest = std::min(deepest, double(wm.separations[k]));
+            if (deepest > -kRunInto) continue;
+            const Vec2d n(wm.normal.x, wm.normal.y);  // from the body into the static fixture
+            const double vn = m.v.dot(n);
+            if (vn > 0) m.changeVelocity(tau0, -vn * n, 0);
+          }
+        }
+      }
+    }
+  }
 }
 
 void World::Impl::collideMoving(StepContext& c, bool atStart) {

@@ -58,7 +58,10 @@ StepContext World::Impl::context(Real dt) {
 void World::Impl::buildStages() {
   stages.clear();
   if (!emitters.empty()) stages.add(plainStage("emit", [this](StepContext& c) { emit(c.dt); }));
-  if (moving.anyDynamic()) stages.add(plainStage("body_gravity", [this](StepContext& c) { bodyGravity(c); }));
+  if (moving.anyDynamic()) {
+    stages.add(plainStage("body_gravity", [this](StepContext& c) { bodyGravity(c); }));
+    stages.add(plainStage("body_walls", [this](StepContext& c) { bodyWalls(c); }));
+  }
   if (bodySamplesOn()) {
     // A particle a body's Box2D step moved onto would read as a compression the solve must
     // remove within one substep (kicks of 50 m/s and more under a crate): put back first.

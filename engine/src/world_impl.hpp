@@ -104,6 +104,9 @@ struct World::Impl {
   bool insideMoving(const Vec2& p) const;
   /// The `body_gravity` stage: each dynamic body's velocity takes its gravity for the substep.
   void bodyGravity(StepContext& c);
+  /// The `body_walls` stage: a dynamic body whose shapes would, by the substep's end, overlap a
+  /// static fixture deeper than Box2D's contact distance loses the part of its velocity into it.
+  void bodyWalls(StepContext& c);
   /// The `bodies` stage: particles that entered a moving body during the substep are put
   /// back on its surface, their velocity into it replaced by the body's (free slip); with a
   /// dynamic body they meet as an inelastic contact, and the body takes the impulse.
