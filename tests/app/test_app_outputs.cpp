@@ -361,6 +361,28 @@ TEST_CASE("sph2d check never takes a variable from a manifest that sph2d does no
   }
 }
 
+namespace {
+
+/// The rows of a bodies_NNNNN.csv (body, x, y, angle, vx, vy, omega), after its comment and header.
+std::vector<std::vector<double>> bodyRows(const std::string& path) {
+  std::vector<std::vector<double>> out;
+  std::istringstream in(readText(path));
+  std::string line;
+  std::getline(in, line);  // the comment
+  std::getline(in, line);
+  CHECK(line == "body,x,y,angle,vx,vy,omega");
+  while (std::getline(in, line)) {
+    std::vector<double> r;
+    std::istringstream cells(line);
+    std::string c;
+    while (std::getline(cells, c, ',')) r.push_back(std::stod(c));
+    out.push_back(r);
+  }
+  return out;
+}
+
+}  // namespace
+
 TEST_CASE("--export csv writes bodies_NNNNN.csv with each kinematic body's pose and velocity, in scene order") {
   const std::string dir = freshDir("export_bodies");
   REQUIRE(run("run " + q(asset("scenes/tests/kinematic_paddle.json")) + " --frames 31 --every 30 --quiet --export csv --out " +
@@ -368,23 +390,7 @@ TEST_CASE("--export csv writes bodies_NNNNN.csv with each kinematic body's pose 
   CHECK(filesEnding(dir, ".csv") ==
         std::vector<std::string>{"bodies_00000.csv", "bodies_00030.csv", "frame_00000.csv", "frame_00030.csv"});
   // body, x, y, angle, vx, vy, omega per row; boundaries[1] the paddle, boundaries[2] the turning arm.
-  auto rows = [&](const std::string& file) {
-    std::vector<std::vector<double>> out;
-    std::istringstream in(readText(dir + "/" + file));
-    std::string line;
-    std::getline(in, line);  // the comment
-    std::getline(in, line);
-    CHECK(line == "body,x,y,angle,vx,vy,omega");
-    while (std::getline(in, line)) {
-      std::vector<double> r;
-      std::istringstream cells(line);
-      std::string c;
-      while (std::getline(cells, c, ',')) r.push_back(std::stod(c));
-      out.push_back(r);
-    }
-    return out;
-  };
-  const auto a = rows("bodies_00000.csv"), b = rows("bodies_00030.csv");
+  const auto a = bodyRows(dir + "/bodies_00000.csv"), b = bodyRows(dir + "/bodies_00030.csv");
   REQUIRE(a.size() == 2);
   REQUIRE(b.size() == 2);
   CHECK(a[0][0] == 1);
@@ -401,24 +407,7 @@ TEST_CASE("--export csv writes the dynamic crates of floating_crates.json too, e
   // x(n+1) = x(n) + dt v(n+1), the rotation's part included up to its second order).
   const std::string dir = freshDir("export_crates");
   REQUIRE(run("run " + q(asset("scenes/floating_crates.json")) + " --frames 40 --quiet --export csv --out " + q(dir)).code == 0);
-  auto rows = [&](int frame) {
-    char name[32];
-    std::snprintf(name, sizeof name, "bodies_%05d.csv", frame);
-    std::vector<std::vector<double>> out;
-    std::istringstream in(readText(dir + "/" + name));
-    std::string line;
-    std::getline(in, line);
-    std::getline(in, line);
-    while (std::getline(in, line)) {
-      std::vector<double> r;
-      std::istringstream cells(line);
-      std::string c;
-      while (std::getline(cells, c, ',')) r.push_back(std::stod(c));
-      out.push_back(r);
-    }
-    return out;
-  };
-  const auto a = rows(38), b = rows(39);
+  const auto a = bodyRows(dir + "/bodies_00038.csv"), b = bodyRows(dir + "/bodies_00039.csv");
   REQUIRE(a.size() == 5);  // the turning bar and four crates, boundaries[1..5]
   REQUIRE(b.size() == 5);
   const double dt = 1.0 / 60;
