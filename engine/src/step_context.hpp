@@ -97,6 +97,10 @@ struct StepContext {
   Real R = 0;                   ///< kernel support
   Real dx = 0;                  ///< particle spacing
   Real dt = 0;                  ///< this substep
+  /// The largest |a| of the particles, when a stage has just measured it and nothing has
+  /// changed a since (force_limit; integrate reads a only), else −1: the `max_acceleration`
+  /// stage then need not measure it again.
+  Real accelMeasured = -1;
   Real mass = 0;                ///< particle mass
   Real rho0 = 1000;             ///< rest density
   Vec2 gravity = Vec2::Zero();

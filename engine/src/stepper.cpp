@@ -91,7 +91,9 @@ void World::Impl::buildStages() {
   }
   if (!marker)
     throw std::logic_error(std::string("solver ") + solver->name() + " has no effects marker in its stages");
-  stages.add(plainStage("max_acceleration", [this](StepContext& c) { lastAccel = maxAccelOf(c.P, c.pool); }));
+  stages.add(plainStage("max_acceleration", [this](StepContext& c) {
+    lastAccel = c.accelMeasured >= 0 ? c.accelMeasured : maxAccelOf(c.P, c.pool);  // the explicit solvers' force_limit measured it
+  }));
   if (bodySamplesOn()) stages.add(plainStage("body_forces", [this](StepContext& c) { bodySamples.react(c, moving); }));
   addParticleSystemStages(stages);
 

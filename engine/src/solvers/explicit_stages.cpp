@@ -24,6 +24,7 @@ namespace {
 /// Shortens c.dt to kForceCfl·sqrt(R/a_max) of this substep's accelerations when that is shorter.
 void limitStepByForce(StepContext& c) {
   const Real amax = maxAccelOf(c.P, c.pool);
+  c.accelMeasured = amax;  // integrate, the last of these stages, leaves a as it is
   if (!(amax > 0)) return;
   const Real limit = kForceCfl * std::sqrt(c.R / amax);
   if (limit < c.dt) c.dt = limit;
