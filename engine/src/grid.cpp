@@ -85,16 +85,57 @@ void Grid::build(const Vec2* x, std::size_t n, Real support, ThreadPool& pool, i
       cellOf[i] = std::uint32_t(coord(x[i].y(), lo.y(), invCellY, ny)) * std::uint32_t(nx) +
                   std::uint32_t(coord(x[i].x(), lo.x(), invCell, nx));
   });
-  // Stable counting sort (serial: it is a few ms at a million particles).
-  cellStart.assign(cells + 1, 0);
-  for (std::size_t i = 0; i < n; ++i) ++cellStart[cellOf[i] + 1];
-  for (std::size_t c = 0; c < cells; ++c) cellStart[c + 1] += cellStart[c];
+  countingSort(cells, pool);
+}
+
+void Grid::countingSort(std::size_t cells, ThreadPool& pool) {
+  // Stable counting sort of the slots by cellOf. The cells are cut into one band of
+  // consecutive cells per thread; each thread reads every cellOf and counts, places and
+  // shifts only its own band's cells, so no two threads write one entry, and the result (the
+  // one stable order) is the same for any number of bands. The bands' edges are the cells of
+  // evenly spaced slots: the particles were put in cell order at the last reordering, so the
+  // bands hold about as many particles each.
+  const std::size_t n = cellOf.size();
+  cellStart.resize(cells + 1);
   sorted.resize(n);
-  // cellStart[c + 1] is the end of cell c: filled from the last particle down (stable),
-  // it becomes the start of cell c, and one shift puts the starts in place (no cursor
-  // array: the grid holds only cellStart, sorted and cellOf).
-  for (std::size_t i = n; i-- > 0;) sorted[--cellStart[cellOf[i] + 1]] = std::uint32_t(i);
-  for (std::size_t c = 0; c < cells; ++c) cellStart[c] = cellStart[c + 1];
+  const std::size_t bands = std::max<std::size_t>(1, std::min<std::size_t>(std::size_t(pool.size()), n / 4096));
+  std::vector<std::size_t> band(bands + 1, 0);  // band t: cells band[t] .. band[t + 1] − 1
+  for (std::size_t t = 1; t < bands; ++t) band[t] = std::max<std::size_t>(band[t - 1], std::min<std::size_t>(cellOf[t * n / bands], cells));
+  band[bands] = cells;
+  std::vector<std::uint32_t> total(bands, 0), edge(bands, 0);
+  // cellStart[c + 1] counts cell c, then (a prefix within the band) ends it within the band.
+  pool.parallelFor(bands, 1, [&](std::size_t t, std::size_t) {
+    const std::size_t a = band[t], w = band[t + 1] - band[t];
+    std::fill(cellStart.begin() + std::ptrdiff_t(a) + 1, cellStart.begin() + std::ptrdiff_t(a + w) + 1, 0u);
+    for (std::size_t i = 0; i < n; ++i)
+      if (std::size_t(cellOf[i]) - a < w) ++cellStart[cellOf[i] + 1];
+    for (std::size_t c = a + 1; c < a + w; ++c) cellStart[c + 1] += cellStart[c];
+    total[t] = w ? cellStart[a + w] : 0;
+  });
+  std::uint32_t offset = 0;
+  for (std::size_t t = 0; t < bands; ++t) {
+    const std::uint32_t mine = total[t];
+    total[t] = offset;  // now the particles before the band
+    offset += mine;
+  }
+  // cellStart[c + 1] is the end of cell c: filled from the last particle down (stable), it
+  // becomes the start of cell c (no cursor array: the grid holds only cellStart, sorted and
+  // cellOf); the band's last entry, which the next band's shift overwrites, is kept aside.
+  pool.parallelFor(bands, 1, [&](std::size_t t, std::size_t) {
+    const std::size_t a = band[t], w = band[t + 1] - band[t];
+    if (!w) return;
+    for (std::size_t c = a; c < a + w; ++c) cellStart[c + 1] += total[t];
+    for (std::size_t i = n; i-- > 0;)
+      if (std::size_t(cellOf[i]) - a < w) sorted[--cellStart[cellOf[i] + 1]] = std::uint32_t(i);
+    edge[t] = cellStart[a + w];
+  });
+  // One shift puts the starts in place, band by band.
+  pool.parallelFor(bands, 1, [&](std::size_t t, std::size_t) {
+    const std::size_t a = band[t], w = band[t + 1] - band[t];
+    if (!w) return;
+    for (std::size_t c = a; c + 1 < a + w; ++c) cellStart[c] = cellStart[c + 1];
+    cellStart[a + w - 1] = edge[t];
+  });
   cellStart[cells] = std::uint32_t(n);
 }
 

@@ -91,6 +91,9 @@ struct Grid {
     return static_cast<int>(c);
   }
 
+  /// Sorts the slots by cellOf (stable) into sorted and cellStart, over `cells` cells.
+  void countingSort(std::size_t cells, ThreadPool& pool);
+
   /// Calls f(begin, end) for each row of cells around p: positions
   /// begin..end of `sorted` (up to 2·reach + 1 ranges, in a fixed order).
   template <class F>

@@ -75,6 +75,43 @@ TEST_CASE("grid neighbours equal brute force: random, clustered and degenerate i
   }
 }
 
+TEST_CASE("grid counting sort: the one stable order by cell for 1 to 4 threads, sorted, shuffled and clustered inputs") {
+  // The sort cuts the cells into one band per thread (at the cells of evenly spaced slots) and
+  // each thread places only its band's particles: any cut must give the same order, and that
+  // order is the stable sort by cell (cells ascending, slots ascending within a cell).
+  std::mt19937_64 rng(777);
+  std::vector<Vec2> sortedInput, shuffled, clustered;
+  for (int j = 0; j < 120; ++j)
+    for (int i = 0; i < 100; ++i) sortedInput.emplace_back(Real(0.01 * i + 0.001 * unit(rng)), Real(0.01 * j + 0.001 * unit(rng)));
+  shuffled = sortedInput;
+  std::shuffle(shuffled.begin(), shuffled.end(), rng);
+  for (int i = 0; i < 12000; ++i)  // most particles in one corner: uneven bands
+    clustered.emplace_back(Real(i < 10000 ? 0.05 * unit(rng) : unit(rng)), Real(i < 10000 ? 0.05 * unit(rng) : unit(rng)));
+  for (const std::vector<Vec2>* x : {&sortedInput, &shuffled, &clustered}) {
+    std::vector<std::uint32_t> order, starts;
+    for (int threads = 1; threads <= 4; ++threads) {
+      CAPTURE(threads);
+      ThreadPool pool(threads);
+      Grid g;
+      g.build(x->data(), x->size(), Real(0.04), pool, 2);
+      if (threads == 1) {
+        order = g.sorted;
+        starts = g.cellStart;
+        // The stable order by cell.
+        for (std::size_t k = 0; k + 1 < g.sorted.size(); ++k) {
+          const std::uint32_t a = g.sorted[k], b = g.sorted[k + 1];
+          REQUIRE((g.cellOf[a] < g.cellOf[b] || (g.cellOf[a] == g.cellOf[b] && a < b)));
+        }
+        for (std::size_t c = 0; c + 1 < g.cellStart.size(); ++c)
+          for (std::uint32_t k = g.cellStart[c]; k < g.cellStart[c + 1]; ++k) REQUIRE(g.cellOf[g.sorted[k]] == c);
+        CHECK(g.cellStart.back() == x->size());
+      }
+      CHECK(g.sorted == order);
+      CHECK(g.cellStart == starts);
+    }
+  }
+}
+
 TEST_CASE("grid build keeps its cell count bounded for a huge bounding box") {
   ThreadPool pool(1);
   std::vector<Vec2> x = {Vec2(0, 0), Vec2(1e6f, 1e6f), Vec2(0.01f, 0)};
