@@ -96,6 +96,7 @@ void Grid::countingSort(std::size_t cells, ThreadPool& pool) {
   // evenly spaced slots: the particles were put in cell order at the last reordering, so the
   // bands hold about as many particles each.
   const std::size_t n = cellOf.size();
+  if (cellStart.capacity() < cells + 1) cellStart.reserve(cells + 1);  // exactly: resize alone would double it
   cellStart.resize(cells + 1);
   sorted.resize(n);
   const std::size_t bands = std::max<std::size_t>(1, std::min<std::size_t>(std::size_t(pool.size()), n / 4096));
