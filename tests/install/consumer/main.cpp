@@ -127,12 +127,14 @@ int main(int argc, char** argv) {
   const b2Body* crate = crateOf(reloaded);
   const double crateY = crate ? double(crate->GetPosition().y) : -1;
   const bool afloat = crateY > 0.3;  // resting on the floor it would be at 0.08 m
-  // The paddle (turning about (0.45, 0.25) m, its tips at 0.45 m/s) stirs the water around it.
+  // The paddle (turning about (0.45, 0.25) m, its tips at 0.45 m/s) stirs the water around it:
+  // 0.21 m/s on average within 0.2 m of its axis after 1 s, where the crate's waves alone (the
+  // paddle held still) leave 0.09 m/s.
   double stirred = 0;
   const std::vector<std::size_t> around = reloaded.particlesInRadius(b2Vec2(0.45f, 0.25f), 0.2);
   for (const std::size_t i : around) stirred += double(reloaded.particles().v[i].norm());
   stirred = around.empty() ? 0 : stirred / double(around.size());
-  const bool pushed = around.size() > 50 && stirred > 0.1;
+  const bool pushed = around.size() > 50 && stirred > 0.15;
   std::size_t dyed = 0;  // the colours came back with the save
   for (std::size_t i = 0; i < reloaded.particleCount(); ++i) {
     const std::uint32_t id = reloaded.particles().id[i];
