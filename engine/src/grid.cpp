@@ -1,5 +1,7 @@
 #include "grid.hpp"
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 
@@ -99,11 +101,12 @@ void Grid::countingSort(std::size_t cells, ThreadPool& pool) {
   if (cellStart.capacity() < cells + 1) cellStart.reserve(cells + 1);  // exactly: resize alone would double it
   cellStart.resize(cells + 1);
   sorted.resize(n);
-  const std::size_t bands = std::max<std::size_t>(1, std::min<std::size_t>(std::size_t(pool.size()), n / 4096));
-  std::vector<std::size_t> band(bands + 1, 0);  // band t: cells band[t] .. band[t + 1] − 1
+  constexpr std::size_t kMaxBands = 64;  // on the stack: no allocation in the step
+  const std::size_t bands = std::max<std::size_t>(1, std::min({std::size_t(pool.size()), n / 4096, kMaxBands}));
+  std::array<std::size_t, kMaxBands + 1> band{};  // band t: cells band[t] .. band[t + 1] − 1
   for (std::size_t t = 1; t < bands; ++t) band[t] = std::max<std::size_t>(band[t - 1], std::min<std::size_t>(cellOf[t * n / bands], cells));
   band[bands] = cells;
-  std::vector<std::uint32_t> total(bands, 0), edge(bands, 0);
+  std::array<std::uint32_t, kMaxBands> total{}, edge{};
   // cellStart[c + 1] counts cell c, then (a prefix within the band) ends it within the band.
   pool.parallelFor(bands, 1, [&](std::size_t t, std::size_t) {
     const std::size_t a = band[t], w = band[t + 1] - band[t];
