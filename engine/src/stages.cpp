@@ -108,8 +108,9 @@ constexpr int kPairShift = 2;
 /// buffer (a pile-up: the caller then searches for i alone); always true without Two.
 template <bool Two>
 __attribute__((target("avx512f,popcnt"))) bool nearInOrder16(const Grid& g, const Vec2* X, std::size_t i, int shift,
-                                                             Real R2, std::vector<std::uint32_t>& out, std::size_t& used,
+                                                             Real R2, std::vector<std::uint32_t>& out, std::size_t& usedOut,
                                                              std::size_t* mid) {
+  std::size_t used = usedOut;  // a local: through the reference it would go through memory every chunk
   const float* xy = reinterpret_cast<const float*>(X);
   const Vec2 xi = X[i], xn = X[i + (Two ? 1 : 0)];
   const __m512 xi16 = _mm512_set1_ps(xi.x()), yi16 = _mm512_set1_ps(xi.y()), r216 = _mm512_set1_ps(R2);
@@ -142,9 +143,9 @@ __attribute__((target("avx512f,popcnt"))) bool nearInOrder16(const Grid& g, cons
     const std::uint32_t kb = g.cellStart[row + x0], ie = g.cellStart[row + x1 + 1];
     const std::uint32_t nbeg = Two ? g.cellStart[row + nx0] : kb, ke = Two ? g.cellStart[row + nx1 + 1] : ie;
     if (!(kb < ke)) continue;
-    const std::size_t need = used + (ie - kb) + 3;  // as stageNeighbours reserves for nearInOrder
+    const std::size_t need = used + (ie - kb) + 16;  // room for a whole vector stored past the last kept entry
     if (out.size() < need) {
-      if (out.capacity() < need) out.reserve(need + need / 8);
+      if (out.capacity() < need) out.reserve(need + need / 16);
       out.resize(need);
     }
     std::uint32_t* dst = out.data();
@@ -171,7 +172,7 @@ __attribute__((target("avx512f,popcnt"))) bool nearInOrder16(const Grid& g, cons
       };
       const unsigned keep = keepOf(xi16, yi16, i, mineI);
       const unsigned got = unsigned(__builtin_popcount(keep));
-      _mm512_mask_storeu_epi32(dst + used, __mmask16((1u << got) - 1), _mm512_maskz_compress_epi32(__mmask16(keep), ks));
+      _mm512_storeu_si512(dst + used, _mm512_maskz_compress_epi32(__mmask16(keep), ks));
       used += got;
       if (Two) {
         const unsigned keepN = keepOf(xn16, yn16, i + 1, mineN);
@@ -180,11 +181,14 @@ __attribute__((target("avx512f,popcnt"))) bool nearInOrder16(const Grid& g, cons
       }
     }
   }
-  if (!Two) return true;
+  if (!Two) {
+    usedOut = used;
+    return true;
+  }
   *mid = used;
   const std::size_t need = used + gotN + 3;
   if (out.size() < need) {
-    if (out.capacity() < need) out.reserve(need + need / 8);
+    if (out.capacity() < need) out.reserve(need + need / 16);
     out.resize(need);
   }
   std::uint32_t* dst = out.data() + used;
@@ -193,7 +197,7 @@ __attribute__((target("avx512f,popcnt"))) bool nearInOrder16(const Grid& g, cons
     const __mmask16 part = left >= 16 ? __mmask16(0xFFFF) : __mmask16((1u << left) - 1);
     _mm512_mask_storeu_epi32(dst + k, part, _mm512_load_si512(bufN + k));
   }
-  used += gotN;
+  usedOut = used + gotN;
   return true;
 }
 #endif
@@ -340,11 +344,11 @@ void stageNeighbours(StepContext& c) {
         {
           g.forCandidateRanges(xi, [&](std::uint32_t kb, std::uint32_t ke) {
             // Room for every candidate (written before the test; and 3 more, nearInOrder's
-            // last group); grown by an eighth, not doubled: the lists are most of the
+            // last group); grown by a sixteenth, not doubled: the lists are most of the
             // engine's memory, and a block's need settles.
             const std::size_t need = used + (ke - kb) + 3;
             if (out.size() < need) {
-              if (out.capacity() < need) out.reserve(need + need / 8);
+              if (out.capacity() < need) out.reserve(need + need / 16);
               out.resize(need);
             }
             std::uint32_t* dst = out.data();

@@ -74,6 +74,10 @@ __attribute__((target("avx2"))) inline void gather8(const Vec2* base, const std:
 /// vector loops run at their throughput rather than at the latency of one add.
 constexpr std::uint32_t kSumLanes = 8;
 
+/// Particles whose pair sums one call of pairSums8 computes: its constants are set once a run,
+/// and the caller's per-particle code follows on the run's results.
+constexpr std::size_t kRun = 64;
+
 /// Σ of eight partial sums in the fixed tree ((s0+s4) + (s2+s6)) + ((s1+s5) + (s3+s7)).
 inline Real laneTotal(const Real s[kSumLanes]) {
   const Real a0 = s[0] + s[4], a1 = s[1] + s[5], a2 = s[2] + s[6], a3 = s[3] + s[7];
@@ -298,99 +302,103 @@ inline void laneTotals4(__m128 lo[4], const __m128 hi[4], Real* sums) {
 #endif
 
 #ifdef SPH2D_AVX2_PAIRS
-/// The pair sums {fpx, fpy, fvx, fvy} of slot i, eight pairs at a time (AVX2, chosen at
-/// run time): the scalar terms' operations lane for lane, the gathers by index, pair k
-/// in lane k mod 8 (kSumLanes); no periodic axis.
+/// The pair sums {fpx, fpy, fvx, fvy} of slots i0..i1 − 1, eight pairs at a time (AVX2, chosen at
+/// run time): the scalar terms' operations lane for lane, the gathers by index, pair k of a list
+/// in lane k mod 8 (kSumLanes); no periodic axis. The constants are set once for the run.
 template <bool Visc>
-__attribute__((target("avx2"))) void pairSums8(const StepContext& c, const PairConstants& k, std::size_t i,
-                                               const std::uint32_t* nb, std::uint32_t cnt, Real pi, Real vix, Real viy,
-                                               Real* sums) {
+__attribute__((target("avx2"))) void pairSums8(const StepContext& c, const PairConstants& k, std::size_t i0,
+                                               std::size_t i1, Real (*out)[4]) {
   const float* IR = c.P.invRho.data();
   const float* POR = c.P.pOverRho.data();
-  const Vec2 xi = c.P.x[i];
-  const __m256 xi8 = _mm256_set1_ps(xi.x()), yi8 = _mm256_set1_ps(xi.y()), pi8 = _mm256_set1_ps(pi);
-  const __m256 vix8 = _mm256_set1_ps(vix), viy8 = _mm256_set1_ps(viy);
   const __m256 R8 = _mm256_set1_ps(k.R), spikyK = _mm256_set1_ps(k.spikyK), halfMass = _mm256_set1_ps(k.halfMass);
   const __m256 one = _mm256_set1_ps(Real(1)), thr = _mm256_set1_ps(k.coincident2);
   const __m256i iota = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
-  // Gathers by plain loads (the hardware gathers were slower on the EPYC measured).
-  __m256 s0 = _mm256_setzero_ps(), s1 = s0, s2 = s0, s3 = s0;  // lanes of fpx, fpy, fvx, fvy
-  for (std::uint32_t kk = 0; kk < cnt; kk += 8) {
-    const std::uint32_t n = std::min<std::uint32_t>(8, cnt - kk);
-    std::uint32_t j[8];
-    for (std::uint32_t l = 0; l < 8; ++l) j[l] = nb[std::min(kk + l, cnt - 1)];  // missing lanes repeat the last (zeroed)
-    __m256 xj, yj;
-    gather8(c.P.x.data(), j, xj, yj);
-    const __m256 dx = _mm256_sub_ps(xi8, xj), dy = _mm256_sub_ps(yi8, yj);
-    const __m256 r2 = _mm256_add_ps(_mm256_mul_ps(dx, dx), _mm256_mul_ps(dy, dy));
-    if (__builtin_expect(_mm256_movemask_ps(_mm256_cmp_ps(r2, thr, _CMP_LT_OQ)) & ((1 << n) - 1), 0)) {
-      alignas(32) Real t[4][8] = {};  // a coincident pair (rare): the scalar terms, in their lanes
-      for (std::uint32_t q = 0; q < n; ++q) {
-        Real tq[4];
-        pairTermScalar<Visc>(c, k, i, nb[kk + q], pi, vix, viy, tq);
-        for (int l = 0; l < 4; ++l) t[l][q] = tq[l];
+  for (std::size_t i = i0; i < i1; ++i) {
+    const std::uint32_t* nb = c.nbr.of(i);
+    const std::uint32_t cnt = c.nbr.count[i];
+    const Vec2 xi = c.P.x[i];
+    const Real pi = c.P.p[i], vix = c.P.v[i].x(), viy = c.P.v[i].y();
+    const __m256 xi8 = _mm256_set1_ps(xi.x()), yi8 = _mm256_set1_ps(xi.y()), pi8 = _mm256_set1_ps(pi);
+    const __m256 vix8 = _mm256_set1_ps(vix), viy8 = _mm256_set1_ps(viy);
+    // Gathers by plain loads (the hardware gathers were slower on the EPYC measured).
+    __m256 s0 = _mm256_setzero_ps(), s1 = s0, s2 = s0, s3 = s0;  // lanes of fpx, fpy, fvx, fvy
+    for (std::uint32_t kk = 0; kk < cnt; kk += 8) {
+      const std::uint32_t n = std::min<std::uint32_t>(8, cnt - kk);
+      std::uint32_t j[8];
+      for (std::uint32_t l = 0; l < 8; ++l) j[l] = nb[std::min(kk + l, cnt - 1)];  // missing lanes repeat the last (zeroed)
+      __m256 xj, yj;
+      gather8(c.P.x.data(), j, xj, yj);
+      const __m256 dx = _mm256_sub_ps(xi8, xj), dy = _mm256_sub_ps(yi8, yj);
+      const __m256 r2 = _mm256_add_ps(_mm256_mul_ps(dx, dx), _mm256_mul_ps(dy, dy));
+      if (__builtin_expect(_mm256_movemask_ps(_mm256_cmp_ps(r2, thr, _CMP_LT_OQ)) & ((1 << n) - 1), 0)) {
+        alignas(32) Real t[4][8] = {};  // a coincident pair (rare): the scalar terms, in their lanes
+        for (std::uint32_t q = 0; q < n; ++q) {
+          Real tq[4];
+          pairTermScalar<Visc>(c, k, i, nb[kk + q], pi, vix, viy, tq);
+          for (int l = 0; l < 4; ++l) t[l][q] = tq[l];
+        }
+        s0 = _mm256_add_ps(s0, _mm256_load_ps(t[0]));
+        s1 = _mm256_add_ps(s1, _mm256_load_ps(t[1]));
+        s2 = _mm256_add_ps(s2, _mm256_load_ps(t[2]));
+        s3 = _mm256_add_ps(s3, _mm256_load_ps(t[3]));
+        continue;
       }
-      s0 = _mm256_add_ps(s0, _mm256_load_ps(t[0]));
-      s1 = _mm256_add_ps(s1, _mm256_load_ps(t[1]));
-      s2 = _mm256_add_ps(s2, _mm256_load_ps(t[2]));
-      s3 = _mm256_add_ps(s3, _mm256_load_ps(t[3]));
-      continue;
+      const __m256 irj = _mm256_setr_ps(IR[j[0]], IR[j[1]], IR[j[2]], IR[j[3]], IR[j[4]], IR[j[5]], IR[j[6]], IR[j[7]]);
+      const __m256 porj =
+          _mm256_setr_ps(POR[j[0]], POR[j[1]], POR[j[2]], POR[j[3]], POR[j[4]], POR[j[5]], POR[j[6]], POR[j[7]]);
+      __m256 sq, invr;
+      if (n <= 4) {
+        // A short last group: the square roots and divisions of its four lanes only (the
+        // divider bounds this loop; a lane's result is the same at either width, the upper
+        // lanes are 0 and masked off below).
+        const __m128 sq4 = _mm_sqrt_ps(_mm256_castps256_ps128(r2));
+        sq = _mm256_zextps128_ps256(sq4);
+        invr = _mm256_zextps128_ps256(_mm_div_ps(_mm_set1_ps(Real(1)), sq4));
+      } else {
+        sq = _mm256_sqrt_ps(r2);
+        invr = _mm256_div_ps(one, sq);
+      }
+      const __m256 a = _mm256_sub_ps(R8, _mm256_mul_ps(r2, invr));
+      const __m256 wp = _mm256_mul_ps(_mm256_mul_ps(_mm256_mul_ps(_mm256_mul_ps(spikyK, a), a), invr),
+                                      _mm256_mul_ps(halfMass, _mm256_add_ps(_mm256_mul_ps(pi8, irj), porj)));
+      __m256 t0 = _mm256_mul_ps(dx, wp), t1 = _mm256_mul_ps(dy, wp), t2 = _mm256_setzero_ps(), t3 = _mm256_setzero_ps();
+      if (Visc) {
+        const __m256 vR2 = _mm256_set1_ps(k.vR2);
+        const __m256 big = _mm256_cmp_ps(r2, _mm256_set1_ps(k.rMin2), _CMP_GT_OQ);
+        const __m256 q = _mm256_blendv_ps(_mm256_set1_ps(k.rMin), sq, big);
+        const __m256 iq = _mm256_blendv_ps(_mm256_set1_ps(k.invRMin), invr, big);
+        const __m256 poly = _mm256_add_ps(
+            _mm256_add_ps(_mm256_add_ps(_mm256_set1_ps(k.vR3), _mm256_mul_ps(vR2, q)), _mm256_mul_ps(_mm256_mul_ps(R8, q), q)),
+            _mm256_mul_ps(_mm256_mul_ps(_mm256_mul_ps(_mm256_set1_ps(Real(9)), q), q), q));
+        __m256 lap = _mm256_mul_ps(_mm256_mul_ps(_mm256_set1_ps(k.lapK), _mm256_sub_ps(R8, q)), poly);
+        lap = _mm256_mul_ps(_mm256_mul_ps(_mm256_mul_ps(lap, iq), iq), iq);
+        lap = _mm256_and_ps(_mm256_cmp_ps(r2, vR2, _CMP_NGE_UQ), lap);  // r² ≥ R²: 0
+        // The stability cap (ViscosityTerm::pairCap · ρ_i): std::min's value for finite lanes.
+        const __m256 w = _mm256_min_ps(_mm256_mul_ps(lap, irj), _mm256_set1_ps(k.pairCap / IR[i]));
+        __m256 vxj, vyj;
+        gather8(c.P.v.data(), j, vxj, vyj);
+        t2 = _mm256_mul_ps(_mm256_sub_ps(vxj, vix8), w);
+        t3 = _mm256_mul_ps(_mm256_sub_ps(vyj, viy8), w);
+      }
+      if (n < 8) {
+        // Missing lanes add +0, which leaves a sum unchanged: a sum that starts at +0 is never −0.
+        const __m256 live = _mm256_castsi256_ps(_mm256_cmpgt_epi32(_mm256_set1_epi32(int(n)), iota));
+        t0 = _mm256_and_ps(t0, live);
+        t1 = _mm256_and_ps(t1, live);
+        t2 = _mm256_and_ps(t2, live);
+        t3 = _mm256_and_ps(t3, live);
+      }
+      s0 = _mm256_add_ps(s0, t0);
+      s1 = _mm256_add_ps(s1, t1);
+      s2 = _mm256_add_ps(s2, t2);
+      s3 = _mm256_add_ps(s3, t3);
     }
-    const __m256 irj = _mm256_setr_ps(IR[j[0]], IR[j[1]], IR[j[2]], IR[j[3]], IR[j[4]], IR[j[5]], IR[j[6]], IR[j[7]]);
-    const __m256 porj =
-        _mm256_setr_ps(POR[j[0]], POR[j[1]], POR[j[2]], POR[j[3]], POR[j[4]], POR[j[5]], POR[j[6]], POR[j[7]]);
-    __m256 sq, invr;
-    if (n <= 4) {
-      // A short last group: the square roots and divisions of its four lanes only (the
-      // divider bounds this loop; a lane's result is the same at either width, the upper
-      // lanes are 0 and masked off below).
-      const __m128 sq4 = _mm_sqrt_ps(_mm256_castps256_ps128(r2));
-      sq = _mm256_zextps128_ps256(sq4);
-      invr = _mm256_zextps128_ps256(_mm_div_ps(_mm_set1_ps(Real(1)), sq4));
-    } else {
-      sq = _mm256_sqrt_ps(r2);
-      invr = _mm256_div_ps(one, sq);
-    }
-    const __m256 a = _mm256_sub_ps(R8, _mm256_mul_ps(r2, invr));
-    const __m256 wp = _mm256_mul_ps(_mm256_mul_ps(_mm256_mul_ps(_mm256_mul_ps(spikyK, a), a), invr),
-                                    _mm256_mul_ps(halfMass, _mm256_add_ps(_mm256_mul_ps(pi8, irj), porj)));
-    __m256 t0 = _mm256_mul_ps(dx, wp), t1 = _mm256_mul_ps(dy, wp), t2 = _mm256_setzero_ps(), t3 = _mm256_setzero_ps();
-    if (Visc) {
-      const __m256 vR2 = _mm256_set1_ps(k.vR2);
-      const __m256 big = _mm256_cmp_ps(r2, _mm256_set1_ps(k.rMin2), _CMP_GT_OQ);
-      const __m256 q = _mm256_blendv_ps(_mm256_set1_ps(k.rMin), sq, big);
-      const __m256 iq = _mm256_blendv_ps(_mm256_set1_ps(k.invRMin), invr, big);
-      const __m256 poly = _mm256_add_ps(
-          _mm256_add_ps(_mm256_add_ps(_mm256_set1_ps(k.vR3), _mm256_mul_ps(vR2, q)), _mm256_mul_ps(_mm256_mul_ps(R8, q), q)),
-          _mm256_mul_ps(_mm256_mul_ps(_mm256_mul_ps(_mm256_set1_ps(Real(9)), q), q), q));
-      __m256 lap = _mm256_mul_ps(_mm256_mul_ps(_mm256_set1_ps(k.lapK), _mm256_sub_ps(R8, q)), poly);
-      lap = _mm256_mul_ps(_mm256_mul_ps(_mm256_mul_ps(lap, iq), iq), iq);
-      lap = _mm256_and_ps(_mm256_cmp_ps(r2, vR2, _CMP_NGE_UQ), lap);  // r² ≥ R²: 0
-      // The stability cap (ViscosityTerm::pairCap · ρ_i): std::min's value for finite lanes.
-      const __m256 w = _mm256_min_ps(_mm256_mul_ps(lap, irj), _mm256_set1_ps(k.pairCap / IR[i]));
-      __m256 vxj, vyj;
-      gather8(c.P.v.data(), j, vxj, vyj);
-      t2 = _mm256_mul_ps(_mm256_sub_ps(vxj, vix8), w);
-      t3 = _mm256_mul_ps(_mm256_sub_ps(vyj, viy8), w);
-    }
-    if (n < 8) {
-      // Missing lanes add +0, which leaves a sum unchanged: a sum that starts at +0 is never −0.
-      const __m256 live = _mm256_castsi256_ps(_mm256_cmpgt_epi32(_mm256_set1_epi32(int(n)), iota));
-      t0 = _mm256_and_ps(t0, live);
-      t1 = _mm256_and_ps(t1, live);
-      t2 = _mm256_and_ps(t2, live);
-      t3 = _mm256_and_ps(t3, live);
-    }
-    s0 = _mm256_add_ps(s0, t0);
-    s1 = _mm256_add_ps(s1, t1);
-    s2 = _mm256_add_ps(s2, t2);
-    s3 = _mm256_add_ps(s3, t3);
+    __m128 lo[4] = {_mm256_castps256_ps128(s0), _mm256_castps256_ps128(s1), _mm256_castps256_ps128(s2),
+                    _mm256_castps256_ps128(s3)};
+    const __m128 hi[4] = {_mm256_extractf128_ps(s0, 1), _mm256_extractf128_ps(s1, 1), _mm256_extractf128_ps(s2, 1),
+                          _mm256_extractf128_ps(s3, 1)};
+    laneTotals4(lo, hi, out[i - i0]);
   }
-  __m128 lo[4] = {_mm256_castps256_ps128(s0), _mm256_castps256_ps128(s1), _mm256_castps256_ps128(s2),
-                  _mm256_castps256_ps128(s3)};
-  const __m128 hi[4] = {_mm256_extractf128_ps(s0, 1), _mm256_extractf128_ps(s1, 1), _mm256_extractf128_ps(s2, 1),
-                        _mm256_extractf128_ps(s3, 1)};
-  laneTotals4(lo, hi, sums);
 }
 #endif
 
@@ -437,6 +445,10 @@ std::size_t pressureForce(StepContext& c, const Spiky<Real>& spiky, const Viscos
             _mm_set1_ps(k.coincident2), _mm_set1_ps(k.vR2), _mm_set1_ps(k.vR3), _mm_set1_ps(k.lapK),
             _mm_set1_ps(k.rMin), _mm_set1_ps(k.rMin2), _mm_set1_ps(k.invRMin), _mm_set1_ps(Real(9))};
 #endif
+#ifdef SPH2D_AVX2_PAIRS
+    alignas(16) Real runSums[kRun][4];
+    std::size_t runBegin = b, runStop = b;
+#endif
     for (std::size_t i = b; i < e; ++i) {
       const Vec2 xi = X[i];
       const Real pi = P.p[i];
@@ -448,7 +460,12 @@ std::size_t pressureForce(StepContext& c, const Spiky<Real>& spiky, const Viscos
       alignas(16) Real sums[4] = {0, 0, 0, 0};
 #ifdef SPH2D_AVX2_PAIRS
       if (simd && wide) {
-        pairSums8<Visc>(c, k, i, nb, cnt, pi, vix, viy, sums);
+        if (i == runStop) {  // the next run of particles' pair sums, at once
+          runBegin = i;
+          runStop = std::min(e, i + kRun);
+          pairSums8<Visc>(c, k, runBegin, runStop, runSums);
+        }
+        std::copy(runSums[i - runBegin], runSums[i - runBegin] + 4, sums);
         kk = cnt;
       } else
 #endif
@@ -519,7 +536,8 @@ std::size_t pressureForce(StepContext& c, const Spiky<Real>& spiky, const Viscos
       if (kk < cnt) pairSumsScalar<Visc>(c, k, i, nb, cnt, pi, vix, viy, sums);
       const Vec2 fp(sums[0], sums[1]);
       const Real invRhoi = IR[i];
-      const Real capWall = vt.pairCap / invRhoi * c.rho0;  // a wall sample's ∇²W at most (ViscosityTerm::pairCap)
+      // A wall sample's ∇²W at most (ViscosityTerm::pairCap): a division, so only near a wall.
+      const auto capWall = [&] { return vt.pairCap / invRhoi * c.rho0; };
       Vec2 acc = -fp * invRhoi;
       if (hasBoundary) {
         // Boundary samples as frozen fluid of mass ρ0·Ψ_b that carries no
@@ -551,9 +569,11 @@ std::size_t pressureForce(StepContext& c, const Spiky<Real>& spiky, const Viscos
         if (vt.walls) {
           Real sum = 0;  // Σ_b Ψ_b ∇²W_ib
           const std::uint32_t* bl = c.nbr.boundaryOf(i);
-          for (std::uint32_t q = 0; q < c.nbr.boundaryCount[i]; ++q) {
+          const std::uint32_t bc = c.nbr.boundaryCount[i];
+          const Real cap = bc > 0 ? capWall() : Real(0);
+          for (std::uint32_t q = 0; q < bc; ++q) {
             const std::uint32_t s = bl[q];
-            sum += B.volume[s] * std::min(W.laplacianR2((xi - B.samples[s]).squaredNorm()), capWall);
+            sum += B.volume[s] * std::min(W.laplacianR2((xi - B.samples[s]).squaredNorm()), cap);
           }
           const Vec2 aWall = Vec2(vix, viy) * (vt.wallFactor * invRhoi * sum);
           av -= aWall;
@@ -568,6 +588,7 @@ std::size_t pressureForce(StepContext& c, const Spiky<Real>& spiky, const Viscos
         const std::uint32_t* ml = c.nbr.movingOf(i);
         const std::uint32_t mc = c.nbr.movingCount[i];
         const Real pK = Real(0.5) * pi * invRhoi;
+        const Real cap = capWall();
         moving->forEachBody(ml, mc, [&](std::uint32_t body, const std::uint32_t* run, const std::uint32_t* runEnd) {
           Vec2 gb = Vec2::Zero(), lv = Vec2::Zero();
           Real tb = 0, tv = 0;  // Σ arm × (the pair's term), for the torque
@@ -579,7 +600,7 @@ std::size_t pressureForce(StepContext& c, const Spiky<Real>& spiky, const Viscos
             gb += g;
             tb += BodySamples::torque(moving->arm[s], g);
             if (Visc && vt.noSlip) {
-              const Vec2 u = (Vec2(vix, viy) - moving->v[s]) * (moving->volume[s] * std::min(W.laplacianR2(rr), capWall));
+              const Vec2 u = (Vec2(vix, viy) - moving->v[s]) * (moving->volume[s] * std::min(W.laplacianR2(rr), cap));
               lv += u;
               tv += BodySamples::torque(moving->arm[s], u);
             }
