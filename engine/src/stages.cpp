@@ -90,60 +90,66 @@ inline void cellOfPoint(const Grid& g, const Vec2& x, int& cx, int& cy) {
 
 /// Entries of nearInOrder16's staging buffer: a query's candidates, plus one vector's overrun.
 constexpr std::size_t kStageEntries = 512;
-/// Two slots are searched together when the second's cell is at most this many cells right
-/// of the first's in the same row: their rows then share all but this many columns.
-constexpr int kPairShift = 2;
+/// Slots are searched together (up to kGroupSlots of them) when each lies in the first's row of
+/// cells at most this many cells right of it: their rows then share all but this many columns.
+constexpr int kPairShift = 3;
+/// The most slots searched together.
+constexpr int kGroupSlots = 4;
 
-/// The fluid neighbours of slot i among the grid's candidates that are slots themselves
-/// (no periodic axis), appended to out from `used`: nearInOrder sixteen candidates at a
-/// time (AVX-512F, chosen at run time). The same r² per lane as the scalar and SSE2
-/// loops (one IEEE operation a lane, in the same order), so the same lists. Masked loads
-/// and stores: nothing is read past the positions or written past the kept entries.
-/// With Two, slot i + 1 lies in the same row of cells, `shift` cells right of i's (0: the
-/// same cell), so their candidate rows overlap: each row's candidates are loaded once over
-/// both slots' columns and tested for both. i + 1's kept slots are stored as whole
-/// vectors into a buffer on the stack (the lanes past them are overwritten or dropped) and
-/// follow i's list, which ends at *mid, at the end. `used` becomes the end of the last
-/// list. False, with nothing written, when Two and the rows hold more candidates than the
-/// buffer (a pile-up: the caller then searches for i alone); always true without Two.
-template <bool Two>
-__attribute__((target("avx512f,popcnt"))) bool nearInOrder16(const Grid& g, const Vec2* X, std::size_t i, int shift,
-                                                             Real R2, std::vector<std::uint32_t>& out, std::size_t& usedOut,
-                                                             std::size_t* mid) {
+/// The fluid neighbours of slots i .. i + N − 1 among the grid's candidates that are slots
+/// themselves (no periodic axis), appended to out from `usedOut`, slot after slot:
+/// nearInOrder sixteen candidates at a time (AVX-512F, chosen at run time). The same r² per
+/// lane as the scalar and SSE2 loops (one IEEE operation a lane, in the same order), so the
+/// same lists. Masked loads: nothing is read past the positions; whole vectors are stored past
+/// the kept entries into room reserved for them. Slot i lies in cell (cx, cy); slot i + s lies
+/// in the same row of cells, shift[s] cells right of it (0: the same cell; shift[0] = 0,
+/// nondecreasing), so their candidate rows overlap: each row's candidates are loaded once over
+/// all the slots' columns, and each slot keeps only candidates of its own columns (so its list
+/// is the one search's exactly). Slot i's kept slots go straight to out; the others' to
+/// buffers on the stack, copied after it at the end. ends[s] is the end of slot i + s's list,
+/// and `usedOut` becomes the last one. False, with nothing written, when N > 1 and the rows
+/// hold more candidates than a buffer (a pile-up: the caller then searches slot by slot).
+template <int N>
+__attribute__((target("avx512f,popcnt"))) bool nearInOrder16(const Grid& g, const Vec2* X, std::size_t i, int cx, int cy,
+                                                             const int* shift, Real R2, std::vector<std::uint32_t>& out,
+                                                             std::size_t& usedOut, std::size_t* ends) {
   std::size_t used = usedOut;  // a local: through the reference it would go through memory every chunk
   const float* xy = reinterpret_cast<const float*>(X);
-  const Vec2 xi = X[i], xn = X[i + (Two ? 1 : 0)];
-  const __m512 xi16 = _mm512_set1_ps(xi.x()), yi16 = _mm512_set1_ps(xi.y()), r216 = _mm512_set1_ps(R2);
-  const __m512 xn16 = _mm512_set1_ps(xn.x()), yn16 = _mm512_set1_ps(xn.y());
+  const __m512 r216 = _mm512_set1_ps(R2);
+  __m512 px[N], py[N];
+  int c0[N], c1[N];  // each slot's columns of cells
+  for (int q = 0; q < N; ++q) {
+    px[q] = _mm512_set1_ps(X[i + q].x());
+    py[q] = _mm512_set1_ps(X[i + q].y());
+    c0[q] = std::max(cx + shift[q] - g.reach, 0);
+    c1[q] = std::min(cx + shift[q] + g.reach, g.nx - 1);
+  }
   const __m512i evens = _mm512_setr_epi32(0, 2, 4, 6, 8, 10, 12, 14, 16, 18, 20, 22, 24, 26, 28, 30);
   const __m512i odds = _mm512_setr_epi32(1, 3, 5, 7, 9, 11, 13, 15, 17, 19, 21, 23, 25, 27, 29, 31);
   const __m512i iota = _mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
   // Grid::forCandidateRanges without a periodic axis, written out (a lambda would not
   // carry this function's target).
-  // Slot i + 1 is `shift` cells to the right of i in the same row of cells: the rows hold
-  // i's columns x0..x1 and its columns nx0..nx1; each row is read over both, and each slot
-  // keeps only candidates of its own columns (so its list is the one search's exactly).
-  int cx, cy;
-  cellOfPoint(g, xi, cx, cy);
-  const int x0 = std::max(cx - g.reach, 0), x1 = std::min(cx + g.reach, g.nx - 1);
-  const int nx0 = std::max(cx + shift - g.reach, 0), nx1 = std::min(cx + shift + g.reach, g.nx - 1);
   const int y0 = std::max(cy - g.reach, 0), y1 = std::min(cy + g.reach, g.ny - 1);
-  if (Two) {
+  if (N > 1) {
     std::size_t total = 0;
     for (int y = y0; y <= y1; ++y)
-      total += g.cellStart[std::size_t(y) * g.nx + nx1 + 1] - g.cellStart[std::size_t(y) * g.nx + x0];
+      total += g.cellStart[std::size_t(y) * g.nx + c1[N - 1] + 1] - g.cellStart[std::size_t(y) * g.nx + c0[0]];
     if (total + 16 > kStageEntries) return false;
   }
   // The first n lanes (n clamped to 0..16).
   const auto below = [](std::int64_t n) { return n <= 0 ? 0u : n >= 16 ? 0xFFFFu : (1u << n) - 1; };
-  alignas(64) std::uint32_t bufN[Two ? kStageEntries : 1];
-  std::size_t gotN = 0;
+  alignas(64) std::uint32_t buf[N > 1 ? N - 1 : 1][N > 1 ? kStageEntries : 1];
+  std::size_t got[N > 1 ? N - 1 : 1] = {};
   for (int y = y0; y <= y1; ++y) {
     const std::size_t row = std::size_t(y) * g.nx;
-    const std::uint32_t kb = g.cellStart[row + x0], ie = g.cellStart[row + x1 + 1];
-    const std::uint32_t nbeg = Two ? g.cellStart[row + nx0] : kb, ke = Two ? g.cellStart[row + nx1 + 1] : ie;
+    std::uint32_t lo[N], hi[N];  // each slot's candidates in this row
+    for (int q = 0; q < N; ++q) {
+      lo[q] = g.cellStart[row + c0[q]];
+      hi[q] = g.cellStart[row + c1[q] + 1];
+    }
+    const std::uint32_t kb = lo[0], ke = hi[N - 1];
     if (!(kb < ke)) continue;
-    const std::size_t need = used + (ie - kb) + 16;  // room for a whole vector stored past the last kept entry
+    const std::size_t need = used + (hi[0] - kb) + 16;  // room for a whole vector stored past the last kept entry
     if (out.size() < need) {
       if (out.capacity() < need) out.reserve(need + need / 16);
       out.resize(need);
@@ -153,51 +159,47 @@ __attribute__((target("avx512f,popcnt"))) bool nearInOrder16(const Grid& g, cons
       // Masks without branches (the row lengths vary: a branch on them mispredicts).
       const std::uint32_t m = std::min<std::uint32_t>(16, ke - k);
       const __mmask16 lanes = __mmask16((1u << m) - 1);
-      const __mmask16 mineI = __mmask16(lanes & below(std::int64_t(ie) - k));   // i's columns
-      const __mmask16 mineN = __mmask16(lanes & ~below(std::int64_t(nbeg) - k));  // i + 1's columns
       const std::uint64_t floats = (std::uint64_t(1) << (2 * m)) - 1;  // the 2m floats of the m candidates
-      const __mmask16 lo = __mmask16(floats & 0xFFFF), hi = __mmask16(floats >> 16);
-      const __m512 a = _mm512_maskz_loadu_ps(lo, xy + 2 * std::size_t(k));
-      const __m512 b = _mm512_maskz_loadu_ps(hi, xy + 2 * std::size_t(k) + 16);
+      const __mmask16 flo = __mmask16(floats & 0xFFFF), fhi = __mmask16(floats >> 16);
+      const __m512 a = _mm512_maskz_loadu_ps(flo, xy + 2 * std::size_t(k));
+      const __m512 b = _mm512_maskz_loadu_ps(fhi, xy + 2 * std::size_t(k) + 16);
       const __m512 xs = _mm512_permutex2var_ps(a, evens, b), ys = _mm512_permutex2var_ps(a, odds, b);
       const __m512i ks = _mm512_add_epi32(_mm512_set1_epi32(int(k)), iota);
-      // The kept lanes of slot `slot` at (px, py): within R, not the slot itself.
-      const auto keepOf = [&](__m512 px, __m512 py, std::size_t slot, __mmask16 mine)
-                              __attribute__((always_inline, target("avx512f"))) {
-        const __m512 dx = _mm512_sub_ps(px, xs), dy = _mm512_sub_ps(py, ys);
+      for (int q = 0; q < N; ++q) {
+        // Slot i + q's kept lanes: its own columns, within R, not itself.
+        const __mmask16 mine =
+            __mmask16(lanes & below(std::int64_t(hi[q]) - k) & ~below(std::int64_t(lo[q]) - k));
+        const __m512 dx = _mm512_sub_ps(px[q], xs), dy = _mm512_sub_ps(py[q], ys);
         const __m512 r2 = _mm512_add_ps(_mm512_mul_ps(dx, dx), _mm512_mul_ps(dy, dy));
-        const unsigned keep = unsigned(_mm512_mask_cmp_ps_mask(mine, r2, r216, _CMP_LT_OQ));
-        const std::size_t self = slot - k;  // wraps around when slot < k
-        return keep & ~(unsigned(self < 16) << (self & 15));
-      };
-      const unsigned keep = keepOf(xi16, yi16, i, mineI);
-      const unsigned got = unsigned(__builtin_popcount(keep));
-      _mm512_storeu_si512(dst + used, _mm512_maskz_compress_epi32(__mmask16(keep), ks));
-      used += got;
-      if (Two) {
-        const unsigned keepN = keepOf(xn16, yn16, i + 1, mineN);
-        _mm512_storeu_si512(bufN + gotN, _mm512_maskz_compress_epi32(__mmask16(keepN), ks));
-        gotN += unsigned(__builtin_popcount(keepN));
+        const std::size_t self = i + q - k;  // wraps around when i + q < k
+        const unsigned keep =
+            unsigned(_mm512_mask_cmp_ps_mask(mine, r2, r216, _CMP_LT_OQ)) & ~(unsigned(self < 16) << (self & 15));
+        const __m512i kept = _mm512_maskz_compress_epi32(__mmask16(keep), ks);
+        if (q == 0) {
+          _mm512_storeu_si512(dst + used, kept);
+          used += unsigned(__builtin_popcount(keep));
+        } else {
+          _mm512_storeu_si512(buf[q - 1] + got[q - 1], kept);
+          got[q - 1] += unsigned(__builtin_popcount(keep));
+        }
       }
     }
   }
-  if (!Two) {
-    usedOut = used;
-    return true;
+  ends[0] = used;
+  for (int q = 1; q < N; ++q) {
+    const std::size_t n = got[q - 1];
+    const std::size_t need = used + n + 16;
+    if (out.size() < need) {
+      if (out.capacity() < need) out.reserve(need + need / 16);
+      out.resize(need);
+    }
+    std::uint32_t* dst = out.data() + used;
+    for (std::size_t k = 0; k < n; k += 16)  // whole vectors: the lanes past the list are room
+      _mm512_storeu_si512(dst + k, _mm512_load_si512(buf[q - 1] + k));
+    used += n;
+    ends[q] = used;
   }
-  *mid = used;
-  const std::size_t need = used + gotN + 3;
-  if (out.size() < need) {
-    if (out.capacity() < need) out.reserve(need + need / 16);
-    out.resize(need);
-  }
-  std::uint32_t* dst = out.data() + used;
-  for (std::size_t k = 0; k < gotN; k += 16) {  // sixteen at a time, the last ones masked
-    const std::size_t left = gotN - k;
-    const __mmask16 part = left >= 16 ? __mmask16(0xFFFF) : __mmask16((1u << left) - 1);
-    _mm512_mask_storeu_epi32(dst + k, part, _mm512_load_si512(bufN + k));
-  }
-  usedOut = used + gotN;
+  usedOut = used;
   return true;
 }
 #endif
@@ -316,7 +318,7 @@ void stageNeighbours(StepContext& c) {
     std::vector<std::uint32_t>& bout = L.boundaryPerBlock[b / kBlock];
     bout.clear();
     std::size_t used = 0;
-    std::size_t listed = b;  // slots below this have their fluid lists (i + 1 of a pair searched with i)
+    std::size_t listed = b;  // slots below this have their fluid lists (those searched with an earlier slot)
     for (std::size_t i = b; i < e; ++i) {
       const Vec2 xi = P.x[i];
       if (i >= listed) {
@@ -324,21 +326,35 @@ void stageNeighbours(StepContext& c) {
         listed = i + 1;
 #ifdef SPH2D_AVX512_NEIGHBOURS
         if (inOrder && wide) {
-          int cx, cy, nx = -1, ny = -1;
+          // Slots i + 1 .. in the same row of cells, at most kPairShift cells right of i's: searched with it.
+          int cx, cy;
           cellOfPoint(g, xi, cx, cy);
-          if (i + 1 < e) cellOfPoint(g, P.x[i + 1], nx, ny);
-          std::size_t mid = 0;
-          if (ny == cy && nx >= cx && nx - cx <= kPairShift &&
-              nearInOrder16<true>(g, P.x.data(), i, nx - cx, R2, out, used, &mid)) {
-            // Near in one row of cells: the shared candidates loaded once for both.
-            L.count[i] = std::uint32_t(mid - L.start[i]);
-            L.start[i + 1] = std::uint32_t(mid);
-            L.count[i + 1] = std::uint32_t(used - mid);
-            listed = i + 2;
-          } else {
-            nearInOrder16<false>(g, P.x.data(), i, 0, R2, out, used, nullptr);  // one slot: always true
-            L.count[i] = std::uint32_t(used - L.start[i]);
+          int shift[kGroupSlots] = {0, 0, 0, 0};
+          int slots = 1;
+          for (; slots < kGroupSlots && i + std::size_t(slots) < e; ++slots) {
+            int nx, ny;
+            cellOfPoint(g, P.x[i + std::size_t(slots)], nx, ny);
+            if (ny != cy || nx < cx || nx - cx > kPairShift) break;
+            shift[slots] = nx - cx;
           }
+          std::size_t ends[kGroupSlots];
+          const Vec2* X = P.x.data();
+          bool done = false;
+          switch (slots) {
+            case 4: done = nearInOrder16<4>(g, X, i, cx, cy, shift, R2, out, used, ends); break;
+            case 3: done = nearInOrder16<3>(g, X, i, cx, cy, shift, R2, out, used, ends); break;
+            case 2: done = nearInOrder16<2>(g, X, i, cx, cy, shift, R2, out, used, ends); break;
+            default: break;
+          }
+          if (!done) {
+            slots = 1;  // alone, or a pile-up: one slot (always true)
+            nearInOrder16<1>(g, X, i, cx, cy, shift, R2, out, used, ends);
+          }
+          for (int q = 0; q < slots; ++q) {
+            L.start[i + std::size_t(q)] = q == 0 ? L.start[i] : std::uint32_t(ends[q - 1]);
+            L.count[i + std::size_t(q)] = std::uint32_t(ends[q] - L.start[i + std::size_t(q)]);
+          }
+          listed = i + std::size_t(slots);
         } else
 #endif
         {

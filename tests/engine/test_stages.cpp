@@ -142,9 +142,10 @@ TEST_CASE("integration is symplectic Euler (v += a dt, then x += v dt) and moves
   CHECK(stageIntegrate(g.c) == 1);
 }
 
-TEST_CASE("neighbour lists: every path (AVX-512 with two near slots of one row of cells searched together, SSE2, scalar) finds exactly the particles within R, in slot order") {
-  // A lattice, a pile-up too dense for the AVX-512 path's buffer (two slots of one cell there
-  // are searched one at a time), and a few isolated particles with no neighbour.
+TEST_CASE("neighbour lists: every path (AVX-512 with up to four near slots of one row of cells searched together, SSE2, scalar) finds exactly the particles within R, in slot order") {
+  // A lattice, a random cloud (groups of one to four slots of varied spread), a pile-up too
+  // dense for the AVX-512 path's buffers (its slots are searched one at a time), and a few
+  // isolated particles with no neighbour.
   ParticleStore P;
   Grid grid;
   NeighbourLists nbr;
@@ -159,6 +160,12 @@ TEST_CASE("neighbour lists: every path (AVX-512 with two near slots of one row o
     for (int x = 0; x < 40; ++x) P.push(Vec2(0.04f * x + 0.007f * (y % 3), 0.04f * y), Vec2(0, 0), id++, 1000);
   for (int k = 0; k < 700; ++k)  // 700 particles in a 0.03 m square: more candidates than a buffer holds
     P.push(Vec2(2.5f + 0.03f * float(k % 27) / 27.0f, 0.5f + 0.03f * float(k / 27) / 26.0f), Vec2(0, 0), id++, 1000);
+  std::uint32_t seed = 12345;  // a fixed LCG: the same cloud every run
+  const auto uniform = [&seed] {
+    seed = seed * 1664525u + 1013904223u;
+    return float(seed >> 8) / float(1u << 24);
+  };
+  for (int k = 0; k < 600; ++k) P.push(Vec2(0.5f + 1.2f * uniform(), 1.4f + 0.6f * uniform()), Vec2(0, 0), id++, 1000);
   for (int k = 0; k < 5; ++k) P.push(Vec2(4.0f + 0.5f * k, 2.0f), Vec2(0, 0), id++, 1000);
   stageGrid(c, true);
   REQUIRE(grid.inOrder);
