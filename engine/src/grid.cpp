@@ -17,7 +17,7 @@ void Grid::build(const Vec2* x, std::size_t n, Real support, ThreadPool& pool, i
   const Real inf = std::numeric_limits<Real>::infinity();
   const Box init{inf, inf, -inf, -inf};
   const Box box = pool.reduce(
-      n, 4096, init,
+      n, 1024, init,
       [&](std::size_t b, std::size_t e) {
         Box bx = init;
         for (std::size_t i = b; i < e; ++i) {
@@ -82,7 +82,7 @@ void Grid::build(const Vec2* x, std::size_t n, Real support, ThreadPool& pool, i
 
   inOrder = false;
   cellOf.resize(n);
-  pool.parallelFor(n, 4096, [&](std::size_t b, std::size_t e) {
+  pool.parallelFor(n, 1024, [&](std::size_t b, std::size_t e) {
     for (std::size_t i = b; i < e; ++i)
       cellOf[i] = std::uint32_t(coord(x[i].y(), lo.y(), invCellY, ny)) * std::uint32_t(nx) +
                   std::uint32_t(coord(x[i].x(), lo.x(), invCell, nx));

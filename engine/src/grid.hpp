@@ -74,7 +74,7 @@ struct Grid {
   bool wrapX = false, wrapY = false;  ///< periodic axes
   std::vector<std::uint32_t> cellStart;  ///< nx·ny + 1 offsets into sorted
   std::vector<std::uint32_t> sorted;     ///< particle indices in cell order (stable)
-  std::vector<std::uint32_t> cellOf;     ///< cell of each particle
+  std::vector<std::uint32_t> cellOf;     ///< cell of each slot at the build (stageGrid does not permute it: only the next build reads it)
   bool inOrder = false;  ///< sorted[k] == k: the particles were just reordered along the grid (stageGrid)
 
   /// Rebuilds the grid over positions x[0..n) for neighbours within `support`,

@@ -280,7 +280,7 @@ void stageGrid(StepContext& c, bool reorder, unsigned rewritten) {
   const std::vector<std::uint32_t>& order = c.grid.sorted;
   permuteParticles(P, order, c.scratch, c.pool, rewritten);
   // After the permutation slot k is the k-th particle in cell order.
-  permuteField(c.grid.cellOf, order, c.scratch.u, c.pool);
+  // grid.cellOf is not permuted: only the next build reads it, and it writes it first.
   for (std::size_t k = 0; k < c.grid.sorted.size(); ++k) c.grid.sorted[k] = std::uint32_t(k);
   c.grid.inOrder = true;
 }
