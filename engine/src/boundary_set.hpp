@@ -92,18 +92,35 @@ struct BoundarySet {
   int nearNx = 0, nearNy = 0;
 
   /// True when resolve(x, v, xOld, clearance) provably finds no candidate collider (and so
-  /// changes nothing and returns false): the move plus the clearance is at most half a
-  /// cell of nearMap, so resolve's swept box lies in the 3×3 cells around x's cell, and no
-  /// collider's bounding box touches them. False means "call resolve" (also for positions
-  /// off the map and non-finite ones).
+  /// changes nothing and returns false). When the move plus the clearance is at most half a
+  /// cell of nearMap, resolve's swept box lies in the 3×3 cells around x's cell, and x's cell
+  /// is unmarked: no collider's bounding box touches them. A longer move (the swept box over
+  /// at most kClearSpan cells a side): every cell the box covers is unmarked. False means
+  /// "call resolve" (also for positions off the map and non-finite ones).
   bool clearOf(const Vec2& x, const Vec2& xOld, Real clearance) const {
     if (bnx == 0) return true;  // resolve's own first test
     const Real d = std::max(std::abs(x.x() - xOld.x()), std::abs(x.y() - xOld.y())) + clearance;
-    if (!(d * nearInv <= Real(0.5))) return false;
-    const Real tx = (x.x() - nearLo.x()) * nearInv, ty = (x.y() - nearLo.y()) * nearInv;
-    if (!(tx >= 0 && tx < Real(nearNx) && ty >= 0 && ty < Real(nearNy))) return false;
-    return nearMap[std::size_t(ty) * std::size_t(nearNx) + std::size_t(tx)] == 0;
+    if (d * nearInv <= Real(0.5)) {
+      const Real tx = (x.x() - nearLo.x()) * nearInv, ty = (x.y() - nearLo.y()) * nearInv;
+      if (!(tx >= 0 && tx < Real(nearNx) && ty >= 0 && ty < Real(nearNy))) return false;
+      return nearMap[std::size_t(ty) * std::size_t(nearNx) + std::size_t(tx)] == 0;
+    }
+    // resolve's swept box, in cells (a cell's neighbours are unmarked too, so a box whose
+    // corner's cell is off by one through rounding is still covered).
+    const Real lx = (std::min(x.x(), xOld.x()) - clearance - nearLo.x()) * nearInv;
+    const Real hx = (std::max(x.x(), xOld.x()) + clearance - nearLo.x()) * nearInv;
+    const Real ly = (std::min(x.y(), xOld.y()) - clearance - nearLo.y()) * nearInv;
+    const Real hy = (std::max(x.y(), xOld.y()) + clearance - nearLo.y()) * nearInv;
+    if (!(lx >= 0 && ly >= 0 && hx < Real(nearNx) && hy < Real(nearNy))) return false;  // off the map, or not finite
+    const int x0 = int(lx), x1 = int(hx), y0 = int(ly), y1 = int(hy);
+    if (x1 - x0 >= kClearSpan || y1 - y0 >= kClearSpan) return false;
+    for (int cy = y0; cy <= y1; ++cy)
+      for (int cx = x0; cx <= x1; ++cx)
+        if (nearMap[std::size_t(cy) * std::size_t(nearNx) + std::size_t(cx)]) return false;
+    return true;
   }
+  /// The longest swept box clearOf tests cell by cell, in its cells a side (longer: resolve).
+  static constexpr int kClearSpan = 4;
 
   /// The colliders whose bounding box meets the box [lo, hi], each once, into out[0, cap)
   /// in bin order (the bins the box covers): returns how many. `overflow` is set when more

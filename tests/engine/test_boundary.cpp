@@ -111,21 +111,25 @@ TEST_CASE("the collision's early-out skips only particles the swept collision le
     seed = seed * 1664525u + 1013904223u;
     return lo + (hi - lo) * Real(double(seed >> 8) / double(1u << 24));
   };
-  int skipped = 0, changed = 0;
+  int skipped = 0, skippedLong = 0, changed = 0;
   for (int k = 0; k < 400000; ++k) {
     // Over the solids, the space between them and off the map (a few cells beyond them).
     const Vec2 xOld(uniform(-1.0f, 2.1f), uniform(-0.7f, 2.2f));
-    const Real reach = k % 4 == 0 ? Real(0.1) : Real(0.01);  // most moves short, some long
+    // Most moves short (within a cell of the map: 0.05 m), some long (up to four cells: the
+    // early-out then tests every cell of the swept box).
+    const Real reach = k % 4 == 0 ? Real(0.1) : Real(0.01);
     const Vec2 x0 = xOld + Vec2(uniform(-reach, reach), uniform(-reach, reach));
     if (!b.clearOf(x0, xOld, clearance)) continue;
     ++skipped;
+    skippedLong += int(std::max(std::abs(x0.x() - xOld.x()), std::abs(x0.y() - xOld.y())) + clearance > Real(0.025));
     Vec2 x = x0, v(uniform(-3, 3), uniform(-3, 3));
     const Vec2 v0 = v;
     const bool contact = b.resolve(x, v, xOld, clearance);
     changed += int(contact || !(x == x0) || !(v == v0));
   }
   CHECK(changed == 0);
-  CHECK(skipped > 100000);  // the early-out does skip most of the open space
+  CHECK(skipped > 100000);     // the early-out does skip most of the open space
+  CHECK(skippedLong > 20000);  // long moves too
 }
 
 TEST_CASE("the swept collision puts a particle that crossed an edge back on its side at the clearance, with the fixture's restitution and friction") {

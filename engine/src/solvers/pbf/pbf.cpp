@@ -283,7 +283,9 @@ std::size_t Pbf::predict(StepContext& c, std::vector<Real>& lambda) {
       if (shift) x += (*shift)[i];
       Vec2 vd = v;  // resolve()'s velocity response is not used: v follows from the positions
       const Vec2 xFree = x;
-      if (c.boundary.resolve(x, vd, x0, c.clearance) && countWall) push += x.cast<double>() - xFree.cast<double>();
+      // clearOf: resolve would find no collider near the move (most particles; exact).
+      if (!c.boundary.clearOf(x, x0, c.clearance) && c.boundary.resolve(x, vd, x0, c.clearance) && countWall)
+        push += x.cast<double>() - xFree.cast<double>();
       P.xPrev[i] = x0;
       P.v[i] = v;
       P.x[i] = x;

@@ -353,7 +353,8 @@ std::size_t Pbf::correct(StepContext& c, std::vector<Real>& lambda, Real omega, 
       if (resolveEach_ && c.nbr.boundaryCount[i]) {
         Vec2 vd = Vec2::Zero();
         const Vec2 xFree = x;
-        if (c.boundary.resolve(x, vd, x0, c.clearance) && countWall) push += x.cast<double>() - xFree.cast<double>();
+        if (!c.boundary.clearOf(x, x0, c.clearance) && c.boundary.resolve(x, vd, x0, c.clearance) && countWall)
+          push += x.cast<double>() - xFree.cast<double>();
       }
       (list ? P.x[i] : xNew_[i]) = x;
       if (bad == kNone && !allFinite(x)) bad = i;
