@@ -50,15 +50,21 @@ class ThreadPool {
   }
 
  private:
-  void workerLoop();
-  void runBlocks(bool front);
+  void workerLoop(std::size_t self);
+  void runBlocks(std::size_t self);
+
+  /// One thread's share of a job's blocks: the next unclaimed (low 32 bits) and one past
+  /// the last (high 32), alone on its cache line.
+  struct alignas(64) Share {
+    std::atomic<std::uint64_t> word{0};
+  };
 
   std::vector<std::thread> workers_;
   std::mutex mutex_;
   std::condition_variable wake_;
   std::atomic<unsigned long long> epoch_{0};
-  std::atomic<std::uint64_t> ticket_{0};  ///< the job's unclaimed blocks: first (low 32 bits), one past the last (high 32)
-  std::atomic<std::size_t> done_{0};      ///< blocks of the job finished
+  std::vector<Share> shares_;             ///< per thread (0: the caller), the job's unclaimed blocks
+  alignas(64) std::atomic<std::size_t> done_{0};  ///< blocks of the job finished
   std::atomic<bool> stop_{false};
   const std::function<void(std::size_t, std::size_t)>* fn_ = nullptr;
   std::size_t n_ = 0, block_ = 1;

@@ -1,16 +1,19 @@
 // The job system (engine/src/thread_pool.cpp): fixed blocks that cover every
 // index once whatever the thread count, reductions combined in block order (the
-// engine's bit-identity across thread counts rests on it), and exceptions
-// carried back to the caller.
+// engine's bit-identity across thread counts rests on it), exceptions carried
+// back to the caller, and the per-thread shares: a held-up thread's blocks are
+// taken by the others, and late workers claim nothing twice.
 #include <doctest/doctest.h>
 
 #include <atomic>
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <memory>
 #include <random>
 #include <stdexcept>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "thread_pool.hpp"
@@ -110,4 +113,71 @@ TEST_CASE("a pool of 0 threads takes the hardware's, at least one") {
   std::atomic<int> sum{0};
   pool.parallelFor(100, 7, [&](std::size_t b, std::size_t e) { sum += int(e - b); });
   CHECK(sum == 100);
+}
+
+namespace {
+/// Runs a 2-thread job of 64 one-item blocks (shares: blocks 0–31 the caller's, 32–63 the
+/// worker's) whose first block on thread `held` (caller or worker) waits until another thread has
+/// run a block of `held`'s share (at most 20 s). Returns how many blocks of that share ran on
+/// another thread; `once` is false when a block ran twice or not at all.
+int blocksTakenFromHeldShare(bool holdCaller, bool& once) {
+  ThreadPool pool(2);
+  const std::size_t n = 64, half = n / 2;
+  const std::thread::id caller = std::this_thread::get_id();
+  std::vector<std::thread::id> ranOn(n);
+  std::unique_ptr<std::atomic<int>[]> calls(new std::atomic<int>[n]);
+  for (std::size_t k = 0; k < n; ++k) calls[k] = 0;
+  std::atomic<int> takenByOther{0};
+  std::atomic<bool> held{false};
+  const std::size_t first = holdCaller ? 0 : half;  // the held thread's share
+  pool.parallelFor(n, 1, [&](std::size_t b, std::size_t) {
+    const bool onCaller = std::this_thread::get_id() == caller;
+    ranOn[b] = std::this_thread::get_id();
+    ++calls[b];
+    const bool inHeldShare = b >= first && b < first + half;
+    if (inHeldShare && onCaller != holdCaller) ++takenByOther;
+    if (onCaller == holdCaller && !held.exchange(true)) {
+      const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(20);
+      while (takenByOther == 0 && std::chrono::steady_clock::now() < until) std::this_thread::yield();
+    }
+  });
+  once = true;
+  for (std::size_t k = 0; k < n; ++k) once = once && calls[k] == 1;
+  return takenByOther;
+}
+}  // namespace
+
+TEST_CASE("work stealing: the blocks of a thread held up in one block are run by the other thread, each once") {
+  // Each thread starts on its own share; when it is used up it takes the others' blocks from
+  // their back. A thread stuck in one block must not hold up the rest of its share.
+  for (bool holdCaller : {true, false}) {
+    CAPTURE(holdCaller);
+    bool once = false;
+    const int taken = blocksTakenFromHeldShare(holdCaller, once);
+    CHECK(once);
+    CHECK(taken > 0);
+  }
+}
+
+TEST_CASE("many short jobs in a row, more threads than cores: each block of each job runs once (late workers claim nothing stale)") {
+  // Oversubscribed pools get their workers descheduled mid-claim: a worker that wakes after its
+  // job ended must not run a block of it again, nor a block of the next job twice.
+  for (int threads : {2, 3, 5}) {
+    CAPTURE(threads);
+    ThreadPool pool(threads);
+    std::vector<std::atomic<int>> hits(800);
+    int bad = 0;
+    for (int job = 0; job < 30000; ++job) {
+      // Every third job has fewer blocks than threads (empty shares, shares of one block:
+      // thieves meet on the last block of a share that starts at block 0).
+      const std::size_t n = job % 3 ? 1 + std::size_t(job * 7919) % 700 : 2 + std::size_t(job) % 4;
+      const std::size_t block = job % 3 ? 1 + std::size_t(job) % 37 : 1;
+      for (std::size_t i = 0; i < n; ++i) hits[i].store(0, std::memory_order_relaxed);
+      pool.parallelFor(n, block, [&](std::size_t b, std::size_t e) {
+        for (std::size_t i = b; i < e; ++i) hits[i].fetch_add(1, std::memory_order_relaxed);
+      });
+      for (std::size_t i = 0; i < n; ++i) bad += hits[i].load(std::memory_order_relaxed) != 1;
+    }
+    CHECK(bad == 0);
+  }
 }
