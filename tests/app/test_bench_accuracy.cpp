@@ -1,6 +1,6 @@
 // `sph2d bench accuracy --quick`: the report's smoke test. It asserts the
 // files, the CSV's columns and that every solver produced a finite error, not
-// any timing (timings belong to the benchmark itself).
+// any timing (timings belong to the benchmark itself), and that every solver keeps its rows.
 #include <doctest/doctest.h>
 
 #include <cmath>
@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "app_util.hpp"
+#include "sph2d/scene.hpp"
 
 using namespace sph2d::apptest;
 
@@ -41,8 +42,12 @@ TEST_CASE("bench accuracy --quick writes the CSV, the table and the charts, with
     ++rows;
   }
   CHECK(cases == std::set<std::string>{"dam_break", "hydrostatic", "taylor_green", "poiseuille"});
-  CHECK(solvers.count("muller2003") == 1);
-  CHECK(solvers.count("wcsph") == 1);
+  // Every solver keeps its rows (issue 15): the seed's, the three quality presets' and pbf.
+  for (const char* s : {"muller2003", "wcsph", "dfsph", "pbf", "game"}) {
+    CAPTURE(s);
+    CHECK(solvers.count(s) == 1);
+  }
+  for (const std::string& q : sph2d::qualityPresets()) CHECK(solvers.count(sph2d::qualityPreset(q).type) == 1);
   CHECK(rows == 4 * int(solvers.size()));
   CHECK(readText(dir + "/accuracy.md").find("| dam_break |") != std::string::npos);
   CHECK(std::filesystem::file_size(dir + "/dam_break.png") > 1000);
