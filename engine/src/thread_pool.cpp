@@ -1,3 +1,27 @@
+// thread_pool.cpp — the job system every stage runs on (thread_pool.hpp): a fork-join
+// pool whose jobs are fixed blocks claimed dynamically, so that results never depend on
+// which thread ran a block (docs/ARCHITECTURE.md, "the job system").
+//
+// The hand-off. A job's blocks are cut into one contiguous share per thread (the same
+// shares for every job of the same size), each share one 64-bit word on its own cache
+// line: the next unclaimed block in the low 32 bits, one past the last in the high 32.
+// A thread claims from the front of its own share (an atomic add on a line the others
+// touch only once their own shares are used up), then from the back of the others' (a
+// compare-and-swap of the high half, only while the share holds a block). Each claim is
+// one atomic read-modify-write of one word, so each block is claimed once: an add whose
+// old word has next >= end claims nothing (and leaves next past the end, which reads the
+// same); the end never drops below next, so never below 0. Each thread adds its count of
+// finished blocks once, at the end. So a particle's data stays in the cache of the core
+// that wrote it in the last stage, and only steals and the one done add per thread move
+// a line between the cores (one shared ticket and a done add per block cost a line
+// transfer per block: 21 us against 6 us for a trivial 79-block job on this 2-core
+// machine). Which thread runs a block never changes what the block computes.
+//
+// A worker that wakes late (descheduled on a busy machine) claims nothing from the
+// shares of a finished job (all used up); if the caller has published the next job's
+// shares meanwhile, its claim is a claim of that job, and it reads the job (fn_, n_,
+// block_, written before the shares) after the claim. The caller waits for the job's
+// blocks to be done, not for every worker to check in.
 #include "thread_pool.hpp"
 
 #include <chrono>
@@ -10,26 +34,6 @@
 
 namespace sph2d {
 
-// The hand-off. A job's blocks are cut into one contiguous share per thread (the same
-// shares for every job of the same size), each share one 64-bit word on its own cache
-// line: the next unclaimed block in the low 32 bits, one past the last in the high 32.
-// A thread claims from the front of its own share (an atomic add on a line no other
-// thread touches until the share runs low), then, when its share is used up, from the
-// back of the others' (a compare-and-swap of the high half, only while the share holds a
-// block). Each claim is one atomic read-modify-write of one word, so each block is
-// claimed once: an add whose old word has next >= end claims nothing (and leaves next
-// past the end, which reads the same); the end never drops below next, so never below 0.
-// So a particle's data stays in the cache of the core that wrote it in the last stage,
-// and the claims do not bounce one cache line between the cores (one shared ticket cost
-// a line transfer per block: 21 us against 6 us for a trivial 79-block job on this
-// 2-core machine). Each thread adds its count of finished blocks once, at the end.
-// Which thread runs a block never changes what the block computes.
-//
-// A worker that wakes late (descheduled on a busy machine) claims nothing from the
-// shares of a finished job (all used up); if the caller has published the next job's
-// shares meanwhile, its claim is a claim of that job, and it reads the job (fn_, n_,
-// block_, written before the shares) after the claim. The caller waits for the job's
-// blocks to be done, not for every worker to check in.
 namespace {
 constexpr std::uint64_t kHalfBits = 32;
 constexpr std::uint64_t kHalfMask = (std::uint64_t(1) << kHalfBits) - 1;
@@ -131,7 +135,7 @@ void ThreadPool::parallelFor(std::size_t n, std::size_t block,
   done_.store(0, std::memory_order_relaxed);
   const std::size_t threads = shares_.size();
   for (std::size_t t = 0; t < threads; ++t) {
-    const std::uint64_t first = blocks * t / threads, last = blocks * (t + 1) / threads;
+    const std::uint64_t first = std::uint64_t(blocks) * t / threads, last = std::uint64_t(blocks) * (t + 1) / threads;
     shares_[t].word.store((last << kHalfBits) | first, std::memory_order_release);
   }
   {

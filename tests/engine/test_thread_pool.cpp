@@ -117,25 +117,28 @@ TEST_CASE("a pool of 0 threads takes the hardware's, at least one") {
 
 namespace {
 /// Runs a 2-thread job of 64 one-item blocks (shares: blocks 0–31 the caller's, 32–63 the
-/// worker's) whose first block on thread `held` (caller or worker) waits until another thread has
-/// run a block of `held`'s share (at most 20 s). Returns how many blocks of that share ran on
-/// another thread; `once` is false when a block ran twice or not at all.
-int blocksTakenFromHeldShare(bool holdCaller, bool& once) {
+/// worker's) whose first block on the held thread (caller or worker) waits until another thread
+/// has run a block of the held thread's share (at most 20 s). Returns the blocks of that share
+/// the other thread ran; `once` is false when a block ran twice or not at all; `ownInOrder` is
+/// false when the other thread ran blocks of its own share out of ascending order.
+std::vector<std::size_t> blocksTakenFromHeldShare(bool holdCaller, bool& once, bool& ownInOrder) {
   ThreadPool pool(2);
   const std::size_t n = 64, half = n / 2;
   const std::thread::id caller = std::this_thread::get_id();
-  std::vector<std::thread::id> ranOn(n);
   std::unique_ptr<std::atomic<int>[]> calls(new std::atomic<int>[n]);
-  for (std::size_t k = 0; k < n; ++k) calls[k] = 0;
+  std::unique_ptr<std::atomic<bool>[]> byOther(new std::atomic<bool>[n]);
+  for (std::size_t k = 0; k < n; ++k) calls[k] = 0, byOther[k] = false;
+  std::unique_ptr<std::atomic<int>[]> stamp(new std::atomic<int>[n]);  // the order blocks started in
+  std::atomic<int> seq{0};
   std::atomic<int> takenByOther{0};
   std::atomic<bool> held{false};
   const std::size_t first = holdCaller ? 0 : half;  // the held thread's share
   pool.parallelFor(n, 1, [&](std::size_t b, std::size_t) {
     const bool onCaller = std::this_thread::get_id() == caller;
-    ranOn[b] = std::this_thread::get_id();
     ++calls[b];
-    const bool inHeldShare = b >= first && b < first + half;
-    if (inHeldShare && onCaller != holdCaller) ++takenByOther;
+    stamp[b] = seq++;
+    byOther[b] = onCaller != holdCaller;  // run by the thread that is not held
+    if (byOther[b] && b >= first && b < first + half) ++takenByOther;
     if (onCaller == holdCaller && !held.exchange(true)) {
       const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(20);
       while (takenByOther == 0 && std::chrono::steady_clock::now() < until) std::this_thread::yield();
@@ -143,33 +146,52 @@ int blocksTakenFromHeldShare(bool holdCaller, bool& once) {
   });
   once = true;
   for (std::size_t k = 0; k < n; ++k) once = once && calls[k] == 1;
-  return takenByOther;
+  // The other thread's own share: the blocks it ran there, in the order they started.
+  const std::size_t otherFirst = holdCaller ? half : 0;
+  ownInOrder = true;
+  int last = -1;
+  for (std::size_t k = otherFirst; k < otherFirst + half; ++k) {
+    if (!byOther[k]) continue;
+    ownInOrder = ownInOrder && stamp[k] > last;
+    last = stamp[k];
+  }
+  std::vector<std::size_t> taken;
+  for (std::size_t k = first; k < first + half; ++k)
+    if (byOther[k]) taken.push_back(k);
+  return taken;
 }
 }  // namespace
 
-TEST_CASE("work stealing: the blocks of a thread held up in one block are run by the other thread, each once") {
+TEST_CASE("work stealing: the blocks of a thread held up in one block are run by the other thread, each once, from its share's back") {
   // Each thread starts on its own share; when it is used up it takes the others' blocks from
-  // their back. A thread stuck in one block must not hold up the rest of its share.
+  // their back. A thread stuck in one block must not hold up the rest of its share, and what
+  // the other takes is the share's end (the held thread keeps the front it will reach first).
   for (bool holdCaller : {true, false}) {
     CAPTURE(holdCaller);
-    bool once = false;
-    const int taken = blocksTakenFromHeldShare(holdCaller, once);
+    bool once = false, ownInOrder = false;
+    const std::vector<std::size_t> taken = blocksTakenFromHeldShare(holdCaller, once, ownInOrder);
     CHECK(once);
-    CHECK(taken > 0);
+    CHECK(ownInOrder);  // its own share front to back (the same particles as in the last stage)
+    REQUIRE(!taken.empty());
+    const std::size_t shareEnd = holdCaller ? 32 : 64;
+    bool suffix = true;  // the taken blocks are the share's last ones, without a gap
+    for (std::size_t k = 0; k < taken.size(); ++k) suffix = suffix && taken[k] == shareEnd - taken.size() + k;
+    CHECK(suffix);
   }
 }
 
-TEST_CASE("many short jobs in a row, more threads than cores: each block of each job runs once (late workers claim nothing stale)") {
+TEST_CASE("many short jobs in a row, up to more threads than cores: each block of each job runs once (late workers claim nothing stale)") {
   // Oversubscribed pools get their workers descheduled mid-claim: a worker that wakes after its
   // job ended must not run a block of it again, nor a block of the next job twice.
-  for (int threads : {2, 3, 5}) {
+  const int over = int(std::thread::hardware_concurrency()) + 1;  // more threads than this machine has cores
+  for (int threads : {2, 3, 5, over}) {
     CAPTURE(threads);
     ThreadPool pool(threads);
     std::vector<std::atomic<int>> hits(800);
     int bad = 0;
     for (int job = 0; job < 30000; ++job) {
-      // Every third job has fewer blocks than threads (empty shares, shares of one block:
-      // thieves meet on the last block of a share that starts at block 0).
+      // Every third job has 2–5 blocks: fewer than the threads of the larger pools (empty
+      // shares, shares of one block: thieves meet on the last block of a share that starts at 0).
       const std::size_t n = job % 3 ? 1 + std::size_t(job * 7919) % 700 : 2 + std::size_t(job) % 4;
       const std::size_t block = job % 3 ? 1 + std::size_t(job) % 37 : 1;
       for (std::size_t i = 0; i < n; ++i) hits[i].store(0, std::memory_order_relaxed);
