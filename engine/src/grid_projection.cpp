@@ -379,6 +379,7 @@ void GridProjection::assemble() {
   diag_.assign(m, 0);
   if (surface_) thetaUp_.assign(type_.size(), Real(1));
   adj_.assign(4 * m, -1);
+  vented_.assign(m, 0);
   forUnknowns([&](std::size_t a, int i, int j) {
     const int k = cells_[a];
     const bool open[4] = {uOpen_[std::size_t(j) * nu + i] != 0, uOpen_[std::size_t(j) * nu + i + 1] != 0,
@@ -397,13 +398,17 @@ void GridProjection::assemble() {
         const Real theta = std::clamp(Real((double(ytop) + 0.5 * double(dx_) - ya) * double(invH_)), kMinSurfaceFraction, Real(1));
         dg += Real(1) / theta;
         thetaUp_[std::size_t(k)] = theta;
+        vented_[a] = 1;
       } else if (open[q] && t != kSolid && t != kBody) {
         dg += 1;
+        if (t == kAir) vented_[a] = 1;
       }
       adj_[4 * a + q] = open[q] ? index_[std::size_t(nb[q])] : -1;  // −1: air, solid or closed
     }
     diag_[a] = dg;
   });
+  assembleCoupling();
+  groundPockets();
   nbrPad_.resize(adj_.size());
   for (std::size_t e = 0; e < adj_.size(); ++e) nbrPad_[e] = adj_[e] >= 0 ? adj_[e] : std::int32_t(m);
   // MIC(0) (Bridson, "Fluid Simulation for Computer Graphics", 2nd ed., fig. 5.7):
@@ -429,7 +434,75 @@ void GridProjection::assemble() {
   }
   precon2_.resize(m);
   for (std::size_t a = 0; a < m; ++a) precon2_[a] = precon_[a] * precon_[a];
-  assembleCoupling();
+}
+
+void GridProjection::groundPockets() {
+  // A pocket: fluid cells joined by open faces with no open face to air (no κ = 0 anywhere)
+  // and no dynamic body to push. Its rows are a pure Neumann Laplacian: singular, κ only up
+  // to a constant, solvable only when its right-hand side sums to zero. Fluid cut off by a
+  // wall from the rest (the cells between the teeth of an acute chain, or a sealed tank
+  // filled to the lid) makes one; conjugate gradients on it divide by a vanishing d·Ad and
+  // return infinities (a 50 m/s jet into a zigzag funnel stopped with a NaN shift). Each
+  // pocket's last cell is grounded (diagonal + 1, so the system is definite), and
+  // balance() takes the pocket's mean out of each right-hand side: then the grounded row's
+  // κ is 0 and every row's equation holds as before. A sealed pocket cannot change its
+  // volume; the mean compression it cannot shed stays with the particle solve.
+  const std::size_t m = cells_.size();
+  std::vector<std::int32_t>& root = pocketOf_;
+  root.resize(m);
+  auto find = [&](std::int32_t a) {
+    while (root[std::size_t(a)] != a) a = root[std::size_t(a)] = root[std::size_t(root[std::size_t(a)])];
+    return a;
+  };
+  for (std::size_t a = 0; a < m; ++a) {
+    root[a] = std::int32_t(a);
+    for (int q : {0, 2}) {  // left and down: already labelled
+      const std::int32_t b = adj_[4 * a + std::size_t(q)];
+      if (b < 0) continue;
+      const std::int32_t ra = find(std::int32_t(a)), rb = find(b);
+      if (ra != rb) root[std::size_t(std::max(ra, rb))] = std::min(ra, rb);  // the lower index is the root
+    }
+  }
+  for (const Coupling& e : coupling_) vented_[std::size_t(find(e.unknown))] = 1;  // a body can move: not sealed
+  for (std::size_t a = 0; a < m; ++a) {
+    const std::int32_t r = find(std::int32_t(a));
+    if (vented_[a]) vented_[std::size_t(r)] = 1;
+    root[a] = r;
+  }
+  // Pocket numbers in order of their roots; −1 for cells of a vented region.
+  pocketCells_.clear();
+  pocketLast_.clear();
+  for (std::size_t a = 0; a < m; ++a) {
+    const std::int32_t r = root[a];
+    if (vented_[std::size_t(r)]) {
+      root[a] = -1;
+      continue;
+    }
+    std::int32_t id;
+    if (std::size_t(r) == a) {
+      id = std::int32_t(pocketCells_.size());
+      pocketCells_.push_back(0);
+      pocketLast_.push_back(0);
+    } else {
+      id = root[std::size_t(r)];  // the root, visited first, holds its pocket's number
+    }
+    root[a] = id;
+    ++pocketCells_[std::size_t(id)];
+    pocketLast_[std::size_t(id)] = std::int32_t(a);
+  }
+  for (const std::int32_t a : pocketLast_) diag_[std::size_t(a)] += 1;
+}
+
+void GridProjection::balance(std::vector<Real>& rhs) const {
+  if (pocketLast_.empty()) return;
+  std::vector<double> sum(pocketLast_.size(), 0.0);  // the two solves balance side by side: no shared scratch
+  for (std::size_t a = 0; a < cells_.size(); ++a)
+    if (pocketOf_[a] >= 0) sum[std::size_t(pocketOf_[a])] += double(rhs[a]);
+  for (std::size_t a = 0; a < cells_.size(); ++a)
+    if (pocketOf_[a] >= 0) {
+      const std::size_t id = std::size_t(pocketOf_[a]);
+      rhs[a] -= Real(sum[id] / double(pocketCells_[id]));
+    }
 }
 
 void GridProjection::precondition(const std::vector<Real>& r, std::vector<Real>& z, std::vector<Real>& y) const {
@@ -632,6 +705,7 @@ void GridProjection::pressureSystem(const StepContext& c) {
     const Real src = div - rate_ * comp / dt;  // a compressed cell is to expand by rate·comp over the substep
     rhs_[a] = -(h_ * h_ / dt) * src;
   });
+  balance(rhs_);
 }
 
 void GridProjection::shiftSystem(const StepContext& c) {
@@ -659,6 +733,7 @@ void GridProjection::shiftSystem(const StepContext& c) {
     }
     rhsS_[a] = (h_ * h_ / dt) * src / dt;
   }
+  balance(rhsS_);
 }
 
 void GridProjection::solve(const StepContext& c) {
@@ -715,6 +790,7 @@ void GridProjection::solve(const StepContext& c) {
     }
   }
   stats_.iterations += itS;
+  stats_.pockets = int(pocketLast_.size());
   stats_.residual = double(res * dt * dt * invH_ * invH_);
   for (std::size_t a = 0; a < m; ++a) kappa_[std::size_t(cells_[a])] = x[a];
   pH_ = h_;

@@ -70,6 +70,7 @@ struct GridProjectionStats {
   int iterations = 0;       ///< conjugate-gradient iterations (the pressure's and the shift's solves)
   int fluidCells = 0;       ///< unknowns
   double residual = 0;      ///< largest |Δρ/ρ0| the pressure solve's remaining residual stands for over the substep
+  int pockets = 0;          ///< sealed pockets grounded (fluid regions with no open face to air and no dynamic body)
 };
 
 class GridProjection {
@@ -123,6 +124,11 @@ class GridProjection {
   void markBodies(const StepContext& c);
   /// The coupling rows G: one per (fluid cell, dynamic body) pair whose faces touch.
   void assembleCoupling();
+  /// Finds the sealed pockets (fluid regions with no open face to air and no dynamic body)
+  /// and grounds each one's last cell (pocketOf_, pocketCells_, pocketLast_; diag_).
+  void groundPockets();
+  /// Takes each sealed pocket's mean out of a right-hand side (summed in cell order).
+  void balance(std::vector<Real>& rhs) const;
   /// The velocity along +x (axis 0, u face) or +y (axis 1, v face) that a moving body's
   /// cell imposes on face (i, j): g·(v, ω) with the face's corrected coupling g.
   Real bodyFaceVelocity(int body, int axis, int i, int j) const;
@@ -191,6 +197,9 @@ class GridProjection {
   std::vector<std::int32_t> nbrPad_;        ///< adj_ with m for none (applyDot reads a 0 there)
   std::vector<Real> precon_, precon2_;      ///< MIC(0) factor: 1/diag(L), and its square
   std::vector<std::int32_t> rowStart_;      ///< per grid row: its first unknown (ny + 1 entries, the last m)
+  std::vector<std::uint8_t> vented_;        ///< per unknown: an open face to air (then per region root: the region has one)
+  std::vector<std::int32_t> pocketOf_;      ///< per unknown: its sealed pocket (−1: a vented region)
+  std::vector<std::int32_t> pocketCells_, pocketLast_;  ///< per pocket: its cell count, its grounded (last) unknown
   // Warm start: the last substep's κ by anchored cell.
   Real pH_ = 0;  ///< the cell size of prevKappa_
   long pI0_ = 0, pJ0_ = 0;

@@ -260,7 +260,7 @@ void Pbf::calibrate(const StepContext& c) {
 
 std::size_t Pbf::predict(StepContext& c, std::vector<Real>& lambda) {
   ParticleStore& P = c.P;
-  const Real dt = c.dt, vmax2 = c.maxSpeed * c.maxSpeed;
+  const Real dt = c.dt, vmax2 = c.maxSpeed * c.maxSpeed, moveMax2 = vmax2 * dt * dt;
   // The grid projection's compression shift of this substep (positions only).
   const std::vector<Vec2>* shift =
       projection_ && projection_->shift().size() == P.size() ? &projection_->shift() : nullptr;
@@ -290,7 +290,10 @@ std::size_t Pbf::predict(StepContext& c, std::vector<Real>& lambda) {
       P.v[i] = v;
       P.x[i] = x;
       lambda[i] = 0;
-      if (bad == kNone && (!allFinite(x) || !allFinite(v) || v.squaredNorm() > vmax2)) bad = i;
+      // A move longer than the speed limit allows over the substep is a runaway too (the
+      // shift and the sweep move positions without a velocity the speed check would see).
+      if (bad == kNone && (!allFinite(x) || !allFinite(v) || v.squaredNorm() > vmax2 || (x - x0).squaredNorm() > moveMax2))
+        bad = i;
     }
     if (countWall) wallBlock_[2 * (b / kBlock) + 1] = push;
     return bad;
