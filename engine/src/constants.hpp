@@ -57,6 +57,12 @@ constexpr Real kStaticPushSpeed = Real(10);
 /// the neighbour search radius before the next step's limits see it.
 constexpr Real kMaxMove = Real(0.5);
 
+/// dt ≤ kPressureCfl·R/sqrt(|g| D), D the greatest depth below the top of a particle's
+/// column: the hydrostatic pressure's own stiffness (a wave of speed ~sqrt(|g| D) crosses at
+/// most this share of a support a substep) for the solvers whose iterations carry that pressure
+/// (dfsph; pbf without the grid projection). docs/SOLVERS.md has the measurements.
+constexpr Real kPressureCfl = Real(0.35);
+
 /// The grid's ghost-fluid surface is never nearer a fluid cell's centre than this
 /// fraction of a cell: nearer, the cell's 1/θ would dominate its row for no gain (its
 /// pressure is ~0 either way) and slow the conjugate gradients.

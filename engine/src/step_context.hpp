@@ -106,6 +106,9 @@ struct StepContext {
   Vec2 gravity = Vec2::Zero();
   Real clearance = 0;           ///< distance kept from solid surfaces
   Real maxSpeed = 0;            ///< the guard's runaway limit
+  /// The fastest particle an emitter may add in this frame (its speed × (1 + jitter)): the
+  /// substep is set for it as for the particles already there (World::Impl::sourceSpeed).
+  Real sourceSpeed = 0;
   std::uint64_t step = 0;       ///< substep counter
   double time = 0;              ///< simulated time at the start of the substep
   Vec2d origin{0, 0};           ///< local frame offset (world = local + origin)

@@ -112,9 +112,25 @@ void World::Impl::addParticleSystemStages(StageList& list) {
   if (contactsOn) list.add(plainStage("contacts", [this](StepContext& c) { recordContacts(c); }));
 }
 
+Real World::Impl::sourceSpeed() const {
+  // An emitter adds particles at its speed within the substep, upstream of its nozzle by up
+  // to that speed × the substep (particle_system.cpp): the substep must be short enough for
+  // them too. An empty world's first substep would otherwise be a whole frame, and a 50 m/s
+  // jet's first particles were placed 0.4 m behind the nozzle (stacked on it where a wall
+  // was nearer).
+  double v = 0;
+  const double horizon = time + 1.0 / double(scene.fps);
+  for (const EmitterState& s : emitters) {
+    const EmitterDef& d = s.def;
+    if (d.enabled && d.rate > 0 && time < d.stop && d.start <= horizon) v = std::max(v, d.speed * (1.0 + d.jitter));
+  }
+  return Real(v);
+}
+
 Real World::Impl::stableDt() {
-  const Real vmax = maxSpeedOf(P, pool);
-  const StepContext c = context(0);
+  StepContext c = context(0);
+  c.sourceSpeed = sourceSpeed();
+  const Real vmax = std::max(maxSpeedOf(P, pool), c.sourceSpeed);
   Real dt = solver->maxTimeStep(c, vmax, lastAccel);
   for (const auto& e : effects)
     if (e->enabled) dt = std::min(dt, e->maxTimeStep(c));

@@ -192,6 +192,8 @@ struct World::Impl {
   void addParticleSystemStages(StageList& list);
   /// The substep length the solver's and the enabled effects' limits allow now.
   Real stableDt();
+  /// The fastest speed an enabled emitter may give a particle within the next frame (0: none).
+  Real sourceSpeed() const;
   /// One substep of length dt (or shorter, if a stage shortened it): the stage list
   /// (driftOnly: the drift list), then the clock. Returns the substep taken.
   Real substep(Real dt, bool driftOnly = false);

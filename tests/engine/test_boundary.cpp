@@ -189,8 +189,8 @@ SceneDef pourScene(std::vector<ShapeDef> container, double x, double stop, const
 /// Fires a 50 m/s jet at x = 0.6..., y = 2 towards +x for 0.15 s into `target` with
 /// `solver`, runs 2 s, and checks every frame: no NaN or Inf, and the kinetic energy
 /// never above what the emitter put in (N · ½ m (50 m/s)², no gravity; 1 % more is
-/// allowed: particles enter with random offsets of ±0.1 dx across the nozzle, and the
-/// pressure of that disorder speeds the stream up a little, at most 0.04 % measured).
+/// allowed: the stream's rows are no rest lattice at its free edges, and their pressure
+/// can speed it up a little; at most 0.04 % measured).
 /// Returns the largest number of particles that `farSide` says got through in any frame.
 template <class FarSide>
 std::size_t jetThrough(const std::string& solver, const ShapeDef& target, FarSide farSide) {

@@ -47,9 +47,10 @@ TEST_CASE("stability: all particles created at one point separate without NaN, f
     REQUIRE(w.particleCount() == 200);
     CHECK(test::allFiniteState(w));
     CHECK(outside(w, 1, 1) == 0);
-    // They spread: the cloud is wider than a spacing. (The emitter's ±0.1 dx offsets
-    // leave the 200 particles on an 8 mm line, 70 ρ0 dense, each neighbouring all 199
-    // others; dfsph needed three measures for it, engine/src/solvers/dfsph/dfsph.cpp.)
+    // They spread: the cloud is wider than a spacing. (A nozzle of width 0 puts all 200
+    // particles on one point, 70 ρ0 dense and more, each neighbouring all 199 others; only
+    // the tie-break directions part them; dfsph needed three measures for it,
+    // engine/src/solvers/dfsph/dfsph.cpp.)
     double minX = 1e9, maxX = -1e9;
     for (std::size_t i = 0; i < w.particleCount(); ++i) {
       minX = std::min(minX, w.worldPosition(i).x());

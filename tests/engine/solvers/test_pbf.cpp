@@ -1,5 +1,5 @@
 // The pbf solver (Macklin & Müller 2013) at frame-sized substeps: a resting
-// tank, the small dam break, determinism across thread counts.
+// tank, a deep tank at any max_move, the small dam break, determinism across thread counts.
 #include <doctest/doctest.h>
 
 #include <algorithm>
@@ -30,12 +30,16 @@ SceneDef pbfScene(const std::string& rel) {
 
 }  // namespace
 
-TEST_CASE("pbf: a resting tank at one substep per frame settles within 2 % of rho0, at rest, nothing escapes") {
+TEST_CASE("pbf: a resting tank at the longest substep its limits allow settles within 2 % of rho0, at rest, nothing escapes") {
   const SceneDef s = pbfScene("tests/resting_column.json");
   World w(s, WorldOptions{2});
   const double H = 0.6, g = 9.81;
   for (int f = 0; f < 120; ++f) w.stepFrame();  // 2 s
-  CHECK(w.substeps() == 120);                    // one substep per 1/60 s frame
+  // At rest the depth limit 0.35 R/sqrt(g D) sets the substep (D < H: the deepest column).
+  const double R = s.solver.spacing * s.solver.supportRatio;
+  const int perFrame = int(std::ceil((1.0 / 60) / (0.35 * R / std::sqrt(g * H))));
+  MESSAGE(w.substeps() << " substeps in 120 frames; the depth limit at D = H allows " << perFrame << " a frame");
+  CHECK(w.substeps() <= 120 * perFrame);
   REQUIRE(test::allFiniteState(w));
   const DensityStats d = w.densityStats();
   MESSAGE("mean compression " << d.meanError << ", max " << d.maxError << ", mean density " << d.meanDensity);
@@ -48,6 +52,36 @@ TEST_CASE("pbf: a resting tank at one substep per frame settles within 2 % of rh
   CHECK(mean < 0.02 * std::sqrt(g * H));
   CHECK(top < 0.1 * std::sqrt(g * H));
   CHECK(outside(w, 0, 0, 0.6, 1.3) == 0);
+}
+
+TEST_CASE("pbf: a 1 m deep tank at 12,800 particles holds at rest whatever max_move it accepts") {
+  // Without the depth limit, max_move 2 let the substep stay a frame long once single particles
+  // burst at 2-4 m/s, the floor rows were crushed and then flung: 5 m/s at frame 20, 24 at
+  // frame 40, 123 at frame 60. The hydrostatic stiffness limit (as dfsph's) holds it at any
+  // max_move in its range.
+  for (const double maxMove : {2.0, 10.0}) {
+    SceneDef s = test::scene("validation/hydrostatic_tank.json");
+    s.solver = solverDefaults("pbf");
+    s.solver.spacing = 0.0125;
+    s.solver.viscosity = 0;
+    s.solver.params["max_move"] = maxMove;
+    World w(s, WorldOptions{2});
+    REQUIRE(w.particleCount() == 12800);
+    double worst = 0;
+    int worstFrame = 0;
+    for (int f = 1; f <= 45; ++f) {
+      w.stepFrame();
+      REQUIRE(test::allFiniteState(w));
+      if (f >= 10 && maxSpeed(w) > worst) {
+        worst = maxSpeed(w);
+        worstFrame = f;
+      }
+    }
+    MESSAGE("max_move " << maxMove << ": fastest particle over frames 10-45 " << worst << " m/s (frame " << worstFrame << "), "
+                        << w.substeps() << " substeps");
+    CHECK(worst < 1.0);
+    CHECK(outside(w, 0, 0, 2, 1.2) == 0);
+  }
 }
 
 TEST_CASE("pbf: the small dam break runs 1 s at frame-sized steps: no NaN, nothing escapes, energy bounded") {

@@ -678,7 +678,6 @@ class Dfsph final : public Solver {
   Real cheb_;                            ///< Chebyshev ρ (0: plain relaxed Jacobi)
   Real cfl_;                             ///< dt ≤ cfl_·R/v_max
   static constexpr int kChebDelay = 5;   ///< plain iterations before the acceleration starts
-  static constexpr Real kPressureCfl = Real(0.35);  ///< dt ≤ kPressureCfl·R/sqrt(|g| D), D the greatest depth
   static constexpr Real kKneeDensity = Real(1.1);   ///< beyond ρ = 1.1 ρ0 the Jacobi step shrinks as 1.1 ρ0/ρ
   static constexpr Real kPushoutSpeed = Real(3);    ///< [m/s] existing compression is removed at most this fast
   std::vector<Vec2> vPrev_;              ///< velocity before the last iteration (Chebyshev)

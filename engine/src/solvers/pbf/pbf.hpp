@@ -49,11 +49,14 @@
 //   the largest eigenvalue of the Jacobi step grows with compression.
 // - Chebyshev semi-iteration on the positions (Wang 2015, "A Chebyshev
 //   semi-iterative approach for accelerating projective and position-based
-//   dynamics"): Jacobi corrects the long (hydrostatic) modes by about N/layers²
+//   dynamics"), but not in a substep that starts beyond chebyshev_plain_above
+//   (an impact): Jacobi corrects the long (hydrostatic) modes by about N/layers²
 //   per N iterations, Chebyshev by N²/layers².
 // - No warm start from the previous substep's multipliers.
 // - Convergence needs the mean compression and the largest below their tolerances.
-// - Time step: min(max_dt, max_move · R / v_max, limit). The compression left
+// - Time step: min(max_dt, max_move · R / v_max, 0.35 R/sqrt(|g| D) without the
+//   grid projection (D the deepest column: the hydrostatic stiffness, as dfsph's),
+//   limit). The compression left
 //   after N iterations grows as dt²/N², so when max_iterations end unconverged
 //   the limit drops to 0.5–0.9 of this substep (not below max_dt/32); when half
 //   of them sufficed it grows back by 1.2 per substep.
@@ -161,6 +164,15 @@ class Pbf final : public Solver {
 
   const char* name_;  ///< "pbf" or "game" (the same method, registered with other defaults)
   int iterations_, maxIterations_;
+  /// A substep whose first constraint pass finds a compression above this runs plain Jacobi
+  /// (chebyshev_plain_above; pbf 0.3, game 0: never). Chebyshev's weights assume the iteration's
+  /// asymptotic regime; extrapolated from an impact's first iterations (compressions of 50 % and
+  /// more, clamped multipliers) they pushed particles past where the constraint wanted them,
+  /// and pbf turns that move into velocity: a 50 m/s jet's impact threw single particles at
+  /// 7–10 times the jet's specific energy, 1.5–2.1 times without the weights there
+  /// (docs/STABILITY.md). Gentle flows keep the acceleration (Poiseuille: 6.7 % either way, 11 %
+  /// with plain Jacobi everywhere). game: its corrections move positions only.
+  Real chebPlainAbove_;
   Real tolerance_, toleranceMax_, relaxation_, chebyshev_, tensileK_;
   int tensileN_;
   Real tensileDq_, xsph_, maxDt_, maxMove_, toVelocity_;
@@ -179,6 +191,7 @@ class Pbf final : public Solver {
   std::vector<std::uint32_t> movedList_;     ///< moved_ listed for the halo pass (sorted)
   static constexpr std::size_t kLocalBlock = 32;  ///< particles per job of a local iteration (few, clustered)
   mutable std::vector<Real> speedScratch_, speedTop_;  ///< robustSpeed(): squared speeds, each block's largest
+  mutable std::vector<Real> depthScratch_;  ///< maxTimeStep(): the highest particle per strip (columnDepths)
   std::unique_ptr<GridProjection> projection_;  ///< the coarse-grid projection (grid_cell > 0)
 
   Real d0_ = 0, eps_ = 0, invWdq_ = 0, sCorrScale_ = 0;

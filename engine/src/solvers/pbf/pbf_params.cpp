@@ -19,6 +19,8 @@ std::vector<SolverParam> pbfParams(bool game) {
        "then at most this many iterations on the particles near a compression above tolerance_max (and their neighbours)"},
       {"relaxation", 0.5, 0, 100, "ε of the constraint denominator, in units of its value on a full rest lattice"},
       {"chebyshev", 0.9, 0, 0.99, "Chebyshev acceleration: spectral radius estimate ρ (0: plain Jacobi)"},
+      {"chebyshev_plain_above", g(0.3, 0), 0, 100,
+       "a substep whose first pass finds a compression above this runs plain Jacobi (an impact; 0: never)"},
       {"tensile_k", 0, 0, 1, "s_corr strength k, in multipliers of a unit density error (0: off)"},
       {"tensile_n", 4, 1, 8, "s_corr exponent n (integer)"},
       {"tensile_dq", 0.2, 0.01, 0.9, "s_corr reference distance Δq, in units of the support R"},
