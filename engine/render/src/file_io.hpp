@@ -2,10 +2,14 @@
 // The writers replace regular files atomically (a temporary file renamed over the
 // target), but renaming over a device, a FIFO or a socket would replace the node itself
 // (as root, `--out /dev/full` turned the device into a PNG file): such a target is
-// written in place instead, and its errors (ENOSPC on /dev/full) reported.
+// written in place instead, and its errors (ENOSPC on /dev/full) reported. A temporary
+// file is created new (O_EXCL, O_NOFOLLOW): an existing file or symbolic link of that name
+// is never written through.
 #pragma once
 
+#include <fcntl.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 #include <cerrno>
 #include <cstdio>
@@ -19,6 +23,21 @@ namespace sph2d {
 inline bool isSpecialFile(const std::string& path) {
   struct stat st {};
   return ::stat(path.c_str(), &st) == 0 && !S_ISREG(st.st_mode);
+}
+
+/// Creates the temporary file `tmp` for writing; it must not exist (a file or a symbolic link
+/// already there is left alone). Throws std::runtime_error naming it and the system's reason.
+inline FILE* createTempFile(const std::string& tmp) {
+  const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0644);
+  if (fd < 0) throw std::runtime_error("cannot create " + tmp + ": " + std::strerror(errno));
+  FILE* f = ::fdopen(fd, "wb");
+  if (!f) {
+    const int err = errno;
+    ::close(fd);
+    ::unlink(tmp.c_str());
+    throw std::runtime_error("cannot create " + tmp + ": " + std::strerror(err));
+  }
+  return f;
 }
 
 /// Writes `size` bytes to `path` in place. Throws std::runtime_error naming the path and

@@ -3,6 +3,7 @@
 #include <cstdio>
 #include <stdexcept>
 
+#include "sph2d/hash.hpp"
 #include "sph2d/render/png_io.hpp"
 #include "sph2d/render/video.hpp"
 
@@ -65,16 +66,29 @@ void FrameWriter::loop() {
     }
     try {
       if (opt_.png) {
-        writePngAtomic(pathOf(job.index), job.width, job.height, job.rgba.data(), opt_.pngLevel);
+        const std::string path = pathOf(job.index);
+        thread_local std::vector<std::uint8_t> bytes;
+        try {
+          encodePng(job.width, job.height, job.rgba.data(), pngSettings(opt_.pngLevel), bytes);
+        } catch (const std::exception& e) {
+          throw std::runtime_error("cannot write " + path + ": " + e.what());
+        }
+        announce(path, bytes.data(), bytes.size());
+        writeEncodedPngAtomic(path, bytes);
         std::lock_guard<std::mutex> lock(mutex_);
         ++counts_.pngs;
       }
       if (opt_.exportFormat) {
-        writeParticlesAtomic(exportPathOf(job.index), *job.particles, *opt_.exportFormat);
+        const std::string path = exportPathOf(job.index);
+        std::string text = encodeParticles(*job.particles, *opt_.exportFormat);
+        announce(path, text.data(), text.size());
+        writeFileAtomic(path, text);
         if (*opt_.exportFormat == ExportFormat::Csv && !job.particles->bodies.empty()) {
           char name[32];
           std::snprintf(name, sizeof name, "/bodies_%05d.csv", job.index);
-          writeBodiesCsvAtomic(opt_.dir + name, *job.particles);
+          text = encodeBodiesCsv(*job.particles);
+          announce(opt_.dir + name, text.data(), text.size());
+          writeFileAtomic(opt_.dir + name, text);
         }
         std::lock_guard<std::mutex> lock(mutex_);
         ++counts_.exports;
@@ -91,6 +105,12 @@ void FrameWriter::loop() {
       cv_.notify_all();
     }
   }
+}
+
+void FrameWriter::announce(const std::string& path, const void* data, std::size_t size) const {
+  if (!opt_.beforeWrite) return;
+  const auto name = [](const std::string& p) { return p.substr(p.find_last_of('/') + 1); };
+  opt_.beforeWrite(name(path), xxh64(data, size), name(tempPathFor(path)));
 }
 
 int FrameWriter::finish() {

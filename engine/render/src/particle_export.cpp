@@ -86,14 +86,16 @@ ParticleSnapshot snapshotOf(const World& world, const Real* age) {
   return s;
 }
 
-void writeBodiesCsvAtomic(const std::string& path, const ParticleSnapshot& s) {
+void writeBodiesCsvAtomic(const std::string& path, const ParticleSnapshot& s) { writeFileAtomic(path, encodeBodiesCsv(s)); }
+
+std::string encodeBodiesCsv(const ParticleSnapshot& s) {
   std::string out;
   appendf(out, "# sph2d bodies: frame %llu, time %.9g s, %zu kinematic or dynamic bodies, world coordinates\n",
           static_cast<unsigned long long>(s.frame), s.time, s.bodies.size());
   out += "body,x,y,angle,vx,vy,omega\n";
   for (const BodySnapshot& b : s.bodies)
     appendf(out, "%d,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g\n", b.body, b.x, b.y, b.angle, b.vx, b.vy, b.omega);
-  writeFileAtomic(path, out);
+  return out;
 }
 
 bool parseExportFormat(const std::string& s, ExportFormat& out) {
@@ -106,11 +108,12 @@ bool parseExportFormat(const std::string& s, ExportFormat& out) {
 
 std::string exportExtension(ExportFormat f) { return f == ExportFormat::Csv ? "csv" : "vtk"; }
 
+std::string tempPathFor(const std::string& path) { return path + ".tmp" + std::to_string(::getpid()); }
+
 void writeFileAtomic(const std::string& path, const std::string& bytes) {
   if (isSpecialFile(path)) return writeInPlace(path, bytes.data(), bytes.size());  // a device, a FIFO: no rename over it
-  const std::string tmp = path + ".tmp" + std::to_string(::getpid());
-  FILE* f = std::fopen(tmp.c_str(), "wb");
-  if (!f) throw std::runtime_error("cannot create " + tmp + ": " + std::strerror(errno));
+  const std::string tmp = tempPathFor(path);
+  FILE* f = createTempFile(tmp);
   bool ok = std::fwrite(bytes.data(), 1, bytes.size(), f) == bytes.size();
   ok = (std::fflush(f) == 0) && ok;
   std::string why = ok ? "" : std::strerror(errno);
@@ -130,6 +133,10 @@ void writeFileAtomic(const std::string& path, const std::string& bytes) {
 }
 
 void writeParticlesAtomic(const std::string& path, const ParticleSnapshot& s, ExportFormat f) {
+  writeFileAtomic(path, encodeParticles(s, f));
+}
+
+std::string encodeParticles(const ParticleSnapshot& s, ExportFormat f) {
   const std::size_t n = s.size();
   const bool hasAge = !s.age.empty();
   std::string out;
@@ -199,7 +206,7 @@ void writeParticlesAtomic(const std::string& path, const ParticleSnapshot& s, Ex
     scalars("pressure", "float", [&](std::size_t k) { return s.p[k]; });
     if (hasAge) scalars("age", "float", [&](std::size_t k) { return s.age[k]; });
   }
-  writeFileAtomic(path, out);
+  return out;
 }
 
 ParticleSnapshot readParticlesCsv(const std::string& path) {

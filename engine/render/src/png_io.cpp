@@ -3,6 +3,7 @@
 #include "sph2d/render/png_io.hpp"
 
 #include "file_io.hpp"
+#include "sph2d/render/particle_export.hpp"
 
 #include <png.h>
 #include <zlib.h>
@@ -165,10 +166,13 @@ void writePngAtomic(const std::string& path, int width, int height, const std::u
   } catch (const std::exception& e) {
     throw std::runtime_error("cannot write " + path + ": " + e.what());
   }
+  writeEncodedPngAtomic(path, bytes);
+}
+
+void writeEncodedPngAtomic(const std::string& path, const std::vector<std::uint8_t>& bytes) {
   if (isSpecialFile(path)) return writeInPlace(path, bytes.data(), bytes.size());  // a device, a FIFO: no rename over it
-  const std::string tmp = path + ".tmp" + std::to_string(::getpid());
-  FILE* f = std::fopen(tmp.c_str(), "wb");
-  if (!f) throw std::runtime_error("cannot create " + tmp + ": " + std::strerror(errno));
+  const std::string tmp = tempPathFor(path);
+  FILE* f = createTempFile(tmp);
   char err[256] = {0};
   bool ok = true;
   if (std::fwrite(bytes.data(), 1, bytes.size(), f) != bytes.size()) {

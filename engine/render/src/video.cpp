@@ -30,17 +30,35 @@ std::string findFfmpeg() {
   return "";
 }
 
+std::string videoTempPath(const std::string& path) {
+  const std::size_t slash = path.find_last_of('/');
+  const std::size_t dot = path.find_last_of('.');
+  const std::string tag = ".tmp" + std::to_string(::getpid());
+  if (dot == std::string::npos || (slash != std::string::npos && dot < slash) || dot == slash + 1) return path + tag;
+  return path.substr(0, dot) + tag + path.substr(dot);
+}
+
 VideoPipe::VideoPipe(const std::string& path, int width, int height, double fps)
     : frameBytes_(std::size_t(width) * std::size_t(height) * 4), path_(path) {
   const std::string exe = findFfmpeg();
   if (exe.empty()) throw std::runtime_error("ffmpeg is not installed (not found on PATH)");
+  // ffmpeg writes a temporary file, renamed to `path` once it is whole; a device or a FIFO
+  // is written in place.
+  struct stat st {};
+  const bool special = ::stat(path.c_str(), &st) == 0 && !S_ISREG(st.st_mode);
+  std::string target = path;
+  if (!special) {
+    temp_ = videoTempPath(path);
+    if (::lstat(temp_.c_str(), &st) == 0) throw std::runtime_error("cannot create " + temp_ + ": " + std::strerror(EEXIST));
+    target = temp_;
+  }
   char size[32], rate[32];
   std::snprintf(size, sizeof size, "%dx%d", width, height);
   std::snprintf(rate, sizeof rate, "%.9g", fps);
   std::vector<std::string> args = {exe,        "-hide_banner", "-loglevel", "error",      "-y",
                                    "-f",       "rawvideo",     "-pixel_format", "rgba",   "-video_size",
                                    size,       "-framerate",   rate,        "-i",         "pipe:0",
-                                   "-vf",      "pad=ceil(iw/2)*2:ceil(ih/2)*2", "-pix_fmt", "yuv420p", path};
+                                   "-vf",      "pad=ceil(iw/2)*2:ceil(ih/2)*2", "-pix_fmt", "yuv420p", target};
   for (const auto& a : args) command_ += (command_.empty() ? "" : " ") + a;
   int fds[2];
   if (::pipe(fds) != 0) throw std::runtime_error(std::string("pipe: ") + std::strerror(errno));
@@ -101,9 +119,16 @@ void VideoPipe::close() {
     while (r < 0 && errno == EINTR);
     pid_ = -1;
     if (r < 0) throw std::runtime_error(std::string("waitpid(ffmpeg): ") + std::strerror(errno));
-    if (!WIFEXITED(status) || WEXITSTATUS(status) != 0)
+    if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) {
+      if (!temp_.empty()) ::unlink(temp_.c_str());
       throw std::runtime_error("ffmpeg failed writing " + path_ + " (exit status " +
                                std::to_string(WIFEXITED(status) ? WEXITSTATUS(status) : -1) + "): " + command_);
+    }
+    if (!temp_.empty() && std::rename(temp_.c_str(), path_.c_str()) != 0) {
+      const std::string why = std::strerror(errno);
+      ::unlink(temp_.c_str());
+      throw std::runtime_error("cannot rename " + temp_ + " to " + path_ + ": " + why);
+    }
   }
 }
 

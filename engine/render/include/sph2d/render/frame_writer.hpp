@@ -3,8 +3,9 @@
 // Design: the frame loop pushes each kept frame (its pixels and, for exports, a
 // particle snapshot); one writer thread does the slow parts in frame order:
 // PNG encoding (libpng, level 1 by default), the raw frame into an ffmpeg pipe,
-// the particle export (CSV or VTK). Every file is written to a temporary name
-// and renamed, so it exists whole or not at all. The queue is bounded (push()
+// the particle export (CSV or VTK). Every file is encoded in memory, announced
+// (beforeWrite: its name, the hash of its bytes, its temporary name), written to
+// the temporary name and renamed, so it exists whole or not at all. The queue is bounded (push()
 // blocks when `capacity` frames wait) and finish() writes everything queued,
 // so a run stopped by Ctrl-C keeps every frame it rendered. The first error
 // stops further writes and is rethrown by the next push() or by finish().
@@ -13,6 +14,7 @@
 #include <condition_variable>
 #include <cstdint>
 #include <deque>
+#include <functional>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -35,6 +37,10 @@ struct FrameWriterOptions {
   std::string videoPath;                    ///< "" = no video; else pipe frames to ffmpeg
   double videoFps = 60;                     ///< frame rate of the video
   std::size_t capacity = 6;                 ///< frames that may wait in the queue
+  /// Called on the writer thread before each file is written (before its temporary file is
+  /// created): the file's name in `dir`, the XXH64 of the bytes it will hold and the name of
+  /// the temporary file it is written through. A throw stops the writer as a write error does.
+  std::function<void(const std::string& name, std::uint64_t xxh64, const std::string& temp)> beforeWrite;
 };
 
 /// Counts of what a FrameWriter wrote.
@@ -80,6 +86,8 @@ class FrameWriter {
   };
   void loop();
   void start();
+  /// Calls beforeWrite for the file `path` that will hold `size` bytes at `data`.
+  void announce(const std::string& path, const void* data, std::size_t size) const;
   FrameWriterOptions opt_;
   std::unique_ptr<VideoPipe> video_;
   std::deque<Job> queue_;

@@ -59,11 +59,20 @@ void writeBodiesCsvAtomic(const std::string& path, const ParticleSnapshot& s);
 
 /// Writes `s` to `path` in format `f`, atomically. Throws std::runtime_error naming the path.
 void writeParticlesAtomic(const std::string& path, const ParticleSnapshot& s, ExportFormat f);
+/// The bytes writeParticlesAtomic writes.
+std::string encodeParticles(const ParticleSnapshot& s, ExportFormat f);
+/// The bytes writeBodiesCsvAtomic writes.
+std::string encodeBodiesCsv(const ParticleSnapshot& s);
 
 /// Reads a CSV written by writeParticlesAtomic. Throws std::runtime_error with the line.
 ParticleSnapshot readParticlesCsv(const std::string& path);
 
-/// Writes `bytes` to `path` through a temporary file and a rename. Throws std::runtime_error.
+/// The temporary name a file is written under before its rename: PATH.tmpPID.
+std::string tempPathFor(const std::string& path);
+
+/// Writes `bytes` to `path` through a temporary file (tempPathFor(path), created new: an
+/// existing file or link of that name is refused) and a rename. A device or FIFO at `path`
+/// is written in place. Throws std::runtime_error.
 void writeFileAtomic(const std::string& path, const std::string& bytes);
 
 }  // namespace sph2d

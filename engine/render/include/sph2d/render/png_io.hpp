@@ -36,9 +36,14 @@ void encodePng(int width, int height, const std::uint8_t* rgba, const PngSetting
                std::vector<std::uint8_t>& out);
 
 /// Writes RGBA8 pixels (rows top-down) as an RGB PNG with libpng (pngSettings(level)). The file
-/// is written to a temporary name beside `path` and renamed, so it exists whole or not at all.
+/// is written to a temporary name beside `path` (created new: an existing file or symbolic link
+/// of that name is refused) and renamed, so it exists whole or not at all.
 /// Throws std::runtime_error with the path.
 void writePngAtomic(const std::string& path, int width, int height, const std::uint8_t* rgba, int level = 1);
+
+/// Writes PNG bytes made by encodePng to `path` as writePngAtomic does (a temporary file
+/// PATH.tmpPID, created new, then a rename; a device or FIFO is written in place).
+void writeEncodedPngAtomic(const std::string& path, const std::vector<std::uint8_t>& bytes);
 
 /// Reads a PNG into RGBA8 (rows top-down). Throws std::runtime_error.
 void readPng(const std::string& path, int& width, int& height, std::vector<std::uint8_t>& rgba);

@@ -5,7 +5,8 @@
 // child gets its own process group, so a Ctrl-C in the terminal reaches only
 // sph2d, which then closes the pipe: ffmpeg sees the end of its input and
 // finishes the file properly. Writes retry on EINTR; a closed pipe (EPIPE, with
-// SIGPIPE ignored by the caller) is an error naming ffmpeg.
+// SIGPIPE ignored by the caller) is an error naming ffmpeg. The video is written to a
+// temporary name and renamed when ffmpeg has finished it, so it is whole or absent.
 #pragma once
 
 #include <sys/types.h>
@@ -19,11 +20,17 @@ namespace sph2d {
 /// The path of `ffmpeg` on PATH, or "" when it is not installed.
 std::string findFfmpeg();
 
+/// The temporary file ffmpeg writes before the video is renamed to `path`: the name with
+/// ".tmpPID" before its extension (out.mp4 -> out.tmp1234.mp4: ffmpeg picks the container by it).
+std::string videoTempPath(const std::string& path);
+
 /// An ffmpeg process encoding the RGBA frames written to it into a video file.
 class VideoPipe {
  public:
   /// Starts ffmpeg writing `path` (its extension picks the container) from frames of
-  /// width × height at `fps`. Throws std::runtime_error when ffmpeg is missing or fails to start.
+  /// width × height at `fps`: into videoTempPath(path), renamed to `path` by close() once
+  /// ffmpeg succeeded (a device or FIFO at `path` is written in place). Throws
+  /// std::runtime_error when ffmpeg is missing or fails to start, or the temporary file exists.
   VideoPipe(const std::string& path, int width, int height, double fps);
   /// Closes the pipe and waits for ffmpeg (errors are swallowed; call close() to see them).
   ~VideoPipe();
@@ -43,7 +50,7 @@ class VideoPipe {
   pid_t pid_ = -1;
   std::size_t frameBytes_ = 0;
   int frames_ = 0;
-  std::string path_, command_;
+  std::string path_, temp_, command_;
 };
 
 }  // namespace sph2d
