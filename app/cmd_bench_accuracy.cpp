@@ -24,14 +24,18 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <vector>
 
 #include "cli.hpp"
 #include "commands.hpp"
+#include "output_dir.hpp"
 #include "validation.hpp"
+#include "sph2d/hash.hpp"
 #include "sph2d/render/image.hpp"
+#include "sph2d/render/particle_export.hpp"
 #include "sph2d/render/png_io.hpp"
 #include "sph2d/scene.hpp"
 #include "sph2d/world.hpp"
@@ -53,7 +57,10 @@ const char* kHelp =
     "(default: ./assets). --levels K runs only the K coarsest resolutions (1..3).\n"
     "--from-csv A.csv[,B.csv...] runs nothing: it redraws accuracy.csv, accuracy.md and the\n"
     "charts in DIR from earlier runs' CSV files. --cases hydrostatic,dam_break,taylor_green,\n"
-    "poiseuille runs only those cases (default: all four).\n";
+    "poiseuille runs only those cases (default: all four).\n"
+    "Those files replace only the ones an earlier bench accuracy wrote in DIR (its\n"
+    "DIR/.sph2d.journal lists them with their hashes): a file of those names that sph2d\n"
+    "cannot prove it wrote is never touched, and the bench exits 2 naming it before it runs.\n";
 
 /// The validation cases, in the order they run.
 const char* const kCases[] = {"hydrostatic", "dam_break", "taylor_green", "poiseuille"};
@@ -164,7 +171,26 @@ Run runHydrostatic(SceneDef s, int threads) {
 }
 
 /// Log-log chart of error against wall seconds per simulated second, one colour per solver, Pareto front.
-void chart(const std::vector<Run>& runs, const std::string& caseName, const std::string& path) {
+/// Writes `bytes` to `out`/`name` whole, noted in the folder's journal first.
+void writeNoted(OutputJournal& journal, const std::string& out, const std::string& name, const std::string& bytes) {
+  const std::string path = out + "/" + name;
+  journal.note(name, fs::path(tempPathFor(path)).filename().string(), xxh64(bytes.data(), bytes.size()));
+  writeFileAtomic(path, bytes);
+}
+
+/// The files `sph2d bench accuracy` writes into its --out folder.
+const char* const kOutputs[] = {"accuracy.csv", "accuracy.md", "dam_break.png", "hydrostatic.png", "taylor_green.png",
+                                "poiseuille.png"};
+
+FolderSpec accuracyFolderSpec() {
+  FolderSpec spec;
+  spec.command = "bench accuracy";
+  spec.writes = [](const std::string& name) { return std::find(std::begin(kOutputs), std::end(kOutputs), name) != std::end(kOutputs); };
+  return spec;
+}
+
+void chart(const std::vector<Run>& runs, const std::string& caseName, OutputJournal& journal, const std::string& out) {
+  const std::string path = out + "/" + caseName + ".png";
   Frame img;
   img.width = 720;
   img.height = 480;
@@ -233,7 +259,10 @@ void chart(const std::vector<Run>& runs, const std::string& caseName, const std:
     ly += 20;
   }
   drawText(img, R - 150, ly, "LINE: PARETO FRONT", 1, axis);
-  writePngAtomic(path, img.width, img.height, img.rgba.data(), 6);
+  std::vector<std::uint8_t> bytes;
+  encodePng(img.width, img.height, img.rgba.data(), pngSettings(6), bytes);
+  journal.note(caseName + ".png", fs::path(tempPathFor(path)).filename().string(), xxh64(bytes.data(), bytes.size()));
+  writeEncodedPngAtomic(path, bytes);
 }
 
 }  // namespace
@@ -316,9 +345,14 @@ int cmdBenchAccuracy(const std::vector<std::string>& args) {
       }
     }
   }
-  std::error_code ec;
-  fs::create_directories(out, ec);
-  if (ec) throw UsageError("cannot create " + out + ": " + ec.message());
+  // The folder, before any run: held by this bench alone, and refused when it holds a file of
+  // the names it writes that an earlier bench accuracy did not write (its journal lists those).
+  const FolderSpec spec = accuracyFolderSpec();
+  std::optional<OutputLock> lock;
+  if (holdsLockFile(out)) lock.emplace(out);
+  refuseForeignFiles(out, scanOutputFolder(out, spec), spec);
+  makeOutputDir(out);
+  if (!lock) lock.emplace(out);
 
   std::vector<double> damSpacings = quick ? std::vector<double>{0.04} : std::vector<double>{0.02, 0.01, 0.005};
   std::vector<double> hydroSpacings = quick ? std::vector<double>{0.05} : std::vector<double>{0.05, 0.025, 0.0125};
@@ -432,16 +466,20 @@ int cmdBenchAccuracy(const std::vector<std::string>& args) {
       }
     }
 
+  // The files replace only an earlier bench accuracy's (scanned again: proven now), each whole.
+  const FolderScan scan = scanOutputFolder(out, spec);
+  refuseForeignFiles(out, scan, spec);
+  OutputJournal journal(out, spec.command, scan.own);
   {
-    std::ofstream csv(out + "/accuracy.csv.tmp");
+    std::ostringstream csv;
     csv << "case,solver,particles,cfl,error_name,error,mean_density_error,max_density_error,wall_s_per_sim_s,ms_per_step\n";
     for (const Run& r : runs)
       csv << r.caseName << ',' << r.solver << ',' << r.particles << ',' << r.cfl << ',' << r.errorName << ',' << r.error << ','
           << r.meanDensityError << ',' << r.maxDensityError << ',' << r.wallPerSim << ',' << r.msPerStep << '\n';
+    writeNoted(journal, out, "accuracy.csv", csv.str());
   }
-  fs::rename(out + "/accuracy.csv.tmp", out + "/accuracy.csv");
   {
-    std::ofstream md(out + "/accuracy.md.tmp");
+    std::ostringstream md;
     md << "| case | solver | particles | cfl | error | value | mean density error | max density error | wall s / sim s | ms / step |\n"
           "|---|---|---|---|---|---|---|---|---|---|\n";
     char line[512];
@@ -451,12 +489,12 @@ int cmdBenchAccuracy(const std::vector<std::string>& args) {
                     100 * r.meanDensityError, 100 * r.maxDensityError, r.wallPerSim, r.msPerStep);
       md << line;
     }
+    writeNoted(journal, out, "accuracy.md", md.str());
   }
-  fs::rename(out + "/accuracy.md.tmp", out + "/accuracy.md");
-  chart(runs, "dam_break", out + "/dam_break.png");
-  chart(runs, "hydrostatic", out + "/hydrostatic.png");
-  chart(runs, "taylor_green", out + "/taylor_green.png");
-  chart(runs, "poiseuille", out + "/poiseuille.png");
+  chart(runs, "dam_break", journal, out);
+  chart(runs, "hydrostatic", journal, out);
+  chart(runs, "taylor_green", journal, out);
+  chart(runs, "poiseuille", journal, out);
   std::printf("bench accuracy: %zu runs; wrote %s/accuracy.csv, accuracy.md, dam_break.png, hydrostatic.png, taylor_green.png, "
               "poiseuille.png\n", runs.size(), out.c_str());
   return runs.empty() ? 1 : 0;

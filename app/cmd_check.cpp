@@ -10,6 +10,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <map>
+#include <regex>
 #include <string>
 #include <utility>
 
@@ -18,7 +19,9 @@
 #include "event_intake.hpp"
 #include "game_loop.hpp"
 #include "manifest.hpp"
+#include "output_dir.hpp"
 #include "sph2d/hash.hpp"
+#include "sph2d/render/particle_export.hpp"
 #include "sph2d/render/png_io.hpp"
 #include "sph2d/render/renderer.hpp"
 #include "sph2d/scene.hpp"
@@ -41,6 +44,9 @@ const char* kCheckHelp =
     "frame, counts its differing pixels and the largest channel difference against the\n"
     "reference PNG beside MANIFEST, writes DIR/frame_NNNNN.png (this run) and\n"
     "DIR/diff_NNNNN.png (differences in red over a dimmed reference), and exits 1.\n"
+    "Those replace only the images an earlier check wrote in DIR (DIR/.sph2d.journal lists\n"
+    "them with their hashes): a frame_NNNNN.png or diff_NNNNN.png there that sph2d cannot\n"
+    "prove it wrote is never touched, and the check exits 2 naming it before it reruns.\n"
     "The events the manifest lists (the run's timeline, --input files and live input)\n"
     "are applied at their frames, so runs driven by input check like any other.\n"
     "The manifest's environment is compared with this one, never trusted: only the\n"
@@ -57,6 +63,17 @@ const char* kCheckHelp =
     "  --out DIR       where the diff image goes (default: out/check-<scene name>)\n"
     "  --threads T     simulation threads (default: all cores; frames do not depend on it)\n"
     "  --quiet         print only the verdict\n";
+
+/// What `sph2d check` writes into its --out folder: this run's frame_NNNNN.png and diff_NNNNN.png.
+FolderSpec checkFolderSpec() {
+  FolderSpec spec;
+  spec.command = "check";
+  spec.writes = [](const std::string& name) {
+    static const std::regex mine(R"((frame|diff)_\d{5,}\.png)");
+    return std::regex_match(name, mine);
+  };
+  return spec;
+}
 
 struct PixelDiff {
   std::size_t differing = 0;
@@ -123,11 +140,25 @@ class FrameCheck : public LoopObserver {
     std::printf("check: state hash %s\n", stateHash == wantState
                                              ? "matches: the simulation agrees, the rendering differs"
                                              : ("differs too (" + stateHash + " vs " + wantState + "): the simulation changed").c_str());
-    std::error_code ec;
-    fs::create_directories(out_, ec);
+    // The folder: this check's files replace an earlier check's (proven by its journal); a
+    // file there that sph2d cannot prove it wrote stops the check (exit 2), untouched.
+    makeOutputDir(out_);
+    OutputLock lock(out_);
+    const FolderSpec spec = checkFolderSpec();
+    const FolderScan scan = scanOutputFolder(out_, spec);
+    refuseForeignFiles(out_, scan, spec);
+    const std::vector<std::string> removed = removeOwnFiles(out_, scan, [](const std::string&) { return true; });
+    if (!removed.empty()) std::printf("check: removed %s that an earlier sph2d check wrote in %s\n", describeFiles(removed).c_str(), out_.c_str());
+    OutputJournal journal(out_, spec.command, {});
+    auto write = [&](const std::string& path, const Frame& image) {
+      std::vector<std::uint8_t> bytes;
+      encodePng(image.width, image.height, image.rgba.data(), pngSettings(1), bytes);
+      journal.note(fs::path(path).filename().string(), fs::path(tempPathFor(path)).filename().string(), xxh64(bytes.data(), bytes.size()));
+      writeEncodedPngAtomic(path, bytes);
+    };
     const std::string name = frameFileName(f);
     const std::string mine = out_ + "/" + name;
-    writePngAtomic(mine, fr.width, fr.height, fr.rgba.data(), 1);
+    write(mine, fr);
     const std::string refPath = (refDir_ / e.value("file", name)).string();
     int rw = 0, rh = 0;
     std::vector<std::uint8_t> ref;
@@ -150,7 +181,7 @@ class FrameCheck : public LoopObserver {
     char diffName[64];
     std::snprintf(diffName, sizeof diffName, "diff_%05d.png", f);
     const std::string diffPath = out_ + "/" + diffName;
-    writePngAtomic(diffPath, diff.width, diff.height, diff.rgba.data(), 1);
+    write(diffPath, diff);
     std::printf("check: frame %d: %zu of %d pixels differ (%.4f %%), max channel difference %d (first at x %d, y %d)\n", f,
                 d.differing, fr.width * fr.height, 100.0 * double(d.differing) / double(fr.width * fr.height), d.maxDiff,
                 d.firstX, d.firstY);
@@ -273,6 +304,11 @@ int cmdCheck(const std::vector<std::string>& args) {
   }
   const SceneDef scene = loadScene(scenePath);
   if (out.empty()) out = "out/check-" + scene.name;
+  {
+    // Before the rerun: a folder it could not write its images into is refused now, not after it.
+    const FolderSpec spec = checkFolderSpec();
+    refuseForeignFiles(out, scanOutputFolder(out, spec), spec);
+  }
   const fs::path refDir = fs::path(manifestPath).parent_path();
   if (files && !checkFiles(mv, refDir)) return 1;
 

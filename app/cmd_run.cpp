@@ -88,7 +88,27 @@ class RunOutputs : public LoopObserver {
   std::shared_ptr<const ParticleSnapshot> snap_;  ///< the export of the kept frame being rendered
 };
 
-/// Creates the output directory or throws UsageError.
+/// What `sph2d run` writes into its folder: frames, exports, and the video and record files
+/// when they are in it (`video`, `record`: their names there, "" when elsewhere).
+FolderSpec runFolderSpec(const std::string& video, const std::string& record) {
+  FolderSpec spec;
+  spec.command = "run";
+  spec.manifest = true;
+  spec.writes = [video, record](const std::string& name) {
+    return isRunFileName(name) || (!video.empty() && name == video) || (!record.empty() && name == record);
+  };
+  return spec;
+}
+
+/// The name of `path` in the output folder `out` when it is there ("" when elsewhere); a name
+/// the run writes itself is refused.
+std::string nameInFolder(const std::string& path, const std::string& out, const std::string& flag) {
+  if (path.empty() || !isInFolder(path, out)) return "";
+  const std::string name = fs::path(path).filename().string();
+  if (isRunFileName(name) || name == "manifest.json" || name.rfind(".sph2d.", 0) == 0 || name.empty() || name == "." || name == "..")
+    throw UsageError(flag + " " + path + ": sph2d run writes a file of that name in " + out + " itself; choose another name");
+  return name;
+}
 
 }  // namespace
 
@@ -112,12 +132,25 @@ int cmdRun(const std::vector<std::string>& args) {
   // Memory, before anything is allocated: a scene that cannot fit is refused now, not after
   // seconds of set-up with std::bad_alloc.
   checkMemory(scene, a.images, a.maxMemory);
-  // The output directory: one run at a time holds it (a second one is refused, naming the first).
+  // The output directory: one run at a time holds it (a second one is refused, naming the
+  // first), and a run writes there only where what is in the way is sph2d's own (output_dir.hpp):
+  // a folder holding a frame, an export, the manifest or the video or record file that sph2d
+  // cannot prove it wrote is refused now, before anything is read or written.
   std::optional<OutputLock> outLock;
+  std::string videoName, recordName;  // their names in the folder ("" when elsewhere)
+  FolderSpec spec;
   if (a.images) {
+    videoName = nameInFolder(a.video, out, "--video");
+    recordName = nameInFolder(a.record, out, "--record");
+    spec = runFolderSpec(videoName, recordName);
+    // A folder another run holds is named as such (its lock first); the scan reads only, so a
+    // refused folder is left as it was (no lock file made in it).
+    if (holdsLockFile(out)) outLock.emplace(out);
+    refuseForeignFiles(out, scanOutputFolder(out, spec), spec);
     makeOutputDir(out);
-    outLock.emplace(out);
+    if (!outLock) outLock.emplace(out);
   }
+  if (!a.video.empty() && videoName.empty()) refuseExistingFile(a.video, "--video");
 
   // The input: the scene's timeline, events files, the record (live input opens last).
   RunConsole console(a.quiet, a.realtime);
@@ -137,13 +170,16 @@ int cmdRun(const std::vector<std::string>& args) {
     if (!a.record.empty() && in != "-" && fs::exists(a.record, ec) && fs::equivalent(in, a.record, ec))
       throw UsageError("--record " + a.record + " is also an --input file: recording would overwrite it; record to another file");
   }
-  EventRecord record(a.record);
+  // A record file in the output folder opens once the folder's journal has noted it (below).
+  if (!a.record.empty() && recordName.empty()) refuseExistingFile(a.record, "--record");
+  std::unique_ptr<EventRecord> record = std::make_unique<EventRecord>(recordName.empty() ? a.record : std::string());
 
   std::signal(SIGPIPE, SIG_IGN);  // a dead ffmpeg shows up as EPIPE, not as a kill
   console.start();
   World world(scene, WorldOptions{a.threads});
   for (const auto& w : world.takeWarnings()) console.warn(w);
   std::unique_ptr<Renderer> renderer;
+  std::unique_ptr<OutputJournal> journal;
   std::unique_ptr<FrameWriter> writer;
   std::unique_ptr<RunManifest> manifest;
   if (a.images) {
@@ -154,21 +190,40 @@ int cmdRun(const std::vector<std::string>& args) {
     wo.exportFormat = a.exportFormat;
     wo.videoPath = a.video;
     wo.videoFps = scene.fps / a.every;
+    // Each file is noted in the folder's journal (its name, the hash of its bytes, its
+    // temporary name) before it is written, so that a later run knows a killed run's files.
+    wo.beforeWrite = [&journal](const std::string& name, std::uint64_t h, const std::string& temp) { journal->note(name, temp, h); };
     writer = std::make_unique<FrameWriter>(wo);
     manifest = std::make_unique<RunManifest>(a, scene, *renderer, frames, world.threads());
-    // Before the first frame: an earlier run's frames and manifest go (a shorter rerun leaves
-    // none behind), and the manifest says "running" until the end, so a run killed midway
-    // never leaves a complete manifest beside its frames.
-    const int removed = removeEarlierRun(out);
-    if (removed)
-      console.say("sph2d: removed " + std::to_string(removed) + " files of an earlier run from " + out +
-                  " (frames, exports, manifest, temporary files)");
+    // Before the first frame: the frames, exports and manifest an earlier run wrote go (a
+    // shorter rerun leaves none behind), once proven its own again (the folder is scanned
+    // anew); and the manifest says "running" until the end, so a run killed midway never
+    // leaves a complete manifest beside its frames.
+    const FolderScan scan = scanOutputFolder(out, spec);
+    refuseForeignFiles(out, scan, spec);
+    auto stale = [](const std::string& name) { return isRunFileName(name) || name == "manifest.json"; };
+    const std::vector<std::string> removed = removeOwnFiles(out, scan, stale);
+    if (!removed.empty())
+      console.notice("sph2d: removed " + describeFiles(removed) + " that an earlier sph2d run wrote in " + out);
+    if (!scan.strayTemps.empty())
+      console.notice("sph2d: left " + describeFiles(scan.strayTemps) + " in " + out +
+                     ": named like the temporary files of an unfinished write, but no record of sph2d lists them");
+    std::vector<OwnedFile> kept;  // an earlier run's video or record, replaced only by one of the same name
+    for (const OwnedFile& f : scan.own)
+      if (!stale(f.name)) kept.push_back(f);
+    journal = std::make_unique<OutputJournal>(out, "run", kept);
+    if (!recordName.empty()) {
+      journal->note(recordName, "", xxh64("", 0));  // opened empty
+      record = std::make_unique<EventRecord>(a.record);
+      record->beforeWrite([&journal, &recordName](std::uint64_t h) { journal->note(recordName, "", h); });
+    }
+    if (!videoName.empty()) journal->note(videoName, fs::path(videoTempPath(a.video)).filename().string(), std::nullopt);
     manifest->writeRunning(out);
   }
   if (std::count(a.inputs.begin(), a.inputs.end(), "-")) input.openLive(STDIN_FILENO);
 
   // The loop. A failure stops it; what was written stays, and the manifest says why.
-  RunOutputs outputs(a, console, record, writer.get(), manifest.get());
+  RunOutputs outputs(a, console, *record, writer.get(), manifest.get());
   LoopSettings settings;
   settings.frames = frames;
   settings.fps = scene.fps;
@@ -216,12 +271,28 @@ int cmdRun(const std::vector<std::string>& args) {
     const FrameWriterCounts counts = writer->counts();
     report.exports = counts.exports;
     report.videoFrames = counts.videoFrames;
+    try {
+      if (!videoName.empty() && counts.videoFrames > 0)
+        if (const auto h = hashFile(a.video)) journal->note(videoName, "", *h);
+    } catch (const std::exception& e) {
+      if (status == 0 || status == 130) {
+        failure = e.what();
+        stopReason = "error";
+        status = 1;
+      }
+    }
   }
   report.wall = console.wall();
   if (status == 3 || status == 1) std::fprintf(stderr, "error: %s\n", failure.c_str());
   if (manifest) {
     // Only the frames whose PNG exists (the writer writes in order and stops at its first error).
-    manifest->finish(report.written, status, stopReason, failure, loop.status().done);
+    // The files it wrote into the folder that are there whole (a failed write left none).
+    std::vector<OwnedFile> files;
+    for (const OwnedFile& f : journal->files()) {
+      std::error_code ec;
+      if (fs::is_regular_file(fs::symlink_status(fs::path(out) / f.name, ec))) files.push_back(f);
+    }
+    manifest->finish(report.written, files, status, stopReason, failure, loop.status().done);
     try {
       manifest->write(out);
     } catch (const std::exception& e) {
@@ -235,7 +306,7 @@ int cmdRun(const std::vector<std::string>& args) {
   report.images = a.images;
   if (a.exportFormat) report.exportExtension = exportExtension(*a.exportFormat);
   report.video = a.video;
-  report.record = record.open() && !record.failed() ? record.path() : "";
+  report.record = record->open() && !record->failed() ? record->path() : "";
   report.pending = input.pending();
   report.realtime = a.realtime;
   report.fps = scene.fps;

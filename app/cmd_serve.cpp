@@ -36,6 +36,7 @@
 #include "commands.hpp"
 #include "event_intake.hpp"
 #include "game_loop.hpp"
+#include "output_dir.hpp"
 #include "serve_server.hpp"
 #include "sph2d/hash.hpp"
 #include "sph2d/render/renderer.hpp"
@@ -300,6 +301,8 @@ int cmdServe(const std::vector<std::string>& args) {
       return std::string("not applied: ") + e.what();
     }
   };
+  // The record starts over at each reset, but the first one must not replace a file sph2d did not write.
+  if (!a.record.empty()) refuseExistingFile(a.record, "--record");
   ServeStatus status;
   ServeServer server(a.server, embeddedPage(), onEvent, [&] {
     std::lock_guard<std::mutex> lock(status.mutex);

@@ -129,6 +129,9 @@ EventRecord::EventRecord(const std::string& path) : path_(path) {
 
 void EventRecord::write(const std::string& line) {
   if (!out_.is_open()) return;
+  hash_.update(line.data(), line.size());
+  hash_.update("\n", 1);
+  if (beforeWrite_) beforeWrite_(hash_.digest());
   errno = 0;
   out_ << line << '\n';
   out_.flush();

@@ -19,12 +19,14 @@
 
 #include <cstdint>
 #include <fstream>
+#include <functional>
 #include <memory>
 #include <mutex>
 #include <string>
 #include <vector>
 
 #include "events.hpp"
+#include "sph2d/hash.hpp"
 #include "sph2d/scene.hpp"
 
 namespace sph2d::cli {
@@ -124,11 +126,18 @@ class EventRecord {
   void write(const std::string& line);
   /// True once a write failed (the file is not a whole record of the run).
   bool failed() const { return failed_; }
+  /// XXH64 of the bytes written so far.
+  std::uint64_t hash() const { return hash_.digest(); }
+  /// Calls `f` before each line is written, with the XXH64 the file will have after it (the
+  /// run notes it in its folder's journal).
+  void beforeWrite(std::function<void(std::uint64_t)> f) { beforeWrite_ = std::move(f); }
 
  private:
   std::string path_;
   std::ofstream out_;
   bool failed_ = false;
+  Xxh64 hash_;
+  std::function<void(std::uint64_t)> beforeWrite_;
 };
 
 }  // namespace sph2d::cli

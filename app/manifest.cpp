@@ -14,12 +14,9 @@ namespace sph2d::cli {
 using json = nlohmann::ordered_json;
 
 std::string fileHash(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw UsageError("cannot read " + path);
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  const std::string bytes = ss.str();
-  return hex64(xxh64(bytes.data(), bytes.size()));
+  const auto h = hashFile(path);
+  if (!h) throw UsageError("cannot read " + path);
+  return hex64(*h);
 }
 
 json environmentJson() {
@@ -57,6 +54,7 @@ RunManifest::RunManifest(const RunArgs& a, const SceneDef& scene, const Renderer
                {"video", a.video}, {"realtime", a.realtime}, {"inputs", a.inputs}};
   j_["frames"] = json::array();
   j_["events"] = json::array();
+  j_["files"] = json::array();
 }
 
 void RunManifest::addFrame(std::int64_t frame, double time, std::uint64_t pixels, std::uint64_t state) {
@@ -69,10 +67,11 @@ void RunManifest::addFrame(std::int64_t frame, double time, std::uint64_t pixels
 
 void RunManifest::addEvent(const std::string& line) { j_["events"].push_back(json::parse(line)); }
 
-void RunManifest::finish(int written, int status, const std::string& reason, const std::string& message,
-                         std::int64_t simulated) {
+void RunManifest::finish(int written, const std::vector<OwnedFile>& files, int status, const std::string& reason,
+                         const std::string& message, std::int64_t simulated) {
   json& list = j_["frames"];
   while (int(list.size()) > written) list.erase(list.size() - 1);
+  for (const OwnedFile& f : files) j_["files"].push_back({{"file", f.name}, {"xxh64", f.xxh64}});
   j_["complete"] = status == 0;
   j_["stop"] = status == 0 ? json(nullptr)
                            : json{{"reason", reason}, {"message", message}, {"frames_simulated", simulated},

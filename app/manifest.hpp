@@ -5,7 +5,10 @@
 // the renderer, the CPU and the Mesa settings, the image, the render options, the
 // run's settings, and per kept frame its number, simulated time, PNG file, the
 // XXH64 of its RGBA pixels and the World's state hash; then every applied event
-// stamped with its frame, and whether the run completed (else why it stopped).
+// stamped with its frame, every file the run wrote into its folder with the XXH64
+// of its bytes ("files": the frames, exports, and the video or record when they are
+// in the folder; what lets a later run prove they are sph2d's, output_dir.hpp), and
+// whether the run completed (else why it stopped).
 // Design: the run fills it as frames are rendered and events applied and writes it
 // once at the end, whole or not at all (writeFileAtomic), listing only the frames
 // whose PNG exists. Keys keep their insertion order, so equal runs give equal bytes.
@@ -18,13 +21,14 @@
 #include <nlohmann/json.hpp>
 
 #include "manifest_reader.hpp"
+#include "output_dir.hpp"
 #include "run_args.hpp"
 #include "sph2d/render/renderer.hpp"
 #include "sph2d/scene.hpp"
 
 namespace sph2d::cli {
 
-/// XXH64 of a file's bytes as 16 hex digits. Throws UsageError when it cannot be read.
+/// XXH64 of a file's bytes as 16 hex digits (read in pieces). Throws UsageError when it cannot be read.
 std::string fileHash(const std::string& path);
 /// The llvmpipe environment as recorded in a manifest (pins it first).
 nlohmann::ordered_json environmentJson();
@@ -41,9 +45,11 @@ class RunManifest {
   void addFrame(std::int64_t frame, double time, std::uint64_t pixels, std::uint64_t state);
   /// Lists an applied event (a recordLine()).
   void addEvent(const std::string& line);
-  /// Keeps the first `written` frames (those whose PNG exists) and says how the run ended:
-  /// complete when `status` is 0, else `reason` ("interrupted", "guard", "error") and `message`.
-  void finish(int written, int status, const std::string& reason, const std::string& message, std::int64_t simulated);
+  /// Keeps the first `written` frames (those whose PNG exists), lists `files` (what the run
+  /// wrote into its folder, with hashes) and says how the run ended: complete when `status`
+  /// is 0, else `reason` ("interrupted", "guard", "error") and `message`.
+  void finish(int written, const std::vector<OwnedFile>& files, int status, const std::string& reason,
+              const std::string& message, std::int64_t simulated);
   /// Writes DIR/manifest.json whole or not at all. Throws std::runtime_error.
   void write(const std::string& dir) const;
   /// Writes DIR/manifest.json as a run under way: no frames, complete false, stop reason

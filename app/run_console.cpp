@@ -40,6 +40,11 @@ void RunConsole::say(const std::string& message) {
   std::printf("%s\n", message.c_str());
 }
 
+void RunConsole::notice(const std::string& message) {
+  clearBar();
+  std::printf("%s\n", message.c_str());
+}
+
 void RunConsole::progress(const World& world, const LoopStatus& s, bool force) {
   if (quiet_) return;
   const double now = wall();

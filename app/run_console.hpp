@@ -4,7 +4,8 @@
 //
 // Design: on a terminal the progress bar owns the current line, so every other
 // message clears it first; warnings go to standard error and are counted for the
-// summary; --quiet silences progress and event lines, never warnings or the summary.
+// summary; --quiet silences progress and event lines, never warnings, notices (files
+// removed from the output folder) or the summary.
 #pragma once
 
 #include <chrono>
@@ -60,6 +61,8 @@ class RunConsole {
   void warn(const std::string& message);
   /// Prints a line unless quiet.
   void say(const std::string& message);
+  /// Prints a line even when quiet (what the run did to files already in its folder).
+  void notice(const std::string& message);
   /// Redraws the progress bar (terminal, at most every 0.1 s) or prints a progress line
   /// (otherwise, every 5 s); `force` prints now.
   void progress(const World& world, const LoopStatus& status, bool force);
