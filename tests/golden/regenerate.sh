@@ -9,8 +9,10 @@ export GALLIUM_OVERRIDE_CPU_CAPS=sse4.1
 here="$(cd "$(dirname "$0")" && pwd)"
 exe="$(cd "${1:-$here/../../build}" && pwd)/app/sph2d"
 gen() {  # gen NAME [run flags...]
+  # The run replaces the frames and manifest it can prove an earlier run wrote (by the
+  # manifest's hashes) and stops, naming it, at a file it cannot (a frame edited by hand).
   local name=$1; shift
-  (cd "$here/$name" && rm -f frame_*.png manifest.json && "$exe" run scene.json --out . --quiet "$@")
+  (cd "$here/$name" && "$exe" run scene.json --out . --quiet "$@")
 }
 gen liquid_dam_break --frames 9 --every 4
 gen particles_pressure --frames 7 --every 3 --color-by pressure
