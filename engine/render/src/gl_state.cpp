@@ -35,10 +35,10 @@ const GLenum kTransferInt[] = {GL_MAP_COLOR, GL_MAP_STENCIL, GL_INDEX_SHIFT, GL_
 
 ContextInfo currentContext() {
   const char* version = reinterpret_cast<const char*>(glGetString(GL_VERSION));
-  if (!version)
-    throw std::runtime_error(
-        "no OpenGL context is current on this thread: make the game's OpenGL 3.3 context current before creating "
-        "or using a Renderer on CurrentGlContext");
+  if (!version)  // the Renderer checks first, with a message for its path; this is the backstop
+    throw std::runtime_error(std::string("no OpenGL context is current on this thread (glGetString(GL_VERSION) "
+                                         "through the renderer's ") +
+                             api().source + " OpenGL functions gives nothing)");
   ContextInfo c;
   c.version = version;
   const char* renderer = reinterpret_cast<const char*>(glGetString(GL_RENDERER));

@@ -3,13 +3,11 @@
 //
 // Design: thin free functions over the GL 3.3 core API of the current context (the Renderer's
 // own OSMesa context, or a game's: gl_state.hpp); they throw std::runtime_error with the
-// shader's log or the object that failed, and hold no state.
+// shader's log or the object that failed, and hold no state. Their gl* calls, like every one of
+// the renderer's, go through the calling thread's function table (gl_api.hpp).
 #pragma once
 
-#define GL_GLEXT_PROTOTYPES 1
-#include <GL/osmesa.h>
-#include <GL/gl.h>
-#include <GL/glext.h>
+#include "gl_api.hpp"
 
 #include <string>
 

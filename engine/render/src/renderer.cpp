@@ -10,7 +10,10 @@
 // the camera flips y) and draws text on the CPU, and draw() draws the target into the caller's
 // framebuffer (present.hpp). In the caller's context both run inside a GlStateGuard; in the
 // Renderer's own OSMesa context nothing needs restoring. Stage times are taken with glFinish
-// between stages only when RenderOptions::profile is set.
+// between stages only when RenderOptions::profile is set. Every public call first makes the
+// Renderer's table of GL functions the thread's (gl_api.hpp): OSMesa's entry points in its own
+// context, so that a program that links libglvnd's libOpenGL still reaches it; in the caller's
+// context the gl* functions the program links, as the game's own calls.
 #include "sph2d/render/renderer.hpp"
 
 #include <algorithm>
@@ -59,6 +62,10 @@ struct Renderer::Impl {
   RenderOptions opt;
   bool ownContext = false;                     // an OSMesa context of the Renderer's, else the caller's
   OSMesaContext ctx = nullptr;
+  // The GL functions every call uses (made the thread's by a gl::UseApi at its top): OSMesa's in
+  // the own context; in the caller's, the linked ones, or OSMesa's when the linked ones (then
+  // libglvnd's libOpenGL) reach no context while an OSMesa one is current (the caller's).
+  const gl::Api* api = &gl::linkedApi();
   // The caller's context only: OSMesa's current context when the Renderer was made. For a game's
   // EGL or GLX context on Mesa it is not null: OSMesa reads Mesa's shared dispatch, which gives
   // the same pointer for the same context (tests/egl); a driver that is not Mesa's OSMesa cannot
@@ -82,6 +89,7 @@ struct Renderer::Impl {
   RenderTimings timings;
 
   ~Impl() {
+    const gl::UseApi use(*api);
     if (ownContext) {
       if (ctx) OSMesaDestroyContext(ctx);  // with it, every GL object of the passes
     } else if (glInfo.major > 0 && glGetString(GL_VERSION) && OSMesaGetCurrentContext() == callerOsmesa) {
@@ -117,12 +125,18 @@ struct Renderer::Impl {
   }
 
   /// Before using the caller's context: one must be current, and no error of the caller's pending
-  /// (glGetError would take it and blame sph2d's calls).
+  /// (glGetError would take it and blame sph2d's calls). `call` is "Renderer" for the constructor.
   void enterCallerContext(const char* call) const {
-    if (!glGetString(GL_VERSION))
+    if (!glGetString(GL_VERSION)) {
+      if (std::string(call) == "Renderer")
+        throw std::runtime_error(
+            "Renderer(currentGlContext, ...): no OpenGL context is current on this thread: make the game's OpenGL "
+            "3.3 context current before creating the Renderer (a Renderer made without currentGlContext renders "
+            "in an OSMesa context of its own and needs none)");
       throw std::runtime_error(std::string("Renderer::") + call +
-                               ": no OpenGL context is current on this thread (make the one the Renderer was "
-                               "created in current)");
+                               " (a Renderer made with currentGlContext): no OpenGL context is current on this "
+                               "thread: make the game's context it was created in current first");
+    }
     if (OSMesaGetCurrentContext() != callerOsmesa)
       throw std::runtime_error(std::string("Renderer::") + call +
                                ": another OpenGL context is current than the one this Renderer was created in "
@@ -290,10 +304,17 @@ Renderer::Renderer(const RenderDef& def, const RenderOptions& options) : impl_(s
   const int attribs[] = {OSMESA_FORMAT, OSMESA_RGBA, OSMESA_DEPTH_BITS, 0, OSMESA_STENCIL_BITS, 0, OSMESA_ACCUM_BITS, 0,
                          OSMESA_PROFILE, OSMESA_CORE_PROFILE, OSMESA_CONTEXT_MAJOR_VERSION, 3,
                          OSMESA_CONTEXT_MINOR_VERSION, 3, 0};
+  r.api = &gl::osmesaApi();
+  const gl::UseApi use(*r.api);
   r.ctx = OSMesaCreateContextAttribs(attribs, nullptr);
   if (!r.ctx) throw std::runtime_error("OSMesa could not create a 3.3 core-profile context (is libosmesa6 installed?)");
   r.makeCurrent();
   OSMesaPixelStore(OSMESA_Y_UP, 0);
+  if (!glGetString(GL_VERSION))
+    throw std::runtime_error(
+        "Renderer (its own OSMesa context): OSMesaMakeCurrent succeeded, but glGetString(GL_VERSION) through "
+        "OSMesaGetProcAddress's entry points gives nothing, so OpenGL calls do not reach the context: libOSMesa "
+        "and the libglapi it loads must come from one Mesa (Debian: libosmesa6 and libglapi-mesa of one version)");
   r.glInfo = gl::currentContext();
   r.init(mode);
 }
@@ -305,6 +326,9 @@ Renderer::Renderer(CurrentGlContext, const RenderDef& def, const RenderOptions& 
   r.opt = options;
   const std::string mode = checkedMode(def, options);
   r.callerOsmesa = OSMesaGetCurrentContext();
+  if (!gl::linkedApi().GetString(GL_VERSION) && r.callerOsmesa && gl::osmesaApi().GetString(GL_VERSION))
+    r.api = &gl::osmesaApi();  // the game's own OSMesa context, which libOpenGL's gl* functions do not reach
+  const gl::UseApi use(*r.api);
   r.enterCallerContext("Renderer");
   r.glInfo = gl::currentContext();
   gl::GlStateGuard saved(r.glInfo);
@@ -330,6 +354,7 @@ const Frame& Renderer::render(const RenderInput& in) {
   timer.profile = r.opt.profile;
   const auto tStart = timer.t;
   r.timings = RenderTimings{};
+  const gl::UseApi use(*r.api);
   std::optional<gl::GlStateGuard> saved;
   if (r.ownContext) {
     r.makeCurrent();
@@ -355,6 +380,7 @@ void Renderer::draw(const RenderInput& in, const GlTarget& target) {
   timer.profile = r.opt.profile;
   const auto tStart = timer.t;
   r.timings = RenderTimings{};
+  const gl::UseApi use(*r.api);
   r.enterCallerContext("draw");
   const gl::GlStateGuard saved(r.glInfo);
   const GLuint fbo = target.framebuffer ? GLuint(*target.framebuffer) : saved.drawFramebuffer();

@@ -1,0 +1,31 @@
+# CTest glvnd/no_link_time_gl: no object of sph2d::render but gl_api.cpp's references a gl*
+# symbol. Such a call would bind to whatever the program links first (libglvnd's libOpenGL in a
+# GL game), which does not reach the Renderer's own OSMesa context; calls go through the tables
+# of engine/render/src/gl_api.hpp instead. Arguments: NM, LIB (the static library).
+execute_process(COMMAND "${NM}" -A -u "${LIB}" RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+if(NOT rc EQUAL 0)
+  message(FATAL_ERROR "${NM} -A -u ${LIB} failed (${rc}): ${err}")
+endif()
+string(REPLACE "\n" ";" lines "${out}")
+set(bad "")
+set(table 0)
+foreach(line IN LISTS lines)
+  if(line MATCHES "^[^ ]*:([^:]+\\.o):[ ]+U (gl[A-Z][A-Za-z0-9_]*)$")
+    set(object "${CMAKE_MATCH_1}")
+    set(symbol "${CMAKE_MATCH_2}")
+    if(object STREQUAL "gl_api.cpp.o")
+      math(EXPR table "${table} + 1")
+    else()
+      list(APPEND bad "${object}: ${symbol}")
+    endif()
+  endif()
+endforeach()
+if(bad)
+  list(JOIN bad "\n  " text)
+  message(FATAL_ERROR "gl* symbols referenced outside gl_api.cpp (add them to SPH2D_GL_FUNCTIONS in "
+                      "engine/render/src/gl_api.hpp, with their macro):\n  ${text}")
+endif()
+if(table EQUAL 0)
+  message(FATAL_ERROR "gl_api.cpp.o references no gl* symbol: is ${LIB} the renderer's library?")
+endif()
+message("sph2d::render: ${table} gl* symbols, all referenced by gl_api.cpp.o only")
