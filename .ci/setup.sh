@@ -5,7 +5,8 @@
 # libboost-dev (Boost.Beast, header-only) + libturbojpeg0-dev: `sph2d serve`; chromium: its
 # browser test (tests/serve, label browser), which fails when chromium is missing.
 # libegl-dev + libopengl-dev + libegl-mesa0: tests/egl, the renderer in a game's EGL context
-# (surfaceless Mesa) with gl* from libglvnd; configuring fails without them.
+# (surfaceless Mesa) with gl* from libglvnd; configuring fails without them. libopengl-dev also
+# serves tests/glvnd: the renderer's own OSMesa context with libOpenGL first in the link.
 SPH2D_PACKAGES="g++ cmake make pkg-config libbox2d-dev libosmesa6-dev libpng-dev libeigen3-dev doctest-dev nlohmann-json3-dev clang-14 libclang-rt-14-dev libboost-dev libturbojpeg0-dev chromium libegl-dev libopengl-dev libegl-mesa0"
 
 sph2d_install() {
