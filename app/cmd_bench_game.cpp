@@ -6,7 +6,7 @@
 // mean and single-particle compression over the frames, the largest gain of
 // kinetic plus potential energy over the initial, particles outside the tank,
 // and the surge front against Martin & Moyce 1952. With --peer it runs the
-// LiquidFun harness (../shared/peers/liquidfun) on the same dam break in the
+// LiquidFun harness (benchmarks/peers/liquidfun) on the same dam break in the
 // same invocation and prints sph2d's time as a ratio of the peer's.
 //
 // A benchmark, not a test: rerun it, and compare figures as ratios within one
@@ -37,7 +37,7 @@ namespace {
 
 const char* kHelp =
     "Usage: sph2d bench game [--particles N] [--threads T[,T...]] [--seconds S] [--presets P[,P...]]\n"
-    "                        [--set KEY=VALUE]... [--peer PATH] [--csv FILE] [--assets DIR]\n"
+    "                        [--set KEY=VALUE]... [--peer [PATH]] [--csv FILE] [--assets DIR]\n"
     "\n"
     "The default dam break (assets/scenes/dam_break.json: a 1 m x 2 m column in a 4 m x 3 m\n"
     "tank) with the spacing set so the column holds about N particles (default 20000), for S\n"
@@ -50,9 +50,10 @@ const char* kHelp =
     "height at the end measured from positions alone (as for the peer).\n"
     "--set KEY=VALUE changes the solver of every run: a shared key (viscosity, support_ratio,\n"
     "cfl, max_substeps) or one of the preset solver's own parameters.\n"
-    "--peer PATH runs the LiquidFun harness at PATH (lf_dam_break, built by\n"
-    "../shared/peers/liquidfun/build.sh) on the same dam break, with its default iterations and\n"
-    "with --static, and prints the ratio of each sph2d run's time to the peer's.\n"
+    "--peer runs the LiquidFun harness (lf_dam_break: cmake -DSPH2D_PEER_LIQUIDFUN=ON, target\n"
+    "lf_dam_break; benchmarks/peers/liquidfun) on the same dam break, with its default iterations\n"
+    "and with --static, and prints the ratio of each sph2d run's time to the peer's; --peer PATH\n"
+    "runs the harness at PATH instead.\n"
     "--csv FILE writes one row per run (fractions, not percent).\n";
 
 struct Row {
@@ -271,7 +272,10 @@ int cmdBenchGame(const std::vector<std::string>& args) {
           throw UsageError("--presets: unknown preset '" + p + "'; presets: game, balanced, accurate");
       if (presets.empty()) throw UsageError("--presets needs at least one preset");
     } else if (a == "--set") sets.push_back(value());
-    else if (a == "--peer") peer = value();
+    else if (a == "--peer") {
+      // `--peer` alone: the harness this build tree builds (-DSPH2D_PEER_LIQUIDFUN=ON); `--peer PATH`: that one.
+      peer = i + 1 < args.size() && args[i + 1].rfind("--", 0) != 0 ? args[++i] : std::string(SPH2D_PEER_EXE);
+    }
     else if (a == "--assets") assetsPath = value();
     else if (a == "--csv") csvPath = value();
     else throw UsageError("unknown option '" + a + "' (see sph2d bench game --help)");
@@ -279,7 +283,9 @@ int cmdBenchGame(const std::vector<std::string>& args) {
   if (peer.find('\'') != std::string::npos)  // it goes into a shell command between single quotes
     throw UsageError("--peer " + peer + ": a path with a single quote is not accepted");
   if (!peer.empty() && ::access(peer.c_str(), X_OK) != 0)
-    throw UsageError("--peer " + peer + ": not an executable (build it with ../shared/peers/liquidfun/build.sh)");
+    throw UsageError("--peer " + peer +
+                     ": not an executable (build the peer: cmake -S . -B build -DSPH2D_PEER_LIQUIDFUN=ON && "
+                     "cmake --build build --target lf_dam_break; benchmarks/peers/liquidfun/README.md)");
   const std::string assets = assetsPath;
   const SceneDef scene = loadScene(assets + "/scenes/dam_break.json");
   const auto surge = validation::readReferenceCsv(assets + "/reference/martin_moyce_1952_surge_front.csv");

@@ -61,6 +61,13 @@ TEST_CASE("bench game refuses a peer that is not an executable, and less than on
   const Result p = run("bench game --particles 600 --seconds 0.25 --presets game --threads 1 --peer /nonexistent/lf_dam_break");
   CHECK(p.code == 2);
   CHECK(p.out.find("--peer /nonexistent/lf_dam_break") != std::string::npos);
+  // `--peer` alone looks for the harness this build tree builds; without -DSPH2D_PEER_LIQUIDFUN=ON
+  // there is none, and the message says how to build it.
+  const Result b = run("bench game --particles 600 --seconds 0.25 --presets game --threads 1 --peer");
+  if (b.code != 0) {
+    CHECK(b.code == 2);
+    CHECK(b.out.find("SPH2D_PEER_LIQUIDFUN=ON") != std::string::npos);
+  }
   const Result s = run("bench game --particles 600 --seconds 0.001");
   CHECK(s.code == 2);
   CHECK(s.out.find("--seconds") != std::string::npos);
