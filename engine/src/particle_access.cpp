@@ -195,7 +195,7 @@ bool World::setParticleUserData(std::uint32_t id, std::uint32_t value) {
 
 std::uint32_t World::particleUserData(std::uint32_t id) const { return getU32(*this, impl_->P, kUserDataField, id); }
 
-std::vector<std::uint32_t> World::addParticles(const std::vector<Vec2d>& points, const std::vector<Vec2d>& velocities) {
+IdRange World::addParticles(const std::vector<Vec2d>& points, const std::vector<Vec2d>& velocities) {
   if (!velocities.empty() && velocities.size() != points.size())
     throw std::invalid_argument("addParticles: " + std::to_string(points.size()) + " points but " +
                                 std::to_string(velocities.size()) + " velocities");
@@ -203,7 +203,8 @@ std::vector<std::uint32_t> World::addParticles(const std::vector<Vec2d>& points,
   checkFinite("addParticles", velocities, "velocity");
   Impl& w = *impl_;
   const Real rho0 = Real(w.scene.solver.restDensity);
-  std::vector<std::uint32_t> ids;
+  IdRange ids;
+  ids.first = w.nextId;  // each particle below takes the next id: the ones added are consecutive
   std::size_t inside = 0, refused = 0;
   for (std::size_t k = 0; k < points.size(); ++k) {
     const Vec2 p(Real(points[k].x() - w.origin.x()), Real(points[k].y() - w.origin.y()));
@@ -216,7 +217,7 @@ std::vector<std::uint32_t> World::addParticles(const std::vector<Vec2d>& points,
       break;
     }
     const Vec2d v = velocities.empty() ? Vec2d(0, 0) : velocities[k];
-    ids.push_back(w.nextId);
+    ++ids.count;
     w.P.push(p, Vec2(Real(v.x()), Real(v.y())), w.nextId++, rho0);
   }
   ++w.edits;  // the query grid is stale
@@ -231,7 +232,7 @@ std::vector<std::uint32_t> World::addParticles(const std::vector<Vec2d>& points,
   return ids;
 }
 
-std::size_t World::removeParticles(const std::vector<std::uint32_t>& ids) {
+std::vector<std::uint32_t> World::removeParticles(const std::vector<std::uint32_t>& ids) {
   Impl& w = *impl_;
   std::vector<std::uint32_t> sorted(ids);
   std::sort(sorted.begin(), sorted.end());
@@ -241,18 +242,19 @@ std::size_t World::removeParticles(const std::vector<std::uint32_t>& ids) {
     w.dead[i] = std::binary_search(sorted.begin(), sorted.end(), w.P.id[i]);
     n += w.dead[i];
   }
-  if (n) w.removeFlagged();
-  return n;
+  std::vector<std::uint32_t> removed;
+  if (n) w.removeFlagged(&removed);
+  return removed;
 }
 
-std::size_t World::removeParticlesInShape(const b2Shape& shape, const b2Transform& xf) {
+std::vector<std::uint32_t> World::removeParticlesInShape(const b2Shape& shape, const b2Transform& xf) {
   const std::vector<std::size_t> in = particlesInShape(shape, xf);
   std::vector<std::uint32_t> ids;
   for (const std::size_t i : in) ids.push_back(impl_->P.id[i]);
   return removeParticles(ids);
 }
 
-std::size_t World::addShape(const b2Shape& shape, const b2Transform& xf, const Vec2d& velocity) {
+IdRange World::addShape(const b2Shape& shape, const b2Transform& xf, const Vec2d& velocity) {
   FluidBlockDef b;
   if (shape.GetType() == b2Shape::e_circle) {
     const auto& c = static_cast<const b2CircleShape&>(shape);

@@ -34,7 +34,9 @@ double uniform(std::uint64_t& state) { return double(splitmix(state) >> 11) * (1
 /// the block is refused with one warning, and no work or memory grows with the
 /// block's size beyond the particles added (rows are computed as they are
 /// filled, a drop's rows only over its chord).
-std::size_t World::Impl::fillBlock(const FluidBlockDef& b, bool hydrostaticStart) {
+IdRange World::Impl::fillBlock(const FluidBlockDef& b, bool hydrostaticStart) {
+  IdRange ids;
+  ids.first = nextId;  // every particle below takes the next id: the ones added are consecutive
   const bool disc = b.shape == FluidBlockDef::Shape::Circle;  // a circle or a drop: row chords
   std::vector<double> crossings;  // a polygon's edges across the current row
   const SolverDef& sd = scene.solver;
@@ -44,7 +46,7 @@ std::size_t World::Impl::fillBlock(const FluidBlockDef& b, bool hydrostaticStart
   const Real rho0 = Real(sd.restDensity);
   const double nxd = std::floor((b.max.x() - b.min.x()) / sd.spacing + 1e-9);
   const double nyd = std::floor((b.max.y() - b.min.y()) / sd.spacing + 1e-9);
-  if (!(nxd >= 1 && nyd >= 1)) return 0;  // empty (or NaN)
+  if (!(nxd >= 1 && nyd >= 1)) return ids;  // empty (or NaN)
   // Lattice indices stay far inside a long: a block wider than 2^52 spacings is cut there
   // (it could never be filled within a budget anyway).
   const double cap = 4503599627370496.0;
@@ -105,7 +107,8 @@ std::size_t World::Impl::fillBlock(const FluidBlockDef& b, bool hydrostaticStart
   }
   ++edits;  // the query grid is stale
   refreshView();
-  return added;
+  ids.count = added;
+  return ids;
 }
 
 bool World::Impl::onStaticSurface(const Vec2& p) const {
@@ -118,7 +121,13 @@ const char* World::Impl::budgetKey() const {
   return scene.effects.budget > 0 ? "effects.budget.max_particles" : "max_particles";
 }
 
-void World::Impl::removeFlagged() {
+void World::Impl::removeFlagged(std::vector<std::uint32_t>* ids) {
+  if (ids) {
+    ids->clear();
+    for (std::size_t i = 0; i < P.size(); ++i)
+      if (dead[i]) ids->push_back(P.id[i]);
+    std::sort(ids->begin(), ids->end());
+  }
   removed += P.compact(dead);
   ++edits;  // the query grid is stale
   refreshView();

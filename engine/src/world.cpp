@@ -244,9 +244,9 @@ void World::setGravity(const Vec2d& g) {
   if (impl_->ownWorld) impl_->ownWorld->SetGravity(b2Vec2(float(g.x()), float(g.y())));
 }
 
-std::size_t World::addBlock(const FluidBlockDef& block) { return impl_->fillBlock(block, false); }
+IdRange World::addBlock(const FluidBlockDef& block) { return impl_->fillBlock(block, false); }
 
-std::size_t World::addDrop(const Vec2d& center, double radius, const Vec2d& velocity) {
+IdRange World::addDrop(const Vec2d& center, double radius, const Vec2d& velocity) {
   FluidBlockDef b = circleRegion(center, radius, impl_->scene.solver.spacing);
   b.velocity = velocity;
   return impl_->fillBlock(b, false);
@@ -287,7 +287,7 @@ void World::removeEmitter(std::size_t index) {
   if (w.emitters.empty()) w.buildStages();
 }
 
-std::size_t World::removeParticlesInBox(const Vec2d& lo, const Vec2d& hi) {
+std::vector<std::uint32_t> World::removeParticlesInBox(const Vec2d& lo, const Vec2d& hi) {
   Impl& w = *impl_;
   const RegionDef r{lo, hi};
   w.dead.assign(w.P.size(), 0);
@@ -296,8 +296,9 @@ std::size_t World::removeParticlesInBox(const Vec2d& lo, const Vec2d& hi) {
     w.dead[i] = r.contains(worldPosition(i));
     n += w.dead[i];
   }
-  if (n) w.removeFlagged();
-  return n;
+  std::vector<std::uint32_t> ids;
+  if (n) w.removeFlagged(&ids);
+  return ids;
 }
 
 namespace {

@@ -214,7 +214,8 @@ struct World::Impl {
   /// Fills a block on the lattice of the spacing (hydrostaticStart: rows closer with
   /// depth, at the density the solver holds at rest), keeping the points of its circle
   /// (a drop, addDrop) or polygon. Stops at the particle budget (one warning for the rest).
-  std::size_t fillBlock(const FluidBlockDef& b, bool hydrostaticStart);
+  /// Returns the ids added (consecutive: each particle takes the next id).
+  IdRange fillBlock(const FluidBlockDef& b, bool hydrostaticStart);
   /// Warns once when a weakly compressible solver's sound speed is below 10 × the fastest
   /// speed the scene sets (blocks, emitters, timeline events).
   void warnLowSoundSpeed();
@@ -228,8 +229,9 @@ struct World::Impl {
   void lifetimes(Real dt);
   /// The sinks stage: removes particles inside sink regions.
   void sinks();
-  /// Removes the particles flagged in `dead` (stable order), counting them.
-  void removeFlagged();
+  /// Removes the particles flagged in `dead` (stable order), counting them; `ids`, when
+  /// given, receives their ids in increasing order.
+  void removeFlagged(std::vector<std::uint32_t>* ids = nullptr);
   /// Removes the k oldest particles (smallest ids).
   void removeOldest(std::size_t k);
 

@@ -187,7 +187,7 @@ TEST_CASE("addDrop fills a disc on the lattice and skips points inside solids") 
   World w(s, WorldOptions{1});
   const std::size_t before = w.particleCount();
   // Radius 0.2 at spacing 0.05: the lattice points of [0.8, 1.2]² within 0.2 of (1, 1).
-  const std::size_t added = w.addDrop(Vec2d(1, 1), 0.2, Vec2d(0.5, -1));
+  const std::size_t added = w.addDrop(Vec2d(1, 1), 0.2, Vec2d(0.5, -1)).count;
   CHECK(added == 52);  // 8 × 8 lattice points, the 12 corner ones outside the disc
   CHECK(std::fabs(double(added) - M_PI * 0.04 / 0.0025) < 3);  // π r² / dx² = 50.3
   CHECK(w.particleCount() == before + added);
@@ -197,7 +197,7 @@ TEST_CASE("addDrop fills a disc on the lattice and skips points inside solids") 
   }
   // Half of this drop lies inside the floor (y < 0): those points are skipped, with a warning.
   w.takeWarnings();
-  const std::size_t half = w.addDrop(Vec2d(1.5, 0.0), 0.1);
+  const std::size_t half = w.addDrop(Vec2d(1.5, 0.0), 0.1).count;
   CHECK(half == 6);  // the 6 lattice points of the upper half of a 4 × 4 patch within the disc
   const auto warnings = w.takeWarnings();
   REQUIRE(warnings.size() == 1);

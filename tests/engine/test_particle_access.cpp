@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iterator>
 #include <limits>
 #include <sstream>
 #include <stdexcept>
@@ -42,8 +43,8 @@ TEST_CASE("particle access: slotOf follows every particle through the grid's reo
   for (int f = 0; f < 30; ++f) w.stepFrame();
   CHECK(w.slotOf(watched) != slot0);  // the grid reordered the particles: the slot moved
   CHECK(everySlotFound(w));
-  const std::size_t removed = w.removeParticlesInBox({0, 0}, {0.2, 0.1});
-  REQUIRE(removed > 0);
+  const std::vector<std::uint32_t> removed = w.removeParticlesInBox({0, 0}, {0.2, 0.1});
+  REQUIRE(!removed.empty());
   CHECK(everySlotFound(w));
   CHECK(w.slotOf(w.particles().id[w.particleCount() - 1] + 100000) == World::npos);  // never made
   Vec2d x(7, 7), v(7, 7);
@@ -154,7 +155,7 @@ TEST_CASE("particle access: addParticles places particles that fall freely, skip
   // Two points inside the floor, then four in the air: three fit the budget.
   const std::vector<Vec2d> pts = {{0.5, -0.1}, {0.3, -0.05}, {0.2, 1.8}, {0.5, 1.8}, {0.8, 1.8}, {0.6, 1.5}};
   const std::vector<Vec2d> vel = {{0, 0}, {0, 0}, {0, 0}, {0.5, 0}, {0, 0}, {0, 0}};
-  const std::vector<std::uint32_t> ids = w.addParticles(pts, vel);
+  const IdRange ids = w.addParticles(pts, vel);
   REQUIRE(ids.size() == 3);
   CHECK(w.particleCount() == n0 + 3);
   const std::vector<std::string> warn = w.takeWarnings();
@@ -188,7 +189,9 @@ TEST_CASE("particle access: removeParticles removes exactly the ids given, and t
   const std::size_t n0 = w.particleCount();
   std::vector<std::uint32_t> ask = gone;
   ask.push_back(4000000000u);  // no such particle
-  CHECK(w.removeParticles(ask) == gone.size());
+  std::vector<std::uint32_t> sorted = gone;
+  std::sort(sorted.begin(), sorted.end());
+  CHECK(w.removeParticles(ask) == sorted);  // exactly the ids a particle had, in increasing order
   CHECK(w.particleCount() == n0 - gone.size());
   Vec2d x, v;
   for (const std::uint32_t id : gone) CHECK_FALSE(w.getParticle(id, x, v));
@@ -196,6 +199,46 @@ TEST_CASE("particle access: removeParticles removes exactly the ids given, and t
   CHECK(x == xk);
   CHECK(v == vk);
   CHECK(everySlotFound(w));
+}
+
+TEST_CASE("particle access: every removal returns exactly the ids that left, in increasing order") {
+  World w(smallDamBreak(), WorldOptions{2});
+  for (int f = 0; f < 20; ++f) w.stepFrame();
+  auto ids = [&] {
+    std::vector<std::uint32_t> out(w.particles().id.begin(), w.particles().id.end());
+    std::sort(out.begin(), out.end());
+    return out;
+  };
+  auto gone = [](const std::vector<std::uint32_t>& before, const std::vector<std::uint32_t>& after) {
+    std::vector<std::uint32_t> out;
+    std::set_difference(before.begin(), before.end(), after.begin(), after.end(), std::back_inserter(out));
+    return out;
+  };
+  // By box: the ids of the particles that were in it.
+  std::vector<std::uint32_t> before = ids();
+  const std::vector<std::uint32_t> inBox = w.removeParticlesInBox({0.0, 0.0}, {0.1, 0.1});
+  CHECK(inBox.size() > 10);
+  CHECK(inBox == gone(before, ids()));
+  CHECK(std::is_sorted(inBox.begin(), inBox.end()));
+  // By shape.
+  b2CircleShape disc;
+  disc.m_radius = 0.06f;
+  const b2Transform at(b2Vec2(0.2f, 0.1f), b2Rot(0));
+  before = ids();
+  const std::vector<std::uint32_t> inDisc = w.removeParticlesInShape(disc, at);
+  CHECK(inDisc.size() > 10);
+  CHECK(inDisc == gone(before, ids()));
+  // By id: repeats, ids removed before and ids never made are not in the answer.
+  before = ids();
+  const std::vector<std::uint32_t> ask = {before[40], before[3], before[40], inBox[0], 4000000000u, before[7]};
+  const std::vector<std::uint32_t> byId = w.removeParticles(ask);
+  CHECK(byId == std::vector<std::uint32_t>{before[3], before[7], before[40]});
+  CHECK(byId == gone(before, ids()));
+  // Nothing to remove: empty, and the World unchanged.
+  const std::uint64_t hash = w.stateHash();
+  CHECK(w.removeParticlesInBox({5, 5}, {6, 6}).empty());
+  CHECK(w.removeParticles({inBox[0]}).empty());
+  CHECK(w.stateHash() == hash);
 }
 
 TEST_CASE("particle access: writes by id give the same state hash for 1, 2 and 3 threads") {
@@ -249,8 +292,8 @@ TEST_CASE("particle colour and user data: allocated by the first set, kept by id
   // Steps reorder the slots; removals compact them; new particles hold 0.
   for (int f = 0; f < 30; ++f) w.stepFrame();
   const std::vector<std::uint32_t> gone(left.begin(), left.begin() + 10);
-  CHECK(w.removeParticles(gone) == 10);
-  const std::vector<std::uint32_t> added = w.addParticles({Vec2d(0.5, 0.9)});
+  CHECK(w.removeParticles(gone).size() == 10);
+  const IdRange added = w.addParticles({Vec2d(0.5, 0.9)});
   REQUIRE(added.size() == 1);
   CHECK(w.particleColor(added[0]) == 0u);
   CHECK(w.particleUserData(added[0]) == 0u);

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iterator>
 #include <set>
 #include <sstream>
 #include <stdexcept>
@@ -157,10 +158,10 @@ TEST_CASE("blocks and drops of any size stop at max_particles: the rest is refus
     FluidBlockDef huge;
     huge.min = Vec2d(-1e6, -1e6);
     huge.max = Vec2d(1e6, 1e6);
-    CHECK(w.addBlock(huge) == 2000);
+    CHECK(w.addBlock(huge).count == 2000);
     CHECK(w.particleCount() == 2000);
     CHECK(budgetWarnings(w) == 1);
-    CHECK(w.addDrop(Vec2d(1, 1), 0.2) == 0);  // full: nothing more, and it says so once
+    CHECK(w.addDrop(Vec2d(1, 1), 0.2).empty());  // full: nothing more, and it says so once
     CHECK(w.particleCount() == 2000);
     CHECK(budgetWarnings(w) == 1);
   }
@@ -168,7 +169,7 @@ TEST_CASE("blocks and drops of any size stop at max_particles: the rest is refus
     // A drop of radius 1e4 centred in the tank: filled from its lowest rows up to the
     // budget, every particle inside the disc (and none inside the tank's walls).
     World w(s, WorldOptions{1});
-    CHECK(w.addDrop(Vec2d(1, 1), 1e4) == 2000);
+    CHECK(w.addDrop(Vec2d(1, 1), 1e4).count == 2000);
     CHECK(budgetWarnings(w) == 1);
     const Vec2d origin = w.origin();
     for (std::size_t i = 0; i < w.particleCount(); ++i) {
@@ -184,7 +185,7 @@ TEST_CASE("blocks and drops of any size stop at max_particles: the rest is refus
     FluidBlockDef b;
     b.min = Vec2d(0.1, 0.1);
     b.max = Vec2d(1.9, 1.9);
-    CHECK(w.addBlock(b) == 300);
+    CHECK(w.addBlock(b).count == 300);
     const auto warnings = w.takeWarnings();
     REQUIRE(warnings.size() == 1);
     CHECK(warnings[0].find("budget of 300 (effects.budget.max_particles)") != std::string::npos);
@@ -486,4 +487,89 @@ TEST_CASE("emitters added and removed at run time: nothing owed for the past, se
   bad.position = Vec2d(std::nan(""), 0);
   CHECK_THROWS_WITH_AS(w.addEmitter(bad), doctest::Contains("position"), std::invalid_argument);
   CHECK(w.emitterCount() == 0);
+}
+
+namespace {
+
+/// The ids of every particle of `w`, in increasing order.
+std::vector<std::uint32_t> allIds(const World& w) {
+  std::vector<std::uint32_t> ids(w.particles().id.begin(), w.particles().id.end());
+  std::sort(ids.begin(), ids.end());
+  return ids;
+}
+
+/// The ids in `after` that are not in `before` (both in increasing order).
+std::vector<std::uint32_t> newIds(const std::vector<std::uint32_t>& before, const std::vector<std::uint32_t>& after) {
+  std::vector<std::uint32_t> out;
+  std::set_difference(after.begin(), after.end(), before.begin(), before.end(), std::back_inserter(out));
+  return out;
+}
+
+}  // namespace
+
+TEST_CASE("every add returns the ids it made: addBlock, addDrop, addShape, addParticles, the budget cutting a block short too") {
+  SceneDef s = box();
+  s.blocks.push_back(test::block({0.1, 0.1}, {0.5, 0.5}));
+  EmitterDef e;  // emitted particles take ids between the adds
+  e.position = Vec2d(1.5, 1.8);
+  e.direction = Vec2d(0, -1);
+  e.rate = 100;
+  e.speed = 1;
+  s.effects.emitters.push_back(e);
+  World w(s, WorldOptions{2});
+  // Each add: the ids new in the World are exactly the range returned, and the range is what it says.
+  auto expectAdded = [&](const std::vector<std::uint32_t>& before, const IdRange& r) {
+    const std::vector<std::uint32_t> made = newIds(before, allIds(w));
+    CHECK(made == r.ids());
+    CHECK(made.size() == r.count);
+    for (const std::uint32_t id : made) CHECK(r.contains(id));
+    CHECK_FALSE(r.contains(r.first - 1));
+    CHECK_FALSE(r.contains(r.first + std::uint32_t(r.count)));
+    CHECK(std::vector<std::uint32_t>(r.begin(), r.end()) == made);
+  };
+  for (int f = 0; f < 10; ++f) w.stepFrame();
+  std::vector<std::uint32_t> before = allIds(w);
+  const IdRange block = w.addBlock(test::block({1.0, 0.1}, {1.3, 0.3}));
+  CHECK(block.count == 35);  // 7 × 5 lattice points at spacing 0.04 (the floor's face left out: none here)
+  CHECK(block.first > before.back());  // after every id given out, the emitted ones included
+  expectAdded(before, block);
+  for (int f = 0; f < 5; ++f) w.stepFrame();
+  before = allIds(w);
+  const IdRange drop = w.addDrop(Vec2d(1.0, 1.0), 0.1, Vec2d(0, -1));
+  CHECK(drop.count > 0);
+  expectAdded(before, drop);
+  before = allIds(w);
+  b2PolygonShape tri;
+  const b2Vec2 corners[3] = {b2Vec2(0.6f, 1.2f), b2Vec2(0.9f, 1.2f), b2Vec2(0.75f, 1.45f)};
+  tri.Set(corners, 3);
+  const IdRange shape = w.addShape(tri, b2Transform(b2Vec2(0, 0), b2Rot(0)));
+  CHECK(shape.count > 10);
+  expectAdded(before, shape);
+  // addParticles: points inside a solid take no id, so the ids stay consecutive.
+  before = allIds(w);
+  const IdRange points = w.addParticles({Vec2d(0.3, 1.0), Vec2d(0.3, -0.1), Vec2d(0.4, 1.0), Vec2d(-0.1, 1.0), Vec2d(0.5, 1.0)});
+  CHECK(points.count == 3);
+  expectAdded(before, points);
+  CHECK(w.takeWarnings().size() == 1);  // the two points in the walls
+  // Removed ids are never given again: the next add starts after the last id given.
+  const std::vector<std::uint32_t> removed = w.removeParticles(points.ids());
+  CHECK(removed == points.ids());
+  before = allIds(w);
+  const IdRange again = w.addParticles({Vec2d(0.3, 1.0)});
+  CHECK(again.first == points.first + 3);
+  expectAdded(before, again);
+  // The budget cuts a block short: the ids it did add are still one range, and a full World adds none.
+  SceneDef small = box();
+  small.maxParticles = 50;
+  World full(small, WorldOptions{1});
+  const IdRange cut = full.addBlock(test::block({0.1, 0.1}, {1.9, 1.9}));
+  CHECK(cut.count == 50);
+  CHECK(cut.first == 0);
+  CHECK(allIds(full) == cut.ids());
+  full.takeWarnings();
+  const IdRange none = full.addDrop(Vec2d(1, 1), 0.2);
+  CHECK(none.empty());
+  CHECK(none.first == 50);  // the id the next particle would take
+  CHECK(none.begin() == none.end());
+  CHECK(allIds(full) == cut.ids());
 }

@@ -91,7 +91,7 @@ void overlapSeparates(const std::string& solver) {
   FluidBlockDef top;
   top.min = Vec2d(0.42, 0.42);
   top.max = Vec2d(0.58, 0.58);
-  const std::size_t added = w.addBlock(top);
+  const std::size_t added = w.addBlock(top).count;
   const double d0 = minPairDistance(w);
   for (int f = 0; f < 60; ++f) w.stepFrame();
   const DensityStats d = w.densityStats();

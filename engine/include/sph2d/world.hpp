@@ -13,6 +13,7 @@
 #include <functional>
 #include <type_traits>
 #include <iosfwd>
+#include <iterator>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -59,6 +60,57 @@ struct UserForce {
   Vec2d point{0, 0};   ///< world coordinates [m]
   double radius = 0.5; ///< reach [m]
   double strength = 0; ///< acceleration at the centre [m/s²]; > 0 pulls towards the point, < 0 pushes away
+};
+
+/// The ids of the particles one call added (World::addBlock, addDrop, addShape, addParticles):
+/// `count` consecutive ids from `first`. A World gives each particle it makes the next id, one
+/// after the other, so those one call adds are consecutive, the budget cutting it short or not
+/// (the points it skips take no id). A range of ids: `for (std::uint32_t id : added)`,
+/// `added[k]`, `added.contains(id)`; `ids()` copies them into a vector.
+struct IdRange {
+  std::uint32_t first = 0;  ///< the first id added (when none was: the id the next particle will get)
+  std::size_t count = 0;    ///< how many were added
+
+  /// True when the call added nothing.
+  bool empty() const { return count == 0; }
+  /// How many were added (count).
+  std::size_t size() const { return count; }
+  /// The k-th id added (k < count).
+  std::uint32_t operator[](std::size_t k) const { return first + std::uint32_t(k); }
+  /// True when `id` is one of the ids added.
+  bool contains(std::uint32_t id) const { return id >= first && std::size_t(id - first) < count; }
+  /// The same ids.
+  bool operator==(const IdRange& o) const { return first == o.first && count == o.count; }
+  /// Other ids.
+  bool operator!=(const IdRange& o) const { return !(*this == o); }
+  /// The ids, in increasing order, as a vector (for removeParticles, setVelocities, ...).
+  std::vector<std::uint32_t> ids() const {
+    std::vector<std::uint32_t> out(count);
+    for (std::size_t k = 0; k < count; ++k) out[k] = (*this)[k];
+    return out;
+  }
+  /// Walks the ids in increasing order.
+  class iterator {
+   public:
+    using iterator_category = std::forward_iterator_tag;
+    using value_type = std::uint32_t;
+    using difference_type = std::ptrdiff_t;
+    using pointer = const std::uint32_t*;
+    using reference = std::uint32_t;
+    iterator() = default;
+    explicit iterator(std::uint32_t id) : id_(id) {}
+    std::uint32_t operator*() const { return id_; }
+    iterator& operator++() { ++id_; return *this; }
+    iterator operator++(int) { iterator t = *this; ++id_; return t; }
+    bool operator==(const iterator& o) const { return id_ == o.id_; }
+    bool operator!=(const iterator& o) const { return id_ != o.id_; }
+   private:
+    std::uint32_t id_ = 0;
+  };
+  /// The first id.
+  iterator begin() const { return iterator(first); }
+  /// One past the last id.
+  iterator end() const { return iterator(first + std::uint32_t(count)); }
 };
 
 /// A saved state that World::load refuses: not a save, another scene's, or damaged.
@@ -211,15 +263,16 @@ class World {
   /// Adds a block of fluid on the lattice of the scene's spacing (particles
   /// inside solids are skipped), row by row from the bottom, until the world holds
   /// its particle budget (max_particles, or effects.budget when set): the rest is
-  /// refused with one warning (takeWarnings). Returns the number of particles added.
-  std::size_t addBlock(const FluidBlockDef& block);
+  /// refused with one warning (takeWarnings). Returns the ids of the particles added.
+  IdRange addBlock(const FluidBlockDef& block);
   /// Adds a drop of fluid: the lattice points of a block around `center` that lie
   /// within `radius` (world coordinates), moving at `velocity`; points inside
-  /// solids are skipped; the particle budget holds as for addBlock. Returns the
-  /// number of particles added.
-  std::size_t addDrop(const Vec2d& center, double radius, const Vec2d& velocity = Vec2d(0, 0));
-  /// Removes the particles inside the box [lo, hi] (world coordinates). Returns how many.
-  std::size_t removeParticlesInBox(const Vec2d& lo, const Vec2d& hi);
+  /// solids are skipped; the particle budget holds as for addBlock. Returns the ids
+  /// of the particles added.
+  IdRange addDrop(const Vec2d& center, double radius, const Vec2d& velocity = Vec2d(0, 0));
+  /// Removes the particles inside the box [lo, hi] (world coordinates). Returns their ids,
+  /// in increasing order.
+  std::vector<std::uint32_t> removeParticlesInBox(const Vec2d& lo, const Vec2d& hi);
 
   /// The shapes of the moving (kinematic and dynamic) bodies at their current pose as the fluid
   /// meets them, in the local frame like colliders() (polygons with Box2D's skin, faces moved
@@ -276,12 +329,13 @@ class World {
   /// caller keeps them about a spacing apart) moving at velocities[k] (`velocities`
   /// empty: at rest). Points inside solids are skipped, and the particle budget holds as
   /// for addBlock (one warning for the refused rest). Returns the ids of the particles
-  /// added, in the order of their points. Throws std::invalid_argument when the lengths
-  /// differ or a value is not finite (then nothing is added).
-  std::vector<std::uint32_t> addParticles(const std::vector<Vec2d>& points, const std::vector<Vec2d>& velocities = {});
-  /// Removes the particles with these ids (ids no particle has are ignored; removedCount()
-  /// counts them). Returns how many were removed.
-  std::size_t removeParticles(const std::vector<std::uint32_t>& ids);
+  /// added, in the order of their points (a skipped point takes none). Throws
+  /// std::invalid_argument when the lengths differ or a value is not finite (then nothing
+  /// is added).
+  IdRange addParticles(const std::vector<Vec2d>& points, const std::vector<Vec2d>& velocities = {});
+  /// Removes the particles with these ids (ids no particle has, and repeats, are ignored).
+  /// Returns the ids removed, in increasing order.
+  std::vector<std::uint32_t> removeParticles(const std::vector<std::uint32_t>& ids);
 
   // Per-particle colour and user data: each field is allocated on the first set (every
   // other particle, and every particle added later, holds 0), kept through reordering,
@@ -305,12 +359,12 @@ class World {
   /// Slots of the particles inside `shape` placed by `xf` (world coordinates; b2Shape::TestPoint:
   /// polygons and circles hold points, edges and chains none), in slot order.
   std::vector<std::size_t> particlesInShape(const b2Shape& shape, const b2Transform& xf) const;
-  /// Removes the particles inside `shape` placed by `xf`. Returns how many.
-  std::size_t removeParticlesInShape(const b2Shape& shape, const b2Transform& xf);
+  /// Removes the particles inside `shape` placed by `xf`. Returns their ids, in increasing order.
+  std::vector<std::uint32_t> removeParticlesInShape(const b2Shape& shape, const b2Transform& xf);
   /// Fills `shape` placed by `xf` (a b2PolygonShape or b2CircleShape) with fluid on the lattice
   /// of the scene's spacing, moving at `velocity`, as addBlock does (solids skipped, the budget
-  /// held). Returns the number added. Throws std::invalid_argument for an edge or chain.
-  std::size_t addShape(const b2Shape& shape, const b2Transform& xf, const Vec2d& velocity = Vec2d(0, 0));
+  /// held). Returns the ids added. Throws std::invalid_argument for an edge or chain.
+  IdRange addShape(const b2Shape& shape, const b2Transform& xf, const Vec2d& velocity = Vec2d(0, 0));
   // The searches below visit only the cells of a grid of the current particles, built on the
   // first search after a step or a change (O(n)), not every particle.
   /// Slots of the particles within `radius` of `center` (world coordinates), in slot order.
@@ -408,7 +462,7 @@ class World {
   void setGravity(const B2& g) { setGravity(Vec2d(g.x, g.y)); }
   /// addDrop with b2Vec2 centre and velocity.
   template <class B2, IfB2<B2> = 0>
-  std::size_t addDrop(const B2& center, double radius, const B2& velocity) {
+  IdRange addDrop(const B2& center, double radius, const B2& velocity) {
     return addDrop(Vec2d(center.x, center.y), radius, Vec2d(velocity.x, velocity.y));
   }
   /// getParticle into b2Vec2s (world coordinates).
@@ -432,7 +486,7 @@ class World {
   }
   /// addParticles at b2Vec2 points (velocities empty: at rest).
   template <class B2, IfB2<B2> = 0>
-  std::vector<std::uint32_t> addParticles(const std::vector<B2>& points, const std::vector<B2>& velocities) {
+  IdRange addParticles(const std::vector<B2>& points, const std::vector<B2>& velocities) {
     return addParticles(toVec2d(points), toVec2d(velocities));
   }
   /// particlesInRadius about a b2Vec2.
@@ -455,12 +509,12 @@ class World {
   }
   /// removeParticlesInBox between b2Vec2 corners.
   template <class B2, IfB2<B2> = 0>
-  std::size_t removeParticlesInBox(const B2& lo, const B2& hi) {
+  std::vector<std::uint32_t> removeParticlesInBox(const B2& lo, const B2& hi) {
     return removeParticlesInBox(Vec2d(lo.x, lo.y), Vec2d(hi.x, hi.y));
   }
   /// addShape moving at a b2Vec2 velocity.
   template <class B2, IfB2<B2> = 0>
-  std::size_t addShape(const b2Shape& shape, const b2Transform& xf, const B2& velocity) {
+  IdRange addShape(const b2Shape& shape, const b2Transform& xf, const B2& velocity) {
     return addShape(shape, xf, Vec2d(velocity.x, velocity.y));
   }
   /// setVelocities from b2Vec2s.

@@ -84,7 +84,7 @@ TEST_CASE("viscosity: two particles pressed to 0.1 R with opposite velocities ne
     s.gravity = Vec2d(0, 0);
     World w(s, WorldOptions{2});
     const double R = double(w.support()), U = 1.0;
-    const std::vector<std::uint32_t> ids = w.addParticles({Vec2d(1, 1), Vec2d(1 + 0.1 * R, 1)}, {Vec2d(0, U), Vec2d(0, -U)});
+    const IdRange ids = w.addParticles({Vec2d(1, 1), Vec2d(1 + 0.1 * R, 1)}, {Vec2d(0, U), Vec2d(0, -U)});
     REQUIRE(ids.size() == 2);
     for (int f = 0; f < 3; ++f) {
       w.stepFrame();
