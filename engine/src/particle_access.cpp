@@ -1,9 +1,11 @@
 // particle_access.cpp — particles by id for a game (World::slotOf, getParticle,
-// setParticle, setVelocities, addParticles, removeParticles, colours and user data),
+// setParticle, setVelocities, addParticles, removeParticles, colours, user data and the
+// emitter tags),
 // after LiquidFun's writable particle buffers (b2ParticleColor, user data) and
 // b2ParticleHandle: slots move (the grid reorders the particles for locality,
-// removals compact them), ids do not. Colour and user data are optional integer
-// fields (ParticleStore::extraU32), allocated by the first set.
+// removals compact them), ids do not. Colour, user data and the emitter tag are optional
+// integer fields (ParticleStore::extraU32), allocated by the first set (the tag: while
+// emitter tracking is on).
 //
 // The id index is a vector of (id, slot) sorted by id, searched by bisection. It is
 // never invalidated explicitly: a lookup checks that the slot it found still holds
@@ -194,6 +196,20 @@ bool World::setParticleUserData(std::uint32_t id, std::uint32_t value) {
 }
 
 std::uint32_t World::particleUserData(std::uint32_t id) const { return getU32(*this, impl_->P, kUserDataField, id); }
+
+void World::setEmitterTracking(bool on) {
+  Impl& w = *impl_;
+  if (on) w.P.fieldU32(ParticleStore::kEmitter);  // every particle there now: none
+  else w.P.dropU32(ParticleStore::kEmitter);
+  w.refreshView();
+}
+
+bool World::emitterTracking() const { return impl_->P.findU32(ParticleStore::kEmitter) != nullptr; }
+
+std::size_t World::particleEmitter(std::uint32_t id) const {
+  const std::uint32_t tag = getU32(*this, impl_->P, ParticleStore::kEmitter, id);
+  return tag == 0 ? npos : std::size_t(tag) - 1;
+}
 
 IdRange World::addParticles(const std::vector<Vec2d>& points, const std::vector<Vec2d>& velocities) {
   if (!velocities.empty() && velocities.size() != points.size())

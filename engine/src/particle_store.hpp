@@ -37,8 +37,8 @@ struct ParticleStore {
   /// a field never moves the others, so references from field() stay valid.
   std::deque<std::pair<std::string, std::vector<Real>>> extra;
   /// Optional per-particle integer fields a game asks for (World::setParticleColor:
-  /// "color", World::setParticleUserData: "user_data"), in creation order; like
-  /// `extra`, permuted with the rest, 0 for new particles.
+  /// "color", World::setParticleUserData: "user_data", World::setEmitterTracking:
+  /// "emitter"), in creation order; like `extra`, permuted with the rest, 0 for new particles.
   std::deque<std::pair<std::string, std::vector<std::uint32_t>>> extraU32;
 
   /// Number of particles.
@@ -64,8 +64,18 @@ struct ParticleStore {
   /// The names of the optional integer fields (a save that holds one makes it one).
   static constexpr const char* kColor = "color";
   static constexpr const char* kUserData = "user_data";
+  /// 1 + the index of the emitter that made the particle; 0: none (World::setEmitterTracking).
+  static constexpr const char* kEmitter = "emitter";
   /// True for the name of an optional integer field.
-  static bool integerField(const std::string& name) { return name == kColor || name == kUserData; }
+  static bool integerField(const std::string& name) { return name == kColor || name == kUserData || name == kEmitter; }
+  /// Removes the optional integer field `name` (nothing when it does not exist).
+  void dropU32(const std::string& name) {
+    for (auto it = extraU32.begin(); it != extraU32.end(); ++it)
+      if (it->first == name) {
+        extraU32.erase(it);
+        return;
+      }
+  }
   /// The optional integer field `name`, or nullptr when nothing created it.
   std::vector<std::uint32_t>* findU32(const std::string& name) {
     for (auto& f : extraU32)

@@ -166,6 +166,9 @@ std::string World::Impl::emitterProblem(const EmitterDef& d) {
 
 void World::Impl::emit(Real dt) {
   const Real rho0 = Real(scene.solver.restDensity);
+  // With emitter tracking on, each particle made here takes 1 + its emitter's index. (A field in
+  // a deque: removeOldest below compacts it, and the pointer stays good.)
+  std::vector<std::uint32_t>* tag = P.findU32(ParticleStore::kEmitter);
   for (std::size_t e = 0; e < emitters.size(); ++e) {
     EmitterState& s = emitters[e];
     const EmitterDef& d = s.def;
@@ -227,6 +230,7 @@ void World::Impl::emit(Real dt) {
         }
       }
       P.push(Vec2(Real(pw.x() - origin.x()), Real(pw.y() - origin.y())), Vec2(Real(vel.x()), Real(vel.y())), nextId++, rho0);
+      if (tag) tag->back() = std::uint32_t(e + 1);
     }
   }
 }

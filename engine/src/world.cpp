@@ -284,6 +284,11 @@ void World::removeEmitter(std::size_t index) {
     throw std::out_of_range("removeEmitter: no emitter " + std::to_string(index) + " (the world has " +
                             std::to_string(w.emitters.size()) + ")");
   w.emitters.erase(w.emitters.begin() + std::ptrdiff_t(index));
+  // Emitter tags follow the indices: the removed one's particles have none now, later ones move down.
+  if (std::vector<std::uint32_t>* tag = w.P.findU32(ParticleStore::kEmitter)) {
+    const std::uint32_t removed = std::uint32_t(index) + 1;
+    for (std::uint32_t& t : *tag) t = t == removed ? 0u : t > removed ? t - 1 : t;
+  }
   if (w.emitters.empty()) w.buildStages();
 }
 
@@ -318,6 +323,7 @@ Particles viewOf(const ParticleStore& S) {
   V.age = opt(S.find("age"));
   V.color = opt(S.findU32(ParticleStore::kColor));
   V.userData = opt(S.findU32(ParticleStore::kUserData));
+  V.emitter = opt(S.findU32(ParticleStore::kEmitter));
   return V;
 }
 
@@ -328,7 +334,7 @@ bool World::Impl::viewCurrent() const {
   auto same = [](const auto& a, const auto& b) { return a.data() == b.data() && a.size() == b.size(); };
   return same(view.x, now.x) && same(view.v, now.v) && same(view.rho, now.rho) && same(view.p, now.p) &&
          same(view.id, now.id) && same(view.age, now.age) && same(view.color, now.color) &&
-         same(view.userData, now.userData);
+         same(view.userData, now.userData) && same(view.emitter, now.emitter);
 }
 
 void World::Impl::refreshView() const { view = viewOf(P); }

@@ -573,3 +573,85 @@ TEST_CASE("every add returns the ids it made: addBlock, addDrop, addShape, addPa
   CHECK(none.begin() == none.end());
   CHECK(allIds(full) == cut.ids());
 }
+
+TEST_CASE("emitter tracking: each particle an emitter makes carries its index, only when asked, with no cost or change when off") {
+  SceneDef s = box();
+  s.blocks.push_back(test::block({0.1, 0.1}, {0.5, 0.3}));
+  EmitterDef left;
+  left.position = Vec2d(0.6, 1.6);
+  left.direction = Vec2d(0, -1);
+  left.rate = 150;
+  left.speed = 1;
+  EmitterDef right = left;
+  right.position = Vec2d(1.4, 1.6);
+  right.start = 0.25;  // the first 15 frames: only the left one
+  right.seed = 3;
+  s.effects.emitters = {left, right};
+  World off(s, WorldOptions{2}), on(s, WorldOptions{2});
+  CHECK_FALSE(on.emitterTracking());
+  on.setEmitterTracking(true);
+  CHECK(on.emitterTracking());
+  const std::vector<std::uint32_t> blockIds = allIds(on);
+  for (const std::uint32_t id : blockIds) CHECK(on.particleEmitter(id) == World::npos);  // there before: none
+  // Frame by frame: the particles new in the World are tagged with the emitter whose count grew.
+  for (int f = 0; f < 40; ++f) {
+    const std::vector<std::uint32_t> before = allIds(on);
+    const std::uint64_t e0 = on.emittedCount(0), e1 = on.emittedCount(1);
+    off.stepFrame();
+    on.stepFrame();
+    std::size_t by0 = 0, by1 = 0;
+    for (const std::uint32_t id : newIds(before, allIds(on))) {
+      const std::size_t e = on.particleEmitter(id);
+      REQUIRE((e == 0 || e == 1));
+      (e == 0 ? by0 : by1) += 1;
+    }
+    CHECK(by0 == on.emittedCount(0) - e0);
+    CHECK(by1 == on.emittedCount(1) - e1);
+    if (f < 14) CHECK(by1 == 0);
+    REQUIRE(on.stateHash() == off.stateHash());  // the tag changes nothing that moves
+  }
+  CHECK(on.emittedCount(1) > 50);
+  // The view shows 1 + the index; the World that did not ask has no such field.
+  const Particles& P = on.particles();
+  REQUIRE(P.emitter.size() == P.size());
+  for (std::size_t i = 0; i < P.size(); ++i)
+    CHECK(P.emitter[i] == (on.particleEmitter(P.id[i]) == World::npos ? 0u : std::uint32_t(on.particleEmitter(P.id[i]) + 1)));
+  CHECK(off.particles().emitter.empty());
+  CHECK_FALSE(has(off.particleFields(), "emitter"));
+  CHECK(has(on.particleFields(), "emitter"));
+  CHECK(off.particleEmitter(P.id[P.size() - 1]) == World::npos);
+  // An emitter added at run time tags with its index; removing one renumbers the tags with the indices.
+  EmitterDef third = left;
+  third.position = Vec2d(1.0, 1.8);
+  third.seed = 9;
+  REQUIRE(on.addEmitter(third) == 2);
+  for (int f = 0; f < 10; ++f) on.stepFrame();
+  std::vector<std::size_t> tagOf;
+  const std::vector<std::uint32_t> ids = allIds(on);
+  std::size_t count[3] = {0, 0, 0};
+  for (const std::uint32_t id : ids) {
+    tagOf.push_back(on.particleEmitter(id));
+    if (tagOf.back() != World::npos) ++count[tagOf.back()];
+  }
+  CHECK(count[2] > 0);
+  on.removeEmitter(0);
+  for (std::size_t k = 0; k < ids.size(); ++k) {
+    const std::size_t expected = tagOf[k] == 0 || tagOf[k] == World::npos ? World::npos : tagOf[k] - 1;
+    CHECK(on.particleEmitter(ids[k]) == expected);
+  }
+  // Saved and loaded with the particles: a World that had it off loads it on.
+  std::stringstream saved;
+  on.save(saved);
+  World loaded(s, WorldOptions{1});
+  loaded.load(saved);  // (the save holds the emitters, the one added at run time too)
+  CHECK(loaded.emitterTracking());
+  for (const std::uint32_t id : ids) CHECK(loaded.particleEmitter(id) == on.particleEmitter(id));
+  // Off again: the field is gone, the state unchanged.
+  const std::uint64_t hash = on.stateHash();
+  on.setEmitterTracking(false);
+  CHECK_FALSE(on.emitterTracking());
+  CHECK(on.particles().emitter.empty());
+  CHECK(on.particleEmitter(ids.back()) == World::npos);
+  CHECK_FALSE(has(on.particleFields(), "emitter"));
+  CHECK(on.stateHash() == hash);
+}

@@ -67,6 +67,9 @@ struct Particles {
   ArrayView<Real> age;                ///< optional: time since emission [s] (scenes with lifetimes)
   ArrayView<std::uint32_t> color;     ///< optional: each particle's own colour 0xRRGGBB (World::setParticleColor; 0 = none)
   ArrayView<std::uint32_t> userData;  ///< optional: the game's value per particle (World::setParticleUserData)
+  /// optional: 1 + the index of the emitter that made the particle, 0 for one no emitter made
+  /// (World::setEmitterTracking; World::particleEmitter gives the index itself)
+  ArrayView<std::uint32_t> emitter;
 
   /// Number of particles.
   std::size_t size() const { return x.size(); }
@@ -83,6 +86,7 @@ struct ParticleBuffer {
   std::vector<Real> age;                ///< optional (empty or one per particle)
   std::vector<std::uint32_t> color;     ///< optional (empty or one per particle)
   std::vector<std::uint32_t> userData;  ///< optional (empty or one per particle)
+  std::vector<std::uint32_t> emitter;   ///< optional (empty or one per particle)
 
   /// Number of particles.
   std::size_t size() const { return x.size(); }
@@ -96,6 +100,7 @@ struct ParticleBuffer {
     if (!age.empty()) age.push_back(0);
     if (!color.empty()) color.push_back(0);
     if (!userData.empty()) userData.push_back(0);
+    if (!emitter.empty()) emitter.push_back(0);
   }
   /// Replaces the contents with copies of every array of `view` (capacity is kept, so a
   /// buffer reused frame after frame stops allocating).
@@ -108,6 +113,7 @@ struct ParticleBuffer {
     copy(view.age, age);
     copy(view.color, color);
     copy(view.userData, userData);
+    copy(view.emitter, emitter);
   }
   /// The buffer as Particles (valid until the buffer changes).
   Particles view() const& {
@@ -120,6 +126,7 @@ struct ParticleBuffer {
     P.age = age;
     P.color = color;
     P.userData = userData;
+    P.emitter = emitter;
     return P;
   }
   /// Not of a temporary buffer: the views would outlive their values.

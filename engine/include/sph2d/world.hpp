@@ -355,6 +355,19 @@ class World {
   bool setParticleUserData(std::uint32_t id, std::uint32_t value);
   /// The game's value of particle `id` (0 when none was set or no particle has the id).
   std::uint32_t particleUserData(std::uint32_t id) const;
+  /// Turns on (or off) the emitter tag: from then on every particle an emitter makes carries
+  /// that emitter's index (particleEmitter(); Particles::emitter holds 1 + it). Particles there
+  /// when it is turned on, and those other calls add, carry none. Off by default: the field
+  /// exists only while it is on (no memory, no work); turning it off frees it. Kept like the
+  /// colour (a save holds it, and loading a save that has it turns it on); not in stateHash().
+  void setEmitterTracking(bool on);
+  /// True while the emitter tag is on (setEmitterTracking).
+  bool emitterTracking() const;
+  /// The index of the emitter that made particle `id`, as emitters are numbered now
+  /// (removeEmitter moves the later ones' particles down one, and leaves the removed one's
+  /// with none); npos when it has none (made by another call, or while tracking was off),
+  /// tracking is off, or no particle has the id.
+  std::size_t particleEmitter(std::uint32_t id) const;
 
   /// Slots of the particles inside `shape` placed by `xf` (world coordinates; b2Shape::TestPoint:
   /// polygons and circles hold points, edges and chains none), in slot order.
