@@ -346,11 +346,36 @@ TEST_CASE("particle access: the b2Vec2 overloads do what the Vec2d calls do, and
   b.setParticleVelocity(b.particles().id[4], b2Vec2(1.0f, 0.0f));
   a.addParticles(std::vector<Vec2d>{{0.8125, 0.875}}, std::vector<Vec2d>{{0.0, 0.0}});
   b.addParticles(std::vector<b2Vec2>{b2Vec2(0.8125f, 0.875f)}, std::vector<b2Vec2>{b2Vec2(0.0f, 0.0f)});
+  // At rest: addDrop without a velocity, addParticles without velocities.
+  CHECK(b.addDrop(b2Vec2(0.375f, 0.8125f), 0.0625) == a.addDrop({0.375, 0.8125}, 0.0625));
+  CHECK(b.addParticles(std::vector<b2Vec2>{b2Vec2(0.6875f, 0.875f), b2Vec2(0.75f, 0.875f)}) ==
+        a.addParticles(std::vector<Vec2d>{{0.6875, 0.875}, {0.75, 0.875}}));
+  // The structs' vectors from b2Vec2s: a user force and an emitter's position and direction.
+  a.setUserForces({UserForce{Vec2d(0.25, 0.3125), 0.25, -10.0}});
+  b.setUserForces({UserForce{b2Vec2(0.25f, 0.3125f), 0.25, -10.0}});
+  EmitterDef hose;
+  hose.rate = 120;
+  hose.speed = 1.5;
+  hose.position = Vec2d(0.5, 0.875);
+  hose.direction = Vec2d(0.5, -1.0);
+  EmitterDef hoseB2 = hose;
+  hoseB2.position = b2Vec2(0.5f, 0.875f);
+  hoseB2.direction = b2Vec2(0.5f, -1.0f);
+  CHECK(b.addEmitter(hoseB2) == a.addEmitter(hose));
+  CHECK(b.emitter(0).position == a.emitter(0).position);
+  CHECK(b.emitter(0).direction == a.emitter(0).direction);
   for (int f = 0; f < 5; ++f) {
     a.stepFrame();
     b.stepFrame();
   }
   CHECK(a.stateHash() == b.stateHash());
+  CHECK(b.emittedCount(0) > 0);
+  for (std::size_t i = 0; i < a.particleCount(); ++i) {
+    const b2Vec2 q = b.worldPosition<b2Vec2>(i);
+    const Vec2d p = a.worldPosition(i);
+    REQUIRE(q.x == float(p.x()));
+    REQUIRE(q.y == float(p.y()));
+  }
   Vec2d pa, va;
   b2Vec2 pb, vb;
   REQUIRE(a.getParticle(id, pa, va));

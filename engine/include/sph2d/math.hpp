@@ -14,6 +14,9 @@
 #pragma once
 
 #include <cmath>
+#include <type_traits>
+
+struct b2Vec2;  // Box2D's vector: a Vector2 is made from one (below) without including Box2D here
 
 namespace sph2d {
 
@@ -28,6 +31,11 @@ struct Vector2 {
   /// (x, y), each converted to T.
   template <class A, class B>
   constexpr Vector2(A x, B y) : v{T(x), T(y)} {}
+  /// Box2D's b2Vec2 (x, y), implicitly: a game sets the fields of the scene and input
+  /// structs (EmitterDef::position, UserForce::point, FluidBlockDef::min ...) from its Box2D
+  /// vectors as they are. A template only b2Vec2 satisfies, so no other type converts.
+  template <class B2, std::enable_if_t<std::is_same<B2, ::b2Vec2>::value, int> = 0>
+  constexpr Vector2(const B2& b) : v{T(b.x), T(b.y)} {}  // NOLINT: implicit on purpose
 
   /// The zero vector.
   static constexpr Vector2 Zero() { return Vector2(); }

@@ -467,7 +467,9 @@ class World {
 
   // b2Vec2 overloads: a game passes its Box2D vectors as they are, with no conversion at the call;
   // each does exactly what the Vec2d call of the same name does. Templates on the type (only
-  // b2Vec2 qualifies), so a braced pair {x, y} still picks the Vec2d call unambiguously.
+  // b2Vec2 qualifies), so a braced pair {x, y} still picks the Vec2d call unambiguously. The
+  // structs' Vec2d fields (EmitterDef, UserForce, FluidBlockDef) take a b2Vec2 as it is: Vec2d
+  // converts from one (math.hpp).
   template <class T>
   using IfB2 = std::enable_if_t<std::is_same<T, b2Vec2>::value, int>;
   /// setGravity with a b2Vec2.
@@ -477,6 +479,17 @@ class World {
   template <class B2, IfB2<B2> = 0>
   IdRange addDrop(const B2& center, double radius, const B2& velocity) {
     return addDrop(Vec2d(center.x, center.y), radius, Vec2d(velocity.x, velocity.y));
+  }
+  /// addDrop at rest about a b2Vec2 centre.
+  template <class B2, IfB2<B2> = 0>
+  IdRange addDrop(const B2& center, double radius) {
+    return addDrop(Vec2d(center.x, center.y), radius);
+  }
+  /// worldPosition as a b2Vec2: `worldPosition<b2Vec2>(i)` (floats of the double position).
+  template <class B2, IfB2<B2> = 0>
+  B2 worldPosition(std::size_t i) const {
+    const Vec2d p = worldPosition(i);
+    return B2(float(p.x()), float(p.y()));
   }
   /// getParticle into b2Vec2s (world coordinates).
   template <class B2, IfB2<B2> = 0>
@@ -501,6 +514,11 @@ class World {
   template <class B2, IfB2<B2> = 0>
   IdRange addParticles(const std::vector<B2>& points, const std::vector<B2>& velocities) {
     return addParticles(toVec2d(points), toVec2d(velocities));
+  }
+  /// addParticles at rest at b2Vec2 points.
+  template <class B2, IfB2<B2> = 0>
+  IdRange addParticles(const std::vector<B2>& points) {
+    return addParticles(toVec2d(points));
   }
   /// particlesInRadius about a b2Vec2.
   template <class B2, IfB2<B2> = 0>
