@@ -13,12 +13,20 @@
 // load() reads the whole input into temporaries and checks it (magic, version,
 // fingerprint, every count against the budget or the scene, field names and sizes,
 // unique ids below the next id) before it changes anything.
+//
+// What no save holds is the b2World's state that Box2D 2.4 keeps private: each contact's
+// and joint's impulses of the last step, from which it warm-starts the next (and a rebuilt
+// b2World, never stepped, would scale restored ones by 0 in its first step: its previous
+// step length is private too), each body's sleep timer, and the order of its contacts
+// (creation order, which a rebuilt world's broad phase decides afresh). save() reports the
+// first two when they are live (SaveReport); docs/EMBEDDING.md gives the remedy.
 #include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <istream>
 #include <iterator>
 #include <ostream>
+#include <sstream>
 
 #include <box2d/box2d.h>
 
@@ -32,8 +40,11 @@ namespace {
 constexpr char kMagic[8] = {'S', 'P', 'H', '2', 'D', 'S', 'A', 'V'};
 constexpr std::uint64_t kMaxEmitters = World::Impl::kMaxEmitters;  // a save holding more is not one of ours
 // 2: every emitter's whole definition (emitters added at run time); 3: bodies' swept poses;
-// 4: the swept poses of a game's b2World's bodies too.
-constexpr std::uint32_t kVersion = 4;
+// 4: the swept poses of a game's b2World's bodies too; 5: the scene's own b2World's warm-starting
+// and sleeping switches and each of its moving bodies' awake state. Version 4 loads as well
+// (those as the loading World has them).
+constexpr std::uint32_t kVersion = 5;
+constexpr std::uint32_t kOldestVersion = 4;
 constexpr std::size_t kMaxFields = 64, kMaxName = 128;
 constexpr const char* kUserForce = "user_force";  ///< the effect setUserForces adds
 
@@ -65,10 +76,53 @@ Vec2d getVec(StateIn& in, const char* what) {
   return Vec2d(x, y);
 }
 
+/// The state of `world` that no save can hold and that is live now (SaveReport).
+SaveReport unsaved(b2World& world) {
+  SaveReport r;
+  auto dynamic = [](b2Body* b) { return b->GetType() == b2_dynamicBody; };
+  if (world.GetWarmStarting()) {
+    for (b2Contact* c = world.GetContactList(); c; c = c->GetNext())
+      if (c->IsTouching() && !c->GetFixtureA()->IsSensor() && !c->GetFixtureB()->IsSensor() &&
+          (dynamic(c->GetFixtureA()->GetBody()) || dynamic(c->GetFixtureB()->GetBody())))
+        ++r.warmStartedContacts;
+    for (b2Joint* j = world.GetJointList(); j; j = j->GetNext())
+      if (dynamic(j->GetBodyA()) || dynamic(j->GetBodyB())) ++r.warmStartedJoints;
+  }
+  if (world.GetAllowSleeping()) {
+    // Box2D's island adds the step to a body's timer while the body is slower than both
+    // tolerances after the step, and zeroes it otherwise.
+    const float linTol2 = b2_linearSleepTolerance * b2_linearSleepTolerance;
+    const float angTol2 = b2_angularSleepTolerance * b2_angularSleepTolerance;
+    for (b2Body* b = world.GetBodyList(); b; b = b->GetNext())
+      if (b->GetType() != b2_staticBody && b->IsAwake() && b->IsEnabled() && b->IsSleepingAllowed() &&
+          b2Dot(b->GetLinearVelocity(), b->GetLinearVelocity()) <= linTol2 &&
+          b->GetAngularVelocity() * b->GetAngularVelocity() <= angTol2)
+        ++r.sleepTimers;
+  }
+  if (r.complete()) return r;
+  std::ostringstream o;
+  o << "save: the b2World holds state no save can: ";
+  if (r.warmStartedContacts || r.warmStartedJoints) {
+    o << r.warmStartedContacts << " touching contact" << (r.warmStartedContacts == 1 ? "" : "s");
+    if (r.warmStartedJoints) o << " and " << r.warmStartedJoints << " joint" << (r.warmStartedJoints == 1 ? "" : "s");
+    o << " of dynamic bodies warm-start from impulses Box2D keeps private";
+    if (r.sleepTimers) o << ", and ";
+  }
+  if (r.sleepTimers)
+    o << r.sleepTimers << " bod" << (r.sleepTimers == 1 ? "y" : "ies") << " at rest " << (r.sleepTimers == 1 ? "has a" : "have")
+      << " sleep timer" << (r.sleepTimers == 1 ? "" : "s") << " running";
+  o << "; a World loaded from this save steps on close to this one, not bit for bit. For replays that match bit for bit, call ";
+  if (r.warmStartedContacts || r.warmStartedJoints) o << "SetWarmStarting(false)" << (r.sleepTimers ? " and " : "");
+  if (r.sleepTimers) o << "SetAllowSleeping(false)";
+  o << " on the b2World from its creation, and on the one rebuilt for the load (docs/EMBEDDING.md, Saving and loading)";
+  r.warning = o.str();
+  return r;
+}
+
 }  // namespace
 
-void World::save(std::ostream& out) const {
-  const Impl& w = *impl_;
+SaveReport World::save(std::ostream& out) const {
+  Impl& w = *impl_;
   StateOut o;
   for (const char c : kMagic) o.put(c);
   o.put(kVersion);
@@ -128,6 +182,10 @@ void World::save(std::ostream& out) const {
     for (b2Body* b = w.b2->GetBodyList(); b; b = b->GetNext()) bodies += b->GetType() != b2_staticBody;
   o.put(bodies);
   o.put(std::uint8_t(w.ownWorld != nullptr));
+  if (w.ownWorld && bodies) {  // the switches the scene's own world steps its bodies with (a game keeps its own)
+    o.put(std::uint8_t(w.ownWorld->GetWarmStarting()));
+    o.put(std::uint8_t(w.ownWorld->GetAllowSleeping()));
+  }
   if (w.b2)
     for (b2Body* b = w.b2->GetBodyList(); b; b = b->GetNext()) {
       if (b->GetType() == b2_staticBody) continue;
@@ -136,6 +194,7 @@ void World::save(std::ostream& out) const {
         o.put(b->GetAngle());
         o.put(b->GetLinearVelocity());
         o.put(b->GetAngularVelocity());
+        o.put(std::uint8_t(b->IsAwake()));
       }
       // The pose the particles last saw a dynamic body at (moving_solid.hpp), if any.
       const MovingSolids::LastPose* last = nullptr;
@@ -149,6 +208,12 @@ void World::save(std::ostream& out) const {
   w.solver->saveState(o);
   out.write(reinterpret_cast<const char*>(o.bytes.data()), std::streamsize(o.bytes.size()));
   if (!out) throw SaveError("World::save: the stream refused the state (" + std::to_string(o.bytes.size()) + " bytes)");
+  SaveReport report = w.b2 ? unsaved(*w.b2) : SaveReport{};
+  if (!report.complete() && !w.warnedSave) {
+    w.warnings.push_back(report.warning);
+    w.warnedSave = true;
+  }
+  return report;
 }
 
 void World::load(std::istream& input) {
@@ -158,9 +223,9 @@ void World::load(std::istream& input) {
   for (const char c : kMagic)
     if (in.get<char>("the header") != c) throw SaveError("not an sph2d saved state (its first bytes are not SPH2DSAV)");
   const std::uint32_t version = in.get<std::uint32_t>("the header");
-  if (version != kVersion)
-    throw SaveError("the saved state has version " + std::to_string(version) + "; this sph2d reads version " +
-                    std::to_string(kVersion));
+  if (version < kOldestVersion || version > kVersion)
+    throw SaveError("the saved state has version " + std::to_string(version) + "; this sph2d reads versions " +
+                    std::to_string(kOldestVersion) + " to " + std::to_string(kVersion));
   if (in.get<std::uint64_t>("the header") != fingerprint(w))
     throw SaveError("the saved state belongs to another scene (its solver, spacing, emitters or effects differ)");
   const double time = in.get<double>("the clock");
@@ -267,9 +332,19 @@ void World::load(std::istream& input) {
   if (savedBodies != movable.size())
     throw SaveError("the saved state has " + std::to_string(savedBodies) + " moving bodies, but " +
                     (w.ownWorld ? "the scene has " : "the game's b2World has ") + std::to_string(movable.size()));
+  // The scene's own world's switches (version 5, with moving bodies): as the loading World has them otherwise.
+  bool warmStarting = w.ownWorld ? w.ownWorld->GetWarmStarting() : true;
+  bool allowSleeping = w.ownWorld ? w.ownWorld->GetAllowSleeping() : true;
+  if (savedOwn && savedBodies && version >= 5) {
+    const std::uint8_t warm = in.get<std::uint8_t>("the bodies"), sleep = in.get<std::uint8_t>("the bodies");
+    if (warm > 1 || sleep > 1) throw SaveError("the saved state is malformed: the b2World's switches");
+    warmStarting = warm != 0;
+    allowSleeping = sleep != 0;
+  }
   struct BodyState {
     b2Vec2 p = b2Vec2(0, 0), v = b2Vec2(0, 0);  // a game's bodies: not in the save
     float angle = 0, omega = 0;
+    std::uint8_t awake = 1;  // version 5 (version 4: left as the loading World has it)
     std::uint8_t hasLast = 0;
     double lastTheta = 0, lastX = 0, lastY = 0;
   };
@@ -280,12 +355,13 @@ void World::load(std::istream& input) {
       b.angle = in.get<float>("a body");
       b.v = in.get<b2Vec2>("a body");
       b.omega = in.get<float>("a body");
+      if (version >= 5) b.awake = in.get<std::uint8_t>("a body");
     }
     b.hasLast = in.get<std::uint8_t>("a body");
     b.lastTheta = in.get<double>("a body");
     b.lastX = in.get<double>("a body");
     b.lastY = in.get<double>("a body");
-    if (!b.p.IsValid() || !b.v.IsValid() || !std::isfinite(b.angle) || !std::isfinite(b.omega) || b.hasLast > 1 ||
+    if (!b.p.IsValid() || !b.v.IsValid() || !std::isfinite(b.angle) || !std::isfinite(b.omega) || b.hasLast > 1 || b.awake > 1 ||
         !std::isfinite(b.lastTheta) || !std::isfinite(b.lastX) || !std::isfinite(b.lastY))
       throw SaveError("the saved state is malformed: a body's pose or velocity is not finite");
   }
@@ -322,10 +398,15 @@ void World::load(std::istream& input) {
   }
   for (auto& e : w.P.extraU32)  // integer fields the save lacks: none set at the time of the save
     if (!find(e.first)) e.second.assign(static_cast<std::size_t>(n), 0u);
+  if (savedOwn) {
+    w.ownWorld->SetWarmStarting(warmStarting);
+    w.ownWorld->SetAllowSleeping(allowSleeping);  // (false wakes every body: before the bodies' own state)
+  }
   for (std::size_t k = 0; k < movable.size() && savedOwn; ++k) {
     movable[k]->SetTransform(bodyStates[k].p, bodyStates[k].angle);
     movable[k]->SetLinearVelocity(bodyStates[k].v);
     movable[k]->SetAngularVelocity(bodyStates[k].omega);
+    if (version >= 5) movable[k]->SetAwake(bodyStates[k].awake != 0);  // asleep: at rest, as Box2D put it to sleep
   }
   w.moving.last.clear();  // the loaded state's, not those of the World's own last step
   for (std::size_t k = 0; k < movable.size(); ++k)

@@ -63,6 +63,7 @@ struct World::Impl {
   std::uint64_t iterations = 0;       ///< solver iterations summed over the substeps
   WallAccount wall;                   ///< World::wallImpulse(): the stages of each substep add to it (substep())
   std::vector<std::string> warnings;
+  bool warnedSave = false;  ///< save() has warned of the b2World's state it cannot hold (once per World)
   std::uint64_t boundarySignature = 0;  ///< staticSignature() when the colliders were last read
   std::uint64_t boundaryVersion = 0;    ///< how many times the colliders were read (StepContext::boundaryVersion)
 

@@ -118,6 +118,31 @@ struct SaveError : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+/// What World::save() could not put in the save: state of the b2World the fluid meets (a game's,
+/// or the scene's own) that Box2D 2.4 keeps to itself and a rebuilt b2World starts without, so
+/// a World loaded from the save, on a b2World rebuilt with the same bodies, steps on close to
+/// the saved one but not bit for bit. All zero (complete()) when none of it is live. What each
+/// is and the remedy: docs/EMBEDDING.md, "Saving and loading".
+struct SaveReport {
+  /// Touching contacts (sensors left out) that involve a dynamic body while the b2World
+  /// warm-starts (b2World::GetWarmStarting()): Box2D starts each contact's solve from its
+  /// impulses of the last step, which it does not expose (nor lets be set); 0 when warm
+  /// starting is off.
+  std::size_t warmStartedContacts = 0;
+  /// Joints that involve a dynamic body while the b2World warm-starts: their impulses likewise.
+  std::size_t warmStartedJoints = 0;
+  /// Awake moving bodies slower than Box2D's sleep tolerances (b2_linearSleepTolerance,
+  /// b2_angularSleepTolerance) while the b2World lets bodies sleep: each has a sleep timer
+  /// running, which no call reads or sets (a rebuilt body's starts at 0, so it falls asleep
+  /// later); 0 when sleeping is off (b2World::GetAllowSleeping()).
+  std::size_t sleepTimers = 0;
+  /// What is lost and the remedy, in a sentence ("" when complete()). save() also gives it to
+  /// takeWarnings(), the first time only (a game that saves every frame is told once).
+  std::string warning;
+  /// True when none of the above is live: with the same bodies rebuilt, a load steps on bit for bit.
+  bool complete() const { return warmStartedContacts == 0 && warmStartedJoints == 0 && sleepTimers == 0; }
+};
+
 /// What an iterative pressure solver did in its last substep (all zero for explicit solvers).
 struct SolverStats {
   int pressureIterations = 0;     ///< constant-density (pressure) solve iterations
@@ -281,9 +306,13 @@ class World {
   std::vector<Collider> movingColliders() const;
   /// Writes the World's whole changing state (particles with every field, time and
   /// counters, emitters with their random streams, gravity, user forces, switched
-  /// effects, the solver's warm starts) to `out`, in this machine's byte order. A World
-  /// built from the same scene and load()ed from it steps on to the same state hashes.
-  void save(std::ostream& out) const;
+  /// effects, the solver's warm starts; the scene's own b2World's moving bodies with their
+  /// awake state, and its warm-starting and sleeping switches) to `out`, in this machine's
+  /// byte order. A World built from the same scene and load()ed from it steps on to the same
+  /// state hashes, as far as the b2World allows: the report says what of its state no save
+  /// can hold (Box2D's contact impulses, sleep timers), with a warning (takeWarnings) the
+  /// first time. Throws SaveError when the stream refuses the bytes.
+  SaveReport save(std::ostream& out) const;
   /// Replaces this World's state with one save() wrote for the same scene (on a machine
   /// with the same byte order). Throws SaveError, changing nothing, when the input is not
   /// a save, belongs to another scene or solver, is truncated, or holds a count beyond
