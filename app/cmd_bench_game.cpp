@@ -26,7 +26,7 @@
 
 #include "cli.hpp"
 #include "commands.hpp"
-#include "kernels.hpp"
+#include "core/kernels.hpp"
 #include "sph2d/render/particle_export.hpp"
 #include "sph2d/scene.hpp"
 #include "sph2d/world.hpp"

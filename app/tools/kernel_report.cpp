@@ -13,7 +13,7 @@
 #include <string>
 #include <vector>
 
-#include "kernels.hpp"
+#include "core/kernels.hpp"
 #include "sph2d/render/png_io.hpp"
 #include "support/field_study.hpp"
 

@@ -14,7 +14,7 @@
 #include <type_traits>
 #include <vector>
 
-#include "field_operators.hpp"
+#include "particles/field_operators.hpp"
 
 namespace sph2d::study {
 

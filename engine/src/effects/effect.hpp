@@ -19,9 +19,9 @@
 #include <memory>
 #include <vector>
 
-#include "kernels.hpp"
+#include "core/kernels.hpp"
 #include "sph2d/world.hpp"
-#include "stages.hpp"
+#include "step/stages.hpp"
 
 namespace sph2d {
 

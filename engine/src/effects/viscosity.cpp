@@ -28,7 +28,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "body_samples.hpp"
+#include "bodies/body_samples.hpp"
 #include "effects/effect.hpp"
 
 namespace sph2d {

@@ -13,9 +13,9 @@
 // tension gained 7× its kinetic energy without it.
 #include <cmath>
 
-#include "constants.hpp"
+#include "core/constants.hpp"
 #include "solvers/solver.hpp"
-#include "stages.hpp"
+#include "step/stages.hpp"
 
 namespace sph2d {
 

@@ -15,8 +15,8 @@
 #include <vector>
 
 #include "sph2d/world.hpp"
-#include "stage_list.hpp"
-#include "stages.hpp"
+#include "step/stage_list.hpp"
+#include "step/stages.hpp"
 
 namespace sph2d {
 

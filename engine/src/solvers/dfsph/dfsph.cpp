@@ -90,7 +90,7 @@
 #include <cmath>
 #include <limits>
 
-#include "body_samples.hpp"
+#include "bodies/body_samples.hpp"
 #include "solvers/solver.hpp"
 
 namespace sph2d {

@@ -15,8 +15,8 @@
 #include <algorithm>
 #include <cmath>
 
-#include "body_samples.hpp"
-#include "constants.hpp"
+#include "bodies/body_samples.hpp"
+#include "core/constants.hpp"
 #include "effects/effect.hpp"
 #include "solvers/solver.hpp"
 

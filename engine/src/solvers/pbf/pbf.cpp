@@ -11,8 +11,8 @@
 #include <limits>
 
 #include "solvers/pbf/pbf.hpp"
-#include "stages.hpp"
-#include "state_io.hpp"
+#include "step/stages.hpp"
+#include "core/state_io.hpp"
 
 namespace sph2d {
 

@@ -71,7 +71,7 @@
 #include <memory>
 #include <vector>
 
-#include "grid_projection.hpp"
+#include "solvers/game/grid_projection.hpp"
 #include "solvers/pbf/slot_set.hpp"
 #include "solvers/solver.hpp"
 

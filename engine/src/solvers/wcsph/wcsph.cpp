@@ -27,7 +27,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "body_samples.hpp"
+#include "bodies/body_samples.hpp"
 #include "solvers/solver.hpp"
 
 namespace sph2d {

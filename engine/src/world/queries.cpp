@@ -1,0 +1,281 @@
+// What readers ask of a World's state: searches by region, the particles
+// touching each fixture (LiquidFun's particle-body contacts), field samples,
+// the state hash, density and energy statistics, memory, and the names of
+// the fields, effects and stages.
+#include <algorithm>
+#include <cmath>
+
+#include <box2d/b2_distance.h>
+#include <box2d/box2d.h>
+
+#include "sph2d/hash.hpp"
+#include "world/world_impl.hpp"
+
+namespace sph2d {
+
+const World::Impl::QueryGrid& World::Impl::currentQueryGrid() const {
+  QueryGrid& g = queryGrid;
+  if (g.steps == steps && g.edits == edits && g.count == P.size()) return g;
+  g.steps = steps;
+  g.edits = edits;
+  g.count = P.size();
+  g.nx = g.ny = 0;
+  g.start.clear();
+  g.items.clear();
+  if (P.size() == 0) return g;
+  double x0 = P.x[0].x(), y0 = P.x[0].y(), x1 = x0, y1 = y0;
+  for (const Vec2& x : P.x) {
+    x0 = std::min(x0, double(x.x()));
+    x1 = std::max(x1, double(x.x()));
+    y0 = std::min(y0, double(x.y()));
+    y1 = std::max(y1, double(x.y()));
+  }
+  // Cells of the support radius, grown when spray makes the bounds huge (at most 4 cells a particle).
+  g.h = double(R);
+  const double most = 4.0 * double(P.size()) + 64;
+  while (((x1 - x0) / g.h + 1) * ((y1 - y0) / g.h + 1) > most) g.h *= 2;
+  g.x0 = x0;
+  g.y0 = y0;
+  g.nx = long((x1 - x0) / g.h) + 1;
+  g.ny = long((y1 - y0) / g.h) + 1;
+  const std::size_t cells = std::size_t(g.nx * g.ny);
+  std::vector<std::uint32_t> cellOf(P.size());
+  g.start.assign(cells + 1, 0);
+  for (std::size_t i = 0; i < P.size(); ++i) {
+    const long ci = std::min(g.nx - 1, long((double(P.x[i].x()) - x0) / g.h));
+    const long cj = std::min(g.ny - 1, long((double(P.x[i].y()) - y0) / g.h));
+    cellOf[i] = std::uint32_t(cj * g.nx + ci);
+    ++g.start[cellOf[i] + 1];
+  }
+  for (std::size_t k = 0; k < cells; ++k) g.start[k + 1] += g.start[k];
+  g.items.resize(P.size());
+  std::vector<std::uint32_t> fill(g.start.begin(), g.start.end() - 1);
+  for (std::size_t i = 0; i < P.size(); ++i) g.items[fill[cellOf[i]]++] = std::uint32_t(i);  // slot order within a cell
+  return g;
+}
+
+namespace {
+/// The slots `f` accepts among the candidates of [lo, hi], in slot order.
+template <class Accept>
+std::vector<std::size_t> collect(const World::Impl& w, const Vec2d& lo, const Vec2d& hi, Accept&& accept) {
+  std::vector<std::size_t> out;
+  w.forCandidates(lo, hi, [&](std::size_t i) {
+    if (accept(i)) out.push_back(i);
+  });
+  std::sort(out.begin(), out.end());
+  return out;
+}
+}  // namespace
+
+std::vector<std::size_t> World::particlesInRadius(const Vec2d& c, double radius) const {
+  const Vec2d r(radius, radius);
+  return collect(*impl_, c - r, c + r, [&](std::size_t i) { return (worldPosition(i) - c).squaredNorm() <= radius * radius; });
+}
+
+std::vector<std::size_t> World::particlesInBox(const Vec2d& lo, const Vec2d& hi) const {
+  const RegionDef r{lo, hi};
+  return collect(*impl_, lo, hi, [&](std::size_t i) { return r.contains(worldPosition(i)); });
+}
+
+std::vector<std::size_t> World::particlesInShape(const b2Shape& shape, const b2Transform& xf) const {
+  b2AABB box;
+  box.lowerBound = box.upperBound = b2Vec2(0, 0);
+  for (int c = 0; c < shape.GetChildCount(); ++c) {
+    b2AABB a;
+    shape.ComputeAABB(&a, xf, c);
+    if (c == 0) box = a;
+    else box.Combine(a);
+  }
+  const Vec2d lo(box.lowerBound.x, box.lowerBound.y), hi(box.upperBound.x, box.upperBound.y);
+  return collect(*impl_, lo, hi, [&](std::size_t i) {
+    const Vec2d p = worldPosition(i);
+    return shape.TestPoint(xf, b2Vec2(float(p.x()), float(p.y())));
+  });
+}
+
+std::vector<std::uint32_t> World::particlesTouching(const b2Fixture& fixture) const {
+  const Impl& w = *impl_;
+  const double reach = double(w.dx);  // the first layer of resting water sits 0.25–0.5 dx off a wall
+  const b2Shape& shape = *fixture.GetShape();
+  const b2Transform& xf = fixture.GetBody()->GetTransform();
+  std::vector<std::uint32_t> ids;
+  for (int child = 0; child < shape.GetChildCount(); ++child) {
+    b2AABB box;
+    shape.ComputeAABB(&box, xf, child);
+    const Vec2d lo(box.lowerBound.x - reach, box.lowerBound.y - reach), hi(box.upperBound.x + reach, box.upperBound.y + reach);
+    b2DistanceProxy part;
+    part.Set(&shape, child);
+    // Distances are to the core shape, less the radius the fluid meets it at: a circle's own, a
+    // moving body's polygon's skin (b2_polygonRadius: moving_bodies.cpp) unless the solver
+    // samples moving bodies and meets their fixtures; a static body's polygons, edges and
+    // chains are seen without their skin.
+    const bool skinned = shape.GetType() == b2Shape::e_polygon && fixture.GetBody()->GetType() != b2_staticBody &&
+                         !w.solver->movingSamples();
+    const double radius = shape.GetType() == b2Shape::e_circle || skinned ? double(shape.m_radius) : 0.0;
+    const std::vector<std::size_t> near = collect(w, lo, hi, [&](std::size_t i) {
+      const Vec2d p = worldPosition(i);
+      const b2Vec2 q(float(p.x()), float(p.y()));
+      b2DistanceProxy point;
+      point.m_vertices = &q;
+      point.m_count = 1;
+      point.m_radius = 0;
+      b2DistanceInput in;
+      in.proxyA = part;
+      in.proxyB = point;
+      in.transformA = xf;
+      in.transformB.SetIdentity();
+      in.useRadii = false;
+      b2SimplexCache cache;
+      cache.count = 0;
+      b2DistanceOutput out;
+      b2Distance(&out, &cache, &in);
+      return double(out.distance) - radius <= reach;
+    });
+    for (const std::size_t i : near) ids.push_back(w.P.id[i]);
+  }
+  // With contact tracking, also those that touched it at the end of a substep of the last
+  // step (and are still there: not removed since).
+  bool merged = false;
+  if (w.contactsOn) {
+    const auto key = std::uintptr_t(static_cast<const void*>(&fixture));
+    const std::pair<std::uintptr_t, std::uint32_t> lo{key, 0}, hi{key, 0xffffffffu};
+    const auto b = std::lower_bound(w.frameContacts.begin(), w.frameContacts.end(), lo);
+    const auto e = std::upper_bound(b, w.frameContacts.end(), hi);
+    for (auto it = b; it != e; ++it)
+      if (slotOf(it->second) != npos) ids.push_back(it->second);
+    merged = b != e;
+  }
+  if (shape.GetChildCount() > 1 || merged) {  // a particle found twice (two links, or now and before) once, in slot order
+    std::vector<std::pair<std::size_t, std::uint32_t>> bySlot;
+    for (const std::uint32_t id : ids) bySlot.push_back({slotOf(id), id});
+    std::sort(bySlot.begin(), bySlot.end());
+    bySlot.erase(std::unique(bySlot.begin(), bySlot.end()), bySlot.end());
+    ids.clear();
+    for (const auto& s : bySlot) ids.push_back(s.second);
+  }
+  return ids;
+}
+
+void World::forEachContact(const std::function<void(const b2Fixture&, const std::vector<std::uint32_t>&)>& f) const {
+  const b2World& b2 = box2d();
+  for (const b2Body* body = b2.GetBodyList(); body; body = body->GetNext())
+    for (const b2Fixture* fx = body->GetFixtureList(); fx; fx = fx->GetNext()) {
+      const std::vector<std::uint32_t> ids = particlesTouching(*fx);
+      if (!ids.empty()) f(*fx, ids);
+    }
+}
+
+World::FieldSample World::sampleAt(const Vec2d& point) const {
+  const Impl& w = *impl_;
+  const WendlandC2<double> W(double(w.R));
+  FieldSample s;
+  double rho = 0;
+  Vec2d vel(0, 0);
+  // The particles within R, summed in slot order (the same sum as a scan of every particle).
+  const Vec2d reach(W.R, W.R);
+  for (const std::size_t i : collect(w, point - reach, point + reach, [](std::size_t) { return true; })) {
+    const double r = (worldPosition(i) - point).norm();
+    if (r >= W.R) continue;
+    const double wv = W.value(r) * double(w.mass) / double(w.P.rho[i]);  // V_j W
+    s.weight += wv;
+    rho += wv * double(w.P.rho[i]);
+    vel += wv * Vec2d(w.P.v[i].x(), w.P.v[i].y());
+  }
+  if (s.weight > 0) {
+    s.density = rho / s.weight;
+    s.velocity = vel / s.weight;
+  }
+  return s;
+}
+
+std::uint64_t World::stateHash() const {
+  const ParticleStore& P = impl_->P;
+  std::vector<std::uint32_t> slotOf(impl_->nextId, 0xffffffffu);
+  for (std::size_t i = 0; i < P.size(); ++i) slotOf[P.id[i]] = std::uint32_t(i);
+  Xxh64 h;
+  h.update(impl_->origin.data(), sizeof(double) * 2);
+  for (std::uint32_t id = 0; id < impl_->nextId; ++id) {
+    const std::uint32_t s = slotOf[id];
+    if (s == 0xffffffffu) continue;
+    h.update(&id, sizeof id);
+    h.update(P.x[s].data(), sizeof(Real) * 2);
+    h.update(P.v[s].data(), sizeof(Real) * 2);
+  }
+  return h.digest();
+}
+
+DensityStats World::densityStats() const {
+  const ParticleStore& P = impl_->P;
+  DensityStats s;
+  if (P.size() == 0) return s;
+  const double rho0 = impl_->scene.solver.restDensity;
+  double sumErr = 0, sumRho = 0, maxErr = 0;
+  for (std::size_t i = 0; i < P.size(); ++i) {
+    const double e = std::max(0.0, (double(P.rho[i]) - rho0) / rho0);
+    sumErr += e;
+    sumRho += P.rho[i];
+    maxErr = std::max(maxErr, e);
+  }
+  s.meanError = sumErr / double(P.size());
+  s.maxError = maxErr;
+  s.meanDensity = sumRho / double(P.size());
+  return s;
+}
+
+double World::kineticEnergy() const {
+  const ParticleStore& P = impl_->P;
+  double e = 0;
+  for (std::size_t i = 0; i < P.size(); ++i) e += 0.5 * double(impl_->mass) * double(P.v[i].squaredNorm());
+  return e;
+}
+
+std::size_t World::neighbourPairs() const { return impl_->nbr.pairs(); }
+
+std::vector<std::string> World::particleFields() const {
+  std::vector<std::string> f;
+  impl_->P.forEachField([&](const char* name, const auto&) { f.push_back(name); });
+  return f;
+}
+
+std::vector<std::string> World::effects() const {
+  std::vector<std::string> out;
+  for (const auto& e : impl_->effects) out.push_back(e->name());
+  return out;
+}
+
+std::vector<std::string> World::stages() const {
+  std::vector<std::string> s;
+  for (const Stage& st : impl_->stages.stages()) s.push_back(st.name);
+  return s;
+}
+
+std::vector<StageTiming> World::timings() const { return impl_->stages.timings(); }
+
+void World::resetTimings() { impl_->stages.resetTimings(); }
+
+SolverStats World::solverStats() const { return impl_->solver->stats(); }
+
+std::uint64_t World::solverIterations() const { return impl_->iterations; }
+
+WallImpulse World::wallImpulse() const { return impl_->wall.sum; }
+
+void World::resetWallImpulse() { impl_->wall.sum = WallImpulse{}; }
+
+std::size_t World::particleBytes() const { return impl_->P.bytes(); }
+
+std::size_t World::memoryBytes() const {
+  const Impl& w = *impl_;
+  auto cap = [](const auto& v) { return v.capacity() * sizeof(v[0]); };
+  std::size_t b = w.P.bytes();
+  b += cap(w.grid.cellStart) + cap(w.grid.sorted) + cap(w.grid.cellOf);
+  b += cap(w.nbr.start) + cap(w.nbr.count) + cap(w.nbr.boundaryStart) + cap(w.nbr.boundaryCount);
+  for (const auto& v : w.nbr.perBlock) b += cap(v);
+  for (const auto& v : w.nbr.boundaryPerBlock) b += cap(v);
+  b += cap(w.scratch.v) + cap(w.scratch.r) + cap(w.scratch.u);
+  b += cap(w.boundary.samples) + cap(w.boundary.volume) + cap(w.boundary.sideNormal) + cap(w.boundary.sideOffset);
+  b += cap(w.idIndex);  // only once a game looked a particle up by id
+  b += cap(w.queryGrid.start) + cap(w.queryGrid.items);  // only once a game searched
+  return b;
+}
+
+}  // namespace sph2d
