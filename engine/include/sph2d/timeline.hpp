@@ -51,6 +51,7 @@ class EventApplier {
  public:
   /// Applies `e` now. Returns "" on success, else why it could not be applied
   /// (e.g. switching user_force before any force exists); the World is then unchanged.
+  /// sph2d::Interrupted (the World's stop flag) propagates: nothing was added.
   std::string apply(World& world, const EventDef& e);
   /// True between a pause and a resume.
   bool paused() const { return paused_; }

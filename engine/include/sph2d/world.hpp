@@ -9,6 +9,7 @@
 // a scene is in docs/ARCHITECTURE.md and printed by `sph2d info`).
 #pragma once
 
+#include <atomic>
 #include <cstdint>
 #include <functional>
 #include <type_traits>
@@ -43,9 +44,29 @@ class SimulationError : public std::runtime_error {
   double time;                ///< simulated time [s]
 };
 
+/// The World was asked to stop (its stop flag, WorldOptions::stop or World::setStopFlag, was
+/// set) and stopped its work: `stage` names where (a stage of the substep, "construction: ..."
+/// or the call that was adding particles). Thrown by the constructor (nothing is built), by
+/// step()/stepFrame()/stepSubstep() (the step is abandoned: see World::interrupted()) and by
+/// the calls that add particles (nothing is added: the World is as before the call).
+class Interrupted : public std::runtime_error {
+ public:
+  /// Builds the error; what() says where the World stopped.
+  Interrupted(const std::string& what, std::string stage);
+  std::string stage;  ///< where the work stopped ("neighbours", "construction: fluid[0]", "addBlock", ...)
+};
+
 /// Options of a World that are not part of the scene.
 struct WorldOptions {
   int threads = 0;            ///< job-system threads; 0 = all hardware threads
+  /// A flag the caller may set from any thread or a signal handler (an atomic<bool> is
+  /// lock-free here) to make the World stop what it is doing within milliseconds: it is read
+  /// between the stages of a substep, before each block of the job system's work and every
+  /// few thousand lattice points when fluid is added or the World is built, then the work
+  /// ends with sph2d::Interrupted. Never written by the World; reading it changes no result
+  /// (the same bits with or without it). Null: the World never stops on its own. It must
+  /// outlive the World (or be replaced with setStopFlag).
+  const std::atomic<bool>* stop = nullptr;
 };
 
 /// Time and call count of one stage.
@@ -200,14 +221,29 @@ class World {
   World(const World&) = delete;
   World& operator=(const World&) = delete;
 
-  /// Advances one frame (1/fps seconds) in CFL substeps. Throws SimulationError.
+  /// Advances one frame (1/fps seconds) in CFL substeps. Throws SimulationError, and
+  /// Interrupted when the stop flag is set (setStopFlag).
   void stepFrame();
   /// Advances `dt` seconds in CFL substeps. The scene's own b2World (not a game's) steps once by
   /// `dt` after them, or with every substep when a dynamic body meets a solver that samples the
-  /// moving bodies (wcsph, muller2003, dfsph). Throws SimulationError.
+  /// moving bodies (wcsph, muller2003, dfsph). Throws SimulationError, and Interrupted when
+  /// the stop flag is set: before the step starts (nothing changed), or within it (the step
+  /// is abandoned: interrupted()).
   void step(double dt);
   /// Advances one CFL-limited substep (for benchmarks and tests). Throws SimulationError.
   void stepSubstep();
+
+  /// Replaces the stop flag (WorldOptions::stop; null: none). While the flag is set, a step
+  /// and the calls that add particles throw sph2d::Interrupted within milliseconds (between
+  /// stages, and at block granularity inside them: the cost is one relaxed load a block).
+  void setStopFlag(const std::atomic<bool>* stop);
+  /// True after a step was interrupted by the stop flag: that step stopped inside a stage,
+  /// so the particles are as that stage left them (readable, every array of one length, but
+  /// not a state the solver produced) and the World will not step again: step(),
+  /// stepFrame() and stepSubstep() throw sph2d::Interrupted naming the stage. load() of a
+  /// saved state clears it (the World is then that state). A game that may stop a World
+  /// midway and go on saves a state to go back to, or builds a new World.
+  bool interrupted() const;
 
   /// The particles as read-only arrays by slot (local frame; add origin() for world
   /// coordinates). No copy is made: the views show the World's own arrays, and the World keeps
@@ -288,12 +324,15 @@ class World {
   /// Adds a block of fluid on the lattice of the scene's spacing (particles
   /// inside solids are skipped), row by row from the bottom, until the world holds
   /// its particle budget (max_particles, or effects.budget when set): the rest is
-  /// refused with one warning (takeWarnings). Returns the ids of the particles added.
+  /// refused with one warning (takeWarnings). Returns the ids of the particles added. The
+  /// work grows with the lattice points of the block's rectangle, not only the particles
+  /// added (points inside solids are visited too): a caller taking blocks from elsewhere
+  /// bounds their area first. Throws Interrupted, adding nothing, when the stop flag is set.
   IdRange addBlock(const FluidBlockDef& block);
   /// Adds a drop of fluid: the lattice points of a block around `center` that lie
   /// within `radius` (world coordinates), moving at `velocity`; points inside
   /// solids are skipped; the particle budget holds as for addBlock. Returns the ids
-  /// of the particles added.
+  /// of the particles added. Throws Interrupted, adding nothing, when the stop flag is set.
   IdRange addDrop(const Vec2d& center, double radius, const Vec2d& velocity = Vec2d(0, 0));
   /// Removes the particles inside the box [lo, hi] (world coordinates). Returns their ids,
   /// in increasing order.
@@ -405,7 +444,8 @@ class World {
   std::vector<std::uint32_t> removeParticlesInShape(const b2Shape& shape, const b2Transform& xf);
   /// Fills `shape` placed by `xf` (a b2PolygonShape or b2CircleShape) with fluid on the lattice
   /// of the scene's spacing, moving at `velocity`, as addBlock does (solids skipped, the budget
-  /// held). Returns the ids added. Throws std::invalid_argument for an edge or chain.
+  /// held). Returns the ids added. Throws std::invalid_argument for an edge or chain, and
+  /// Interrupted (nothing added) when the stop flag is set.
   IdRange addShape(const b2Shape& shape, const b2Transform& xf, const Vec2d& velocity = Vec2d(0, 0));
   // The searches below visit only the cells of a grid of the current particles, built on the
   // first search after a step or a change (O(n)), not every particle.
@@ -613,6 +653,7 @@ class World {
     return out;
   }
   void init();
+  void initPhases(std::string& phase);
   std::unique_ptr<Impl> impl_;
 };
 

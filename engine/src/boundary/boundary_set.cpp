@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "boundary/boundary_set.hpp"
+#include "sph2d/world.hpp"  // sph2d::Interrupted
 
 namespace sph2d {
 namespace {
@@ -285,7 +286,11 @@ Real BoundarySet::insideDepth(const Vec2& p) const {
 void colliderBounds(Collider& c) { finishBounds(c); }
 
 void sampleColliders(const std::vector<Collider>& colliders, Real dx, Real depth, std::vector<Vec2>& samples,
-                     std::vector<Real>& volume, std::vector<Vec2>& sideNormal, std::vector<Real>& sideOffset) {
+                     std::vector<Real>& volume, std::vector<Vec2>& sideNormal, std::vector<Real>& sideOffset,
+                     const std::atomic<bool>* stop) {
+  auto checkStop = [stop] {
+    if (stop && stop->load(std::memory_order_relaxed)) throw Interrupted("stopped by the stop flag", "");
+  };
   samples.clear();
   volume.clear();
   sideNormal.clear();
@@ -298,6 +303,7 @@ void sampleColliders(const std::vector<Collider>& colliders, Real dx, Real depth
     sideOffset.push_back(off);
   };
   for (std::size_t ci = 0; ci < colliders.size(); ++ci) {
+    checkStop();
     const Collider& c = colliders[ci];
     const std::size_t first = samples.size();
     if (c.kind == Collider::Kind::Polygon) {
@@ -353,6 +359,7 @@ void sampleColliders(const std::vector<Collider>& colliders, Real dx, Real depth
     // Samples inside an earlier solid collider are already represented there.
     std::size_t out = first;
     for (std::size_t k = first; k < samples.size(); ++k) {
+      if ((k - first) % 4096 == 4095) checkStop();  // each sample is tested against every earlier collider
       bool covered = false;
       for (std::size_t e = 0; e < ci && !covered; ++e) {
         const Collider& o = colliders[e];
@@ -380,8 +387,8 @@ void sampleColliders(const std::vector<Collider>& colliders, Real dx, Real depth
   }
 }
 
-void BoundarySet::sample(Real dx, Real depth, ThreadPool& pool) {
-  sampleColliders(colliders, dx, depth, samples, volume, sideNormal, sideOffset);
+void BoundarySet::sample(Real dx, Real depth, ThreadPool& pool, const std::atomic<bool>* stop) {
+  sampleColliders(colliders, dx, depth, samples, volume, sideNormal, sideOffset, stop);
   sampleGrid.build(samples.data(), samples.size(), depth, pool);
   // noSamplesNear's map: each occupied cell marks the block of cells whose queries visit it.
   const Grid& g = sampleGrid;

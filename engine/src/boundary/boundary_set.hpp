@@ -19,6 +19,7 @@
 #pragma once
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstdint>
 #include <string>
@@ -37,8 +38,11 @@ namespace sph2d {
 /// an earlier solid collider is left out): positions, volumes Ψ_b and, for a two-sided
 /// segment's samples, the side they are visible from (BoundarySet's fields of those names).
 /// BoundarySet::sample for the static solids; body_samples.cpp for each moving body, in its frame.
+/// With `stop` (the World's stop flag) set, throws Interrupted (empty stage) between colliders
+/// and every few thousand samples: the output is then incomplete.
 void sampleColliders(const std::vector<Collider>& colliders, Real dx, Real depth, std::vector<Vec2>& samples,
-                     std::vector<Real>& volume, std::vector<Vec2>& sideNormal, std::vector<Real>& sideOffset);
+                     std::vector<Real>& volume, std::vector<Vec2>& sideNormal, std::vector<Real>& sideOffset,
+                     const std::atomic<bool>* stop = nullptr);
 
 /// Sets c.lo and c.hi, the bounds of a polygon's vertices or of a circle.
 void colliderBounds(Collider& c);
@@ -145,7 +149,7 @@ struct BoundarySet {
   /// the bodies in `skip` left out.
   void collect(b2World& world, const Vec2d& origin, const std::vector<const void*>& skip = {});
   /// Fills every collider with layers of samples at spacing dx down to depth `depth`.
-  void sample(Real dx, Real depth, ThreadPool& pool);
+  void sample(Real dx, Real depth, ThreadPool& pool, const std::atomic<bool>* stop = nullptr);
   /// Builds the collider bins.
   void buildBins(Real binSizeHint);
   /// Depth of p inside any solid collider (polygon or circle); ≤ 0 when outside all.

@@ -25,6 +25,8 @@
 #include "core/thread_pool.hpp"
 
 #include <chrono>
+
+#include "sph2d/world.hpp"  // sph2d::Interrupted
 #if defined(__x86_64__) || defined(__i386__)
 #include <immintrin.h>
 #define SPH2D_PAUSE() _mm_pause()
@@ -83,7 +85,7 @@ void ThreadPool::runBlocks(std::size_t self) {
       const std::size_t b = blk * block_;
       const std::size_t e = b + block_ < n_ ? b + block_ : n_;
       try {
-        (*fn_)(b, e);
+        if (!cancelNow()) (*fn_)(b, e);  // a skipped block still counts as done
       } catch (...) {
         std::lock_guard<std::mutex> lock(errorMutex_);
         if (!error_) error_ = std::current_exception();
@@ -123,7 +125,11 @@ void ThreadPool::parallelFor(std::size_t n, std::size_t block,
   // Serial when alone, when one block holds everything, and (never met: blocks are
   // hundreds of items) beyond a share's block count. The same blocks either way.
   if (workers_.empty() || blocks == 1 || blocks + 1024 > kHalfMask) {
-    for (std::size_t b = 0; b < n; b += block) fn(b, b + block < n ? b + block : n);
+    for (std::size_t b = 0; b < n; b += block) {
+      if (cancelNow()) break;
+      fn(b, b + block < n ? b + block : n);
+    }
+    throwIfCancelled();
     return;
   }
   // Every share of the last job is used up here: no worker reads what is written before
@@ -153,8 +159,15 @@ void ThreadPool::parallelFor(std::size_t n, std::size_t block,
   if (error_) {
     std::exception_ptr e = error_;
     error_ = nullptr;
+    cancelled_.store(false, std::memory_order_relaxed);
     std::rethrow_exception(e);
   }
+  throwIfCancelled();
+}
+
+void ThreadPool::throwIfCancelled() {
+  if (!cancelled_.exchange(false, std::memory_order_relaxed)) return;
+  throw Interrupted("stopped by the stop flag", "");
 }
 
 }  // namespace sph2d

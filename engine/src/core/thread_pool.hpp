@@ -34,8 +34,16 @@ class ThreadPool {
   int size() const { return static_cast<int>(workers_.size()) + 1; }
 
   /// Calls fn(begin, end) for every block [k·block, min(n, (k+1)·block)).
-  /// Returns when all blocks are done; rethrows the first exception thrown.
+  /// Returns when all blocks are done; rethrows the first exception thrown. With a cancel
+  /// flag set (setCancel) the blocks not started yet are skipped and it throws
+  /// sph2d::Interrupted (with an empty stage: the caller names it).
   void parallelFor(std::size_t n, std::size_t block, const std::function<void(std::size_t, std::size_t)>& fn);
+
+  /// Makes every job read `*flag` (null: nothing) before each block it starts: once it is
+  /// true, the job's remaining blocks are skipped and parallelFor throws Interrupted. Set
+  /// between jobs by the thread that calls parallelFor. A relaxed load a block: blocks are
+  /// hundreds of items, and the blocks (so the results) do not change.
+  void setCancel(const std::atomic<bool>* flag) { cancel_ = flag; }
 
   /// Deterministic reduction: blockFn(begin, end) → T per block, then
   /// combine(acc, part) over blocks in increasing order starting from init.
@@ -68,6 +76,16 @@ class ThreadPool {
   std::atomic<bool> stop_{false};
   const std::function<void(std::size_t, std::size_t)>* fn_ = nullptr;
   std::size_t n_ = 0, block_ = 1;
+  const std::atomic<bool>* cancel_ = nullptr;  ///< setCancel's flag (read after a claim, like fn_)
+  std::atomic<bool> cancelled_{false};          ///< a block of this job was skipped
+  /// True when the cancel flag is set (then the job is marked cancelled).
+  bool cancelNow() {
+    if (!cancel_ || !cancel_->load(std::memory_order_relaxed)) return false;
+    cancelled_.store(true, std::memory_order_relaxed);
+    return true;
+  }
+  /// Throws Interrupted when the job just run was cancelled.
+  void throwIfCancelled();
   std::mutex errorMutex_;
   std::exception_ptr error_;
 };

@@ -144,6 +144,10 @@ struct ParticleStore {
     forEachField([&](const char*, auto& field) { field.resize(out); });
     return n - out;
   }
+  /// Keeps the first n particles (n <= size()), every field cut alike.
+  void truncate(std::size_t n) {
+    forEachField([&](const char*, auto& field) { field.resize(n); });
+  }
   /// Bytes held by the particle arrays (capacity, not size).
   std::size_t bytes() const {
     std::size_t b = 0;

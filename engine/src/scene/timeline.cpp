@@ -75,6 +75,8 @@ std::string EventApplier::apply(World& w, const EventDef& e) {
       for (const auto& f : forces_) list.push_back(f.second);
       w.setUserForces(list);
     }
+  } catch (const Interrupted&) {
+    throw;  // the World's stop flag: not a property of the event (nothing was added)
   } catch (const std::exception& ex) {
     return ex.what();
   }

@@ -20,11 +20,18 @@ void StageList::add(Stage s) {
   stages_.push_back(std::move(s));
 }
 
-void StageList::run(StepContext& c, const Fail& fail) {
+void StageList::run(StepContext& c, const Fail& fail, const std::atomic<bool>* stop) {
   using Clock = std::chrono::steady_clock;
   for (std::size_t k = 0; k < stages_.size(); ++k) {
+    if (stop && stop->load(std::memory_order_relaxed)) throw Interrupted("stopped by the stop flag", stages_[k].name);
     const auto t0 = Clock::now();
-    const std::size_t bad = stages_[k].run(c);
+    std::size_t bad = kNone;
+    try {
+      bad = stages_[k].run(c);
+    } catch (const Interrupted& e) {
+      if (!e.stage.empty()) throw;
+      throw Interrupted(e.what(), stages_[k].name);  // the job system stopped inside this stage
+    }
     StageTiming& t = timing_[timingOf_[k]];
     t.seconds += std::chrono::duration<double>(Clock::now() - t0).count();
     ++t.calls;

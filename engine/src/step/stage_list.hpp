@@ -9,6 +9,7 @@
 // and docs/ARCHITECTURE.md come from this list.
 #pragma once
 
+#include <atomic>
 #include <cstddef>
 #include <functional>
 #include <string>
@@ -51,7 +52,9 @@ class StageList {
   /// The stages, in order.
   const std::vector<Stage>& stages() const { return stages_; }
   /// Runs every stage in order, timing each; a stage that reports a bad slot calls `fail`.
-  void run(StepContext& c, const Fail& fail);
+  /// With `stop` set (the World's stop flag) it is read before each stage, and the job
+  /// system reads it inside them: either way Interrupted is thrown naming the stage.
+  void run(StepContext& c, const Fail& fail, const std::atomic<bool>* stop = nullptr);
   /// Wall time and calls per stage name, in the order names first entered the list.
   const std::vector<StageTiming>& timings() const { return timing_; }
   /// Zeroes the timings.

@@ -108,8 +108,9 @@ std::uint64_t World::Impl::staticSignature() const {
 void World::Impl::rebuildBoundary() {
   std::vector<const void*> skip;
   for (const SlidingStatic& s : sliding) skip.push_back(s.body);
+  boundarySignature = 0;  // until the samples are complete: a stop midway leaves them to be read again
   boundary.collect(*b2, origin, skip);
-  boundary.sample(dx, R, pool);
+  boundary.sample(dx, R, pool, stop);
   boundary.buildBins(Real(4) * R);
   boundarySignature = staticSignature();
   ++boundaryVersion;  // a count, not the signature: a rebuilt fixture may reuse a freed one's address

@@ -33,10 +33,22 @@ double uniform(std::uint64_t& state) { return double(splitmix(state) >> 11) * (1
 /// The particle budget holds: once the world holds `budget` particles the rest of
 /// the block is refused with one warning, and no work or memory grows with the
 /// block's size beyond the particles added (rows are computed as they are
-/// filled, a drop's rows only over its chord).
+/// filled, a drop's rows only over its chord). The stop flag is read at every row and every
+/// 4096 lattice points: when it is set the particles this call added are taken back (the
+/// World is as before it) and Interrupted is thrown (empty stage: the caller names it).
 IdRange World::Impl::fillBlock(const FluidBlockDef& b, bool hydrostaticStart) {
   IdRange ids;
   ids.first = nextId;  // every particle below takes the next id: the ones added are consecutive
+  const std::size_t before = P.size();
+  const std::uint32_t idBefore = nextId;
+  std::uint32_t visited = 0;  // lattice points since the stop flag was last read
+  auto checkStop = [&] {
+    if (!stopSet()) return;
+    P.truncate(before);
+    nextId = idBefore;
+    refreshView();
+    throw Interrupted("stopped by the stop flag", "");
+  };
   const bool disc = b.shape == FluidBlockDef::Shape::Circle;  // a circle or a drop: row chords
   std::vector<double> crossings;  // a polygon's edges across the current row
   const SolverDef& sd = scene.solver;
@@ -56,6 +68,7 @@ IdRange World::Impl::fillBlock(const FluidBlockDef& b, bool hydrostaticStart) {
   Vec2d dlo(0, 0), dhi(0, 0);
   double y = 0, prevScale = 1;
   for (long j = 0; j < ny && !refused; ++j) {
+    checkStop();
     const double depth = (double(ny - j) - 0.5) * sd.spacing;
     const double scale = hydrostatic ? 1.0 / (1.0 + hydroFactor * gz * depth) : 1.0;
     y = j == 0 ? b.min.y() + 0.5 * sd.spacing * scale : y + 0.5 * sd.spacing * (prevScale + scale);
@@ -71,6 +84,10 @@ IdRange World::Impl::fillBlock(const FluidBlockDef& b, bool hydrostaticStart) {
       i1 = long(std::min(double(nx), std::ceil((b.center.x() + half - b.min.x()) / sd.spacing + 0.5)));
     }
     for (long i = i0; i < i1; ++i) {
+      if (++visited == 4096) {
+        visited = 0;
+        checkStop();
+      }
       const Vec2d pw(b.min.x() + (double(i) + 0.5) * sd.spacing, y);
       if (disc && !((pw - b.center).squaredNorm() <= b.radius * b.radius)) continue;
       if (b.shape == FluidBlockDef::Shape::Polygon && !FluidBlockDef::insideRow(crossings, pw.x())) continue;

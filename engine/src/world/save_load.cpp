@@ -444,6 +444,7 @@ void World::load(std::istream& input) {
   ++w.edits;
   w.refreshView();
   w.idIndex.clear();
+  w.abandonedIn.clear();  // an interrupted World is this state now, and steps again
 }
 
 }  // namespace sph2d

@@ -152,7 +152,7 @@ Real World::Impl::substep(Real dt, bool driftOnly) {
   StepContext c = context(dt);
   c.wall = &wall;
   wall.force = Vec2d(0, 0);
-  (driftOnly ? drift : stages).run(c, [this](const std::string& stage, std::size_t slot) { fail(stage, slot); });
+  (driftOnly ? drift : stages).run(c, [this](const std::string& stage, std::size_t slot) { fail(stage, slot); }, stop);
   dt = c.dt;
   wall.sum.samples += wall.force * double(dt);  // the explicit solvers' wall force, over the substep taken
   wall.force = Vec2d(0, 0);

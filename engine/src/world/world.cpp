@@ -12,6 +12,9 @@
 
 namespace sph2d {
 
+Interrupted::Interrupted(const std::string& what, std::string stage_)
+    : std::runtime_error(what), stage(std::move(stage_)) {}
+
 SimulationError::SimulationError(const std::string& what, std::string stage_, std::uint32_t particleId_,
                                  std::uint64_t step_, double time_)
     : std::runtime_error(what), stage(std::move(stage_)), particleId(particleId_), step(step_), time(time_) {}
@@ -125,6 +128,21 @@ void World::Impl::warnMovingBodiesInPeriodic() {
 
 void World::init() {
   Impl& w = *impl_;
+  // The stop flag is read through the set-up too (sampling long solids, filling the blocks,
+  // the first density pass): an interrupted constructor throws, and nothing is built.
+  Impl::StopScope scope(w.pool, w.stop);
+  std::string phase = "solver";
+  try {
+    initPhases(phase);
+  } catch (const Interrupted&) {
+    throw Interrupted("the World's construction was stopped by the stop flag (" + phase + "); nothing is built",
+                      "construction: " + phase);
+  }
+}
+
+void World::initPhases(std::string& phase) {
+  Impl& w = *impl_;
+  if (w.stopSet()) throw Interrupted("stopped by the stop flag", "");
   // A scene built in code may leave solver parameters out: give them their defaults.
   fillSolverDefaults(w.scene.solver);
   const SceneDef& scene = w.scene;
@@ -189,11 +207,16 @@ void World::init() {
     w.periodic.lx = pd.x ? Real(pd.max.x() - pd.min.x()) : Real(0);
     w.periodic.ly = pd.y ? Real(pd.max.y() - pd.min.y()) : Real(0);
   }
+  phase = "boundary samples";
   w.rebuildBoundary();
   w.recordStaticPoses();
   w.captureBodies();
   // Fluid blocks on a square lattice; particles inside solids (moving ones too) are dropped.
-  for (const FluidBlockDef& b : scene.blocks) w.fillBlock(b, true);
+  for (std::size_t k = 0; k < scene.blocks.size(); ++k) {
+    phase = "fluid[" + std::to_string(k) + "]";
+    w.fillBlock(scene.blocks[k], true);
+  }
+  phase = "first density";
   // The blocks were filled particle by particle: give back what the arrays' doubling kept
   // spare (up to 40 % of their bytes: 20,100 particles held room for 32,768).
   w.P.forEachField([](const char*, auto& field) { field.shrink_to_fit(); });
@@ -223,20 +246,50 @@ World::~World() = default;
 
 void World::stepFrame() { step(1.0 / impl_->scene.fps); }
 
-void World::step(double dt) {
-  // A game may edit its level between frames: a static body it slid moves through this step
-  // as a kinematic one; other changes are re-read (the particles a new solid covers dropped).
-  impl_->readStatics(dt);
-  impl_->frameContacts.clear();  // the contacts stage's record is this step's
-  impl_->captureBodies();  // the moving bodies' pose and velocity for this step
-  const double t0 = impl_->time;
-  const bool everySubstep = impl_->bodiesEverySubstep();  // then advance() stepped the bodies
-  impl_->advance(dt);
-  if (!everySubstep) impl_->moveOwnBodies(impl_->time - t0);
-  if (impl_->contactsOn) impl_->finishContacts();
-  ++impl_->frames;
-  impl_->refreshView();
+void World::Impl::beforeStep(const char* call) {
+  if (!abandonedIn.empty())
+    throw Interrupted(std::string(call) + ": the World was interrupted in stage '" + abandonedIn +
+                          "' and does not step again; load() a saved state or build a new World",
+                      abandonedIn);
+  if (stopSet())  // set before the step began: nothing has changed
+    throw Interrupted(std::string(call) + ": the stop flag is set; the step was not started", call);
 }
+
+void World::Impl::abandon(const Interrupted& e) {
+  abandonedIn = e.stage.empty() ? std::string("step") : e.stage;
+  refreshView();  // the arrays may have moved; every field has one length
+  std::ostringstream o;
+  o.precision(9);
+  o << "stopped by the stop flag in stage '" << abandonedIn << "' of substep " << steps << " (frame " << frames
+    << ", t = " << time << " s): the step is abandoned and the World does not step again (World::interrupted())";
+  throw Interrupted(o.str(), abandonedIn);
+}
+
+void World::step(double dt) {
+  Impl& w = *impl_;
+  w.beforeStep("step");
+  Impl::StopScope scope(w.pool, w.stop);
+  try {
+    // A game may edit its level between frames: a static body it slid moves through this step
+    // as a kinematic one; other changes are re-read (the particles a new solid covers dropped).
+    w.readStatics(dt);
+    w.frameContacts.clear();  // the contacts stage's record is this step's
+    w.captureBodies();  // the moving bodies' pose and velocity for this step
+    const double t0 = w.time;
+    const bool everySubstep = w.bodiesEverySubstep();  // then advance() stepped the bodies
+    w.advance(dt);
+    if (!everySubstep) w.moveOwnBodies(w.time - t0);
+    if (w.contactsOn) w.finishContacts();
+    ++w.frames;
+    w.refreshView();
+  } catch (const Interrupted& e) {
+    w.abandon(e);
+  }
+}
+
+void World::setStopFlag(const std::atomic<bool>* stop) { impl_->stop = stop; }
+
+bool World::interrupted() const { return !impl_->abandonedIn.empty(); }
 
 void World::setGravity(const Vec2d& g) {
   impl_->scene.gravity = g;
@@ -244,12 +297,20 @@ void World::setGravity(const Vec2d& g) {
   if (impl_->ownWorld) impl_->ownWorld->SetGravity(b2Vec2(float(g.x()), float(g.y())));
 }
 
-IdRange World::addBlock(const FluidBlockDef& block) { return impl_->fillBlock(block, false); }
+IdRange World::Impl::fillNamed(const FluidBlockDef& b, const char* call) {
+  try {
+    return fillBlock(b, false);
+  } catch (const Interrupted&) {
+    throw Interrupted(std::string(call) + ": stopped by the stop flag; nothing was added", call);
+  }
+}
+
+IdRange World::addBlock(const FluidBlockDef& block) { return impl_->fillNamed(block, "addBlock"); }
 
 IdRange World::addDrop(const Vec2d& center, double radius, const Vec2d& velocity) {
   FluidBlockDef b = circleRegion(center, radius, impl_->scene.solver.spacing);
   b.velocity = velocity;
-  return impl_->fillBlock(b, false);
+  return impl_->fillNamed(b, "addDrop");
 }
 
 void World::moveEmitter(std::size_t index, const Vec2d& position, const Vec2d& direction) {
@@ -399,12 +460,19 @@ std::uint64_t World::emittedCount(std::size_t index) const { return impl_->emitt
 std::uint64_t World::removedCount() const { return impl_->removed; }
 
 void World::stepSubstep() {
-  impl_->readStatics(0);  // the level's edits (a moved static body is re-read where it is: no step to slide it over)
-  impl_->frameContacts.clear();
-  impl_->captureBodies();
-  impl_->moveOwnBodies(double(impl_->substep(impl_->stableDt())));
-  if (impl_->contactsOn) impl_->finishContacts();
-  impl_->refreshView();
+  Impl& w = *impl_;
+  w.beforeStep("stepSubstep");
+  Impl::StopScope scope(w.pool, w.stop);
+  try {
+    w.readStatics(0);  // the level's edits (a moved static body is re-read where it is: no step to slide it over)
+    w.frameContacts.clear();
+    w.captureBodies();
+    w.moveOwnBodies(double(w.substep(w.stableDt())));
+    if (w.contactsOn) w.finishContacts();
+    w.refreshView();
+  } catch (const Interrupted& e) {
+    w.abandon(e);
+  }
 }
 
 std::vector<std::string> World::takeWarnings() {

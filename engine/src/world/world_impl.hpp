@@ -67,6 +67,30 @@ struct World::Impl {
   std::uint64_t boundarySignature = 0;  ///< staticSignature() when the colliders were last read
   std::uint64_t boundaryVersion = 0;    ///< how many times the colliders were read (StepContext::boundaryVersion)
 
+  // Stopping on request (World::setStopFlag, WorldOptions::stop).
+  const std::atomic<bool>* stop = nullptr;  ///< the caller's stop flag (null: none)
+  std::string abandonedIn;                  ///< the stage an interrupted step stopped in ("" : none)
+  /// Refuses a step of an abandoned World, or one asked for while the flag is set
+  /// (Interrupted; `call` names the API call).
+  void beforeStep(const char* call);
+  /// After an Interrupted inside a step: marks the World abandoned in its stage and throws
+  /// the Interrupted the caller sees (the stage, substep, frame and time).
+  [[noreturn]] void abandon(const Interrupted& e);
+  /// fillBlock for the API (no hydrostatic start); an interruption names `call`.
+  IdRange fillNamed(const FluidBlockDef& b, const char* call);
+  /// True when the stop flag is set (one relaxed load).
+  bool stopSet() const { return stop && stop->load(std::memory_order_relaxed); }
+  /// While it lives, the job system skips the blocks it has not started once the stop flag is
+  /// set, and the job then throws Interrupted (thread_pool.hpp). Scoped to the World's own
+  /// work (construction, steps, adding fluid), so that reading a World never throws it.
+  struct StopScope {
+    ThreadPool& pool;
+    StopScope(ThreadPool& p, const std::atomic<bool>* flag) : pool(p) { pool.setCancel(flag); }
+    ~StopScope() { pool.setCancel(nullptr); }
+    StopScope(const StopScope&) = delete;
+    StopScope& operator=(const StopScope&) = delete;
+  };
+
   // The particle system (particle_sources.cpp): emitters, lifetimes, sinks, budget.
   struct EmitterState {
     EmitterDef def;
@@ -183,7 +207,7 @@ struct World::Impl {
   }
 
   /// The state of the particles and the scene's constants for a substep of length dt.
-  Impl(const SceneDef& s, const WorldOptions& o) : scene(s), pool(o.threads) {}
+  Impl(const SceneDef& s, const WorldOptions& o) : scene(s), pool(o.threads), stop(o.stop) {}
   StepContext context(Real dt);
 
   // stepper.cpp

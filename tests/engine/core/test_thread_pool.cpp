@@ -2,7 +2,8 @@
 // index once whatever the thread count, reductions combined in block order (the
 // engine's bit-identity across thread counts rests on it), exceptions carried
 // back to the caller, and the per-thread shares: a held-up thread's blocks are
-// taken by the others, and late workers claim nothing twice.
+// taken by the others, and late workers claim nothing twice; a cancel flag skips the
+// blocks not started.
 #include <doctest/doctest.h>
 
 #include <atomic>
@@ -17,6 +18,7 @@
 #include <vector>
 
 #include "core/thread_pool.hpp"
+#include "sph2d/world.hpp"  // sph2d::Interrupted
 
 using namespace sph2d;
 
@@ -201,5 +203,44 @@ TEST_CASE("many short jobs in a row, up to more threads than cores: each block o
       for (std::size_t i = 0; i < n; ++i) bad += hits[i].load(std::memory_order_relaxed) != 1;
     }
     CHECK(bad == 0);
+  }
+}
+
+TEST_CASE("a cancel flag set during a job skips the blocks not started and throws Interrupted, for 1 to 3 threads") {
+  for (int threads = 1; threads <= 3; ++threads) {
+    CAPTURE(threads);
+    ThreadPool pool(threads);
+    std::atomic<bool> cancel{false};
+    pool.setCancel(&cancel);
+    // Unset: every block runs, nothing is thrown.
+    std::atomic<std::size_t> ran{0};
+    pool.parallelFor(1000, 10, [&](std::size_t, std::size_t) { ++ran; });
+    CHECK(ran.load() == 100);
+    // Set by block 5: the blocks under way finish, the rest are skipped, and the caller is told.
+    ran = 0;
+    bool interrupted = false;
+    try {
+      pool.parallelFor(1000, 10, [&](std::size_t b, std::size_t) {
+        ++ran;
+        if (b == 50) cancel.store(true);
+        std::this_thread::sleep_for(std::chrono::milliseconds(1));
+      });
+    } catch (const Interrupted& e) {
+      interrupted = true;
+      CHECK(e.stage.empty());  // the caller (the stage list) names the stage
+    }
+    CHECK(interrupted);
+    CHECK(ran.load() >= 1);
+    CHECK(ran.load() < 100);
+    // Cleared: the pool runs whole jobs again; without a flag it never throws.
+    cancel.store(false);
+    ran = 0;
+    pool.parallelFor(1000, 10, [&](std::size_t, std::size_t) { ++ran; });
+    CHECK(ran.load() == 100);
+    cancel.store(true);
+    pool.setCancel(nullptr);
+    ran = 0;
+    pool.parallelFor(1000, 10, [&](std::size_t, std::size_t) { ++ran; });
+    CHECK(ran.load() == 100);
   }
 }

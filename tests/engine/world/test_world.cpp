@@ -1,13 +1,19 @@
 // The World's construction and public API (engine/src/world/world.cpp): the particle
-// mass, the local frame, what a scene is refused for, and the effect switches.
+// mass, the local frame, what a scene is refused for, the effect switches, and the
+// stop flag (a long step or set-up ended on request, with no bit changed otherwise).
 #include <doctest/doctest.h>
 
 #include <box2d/box2d.h>
 
 #include <algorithm>
+#include <atomic>
+#include <chrono>
 #include <cmath>
+#include <memory>
+#include <sstream>
 #include <stdexcept>
 #include <string>
+#include <thread>
 
 #include "sph2d/world.hpp"
 #include "support/fixture.hpp"
@@ -109,4 +115,163 @@ TEST_CASE("a World in a game's b2World ignores the scene's own bodies and says s
   CHECK(warnings[0].find("1 boundary bodies are ignored") != std::string::npos);
   CHECK(w.colliders().empty());
   CHECK(&w.box2d() == &game);
+}
+
+// --- the stop flag (WorldOptions::stop, World::setStopFlag) ----------------------
+
+namespace {
+
+/// The small dam break with a row of `n` particles 1 km below it, `n` × 4 cm long: the neighbour
+/// grid over that span cannot keep cells of the support radius, so its frames are slow (200,000
+/// particles: 18 substeps of 0.15 s on 2 threads here; the shape, a million particles smaller,
+/// of the block from the network that froze `sph2d serve`).
+std::unique_ptr<World> spreadWorld(std::size_t n, const std::atomic<bool>* stop, int threads) {
+  const SceneDef s = test::scene("tests/small_dam_break.json");
+  auto w = std::make_unique<World>(s, WorldOptions{threads, stop});
+  FluidBlockDef row;
+  row.min = Vec2d(-0.02 * double(n), -1000);
+  row.max = Vec2d(0.02 * double(n), -1000 + 0.05);
+  w->addBlock(row);
+  return w;
+}
+
+using Clock = std::chrono::steady_clock;
+double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+}  // namespace
+
+TEST_CASE("the stop flag ends a long step within 0.3 s, naming the stage, and the World then refuses to step") {
+  // Before: nothing could end World::step early. A frame of this World takes about 6 s here;
+  // the flag, set 0.5 s into it from another thread, must end it at the next block of work.
+  for (int threads : {1, 2}) {
+    CAPTURE(threads);
+    std::atomic<bool> stop{false};
+    auto w = spreadWorld(400000, &stop, threads);
+    REQUIRE(w->particleCount() > 400000);
+    Clock::time_point setAt;
+    std::thread setter([&] {
+      std::this_thread::sleep_for(std::chrono::milliseconds(500));
+      setAt = Clock::now();
+      stop.store(true);
+    });
+    std::string stage, what;
+    const auto t0 = Clock::now();
+    try {
+      w->stepFrame();
+    } catch (const Interrupted& e) {
+      stage = e.stage;
+      what = e.what();
+    }
+    const double total = since(t0);
+    setter.join();
+    const double afterFlag = std::chrono::duration<double>(Clock::now() - setAt).count();
+    MESSAGE(threads << " thread(s): the step ran " << total << " s and ended " << 1e3 * afterFlag
+                    << " ms after the flag, in stage '" << stage << "'");
+    REQUIRE_MESSAGE(!stage.empty(), "the step ended without Interrupted (it was not long enough to test)");
+    CHECK(total >= 0.5);
+    CHECK(afterFlag < 0.3);
+    CHECK(what.find("stopped by the stop flag in stage '" + stage + "'") != std::string::npos);
+    CHECK(w->interrupted());
+    CHECK(w->frame() == 0);
+    // Abandoned: every array still one length, and a later step is refused even with the flag down.
+    CHECK(w->particles().x.size() == w->particleCount());
+    CHECK(w->particles().id.size() == w->particleCount());
+    stop.store(false);
+    std::string again;
+    try {
+      w->stepFrame();
+    } catch (const Interrupted& e) {
+      again = e.what();
+    }
+    CHECK(again.find("was interrupted in stage '" + stage + "' and does not step again") != std::string::npos);
+  }
+}
+
+TEST_CASE("a stop flag that is never set changes no bit: the pinned state hash of the small dam break") {
+  // tests/engine/test_pinned_hashes.cpp pins muller2003 on the small dam break after 30 frames.
+  for (int threads : {1, 2, 3}) {
+    CAPTURE(threads);
+    std::atomic<bool> stop{false};
+    World w(test::scene("tests/small_dam_break.json"), WorldOptions{threads, &stop});
+    for (int f = 0; f < 30; ++f) w.stepFrame();
+    CHECK(w.stateHash() == 0xfe2b099464050078ULL);
+    CHECK(!w.interrupted());
+  }
+}
+
+TEST_CASE("a stop flag set before a step or an addBlock changes nothing: the World steps on to the same hash") {
+  const SceneDef s = test::scene("tests/small_dam_break.json");
+  std::atomic<bool> stop{false};
+  World w(s, WorldOptions{2, &stop});
+  World ref(s, WorldOptions{2});
+  for (int f = 0; f < 5; ++f) {
+    w.stepFrame();
+    ref.stepFrame();
+  }
+  stop.store(true);
+  const std::size_t n = w.particleCount();
+  std::string stage;
+  try {
+    w.stepFrame();
+  } catch (const Interrupted& e) {
+    stage = e.stage;
+  }
+  CHECK(stage == "step");
+  CHECK(!w.interrupted());
+  // A block of a million lattice points: the flag is read before its first row and every 4096 points.
+  FluidBlockDef big;
+  big.min = Vec2d(0.5, 2.0);
+  big.max = Vec2d(40.5, 3.0);
+  std::string what;
+  try {
+    w.addBlock(big);
+  } catch (const Interrupted& e) {
+    stage = e.stage;
+    what = e.what();
+  }
+  CHECK(stage == "addBlock");
+  CHECK(what.find("nothing was added") != std::string::npos);
+  CHECK(w.particleCount() == n);
+  stop.store(false);
+  for (int f = 0; f < 5; ++f) {
+    w.stepFrame();
+    ref.stepFrame();
+  }
+  CHECK(w.stateHash() == ref.stateHash());
+}
+
+TEST_CASE("a World built with its stop flag set throws Interrupted naming the construction phase") {
+  std::atomic<bool> stop{true};
+  std::string stage;
+  try {
+    World w(test::scene("tests/small_dam_break.json"), WorldOptions{1, &stop});
+  } catch (const Interrupted& e) {
+    stage = e.stage;
+  }
+  CHECK(stage.rfind("construction: ", 0) == 0);
+}
+
+TEST_CASE("an interrupted World steps again after load(): to the same hash as the World it was saved from") {
+  const SceneDef s = test::scene("tests/small_dam_break.json");
+  World ref(s, WorldOptions{2});
+  for (int f = 0; f < 3; ++f) ref.stepFrame();
+  std::stringstream saved;
+  ref.save(saved);
+  std::atomic<bool> stop{false};
+  auto w = spreadWorld(100000, &stop, 2);
+  std::thread setter([&] {
+    std::this_thread::sleep_for(std::chrono::milliseconds(200));
+    stop.store(true);
+  });
+  CHECK_THROWS_AS(w->stepFrame(), Interrupted);
+  setter.join();
+  REQUIRE(w->interrupted());
+  stop.store(false);
+  w->load(saved);
+  CHECK(!w->interrupted());
+  for (int f = 0; f < 3; ++f) {
+    w->stepFrame();
+    ref.stepFrame();
+  }
+  CHECK(w->stateHash() == ref.stateHash());
 }
