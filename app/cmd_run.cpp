@@ -220,7 +220,13 @@ int cmdRun(const std::vector<std::string>& args) {
     if (!videoName.empty()) journal->note(videoName, fs::path(videoTempPath(a.video)).filename().string(), std::nullopt);
     manifest->writeRunning(out);
   }
-  if (std::count(a.inputs.begin(), a.inputs.end(), "-")) input.openLive(STDIN_FILENO);
+  // Standard input is input from elsewhere: its block and drop events are capped as the network's are.
+  LiveLimits limits = LiveLimits::forScene(scene);
+  if (a.maxEventParticles) limits.perEvent = a.maxEventParticles;
+  if (a.maxParticlesPerSecond) limits.perSecond = a.maxParticlesPerSecond;
+  if (a.maxParticles) limits.budget = a.maxParticles;
+  const bool live = std::count(a.inputs.begin(), a.inputs.end(), "-") > 0;
+  if (live) input.openLive(STDIN_FILENO, std::make_shared<LiveGate>(scene, limits));
 
   // The loop. A failure stops it; what was written stays, and the manifest says why.
   RunOutputs outputs(a, console, *record, writer.get(), manifest.get());
@@ -230,6 +236,7 @@ int cmdRun(const std::vector<std::string>& args) {
   settings.realtime = a.realtime;
   settings.catchUp = a.catchUp;
   settings.stop = &stopRequested;
+  if (live) settings.live = limits;
   GameLoop loop(world, input, outputs, renderer.get(), settings);
   // From here a signal stops the loop at the next frame and the files are finished. Until
   // now it ended the process at once: set-up wrote nothing that needs finishing (the

@@ -16,6 +16,11 @@
 // ends the loop and starts the scene again from frame 0 in a new World; the record
 // starts over with it (the record always replays what the page shows since the last
 // reset). The loop runs until SIGINT/SIGTERM (exit 130, the record whole).
+//
+// No request takes the loop out of real time: the particles events from the network may
+// add are capped before anything is allocated (LiveGate: per event and per second, and a
+// budget on the count the fluid may reach), each cap a share of the scene's own count unless
+// an option says otherwise; a refused event is answered 4xx naming the cap and its option.
 #include <unistd.h>
 
 #include <algorithm>
@@ -70,6 +75,13 @@ const char* kServeHelp =
     "  --format F       live frames as jpeg (default) or png\n"
     "  --quality Q      JPEG quality 1..100 (default 80)\n"
     "  --catch-up N     at most N frames stepped per render (default 4)\n"
+    "  --max-event-particles N      the most particles one event may add (a block's or a drop's\n"
+    "                   lattice points; default a quarter of S, the scene's own particle count:\n"
+    "                   max(1024, its blocks, emitters and timeline)); more: 422\n"
+    "  --max-particles-per-second N the most particles events may add in any second (default\n"
+    "                   S/2); more: 429 with Retry-After\n"
+    "  --max-particles N            no event takes the fluid past N particles (default 4 x S,\n"
+    "                   at most the scene's own budget); more: 409\n"
     "%s"
     "  --quiet          print only the address, warnings and the summary\n"
     "  --help           this text\n"
@@ -86,6 +98,9 @@ struct ServeArgs {
   int catchUp = 4;        ///< --catch-up
   RenderOptions render;   ///< the render flags
   bool quiet = false;     ///< --quiet
+  std::size_t maxEventParticles = 0;      ///< --max-event-particles (0: the scene's default)
+  std::size_t maxParticlesPerSecond = 0;  ///< --max-particles-per-second (0: the scene's default)
+  std::size_t maxParticles = 0;           ///< --max-particles (0: the scene's default)
 };
 
 ServeArgs parseServeArgs(const std::vector<std::string>& a) {
@@ -106,6 +121,9 @@ ServeArgs parseServeArgs(const std::vector<std::string>& a) {
     else if (s == "--max-clients") r.server.maxClients = parseInt(s, value(), 1, 64);
     else if (s == "--quality") r.server.jpegQuality = parseInt(s, value(), 1, 100);
     else if (s == "--catch-up") r.catchUp = parseInt(s, value(), 1, 1000);
+    else if (s == "--max-event-particles") r.maxEventParticles = std::size_t(parseInt(s, value(), 1, 100000000));
+    else if (s == "--max-particles-per-second") r.maxParticlesPerSecond = std::size_t(parseInt(s, value(), 1, 100000000));
+    else if (s == "--max-particles") r.maxParticles = std::size_t(parseInt(s, value(), 1, 100000000));
     else if (s == "--format") {
       const std::string v = value();
       if (v == "jpeg" || v == "jpg") r.server.format = ImageFormat::Jpeg;
@@ -114,7 +132,8 @@ ServeArgs parseServeArgs(const std::vector<std::string>& a) {
     } else if (s == "--quiet") r.quiet = true;
     else if (!s.empty() && s[0] == '-')
       throw UsageError("unknown option '" + s + "' for serve; options: --port, --bind, --record, --threads, "
-                       "--max-clients, --format, --quality, --catch-up, --mode, --color-by, --range, --overlay, "
+                       "--max-clients, --format, --quality, --catch-up, --max-event-particles, --max-particles-per-second, "
+                       "--max-particles, --mode, --color-by, --range, --overlay, "
                        "--foam-speed, --depth-scale, --quiet (see sph2d serve --help)");
     else if (r.scene.empty()) r.scene = s;
     else throw UsageError("serve takes one scene file; got '" + r.scene + "' and '" + s + "'");
@@ -142,9 +161,9 @@ struct ServeStatus {
 class ServeOutputs : public LoopObserver {
  public:
   ServeOutputs(const SceneDef& scene, const ServeArgs& a, EventRecord& record, ServeServer& server, ServeStatus& status,
-               Renderer& renderer, std::map<std::string, bool>& effects, int reset)
+               Renderer& renderer, std::map<std::string, bool>& effects, int reset, std::atomic<std::size_t>& liveCount)
       : scene_(scene), a_(a), record_(record), server_(server), status_(status), renderer_(renderer), effects_(effects),
-        reset_(reset) {}
+        reset_(reset), liveCount_(liveCount) {}
 
   void warn(const std::string& m) override { std::fprintf(stderr, "warning: %s\n", m.c_str()); }
   void note(const std::string& m) override {
@@ -169,6 +188,7 @@ class ServeOutputs : public LoopObserver {
     warn(t.where + ": " + describeEvent(t.event) + " at frame " + std::to_string(frame) + " not applied: " + why);
   }
   void boundary(const World& world, std::int64_t frame, bool rendered) override {
+    liveCount_.store(world.particleCount());  // every boundary: the network's budget check reads it
     if (rendered) particles_ = world.particleCount();
   }
   bool keeps(std::int64_t) override { return true; }
@@ -240,6 +260,7 @@ class ServeOutputs : public LoopObserver {
   Renderer& renderer_;
   std::map<std::string, bool>& effects_;
   int reset_;
+  std::atomic<std::size_t>& liveCount_;  ///< the World's particles at the last boundary (read by the io thread)
   std::size_t particles_ = 0;
   std::uint64_t dropped_ = 0, late_ = 0;
   bool paused_ = false;
@@ -268,37 +289,55 @@ int cmdServe(const std::vector<std::string>& args) {
   }
   const SceneDef scene = loadScene(a.scene);
   checkMemory(scene, true, 0);
+  LiveLimits limits = LiveLimits::forScene(scene);
+  if (a.maxEventParticles) limits.perEvent = a.maxEventParticles;
+  if (a.maxParticlesPerSecond) limits.perSecond = a.maxParticlesPerSecond;
+  if (a.maxParticles) limits.budget = a.maxParticles;
+  auto gate = std::make_shared<LiveGate>(scene, limits);
+  std::atomic<std::size_t> liveCount{0};  // the World's particles at the last boundary
 
-  // Events from the network: parsed and validated here (io thread), applied by the loop.
+  // Events from the network: parsed, validated and held to the caps here (io thread), applied
+  // by the loop.
   auto queue = std::make_shared<EventQueue>(256);
   std::atomic<bool> resetRequested{false};
   std::atomic<int> received{0};
-  ServeEventHandler onEvent = [&](const std::string& text, const std::string& where) -> std::string {
+  const auto clock0 = std::chrono::steady_clock::now();
+  ServeEventHandler onEvent = [&](const std::string& text, const std::string& where) -> EventReply {
     const int n = ++received;
+    auto refuse = [](std::string why, int status = 400, double retry = 0) { return EventReply{status, std::move(why), retry}; };
     // "reset" is the page's own message (not an event of the format: a replay cannot reset).
     const nlohmann::json j = nlohmann::json::parse(text, nullptr, false);
     if (!j.is_discarded() && j.is_object() && j.contains("type") && j["type"] == "reset") {
-      if (j.size() != 1) return where + ":" + std::to_string(n) + ": {\"type\": \"reset\"} takes no other keys; nothing reset";
+      if (j.size() != 1) return refuse(where + ":" + std::to_string(n) + ": {\"type\": \"reset\"} takes no other keys; nothing reset");
       resetRequested.store(true);
       stopRequested.store(true);
-      return "";
+      return {};
     }
     try {
       TimedEvent t = parseLiveEvent(text, where, n, scene);
       // A stamp would park the event in the schedule until its frame (unbounded for a
       // client that sends far-future stamps): the network's events apply at the next boundary.
       if (t.event.frame >= 0 || t.event.t >= 0)
-        return t.where + ": keys 'frame' and 't' are not allowed in events from the network (they apply at the next "
-                         "frame boundary); nothing applied";
+        return refuse(t.where + ": keys 'frame' and 't' are not allowed in events from the network (they apply at the "
+                                "next frame boundary); nothing applied");
+      // The caps, before anything is allocated: the event's particles are counted from its numbers.
+      const double now = std::chrono::duration<double>(std::chrono::steady_clock::now() - clock0).count();
+      const double adds = liveEventParticles(t.event, scene);
+      if (const LiveRefusal r = gate->admit(t.event, now, double(liveCount.load()) + queue->particles()))
+        return refuse(t.where + ": " + r.message + "; nothing applied", r.status, r.retryAfter);
       const std::string at = t.where;
-      if (!queue->push(std::move(t)))
-        return at + ": too many events waiting for the next frame (at most 256; while paused only pause and "
-                    "resume are taken); nothing applied";
-      return "";
+      const EventDef admitted = t.event;
+      if (!queue->push(std::move(t), adds)) {
+        gate->forget(admitted);
+        return refuse(at + ": too many events waiting for the next frame (at most 256; while paused only pause and "
+                           "resume are taken); nothing applied",
+                      429, 1);
+      }
+      return {};
     } catch (const SceneError& e) {
-      return std::string(e.what()) + " (not applied)";
+      return refuse(std::string(e.what()) + " (not applied)");
     } catch (const std::exception& e) {
-      return std::string("not applied: ") + e.what();
+      return refuse(std::string("not applied: ") + e.what());
     }
   };
   // The record starts over at each reset, but the first one must not replace a file sph2d did not write.
@@ -308,6 +347,8 @@ int cmdServe(const std::vector<std::string>& args) {
     std::lock_guard<std::mutex> lock(status.mutex);
     nlohmann::json s = status.state;
     s["events_waiting"] = queue->size();
+    s["limits"] = {{"event_particles", limits.perEvent}, {"particles_per_second", limits.perSecond},
+                   {"max_particles", limits.budget}};
     return s;
   });
 
@@ -321,6 +362,10 @@ int cmdServe(const std::vector<std::string>& args) {
   std::printf("sph2d serve: http://%s:%d/ (scene %s, solver %s, %d×%d, %s frames; Ctrl-C stops)\n", host.c_str(),
               server.port(), scene.name.c_str(), scene.solver.type.c_str(), scene.render.width, scene.render.height,
               imageFormatName(a.server.format));
+  if (!a.quiet)
+    std::printf("sph2d serve: events from the network add at most %zu particles each, %zu a second, and take the "
+                "fluid to at most %zu (--max-event-particles, --max-particles-per-second, --max-particles)\n",
+                limits.perEvent, limits.perSecond, limits.budget);
   std::fflush(stdout);
 
   std::map<std::string, bool> effects;
@@ -333,6 +378,7 @@ int cmdServe(const std::vector<std::string>& args) {
   int code = 130;
   for (;;) {
     World world(scene, WorldOptions{a.threads});
+    liveCount.store(world.particleCount());
     for (const auto& w : world.takeWarnings()) std::fprintf(stderr, "warning: %s\n", w.c_str());
     EventIntake input(scene, [](const std::string& m) { std::fprintf(stderr, "warning: %s\n", m.c_str()); });
     input.addScene();
@@ -349,13 +395,14 @@ int cmdServe(const std::vector<std::string>& args) {
       status.state["record"] = a.record;
       status.state["reset"] = resets;
     }
-    ServeOutputs outputs(scene, a, record, server, status, renderer, effects, resets);
+    ServeOutputs outputs(scene, a, record, server, status, renderer, effects, resets, liveCount);
     LoopSettings settings;
     settings.frames = std::numeric_limits<std::int64_t>::max();
     settings.fps = scene.fps;
     settings.realtime = true;
     settings.catchUp = a.catchUp;
     settings.stop = &stopRequested;
+    settings.live = limits;
     GameLoop loop(world, input, outputs, &renderer, settings);
     LoopEnd end = LoopEnd::Finished;
     try {

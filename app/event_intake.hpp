@@ -13,16 +13,20 @@
 // (sph2d serve) are parsed on the network threads, so that a bad one is answered to
 // its client; they reach the loop through an EventQueue and are live events like
 // standard input's lines from then on (while the loop is paused only pause and resume
-// leave the queue, so it stays bounded). Events of one frame come in
+// leave the queue, so it stays bounded). Live input is input from elsewhere: the particles
+// its blocks and drops may add are capped (LiveGate, LiveLimits) before any is allocated.
+// Events of one frame come in
 // the order: the timeline's, the events files' (command-line and line order), live.
 #pragma once
 
 #include <cstdint>
+#include <deque>
 #include <fstream>
 #include <functional>
 #include <memory>
 #include <mutex>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "events.hpp"
@@ -31,6 +35,61 @@
 
 namespace sph2d::cli {
 
+/// Caps on the particles live input (`sph2d run --input -`, `sph2d serve`'s network) may add,
+/// so that no line or request takes the loop out of real time: per event, per second of wall
+/// time, and the count the fluid may reach through live input. Only block and drop events add
+/// particles (an emitter event switches or moves one of the scene's emitters, at the scene's
+/// rate and under its budget). 0: no cap.
+struct LiveLimits {
+  std::size_t perEvent = 0;    ///< --max-event-particles: the most one event may add
+  std::size_t perSecond = 0;   ///< --max-particles-per-second: the most added in any second
+  std::size_t budget = 0;      ///< --max-particles: no live event takes the fluid past it
+  std::size_t sceneCount = 0;  ///< S, the scene's own count the defaults are shares of
+  /// The defaults for `scene`: with S = max(1024, peakParticles(scene)) (its blocks, emitters
+  /// and timeline), S/4 an event, S/2 a second and 4·S in all, the last never above the
+  /// scene's own budget (effects.budget or max_particles).
+  static LiveLimits forScene(const SceneDef& scene);
+};
+
+/// Why a live event was refused: the HTTP status that says so (422: over the per-event cap,
+/// 429: over the per-second cap, 409: over the budget) and a message naming the cap and the
+/// option that raises it; status 0 when it is admitted.
+struct LiveRefusal {
+  int status = 0;
+  std::string message;
+  double retryAfter = 0;  ///< 429: seconds until the event would fit in the last second's window
+  explicit operator bool() const { return status != 0; }
+};
+
+/// The particles live event `e` can add at the scene's spacing (sph2d::eventParticles).
+double liveEventParticles(const EventDef& e, const SceneDef& scene);
+
+/// The budget check of LiveLimits: refuses `e` when the fluid, holding `particles` (with the
+/// events admitted and not applied yet), would pass `limits.budget` with it.
+LiveRefusal checkLiveBudget(const EventDef& e, const SceneDef& scene, const LiveLimits& limits, double particles);
+
+/// Admits live events under the per-event and per-second caps of LiveLimits, counting what it
+/// admitted in a sliding one-second window of wall time. Thread-safe.
+class LiveGate {
+ public:
+  LiveGate(const SceneDef& scene, LiveLimits limits) : scene_(scene), limits_(limits) {}
+  /// Checks `e`, arriving at wall time `now` [s, any steady origin], against the per-event and
+  /// per-second caps and, when `particles` >= 0 (the fluid's count with the events admitted
+  /// and not applied yet), the budget; when admitted, counts it in the window.
+  LiveRefusal admit(const EventDef& e, double now, double particles = -1);
+  /// Takes back the last event admitted, `e`, when it could not be queued after all.
+  void forget(const EventDef& e);
+  /// The caps.
+  const LiveLimits& limits() const { return limits_; }
+
+ private:
+  const SceneDef& scene_;
+  LiveLimits limits_;
+  std::mutex mutex_;
+  std::deque<std::pair<double, double>> window_;  ///< (time, particles) admitted in the last second
+  double inWindow_ = 0;                           ///< the sum of window_'s particles
+};
+
 /// Live events parsed on other threads (sph2d serve's network threads), waiting for the
 /// loop's next boundary. Bounded: a client that floods it is refused, not queued.
 class EventQueue {
@@ -38,9 +97,11 @@ class EventQueue {
   /// A queue that holds at most `capacity` events not taken yet, and besides them at most
   /// `capacity` pause and resume events (so that a resume gets in while others fill it).
   explicit EventQueue(std::size_t capacity = 256) : capacity_(capacity) {}
-  /// Adds `e`; false (nothing added) when `capacity` events of its kind (pause and resume,
-  /// or the others) wait already.
-  bool push(TimedEvent e);
+  /// Adds `e`, which may add `particles` to the fluid; false (nothing added) when `capacity`
+  /// events of its kind (pause and resume, or the others) wait already.
+  bool push(TimedEvent e, double particles = 0);
+  /// The particles the waiting events may add (pushed and not taken).
+  double particles() const;
   /// Removes and returns every event waiting, in the order pushed.
   std::vector<TimedEvent> take();
   /// Removes and returns the pause and resume events waiting (in order); the others stay,
@@ -53,6 +114,7 @@ class EventQueue {
   mutable std::mutex mutex_;
   std::size_t capacity_;
   std::size_t pauses_ = 0;  ///< pause and resume events in events_
+  double particles_ = 0;    ///< what the waiting non-pause events may add
   std::vector<TimedEvent> events_;
 };
 
@@ -69,8 +131,9 @@ class EventIntake {
   std::size_t addFile(const std::string& path);
   /// Adds one event at its frame (e.g. an event a manifest lists).
   void add(TimedEvent e);
-  /// Starts reading live events from `fd` (`--input -`).
-  void openLive(int fd);
+  /// Starts reading live events from `fd` (`--input -`); with `gate`, each line's event must
+  /// pass its per-event and per-second caps (else it is skipped with a warning naming the cap).
+  void openLive(int fd, std::shared_ptr<LiveGate> gate = nullptr);
   /// Stops reading live events (joins the reader thread).
   void closeLive();
   /// Takes live events from `queue` too (sph2d serve); live input is open while it is set.
@@ -97,6 +160,7 @@ class EventIntake {
   EventSchedule schedule_;
   std::size_t skippedScene_ = 0;  ///< events files' lines a record took from the timeline
   std::unique_ptr<LiveInput> live_;
+  std::shared_ptr<LiveGate> gate_;
   std::shared_ptr<EventQueue> queue_;
   std::vector<TimedEvent> liveQueue_;  ///< parsed live events not taken yet
 };

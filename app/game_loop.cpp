@@ -107,7 +107,16 @@ void GameLoop::applyOne(const TimedEvent& t, std::int64_t frame) {
 
 void GameLoop::applyDue(std::int64_t frame) {
   for (const TimedEvent& t : input_.takeScheduled(frame)) applyOne(t, frame);
-  for (const TimedEvent& t : input_.takeLive(frame)) applyOne(t, frame);
+  for (const TimedEvent& t : input_.takeLive(frame)) {
+    if (settings_.live.budget) {
+      const LiveRefusal r = checkLiveBudget(t.event, world_.scene(), settings_.live, double(world_.particleCount()));
+      if (r) {
+        observer_.notApplied(t, frame, r.message);
+        continue;
+      }
+    }
+    applyOne(t, frame);
+  }
   status_.paused = applier_.paused();
 }
 

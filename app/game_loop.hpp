@@ -45,6 +45,10 @@ struct LoopSettings {
   bool realtime = false;                  ///< pace to the wall clock (else as fast as possible)
   int catchUp = 4;                        ///< real time: at most this many steps per render
   const std::atomic<bool>* stop = nullptr;  ///< when set and true, the loop ends (SIGINT/SIGTERM)
+  /// Live input's caps: at each boundary a live event (EventIntake::takeLive) that would take
+  /// the fluid past `live.budget` is not applied (observer.notApplied); the per-event and
+  /// per-second caps are the intake's (LiveGate). Budget 0: no cap.
+  LiveLimits live;
 };
 
 /// Where the loop is, for progress lines and the summary.

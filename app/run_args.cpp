@@ -37,7 +37,17 @@ const char* kRunHelp =
     "  --input FILE    apply the events of FILE: one JSON object per line, each with\n"
     "                  \"frame\" or \"t\" (docs/SCENES.md); may be repeated\n"
     "  --input -       apply events read from standard input, one JSON object per line,\n"
-    "                  at the next frame; a bad line is reported and skipped\n"
+    "                  at the next frame; a bad line is reported and skipped. Standard input\n"
+    "                  is input from elsewhere: its block and drop events are held to the caps\n"
+    "                  of `sph2d serve`'s network (a line over one is skipped with a warning):\n"
+    "  --max-event-particles N      the most particles one --input - event may add (default\n"
+    "                  a quarter of S, the scene's own count: max(1024, its blocks, emitters\n"
+    "                  and timeline))\n"
+    "  --max-particles-per-second N the most --input - events may add in any second of wall\n"
+    "                  time (default S/2)\n"
+    "  --max-particles N            no --input - event takes the fluid past N particles\n"
+    "                  (default 4 x S, at most the scene's own budget); events files and the\n"
+    "                  scene's timeline are the scene author's: only the scene's budget holds them\n"
     "  --record FILE   write every applied event with its frame (replay it with --input);\n"
     "                  an existing FILE is replaced only when it is in DIR and an earlier\n"
     "                  run's manifest lists it (else exit 2)\n"
@@ -97,6 +107,9 @@ RunArgs parseRunArgs(const std::vector<std::string>& a) {
         throw UsageError("--input - may be given once (there is one standard input)");
     } else if (s == "--record") r.record = value();
     else if (s == "--max-memory") r.maxMemory = parseBytes(s, value());
+    else if (s == "--max-event-particles") r.maxEventParticles = std::size_t(parseInt(s, value(), 1, 100000000));
+    else if (s == "--max-particles-per-second") r.maxParticlesPerSecond = std::size_t(parseInt(s, value(), 1, 100000000));
+    else if (s == "--max-particles") r.maxParticles = std::size_t(parseInt(s, value(), 1, 100000000));
     else if (s == "--no-images") r.images = false;
     else if (s == "--state-hash") r.stateHash = true;
     else if (s == "--profile") r.profile = true;

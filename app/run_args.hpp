@@ -30,6 +30,9 @@ struct RunArgs {
   int catchUp = 4;                           ///< --catch-up
   std::vector<std::string> inputs;           ///< --input: events files, "-" for standard input
   std::string record;                        ///< --record FILE ("" : none)
+  std::size_t maxEventParticles = 0;         ///< --max-event-particles (0: the scene's default)
+  std::size_t maxParticlesPerSecond = 0;     ///< --max-particles-per-second (0: the scene's default)
+  std::size_t maxParticles = 0;              ///< --max-particles (0: the scene's default)
 };
 
 /// True when `args` asks for help (--help or -h anywhere).

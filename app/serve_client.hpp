@@ -30,6 +30,7 @@ struct HttpResult {
   int status = 0;          ///< the status code (0: no answer)
   std::string body;        ///< the body
   std::string contentType; ///< the Content-Type header
+  std::string retryAfter;  ///< the Retry-After header ("" when absent)
 };
 
 /// One HTTP/1.1 request to host:port (a new connection), waiting at most `timeout`. Throws
@@ -59,6 +60,7 @@ inline HttpResult httpRequest(const std::string& host, int port, http::verb meth
   r.status = int(parser.get().result_int());
   r.body = parser.get().body();
   r.contentType = std::string(parser.get()[http::field::content_type]);
+  r.retryAfter = std::string(parser.get()[http::field::retry_after]);
   beast::error_code ec;
   stream.socket().shutdown(tcp::socket::shutdown_both, ec);
   return r;

@@ -3,8 +3,10 @@
 // io thread; the encoder thread hands its messages over with net::post.
 #include "serve_server.hpp"
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <condition_variable>
 #include <cstring>
 #include <deque>
@@ -41,6 +43,8 @@ constexpr auto kWriteStall = std::chrono::seconds(10);
 constexpr int kMaxHttp = 16;
 
 std::string errorJson(const std::string& why) { return nlohmann::json{{"error", why}}.dump(); }
+/// A refused event's reply: the error and its HTTP status.
+std::string errorJson(const EventReply& r) { return nlohmann::json{{"error", r.error}, {"status", r.status}}.dump(); }
 
 }  // namespace
 
@@ -149,8 +153,8 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
                         std::to_string(s_.cfg.maxEventBytes) + " bytes; nothing applied");
     } else {
       const std::string text = beast::buffers_to_string(buf_.data());
-      const std::string err = s_.onEvent(text, name_);
-      reply = err.empty() ? std::string("{\"ok\":true}") : errorJson(err);
+      const EventReply r = s_.onEvent(text, name_);
+      reply = r.error.empty() ? std::string("{\"ok\":true}") : errorJson(r);
     }
     buf_.consume(buf_.size());
     if (buf_.capacity() > s_.cfg.maxEventBytes) buf_.shrink_to_fit();  // keep no oversized message's memory
@@ -289,10 +293,13 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
     }
     if (target == "/event") {
       if (method != http::verb::post) return wrongMethod("POST");
-      const std::string err = s_.onEvent(req.body(), "POST /event");
-      if (!err.empty()) {
+      const EventReply r = s_.onEvent(req.body(), "POST /event");
+      if (!r.error.empty()) {
         s_.count(&ServeCounters::rejected);
-        return make(http::status::bad_request, "application/json", errorJson(err));
+        const int code = r.status >= 400 && r.status < 500 ? r.status : 400;
+        Response res = make(http::int_to_status(unsigned(code)), "application/json", errorJson(r));
+        if (code == 429) res.set(http::field::retry_after, std::to_string(std::max(1L, long(std::ceil(r.retryAfter)))));
+        return res;
       }
       return make(http::status::ok, "application/json", "{\"ok\":true}");
     }

@@ -50,10 +50,18 @@ struct ServeCounters {
   double encodeSeconds = 0;     ///< wall seconds compressing frames
 };
 
+/// The answer to a client's event: accepted (`error` empty), or refused with why (sent back
+/// to the client) and the HTTP status that says so (400 a malformed or invalid event; 422, 429
+/// or 409 an event over live input's caps, event_intake.hpp's LiveRefusal).
+struct EventReply {
+  int status = 200;
+  std::string error;
+  double retryAfter = 0;  ///< with 429: seconds until it would be taken (the Retry-After header, rounded up)
+};
+
 /// An event from a client: its text (at most maxEventBytes) and who sent it ("ws client 3",
-/// "POST /event"). Returns "" when accepted, else what is wrong (sent back to the client).
-/// Called on the io thread.
-using ServeEventHandler = std::function<std::string(const std::string& text, const std::string& where)>;
+/// "POST /event"). Called on the io thread.
+using ServeEventHandler = std::function<EventReply(const std::string& text, const std::string& where)>;
 /// The overlay data of the moment (GET /state). Called on the io thread.
 using ServeStateFn = std::function<nlohmann::json()>;
 

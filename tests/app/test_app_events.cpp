@@ -191,6 +191,33 @@ TEST_CASE("block and drop events of any size, from the timeline or a file, stop 
   CHECK(r.out.find("2 events applied, 2 warnings") != std::string::npos);
 }
 
+TEST_CASE("--input - is held to the caps of live input: a block over the per-event cap is skipped naming it") {
+  // Standard input is input from elsewhere, as the network is to sph2d serve: before, this
+  // line added particles up to the 4,000,000 budget (3,998,750) before the next frame.
+  const std::string feed =
+      "printf '%s\\n' '{\"type\": \"block\", \"min\": [-1e6, -1e6], \"max\": [1e6, 1e6]}' "
+      "'{\"type\": \"drop\", \"center\": [2, 2], \"radius\": 0.15}' "
+      "'{\"type\": \"drop\", \"center\": [2, 2], \"radius\": 0.15}' | ";
+  Result r = run("run " + q(kSmall) + " --frames 20 --realtime --no-images --input -", feed);
+  INFO(r.out);
+  CHECK(r.code == 0);
+  CHECK(r.out.find("stdin:1: the block would add up to 2.5e+15 particles, more than the 312 one live event may add "
+                   "(--max-event-particles") != std::string::npos);
+  CHECK(r.out.find("2 events applied") != std::string::npos);
+  // The other caps, lowered: the second drop (44 more) passes the per-second cap, then the budget.
+  r = run("run " + q(kSmall) + " --frames 20 --realtime --no-images --input - --max-particles-per-second 50", feed);
+  INFO(r.out);
+  CHECK(r.out.find("stdin:3: the drop would add up to 44 particles to the 44 live input added in the last second: "
+                   "more than the 50 a second allows (--max-particles-per-second") != std::string::npos);
+  CHECK(r.out.find("1 event applied") != std::string::npos);
+  r = run("run " + q(kSmall) + " --frames 20 --realtime --no-images --input - --max-particles 1300", feed);
+  INFO(r.out);
+  CHECK(r.out.find("more than the 1300 live input may bring it to (--max-particles") != std::string::npos);
+  CHECK(r.out.find("1 event applied") != std::string::npos);
+  r = run("run --help");
+  CHECK(r.out.find("--max-event-particles N") != std::string::npos);
+}
+
 TEST_CASE("--record: a write error stops the run with exit 1 naming the file, and an --input file is never the record") {
   // Before (issue 18): --record on a full disk wrote 0 bytes, exited 0 and the summary said the
   // events were recorded; --input F --record F truncated F.

@@ -1,6 +1,7 @@
 // tests/serve/test_serve.cpp — `sph2d serve` over real sockets: bad and oversized
 // messages, clients that never read or vanish mid-frame, --max-clients, the snapshot, POST
-// /event, SIGTERM with a whole record that replays to the live hashes, reset and pause.
+// /event, SIGTERM with a whole record that replays to the live hashes, reset and pause, and
+// the caps on the particles events may add.
 // Each case starts the real server on a free port (serve_fixture.hpp) with the small dam
 // break (1,250 particles, 192×144), and asserts behaviour, never speed.
 #include <doctest/doctest.h>
@@ -310,6 +311,83 @@ TEST_CASE("serve: pause holds the frame, resume goes on, reset starts frame 0 an
   // The frame counter starts again (read in the same answer as the reset count).
   CHECK(after.value("frame", std::int64_t(1000000)) < f0 + 60);
   CHECK(slurp(rec).empty());  // the record replays the run since the reset
+  CHECK(s.stop() == 130);
+}
+
+namespace {
+
+/// The frame the server's loop reached (GET /state; -1 when it does not answer).
+std::int64_t frameOf(const Server& s) { return s.state().value("frame", std::int64_t(-1)); }
+
+}  // namespace
+
+TEST_CASE("serve: a block or drop over the per-event cap is refused 422 naming the cap, and the frames keep advancing") {
+  // Before: {"type":"block","min":[-1e6,-1e6],"max":[1e6,1e6]} was accepted (200) and added
+  // 3,998,750 particles (the 4,000,000 budget); the loop never finished the next frame.
+  const std::string dir = scratch("serve_event_cap");
+  Server s(kScene, {"--threads", "1"}, dir + "/serve.log");
+  REQUIRE_MESSAGE(s.port > 0, slurp(s.log));
+  REQUIRE(waitFor([&] { return frameOf(s) >= 0; }));
+  // The defaults, shares of the scene's own 1,250 particles.
+  const nlohmann::json limits = s.state()["limits"];
+  CHECK(limits.value("event_particles", 0) == 312);
+  CHECK(limits.value("particles_per_second", 0) == 625);
+  CHECK(limits.value("max_particles", 0) == 5000);
+
+  auto p = s.post(R"({"type":"block","min":[-1e6,-1e6],"max":[1e6,1e6]})");
+  INFO(p.body);
+  CHECK(p.status == 422);
+  CHECK(p.body.find("the block would add up to 2.5e+15 particles, more than the 312 one live event may add "
+                    "(--max-event-particles") != std::string::npos);
+  p = s.post(R"({"type":"drop","center":[2,2],"radius":1e4})");
+  CHECK(p.status == 422);
+  CHECK(p.body.find("--max-event-particles") != std::string::npos);
+  // The same over the WebSocket: an error reply with its status.
+  sc::WsClient c("127.0.0.1", s.port);
+  c.send(R"({"type":"block","min":[-1e6,-1e6],"max":[1e6,1e6]})");
+  auto r = c.readReply();
+  REQUIRE(r);
+  CHECK(r->header.value("status", 0) == 422);
+  CHECK(r->header.value("error", "").find("--max-event-particles") != std::string::npos);
+
+  // The loop goes on: 60 more frames, the particles unchanged, and a drop within the cap is taken.
+  const std::int64_t f0 = frameOf(s);
+  CHECK(waitFor([&] { return frameOf(s) >= f0 + 60; }, 30000ms));
+  CHECK(s.state().value("particles", std::size_t(0)) == 1250);
+  CHECK(s.post(R"({"type": "drop", "center": [2.5, 2.2], "radius": 0.15})").status == 200);
+  CHECK(waitFor([&] { return s.state().value("particles", std::size_t(0)) > 1250; }));
+  CHECK(s.stop() == 130);
+}
+
+TEST_CASE("serve: particles per second and in all are capped: 429 with Retry-After, then taken again, and 409 at the budget") {
+  const std::string dir = scratch("serve_rate_cap");
+  Server s(kScene, {"--threads", "1", "--max-event-particles", "100", "--max-particles-per-second", "100",
+                    "--max-particles", "1400"}, dir + "/serve.log");
+  REQUIRE_MESSAGE(s.port > 0, slurp(s.log));
+  REQUIRE(waitFor([&] { return frameOf(s) >= 0; }));
+  const std::string drop = R"({"type": "drop", "center": [2.5, 2.2], "radius": 0.15})";  // 44 particles
+  // Two drops (88) fit in a second; the third (132) does not.
+  const auto t0 = std::chrono::steady_clock::now();
+  CHECK(s.post(drop).status == 200);
+  CHECK(s.post(drop).status == 200);
+  const auto third = s.post(drop);
+  const double span = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  REQUIRE_MESSAGE(span < 0.9, "three local requests took " << span << " s: the machine is too slow for this test");
+  INFO(third.body);
+  CHECK(third.status == 429);
+  CHECK(third.body.find("more than the 100 a second allows (--max-particles-per-second") != std::string::npos);
+  CHECK(third.retryAfter == "1");
+  // A second later the window has room again.
+  std::this_thread::sleep_for(1100ms);
+  CHECK(s.post(drop).status == 200);
+  // 1,250 + 3 × 44 = 1,382; one more drop would pass --max-particles 1400.
+  REQUIRE(waitFor([&] { return s.state().value("applied", 0) == 3; }));
+  std::this_thread::sleep_for(1100ms);
+  const auto over = s.post(drop);
+  INFO(over.body);
+  CHECK(over.status == 409);
+  CHECK(over.body.find("more than the 1400 live input may bring it to (--max-particles") != std::string::npos);
+  CHECK(s.state().value("particles", std::size_t(0)) == 1382);
   CHECK(s.stop() == 130);
 }
 

@@ -73,6 +73,14 @@ EventDef parseEvent(const std::string& text, const std::string& file, int line, 
 /// first frame at or after its time, ceil(t·fps − 1e-9); -1 when unstamped.
 std::int64_t eventFrame(const EventDef& event, double fps);
 
+/// The most particles event `e` can add to a World of lattice spacing `spacing` (before any is
+/// allocated, in O(1)): a block's lattice points (exact for its rectangle, before solids and the
+/// budget skip some), a drop's points within its radius (exact up to 4096 rows, beyond them
+/// π(r/dx + 1)², an upper bound); 0 for the events that add no particles (an emitter event
+/// switches or moves an emitter of the scene, whose rate and budget are the scene's). As a
+/// double: a hostile event's count does not overflow.
+double eventParticles(const EventDef& e, double spacing);
+
 /// The event's name in files: "force", "release", "block", "drop", "emitter",
 /// "gravity", "effect", "pause" or "resume".
 const char* eventTypeName(EventDef::Type type);

@@ -174,6 +174,17 @@ const char* eventTypeName(EventDef::Type type) {
   return "?";
 }
 
+double eventParticles(const EventDef& e, double spacing) {
+  if (!(spacing > 0)) return 0;
+  if (e.type == EventDef::Type::Block) return regionLatticeCount(e.block, spacing);  // a box: nx·ny
+  if (e.type != EventDef::Type::Drop) return 0;
+  const FluidBlockDef region = circleRegion(e.point, e.radius, spacing);
+  const double rows = std::floor((region.max.y() - region.min.y()) / spacing + 1e-9);
+  if (rows <= 4096) return regionLatticeCount(region, spacing);  // the points World::addDrop keeps
+  const double r = e.radius / spacing + 1;
+  return 3.14159265358979323846 * r * r;
+}
+
 std::int64_t eventFrame(const EventDef& e, double fps) {
   if (e.frame >= 0) return e.frame;
   if (e.t < 0) return -1;
