@@ -9,20 +9,50 @@
 #include <fstream>
 #include <sstream>
 
+#include <semaphore.h>
 #include <signal.h>
+#include <time.h>
 #include <unistd.h>
+
+#include <thread>
 
 namespace sph2d::cli {
 
 std::atomic<bool> stopRequested{false};
+std::atomic<bool> signalReceived{false};
 
 namespace {
-extern "C" void onSignal(int) { stopRequested.store(true); }
-extern "C" void onSignalExit(int) {
-  static const char msg[] = "sph2d: interrupted (SIGINT or SIGTERM)\n";
-  const ssize_t w = ::write(2, msg, sizeof msg - 1);  // async-signal-safe, unlike stdio
+static_assert(std::atomic<bool>::is_always_lock_free, "the signal handlers use atomic<bool>");
+sem_t watchdogWake;  ///< posted by the first signal (sem_post is async-signal-safe)
+
+/// Writes a message with write(2) (async-signal-safe, unlike stdio) and ends the process.
+[[noreturn]] void exitNow(const char* msg, std::size_t n) {
+  const ssize_t w = ::write(2, msg, n);
   (void)w;
   ::_exit(130);
+}
+extern "C" void onSignal(int) {
+  if (signalReceived.exchange(true)) {
+    static const char msg[] = "sph2d: second SIGINT/SIGTERM: exiting now\n";
+    exitNow(msg, sizeof msg - 1);
+  }
+  stopRequested.store(true);
+  sem_post(&watchdogWake);
+}
+extern "C" void onSignalExit(int) {
+  static const char msg[] = "sph2d: interrupted (SIGINT or SIGTERM)\n";
+  exitNow(msg, sizeof msg - 1);
+}
+/// Waits for the first signal, then gives the command kStopGraceSeconds to end on its own.
+void watchdog() {
+  while (sem_wait(&watchdogWake) != 0) {
+  }
+  timespec left{0, long(kStopGraceSeconds * 1e9)};
+  while (nanosleep(&left, &left) != 0) {
+  }
+  static const char msg[] = "sph2d: still busy 0.8 s after SIGINT/SIGTERM: exiting now (exit 130; the files "
+                            "written are whole)\n";
+  exitNow(msg, sizeof msg - 1);
 }
 void setHandler(int sig, void (*fn)(int)) {
   struct sigaction sa {};
@@ -34,6 +64,12 @@ void setHandler(int sig, void (*fn)(int)) {
 }  // namespace
 
 void installStopHandler() {
+  static const bool started = [] {
+    sem_init(&watchdogWake, 0, 0);
+    std::thread(watchdog).detach();
+    return true;
+  }();
+  (void)started;
   setHandler(SIGINT, onSignal);
   setHandler(SIGTERM, onSignal);
 }

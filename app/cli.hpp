@@ -42,10 +42,22 @@ void checkMemory(const SceneDef& scene, bool images, double limit);
 std::vector<int> parseIntList(const std::string& flag, const std::string& v, int lo, int hi);
 /// Splits a comma-separated list (empty items dropped).
 std::vector<std::string> splitList(const std::string& s);
-/// Set by SIGINT/SIGTERM once installStopHandler() ran.
+/// Set by SIGINT/SIGTERM once installStopHandler() ran (and by serve's reset). The commands
+/// give it to their World as its stop flag (WorldOptions::stop), so a step stops within
+/// milliseconds, not at the end of the frame.
 extern std::atomic<bool> stopRequested;
-/// Makes SIGINT/SIGTERM set stopRequested instead of killing the process (the run's
-/// loop then stops at the next frame and finishes its files).
+/// Set by SIGINT/SIGTERM alone once installStopHandler() ran.
+extern std::atomic<bool> signalReceived;
+/// Seconds after SIGINT/SIGTERM at which the process ends with exit 130 whatever it is doing
+/// (the watchdog of installStopHandler): the loop normally ends long before, with its files
+/// finished; whatever is still being written then is left as it was, and every file the
+/// commands write is whole (written under a temporary name and renamed).
+constexpr double kStopGraceSeconds = 0.8;
+/// Makes SIGINT/SIGTERM set stopRequested and signalReceived instead of killing the process
+/// (the loop then stops, the World within its step, and the files are finished). A watchdog
+/// thread ends the process with exit 130 kStopGraceSeconds after the signal if it is still
+/// running then, and a second signal ends it at once: a signal always ends the process within
+/// a second.
 void installStopHandler();
 /// Makes SIGINT/SIGTERM end the process at once with exit 130 and one line on stderr,
 /// even where the parent ignored them (a background job of a script): set-up (reading

@@ -176,7 +176,9 @@ int cmdRun(const std::vector<std::string>& args) {
 
   std::signal(SIGPIPE, SIG_IGN);  // a dead ffmpeg shows up as EPIPE, not as a kill
   console.start();
-  World world(scene, WorldOptions{a.threads});
+  // The World reads the stop flag (set by SIGINT/SIGTERM once the loop starts): a signal ends
+  // the step under way within milliseconds. Until then a signal ends the process at once.
+  World world(scene, WorldOptions{a.threads, &stopRequested});
   for (const auto& w : world.takeWarnings()) console.warn(w);
   std::unique_ptr<Renderer> renderer;
   std::unique_ptr<OutputJournal> journal;

@@ -15,7 +15,8 @@
 // replay's manifest. "reset" is the page's one message outside the event format: it
 // ends the loop and starts the scene again from frame 0 in a new World; the record
 // starts over with it (the record always replays what the page shows since the last
-// reset). The loop runs until SIGINT/SIGTERM (exit 130, the record whole).
+// reset). The loop runs until SIGINT/SIGTERM (exit 130, the record whole): the World shares
+// the loop's stop flag, so a signal ends even a step under way within milliseconds.
 //
 // No request takes the loop out of real time: the particles events from the network may
 // add are capped before anything is allocated (LiveGate: per event and per second, and a
@@ -140,14 +141,6 @@ ServeArgs parseServeArgs(const std::vector<std::string>& a) {
   }
   if (r.scene.empty()) throw UsageError("serve needs a scene file: sph2d serve SCENE.json [options]");
   return r;
-}
-
-/// Set only by serve's own signal handler, so that a reset (which also stops the loop
-/// through stopRequested) is told apart from SIGINT/SIGTERM.
-std::atomic<bool> signalled{false};
-extern "C" void onServeSignal(int) {
-  signalled.store(true);
-  stopRequested.store(true);
 }
 
 /// The overlay data shared between the loop's thread (writes) and the io thread (GET /state).
@@ -277,16 +270,10 @@ int cmdServe(const std::vector<std::string>& args) {
     return 0;
   }
   const ServeArgs a = parseServeArgs(args);
-  // From here SIGINT/SIGTERM stop the loop (at once if it comes while starting): exit 130.
+  // From here SIGINT/SIGTERM stop the loop, and the World inside its step or its construction
+  // (exit 130); the watchdog ends the process 0.8 s after the signal whatever it is doing.
   std::signal(SIGPIPE, SIG_IGN);  // a vanished client shows up as EPIPE, never as a kill
-  {
-    struct sigaction sa {};
-    sa.sa_handler = onServeSignal;
-    sigemptyset(&sa.sa_mask);
-    sa.sa_flags = SA_RESTART;
-    sigaction(SIGINT, &sa, nullptr);
-    sigaction(SIGTERM, &sa, nullptr);
-  }
+  installStopHandler();
   const SceneDef scene = loadScene(a.scene);
   checkMemory(scene, true, 0);
   LiveLimits limits = LiveLimits::forScene(scene);
@@ -377,7 +364,19 @@ int cmdServe(const std::vector<std::string>& args) {
   std::string failure;
   int code = 130;
   for (;;) {
-    World world(scene, WorldOptions{a.threads});
+    // The World reads the stop flag too: a signal (or a reset) ends its construction or a step
+    // under way within milliseconds.
+    std::unique_ptr<World> built;
+    try {
+      built = std::make_unique<World>(scene, WorldOptions{a.threads, &stopRequested});
+    } catch (const Interrupted&) {
+      stopRequested.store(false);
+      if (signalReceived.load() || !resetRequested.exchange(false)) break;  // a signal: exit 130
+      queue->take();
+      ++resets;
+      continue;  // a reset while the World was being built: build it again
+    }
+    World& world = *built;
     liveCount.store(world.particleCount());
     for (const auto& w : world.takeWarnings()) std::fprintf(stderr, "warning: %s\n", w.c_str());
     EventIntake input(scene, [](const std::string& m) { std::fprintf(stderr, "warning: %s\n", m.c_str()); });
@@ -420,7 +419,7 @@ int cmdServe(const std::vector<std::string>& args) {
     // A reset, unless a signal came too: clear the flag first, then look for a signal, so
     // a signal that arrives in between is never lost.
     stopRequested.store(false);
-    if (signalled.load() || !resetRequested.exchange(false)) break;
+    if (signalReceived.load() || !resetRequested.exchange(false)) break;
     queue->take();  // events sent to the old World do not carry over
     for (auto& e : effects) e.second = true;
     ++resets;

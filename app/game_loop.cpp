@@ -27,6 +27,18 @@ double GameLoop::wallNow() const {
 bool GameLoop::stopRequested() const { return settings_.stop && settings_.stop->load(); }
 
 LoopEnd GameLoop::run() {
+  try {
+    return runFrames();
+  } catch (const Interrupted&) {
+    // The World read the loop's stop flag inside a step or while adding an event's fluid:
+    // the loop ends as at a stop between frames (the frame that was being stepped is not done).
+    if (!stopRequested()) throw;
+    status_.paused = applier_.paused();
+    return LoopEnd::Interrupted;
+  }
+}
+
+LoopEnd GameLoop::runFrames() {
   if (settings_.frames < 1) return LoopEnd::Finished;
   std::int64_t& f = status_.frame;
   f = 0;

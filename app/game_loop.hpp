@@ -44,7 +44,7 @@ struct LoopSettings {
   double fps = 60;                        ///< the scene's frame rate (one step = 1/fps)
   bool realtime = false;                  ///< pace to the wall clock (else as fast as possible)
   int catchUp = 4;                        ///< real time: at most this many steps per render
-  const std::atomic<bool>* stop = nullptr;  ///< when set and true, the loop ends (SIGINT/SIGTERM)
+  const std::atomic<bool>* stop = nullptr;  ///< when set and true, the loop ends (SIGINT/SIGTERM; give the World the same flag)
   /// Live input's caps: at each boundary a live event (EventIntake::takeLive) that would take
   /// the fluid past `live.budget` is not applied (observer.notApplied); the per-event and
   /// per-second caps are the intake's (LiveGate). Budget 0: no cap.
@@ -111,7 +111,10 @@ class GameLoop {
   /// `renderer` may be null (no images: nothing is rendered and nothing dropped).
   GameLoop(World& world, EventIntake& input, LoopObserver& observer, Renderer* renderer, LoopSettings settings);
   /// Runs boundary 0 and then steps until frames − 1, the stop flag or the observer ends it
-  /// (nothing when frames < 1).
+  /// (nothing when frames < 1). When the World is built with the same flag as its stop flag
+  /// (WorldOptions::stop), a stop also ends the step under way within milliseconds: the
+  /// World's Interrupted becomes LoopEnd::Interrupted (that World is then abandoned,
+  /// World::interrupted()).
   /// Exceptions (SimulationError from a step, a renderer error) propagate; status() then
   /// says how far the loop got.
   LoopEnd run();
@@ -121,6 +124,8 @@ class GameLoop {
  private:
   double wallNow() const;
   bool stopRequested() const;
+  /// run()'s body (run() turns the World's Interrupted into LoopEnd::Interrupted).
+  LoopEnd runFrames();
   void applyOne(const TimedEvent& t, std::int64_t frame);
   void applyDue(std::int64_t frame);
   /// Completes boundary status_.frame; renders it unless `drop`. False: the observer ended the loop.

@@ -68,7 +68,8 @@ const char* kRunHelp =
     "Exit codes: 0 ok; 1 runtime failure; 2 bad input (command line, scene, an unreadable\n"
     "--input file, an unwritable --record file, an output file sph2d did not write in the\n"
     "way); 3 the simulation guard stopped the run;\n"
-    "130 interrupted (SIGINT/SIGTERM: the frames written stay whole). A malformed event\n"
+    "130 interrupted (SIGINT/SIGTERM: the step under way stops within milliseconds, the\n"
+    "frames written stay whole, and the process ends within a second). A malformed event\n"
     "line is a warning, not an error.\n";
 
 }  // namespace

@@ -93,7 +93,12 @@ void RunConsole::summary(const World& world, const RunReport& r) const {
   if (r.exports) std::printf("sph2d: %d particle files (%s) in %s\n", r.exports, r.exportExtension.c_str(), r.out.c_str());
   if (r.videoFrames) std::printf("sph2d: %d frames encoded into %s\n", r.videoFrames, r.video.c_str());
   if (r.profile) printProfile(world);
-  if (r.stateHash) std::printf("state-hash: %s\n", hex64(world.stateHash()).c_str());
+  if (r.stateHash) {
+    if (world.interrupted())  // stopped inside a step: no state the solver produced
+      std::printf("state-hash: none (SIGINT/SIGTERM stopped the World inside a step)\n");
+    else
+      std::printf("state-hash: %s\n", hex64(world.stateHash()).c_str());
+  }
 }
 
 void printProfile(const World& w) {

@@ -94,6 +94,50 @@ TEST_CASE("SIGINT stops a run: exit 130, every PNG whole, no temporary file, the
     CHECK(m["frames"][k].at("rgba_xxh64").get<std::string>() == pngHash(dir + "/" + pngs[k]));
 }
 
+TEST_CASE("SIGINT or SIGTERM inside a step of seconds ends a run within a second: exit 130, every PNG whole") {
+  // Before: the signal only set the loop's flag, read between frames, so a run stepping a
+  // slow frame (here 400,000 particles a timeline block spreads over 16 km, about 6 s a frame)
+  // went on to the frame's end.
+  const std::string dir = freshDir("signal_step");
+  json scene = json::parse(readText(kSmall));
+  scene["events"] = json::array({{{"frame", 1}, {"type", "block"}, {"min", {-8000, -1000}}, {"max", {8000, -999.95}}}});
+  const std::string path = dir + "/spread.json";
+  std::ofstream(path) << scene.dump();
+  for (const int sig : {SIGINT, SIGTERM}) {
+    CAPTURE(sig);
+    const std::string out = dir + "/out" + std::to_string(sig), log = out + ".log";
+    const pid_t pid = spawnSph2d({"run", path, "--frames", "100", "--threads", "1", "--out", out, "--quiet"}, log);
+    REQUIRE(pid > 0);
+    // Frame 1 (the block applied) is written while frame 2 steps: then the slow step is under way.
+    const auto t0 = std::chrono::steady_clock::now();
+    while (!fs::exists(out + "/frame_00001.png") && std::chrono::steady_clock::now() - t0 < std::chrono::seconds(60))
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    REQUIRE(fs::exists(out + "/frame_00001.png"));
+    std::this_thread::sleep_for(std::chrono::milliseconds(500));
+    REQUIRE(!fs::exists(out + "/frame_00002.png"));  // still inside frame 2's step
+    const auto s0 = std::chrono::steady_clock::now();
+    REQUIRE(::kill(pid, sig) == 0);
+    int status = 0;
+    REQUIRE(::waitpid(pid, &status, 0) == pid);
+    const double waited = std::chrono::duration<double>(std::chrono::steady_clock::now() - s0).count();
+    const std::string text = readText(log);
+    MESSAGE("signal " << sig << ": exit after " << 1e3 * waited << " ms");
+    INFO(text);
+    REQUIRE(WIFEXITED(status));
+    CHECK(WEXITSTATUS(status) == 130);
+    CHECK(waited < 1.0);
+    CHECK(text.find("interrupted after 2 of 100 frames") != std::string::npos);  // the loop's own end
+    CHECK_FALSE(anyTemporary(out));
+    const json m = readManifest(out);
+    CHECK(m.at("stop").at("reason").get<std::string>() == "interrupted");
+    const auto pngs = filesEnding(out, ".png");
+    REQUIRE(pngs.size() == 2);
+    REQUIRE(m.at("frames").size() == 2);
+    for (std::size_t k = 0; k < pngs.size(); ++k)
+      CHECK(m["frames"][k].at("rgba_xxh64").get<std::string>() == pngHash(out + "/" + pngs[k]));
+  }
+}
+
 TEST_CASE("SIGINT or SIGTERM during set-up ends run and info at once with exit 130") {
   // Before (issue 18): SIGTERM while a 100k-vertex chain was prepared took 49 s to act (the
   // handler only set the loop's flag), and info ran on for 40 s after SIGINT.

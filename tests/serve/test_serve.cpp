@@ -1,7 +1,7 @@
 // tests/serve/test_serve.cpp — `sph2d serve` over real sockets: bad and oversized
 // messages, clients that never read or vanish mid-frame, --max-clients, the snapshot, POST
-// /event, SIGTERM with a whole record that replays to the live hashes, reset and pause, and
-// the caps on the particles events may add.
+// /event, SIGTERM with a whole record that replays to the live hashes, reset and pause, the
+// caps on the particles events may add, and signals during a long step or set-up.
 // Each case starts the real server on a free port (serve_fixture.hpp) with the small dam
 // break (1,250 particles, 192×144), and asserts behaviour, never speed.
 #include <doctest/doctest.h>
@@ -316,6 +316,25 @@ TEST_CASE("serve: pause holds the frame, resume goes on, reset starts frame 0 an
 
 namespace {
 
+/// Sends `sig` to the server and waits for it to end, polling every 5 ms for at most `limit`;
+/// returns the exit code (-1: killed by a signal, or still running at `limit`: then SIGKILLed)
+/// and the seconds it took.
+std::pair<int, double> signalAndTime(Server& s, int sig, std::chrono::milliseconds limit = 20000ms) {
+  const auto t0 = std::chrono::steady_clock::now();
+  ::kill(s.pid, sig);
+  int st = 0;
+  bool ended = false;
+  while (!(ended = ::waitpid(s.pid, &st, WNOHANG) == s.pid) && std::chrono::steady_clock::now() - t0 < limit)
+    std::this_thread::sleep_for(5ms);
+  const double took = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  if (!ended) {
+    ::kill(s.pid, SIGKILL);
+    ::waitpid(s.pid, &st, 0);
+  }
+  s.pid = -1;
+  return {ended && WIFEXITED(st) ? WEXITSTATUS(st) : -1, took};
+}
+
 /// The frame the server's loop reached (GET /state; -1 when it does not answer).
 std::int64_t frameOf(const Server& s) { return s.state().value("frame", std::int64_t(-1)); }
 
@@ -389,6 +408,52 @@ TEST_CASE("serve: particles per second and in all are capped: 429 with Retry-Aft
   CHECK(over.body.find("more than the 1400 live input may bring it to (--max-particles") != std::string::npos);
   CHECK(s.state().value("particles", std::size_t(0)) == 1382);
   CHECK(s.stop() == 130);
+}
+
+TEST_CASE("serve: SIGTERM and SIGINT inside a step of many seconds end it with exit 130 within a second") {
+  // Before: the signal only set the loop's flag, read between frames, and a frame of a million
+  // particles spread over 40 km (the grid cannot keep small cells) takes many seconds.
+  // The caps are raised here on purpose to let the block in.
+  for (const int sig : {SIGTERM, SIGINT}) {
+    CAPTURE(sig);
+    const std::string dir = scratch("serve_long_step");
+    Server s(kScene, {"--threads", "1", "--max-event-particles", "1000000", "--max-particles-per-second", "1000000",
+                      "--max-particles", "1100000"}, dir + "/serve.log");
+    REQUIRE_MESSAGE(s.port > 0, slurp(s.log));
+    REQUIRE(waitFor([&] { return frameOf(s) >= 0; }));
+    CHECK(s.post(R"({"type":"block","min":[-20000,-1000],"max":[20000,-999.95]})").status == 200);
+    REQUIRE(waitFor([&] { return s.state().value("applied", 0) == 1; }));
+    // Inside the long step: the frame does not move.
+    const std::int64_t f = frameOf(s);
+    std::this_thread::sleep_for(1500ms);
+    CHECK(frameOf(s) <= f + 1);
+    const auto [code, took] = signalAndTime(s, sig);
+    const std::string log = slurp(s.log);
+    MESSAGE("signal " << sig << ": exit " << code << " after " << 1e3 * took << " ms");
+    INFO(log);
+    CHECK(code == 130);
+    CHECK(took < 1.0);
+    CHECK(log.find("sph2d serve: stopped after") != std::string::npos);  // the loop's own end, not the watchdog's
+  }
+}
+
+TEST_CASE("serve: SIGTERM during a long set-up (a 100k-vertex chain) ends it with exit 130 within a second") {
+  // Before: serve's handler only set the loop's flag; building the World went on for tens of seconds.
+  const std::string dir = scratch("serve_long_setup");
+  nlohmann::json scene = nlohmann::json::parse(slurp(kScene));
+  nlohmann::json chain = {{"shape", "chain"}, {"vertices", nlohmann::json::array()}};
+  for (int k = 0; k < 100000; ++k) chain["vertices"].push_back({0.01 * k, 0.05 * std::sin(0.3 * k) - 1.0});
+  scene["boundaries"][0]["fixtures"].push_back(chain);
+  std::ofstream(dir + "/long_chain.json") << scene.dump();
+  Server s(dir + "/long_chain.json", {"--threads", "1"}, dir + "/serve.log");
+  REQUIRE_MESSAGE(s.port > 0, slurp(s.log));
+  std::this_thread::sleep_for(700ms);  // inside the World's construction (tens of seconds)
+  REQUIRE(frameOf(s) < 0);             // no frame yet
+  const auto [code, took] = signalAndTime(s, SIGTERM);
+  MESSAGE("exit " << code << " after " << 1e3 * took << " ms");
+  INFO(slurp(s.log));
+  CHECK(code == 130);
+  CHECK(took < 1.0);
 }
 
 TEST_CASE("serve: command-line errors name the option and what it allows") {
