@@ -164,7 +164,7 @@ TEST_CASE("output folder: symbolic links are never written through: a frame or l
   CHECK(fs::is_symlink(dir + "/.sph2d.lock"));
 }
 
-TEST_CASE("output folder: --record and --video replace no file sph2d did not write; in the run's folder, its own are replaced") {
+TEST_CASE("output folder: --record and --video replace no file sph2d did not write, and in the run's folder its own are replaced") {
   const std::string dir = freshDir("of_record"), elsewhere = freshDir("of_record_elsewhere");
   // Outside any output folder, an existing record file has no record that could vouch for it.
   write(elsewhere + "/mine.jsonl", "my own notes\n");
