@@ -11,7 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "app_util.hpp"
-#include "frame_clock.hpp"
+#include "loop/frame_clock.hpp"
 
 using namespace sph2d;
 using namespace sph2d::apptest;

@@ -1,4 +1,4 @@
-// The manifest reader (app/manifest_reader.cpp) on its own: a manifest is input from
+// The manifest reader (app/output/manifest_reader.cpp) on its own: a manifest is input from
 // elsewhere, so every value is read with its type and range, a refusal names the file
 // and the key, and nothing it says sizes an allocation. The same reader runs under the
 // fuzz target (tests/fuzz/fuzz_scene.cpp).
@@ -11,7 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli.hpp"
-#include "manifest_reader.hpp"
+#include "output/manifest_reader.hpp"
 
 using json = nlohmann::ordered_json;
 using namespace sph2d::cli;

@@ -29,7 +29,7 @@
 #include <string>
 
 #include "cli.hpp"
-#include "manifest_reader.hpp"
+#include "output/manifest_reader.hpp"
 #include "sph2d/render/render_env.hpp"
 
 #include "sph2d/events.hpp"

@@ -1,5 +1,5 @@
 // tests/serve/serve_fixture.hpp — starts a real `sph2d serve` on a free port for the serve
-// and browser tests, talks to it (app/serve_client.hpp: Boost.Beast) and stops it.
+// and browser tests, talks to it (app/serve/serve_client.hpp: Boost.Beast) and stops it.
 //
 // Design: the server is the real executable on a real socket (--port 0: the kernel picks a
 // free port, which the server prints on its first line); tests wait for conditions with
@@ -23,7 +23,7 @@
 #include <doctest/doctest.h>
 
 #include "app/app_runner.hpp"
-#include "serve_client.hpp"
+#include "serve/serve_client.hpp"
 #include "sph2d/render/png_io.hpp"
 
 namespace sph2d::servetest {

@@ -1,6 +1,6 @@
 // tests/support/taylor_green.hpp — the Taylor–Green vortex at Re = 100 against
 // assets/reference/taylor_green_decay.csv, shared by the wcsph and dfsph tests
-// (tests/engine/solvers/). Uses the app's validation runner (app/validation.hpp).
+// (tests/engine/solvers/). Uses the app's validation runner (app/bench/validation.hpp).
 #pragma once
 
 #include <doctest/doctest.h>
@@ -10,7 +10,7 @@
 
 #include "sph2d/scene.hpp"
 #include "test_util.hpp"
-#include "validation.hpp"
+#include "bench/validation.hpp"
 
 namespace sph2d::test {
 

@@ -8,7 +8,7 @@
 // the same states bit for bit (what `sph2d run --record` / `--input` rely on). A game
 // that wants a scene's timeline played calls TimelinePlayer::stepFrame instead of
 // World::stepFrame; the app's loop uses the schedule and the applier directly, adding
-// events files and live input (app/events.hpp).
+// events files and live input (app/loop/input_events.hpp).
 #pragma once
 
 #include <cstdint>

@@ -8,7 +8,7 @@
 #include "sph2d/world.hpp"
 #include "support/fixture.hpp"
 #include "support/taylor_green.hpp"
-#include "validation.hpp"
+#include "bench/validation.hpp"
 
 using namespace sph2d;
 using test::boxShape;

@@ -12,7 +12,7 @@
 
 #include "sph2d/world.hpp"
 #include "support/fixture.hpp"
-#include "validation.hpp"
+#include "bench/validation.hpp"
 
 using namespace sph2d;
 using test::boxShape;

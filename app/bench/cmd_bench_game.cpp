@@ -1,0 +1,349 @@
+// `sph2d bench game`: the game end of the accuracy/cost trade-off (issue 15).
+// Runs the default dam break (a 1 m × 2 m column in a 4 m × 3 m tank) at N
+// particles for each quality preset and thread count, frame by frame as a
+// game does, and reports what a game developer asks of it: wall seconds per
+// simulated second, substeps and pressure iterations per frame, the worst
+// mean and single-particle compression over the frames, the largest gain of
+// kinetic plus potential energy over the initial, particles outside the tank,
+// and the surge front against Martin & Moyce 1952. With --peer it runs the
+// LiquidFun harness (benchmarks/peers/liquidfun) on the same dam break in the
+// same invocation and prints sph2d's time as a ratio of the peer's.
+//
+// A benchmark, not a test: rerun it, and compare figures as ratios within one
+// run (the machines are shared and noisy).
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <map>
+#include <memory>
+#include <sstream>
+#include <string>
+
+#include "cli.hpp"
+#include "commands.hpp"
+#include "core/kernels.hpp"
+#include "sph2d/render/particle_export.hpp"
+#include "sph2d/scene.hpp"
+#include "sph2d/world.hpp"
+#include "bench/validation.hpp"
+
+namespace sph2d::cli {
+namespace {
+
+const char* kHelp =
+    "Usage: sph2d bench game [--particles N] [--threads T[,T...]] [--seconds S] [--presets P[,P...]]\n"
+    "                        [--set KEY=VALUE]... [--peer [PATH]] [--csv FILE] [--assets DIR]\n"
+    "\n"
+    "The default dam break (assets/scenes/dam_break.json: a 1 m x 2 m column in a 4 m x 3 m\n"
+    "tank) with the spacing set so the column holds about N particles (default 20000), for S\n"
+    "simulated seconds (default 4), once per quality preset P (default game,balanced,accurate)\n"
+    "and thread count T (default 1,2). Each run prints: wall seconds per simulated second,\n"
+    "substeps and pressure iterations per frame, the worst per-frame mean compression and the\n"
+    "worst single-particle compression, the largest gain of kinetic plus potential energy over\n"
+    "the initial (a fraction of it), the most particles outside the tank in any frame, the RMS\n"
+    "of the surge front Z = x/a against Martin & Moyce 1952, and the compression and surface\n"
+    "height at the end measured from positions alone (as for the peer).\n"
+    "--set KEY=VALUE changes the solver of every run: a shared key (viscosity, support_ratio,\n"
+    "cfl, max_substeps) or one of the preset solver's own parameters.\n"
+    "--peer runs the LiquidFun harness (lf_dam_break: cmake -DSPH2D_PEER_LIQUIDFUN=ON, target\n"
+    "lf_dam_break; benchmarks/peers/liquidfun) on the same dam break, with its default iterations\n"
+    "and with --static, and prints the ratio of each sph2d run's time to the peer's; --peer PATH\n"
+    "runs the harness at PATH instead.\n"
+    "--csv FILE writes one row per run (fractions, not percent).\n";
+
+struct Row {
+  std::string name;
+  std::size_t particles = 0;
+  int threads = 1;
+  double wallPerSim = NAN, substepsPerFrame = NAN, iterationsPerFrame = NAN;
+  double meanCompression = NAN, maxCompression = NAN, energyGain = NAN, surgeRms = NAN;
+  double outside = NAN, endCompression = NAN, endSurface = NAN;
+};
+
+/// Positions-only measures of a final state, the same for sph2d and the peer:
+/// the mean compression max(ρ/ρ0 − 1, 0) with ρ summed by Wendland C2 of
+/// support 2.5 dx, the mass calibrated so a square lattice of spacing dx has
+/// ρ0 (the tank's walls are not counted: wall rows read low, for both), and the
+/// mean height of the free surface over x in [0.5, 3.5] (highest particle per
+/// 5 cm bin, as the peer harness measures it).
+void endMeasures(const std::vector<Vec2d>& pos, double dx, double& compression, double& surface) {
+  const double R = 2.5 * dx;
+  const WendlandC2<double> W(R);
+  double lattice = 0;
+  const int n = int(std::ceil(R / dx)) + 1;
+  for (int j = -n; j <= n; ++j)
+    for (int i = -n; i <= n; ++i) lattice += W.value(std::sqrt(double(i * i + j * j)) * dx);
+  // A uniform grid of cells of size R over the points.
+  std::map<std::pair<long, long>, std::vector<std::size_t>> cells;
+  for (std::size_t k = 0; k < pos.size(); ++k)
+    cells[{long(std::floor(pos[k].x() / R)), long(std::floor(pos[k].y() / R))}].push_back(k);
+  double sum = 0;
+  for (std::size_t k = 0; k < pos.size(); ++k) {
+    const long cx = long(std::floor(pos[k].x() / R)), cy = long(std::floor(pos[k].y() / R));
+    double s = 0;
+    for (long dy = -1; dy <= 1; ++dy)
+      for (long dxc = -1; dxc <= 1; ++dxc) {
+        auto it = cells.find({cx + dxc, cy + dy});
+        if (it == cells.end()) continue;
+        for (std::size_t j : it->second) s += W.value((pos[k] - pos[j]).norm());
+      }
+    sum += std::max(0.0, s / lattice - 1);
+  }
+  compression = pos.empty() ? 0 : sum / double(pos.size());
+  std::map<int, double> top;
+  for (const Vec2d& p : pos)
+    if (p.x() >= 0.5 && p.x() < 3.5) {
+      const int b = int((p.x() - 0.5) / 0.05);
+      auto it = top.find(b);
+      if (it == top.end() || it->second < p.y()) top[b] = p.y();
+    }
+  surface = 0;
+  for (const auto& kv : top) surface += kv.second;
+  surface = top.empty() ? 0 : surface / double(top.size());
+}
+
+Row runSph2d(const SceneDef& base, const std::string& preset, int threads, double seconds,
+             const std::vector<std::vector<double>>& surgeTable) {
+  SceneDef s = base;
+  Row r;
+  r.name = "sph2d_" + preset;
+  r.threads = threads;
+  World w(s, WorldOptions{threads});
+  w.takeWarnings();
+  r.particles = w.particleCount();
+  const double g = 9.81, m = double(w.particleMass()), a = 1.0;
+  auto energy = [&] {
+    double e = w.kineticEnergy();
+    for (std::size_t i = 0; i < w.particleCount(); ++i) e += m * g * w.worldPosition(i).y();
+    return e;
+  };
+  auto front = [&] {
+    double f = 0;
+    for (std::size_t i = 0; i < w.particleCount(); ++i) f = std::max(f, w.worldPosition(i).x());
+    return f;
+  };
+  const double e0 = energy();
+  std::vector<double> times = {0}, fronts = {front()};
+  const int frames = int(std::lround(seconds * s.fps));
+  double wall = 0, worstMean = 0, worstMax = 0, gain = 0, outside = 0;
+  const std::uint64_t it0 = w.solverIterations();
+  for (int f = 0; f < frames; ++f) {
+    const auto t0 = std::chrono::steady_clock::now();
+    w.stepFrame();
+    wall += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    const DensityStats d = w.densityStats();
+    worstMean = std::max(worstMean, d.meanError);
+    worstMax = std::max(worstMax, d.maxError);
+    gain = std::max(gain, (energy() - e0) / e0);
+    double out = 0;
+    for (std::size_t i = 0; i < w.particleCount(); ++i) {
+      const Vec2d p = w.worldPosition(i);
+      out += !(p.x() >= 0 && p.x() <= 4 && p.y() >= 0 && p.y() <= 3);
+    }
+    outside = std::max(outside, out);
+    times.push_back(w.time());
+    fronts.push_back(front());
+  }
+  r.wallPerSim = wall / w.time();
+  r.substepsPerFrame = double(w.substeps()) / frames;
+  r.iterationsPerFrame = double(w.solverIterations() - it0) / frames;
+  r.meanCompression = worstMean;
+  r.maxCompression = worstMax;
+  r.energyGain = gain;
+  r.outside = outside;
+  // Surge front over the table's times within the run (the front reaches the far wall at T ≈ 3.4).
+  double se = 0;
+  int n = 0;
+  for (const auto& row : surgeTable) {
+    const double t = row[0] / std::sqrt(2 * g / a);
+    if (t > times.back() || row[1] >= 4.0 - 1e-9) continue;
+    std::size_t k = 1;
+    while (k + 1 < times.size() && times[k] < t) ++k;
+    const double u = (t - times[k - 1]) / (times[k] - times[k - 1]);
+    const double x = fronts[k - 1] + u * (fronts[k] - fronts[k - 1]);
+    se += (x / a - row[1]) * (x / a - row[1]);
+    ++n;
+  }
+  r.surgeRms = n ? std::sqrt(se / n) : NAN;
+  std::vector<Vec2d> pos;
+  for (std::size_t i = 0; i < w.particleCount(); ++i) pos.push_back(w.worldPosition(i));
+  endMeasures(pos, s.solver.spacing, r.endCompression, r.endSurface);
+  return r;
+}
+
+/// Runs the LiquidFun harness and parses its summary line; false when it cannot run.
+bool runPeer(const std::string& exe, double spacing, double seconds, bool stat, Row& r) {
+  const std::string csv = "/tmp/sph2d_bench_game_peer_" + std::to_string(::getpid()) + ".csv";
+  const std::string cmd = "'" + exe + "' --spacing " + std::to_string(spacing) + " --seconds " + std::to_string(seconds) +
+                          (stat ? " --static" : "") + " --csv '" + csv + "' 2>&1";
+  FILE* p = ::popen(cmd.c_str(), "r");
+  if (!p) return false;
+  std::string out;
+  char buf[512];
+  while (std::fgets(buf, sizeof buf, p)) out += buf;
+  const int rc = ::pclose(p);
+  int particles = 0;
+  double wps = NAN;
+  const auto at = out.find("liquidfun: ");
+  if (rc != 0 || at == std::string::npos ||
+      std::sscanf(out.c_str() + at, "liquidfun: %d particles", &particles) != 1)
+    throw std::runtime_error("the peer " + exe + " failed: " + out);
+  const auto w = out.find(" wall s per simulated s");
+  if (w != std::string::npos) {
+    const std::size_t b = out.rfind(", ", w);
+    if (b != std::string::npos) wps = std::atof(out.c_str() + b + 2);
+  }
+  if (!(wps > 0)) throw std::runtime_error("the peer " + exe + " printed no wall time per simulated second: " + out);
+  r.name = stat ? "liquidfun_static" : "liquidfun";
+  r.particles = std::size_t(particles);
+  r.threads = 1;
+  r.wallPerSim = wps;
+  r.substepsPerFrame = NAN;
+  std::vector<Vec2d> pos;
+  std::ifstream in(csv);
+  std::string line;
+  std::getline(in, line);
+  while (std::getline(in, line)) {
+    double x, y;
+    if (std::sscanf(line.c_str(), "%lf,%lf", &x, &y) == 2) pos.emplace_back(x, y);
+  }
+  std::remove(csv.c_str());
+  endMeasures(pos, spacing, r.endCompression, r.endSurface);
+  return true;
+}
+
+std::string fmt(double v, const char* f) {
+  if (std::isnan(v)) return "-";
+  char b[64];
+  std::snprintf(b, sizeof b, f, v);
+  return b;
+}
+
+/// Applies KEY=VALUE to a solver definition (a shared key or a solver parameter).
+void applySet(SolverDef& d, const std::string& kv) {
+  const auto eq = kv.find('=');
+  if (eq == std::string::npos) throw UsageError("--set expects KEY=VALUE, got '" + kv + "'");
+  const std::string k = kv.substr(0, eq);
+  const double v = parseNumber("--set " + k, kv.substr(eq + 1));
+  if (k == "viscosity") d.viscosity = v;
+  else if (k == "support_ratio") d.supportRatio = v;
+  else if (k == "cfl") d.cfl = v;
+  else if (k == "max_substeps") d.maxSubsteps = int(v);
+  else if (d.params.count(k)) d.params[k] = v;
+  else {
+    std::string keys = "viscosity, support_ratio, cfl, max_substeps";
+    for (const auto& p : d.params) keys += ", " + p.first;
+    throw UsageError("--set: '" + k + "' is not a key of the " + d.type + " solver; keys: " + keys);
+  }
+}
+
+}  // namespace
+
+int cmdBenchGame(const std::vector<std::string>& args) {
+  int particles = 20000;
+  std::vector<int> threads = {1, 2};
+  double seconds = 4;
+  std::vector<std::string> presets = {"game", "balanced", "accurate"}, sets;
+  std::string peer, csvPath, assetsPath = "assets";
+  for (std::size_t i = 0; i < args.size(); ++i) {
+    const std::string& a = args[i];
+    auto value = [&]() -> std::string {
+      if (i + 1 >= args.size()) throw UsageError(a + " needs a value");
+      return args[++i];
+    };
+    if (a == "--help" || a == "-h") {
+      std::fputs(kHelp, stdout);
+      return 0;
+    } else if (a == "--particles") particles = parseInt(a, value(), 100, 50000000);
+    else if (a == "--threads") threads = parseIntList(a, value(), 1, 256);
+    else if (a == "--seconds") {
+      seconds = parseNumber(a, value());
+      // At least one frame of 1/60 s, so that every figure measures something.
+      if (!(seconds >= 1.0 / 60 && seconds <= 60)) throw UsageError("--seconds must be in [1/60, 60]");
+    } else if (a == "--presets") {
+      presets = splitList(value());
+      for (const std::string& p : presets)
+        if (p != "game" && p != "balanced" && p != "accurate")
+          throw UsageError("--presets: unknown preset '" + p + "'; presets: game, balanced, accurate");
+      if (presets.empty()) throw UsageError("--presets needs at least one preset");
+    } else if (a == "--set") sets.push_back(value());
+    else if (a == "--peer") {
+      // `--peer` alone: the harness this build tree builds (-DSPH2D_PEER_LIQUIDFUN=ON); `--peer PATH`: that one.
+      peer = i + 1 < args.size() && args[i + 1].rfind("--", 0) != 0 ? args[++i] : std::string(SPH2D_PEER_EXE);
+    }
+    else if (a == "--assets") assetsPath = value();
+    else if (a == "--csv") csvPath = value();
+    else throw UsageError("unknown option '" + a + "' (see sph2d bench game --help)");
+  }
+  if (peer.find('\'') != std::string::npos)  // it goes into a shell command between single quotes
+    throw UsageError("--peer " + peer + ": a path with a single quote is not accepted");
+  if (!peer.empty() && ::access(peer.c_str(), X_OK) != 0)
+    throw UsageError("--peer " + peer +
+                     ": not an executable (build the peer: cmake -S . -B build -DSPH2D_PEER_LIQUIDFUN=ON && "
+                     "cmake --build build --target lf_dam_break; benchmarks/peers/liquidfun/README.md)");
+  const std::string assets = assetsPath;
+  const SceneDef scene = loadScene(assets + "/scenes/dam_break.json");
+  const auto surge = validation::readReferenceCsv(assets + "/reference/martin_moyce_1952_surge_front.csv");
+  const double spacing = std::sqrt(2.0 / double(particles));
+  std::printf("bench game: dam break, 1 m x 2 m column, spacing %.4g m, %g simulated s, one stepFrame of 1/%g s per frame\n",
+              spacing, seconds, scene.fps);
+  std::printf("%-18s %9s %3s %9s %8s %8s %8s %8s %8s %7s %8s %5s %8s %8s\n", "run", "particles", "thr", "wall/sim",
+              "vs peer", "substp/f", "iter/f", "mean cmp", "max cmp", "E gain", "surge", "out", "end cmp", "surface");
+  std::fflush(stdout);
+  std::vector<Row> rows;
+  double peerTime = NAN;
+  auto print = [&](const Row& r) {
+    std::printf("%-18s %9zu %3d %9s %8s %8s %8s %8s %8s %7s %8s %5s %8s %8s\n", r.name.c_str(), r.particles, r.threads,
+                fmt(r.wallPerSim, "%.3f").c_str(), fmt(r.wallPerSim / peerTime, "%.2fx").c_str(),
+                fmt(r.substepsPerFrame, "%.2f").c_str(), fmt(r.iterationsPerFrame, "%.1f").c_str(),
+                fmt(100 * r.meanCompression, "%.2f%%").c_str(), fmt(100 * r.maxCompression, "%.1f%%").c_str(),
+                fmt(100 * r.energyGain, "%.2f%%").c_str(), fmt(r.surgeRms, "%.3f").c_str(), fmt(r.outside, "%.0f").c_str(),
+                fmt(100 * r.endCompression, "%.2f%%").c_str(), fmt(r.endSurface, "%.3f").c_str());
+    std::fflush(stdout);
+  };
+  if (!peer.empty()) {
+    for (bool stat : {false, true}) {
+      Row r;
+      runPeer(peer, spacing, seconds, stat, r);
+      if (stat) peerTime = r.wallPerSim;
+      rows.push_back(r);
+    }
+    for (const Row& r : rows) print(r);
+  }
+  for (const std::string& preset : presets) {
+    SceneDef s = scene;
+    s.solver = qualityPreset(preset);
+    s.solver.spacing = spacing;
+    for (const std::string& kv : sets) applySet(s.solver, kv);
+    s.maxParticles = std::size_t(particles) * 2 + 1000;
+    for (int t : threads) {
+      Row r = runSph2d(s, preset, t, seconds, surge);
+      rows.push_back(r);
+      print(r);
+    }
+  }
+  if (!peer.empty())
+    std::printf("vs peer: sph2d's wall time per simulated second over LiquidFun --static's (%.3f s/s), measured in this run\n",
+                peerTime);
+  if (!csvPath.empty()) {
+    std::ostringstream o;
+    o << "name,particles,threads,wall_s_per_sim_s,ratio_to_peer,substeps_per_frame,iterations_per_frame,mean_compression,"
+         "max_compression,energy_gain,surge_rms,outside,end_compression,end_surface_m\n";
+    auto v = [](double x) { return std::isnan(x) ? std::string("") : fmt(x, "%.6g"); };
+    for (const Row& r : rows)
+      o << r.name << ',' << r.particles << ',' << r.threads << ',' << v(r.wallPerSim) << ',' << v(r.wallPerSim / peerTime) << ','
+        << v(r.substepsPerFrame) << ',' << v(r.iterationsPerFrame) << ',' << v(r.meanCompression) << ','
+        << v(r.maxCompression) << ',' << v(r.energyGain) << ',' << v(r.surgeRms) << ',' << v(r.outside) << ','
+        << v(r.endCompression) << ',' << v(r.endSurface) << '\n';
+    writeFileAtomic(csvPath, o.str());
+    std::printf("wrote %s\n", csvPath.c_str());
+  }
+  return 0;
+}
+
+}  // namespace sph2d::cli
