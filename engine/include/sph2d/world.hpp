@@ -534,127 +534,60 @@ class World {
   /// set or an effect is switched.
   std::vector<std::string> stages() const;
 
-  // b2Vec2 overloads: a game passes its Box2D vectors as they are, with no conversion at the call;
-  // each does exactly what the Vec2d call of the same name does. Templates on the type (only
-  // b2Vec2 qualifies), so a braced pair {x, y} still picks the Vec2d call unambiguously. The
-  // structs' Vec2d fields (EmitterDef, UserForce, FluidBlockDef) take a b2Vec2 as it is: Vec2d
-  // converts from one (math.hpp).
+  // b2Vec2 overloads (defined in sph2d/world_b2vec2.hpp): a game passes its Box2D vectors as
+  // they are; each does exactly what the Vec2d call of the same name does. Templates on the type
+  // (only b2Vec2 qualifies), so a braced pair {x, y} still picks the Vec2d call. The structs'
+  // Vec2d fields take a b2Vec2 as it is: Vec2d converts from one (math.hpp).
   template <class T>
   using IfB2 = std::enable_if_t<std::is_same<T, b2Vec2>::value, int>;
-  /// setGravity with a b2Vec2.
   template <class B2, IfB2<B2> = 0>
-  void setGravity(const B2& g) { setGravity(Vec2d(g.x, g.y)); }
-  /// addDrop with b2Vec2 centre and velocity.
+  void setGravity(const B2& g);
   template <class B2, IfB2<B2> = 0>
-  IdRange addDrop(const B2& center, double radius, const B2& velocity) {
-    return addDrop(Vec2d(center.x, center.y), radius, Vec2d(velocity.x, velocity.y));
-  }
-  /// addDrop at rest about a b2Vec2 centre.
+  IdRange addDrop(const B2& center, double radius, const B2& velocity);
   template <class B2, IfB2<B2> = 0>
-  IdRange addDrop(const B2& center, double radius) {
-    return addDrop(Vec2d(center.x, center.y), radius);
-  }
-  /// worldPosition as a b2Vec2: `worldPosition<b2Vec2>(i)` (floats of the double position).
+  IdRange addDrop(const B2& center, double radius);
   template <class B2, IfB2<B2> = 0>
-  B2 worldPosition(std::size_t i) const {
-    const Vec2d p = worldPosition(i);
-    return B2(float(p.x()), float(p.y()));
-  }
-  /// getParticle into b2Vec2s (world coordinates).
+  B2 worldPosition(std::size_t i) const;
   template <class B2, IfB2<B2> = 0>
-  bool getParticle(std::uint32_t id, B2& position, B2& velocity) const {
-    Vec2d p, v;
-    if (!getParticle(id, p, v)) return false;
-    position.Set(float(p.x()), float(p.y()));
-    velocity.Set(float(v.x()), float(v.y()));
-    return true;
-  }
-  /// setParticle with b2Vec2s.
+  bool getParticle(std::uint32_t id, B2& position, B2& velocity) const;
   template <class B2, IfB2<B2> = 0>
-  bool setParticle(std::uint32_t id, const B2& position, const B2& velocity) {
-    return setParticle(id, Vec2d(position.x, position.y), Vec2d(velocity.x, velocity.y));
-  }
-  /// setParticleVelocity with a b2Vec2.
+  bool setParticle(std::uint32_t id, const B2& position, const B2& velocity);
   template <class B2, IfB2<B2> = 0>
-  bool setParticleVelocity(std::uint32_t id, const B2& velocity) {
-    return setParticleVelocity(id, Vec2d(velocity.x, velocity.y));
-  }
-  /// addParticles at b2Vec2 points (velocities empty: at rest).
+  bool setParticleVelocity(std::uint32_t id, const B2& velocity);
   template <class B2, IfB2<B2> = 0>
-  IdRange addParticles(const std::vector<B2>& points, const std::vector<B2>& velocities) {
-    return addParticles(toVec2d(points), toVec2d(velocities));
-  }
-  /// addParticles at rest at b2Vec2 points.
+  IdRange addParticles(const std::vector<B2>& points, const std::vector<B2>& velocities);
   template <class B2, IfB2<B2> = 0>
-  IdRange addParticles(const std::vector<B2>& points) {
-    return addParticles(toVec2d(points));
-  }
-  /// particlesInRadius about a b2Vec2.
+  IdRange addParticles(const std::vector<B2>& points);
   template <class B2, IfB2<B2> = 0>
-  std::vector<std::size_t> particlesInRadius(const B2& center, double radius) const {
-    return particlesInRadius(Vec2d(center.x, center.y), radius);
-  }
-  /// particlesInBox between b2Vec2 corners.
+  std::vector<std::size_t> particlesInRadius(const B2& center, double radius) const;
   template <class B2, IfB2<B2> = 0>
-  std::vector<std::size_t> particlesInBox(const B2& lo, const B2& hi) const {
-    return particlesInBox(Vec2d(lo.x, lo.y), Vec2d(hi.x, hi.y));
-  }
-  /// sampleAt a b2Vec2.
+  std::vector<std::size_t> particlesInBox(const B2& lo, const B2& hi) const;
   template <class B2, IfB2<B2> = 0>
-  FieldSample sampleAt(const B2& point) const { return sampleAt(Vec2d(point.x, point.y)); }
-  /// moveEmitter with b2Vec2 position and direction.
+  FieldSample sampleAt(const B2& point) const;
   template <class B2, IfB2<B2> = 0>
-  void moveEmitter(std::size_t index, const B2& position, const B2& direction) {
-    moveEmitter(index, Vec2d(position.x, position.y), Vec2d(direction.x, direction.y));
-  }
-  /// removeParticlesInBox between b2Vec2 corners.
+  void moveEmitter(std::size_t index, const B2& position, const B2& direction);
   template <class B2, IfB2<B2> = 0>
-  std::vector<std::uint32_t> removeParticlesInBox(const B2& lo, const B2& hi) {
-    return removeParticlesInBox(Vec2d(lo.x, lo.y), Vec2d(hi.x, hi.y));
-  }
-  /// addShape moving at a b2Vec2 velocity.
+  std::vector<std::uint32_t> removeParticlesInBox(const B2& lo, const B2& hi);
   template <class B2, IfB2<B2> = 0>
-  IdRange addShape(const b2Shape& shape, const b2Transform& xf, const B2& velocity) {
-    return addShape(shape, xf, Vec2d(velocity.x, velocity.y));
-  }
-  /// setVelocities from b2Vec2s.
+  IdRange addShape(const b2Shape& shape, const b2Transform& xf, const B2& velocity);
   template <class B2, IfB2<B2> = 0>
-  std::size_t setVelocities(const std::vector<std::uint32_t>& ids, const std::vector<B2>& velocities) {
-    return setVelocities(ids, toVec2d(velocities));
-  }
-  /// setPositions from b2Vec2s (world coordinates).
+  std::size_t setVelocities(const std::vector<std::uint32_t>& ids, const std::vector<B2>& velocities);
   template <class B2, IfB2<B2> = 0>
-  std::size_t setPositions(const std::vector<std::uint32_t>& ids, const std::vector<B2>& positions) {
-    return setPositions(ids, toVec2d(positions));
-  }
-  /// getParticles into b2Vec2s (world coordinates; an id no particle has gets NaN in both).
+  std::size_t setPositions(const std::vector<std::uint32_t>& ids, const std::vector<B2>& positions);
   template <class B2, IfB2<B2> = 0>
   std::size_t getParticles(const std::vector<std::uint32_t>& ids, std::vector<B2>& positions,
-                           std::vector<B2>& velocities) const {
-    std::vector<Vec2d> p, v;
-    const std::size_t found = getParticles(ids, p, v);
-    positions.resize(p.size());
-    velocities.resize(v.size());
-    for (std::size_t k = 0; k < p.size(); ++k) {
-      positions[k].Set(float(p[k].x()), float(p[k].y()));
-      velocities[k].Set(float(v[k].x()), float(v[k].y()));
-    }
-    return found;
-  }
+                           std::vector<B2>& velocities) const;
 
   struct Impl;
 
  private:
   template <class B2>
-  static std::vector<Vec2d> toVec2d(const std::vector<B2>& in) {
-    std::vector<Vec2d> out;
-    out.reserve(in.size());
-    for (const B2& q : in) out.emplace_back(q.x, q.y);
-    return out;
-  }
+  static std::vector<Vec2d> toVec2d(const std::vector<B2>& in);
   void init();
   void initPhases(std::string& phase);
   std::unique_ptr<Impl> impl_;
 };
 
 }  // namespace sph2d
+
+#include "sph2d/world_b2vec2.hpp"
