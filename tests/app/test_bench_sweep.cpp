@@ -215,3 +215,46 @@ TEST_CASE("bench accuracy surge_long: one row per floor, both errors measured, e
   CHECK(errors.size() > 1);  // the floor changes the front
   CHECK(std::filesystem::file_size(dir + "/surge_long.png") > 1000);
 }
+
+TEST_CASE("bench game: --list run by parallel -j2 and merged gives the one-process CSV, wall times apart, --only checks ids") {
+  requireParallel();
+  const std::string dir = freshDir("sweep_game");
+  const std::string sweep = "bench game --particles 600 --seconds 0.25 --presets game --threads 1,2 --floors scene,noslip --assets " +
+                            q(std::string(SPH2D_ASSETS));
+  const Result one = run(sweep + " --out " + q(dir + "/one"));
+  INFO(one.out);
+  REQUIRE(one.code == 0);
+  const Result listed = run(sweep + " --list --out " + q(dir + "/runs"));
+  REQUIRE(listed.code == 0);
+  const std::vector<std::string> commands = lines(listed.out, " bench game --only ");
+  REQUIRE(commands.size() == 4);
+  CHECK(commands[0].find("--only game-600-t1 ") != std::string::npos);
+  CHECK(commands[3].find("--only game-600-t2-noslip ") != std::string::npos);
+  {
+    std::ofstream f(dir + "/commands.txt");
+    for (const std::string& c : commands) f << c << "\n";
+  }
+  const Result par = runShell("parallel -j2 < " + q(dir + "/commands.txt"));
+  INFO(par.out);
+  REQUIRE(par.code == 0);
+  const Result merged = run("bench game --merge " + q(dir + "/runs") + " --out " + q(dir + "/merged"));
+  INFO(merged.out);
+  REQUIRE(merged.code == 0);
+  const Table a = readTable(dir + "/one/game.csv"), b = readTable(dir + "/merged/game.csv");
+  REQUIRE(a.rows.size() == 4);
+  checkSameRows(a, b, {"wall_s_per_sim_s", "ratio_to_peer"});
+  // The floor is applied: no-slip walls change the flow (the game solver takes no Coulomb friction).
+  CHECK(a.rows[2][0] == "game-600-t1-noslip");
+  bool differs = false;
+  for (const char* c : {"surge_rms", "max_compression", "end_surface_m"})
+    differs = differs || a.rows[0][std::size_t(a.col(c))] != a.rows[2][std::size_t(a.col(c))];
+  CHECK(differs);
+
+  const Result bad = run("bench game --only game-600-x2 --out " + q(dir + "/bad"));
+  CHECK(bad.code == 2);
+  CHECK(bad.out.find("--only") != std::string::npos);
+  CHECK(bad.out.find("game-600-x2") != std::string::npos);
+  CHECK(bad.out.find("--list-ids") != std::string::npos);
+  CHECK(run("bench game --only game-600-t1-noslip --presets game").code == 2);
+  CHECK(run("bench game --only liquidfun_static-600").code == 2);  // a peer run needs --peer
+}
