@@ -244,7 +244,7 @@ Spec makeSpec(const Inputs& in, const std::string& caseName, const std::string& 
   p.cfl = setSolver(s, solver, double(cflIndex));
   s.solver.spacing = dx;
   s.solver.maxSubsteps = 100000;
-  if ((caseName == "dam_break" || caseName == "surge_long")) s.maxParticles = 1000000;
+  if (caseName == "dam_break" || caseName == "surge_long") s.maxParticles = 1000000;
   if (solver == "muller2003" && (caseName == "hydrostatic" || caseName == "dam_break" || caseName == "surge_long"))
     s.solver.viscosity = 0.01;
   if (caseName == "poiseuille") {
@@ -542,7 +542,7 @@ int cmdBenchAccuracy(const std::vector<std::string>& args) {
       wrote += std::string(", ") + c + ".png";
     }
   }
-  std::printf("bench accuracy: %zu runs; wrote %s/ %s\n", runs.size(), out.c_str(), wrote.c_str());
+  std::printf("bench accuracy: %zu runs; wrote %s into %s\n", runs.size(), wrote.c_str(), out.c_str());
   return runs.empty() ? 1 : 0;
 }
 
