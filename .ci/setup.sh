@@ -7,7 +7,9 @@
 # libegl-dev + libopengl-dev + libegl-mesa0: tests/egl, the renderer in a game's EGL context
 # (surfaceless Mesa) with gl* from libglvnd; configuring fails without them. libopengl-dev also
 # serves tests/glvnd: the renderer's own OSMesa context with libOpenGL first in the link.
-SPH2D_PACKAGES="g++ cmake make pkg-config libbox2d-dev libosmesa6-dev libpng-dev libeigen3-dev doctest-dev nlohmann-json3-dev clang-14 libclang-rt-14-dev libboost-dev libturbojpeg0-dev chromium libegl-dev libopengl-dev libegl-mesa0"
+# parallel (GNU parallel): the bench tests run `sph2d bench accuracy --list` and `bench game --list`
+# through it and compare the merged report with a one-process run (tests/app/test_bench_sweep.cpp).
+SPH2D_PACKAGES="g++ cmake make pkg-config libbox2d-dev libosmesa6-dev libpng-dev libeigen3-dev doctest-dev nlohmann-json3-dev clang-14 libclang-rt-14-dev libboost-dev libturbojpeg0-dev chromium libegl-dev libopengl-dev libegl-mesa0 parallel"
 
 sph2d_install() {
   local missing=() p sudo=""

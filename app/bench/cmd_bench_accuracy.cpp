@@ -15,24 +15,36 @@
 //                (assets/reference/taylor_green_decay.csv) over 1 s (app/bench/validation.hpp).
 //   poiseuille   start-up flow between plates, periodic in x: RMS of u/u_c against
 //                Morris, Fox & Zhu's series (channel_flow_transient.csv), τ ≤ 0.5.
+//   surge_long   the same column in a 16 m tank for 2 s (T ≈ 8.9): RMS of Z against
+//                Martin & Moyce's long record (Figure 3) over every point and over the
+//                points to T = 3.35, per floor: free-slip, Coulomb friction μ 0.2 / 0.5 / 1
+//                at contact, no-slip (solver.no_slip). Only when named (--cases).
 // The CFL number varied is each solver's own: solver.cfl (muller2003, wcsph),
-// solver.velocity_cfl (dfsph), solver.max_move (pbf).
+// solver.velocity_cfl (dfsph), solver.max_move (pbf, game).
+//
+// Every run has an id (case-solver-particles-cflK[-floor]); --list prints each run as
+// a command of its own (--only ID --out DIR/ID) for a scheduler, and --merge DIR gathers
+// their CSV files into one report (app/bench/sweep.hpp).
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <map>
 #include <optional>
+#include <set>
 #include <sstream>
 #include <string>
 #include <vector>
 
 #include "cli.hpp"
 #include "commands.hpp"
-#include "output/output_dir.hpp"
+#include "bench/accuracy_report.hpp"
+#include "bench/sweep.hpp"
 #include "bench/validation.hpp"
+#include "output/output_dir.hpp"
 #include "sph2d/hash.hpp"
 #include "sph2d/render/image.hpp"
 #include "sph2d/render/particle_export.hpp"
@@ -45,8 +57,12 @@ namespace fs = std::filesystem;
 namespace sph2d::cli {
 namespace {
 
+using namespace accuracy;
+
 const char* kHelp =
-    "Usage: sph2d bench accuracy [--out DIR] [--quick] [--solvers A,B] [--cases A,B] [--threads T] [--assets DIR]\n"
+    "Usage: sph2d bench accuracy [--out DIR] [--quick] [--levels K] [--solvers A,B] [--cases A,B] [--threads T]\n"
+    "                            [--assets DIR] [--list | --list-ids | --only ID[,ID...]]\n"
+    "       sph2d bench accuracy --merge DIR | --from-csv A.csv[,B.csv...] [--allow-mixed] [--out DIR]\n"
     "\n"
     "Runs every solver over the validation cases (hydrostatic tank, dam break against\n"
     "Martin & Moyce 1952, Taylor-Green vortex, start-up Poiseuille flow) at three\n"
@@ -55,40 +71,46 @@ const char* kHelp =
     "DIR/<case>.png (default DIR: out/accuracy). --quick runs one small resolution and one\n"
     "CFL number per solver (a smoke test of a minute or two). --assets: the assets folder\n"
     "(default: ./assets). --levels K runs only the K coarsest resolutions (1..3).\n"
-    "--from-csv A.csv[,B.csv...] runs nothing: it redraws accuracy.csv, accuracy.md and the\n"
-    "charts in DIR from earlier runs' CSV files. --cases hydrostatic,dam_break,taylor_green,\n"
-    "poiseuille runs only those cases (default: all four).\n"
+    "--cases hydrostatic,dam_break,taylor_green,poiseuille,surge_long (or all) runs only those\n"
+    "cases (default: the first four). surge_long: the column in a 16 m tank for 2 s against\n"
+    "Martin & Moyce's long record, per floor (free, mu0.2, mu0.5, mu1, noslip), at the first\n"
+    "CFL number and the two coarsest resolutions only.\n"
+    "\n"
+    "One run at a time, for a scheduler (GNU parallel, Slurm, a CI matrix; docs/ACCURACY.md):\n"
+    "--list prints every run of the sweep the other options select as one command line,\n"
+    "  `sph2d bench accuracy --only ID --out DIR/ID ...`, each writing its own accuracy.csv\n"
+    "  (paths made absolute); --list-ids prints the ids alone. Neither runs anything.\n"
+    "--only ID[,ID...] runs exactly those runs of the sweep that --quick and --levels define\n"
+    "  (ids like dam_break-dfsph-20000-cfl1, surge_long-game-5000-cfl1-mu0.5) and writes\n"
+    "  DIR/accuracy.csv and DIR/accuracy.md; not with --solvers or --cases.\n"
+    "--merge DIR gathers every DIR/*/accuracy.csv (the runs of --list's --out DIR) and\n"
+    "--from-csv A.csv[,B.csv...] the files named; either runs nothing and writes the report\n"
+    "  and charts into --out from them, rows in the sweep's order. Every row records the\n"
+    "  build's commit and the settings (quick, levels, threads, the assets' hash): rows of\n"
+    "  different builds or settings are refused (exit 2, naming two files) unless\n"
+    "  --allow-mixed, and a run id twice is refused.\n"
+    "\n"
     "Those files replace only the ones an earlier bench accuracy wrote in DIR (its\n"
     "DIR/.sph2d.journal lists them with their hashes): a file of those names that sph2d\n"
     "cannot prove it wrote is never touched, and the bench exits 2 naming it before it runs.\n";
 
-/// The validation cases, in the order they run.
-const char* const kCases[] = {"hydrostatic", "dam_break", "taylor_green", "poiseuille"};
+/// surge_long's floors, in the order they run.
+const char* const kSurgeFloors[] = {"free", "mu0.2", "mu0.5", "mu1", "noslip"};
+/// surge_long: Martin & Moyce's points up to this T make the second error (the span of Table 2).
+constexpr double kSurgeEarlyT = 3.35;
+/// surge_long's tank (assets/scenes/validation/surge_long.json): the far wall's inner face [m].
+constexpr double kSurgeLongTank = 16.0;
 
-struct Run {
-  std::string caseName, solver;
-  std::size_t particles = 0;
-  double cfl = 0;
-  std::string errorName;
-  double error = 0, meanDensityError = 0, maxDensityError = 0, wallPerSim = 0, msPerStep = 0;
-};
-
-/// Sets `solver` and its own CFL-type number to `scale` × its default; returns the number.
-double setSolver(SceneDef& s, const std::string& solver, double scale) {
-  const SolverDef d = solverDefaults(solver);
-  if (s.solver.type != solver) {
-    s.solver.type = solver;
-    s.solver.params = d.params;
-    // The support a solver tunes (the game solver's 2 dx); the case keeps its own viscosity.
-    s.solver.supportRatio = d.supportRatio;
-  }
-  if (solver == "dfsph") return s.solver.params["velocity_cfl"] = 0.4 * scale;
-  if (solver == "pbf" || solver == "game") return s.solver.params["max_move"] = d.param("max_move") * scale;
-  return s.solver.cfl = 0.25 * scale;
+std::string caseList() {
+  std::string s;
+  for (const char* c : kCases) s += std::string(s.empty() ? "" : ", ") + c;
+  return s;
 }
 
-/// `table`: Martin & Moyce 1952's (T, Z) rows.
-Run runDamBreak(SceneDef s, const std::vector<std::vector<double>>& table, int threads) {
+/// The surge front of a column of width a = 1 m against `table`'s (T, Z) rows, T = t·sqrt(2g/a):
+/// `error` over every row within the run (and short of the far wall at `tankLength`),
+/// `error2` over those with T ≤ `earlyT` (when earlyT > 0). x_front: the largest x of any particle.
+Run runSurge(SceneDef s, const std::vector<std::vector<double>>& table, double tankLength, double earlyT, int threads) {
   Run r;
   World w(s, WorldOptions{threads});
   w.takeWarnings();
@@ -112,21 +134,25 @@ Run runDamBreak(SceneDef s, const std::vector<std::vector<double>>& table, int t
     densMax = std::max(densMax, d.meanError);
   }
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  double se = 0;
-  int n = 0;
+  double se = 0, se2 = 0;
+  int n = 0, n2 = 0;
   for (const auto& row : table) {
     const double t = row[0] / std::sqrt(2 * g / a);
-    if (t > times.back()) continue;
+    if (t > times.back() || row[1] * a >= tankLength) continue;
     std::size_t k = 1;
     while (k + 1 < times.size() && times[k] < t) ++k;
     const double u = (t - times[k - 1]) / (times[k] - times[k - 1]);
     const double x = fronts[k - 1] + u * (fronts[k] - fronts[k - 1]);
-    se += (x / a - row[1]) * (x / a - row[1]);
+    const double e2 = (x / a - row[1]) * (x / a - row[1]);
+    se += e2;
     ++n;
+    if (row[0] <= earlyT) {
+      se2 += e2;
+      ++n2;
+    }
   }
-  r.caseName = "dam_break";
-  r.errorName = "surge_front_rms_Z";
   r.error = n ? std::sqrt(se / n) : 0;
+  if (earlyT > 0) r.error2 = n2 ? std::sqrt(se2 / n2) : NAN;
   r.particles = w.particleCount();
   r.meanDensityError = densSum / frames;
   r.maxDensityError = densMax;
@@ -159,8 +185,6 @@ Run runHydrostatic(SceneDef s, int threads) {
   const double expectScale = s.solver.type == "muller2003" ? 2.0 : 1.0;
   int measured = 0, empty = 0;
   const double worst = profile.worstError(H, rho0, g, dx, expectScale, measured, empty);
-  r.caseName = "hydrostatic";
-  r.errorName = "pressure_profile_max_rel";
   r.error = measured ? worst : NAN;  // nothing measured: no figure, not a perfect one
   r.particles = w.particleCount();
   r.meanDensityError = densSum / std::max(1, frames - avgFrom);
@@ -170,108 +194,169 @@ Run runHydrostatic(SceneDef s, int threads) {
   return r;
 }
 
-/// Log-log chart of error against wall seconds per simulated second, one colour per solver, Pareto front.
-/// Writes `bytes` to `out`/`name` whole, noted in the folder's journal first.
-void writeNoted(OutputJournal& journal, const std::string& out, const std::string& name, const std::string& bytes) {
-  const std::string path = out + "/" + name;
-  journal.note(name, fs::path(tempPathFor(path)).filename().string(), xxh64(bytes.data(), bytes.size()));
-  writeFileAtomic(path, bytes);
+/// The scenes and reference tables of the cases.
+struct Inputs {
+  SceneDef dam, hydro, tg, channel, surgeLong;
+  std::vector<std::vector<double>> damTable, surgeLongTable, tgTable, channelTable;
+  std::vector<std::string> files;  ///< every file read, for the assets' hash
+};
+
+Inputs loadInputs(const std::string& assets) {
+  Inputs in;
+  const std::string v = assets + "/scenes/validation/", ref = assets + "/reference/";
+  in.files = {v + "dam_break.json", v + "hydrostatic_tank.json", v + "taylor_green.json", v + "poiseuille.json",
+              v + "surge_long.json", ref + "martin_moyce_1952_surge_front.csv", ref + "martin_moyce_1952_surge_front_long.csv",
+              ref + "taylor_green_decay.csv", ref + "channel_flow_transient.csv"};
+  in.dam = loadScene(in.files[0]);
+  in.hydro = loadScene(in.files[1]);
+  in.tg = loadScene(in.files[2]);
+  in.channel = loadScene(in.files[3]);
+  in.surgeLong = loadScene(in.files[4]);
+  in.damTable = validation::readReferenceCsv(in.files[5]);
+  in.surgeLongTable = validation::readReferenceCsv(in.files[6]);
+  in.tgTable = validation::readReferenceCsv(in.files[7]);
+  in.channelTable = validation::readReferenceCsv(in.files[8]);
+  return in;
 }
 
-/// The files `sph2d bench accuracy` writes into its --out folder.
-const char* const kOutputs[] = {"accuracy.csv", "accuracy.md", "dam_break.png", "hydrostatic.png", "taylor_green.png",
-                                "poiseuille.png"};
+/// One run of the sweep before it runs: what it is, its scene and its id.
+struct Spec {
+  std::string id, caseName, solver, floor;
+  int cflIndex = 1;  ///< 1: each solver's CFL-type number at its default, 2: twice it
+  double cfl = 0;
+  SceneDef scene;
+};
 
-FolderSpec accuracyFolderSpec() {
-  FolderSpec spec;
-  spec.command = "bench accuracy";
-  spec.writes = [](const std::string& name) { return std::find(std::begin(kOutputs), std::end(kOutputs), name) != std::end(kOutputs); };
-  return spec;
+/// The scene of a run: the case's scene with the solver, its CFL-type number, the spacing and the floor.
+Spec makeSpec(const Inputs& in, const std::string& caseName, const std::string& solver, int cflIndex, double dx,
+              const std::string& floor) {
+  Spec p;
+  p.caseName = caseName;
+  p.solver = solver;
+  p.floor = floor;
+  p.cflIndex = cflIndex;
+  SceneDef& s = p.scene;
+  s = caseName == "hydrostatic" ? in.hydro
+      : caseName == "dam_break"  ? in.dam
+      : caseName == "taylor_green" ? in.tg
+      : caseName == "poiseuille" ? in.channel
+                                 : in.surgeLong;
+  p.cfl = setSolver(s, solver, double(cflIndex));
+  s.solver.spacing = dx;
+  s.solver.maxSubsteps = 100000;
+  if (caseName == "dam_break" || caseName == "surge_long") s.maxParticles = 1000000;
+  if (solver == "muller2003" && (caseName == "hydrostatic" || caseName == "dam_break" || caseName == "surge_long"))
+    s.solver.viscosity = 0.01;
+  if (caseName == "poiseuille") {
+    // The period must hold 3 support radii: 8 spacings at the coarse level (the plates reach 1 m beyond).
+    const double period = std::max(s.periodic.max.x() - s.periodic.min.x(), 8 * dx);
+    s.periodic.max.x() = s.periodic.min.x() + period;
+    s.blocks[0].max.x() = s.blocks[0].min.x() + period;
+  }
+  if (!floor.empty()) applyFloorVariant(s, parseFloorVariant("floor", floor));
+  p.id = caseName + "-" + solver + "-" + std::to_string(countBlockParticles(s)) + "-cfl" + std::to_string(cflIndex) +
+         (floor.empty() ? "" : "-" + floor);
+  return p;
 }
 
-void chart(const std::vector<Run>& runs, const std::string& caseName, OutputJournal& journal, const std::string& out) {
-  const std::string path = out + "/" + caseName + ".png";
-  Frame img;
-  img.width = 720;
-  img.height = 480;
-  img.rgba.assign(std::size_t(img.width) * img.height * 4, 255);
-  std::vector<const Run*> rs;
-  for (const Run& r : runs)
-    if (r.caseName == caseName && r.error > 0 && r.wallPerSim > 0) rs.push_back(&r);
-  if (rs.empty()) return;
-  double x0 = 1e30, x1 = -1e30, y0 = 1e30, y1 = -1e30;
-  for (const Run* r : rs) {
-    x0 = std::min(x0, std::log10(r->wallPerSim));
-    x1 = std::max(x1, std::log10(r->wallPerSim));
-    y0 = std::min(y0, std::log10(r->error));
-    y1 = std::max(y1, std::log10(r->error));
+/// The runs of the sweep, in the order they run (and the CSV's).
+std::vector<Spec> sweep(const Inputs& in, const std::vector<std::string>& solvers, const std::vector<std::string>& cases,
+                        bool quick, int levels) {
+  auto spacings = [&](std::vector<double> full, double q, std::size_t cap) {
+    if (quick) return std::vector<double>{q};
+    full.resize(std::min<std::size_t>(std::size_t(levels), cap));
+    return full;
+  };
+  const std::map<std::string, std::vector<double>> dx = {
+      {"hydrostatic", spacings({0.05, 0.025, 0.0125}, 0.05, 3)},
+      {"dam_break", spacings({0.02, 0.01, 0.005}, 0.04, 3)},
+      {"taylor_green", spacings({0.04, 0.02, 0.01}, 0.04, 3)},
+      {"poiseuille", spacings({0.1, 0.05, 0.025}, 0.1, 3)},
+      {"surge_long", spacings({0.02, 0.01}, 0.04, 2)}};
+  std::vector<Spec> out;
+  for (const std::string& solver : solvers)
+    for (int k = 1; k <= (quick ? 1 : 2); ++k)
+      for (const char* c : kCases) {
+        if (std::find(cases.begin(), cases.end(), c) == cases.end()) continue;
+        if (std::string(c) == "surge_long" && k > 1) continue;  // the floor is its variable, not the CFL number
+        for (double h : dx.at(c)) {
+          if (std::string(c) == "surge_long")
+            for (const char* f : kSurgeFloors) out.push_back(makeSpec(in, c, solver, k, h, f));
+          else
+            out.push_back(makeSpec(in, c, solver, k, h, ""));
+        }
+      }
+  return out;
+}
+
+/// Runs one run; an unstable run (the guard stopped it) gives a row with status "unstable".
+Run execute(const Spec& p, const Inputs& in, int threads) {
+  Run r;
+  const SceneDef& s = p.scene;
+  try {
+    if (p.caseName == "hydrostatic") {
+      r = runHydrostatic(s, threads);
+      r.errorName = "pressure_profile_max_rel";
+    } else if (p.caseName == "dam_break") {
+      r = runSurge(s, in.damTable, 1e9, 0, threads);
+      r.errorName = "surge_front_rms_Z";
+    } else if (p.caseName == "surge_long") {
+      r = runSurge(s, in.surgeLongTable, kSurgeLongTank, kSurgeEarlyT, threads);
+      r.errorName = "surge_front_rms_Z";
+      r.error2Name = "surge_front_rms_Z_to_T3.35";
+    } else {
+      // The analytic cases: error, mean and max density error, simulated s, substeps.
+      struct Measured {
+        double error, meanDensityError, maxDensityError, simSeconds;
+        std::uint64_t substeps;
+      };
+      const auto t0 = std::chrono::steady_clock::now();
+      Measured v{};
+      if (p.caseName == "taylor_green") {
+        const auto m = validation::runTaylorGreen(s, s.duration, in.tgTable, threads);
+        v = Measured{m.umaxRms, m.meanDensityError, m.maxDensityError, m.simSeconds, m.substeps};
+        r.errorName = "umax_ratio_rms";
+      } else {
+        const auto m = validation::runPoiseuille(s, 0.0, 1.0, in.channelTable, threads);
+        v = Measured{m.rmsError, m.meanDensityError, m.maxDensityError, m.simSeconds, m.substeps};
+        r.errorName = "u_rms_vs_series";
+      }
+      const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+      r.error = v.error;
+      r.particles = countBlockParticles(s);
+      r.meanDensityError = v.meanDensityError;
+      r.maxDensityError = v.maxDensityError;
+      r.wallPerSim = wall / v.simSeconds;
+      r.msPerStep = 1e3 * wall / double(std::max<std::uint64_t>(1, v.substeps));
+    }
+  } catch (const SimulationError& e) {
+    std::printf("%-12s %-11s dx %.4f cfl %.3f%s: unstable (%s)\n", p.caseName.c_str(), p.solver.c_str(), s.solver.spacing,
+                p.cfl, p.floor.empty() ? "" : (" floor " + p.floor).c_str(), e.what());
+    r = Run{};
+    r.status = "unstable";
+    r.particles = countBlockParticles(s);
+    r.errorName = p.caseName == "hydrostatic" ? "pressure_profile_max_rel"
+                  : p.caseName == "taylor_green" ? "umax_ratio_rms"
+                  : p.caseName == "poiseuille"   ? "u_rms_vs_series"
+                                                 : "surge_front_rms_Z";
+    if (p.caseName == "surge_long") r.error2Name = "surge_front_rms_Z_to_T3.35";
   }
-  x0 = std::floor(x0 - 0.1);
-  x1 = std::ceil(x1 + 0.1);
-  y0 = std::floor(y0 - 0.1);
-  y1 = std::ceil(y1 + 0.1);
-  const int L = 90, R = 700, T = 40, B = 420;
-  auto px = [&](double lx) { return L + int((lx - x0) / (x1 - x0) * (R - L)); };
-  auto py = [&](double ly) { return B - int((ly - y0) / (y1 - y0) * (B - T)); };
-  const Rgba8 axis{40, 40, 40, 255}, grid{220, 220, 220, 255};
-  for (double d = x0; d <= x1 + 1e-9; d += 1) {
-    fillRect(img, px(d), T, px(d) + 1, B, grid);
-    drawText(img, px(d) - 12, B + 8, formatLabel(std::pow(10.0, d)), 2, axis);
-  }
-  for (double d = y0; d <= y1 + 1e-9; d += 1) {
-    fillRect(img, L, py(d), R, py(d) + 1, grid);
-    drawText(img, 4, py(d) - 7, formatLabel(std::pow(10.0, d)), 2, axis);
-  }
-  fillRect(img, L, B, R, B + 2, axis);
-  fillRect(img, L - 2, T, L, B, axis);
-  drawText(img, L, 8, caseName + ": " + rs[0]->errorName + " vs wall s per sim s", 2, axis);
-  std::map<std::string, Rgba8> colour;
-  const Rgba8 palette[] = {{200, 40, 40, 255}, {40, 120, 200, 255}, {40, 160, 60, 255}, {200, 140, 0, 255}, {140, 60, 180, 255}};
-  for (const Run* r : rs)
-    if (!colour.count(r->solver)) colour[r->solver] = palette[colour.size() % 5];
-  // Pareto front: runs no other run beats in both error and cost.
-  std::vector<const Run*> front;
-  for (const Run* a : rs) {
-    bool dominated = false;
-    for (const Run* b : rs)
-      dominated = dominated || (b != a && b->error <= a->error && b->wallPerSim <= a->wallPerSim &&
-                                (b->error < a->error || b->wallPerSim < a->wallPerSim));
-    if (!dominated) front.push_back(a);
-  }
-  std::sort(front.begin(), front.end(), [](const Run* a, const Run* b) { return a->wallPerSim < b->wallPerSim; });
-  for (std::size_t k = 1; k < front.size(); ++k) {
-    const int ax = px(std::log10(front[k - 1]->wallPerSim)), ay = py(std::log10(front[k - 1]->error));
-    const int bx = px(std::log10(front[k]->wallPerSim)), by = py(std::log10(front[k]->error));
-    const int steps = std::max(std::abs(bx - ax), std::abs(by - ay)) + 1;
-    for (int s = 0; s <= steps; ++s)
-      fillRect(img, ax + (bx - ax) * s / steps, ay + (by - ay) * s / steps, ax + (bx - ax) * s / steps + 2,
-               ay + (by - ay) * s / steps + 2, Rgba8{120, 120, 120, 255});
-  }
-  for (const Run* r : rs) {
-    const int x = px(std::log10(r->wallPerSim)), y = py(std::log10(r->error));
-    const int size = 3 + int(std::log10(double(std::max<std::size_t>(r->particles, 10))));
-    fillRect(img, x - size, y - size, x + size + 1, y + size + 1, colour[r->solver]);
-  }
-  int ly = T + 10;
-  for (const auto& c : colour) {
-    fillRect(img, R - 150, ly, R - 138, ly + 12, c.second);
-    drawText(img, R - 132, ly, c.first, 2, axis);
-    ly += 20;
-  }
-  drawText(img, R - 150, ly, "LINE: PARETO FRONT", 1, axis);
-  std::vector<std::uint8_t> bytes;
-  encodePng(img.width, img.height, img.rgba.data(), pngSettings(6), bytes);
-  journal.note(caseName + ".png", fs::path(tempPathFor(path)).filename().string(), xxh64(bytes.data(), bytes.size()));
-  writeEncodedPngAtomic(path, bytes);
+  r.id = p.id;
+  r.caseName = p.caseName;
+  r.solver = p.solver;
+  r.floor = p.floor;
+  r.cfl = p.cfl;
+  r.params = solverParamsText(s.solver);
+  return r;
 }
 
 }  // namespace
 
 int cmdBenchAccuracy(const std::vector<std::string>& args) {
   std::string out = "out/accuracy", assets = "assets";
-  bool quick = false;
+  bool quick = false, list = false, listIds = false, allowMixed = false, filtered = false;
   int threads = 0, levels = 3;
-  std::vector<std::string> solvers, fromCsv, cases(std::begin(kCases), std::end(kCases));
+  std::vector<std::string> solvers, fromCsv, only, mergeDirs, cases(std::begin(kCases), std::begin(kCases) + kDefaultCases);
   for (std::size_t i = 0; i < args.size(); ++i) {
     const std::string& a = args[i];
     auto value = [&]() -> std::string {
@@ -286,55 +371,71 @@ int cmdBenchAccuracy(const std::vector<std::string>& args) {
     else if (a == "--quick") quick = true;
     else if (a == "--threads") threads = parseInt(a, value(), 1, 256);
     else if (a == "--levels") levels = parseInt(a, value(), 1, 3);
-    else if (a == "--from-csv") fromCsv = splitList(value());
-    else if (a == "--solvers") solvers = splitList(value());
-    else if (a == "--cases") {
+    else if (a == "--from-csv") {
+      for (const std::string& f : splitList(value())) fromCsv.push_back(f);
+    } else if (a == "--merge") mergeDirs.push_back(value());
+    else if (a == "--allow-mixed") allowMixed = true;
+    else if (a == "--list") list = true;
+    else if (a == "--list-ids") listIds = true;
+    else if (a == "--only") {
+      only = splitList(value());
+      if (only.empty()) throw UsageError("--only needs a run id (sph2d bench accuracy --list-ids lists them)");
+    } else if (a == "--solvers") {
+      solvers = splitList(value());
+      filtered = true;
+    } else if (a == "--cases") {
       cases = splitList(value());
-      if (cases.empty()) throw UsageError("--cases needs at least one case (hydrostatic, dam_break, taylor_green, poiseuille)");
+      filtered = true;
+      if (cases.size() == 1 && cases[0] == "all") cases.assign(std::begin(kCases), std::end(kCases));
+      if (cases.empty()) throw UsageError("--cases needs at least one case (" + caseList() + ", or all)");
       for (const std::string& k : cases)
-        if (std::find(std::begin(kCases), std::end(kCases), k) == std::end(kCases))
-          throw UsageError("--cases: unknown case '" + k + "' (allowed: hydrostatic, dam_break, taylor_green, poiseuille)");
+        if (indexOf(kCases, k) < 0) throw UsageError("--cases: unknown case '" + k + "' (allowed: " + caseList() + ", or all)");
     }
     else throw UsageError("unknown option '" + a + "' (see sph2d bench accuracy --help)");
   }
+  const bool merging = !fromCsv.empty() || !mergeDirs.empty();
+  if (int(list) + int(listIds) + int(!only.empty()) + int(merging) > 1)
+    throw UsageError("--list, --list-ids, --only and --merge/--from-csv are one each: give one of them");
+  if (!only.empty() && filtered)
+    throw UsageError("--only names its runs: not with --solvers or --cases (they select what --list prints)");
+  if (allowMixed && !merging) throw UsageError("--allow-mixed is for --merge and --from-csv");
+
+  // The folder, before any run: held by this bench alone, and refused when it holds a file of
+  // the names it writes that an earlier bench accuracy did not write (its journal lists those).
+  const FolderSpec spec = accuracyFolderSpec();
+  auto holdFolder = [&](std::optional<OutputLock>& lock) {
+    if (holdsLockFile(out)) lock.emplace(out);
+    refuseForeignFiles(out, scanOutputFolder(out, spec), spec);
+    makeOutputDir(out);
+    if (!lock) lock.emplace(out);
+  };
+  std::optional<OutputLock> lock;
   std::vector<Run> runs;
-  if (!fromCsv.empty()) {
-    for (const std::string& path : fromCsv) {
-      std::ifstream in(path);
-      if (!in) throw UsageError("cannot open " + path);
-      std::string line;
-      std::getline(in, line);  // header
-      while (std::getline(in, line)) {
-        std::vector<std::string> f;
-        std::stringstream ls(line);
-        std::string cell;
-        while (std::getline(ls, cell, ',')) f.push_back(cell);
-        if (f.size() != 10) throw UsageError(path + ": expected 10 columns in '" + line + "'");
-        Run r;
-        r.caseName = f[0];
-        r.solver = f[1];
-        r.particles = std::size_t(std::stoull(f[2]));
-        r.cfl = std::stod(f[3]);
-        r.errorName = f[4];
-        r.error = std::stod(f[5]);
-        r.meanDensityError = std::stod(f[6]);
-        r.maxDensityError = std::stod(f[7]);
-        r.wallPerSim = std::stod(f[8]);
-        r.msPerStep = std::stod(f[9]);
-        runs.push_back(r);
+  std::string header;
+
+  if (merging) {
+    for (const std::string& d : mergeDirs)
+      for (const std::string& f : mergeParts("--merge", d, "accuracy.csv")) fromCsv.push_back(f);
+    std::map<std::string, std::string> seen;  // run id → file
+    std::vector<RowOrigin> origins;
+    for (const std::string& path : fromCsv)
+      for (Run& r : readRuns(path)) {
+        const auto [it, fresh] = seen.emplace(r.id, path);
+        if (!fresh)
+          throw UsageError("bench accuracy: run " + r.id + " is in " + it->second + (it->second == path ? " twice" : " and in " + path) +
+                           ": merge each run once");
+        origins.push_back(RowOrigin{path, r.build, r.settings});
+        runs.push_back(std::move(r));
       }
-    }
-  }
-  SceneDef dam = loadScene(assets + "/scenes/validation/dam_break.json");
-  SceneDef hydro = loadScene(assets + "/scenes/validation/hydrostatic_tank.json");
-  SceneDef tg = loadScene(assets + "/scenes/validation/taylor_green.json");
-  SceneDef channel = loadScene(assets + "/scenes/validation/poiseuille.json");
-  const auto tgTable = validation::readReferenceCsv(assets + "/reference/taylor_green_decay.csv");
-  const auto channelTable = validation::readReferenceCsv(assets + "/reference/channel_flow_transient.csv");
-  const auto table = validation::readReferenceCsv(assets + "/reference/martin_moyce_1952_surge_front.csv");
-  if (solvers.empty()) solvers = {"muller2003", "wcsph", "dfsph", "pbf", "game"};
-  std::vector<std::string> known;
-  {
+    const std::vector<RowOrigin> kinds = checkOrigins("bench accuracy", origins, allowMixed);
+    for (const RowOrigin& k : kinds)
+      header += "build " + k.build + ", settings " + k.settings + (kinds.size() > 1 ? " (mixed: --allow-mixed)" : "") + "\n";
+    std::printf("bench accuracy: %zu rows from %zu files; %s", runs.size(), fromCsv.size(), header.c_str());
+    holdFolder(lock);
+  } else {
+    const Inputs in = loadInputs(assets);
+    if (solvers.empty()) solvers.assign(std::begin(kSolvers), std::end(kSolvers));
+    std::vector<std::string> known;
     // Keep the solvers this build has (a scene with an unknown type fails to load).
     for (const auto& s : solvers) {
       try {
@@ -344,159 +445,104 @@ int cmdBenchAccuracy(const std::vector<std::string>& args) {
         std::fprintf(stderr, "bench accuracy: solver '%s' is not in this build, skipped\n", s.c_str());
       }
     }
-  }
-  // The folder, before any run: held by this bench alone, and refused when it holds a file of
-  // the names it writes that an earlier bench accuracy did not write (its journal lists those).
-  const FolderSpec spec = accuracyFolderSpec();
-  std::optional<OutputLock> lock;
-  if (holdsLockFile(out)) lock.emplace(out);
-  refuseForeignFiles(out, scanOutputFolder(out, spec), spec);
-  makeOutputDir(out);
-  if (!lock) lock.emplace(out);
-
-  std::vector<double> damSpacings = quick ? std::vector<double>{0.04} : std::vector<double>{0.02, 0.01, 0.005};
-  std::vector<double> hydroSpacings = quick ? std::vector<double>{0.05} : std::vector<double>{0.05, 0.025, 0.0125};
-  std::vector<double> tgSpacings = quick ? std::vector<double>{0.04} : std::vector<double>{0.04, 0.02, 0.01};
-  std::vector<double> channelSpacings = quick ? std::vector<double>{0.1} : std::vector<double>{0.1, 0.05, 0.025};
-  if (!quick) {
-    damSpacings.resize(std::size_t(levels));
-    hydroSpacings.resize(std::size_t(levels));
-    tgSpacings.resize(std::size_t(levels));
-    channelSpacings.resize(std::size_t(levels));
-  }
-  auto want = [&](const char* k) { return std::find(cases.begin(), cases.end(), k) != cases.end(); };
-  if (!want("hydrostatic")) hydroSpacings.clear();
-  if (!want("dam_break")) damSpacings.clear();
-  if (!want("taylor_green")) tgSpacings.clear();
-  if (!want("poiseuille")) channelSpacings.clear();
-  const std::vector<double> cflScales = quick ? std::vector<double>{1.0} : std::vector<double>{1.0, 2.0};
-  if (!fromCsv.empty()) known.clear();  // redraw only
-  std::printf("%-12s %-11s %9s %6s %-26s %10s %10s %10s %12s %10s\n", "case", "solver", "particles", "cfl", "error_name",
-              "error", "mean_rho", "max_rho", "wall/sim_s", "ms/step");
-  auto report = [&](const Run& r) {
-    runs.push_back(r);
-    std::printf("%-12s %-11s %9zu %6.3f %-26s %10.4f %9.3f%% %9.3f%% %12.3f %10.3f\n", r.caseName.c_str(), r.solver.c_str(),
-                r.particles, r.cfl, r.errorName.c_str(), r.error, 100 * r.meanDensityError, 100 * r.maxDensityError,
-                r.wallPerSim, r.msPerStep);
-    std::fflush(stdout);
-  };
-  for (const std::string& solver : known)
-    for (double cs : cflScales) {
-      for (double dx : hydroSpacings) {
-        SceneDef s = hydro;
-        const double cfl = setSolver(s, solver, cs);
-        s.solver.spacing = dx;
-        s.solver.maxSubsteps = 100000;
-        if (solver == "muller2003") s.solver.viscosity = 0.01;
-        try {
-          Run r = runHydrostatic(s, threads);
-          r.solver = solver;
-          r.cfl = cfl;
-          report(r);
-        } catch (const SimulationError& e) {
-          std::printf("hydrostatic  %-11s dx %.4f cfl %.3f: unstable (%s)\n", solver.c_str(), dx, cfl, e.what());
+    std::vector<Spec> specs = sweep(in, known, only.empty() ? cases : std::vector<std::string>(std::begin(kCases), std::end(kCases)),
+                                    quick, levels);
+    const std::string settings = "quick=" + std::string(quick ? "1" : "0") + ";levels=" + std::to_string(levels) +
+                                 ";threads=" + (threads ? std::to_string(threads) : std::string("auto")) +
+                                 ";assets=" + filesHash(in.files);
+    if (list || listIds) {
+      // One line per run: a command that runs it alone into its own folder.
+      const std::string exe = shellQuote(selfExe()), root = absolutePath(out), assetsAbs = shellQuote(absolutePath(assets));
+      for (const Spec& p : specs) {
+        if (listIds) {
+          std::printf("%s\n", p.id.c_str());
+          continue;
         }
+        std::string cmd = exe + " bench accuracy --only " + p.id + " --out " + shellQuote(root + "/" + p.id) + " --assets " + assetsAbs;
+        if (quick) cmd += " --quick";
+        if (levels != 3) cmd += " --levels " + std::to_string(levels);
+        if (threads) cmd += " --threads " + std::to_string(threads);
+        std::printf("%s\n", cmd.c_str());
       }
-      for (double dx : damSpacings) {
-        SceneDef s = dam;
-        const double cfl = setSolver(s, solver, cs);
-        s.solver.spacing = dx;
-        s.solver.maxSubsteps = 100000;
-        s.maxParticles = 1000000;
-        if (solver == "muller2003") s.solver.viscosity = 0.01;
-        try {
-          Run r = runDamBreak(s, table, threads);
-          r.solver = solver;
-          r.cfl = cfl;
-          report(r);
-        } catch (const SimulationError& e) {
-          std::printf("dam_break    %-11s dx %.4f cfl %.3f: unstable (%s)\n", solver.c_str(), dx, cfl, e.what());
-        }
-      }
-      // The analytic cases: `run` returns (error, mean and max density error, simulated s, substeps).
-      auto analytic = [&](const char* caseName, const char* errorName, const SceneDef& s, double cfl, auto run) {
-        try {
-          const auto t0 = std::chrono::steady_clock::now();
-          const auto v = run(s);
-          const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-          Run r;
-          r.caseName = caseName;
-          r.errorName = errorName;
-          r.error = v.error;
-          r.particles = countBlockParticles(s);
-          r.meanDensityError = v.meanDensityError;
-          r.maxDensityError = v.maxDensityError;
-          r.wallPerSim = wall / v.simSeconds;
-          r.msPerStep = 1e3 * wall / double(std::max<std::uint64_t>(1, v.substeps));
-          r.solver = s.solver.type;
-          r.cfl = cfl;
-          report(r);
-        } catch (const SimulationError& e) {
-          std::printf("%-12s %-11s dx %.4f cfl %.3f: unstable (%s)\n", caseName, s.solver.type.c_str(), s.solver.spacing, cfl,
-                      e.what());
-        }
-      };
-      struct Measured {
-        double error, meanDensityError, maxDensityError, simSeconds;
-        std::uint64_t substeps;
-      };
-      for (double dx : tgSpacings) {
-        SceneDef s = tg;
-        const double cfl = setSolver(s, solver, cs);
-        s.solver.spacing = dx;
-        s.solver.maxSubsteps = 100000;
-        analytic("taylor_green", "umax_ratio_rms", s, cfl, [&](const SceneDef& sc) {
-          const auto v = validation::runTaylorGreen(sc, sc.duration, tgTable, threads);
-          return Measured{v.umaxRms, v.meanDensityError, v.maxDensityError, v.simSeconds, v.substeps};
-        });
-      }
-      for (double dx : channelSpacings) {
-        SceneDef s = channel;
-        const double cfl = setSolver(s, solver, cs);
-        s.solver.spacing = dx;
-        // The period must hold 3 support radii: 8 spacings at the coarse level (the plates reach 1 m beyond).
-        const double period = std::max(s.periodic.max.x() - s.periodic.min.x(), 8 * dx);
-        s.periodic.max.x() = s.periodic.min.x() + period;
-        s.blocks[0].max.x() = s.blocks[0].min.x() + period;
-        s.solver.maxSubsteps = 100000;
-        analytic("poiseuille", "u_rms_vs_series", s, cfl, [&](const SceneDef& sc) {
-          const auto v = validation::runPoiseuille(sc, 0.0, 1.0, channelTable, threads);
-          return Measured{v.rmsError, v.meanDensityError, v.maxDensityError, v.simSeconds, v.substeps};
-        });
-      }
+      return specs.empty() ? 1 : 0;
     }
+    if (!only.empty()) {
+      std::vector<Spec> chosen;
+      for (const std::string& id : only) {
+        const auto it = std::find_if(specs.begin(), specs.end(), [&](const Spec& p) { return p.id == id; });
+        if (it == specs.end()) {
+          const std::string flags = std::string(quick ? " --quick" : "") + (levels != 3 ? " --levels " + std::to_string(levels) : "");
+          throw UsageError("--only: no run '" + id + "' in this sweep (" + std::to_string(specs.size()) + " runs" +
+                           (quick ? ", --quick" : "") + "); ids are case-solver-particles-cflK[-floor], e.g. " +
+                           (specs.empty() ? std::string("dam_break-dfsph-20000-cfl1") : specs.front().id) +
+                           "; `sph2d bench accuracy --list-ids" + flags + "` lists them all");
+        }
+        chosen.push_back(*it);
+      }
+      specs = chosen;
+    }
+    holdFolder(lock);
+    std::printf("%-12s %-11s %9s %6s %-8s %-26s %10s %10s %10s %12s %10s\n", "case", "solver", "particles", "cfl", "floor",
+                "error_name", "error", "mean_rho", "max_rho", "wall/sim_s", "ms/step");
+    std::fflush(stdout);
+    for (const Spec& p : specs) {
+      Run r = execute(p, in, threads);
+      r.build = buildCommit();
+      r.settings = settings;
+      if (r.status == "ok") {
+        std::printf("%-12s %-11s %9zu %6.3f %-8s %-26s %10.4f %9.3f%% %9.3f%% %12.3f %10.3f", r.caseName.c_str(), r.solver.c_str(),
+                    r.particles, r.cfl, r.floor.empty() ? "-" : r.floor.c_str(), r.errorName.c_str(), r.error,
+                    100 * r.meanDensityError, 100 * r.maxDensityError, r.wallPerSim, r.msPerStep);
+        if (!r.error2Name.empty()) std::printf("  %s %.4f", r.error2Name.c_str(), r.error2);
+        std::printf("\n");
+      }
+      std::fflush(stdout);
+      runs.push_back(std::move(r));
+    }
+    header = "build " + std::string(buildCommit()) + ", settings " + settings + "\n";
+  }
+  sortRuns(runs);
 
   // The files replace only an earlier bench accuracy's (scanned again: proven now), each whole.
   const FolderScan scan = scanOutputFolder(out, spec);
   refuseForeignFiles(out, scan, spec);
   OutputJournal journal(out, spec.command, scan.own);
   {
-    std::ostringstream csv;
-    csv << "case,solver,particles,cfl,error_name,error,mean_density_error,max_density_error,wall_s_per_sim_s,ms_per_step\n";
-    for (const Run& r : runs)
-      csv << r.caseName << ',' << r.solver << ',' << r.particles << ',' << r.cfl << ',' << r.errorName << ',' << r.error << ','
-          << r.meanDensityError << ',' << r.maxDensityError << ',' << r.wallPerSim << ',' << r.msPerStep << '\n';
-    writeNoted(journal, out, "accuracy.csv", csv.str());
+    std::string csv = std::string(kCsvHeader) + "\n";
+    for (const Run& r : runs) csv += csvLine(r);
+    writeNoted(journal, out, "accuracy.csv", csv);
   }
   {
     std::ostringstream md;
-    md << "| case | solver | particles | cfl | error | value | mean density error | max density error | wall s / sim s | ms / step |\n"
-          "|---|---|---|---|---|---|---|---|---|---|\n";
-    char line[512];
+    md << "<!-- " << header.substr(0, header.size() - 1) << " -->\n\n";
+    md << "| run | case | solver | floor | particles | cfl | error | value | error 2 | value | mean density error | max density error | wall s / sim s | ms / step |\n"
+          "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+    char line[1024];
     for (const Run& r : runs) {
-      std::snprintf(line, sizeof line, "| %s | %s | %zu | %.3f | %s | %.4f | %.3f %% | %.3f %% | %.3f | %.3f |\n",
-                    r.caseName.c_str(), r.solver.c_str(), r.particles, r.cfl, r.errorName.c_str(), r.error,
-                    100 * r.meanDensityError, 100 * r.maxDensityError, r.wallPerSim, r.msPerStep);
+      if (r.status != "ok") {
+        std::snprintf(line, sizeof line, "| %s | %s | %s | %s | %zu | %.3f | %s | %s | | | | | | |\n", r.id.c_str(), r.caseName.c_str(),
+                      r.solver.c_str(), r.floor.c_str(), r.particles, r.cfl, r.errorName.c_str(), r.status.c_str());
+      } else {
+        std::snprintf(line, sizeof line, "| %s | %s | %s | %s | %zu | %.3f | %s | %.4f | %s | %s | %.3f %% | %.3f %% | %.3f | %.3f |\n",
+                      r.id.c_str(), r.caseName.c_str(), r.solver.c_str(), r.floor.c_str(), r.particles, r.cfl,
+                      r.errorName.c_str(), r.error, r.error2Name.c_str(),
+                      std::isnan(r.error2) ? "" : num(std::round(r.error2 * 1e4) / 1e4).c_str(), 100 * r.meanDensityError,
+                      100 * r.maxDensityError, r.wallPerSim, r.msPerStep);
+      }
       md << line;
     }
     writeNoted(journal, out, "accuracy.md", md.str());
   }
-  chart(runs, "dam_break", journal, out);
-  chart(runs, "hydrostatic", journal, out);
-  chart(runs, "taylor_green", journal, out);
-  chart(runs, "poiseuille", journal, out);
-  std::printf("bench accuracy: %zu runs; wrote %s/accuracy.csv, accuracy.md, dam_break.png, hydrostatic.png, taylor_green.png, "
-              "poiseuille.png\n", runs.size(), out.c_str());
+  std::string wrote = "accuracy.csv, accuracy.md";
+  if (only.empty()) {
+    // The charts: for the sweep and for merges, not for single runs.
+    for (const char* c : kCases) {
+      if (std::none_of(runs.begin(), runs.end(), [&](const Run& r) { return r.caseName == c; })) continue;
+      chart(runs, c, journal, out);
+      wrote += std::string(", ") + c + ".png";
+    }
+  }
+  std::printf("bench accuracy: %zu runs; wrote %s into %s\n", runs.size(), wrote.c_str(), out.c_str());
   return runs.empty() ? 1 : 0;
 }
 

@@ -11,6 +11,10 @@
 //
 // A benchmark, not a test: rerun it, and compare figures as ratios within one
 // run (the machines are shared and noisy).
+//
+// Every run has an id (preset-particles-tthreads[-floor], liquidfun[_static]-particles);
+// --list prints each run as a command of its own (--only ID --out DIR/ID) for a scheduler,
+// and --merge DIR gathers their game.csv files into one (app/bench/sweep.hpp).
 #include <unistd.h>
 
 #include <algorithm>
@@ -18,6 +22,8 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
+#include <optional>
 #include <fstream>
 #include <map>
 #include <memory>
@@ -26,7 +32,11 @@
 
 #include "cli.hpp"
 #include "commands.hpp"
+#include "bench/game_runs.hpp"
+#include "bench/sweep.hpp"
 #include "core/kernels.hpp"
+#include "output/output_dir.hpp"
+#include "sph2d/hash.hpp"
 #include "sph2d/render/particle_export.hpp"
 #include "sph2d/scene.hpp"
 #include "sph2d/world.hpp"
@@ -35,35 +45,46 @@
 namespace sph2d::cli {
 namespace {
 
+using namespace game_bench;
+
 const char* kHelp =
-    "Usage: sph2d bench game [--particles N] [--threads T[,T...]] [--seconds S] [--presets P[,P...]]\n"
-    "                        [--set KEY=VALUE]... [--peer [PATH]] [--csv FILE] [--assets DIR]\n"
+    "Usage: sph2d bench game [--particles N[,N...]] [--threads T[,T...]] [--seconds S] [--presets P[,P...]]\n"
+    "                        [--floors F[,F...]] [--set KEY=VALUE]... [--peer [PATH]] [--csv FILE] [--out DIR]\n"
+    "                        [--assets DIR] [--list | --list-ids | --only ID[,ID...]]\n"
+    "       sph2d bench game --merge DIR | --from-csv A.csv[,B.csv...] [--allow-mixed] (--out DIR | --csv FILE)\n"
     "\n"
     "The default dam break (assets/scenes/dam_break.json: a 1 m x 2 m column in a 4 m x 3 m\n"
     "tank) with the spacing set so the column holds about N particles (default 20000), for S\n"
-    "simulated seconds (default 4), once per quality preset P (default game,balanced,accurate)\n"
-    "and thread count T (default 1,2). Each run prints: wall seconds per simulated second,\n"
+    "simulated seconds (default 4), once per quality preset P (default game,balanced,accurate),\n"
+    "particle count N, floor F and thread count T (default 1,2). Each run prints: wall seconds\n"
+    "per simulated second,\n"
     "substeps and pressure iterations per frame, the worst per-frame mean compression and the\n"
     "worst single-particle compression, the largest gain of kinetic plus potential energy over\n"
     "the initial (a fraction of it), the most particles outside the tank in any frame, the RMS\n"
     "of the surge front Z = x/a against Martin & Moyce 1952, and the compression and surface\n"
     "height at the end measured from positions alone (as for the peer).\n"
+    "--floors: the tank's walls: scene (as the scene says, the default), free (friction 0),\n"
+    "muX (Coulomb friction X at contact, e.g. mu0.5), noslip (friction 0, solver.no_slip with\n"
+    "the viscosity at least 7.3e-5 m2/s, Martin & Moyce's Reynolds number at a = 1 m).\n"
     "--set KEY=VALUE changes the solver of every run: a shared key (viscosity, support_ratio,\n"
     "cfl, max_substeps) or one of the preset solver's own parameters.\n"
     "--peer runs the LiquidFun harness (lf_dam_break: cmake -DSPH2D_PEER_LIQUIDFUN=ON, target\n"
     "lf_dam_break; benchmarks/peers/liquidfun) on the same dam break, with its default iterations\n"
     "and with --static, and prints the ratio of each sph2d run's time to the peer's; --peer PATH\n"
     "runs the harness at PATH instead.\n"
-    "--csv FILE writes one row per run (fractions, not percent).\n";
-
-struct Row {
-  std::string name;
-  std::size_t particles = 0;
-  int threads = 1;
-  double wallPerSim = NAN, substepsPerFrame = NAN, iterationsPerFrame = NAN;
-  double meanCompression = NAN, maxCompression = NAN, energyGain = NAN, surgeRms = NAN;
-  double outside = NAN, endCompression = NAN, endSurface = NAN;
-};
+    "--csv FILE writes one row per run (fractions, not percent); --out DIR writes DIR/game.csv\n"
+    "(replacing only a game.csv an earlier bench game wrote there).\n"
+    "\n"
+    "One run at a time, for a scheduler (docs/PERFORMANCE.md, docs/ACCURACY.md):\n"
+    "--list prints every run the other options select as one command line,\n"
+    "  `sph2d bench game --only ID --out DIR/ID ...` (default DIR: out/bench_game); --list-ids\n"
+    "  the ids alone: PRESET-PARTICLES-tTHREADS[-FLOOR] (game-20000-t2, balanced-5000-t1-mu0.5)\n"
+    "  and, with --peer, liquidfun-PARTICLES and liquidfun_static-PARTICLES.\n"
+    "--only ID[,ID...] runs exactly those runs (not with --presets, --particles, --threads, --floors).\n"
+    "--merge DIR gathers every DIR/*/game.csv, --from-csv the files named, into --out or --csv,\n"
+    "  rows in the sweep's order, the peer ratio taken from the liquidfun_static row of the same\n"
+    "  particle count. Rows record the build's commit and the settings (seconds, --set, the\n"
+    "  assets' hash): rows of different builds or settings are refused (exit 2) unless --allow-mixed.\n";
 
 /// Positions-only measures of a final state, the same for sph2d and the peer:
 /// the mean compression max(ρ/ρ0 − 1, 0) with ρ summed by Wendland C2 of
@@ -217,13 +238,6 @@ bool runPeer(const std::string& exe, double spacing, double seconds, bool stat, 
   return true;
 }
 
-std::string fmt(double v, const char* f) {
-  if (std::isnan(v)) return "-";
-  char b[64];
-  std::snprintf(b, sizeof b, f, v);
-  return b;
-}
-
 /// Applies KEY=VALUE to a solver definition (a shared key or a solver parameter).
 void applySet(SolverDef& d, const std::string& kv) {
   const auto eq = kv.find('=');
@@ -245,11 +259,12 @@ void applySet(SolverDef& d, const std::string& kv) {
 }  // namespace
 
 int cmdBenchGame(const std::vector<std::string>& args) {
-  int particles = 20000;
+  std::vector<int> particles = {20000};
   std::vector<int> threads = {1, 2};
   double seconds = 4;
-  std::vector<std::string> presets = {"game", "balanced", "accurate"}, sets;
-  std::string peer, csvPath, assetsPath = "assets";
+  std::vector<std::string> presets = {"game", "balanced", "accurate"}, sets, floors = {"scene"}, only, fromCsv, mergeDirs;
+  std::string peer, csvPath, out, assetsPath = "assets";
+  bool list = false, listIds = false, allowMixed = false, shaped = false;
   for (std::size_t i = 0; i < args.size(); ++i) {
     const std::string& a = args[i];
     auto value = [&]() -> std::string {
@@ -259,18 +274,28 @@ int cmdBenchGame(const std::vector<std::string>& args) {
     if (a == "--help" || a == "-h") {
       std::fputs(kHelp, stdout);
       return 0;
-    } else if (a == "--particles") particles = parseInt(a, value(), 100, 50000000);
-    else if (a == "--threads") threads = parseIntList(a, value(), 1, 256);
-    else if (a == "--seconds") {
+    } else if (a == "--particles") {
+      particles = parseIntList(a, value(), 100, 50000000);
+      shaped = true;
+    } else if (a == "--threads") {
+      threads = parseIntList(a, value(), 1, 256);
+      shaped = true;
+    } else if (a == "--seconds") {
       seconds = parseNumber(a, value());
       // At least one frame of 1/60 s, so that every figure measures something.
       if (!(seconds >= 1.0 / 60 && seconds <= 60)) throw UsageError("--seconds must be in [1/60, 60]");
     } else if (a == "--presets") {
       presets = splitList(value());
+      shaped = true;
       for (const std::string& p : presets)
         if (p != "game" && p != "balanced" && p != "accurate")
           throw UsageError("--presets: unknown preset '" + p + "'; presets: game, balanced, accurate");
       if (presets.empty()) throw UsageError("--presets needs at least one preset");
+    } else if (a == "--floors") {
+      floors.clear();
+      shaped = true;
+      for (const std::string& f : splitList(value())) floors.push_back(parseFloorVariant(a, f).name);
+      if (floors.empty()) throw UsageError("--floors needs at least one floor (scene, free, muX, noslip)");
     } else if (a == "--set") sets.push_back(value());
     else if (a == "--peer") {
       // `--peer` alone: the harness this build tree builds (-DSPH2D_PEER_LIQUIDFUN=ON); `--peer PATH`: that one.
@@ -278,71 +303,178 @@ int cmdBenchGame(const std::vector<std::string>& args) {
     }
     else if (a == "--assets") assetsPath = value();
     else if (a == "--csv") csvPath = value();
+    else if (a == "--out") out = value();
+    else if (a == "--list") list = true;
+    else if (a == "--list-ids") listIds = true;
+    else if (a == "--only") {
+      only = splitList(value());
+      if (only.empty()) throw UsageError("--only needs a run id (sph2d bench game --list-ids lists them)");
+    } else if (a == "--merge") mergeDirs.push_back(value());
+    else if (a == "--from-csv") {
+      for (const std::string& f : splitList(value())) fromCsv.push_back(f);
+    } else if (a == "--allow-mixed") allowMixed = true;
     else throw UsageError("unknown option '" + a + "' (see sph2d bench game --help)");
   }
+  const bool merging = !fromCsv.empty() || !mergeDirs.empty();
+  if (int(list) + int(listIds) + int(!only.empty()) + int(merging) > 1)
+    throw UsageError("--list, --list-ids, --only and --merge/--from-csv are one each: give one of them");
+  if (!only.empty() && shaped)
+    throw UsageError("--only names its runs: not with --presets, --particles, --threads or --floors (they select what --list prints)");
+  if (allowMixed && !merging) throw UsageError("--allow-mixed is for --merge and --from-csv");
+  if (merging && out.empty() && csvPath.empty()) throw UsageError("--merge and --from-csv write --out DIR or --csv FILE: give one");
   if (peer.find('\'') != std::string::npos)  // it goes into a shell command between single quotes
     throw UsageError("--peer " + peer + ": a path with a single quote is not accepted");
-  if (!peer.empty() && ::access(peer.c_str(), X_OK) != 0)
+  if (!peer.empty() && !list && !listIds && ::access(peer.c_str(), X_OK) != 0)
     throw UsageError("--peer " + peer +
                      ": not an executable (build the peer: cmake -S . -B build -DSPH2D_PEER_LIQUIDFUN=ON && "
                      "cmake --build build --target lf_dam_break; benchmarks/peers/liquidfun/README.md)");
+
+  // --out: held by this bench alone, and refused when it holds a game.csv an earlier bench game did not write.
+  const FolderSpec spec = gameFolderSpec();
+  std::optional<OutputLock> lock;
+  auto holdFolder = [&] {
+    if (out.empty()) return;
+    if (holdsLockFile(out)) lock.emplace(out);
+    refuseForeignFiles(out, scanOutputFolder(out, spec), spec);
+    makeOutputDir(out);
+    if (!lock) lock.emplace(out);
+  };
+  auto writeOutputs = [&](std::vector<Row> rows) {
+    sortRows(rows);
+    const std::string text = csvText(rows);
+    if (!out.empty()) {
+      const FolderScan scan = scanOutputFolder(out, spec);
+      refuseForeignFiles(out, scan, spec);
+      OutputJournal journal(out, spec.command, scan.own);
+      const std::string path = out + "/game.csv";
+      journal.note("game.csv", std::filesystem::path(tempPathFor(path)).filename().string(), xxh64(text.data(), text.size()));
+      writeFileAtomic(path, text);
+      std::printf("wrote %s\n", path.c_str());
+    }
+    if (!csvPath.empty()) {
+      writeFileAtomic(csvPath, text);
+      std::printf("wrote %s\n", csvPath.c_str());
+    }
+  };
+
+  if (merging) {
+    for (const std::string& d : mergeDirs)
+      for (const std::string& f : mergeParts("--merge", d, "game.csv")) fromCsv.push_back(f);
+    std::vector<Row> rows;
+    std::map<std::string, std::string> seen;
+    std::vector<RowOrigin> origins;
+    for (const std::string& path : fromCsv)
+      for (Row& r : readRows(path)) {
+        const auto [it, fresh] = seen.emplace(r.id, path);
+        if (!fresh)
+          throw UsageError("bench game: run " + r.id + " is in " + it->second + (it->second == path ? " twice" : " and in " + path) +
+                           ": merge each run once");
+        origins.push_back(RowOrigin{path, r.build, r.settings});
+        rows.push_back(std::move(r));
+      }
+    const std::vector<RowOrigin> kinds = checkOrigins("bench game", origins, allowMixed);
+    std::printf("bench game: %zu rows from %zu files", rows.size(), fromCsv.size());
+    for (const RowOrigin& k : kinds) std::printf("; build %s, settings %s", k.build.c_str(), k.settings.c_str());
+    std::printf("\n");
+    holdFolder();
+    writeOutputs(rows);
+    return 0;
+  }
+
+  // The runs: the sweep's, or --only's.
+  std::vector<Spec> specs;
+  if (!only.empty()) {
+    for (const std::string& id : only) specs.push_back(parseId(id, !peer.empty()));
+  } else {
+    for (int n : particles) {
+      if (!peer.empty())
+        for (const char* pn : kPeers) {
+          Spec p;
+          p.peer = pn;
+          p.particles = n;
+          specs.push_back(p);
+        }
+      for (const std::string& preset : presets)
+        for (const std::string& f : floors)
+          for (int t : threads) {
+            Spec p;
+            p.preset = preset;
+            p.particles = n;
+            p.floor = f;
+            p.threads = t;
+            specs.push_back(p);
+          }
+    }
+    for (Spec& p : specs) p.id = specId(p);
+  }
   const std::string assets = assetsPath;
-  const SceneDef scene = loadScene(assets + "/scenes/dam_break.json");
-  const auto surge = validation::readReferenceCsv(assets + "/reference/martin_moyce_1952_surge_front.csv");
-  const double spacing = std::sqrt(2.0 / double(particles));
-  std::printf("bench game: dam break, 1 m x 2 m column, spacing %.4g m, %g simulated s, one stepFrame of 1/%g s per frame\n",
-              spacing, seconds, scene.fps);
-  std::printf("%-18s %9s %3s %9s %8s %8s %8s %8s %8s %7s %8s %5s %8s %8s\n", "run", "particles", "thr", "wall/sim",
+  const std::string scenePath = assets + "/scenes/dam_break.json", surgePath = assets + "/reference/martin_moyce_1952_surge_front.csv";
+  std::string setText;
+  for (const std::string& kv : sets) setText += (setText.empty() ? "" : "|") + kv;
+  const std::string settings =
+      "seconds=" + fmt(seconds, "%g") + ";set=" + (setText.empty() ? "none" : setText) + ";assets=" + filesHash({scenePath, surgePath});
+  if (list || listIds) {
+    const std::string exe = shellQuote(selfExe()), root = absolutePath(out.empty() ? "out/bench_game" : out);
+    for (const Spec& p : specs) {
+      if (listIds) {
+        std::printf("%s\n", p.id.c_str());
+        continue;
+      }
+      std::string cmd = exe + " bench game --only " + p.id + " --out " + shellQuote(root + "/" + p.id) + " --assets " +
+                        shellQuote(absolutePath(assets)) + " --seconds " + fmt(seconds, "%.17g");
+      for (const std::string& kv : sets) cmd += " --set " + shellQuote(kv);
+      if (!p.peer.empty()) cmd += " --peer " + shellQuote(absolutePath(peer));
+      std::printf("%s\n", cmd.c_str());
+    }
+    return 0;
+  }
+  const SceneDef scene = loadScene(scenePath);
+  const auto surge = validation::readReferenceCsv(surgePath);
+  holdFolder();
+  std::printf("bench game: dam break, 1 m x 2 m column, spacing sqrt(2/N) m, %g simulated s, one stepFrame of 1/%g s per frame\n",
+              seconds, scene.fps);
+  std::printf("%-22s %-18s %9s %3s %9s %8s %8s %8s %8s %8s %7s %8s %5s %8s %8s\n", "id", "run", "particles", "thr", "wall/sim",
               "vs peer", "substp/f", "iter/f", "mean cmp", "max cmp", "E gain", "surge", "out", "end cmp", "surface");
   std::fflush(stdout);
   std::vector<Row> rows;
-  double peerTime = NAN;
-  auto print = [&](const Row& r) {
-    std::printf("%-18s %9zu %3d %9s %8s %8s %8s %8s %8s %7s %8s %5s %8s %8s\n", r.name.c_str(), r.particles, r.threads,
-                fmt(r.wallPerSim, "%.3f").c_str(), fmt(r.wallPerSim / peerTime, "%.2fx").c_str(),
+  std::map<int, double> peerTime;  // requested particles → liquidfun_static's wall time, this run
+  auto print = [&](const Row& r, int n) {
+    const auto pt = peerTime.find(n);
+    std::printf("%-22s %-18s %9zu %3d %9s %8s %8s %8s %8s %8s %7s %8s %5s %8s %8s\n", r.id.c_str(), r.name.c_str(), r.particles,
+                r.threads, fmt(r.wallPerSim, "%.3f").c_str(),
+                fmt(pt == peerTime.end() ? NAN : r.wallPerSim / pt->second, "%.2fx").c_str(),
                 fmt(r.substepsPerFrame, "%.2f").c_str(), fmt(r.iterationsPerFrame, "%.1f").c_str(),
                 fmt(100 * r.meanCompression, "%.2f%%").c_str(), fmt(100 * r.maxCompression, "%.1f%%").c_str(),
                 fmt(100 * r.energyGain, "%.2f%%").c_str(), fmt(r.surgeRms, "%.3f").c_str(), fmt(r.outside, "%.0f").c_str(),
                 fmt(100 * r.endCompression, "%.2f%%").c_str(), fmt(r.endSurface, "%.3f").c_str());
     std::fflush(stdout);
   };
-  if (!peer.empty()) {
-    for (bool stat : {false, true}) {
-      Row r;
-      runPeer(peer, spacing, seconds, stat, r);
-      if (stat) peerTime = r.wallPerSim;
-      rows.push_back(r);
+  for (const Spec& p : specs) {
+    const double spacing = std::sqrt(2.0 / double(p.particles));
+    Row r;
+    if (!p.peer.empty()) {
+      runPeer(peer, spacing, seconds, p.peer == "liquidfun_static", r);
+      if (p.peer == "liquidfun_static") peerTime[p.particles] = r.wallPerSim;
+      r.floor = "";
+    } else {
+      SceneDef s = scene;
+      s.solver = qualityPreset(p.preset);
+      s.solver.spacing = spacing;
+      for (const std::string& kv : sets) applySet(s.solver, kv);
+      s.maxParticles = std::size_t(p.particles) * 2 + 1000;
+      applyFloorVariant(s, parseFloorVariant("--floors", p.floor));
+      r = runSph2d(s, p.preset, p.threads, seconds, surge);
+      r.floor = p.floor;
     }
-    for (const Row& r : rows) print(r);
+    r.id = p.id;
+    r.build = buildCommit();
+    r.settings = settings;
+    rows.push_back(r);
+    print(r, p.particles);
   }
-  for (const std::string& preset : presets) {
-    SceneDef s = scene;
-    s.solver = qualityPreset(preset);
-    s.solver.spacing = spacing;
-    for (const std::string& kv : sets) applySet(s.solver, kv);
-    s.maxParticles = std::size_t(particles) * 2 + 1000;
-    for (int t : threads) {
-      Row r = runSph2d(s, preset, t, seconds, surge);
-      rows.push_back(r);
-      print(r);
-    }
-  }
-  if (!peer.empty())
-    std::printf("vs peer: sph2d's wall time per simulated second over LiquidFun --static's (%.3f s/s), measured in this run\n",
-                peerTime);
-  if (!csvPath.empty()) {
-    std::ostringstream o;
-    o << "name,particles,threads,wall_s_per_sim_s,ratio_to_peer,substeps_per_frame,iterations_per_frame,mean_compression,"
-         "max_compression,energy_gain,surge_rms,outside,end_compression,end_surface_m\n";
-    auto v = [](double x) { return std::isnan(x) ? std::string("") : fmt(x, "%.6g"); };
-    for (const Row& r : rows)
-      o << r.name << ',' << r.particles << ',' << r.threads << ',' << v(r.wallPerSim) << ',' << v(r.wallPerSim / peerTime) << ','
-        << v(r.substepsPerFrame) << ',' << v(r.iterationsPerFrame) << ',' << v(r.meanCompression) << ','
-        << v(r.maxCompression) << ',' << v(r.energyGain) << ',' << v(r.surgeRms) << ',' << v(r.outside) << ','
-        << v(r.endCompression) << ',' << v(r.endSurface) << '\n';
-    writeFileAtomic(csvPath, o.str());
-    std::printf("wrote %s\n", csvPath.c_str());
-  }
+  if (!peer.empty() && !peerTime.empty())
+    std::printf("vs peer: sph2d's wall time per simulated second over LiquidFun --static's, measured in this run\n");
+  writeOutputs(rows);
   return 0;
 }
 

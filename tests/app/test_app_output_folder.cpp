@@ -5,6 +5,8 @@
 
 #include <sys/stat.h>
 
+#include <algorithm>
+
 #include <map>
 
 #include <nlohmann/json.hpp>
@@ -268,11 +270,18 @@ TEST_CASE("output folder: bench accuracy --out replaces only the files an earlie
   CHECK(readText(dir + "/accuracy.md") == "my own table");
   CHECK_FALSE(fs::exists(dir + "/accuracy.csv"));
   fs::remove(dir + "/accuracy.md");
+  // The runs' CSV from before run ids is redrawn in today's columns, the same bytes each time.
+  const std::string legacy = readText(in + "/runs.csv");
+  std::string first;
   for (int k = 0; k < 2; ++k) {
     r = run(args);
     INFO(k, r.out);
     CHECK(r.code == 0);
-    CHECK(readText(dir + "/accuracy.csv") == readText(in + "/runs.csv"));
+    const std::string csv = readText(dir + "/accuracy.csv");
+    CHECK(std::count(csv.begin(), csv.end(), '\n') == std::count(legacy.begin(), legacy.end(), '\n'));
+    CHECK(has(csv, "\nhydrostatic-muller2003-800-cfl1,hydrostatic,muller2003,,800,0.25,pressure_profile_max_rel,0.21387,"));
+    if (k == 0) first = csv;
+    else CHECK(csv == first);
   }
 }
 

@@ -22,7 +22,9 @@ TEST_CASE("bench accuracy --quick writes the CSV, the table and the charts, with
   std::istringstream in(csv);
   std::string header;
   std::getline(in, header);
-  CHECK(header == "case,solver,particles,cfl,error_name,error,mean_density_error,max_density_error,wall_s_per_sim_s,ms_per_step");
+  CHECK(header ==
+        "run_id,case,solver,floor,particles,cfl,error_name,error,error2_name,error2,mean_density_error,max_density_error,"
+        "wall_s_per_sim_s,ms_per_step,status,build,settings,solver_params");
   std::set<std::string> cases, solvers;
   std::string line;
   int rows = 0;
@@ -31,14 +33,21 @@ TEST_CASE("bench accuracy --quick writes the CSV, the table and the charts, with
     std::stringstream ls(line);
     std::string cell;
     while (std::getline(ls, cell, ',')) f.push_back(cell);
-    REQUIRE(f.size() == 10);
-    cases.insert(f[0]);
-    solvers.insert(f[1]);
-    const double err = std::stod(f[5]);
+    REQUIRE(f.size() == 18);
+    cases.insert(f[1]);
+    solvers.insert(f[2]);
+    CHECK(f[14] == "ok");
+    // The id names the run: case-solver-particles-cfl1 (one CFL number in --quick).
+    CHECK(f[0] == f[1] + "-" + f[2] + "-" + f[4] + "-cfl1");
+    const double err = std::stod(f[7]);
     CHECK(std::isfinite(err));
     CHECK(err >= 0);
-    if (f[0] == "dam_break") CHECK(err < 1.0);  // the surge front within one column width (RMS of Z) at the coarse resolution
-    if (f[0] == "poiseuille") CHECK(err < 0.1);  // u/u_c against the series: every solver within 10 % RMS, even coarse
+    if (f[1] == "dam_break") CHECK(err < 1.0);  // the surge front within one column width (RMS of Z) at the coarse resolution
+    if (f[1] == "poiseuille") CHECK(err < 0.1);  // u/u_c against the series: every solver within 10 % RMS, even coarse
+    // The settings that made it, and the solver's parameters.
+    CHECK(!f[15].empty());
+    CHECK(f[16].find("quick=1;") == 0);
+    CHECK(f[17].find("spacing=") == 0);
     ++rows;
   }
   CHECK(cases == std::set<std::string>{"dam_break", "hydrostatic", "taylor_green", "poiseuille"});

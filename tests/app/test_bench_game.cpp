@@ -34,27 +34,31 @@ TEST_CASE("bench game writes one row per preset and thread count, fractions in r
   std::string header;
   const auto rs = rows(readText(csvPath), header);
   CHECK(header ==
-        "name,particles,threads,wall_s_per_sim_s,ratio_to_peer,substeps_per_frame,iterations_per_frame,mean_compression,"
-        "max_compression,energy_gain,surge_rms,outside,end_compression,end_surface_m");
+        "run_id,name,floor,particles,threads,wall_s_per_sim_s,ratio_to_peer,substeps_per_frame,iterations_per_frame,"
+        "mean_compression,max_compression,energy_gain,surge_rms,outside,end_compression,end_surface_m,build,settings");
   REQUIRE(rs.size() == 4);
   for (const auto& f : rs) {
-    REQUIRE(f.size() == 14);
-    CHECK((f[0] == "sph2d_game" || f[0] == "sph2d_accurate"));
-    CHECK(std::stoul(f[1]) > 400);
-    CHECK(std::stod(f[3]) > 0);             // wall seconds per simulated second: measured
-    CHECK(std::stod(f[5]) >= 1);            // at least one substep a frame
-    const double mean = std::stod(f[7]), mx = std::stod(f[8]);
+    REQUIRE(f.size() == 18);
+    CHECK((f[1] == "sph2d_game" || f[1] == "sph2d_accurate"));
+    CHECK(f[0] == f[1].substr(6) + "-600-t" + f[4]);  // the run id: preset-particles-tthreads
+    CHECK(f[2] == "scene");
+    CHECK(std::stoul(f[3]) > 400);
+    CHECK(std::stod(f[5]) > 0);             // wall seconds per simulated second: measured
+    CHECK(std::stod(f[7]) >= 1);            // at least one substep a frame
+    const double mean = std::stod(f[9]), mx = std::stod(f[10]);
     CHECK(mean >= 0);
     CHECK(mean < 0.05);                     // a fraction, not percent
     CHECK(mx >= mean);
     CHECK(mx < 0.5);
-    CHECK(std::stod(f[9]) >= 0);            // energy gain: a fraction of the initial energy
-    CHECK(std::isfinite(std::stod(f[10])));  // surge RMS against Martin & Moyce
-    CHECK(std::stod(f[11]) == 0);           // nothing outside the tank
+    CHECK(std::stod(f[11]) >= 0);           // energy gain: a fraction of the initial energy
+    CHECK(std::isfinite(std::stod(f[12])));  // surge RMS against Martin & Moyce
+    CHECK(std::stod(f[13]) == 0);           // nothing outside the tank
+    CHECK(!f[16].empty());                  // the build's commit
+    CHECK(f[17].find("seconds=0.25;") == 0);
   }
   // Rows come per preset, thread counts in order: the physics columns agree.
   for (std::size_t k = 0; k < rs.size(); k += 2)
-    for (std::size_t c : {5u, 6u, 7u, 8u, 9u, 10u, 12u, 13u}) CHECK(rs[k][c] == rs[k + 1][c]);
+    for (std::size_t c : {7u, 8u, 9u, 10u, 11u, 12u, 14u, 15u}) CHECK(rs[k][c] == rs[k + 1][c]);
 }
 
 TEST_CASE("bench game refuses a peer that is not an executable, and less than one frame") {
