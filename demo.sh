@@ -1,12 +1,12 @@
 #!/usr/bin/env bash
-# Installs what is missing, builds (Release), and renders the default scene
+# Installs what the demo needs, builds the `sph2d` app alone (Release), and renders the default scene
 # (the dam break) to out/dam_break/frame_NNNNN.png. Extra arguments go to
 # `sph2d run` (e.g. ./demo.sh --frames 60 --threads 2).
 set -euo pipefail
 cd "$(dirname "$0")"
 source .ci/setup.sh
-sph2d_install
-sph2d_build
+sph2d_install "$SPH2D_DEMO_PACKAGES"
+sph2d_build_demo
 scene="assets/scenes/dam_break.json"
 out="out/dam_break"
 # No rm -rf: sph2d replaces only the frames an earlier run of it wrote there (their hashes are in

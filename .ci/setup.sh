@@ -1,5 +1,6 @@
 # Sourced by ./demo.sh and ./test.sh: install what a fresh Debian 12 machine
-# lacks (apt-get, sudo when not root) and build the Release tree in build/.
+# lacks (apt-get, sudo when not root) and build the Release tree in build/: the demo
+# installs and builds only what it runs, the tests the rest.
 # clang-14 + libclang-rt-14-dev: libFuzzer for the scene-loader fuzz smoke test
 # that ./test.sh runs through CTest (docs/STABILITY.md).
 # libboost-dev (Boost.Beast, header-only) + libturbojpeg0-dev: `sph2d serve`; chromium: its
@@ -9,11 +10,16 @@
 # serves tests/glvnd: the renderer's own OSMesa context with libOpenGL first in the link.
 # parallel (GNU parallel): the bench tests run `sph2d bench accuracy --list` and `bench game --list`
 # through it and compare the merged report with a one-process run (tests/app/test_bench_sweep.cpp).
-SPH2D_PACKAGES="g++ cmake make pkg-config libbox2d-dev libosmesa6-dev libpng-dev libeigen3-dev doctest-dev nlohmann-json3-dev clang-14 libclang-rt-14-dev libboost-dev libturbojpeg0-dev chromium libegl-dev libopengl-dev libegl-mesa0 parallel"
+# What the demo needs (the engine, the renderer and the `sph2d` app, serve included):
+SPH2D_DEMO_PACKAGES="g++ cmake make pkg-config libbox2d-dev libosmesa6-dev libpng-dev libeigen3-dev nlohmann-json3-dev libboost-dev libturbojpeg0-dev"
+# What the tests add:
+SPH2D_TEST_PACKAGES="doctest-dev clang-14 libclang-rt-14-dev chromium libegl-dev libopengl-dev libegl-mesa0 parallel"
+SPH2D_PACKAGES="$SPH2D_DEMO_PACKAGES $SPH2D_TEST_PACKAGES"
 
+# sph2d_install [PACKAGES]: installs those of PACKAGES (default: all) that are missing.
 sph2d_install() {
-  local missing=() p sudo=""
-  for p in $SPH2D_PACKAGES; do
+  local missing=() p sudo="" want="${1:-$SPH2D_PACKAGES}"
+  for p in $want; do
     dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
   done
   if [ "${#missing[@]}" -gt 0 ]; then
@@ -24,7 +30,18 @@ sph2d_install() {
   fi
 }
 
+# Everything: the engine, renderer, app, examples and every test.
 sph2d_build() {
-  cmake -S . -B build -DCMAKE_BUILD_TYPE=Release >/dev/null
+  cmake -S . -B build -DCMAKE_BUILD_TYPE=Release -DSPH2D_BUILD_TESTS=ON -DSPH2D_BUILD_EXAMPLES=ON >/dev/null
   cmake --build build -j"$(nproc)"
+}
+
+# The demo's executable alone (target sph2d). The same build tree as sph2d_build: a later
+# ./test.sh builds the rest and reuses what this built. A first configure leaves the tests and
+# examples out (their packages may be missing); a tree ./test.sh configured keeps them.
+sph2d_build_demo() {
+  local first=()
+  [ -f build/CMakeCache.txt ] || first=(-DSPH2D_BUILD_TESTS=OFF -DSPH2D_BUILD_EXAMPLES=OFF)
+  cmake -S . -B build -DCMAKE_BUILD_TYPE=Release "${first[@]}" >/dev/null
+  cmake --build build -j"$(nproc)" --target sph2d
 }
