@@ -321,6 +321,7 @@ class World {
   /// Sets gravity [m/s²] from the next substep on (tilting the tank); the scene's own b2World
   /// takes it too (its dynamic bodies fall the same way). A game sets its own b2World's.
   void setGravity(const Vec2d& g);
+  Vec2d gravity() const;  ///< the gravity of the next substep [m/s²] (setGravity or the scene's)
   /// Adds a block of fluid on the lattice of the scene's spacing (particles
   /// inside solids are skipped), row by row from the bottom, until the world holds
   /// its particle budget (max_particles, or effects.budget when set): the rest is
@@ -496,8 +497,10 @@ class World {
   /// Replaces the user forces (push/pull at points). The user_force stage
   /// exists only once a force has been set.
   void setUserForces(const std::vector<UserForce>& forces);
+  const std::vector<UserForce>& userForces() const;  ///< the forces setUserForces set (none at first)
   /// Enables or disables emitter `index` (scene order). Throws std::out_of_range.
   void setEmitterEnabled(std::size_t index, bool enabled);
+  bool emitterEnabled(std::size_t index) const;  ///< emitter `index` emits (std::out_of_range)
   /// Moves emitter `index` to `position` shooting along `direction` (normalised here)
   /// from the next substep on; its timing, seed and count continue. Throws
   /// std::out_of_range for a bad index, std::invalid_argument for a zero direction.
@@ -519,6 +522,7 @@ class World {
   /// "surface_tension", "user_force") on or off. Throws std::invalid_argument
   /// naming the scene's effects when it has no such effect.
   void setEffectEnabled(const std::string& name, bool enabled);
+  bool effectEnabled(const std::string& name) const;  ///< the effect runs (refused as setEffectEnabled)
   /// Names of the effects this world can run (enabled or not), in stage order.
   std::vector<std::string> effects() const;
   /// Particles emitted so far by emitter `index`.

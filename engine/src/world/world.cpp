@@ -437,21 +437,36 @@ void World::setUserForces(const std::vector<UserForce>& forces) {
 
 void World::setEmitterEnabled(std::size_t index, bool enabled) { impl_->emitters.at(index).def.enabled = enabled; }
 
-void World::setEffectEnabled(const std::string& name, bool enabled) {
+namespace {
+
+/// The scene's effect called `name`; std::invalid_argument naming the scene's effects if none.
+template <class Effects>
+auto& effectNamed(Effects& effects, const std::string& name) {
   std::string names;
-  for (const auto& e : impl_->effects) {
-    if (name == e->name()) {
-      if (e->enabled != enabled) {
-        e->enabled = enabled;
-        impl_->buildStages();
-      }
-      return;
-    }
+  for (auto& e : effects) {
+    if (name == e->name()) return *e;
     names += (names.empty() ? "" : ", ") + std::string(e->name());
   }
   throw std::invalid_argument("the scene does not enable the effect '" + name + "'; its effects: " +
                               (names.empty() ? std::string("none") : names));
 }
+
+}  // namespace
+
+void World::setEffectEnabled(const std::string& name, bool enabled) {
+  auto& e = effectNamed(impl_->effects, name);
+  if (e.enabled == enabled) return;
+  e.enabled = enabled;
+  impl_->buildStages();
+}
+
+bool World::effectEnabled(const std::string& name) const { return effectNamed(impl_->effects, name).enabled; }
+
+Vec2d World::gravity() const { return impl_->scene.gravity; }
+
+const std::vector<UserForce>& World::userForces() const { return impl_->userForces; }
+
+bool World::emitterEnabled(std::size_t index) const { return impl_->emitters.at(index).def.enabled; }
 
 std::size_t World::emitterCount() const { return impl_->emitters.size(); }
 

@@ -275,3 +275,39 @@ TEST_CASE("an interrupted World steps again after load(): to the same hash as th
   }
   CHECK(w->stateHash() == ref.stateHash());
 }
+
+TEST_CASE("every setter has a getter: gravity, user forces, an emitter's and an effect's switch read back what was set, and steer the step") {
+  SceneDef s = test::scene("tests/resting_column.json");  // muller2003 with viscosity
+  EmitterDef e;
+  e.position = Vec2d(0.1, 0.9);
+  e.direction = Vec2d(0, -1);
+  e.rate = 200;
+  e.speed = 1.0;
+  s.effects.emitters.push_back(e);
+  World w(s, WorldOptions{1});
+  CHECK(w.gravity() == s.gravity);
+  CHECK(w.userForces().empty());
+  CHECK(w.emitterEnabled(0));
+  CHECK(w.effectEnabled("viscosity"));
+
+  w.setGravity(Vec2d(1.5, -4.0));
+  CHECK(w.gravity() == Vec2d(1.5, -4.0));
+  w.setUserForces({UserForce{Vec2d(0.2, 0.2), 0.3, 5.0}});
+  REQUIRE(w.userForces().size() == 1);
+  CHECK(w.userForces()[0].strength == 5.0);
+  CHECK(w.effectEnabled("user_force"));
+  w.setEmitterEnabled(0, false);
+  CHECK_FALSE(w.emitterEnabled(0));
+  w.setEffectEnabled("viscosity", false);
+  CHECK_FALSE(w.effectEnabled("viscosity"));
+
+  // What the getters report is what the step does: a disabled emitter emits nothing and a
+  // disabled effect has no stage.
+  const std::uint64_t before = w.emittedCount(0);
+  for (int f = 0; f < 10; ++f) w.stepFrame();
+  CHECK(w.emittedCount(0) == before);
+  for (const std::string& st : w.stages()) CHECK(st.find("viscosity") == std::string::npos);
+
+  CHECK_THROWS_AS(w.emitterEnabled(1), std::out_of_range);
+  CHECK_THROWS_WITH_AS(w.effectEnabled("foam"), doctest::Contains("its effects: viscosity"), std::invalid_argument);
+}
