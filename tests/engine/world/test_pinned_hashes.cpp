@@ -36,7 +36,7 @@ const Pinned kPinned[] = {
     {"tests/small_dam_break.json", "game", 30, false, 0xdadcd2c66385802cULL},
     {"tests/every_stage.json", "muller2003", 20, true, 0x72355bd9fce4ebf4ULL},
     {"tests/every_stage.json", "wcsph", 20, true, 0xceb4da8bbbfd85d7ULL},
-    {"tests/every_stage.json", "pbf", 20, true, 0x4230dd77fa364c76ULL},
+    {"tests/every_stage.json", "pbf", 20, true, 0xdab73aa1fec082e7ULL},
     {"tests/every_stage.json", "dfsph", 20, true, 0xb2169165f6f130d8ULL},
     {"tests/every_stage.json", "game", 20, true, 0x67ed88475eaf3e55ULL},
     {"validation/poiseuille.json", "wcsph", 20, false, 0x377f8c008f15fca1ULL},
