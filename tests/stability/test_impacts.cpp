@@ -47,9 +47,10 @@ bool inside(const std::vector<Vec2d>& poly, const Vec2d& p) {
 }
 
 /// The most energetic particle's specific energy, as a share of the jet's, that every solver
-/// keeps below (docs/STABILITY.md: what is left is the impulsive pressure at the jet's blunt
-/// front and, for the weakly compressible solvers, the rebound of its compression).
-constexpr double kSpecificEnergyBound = 3.0;
+/// keeps below (docs/STABILITY.md: measured at most 2.32, dfsph; before the impact viscosity
+/// of wcsph and muller2003 and pbf's bounded pushout, wcsph threw one at 2.82). What is left
+/// is the impulsive pressure at the jet's blunt front, which no solver here bounds per particle.
+constexpr double kSpecificEnergyBound = 2.5;
 
 struct JetCase {
   double leftAngle, rightAngle;  ///< the teeth's vertex angles [°]
@@ -82,6 +83,8 @@ void zigzagFunnel(const std::string& solver, const JetCase& jc) {
   const double eJet = 0.5 * jc.speed * jc.speed + g * (e.position.y() + 0.1);
   std::size_t inWall = 0, above = 0;
   double eWorst = 0, totalWorst = 0;
+  Vec2d worstAt(0, 0);  // where and when the most energetic particle was
+  int worstFrame = 0;
   for (int f = 0; f < 90; ++f) {
     w.stepFrame();
     REQUIRE(test::allFiniteState(w));
@@ -90,7 +93,11 @@ void zigzagFunnel(const std::string& solver, const JetCase& jc) {
       const Vec2d p = w.worldPosition(i);
       inWall += inside(left, p) || inside(right, p) || !(p.x() > 0 && p.x() < 4 && p.y() > 0 && p.y() < 4);
       const double ei = 0.5 * double(w.particles().v[i].squaredNorm()) + g * p.y();
-      eWorst = std::max(eWorst, ei / eJet);
+      if (ei / eJet > eWorst) {
+        eWorst = ei / eJet;
+        worstAt = p;
+        worstFrame = f + 1;
+      }
       above += ei > 1.2 * eJet;
       total += ei;
     }
@@ -98,17 +105,18 @@ void zigzagFunnel(const std::string& solver, const JetCase& jc) {
   }
   MESSAGE(solver << " (teeth " << jc.leftAngle << "° and " << jc.rightAngle << "°, " << jc.speed << " m/s): "
                  << w.particleCount() << " particles, " << inWall << " particle-frames inside a wall, the most energetic particle at "
-                 << eWorst << " of the jet's specific energy, " << above << " particle-frames above 1.2, total at most " << totalWorst);
+                 << eWorst << " of the jet's specific energy (frame " << worstFrame << ", at " << worstAt << "), " << above << " particle-frames above 1.2, total at most " << totalWorst);
   CHECK(w.particleCount() > 1000);
   CHECK(inWall == 0);
   CHECK(totalWorst <= 1.0);
-  // Today's main threw single particles at 6.7-7.9 times the jet's specific energy (pbf) and
-  // stopped the game solver with a NaN position; docs/STABILITY.md has each solver's figure.
+  // Once single particles left at 6.7-7.9 times the jet's specific energy (pbf), and the game
+  // solver stopped with a NaN position; docs/STABILITY.md has each solver's figure.
   CHECK(eWorst <= kSpecificEnergyBound);
 }
 
 void funnelHeadOn(const std::string& solver) { zigzagFunnel(solver, JetCase{25, 25, Vec2d(0, -1), 50}); }
 void funnelIntoTeeth(const std::string& solver) { zigzagFunnel(solver, JetCase{20, 32, Vec2d(-0.45, -1), 50}); }
+void funnelSlowerSharper(const std::string& solver) { zigzagFunnel(solver, JetCase{15, 40, Vec2d(0.3, -1), 35}); }
 
 }  // namespace
 
@@ -116,3 +124,5 @@ TEST_CASE_EVERY_SOLVER("a 50 m/s jet down a funnel of 25 degree zigzag chains: f
                        funnelHeadOn)
 TEST_CASE_EVERY_SOLVER("a 50 m/s jet into 20 degree chain teeth: finite, none inside a wall, no particle above the jet's energy",
                        funnelIntoTeeth)
+TEST_CASE_EVERY_SOLVER("a 35 m/s jet into 15 and 40 degree chain teeth: finite, none inside a wall, no particle above the jet's energy",
+                       funnelSlowerSharper)

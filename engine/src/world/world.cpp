@@ -96,6 +96,21 @@ void World::Impl::warnLowSoundSpeed() {
   warnings.push_back(o.str());
 }
 
+/// muller2003's pressure force is not the gradient of an energy (poly6 density, spiky
+/// gradient): with nothing to dissipate what it feeds in, a flow heats up. Monaghan's
+/// elliptical drop (u = −100x, v = 100y, ν = 0; tests/engine/solvers/test_elliptic_drop.cpp)
+/// ended with 2.3 × the exact kinetic energy at 40 spacings a radius and was stopped by
+/// the guard at 80; with effects.shifting it stays within 2 %. One warning names the key and
+/// the remedy (docs/SOLVERS.md has what was measured).
+void World::Impl::warnInviscidMuller() {
+  const SolverDef& sd = scene.solver;
+  if (sd.type != "muller2003" || sd.viscosity > 0) return;
+  warnings.push_back(
+      "solver.viscosity is 0 with muller2003: its pressure force is not the gradient of an energy, so a flow without "
+      "viscosity gains kinetic energy (a strained drop: 2.3 x the exact); set solver.viscosity (about 0.005 m^2/s at "
+      "dx = 0.02 m), or keep the particles evenly spread with effects.shifting (strength 2)");
+}
+
 /// Moving bodies are not wrapped across a periodic seam (Box2D's bodies know no period, and a
 /// particle meets a body's samples and skin only directly, not through the nearest image).
 /// One warning names the scene's first moving body and the seam (or, with a game's b2World,
@@ -162,6 +177,7 @@ void World::initPhases(std::string& phase) {
   w.budget = scene.effects.budget > 0 ? scene.effects.budget : scene.maxParticles;
   if (scene.effects.lifetime) w.P.field("age");
   w.warnLowSoundSpeed();
+  w.warnInviscidMuller();
   w.warnMovingBodiesInPeriodic();
 
   // Local frame: the centre of the scene's box, rounded to 64 m, so that

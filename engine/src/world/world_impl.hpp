@@ -244,6 +244,8 @@ struct World::Impl {
   /// Warns once when a weakly compressible solver's sound speed is below 10 × the fastest
   /// speed the scene sets (blocks, emitters, timeline events).
   void warnLowSoundSpeed();
+  /// One warning when a muller2003 scene has no viscosity (world.cpp).
+  void warnInviscidMuller();
   /// A warning when the scene has moving bodies and a periodic axis (they do not wrap).
   void warnMovingBodiesInPeriodic();
   /// The scene key that sets the particle budget.

@@ -155,10 +155,15 @@ class GridProjection {
   FaceWeights faceWeights(Real px, Real py) const;
   /// Bilinear sample of face fields u, v with weights `w`.
   Vec2 sampleFaces(const std::vector<Real>& u, const std::vector<Real>& v, const FaceWeights& w) const;
+  /// vp no faster than v0, or than the projected velocities of the faces `w` samples together.
+  Vec2 clampToFaces(const Vec2& vp, const Vec2& v0, const FaceWeights& w) const;
 
  public:
   Real pic_ = 0;  ///< share of the projected grid velocity given to the particles (PIC; the rest FLIP)
   bool surface_ = false;  ///< ghost-fluid free surface at the fill level (else at the air cells' centres)
+  /// grid_flip_clamp: a particle's new speed stays within its old one or what the projected
+  /// velocities of the faces it samples reach (grid_projection.cpp, clampToFaces).
+  bool flipClamp_ = false;
   /// Per particle (slot order), the move the last projection's compression shift asks for
   /// (empty when the shift is off); read by the prediction of the same substep.
   const std::vector<Vec2>& shift() const { return shift_; }

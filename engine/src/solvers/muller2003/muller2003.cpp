@@ -18,6 +18,7 @@
 #include "bodies/body_samples.hpp"
 #include "core/constants.hpp"
 #include "effects/effect.hpp"
+#include "solvers/impact_viscosity.hpp"
 #include "solvers/solver.hpp"
 
 #if defined(__SSE2__) && !defined(SPH2D_NO_SIMD)
@@ -232,12 +233,18 @@ void pressure(StepContext& c) {
 /// The constants of one pair term: the spiky gradient and, with the viscosity, its Laplacian.
 struct PairConstants {
   Real R, spikyK, halfMass, coincident2;
+  // The impact viscosity (impact_viscosity.hpp): on, w0, 1/w0, h = R/2, 0.01h², 2 m α c.
+  bool impact;
+  Real impW0, impInvW0, impH, impEta2, impK;
   // ViscosityKernel::laplacianR2's constants, computed as it computes them.
   Real vR2, vR3, pairCap, lapK, rMin, rMin2, invRMin;  // pairCap: ViscosityTerm::pairCap
 };
 
 /// The four contributions of pair (i, j) in scalar code: out = {fpx, fpy, fvx, fvy}
 /// increments (the reference the SIMD lanes reproduce; also coincident pairs and the tail).
+/// With the impact viscosity (k.impact), a pair closing faster than w0 adds −m Π ∇W to the
+/// pressure part, Π = α(w) c μ̄ 2/(ρ_i + ρ_j), μ̄ = h (−v_ij·x_ij)/(r² + 0.01h²), written into
+/// the force density as ρ_i m Π ∇W (impK = 2 m α c, so ρ_i impK s μ̄/(ρ_i + ρ_j)).
 template <bool Visc>
 inline void pairTermScalar(const StepContext& c, const PairConstants& k, std::size_t i, std::uint32_t j, Real pi, Real vix,
                            Real viy, Real out[4]) {
@@ -252,7 +259,19 @@ inline void pairTermScalar(const StepContext& c, const PairConstants& k, std::si
   const Real a = k.R - r;
   const Real irj = IR[j];
   // Spiky gradient dW/dr · d/r, dW/dr = −3c(R − r)², times m (p_i + p_j)/(2 ρ_j).
-  const Real wp = k.spikyK * a * a * invr * (k.halfMass * (pi * irj + POR[j]));
+  const Real g = k.spikyK * a * a * invr;
+  Real wp = g * (k.halfMass * (pi * irj + POR[j]));
+  if (k.impact) {
+    const Vec2* V = c.P.v.data();
+    const Real nv = -((vix - V[j].x()) * dx + (viy - V[j].y()) * dy);  // −v_ij·x_ij
+    const Real w = nv * invr;                                            // approach speed
+    if (w > k.impW0) {
+      const Real rhoi = Real(1) / IR[i];
+      const Real s = std::min((w - k.impW0) * k.impInvW0, Real(1));
+      const Real mu = k.impH * nv / (r2 + k.impEta2);
+      wp = wp + g * (k.impK * rhoi * s * mu / (rhoi + Real(1) / irj));
+    }
+  }
   out[0] = dx * wp;
   out[1] = dy * wp;
   if (Visc) {
@@ -359,8 +378,26 @@ __attribute__((target("avx2"))) void pairSums8(const StepContext& c, const PairC
         invr = _mm256_div_ps(one, sq);
       }
       const __m256 a = _mm256_sub_ps(R8, _mm256_mul_ps(r2, invr));
-      const __m256 wp = _mm256_mul_ps(_mm256_mul_ps(_mm256_mul_ps(_mm256_mul_ps(spikyK, a), a), invr),
-                                      _mm256_mul_ps(halfMass, _mm256_add_ps(_mm256_mul_ps(pi8, irj), porj)));
+      const __m256 gs = _mm256_mul_ps(_mm256_mul_ps(_mm256_mul_ps(spikyK, a), a), invr);
+      __m256 wp = _mm256_mul_ps(gs, _mm256_mul_ps(halfMass, _mm256_add_ps(_mm256_mul_ps(pi8, irj), porj)));
+      __m256 vxj = _mm256_setzero_ps(), vyj = _mm256_setzero_ps();
+      if (Visc || k.impact) gather8(c.P.v.data(), j, vxj, vyj);
+      if (k.impact) {  // pairTermScalar's impact term, lane-wise
+        const __m256 nv = _mm256_sub_ps(_mm256_setzero_ps(), _mm256_add_ps(_mm256_mul_ps(_mm256_sub_ps(vix8, vxj), dx),
+                                                                           _mm256_mul_ps(_mm256_sub_ps(viy8, vyj), dy)));
+        const __m256 w = _mm256_mul_ps(nv, invr);
+        const __m256 fast = _mm256_cmp_ps(w, _mm256_set1_ps(k.impW0), _CMP_GT_OQ);
+        if (_mm256_movemask_ps(fast) & ((1 << n) - 1)) {
+          const __m256 rhoi = _mm256_set1_ps(Real(1) / IR[i]);
+          const __m256 sw =
+              _mm256_min_ps(_mm256_mul_ps(_mm256_sub_ps(w, _mm256_set1_ps(k.impW0)), _mm256_set1_ps(k.impInvW0)), one);
+          const __m256 mu =
+              _mm256_div_ps(_mm256_mul_ps(_mm256_set1_ps(k.impH), nv), _mm256_add_ps(r2, _mm256_set1_ps(k.impEta2)));
+          const __m256 f = _mm256_div_ps(_mm256_mul_ps(_mm256_mul_ps(_mm256_mul_ps(_mm256_set1_ps(k.impK), rhoi), sw), mu),
+                                         _mm256_add_ps(rhoi, _mm256_div_ps(one, irj)));
+          wp = _mm256_blendv_ps(wp, _mm256_add_ps(wp, _mm256_mul_ps(gs, f)), fast);
+        }
+      }
       __m256 t0 = _mm256_mul_ps(dx, wp), t1 = _mm256_mul_ps(dy, wp), t2 = _mm256_setzero_ps(), t3 = _mm256_setzero_ps();
       if (Visc) {
         const __m256 vR2 = _mm256_set1_ps(k.vR2);
@@ -375,8 +412,6 @@ __attribute__((target("avx2"))) void pairSums8(const StepContext& c, const PairC
         lap = _mm256_and_ps(_mm256_cmp_ps(r2, vR2, _CMP_NGE_UQ), lap);  // r² ≥ R²: 0
         // The stability cap (ViscosityTerm::pairCap · ρ_i): std::min's value for finite lanes.
         const __m256 w = _mm256_min_ps(_mm256_mul_ps(lap, irj), _mm256_set1_ps(k.pairCap / IR[i]));
-        __m256 vxj, vyj;
-        gather8(c.P.v.data(), j, vxj, vyj);
         t2 = _mm256_mul_ps(_mm256_sub_ps(vxj, vix8), w);
         t3 = _mm256_mul_ps(_mm256_sub_ps(vyj, viy8), w);
       }
@@ -403,7 +438,7 @@ __attribute__((target("avx2"))) void pairSums8(const StepContext& c, const PairC
 #endif
 
 template <bool Visc>
-std::size_t pressureForce(StepContext& c, const Spiky<Real>& spiky, const ViscosityTerm& vt,
+std::size_t pressureForce(StepContext& c, const Spiky<Real>& spiky, const ViscosityTerm& vt, const ImpactViscosity& impact,
                           std::vector<Vec2d>& wallBlock) {
   ParticleStore& P = c.P;
   const BoundarySet& B = c.boundary;
@@ -414,6 +449,14 @@ std::size_t pressureForce(StepContext& c, const Spiky<Real>& spiky, const Viscos
   k.spikyK = Real(-3) * spiky.c;  // dW/dr = −3c(R − r)²
   k.halfMass = Real(0.5) * c.mass;
   k.coincident2 = kCoincident2 * (c.R * c.R);
+  k.impact = impact.on();
+  if (k.impact) {
+    k.impW0 = impact.w0;
+    k.impInvW0 = Real(1) / impact.w0;
+    k.impH = Real(0.5) * c.R;
+    k.impEta2 = Real(0.01) * k.impH * k.impH;
+    k.impK = Real(2) * c.mass * impact.alpha0 * Real(c.def.soundSpeed);
+  }
   const ViscosityKernel<Real>& W = vt.W;
   if (Visc) {
     k.vR2 = W.R * W.R;
@@ -502,8 +545,24 @@ std::size_t pressureForce(StepContext& c, const Spiky<Real>& spiky, const Viscos
           const __m128 sq = _mm_sqrt_ps(r2);
           const __m128 invr = _mm_div_ps(K4.one, sq);
           const __m128 a = _mm_sub_ps(K4.R, _mm_mul_ps(r2, invr));
-          const __m128 wp = _mm_mul_ps(_mm_mul_ps(_mm_mul_ps(_mm_mul_ps(K4.spikyK, a), a), invr),
-                                       _mm_mul_ps(K4.halfMass, _mm_add_ps(_mm_mul_ps(pi4, irj), porj)));
+          const __m128 gs = _mm_mul_ps(_mm_mul_ps(_mm_mul_ps(K4.spikyK, a), a), invr);
+          __m128 wp = _mm_mul_ps(gs, _mm_mul_ps(K4.halfMass, _mm_add_ps(_mm_mul_ps(pi4, irj), porj)));
+          __m128 vxj = _mm_setzero_ps(), vyj = _mm_setzero_ps();
+          if (Visc || k.impact) gather4(V, j0, j1, j2, j3, vxj, vyj);
+          if (k.impact) {  // pairTermScalar's impact term, lane-wise
+            const __m128 nv = _mm_sub_ps(_mm_setzero_ps(), _mm_add_ps(_mm_mul_ps(_mm_sub_ps(vix4, vxj), dx),
+                                                                      _mm_mul_ps(_mm_sub_ps(viy4, vyj), dy)));
+            const __m128 w = _mm_mul_ps(nv, invr);
+            const __m128 fast = _mm_cmpgt_ps(w, _mm_set1_ps(k.impW0));
+            if (_mm_movemask_ps(fast) & ((1 << n) - 1)) {
+              const __m128 rhoi = _mm_set1_ps(Real(1) / IR[i]);
+              const __m128 sw = _mm_min_ps(_mm_mul_ps(_mm_sub_ps(w, _mm_set1_ps(k.impW0)), _mm_set1_ps(k.impInvW0)), K4.one);
+              const __m128 mu = _mm_div_ps(_mm_mul_ps(_mm_set1_ps(k.impH), nv), _mm_add_ps(r2, _mm_set1_ps(k.impEta2)));
+              const __m128 f = _mm_div_ps(_mm_mul_ps(_mm_mul_ps(_mm_mul_ps(_mm_set1_ps(k.impK), rhoi), sw), mu),
+                                          _mm_add_ps(rhoi, _mm_div_ps(K4.one, irj)));
+              wp = _mm_or_ps(_mm_and_ps(fast, _mm_add_ps(wp, _mm_mul_ps(gs, f))), _mm_andnot_ps(fast, wp));
+            }
+          }
           __m128 t[4] = {_mm_mul_ps(dx, wp), _mm_mul_ps(dy, wp), _mm_setzero_ps(), _mm_setzero_ps()};
           if (Visc) {
             const __m128 big = _mm_cmpgt_ps(r2, K4.rMin2);
@@ -516,8 +575,6 @@ std::size_t pressureForce(StepContext& c, const Spiky<Real>& spiky, const Viscos
             lap = _mm_mul_ps(_mm_mul_ps(_mm_mul_ps(lap, iq), iq), iq);
             lap = _mm_and_ps(_mm_cmpnge_ps(r2, K4.vR2), lap);  // r² ≥ R²: 0
             const __m128 w = _mm_min_ps(_mm_mul_ps(lap, irj), capI4);  // the stability cap (std::min's value for finite lanes)
-            __m128 vxj, vyj;
-            gather4(V, j0, j1, j2, j3, vxj, vyj);
             t[2] = _mm_mul_ps(_mm_sub_ps(vxj, vix4), w);
             t[3] = _mm_mul_ps(_mm_sub_ps(vyj, viy4), w);
           }
@@ -626,7 +683,8 @@ std::size_t pressureForce(StepContext& c, const Spiky<Real>& spiky, const Viscos
 
 class Muller2003 final : public Solver {
  public:
-  explicit Muller2003(const SolverDef& d) : c_(d.soundSpeed) {}
+  explicit Muller2003(const SolverDef& d)
+      : c_(d.soundSpeed), impact_(Real(d.param("impact_alpha")), Real(d.param("impact_speed") * d.soundSpeed)) {}
   const char* name() const override { return "muller2003"; }
   // p = c²(ρ − ρ0) and the symmetric force recovers ∇p/2: ρ = ρ0(1 + 2 g z / c²).
   double hydrostaticFactor() const override { return 2.0 / (c_ * c_); }
@@ -661,14 +719,15 @@ class Muller2003 final : public Solver {
   std::vector<Stage> stages(bool) override {
     std::vector<Stage> s = explicitStages([](StepContext& c) { return density(c, Poly6<Real>(c.R)); }, pressure,
                                           [this](StepContext& c) {
-                                            return pressureForce<false>(c, Spiky<Real>(c.R), ViscosityTerm{}, wallBlock_);
+                                            return pressureForce<false>(c, Spiky<Real>(c.R), ViscosityTerm{}, impact_,
+                                                                        wallBlock_);
                                           });
     if (Effect* v = viscosity_) {
       for (Stage& st : s)
         if (st.name == "pressure_force") {
           st.name = "pressure_force+viscosity";
           st.run = [this, v](StepContext& c) {
-            return pressureForce<true>(c, Spiky<Real>(c.R), v->viscosityTerm(c), wallBlock_);
+            return pressureForce<true>(c, Spiky<Real>(c.R), v->viscosityTerm(c), impact_, wallBlock_);
           };
         }
     }
@@ -677,15 +736,18 @@ class Muller2003 final : public Solver {
 
  private:
   double c_;
+  ImpactViscosity impact_;        ///< impact_alpha, impact_speed (impact_viscosity.hpp)
   Effect* viscosity_ = nullptr;  ///< the folded viscosity effect (foldViscosity), or null
   std::vector<Vec2d> wallBlock_;  ///< per block of kBlock particles, Σ of the walls' acceleration
 };
 
 }  // namespace
 
-/// muller2003's registration (solvers.def): no parameters of its own (solver.sound_speed is its stiffness).
+/// muller2003's registration (solvers.def): its parameters are the impact viscosity's
+/// (solver.sound_speed is its stiffness).
 SolverInfo muller2003Solver() {
-  return {"muller2003", {}, [](const SolverDef& d) -> std::unique_ptr<Solver> { return std::make_unique<Muller2003>(d); }};
+  return {"muller2003", {kImpactAlphaParam, kImpactSpeedParam},
+          [](const SolverDef& d) -> std::unique_ptr<Solver> { return std::make_unique<Muller2003>(d); }};
 }
 
 }  // namespace sph2d

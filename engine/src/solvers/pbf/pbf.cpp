@@ -31,7 +31,10 @@ Pbf::Pbf(const SolverDef& d)
       xsph_(Real(d.param("xsph"))),
       maxDt_(Real(d.param("max_dt"))),
       maxMove_(Real(d.param("max_move"))),
-      toVelocity_(Real(d.param("correction_to_velocity"))), adaptiveDt_(d.param("adaptive_dt") != 0),
+      toVelocity_(Real(d.param("correction_to_velocity"))),
+      pushoutSpeed_(Real(d.param("pushout_speed"))),
+      maxApproach_(Real(d.param("max_approach"))),
+      adaptiveDt_(d.param("adaptive_dt") != 0),
       quantile_(Real(d.param("speed_quantile"))), moveCap_(Real(d.param("move_cap"))),
       localIterations_(int(std::lround(d.param("local_iterations")))), resolveEach_(d.param("resolve_each") != 0) {
   if (d.param("grid_cell") > 0)
@@ -42,11 +45,15 @@ Pbf::Pbf(const SolverDef& d)
                                                              Real(d.param("grid_shift_tolerance")), Real(d.param("grid_fill"))});
   if (projection_) projection_->pic_ = Real(d.param("grid_pic"));
   if (projection_) projection_->surface_ = d.param("grid_surface") > 0;
+  if (projection_) projection_->flipClamp_ = d.param("grid_flip_clamp") > 0;
 }
 
 void Pbf::prepare(StepContext& c) {
   calibrate(c);
   c.P.field("pbf.lambda");
+  // Every field before any stage takes a reference to one (a new field may move the others).
+  if (pushoutSpeed_ > 0 && toVelocity_ > 0) c.P.field("pbf.carried");
+  if (maxApproach_ > 0) c.P.field("pbf.approach");
   if (c.P.size() == 0) return;
   stageGrid(c, false);
   stageNeighbours(c);
@@ -58,6 +65,20 @@ Real Pbf::maxTimeStep(const StepContext& c, Real vmax, Real amax) const {
   Real dt = std::min(maxDt_, dtLimit_);
   if (quantile_ > 0 && c.P.size() > 0) vmax = std::max(robustSpeed(c), c.sourceSpeed);  // an emitter's jet is no spray
   if (vmax > 0) dt = std::min(dt, maxMove_ * c.R / vmax);
+  if (maxApproach_ > 0 && c.P.size() > 0) {
+    // The fastest approach of two neighbours as the last substep ended (velocity()).
+    const std::vector<Real>* ap = c.P.find("pbf.approach");
+    const Real w = ap ? c.pool.reduce(
+                            c.P.size(), kStreamBlock, Real(0),
+                            [&](std::size_t b, std::size_t e) {
+                              Real m = 0;
+                              for (std::size_t i = b; i < e; ++i) m = std::max(m, (*ap)[i]);
+                              return m;
+                            },
+                            [](Real a, Real b2) { return std::max(a, b2); })
+                      : Real(0);
+    if (w > 0) dt = std::min(dt, maxApproach_ * c.R / w);
+  }
   // The hydrostatic pressure's own stiffness, as dfsph's (docs/SOLVERS.md): without the grid
   // projection the Jacobi iterations carry a deep column's pressure, and a substep in which a
   // wave of speed sqrt(|g| D) runs past a support leaves the floor rows crushed and then
@@ -138,20 +159,32 @@ std::size_t Pbf::solve(StepContext& c) {
   lOld_.resize(n);
   wallGrad_.resize(n);
   const int maxIt = std::max(iterations_, maxIterations_);
-  const Real rho2 = chebyshev_ * chebyshev_;
-  Real omega = 1;
   int used = 0;
-  bool plain = false;
-  for (int k = 0; k < maxIt; ++k, ++used) {
-    const std::size_t bad = constraint(c, lambda);
-    if (bad != kNone) return bad;
-    if (k >= iterations_ && (localIterations_ > 0 ? meanCompression_ <= tolerance_ : converged())) break;
-    // Chebyshev weights (Wang 2015): ω1 = 1, ω2 = 2/(2 − ρ²), ω_{k+1} = 4/(4 − ρ²ω_k); none
-    // in a substep whose first pass finds a compression above chebyshev_plain_above.
-    if (k == 0) plain = chebPlainAbove_ > 0 && maxCompression_ > chebPlainAbove_;  // an impact (pbf.hpp)
-    omega = plain || k == 0 ? Real(1) : k == 1 ? Real(2) / (Real(2) - rho2) : Real(4) / (Real(4) - rho2 * omega);
-    const std::size_t badC = correct(c, lambda, omega);
-    if (badC != kNone) return badC;
+  // pushout_speed (pbf.hpp): first what becomes velocity, then the rest with positions only.
+  const bool split = pushoutSpeed_ > 0 && toVelocity_ > 0;
+  againstStart_ = split;
+  velocityFromSnapshot_ = false;
+  std::size_t badIt = iterate(c, lambda, maxIt, used);
+  if (badIt != kNone) return badIt;
+  // The first solve's figures, for the step-limit controller (below).
+  bool convergedFirst = converged();
+  Real meanFirst = meanCompression_, maxFirst = maxCompression_;
+  const int usedFirst = used;
+  if (split) {
+    againstStart_ = false;
+    if (!(plainMean_ <= tolerance_ && plainMax_ <= toleranceMax_)) {
+      // The rest (the compression the substep started with) is pushed out with positions only.
+      xVel_.assign(c.P.x.begin(), c.P.x.end());
+      wallMoveVel_[0] = wallMove_[0];
+      wallMoveVel_[1] = wallMove_[1];
+      velocityFromSnapshot_ = true;
+      int more = 0;
+      badIt = iterate(c, lambda, maxIt, more);
+      if (badIt != kNone) return badIt;
+      used += more;
+    }
+    meanCompression_ = plainMean_;  // what the substep leaves
+    maxCompression_ = plainMax_;
   }
   // Local iterations: only the particles near a compression above tolerance_max
   // (and their neighbours) take further Jacobi steps; the rest keep their place.
@@ -227,17 +260,41 @@ std::size_t Pbf::solve(StepContext& c) {
   }
   stats_.pressureIterations = used + local;  // corrections applied
   stats_.densityError = double(meanCompression_);
+  if (!split) {  // the last pass's (the local iterations may have gone on)
+    convergedFirst = converged();
+    meanFirst = meanCompression_;
+    maxFirst = maxCompression_;
+  }
   if (tolerance_ > 0 && adaptiveDt_) {
     // The compression left after N iterations grows as dt²/N²: when max_iterations
     // did not reach the tolerance, the next substeps are shorter; when half of them
-    // sufficed, the limit grows back towards max_dt.
-    if (!converged()) {
-      const Real ratio = std::min(tolerance_ / meanCompression_, toleranceMax_ / maxCompression_);
+    // sufficed, the limit grows back towards max_dt. (pushout_speed: the first solve's, the
+    // one a shorter substep helps; the rest of the older compression moves positions only.)
+    if (!convergedFirst) {
+      const Real ratio = std::min(tolerance_ / meanFirst, toleranceMax_ / maxFirst);
       dtLimit_ = c.dt * std::min(Real(0.9), std::max(Real(0.5), Real(0.9) * std::sqrt(ratio)));
       dtLimit_ = std::max(dtLimit_, maxDt_ / Real(32));  // a jam it cannot resolve must not stall the run
-    } else if (2 * used <= maxIt) {
+    } else if (2 * (split ? usedFirst : used) <= maxIt) {
       dtLimit_ = std::min(maxDt_, dtLimit_ * Real(1.2));
     }
+  }
+  return kNone;
+}
+
+std::size_t Pbf::iterate(StepContext& c, std::vector<Real>& lambda, int maxIt, int& used) {
+  const Real rho2 = chebyshev_ * chebyshev_;
+  Real omega = 1;
+  bool plain = false;
+  for (int k = 0; k < maxIt; ++k, ++used) {
+    const std::size_t bad = constraint(c, lambda);
+    if (bad != kNone) return bad;
+    if (k >= iterations_ && (localIterations_ > 0 ? meanCompression_ <= tolerance_ : converged())) break;
+    // Chebyshev weights (Wang 2015): ω1 = 1, ω2 = 2/(2 − ρ²), ω_{k+1} = 4/(4 − ρ²ω_k); none
+    // in a substep whose first pass finds a compression above chebyshev_plain_above.
+    if (k == 0) plain = chebPlainAbove_ > 0 && maxCompression_ > chebPlainAbove_;  // an impact (pbf.hpp)
+    omega = plain || k == 0 ? Real(1) : k == 1 ? Real(2) / (Real(2) - rho2) : Real(4) / (Real(4) - rho2 * omega);
+    const std::size_t badC = correct(c, lambda, omega);
+    if (badC != kNone) return badC;
   }
   return kNone;
 }
@@ -284,6 +341,11 @@ std::size_t Pbf::predict(StepContext& c, std::vector<Real>& lambda) {
   const bool countWall = c.wall && toVelocity_ > 0;
   const std::size_t blocks = (P.size() + kBlock - 1) / kBlock;
   if (countWall) wallBlock_.assign(2 * blocks, Vec2d(0, 0));
+  // pushout_speed: the compression each particle starts with (ρ of its positions: the last
+  // substep's final density; ρ0 for a particle added since), less what the pushout speed
+  // may remove as velocity in this substep.
+  std::vector<Real>* carried = pushoutSpeed_ > 0 && toVelocity_ > 0 ? P.find("pbf.carried") : nullptr;
+  const Real pushout = Real(2) * pushoutSpeed_ * dt / c.dx;
   const std::size_t first = firstBad(c.pool, P.size(), [&](std::size_t b, std::size_t e) {
     std::size_t bad = kNone;
     Vec2d push(0, 0);
@@ -305,6 +367,7 @@ std::size_t Pbf::predict(StepContext& c, std::vector<Real>& lambda) {
       P.v[i] = v;
       P.x[i] = x;
       lambda[i] = 0;
+      if (carried) (*carried)[i] = std::max(Real(0), P.rho[i] / c.rho0 - Real(1) - pushout);
       // A move longer than the speed limit allows over the substep is a runaway too (the
       // shift and the sweep move positions without a velocity the speed check would see).
       if (bad == kNone && (!allFinite(x) || !allFinite(v) || v.squaredNorm() > vmax2 || (x - x0).squaredNorm() > moveMax2))
@@ -408,7 +471,10 @@ std::size_t Pbf::finalDensity(StepContext& c, Real dt) {
 std::size_t Pbf::velocity(StepContext& c) {
   ParticleStore& P = c.P;
   const Real invDt = Real(1) / c.dt, vmax2 = c.maxSpeed * c.maxSpeed;
-  const Vec2* X = P.x.data();
+  // pushout_speed: the positions the first solve left (what came after moved positions only).
+  const Vec2* X = velocityFromSnapshot_ && xVel_.size() == P.size() ? xVel_.data() : P.x.data();
+  const Vec2* XF = P.x.data();  // the final positions: the pairs' directions
+  std::vector<Real>* approach = maxApproach_ > 0 ? P.find("pbf.approach") : nullptr;
   const Vec2* X0 = P.xPrev.data();
   const Real* IR = P.invRho.data();
   const Spiky<Real> S(c.R);
@@ -428,6 +494,22 @@ std::size_t Pbf::velocity(StepContext& c) {
     std::size_t bad = kNone;
     for (std::size_t i = b; i < e; ++i) {
       const Vec2 vi = vel(i);
+      if (approach) {
+        // max_approach: the fastest a neighbour closes on i, −(v_i − v_j)·x_ij/|x_ij| (pbf.hpp).
+        const std::uint32_t* nb = c.nbr.of(i);
+        const std::uint32_t cnt = c.nbr.count[i];
+        Real w2 = 0;  // the largest (v_ij·x_ij)²/|x_ij|² of an approaching pair
+        for (std::uint32_t k = 0; k < cnt; ++k) {
+          const std::uint32_t j = nb[k];
+          Real dx = XF[i].x() - XF[j].x(), dy = XF[i].y() - XF[j].y();
+          c.periodic.nearest(dx, dy);
+          const Vec2 vj = vel(j);
+          const Real vd = (vi.x() - vj.x()) * dx + (vi.y() - vj.y()) * dy;
+          const Real r2 = dx * dx + dy * dy;
+          if (vd < 0 && r2 > 0) w2 = std::max(w2, vd * vd / r2);
+        }
+        (*approach)[i] = std::sqrt(w2);
+      }
       Vec2 v = vi;
       if (cm > 0) {
         const std::uint32_t* nb = c.nbr.of(i);
@@ -457,8 +539,9 @@ std::size_t Pbf::velocity(StepContext& c) {
   // The walls' share of the move becomes velocity as the move does: kc·D/dt (XSPH then mixes
   // velocities among the particles, which keeps their sum up to the density ratio).
   if (c.wall && kc > 0) {
-    c.wall->sum.samples += wallMove_[0] * (double(c.mass) * double(kc) / double(c.dt));
-    c.wall->sum.collision += wallMove_[1] * (double(c.mass) * double(kc) / double(c.dt));
+    const Vec2d* moved = velocityFromSnapshot_ ? wallMoveVel_ : wallMove_;  // pushout_speed: the first solve's
+    c.wall->sum.samples += moved[0] * (double(c.mass) * double(kc) / double(c.dt));
+    c.wall->sum.collision += moved[1] * (double(c.mass) * double(kc) / double(c.dt));
   }
   return first;
 }

@@ -143,10 +143,14 @@ std::size_t Pbf::constraint(StepContext& c, const std::vector<Real>& lambda, con
   blockMax_.resize(parts);
   const Vec2* X = P.x.data();
   const bool periodic = c.periodic.any();
+  // The first solve of a pushout substep: C_i − K_i (pbf.hpp, pushout_speed).
+  const Real* start = againstStart_ ? P.find("pbf.carried")->data() : nullptr;
+  blockPlainErr_.resize(parts);
+  blockPlainMax_.resize(parts);
   const std::size_t first = c.pool.reduce(count, step, kNone, [&](std::size_t b, std::size_t e) {
     std::size_t bad = kNone;
-    double err = 0;
-    Real worst = 0;
+    double err = 0, plainErr = 0;
+    Real worst = 0, plainWorst = 0;
     const Lane4 zero = Lane4::all(0), one = Lane4::all(1), vInvR = Lane4::all(invR), vVg = Lane4::all(Vg);
     const Lane4 vFar2 = Lane4::all(far2), vTiny2 = Lane4::all(tiny2);
     const float* xy = reinterpret_cast<const float*>(X);
@@ -266,7 +270,8 @@ std::size_t Pbf::constraint(StepContext& c, const std::vector<Real>& lambda, con
         giy += wall.y();
       }
       wallGrad_[i] = wall;
-      const Real C = rho / c.rho0 - Real(1);
+      const Real plainC = rho / c.rho0 - Real(1);
+      const Real C = start ? plainC - start[i] : plainC;
       const Real D = gix * gix + giy * giy + g2;
       // ρ0/ρ when compressed, else 1: min(1, ρ0/ρ) is the same value (ρ ≥ 0; for ρ > ρ0,
       // ρ0/ρ rounds to 1 at most; for ρ ≤ ρ0, to 1 at least).
@@ -277,20 +282,32 @@ std::size_t Pbf::constraint(StepContext& c, const std::vector<Real>& lambda, con
       P.rho[i] = rho;
       err += double(maxOf(Real(0), C));
       worst = maxOf(worst, C);
+      if (start) {
+        plainErr += double(maxOf(Real(0), plainC));
+        plainWorst = maxOf(plainWorst, plainC);
+      }
       if (bad == kNone && !std::isfinite(lNew)) bad = i;
     }
     blockErr_[b / step] = err;
     blockMax_[b / step] = worst;
+    blockPlainErr_[b / step] = start ? plainErr : err;
+    blockPlainMax_[b / step] = start ? plainWorst : worst;
     return bad;
   }, [](std::size_t a, std::size_t b2) { return std::min(a, b2); });
-  double sum = 0;
-  Real mx = 0;
+  double sum = 0, plainSum = 0;
+  Real mx = 0, plainMx = 0;
   for (std::size_t k = 0; k < parts; ++k) {  // in block order: the same for any thread count
     sum += blockErr_[k];
     mx = std::max(mx, blockMax_[k]);
+    plainSum += blockPlainErr_[k];
+    plainMx = std::max(plainMx, blockPlainMax_[k]);
   }
-  if (!list) meanCompression_ = Real(sum / double(P.size()));
+  if (!list) {
+    meanCompression_ = Real(sum / double(P.size()));
+    plainMean_ = Real(plainSum / double(P.size()));
+  }
   maxCompression_ = mx;
+  plainMax_ = plainMx;
   rhoCurrent_ = list == nullptr;  // a full pass: ρ and W are those of the current positions
   return first;
 }

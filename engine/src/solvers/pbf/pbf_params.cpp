@@ -19,8 +19,9 @@ std::vector<SolverParam> pbfParams(bool game) {
        "then at most this many iterations on the particles near a compression above tolerance_max (and their neighbours)"},
       {"relaxation", 0.5, 0, 100, "ε of the constraint denominator, in units of its value on a full rest lattice"},
       {"chebyshev", 0.9, 0, 0.99, "Chebyshev acceleration: spectral radius estimate ρ (0: plain Jacobi)"},
-      {"chebyshev_plain_above", g(0.3, 0), 0, 100,
-       "a substep whose first pass finds a compression above this runs plain Jacobi (an impact; 0: never)"},
+      {"chebyshev_plain_above", g(0.1, 0), 0, 100,
+       "a substep whose first pass finds a compression above this runs plain Jacobi (an impact; 0: never; with "
+       "pushout_speed, beyond what the substep may remove as velocity)"},
       {"tensile_k", 0, 0, 1, "s_corr strength k, in multipliers of a unit density error (0: off)"},
       {"tensile_n", 4, 1, 8, "s_corr exponent n (integer)"},
       {"tensile_dq", 0.2, 0.01, 0.9, "s_corr reference distance Δq, in units of the support R"},
@@ -32,6 +33,11 @@ std::vector<SolverParam> pbfParams(bool game) {
       {"move_cap", g(0, 1.5), 0, 100, "> 0: no particle moves more than move_cap · max_move · R in a substep (its speed is cut)"},
       {"adaptive_dt", g(1, 0), 0, 1, "1: shorter substeps while max_iterations end above the tolerances"},
       {"correction_to_velocity", g(1, 0), 0, 1, "share of the density correction's move that becomes velocity"},
+      {"pushout_speed", g(0.3, 0), 0, 1000,
+       "m/s: the compression a substep starts with becomes velocity at most at this speed (ρ0·2·v·dt/dx a substep); the "
+       "rest is pushed out moving positions only (with correction_to_velocity > 0; 0: no limit)"},
+      {"max_approach", g(0.5, 0), 0, 10,
+       "dt ≤ max_approach · R / w, w the fastest approach of two neighbours (m/s) at the end of the last substep (0: off)"},
       {"resolve_each", 1, 0, 1, "1: every correction is swept out of the solids (0: the World's collision after the substep)"},
       {"grid_cell", g(0, 2), 0, 16, "coarse-grid projection (Hybrid SPH): cell size in spacings (0: none)"},
       {"grid_fluid_fraction", g(0.5, 0.15), 0.01, 1,
@@ -49,6 +55,9 @@ std::vector<SolverParam> pbfParams(bool game) {
       {"grid_tolerance", 1e-3, 1e-7, 1, "grid solve: the density change per substep its largest residual may stand for"},
       {"grid_max_iterations", 200, 1, 10000, "grid solve: conjugate-gradient iterations at most"},
       {"grid_pic", g(0, 0.05), 0, 1, "share of the projected grid velocity the particles take (PIC; the rest is the FLIP change)"},
+      {"grid_flip_clamp", 0, 0, 1,
+       "1: the transfer makes no particle faster than it was or than the projected velocities of the faces it samples "
+       "reach (no new extreme of speed)"},
   };
 }
 

@@ -23,11 +23,17 @@
 // Beyond ρ = 1.1 ρ0 the equation of state continues along its tangent (stacked
 // or overlapping particles separate instead of exploding).
 //
-// Parameters (solver.*): gamma, alpha, expected_speed.
+// Impacts (impact_alpha, impact_speed; solvers/impact_viscosity.hpp): a pair
+// approaching faster than impact_speed·c0 takes up to impact_alpha more of the same
+// artificial viscosity, so that a collision at impact speeds is damped near critically
+// instead of bouncing off the compression it stores.
+//
+// Parameters (solver.*): gamma, alpha, expected_speed, impact_alpha, impact_speed.
 #include <algorithm>
 #include <cmath>
 
 #include "bodies/body_samples.hpp"
+#include "solvers/impact_viscosity.hpp"
 #include "solvers/solver.hpp"
 
 namespace sph2d {
@@ -38,7 +44,8 @@ class Wcsph final : public Solver {
   explicit Wcsph(const SolverDef& d)
       : gamma_(Real(d.param("gamma"))),
         alpha_(Real(d.param("alpha"))),
-        c0_(Real(d.param("expected_speed") > 0 ? 10 * d.param("expected_speed") : d.soundSpeed)) {}
+        c0_(Real(d.param("expected_speed") > 0 ? 10 * d.param("expected_speed") : d.soundSpeed)),
+        impact_(Real(d.param("impact_alpha")), Real(d.param("impact_speed")) * c0_) {}
 
   const char* name() const override { return "wcsph"; }
   // Tait linearised at rest: ρ ≈ ρ0(1 + g z / c0²).
@@ -164,6 +171,7 @@ class Wcsph final : public Solver {
     const Real gradFlat = gradK * aFlat * aFlat * aFlat * (kFlatGradientQ * R);  // |∇W| at its peak, times r/|d|
     const Real pScale = Real(1.0 / latticeGradientMoment(WendlandC2<double>(double(c.R)), double(c.dx), double(c.mass / c.rho0)));
     const Real avK = alpha_ * c0_;  // Π = −α c μ / ρ̄ with μ = h v·x / (r² + 0.01h²)
+    const ImpactViscosity& imp = impact_;  // + the impact share for fast approaches
     const Real eta2 = Real(0.01) * h * h;
     const Vec2* X = P.x.data();
     const Vec2* V = P.v.data();
@@ -197,6 +205,8 @@ class Wcsph final : public Solver {
           if (vdotx < 0) {
             const Real mu = h * vdotx / (r2 + eta2);
             coef += c.mass * avK * mu * Real(2) / (Real(1) / iri + Real(1) / IR[j]);
+            const Real ai = imp.alpha(vdotx, r);
+            if (ai > 0) coef += c.mass * (c0_ * ai) * mu * Real(2) / (Real(1) / iri + Real(1) / IR[j]);
           }
           ax += coef * g * dx;
           ay += coef * g * dy;
@@ -204,7 +214,8 @@ class Wcsph final : public Solver {
         Vec2 acc(ax, ay);
         if (walls) {
           const Real pi = P.p[i], rhoi = P.rho[i];
-          Vec2 gb = Vec2::Zero(), gv = Vec2::Zero();
+          Vec2 gb = Vec2::Zero(), gv = Vec2::Zero(), gi = Vec2::Zero();  // gi: the impact share of gv, by α
+          bool impactWall = false;
           const std::uint32_t* bl = c.nbr.boundaryOf(i);
           for (std::uint32_t k = 0; k < c.nbr.boundaryCount[i]; ++k) {
             const std::uint32_t s = bl[k];
@@ -218,9 +229,16 @@ class Wcsph final : public Solver {
             gb += d * (gw * (pri + pb / (c.rho0 * c.rho0)));
             // Artificial viscosity against the sample (frozen fluid at rest) when approaching it.
             const Real vdotx = vix * d.x() + viy * d.y();
-            if (vdotx < 0) gv += d * (gw * (h * vdotx / (rr + eta2)));
+            if (vdotx < 0) {
+              const Vec2 t = d * (gw * (h * vdotx / (rr + eta2)));
+              gv += t;
+              const Real ai = imp.alpha(vdotx, std::sqrt(rr));
+              if (ai > 0) gi += t * ai, impactWall = true;
+            }
           }
-          const Vec2 aPressure = gb * (c.rho0 * pScale), aViscous = gv * (c.rho0 * avK * Real(2) / (rhoi + c.rho0));
+          Vec2 aViscous = gv * (c.rho0 * avK * Real(2) / (rhoi + c.rho0));
+          if (impactWall) aViscous += gi * (c.rho0 * c0_ * Real(2) / (rhoi + c.rho0));
+          const Vec2 aPressure = gb * (c.rho0 * pScale);
           acc -= aPressure;
           acc += aViscous;
           wallAcc += aViscous.cast<double>() - aPressure.cast<double>();  // this particle's wall acceleration
@@ -231,11 +249,13 @@ class Wcsph final : public Solver {
           // share of the acceleration is also its reaction (body_samples.hpp).
           const Real pi = P.p[i], rhoi = P.rho[i];
           const Real pressK = c.rho0 * pScale, viscK = c.rho0 * avK * Real(2) / (rhoi + c.rho0);
+          const Real impactK = c.rho0 * c0_ * Real(2) / (rhoi + c.rho0);
           const std::uint32_t* ml = c.nbr.movingOf(i);
           const std::uint32_t mc = c.nbr.movingCount[i];
           moving->forEachBody(ml, mc, [&](std::uint32_t body, const std::uint32_t* run, const std::uint32_t* runEnd) {
-            Vec2 gb = Vec2::Zero(), gv = Vec2::Zero();
-            Real tb = 0, tv = 0;  // Σ arm × (the pair's term), for the torque
+            Vec2 gb = Vec2::Zero(), gv = Vec2::Zero(), gi = Vec2::Zero();  // gi: the impact share of gv, by α
+            Real tb = 0, tv = 0, ti = 0;  // Σ arm × (the pair's term), for the torque
+            bool impact = false;
             for (const std::uint32_t* p = run; p != runEnd; ++p) {
               const std::uint32_t s = *p;
               const Vec2 d = X[i] - moving->x[s];
@@ -253,13 +273,23 @@ class Wcsph final : public Solver {
                 const Vec2 fv = d * (gw * (h * vdotx / (rr + eta2)));
                 gv += fv;
                 tv += BodySamples::torque(moving->arm[s], fv);
+                const Real ai = imp.alpha(vdotx, std::sqrt(rr));
+                if (ai > 0) {
+                  gi += fv * ai;
+                  ti += BodySamples::torque(moving->arm[s], fv * ai);
+                  impact = true;
+                }
               }
             }
-            const Vec2 aBody = gv * viscK - gb * pressK;
+            Vec2 aBody = gv * viscK - gb * pressK;
+            double torque = double(tv) * double(viscK) - double(tb) * double(pressK);
+            if (impact) {
+              aBody += gi * impactK;
+              torque += double(ti) * double(impactK);
+            }
             acc += aBody;
             if (moving->placed[body].dynamic)
-              moving->addReaction(b / kBlock, body, aBody.cast<double>() * double(c.mass),
-                                  (double(tv) * double(viscK) - double(tb) * double(pressK)) * double(c.mass));
+              moving->addReaction(b / kBlock, body, aBody.cast<double>() * double(c.mass), torque * double(c.mass));
           });
         }
         acc += c.gravity;
@@ -276,6 +306,7 @@ class Wcsph final : public Solver {
   }
 
   Real gamma_, alpha_, c0_;
+  ImpactViscosity impact_;
   /// p/ρ² per particle, written by the pressure stage for the pressure force of the
   /// same substep (no reordering between them).
   std::vector<Real> pOverRho2_;
@@ -290,7 +321,8 @@ SolverInfo wcsphSolver() {
   return {"wcsph",
           {{"gamma", 7, 1, 10, "Tait exponent γ in p = B((ρ/ρ0)^γ − 1), B = ρ0c²/γ"},
            {"alpha", 0.05, 0, 2, "Monaghan artificial viscosity α (Π = −α c h μ/ρ̄ for approaching pairs)"},
-           {"expected_speed", 0, 0, 1e4, "when > 0, the sound speed is 10 × this (m/s) instead of sound_speed"}},
+           {"expected_speed", 0, 0, 1e4, "when > 0, the sound speed is 10 × this (m/s) instead of sound_speed"},
+           kImpactAlphaParam, kImpactSpeedParam},
           [](const SolverDef& d) -> std::unique_ptr<Solver> { return std::make_unique<Wcsph>(d); }};
 }
 
