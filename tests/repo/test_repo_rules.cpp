@@ -1,11 +1,14 @@
-// What must stay true of the repository itself (CONTRIBUTING.md): no include against the
-// engine's folder order (docs/ARCHITECTURE.md).
+// What must stay true of the repository itself (CONTRIBUTING.md): no source file over 600
+// lines; no include against the engine's folder order (docs/ARCHITECTURE.md); no reference doc
+// naming an issue, a session or a date, or a path outside the repository (docs/notes/ and
+// CHANGELOG.md are history: they may).
 #include <doctest/doctest.h>
 
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <regex>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -28,7 +31,42 @@ bool isSource(const fs::path& p) {
   return e == ".cpp" || e == ".hpp" || e == ".h" || e == ".glsl" || e == ".def";
 }
 
+/// Our own sources (third-party code under benchmarks/peers is not ours).
+std::vector<fs::path> ownSources() {
+  std::vector<fs::path> out;
+  for (const char* top : {"engine", "app", "tests", "shaders", "benchmarks"})
+    for (const auto& e : fs::recursive_directory_iterator(kRoot / top)) {
+      const std::string rel = fs::relative(e.path(), kRoot).generic_string();
+      if (rel.rfind("benchmarks/peers/", 0) == 0 || rel.rfind("tests/fuzz/corpus", 0) == 0) continue;
+      if (e.is_regular_file() && isSource(e.path())) out.push_back(e.path());
+    }
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
 }  // namespace
+
+TEST_CASE("repository: no source file of ours is over 600 lines, but the two still to split") {
+  // Still to split, each by the jobs it does: the game solver's grid projection (grid and
+  // splatting, body coupling, the PCG solver, the transfer back) and muller2003 (the paper's
+  // plain pair loop beside its SSE2 and AVX2 lanes). A file leaves this list when it is split:
+  // the test fails if one listed is no longer over the limit.
+  const std::set<std::string> toSplit = {"engine/src/solvers/game/grid_projection.cpp",
+                                         "engine/src/solvers/muller2003/muller2003.cpp"};
+  int checked = 0;
+  for (const fs::path& p : ownSources()) {
+    ++checked;
+    const std::string rel = fs::relative(p, kRoot).generic_string();
+    const std::size_t n = lines(p).size();
+    CAPTURE(rel);
+    CAPTURE(n);
+    if (toSplit.count(rel))
+      CHECK_MESSAGE(n > 600, "split now: take it off the list");
+    else
+      CHECK(n <= 600);
+  }
+  CHECK(checked > 100);
+}
 
 TEST_CASE("repository: engine includes follow the folder order core < particles < boundary < bodies < step < effects < solvers < scene < world") {
   // A folder may include its own headers, lower folders' and the public API (sph2d/...);
@@ -61,4 +99,31 @@ TEST_CASE("repository: engine includes follow the folder order core < particles 
     }
   }
   CHECK(edges > 50);
+}
+
+TEST_CASE("repository: reference docs name no issue, session or date, and no path outside the repository") {
+  // CHANGELOG.md is history and docs/notes/ holds what was tried and dropped: both may date.
+  std::vector<fs::path> docs = {kRoot / "README.md", kRoot / "CONTRIBUTING.md"};
+  for (const auto& e : fs::recursive_directory_iterator(kRoot / "docs")) {
+    const std::string rel = fs::relative(e.path(), kRoot).generic_string();
+    if (e.is_regular_file() && e.path().extension() == ".md" && rel.rfind("docs/notes/", 0) != 0) docs.push_back(e.path());
+  }
+  const std::regex issue(
+      R"(\b[Ii]ssues? #?\d+|\b(first|second|third|fourth|fifth|sixth|seventh|eighth|ninth|tenth|\d+(st|nd|rd|th)) session\b)");
+  const std::regex date(
+      R"(\b20\d\d-\d\d-\d\d\b|\b\d{1,2} (Jan|Feb|Mar|Apr|May|Jun|Jul|Aug|Sep|Oct|Nov|Dec)[a-z]*\b|\b(Jan|Feb|Mar|Apr|May|Jun|Jul|Aug|Sep|Oct|Nov|Dec)[a-z]* \d{1,2}\b)");
+  const std::regex outside(R"(\.\./shared|/work/|/home/|/tmp/)");
+  int checked = 0;
+  for (const fs::path& p : docs) {
+    const std::vector<std::string> ls = lines(p);
+    for (std::size_t k = 0; k < ls.size(); ++k) {
+      ++checked;
+      const std::string where = fs::relative(p, kRoot).generic_string() + ":" + std::to_string(k + 1) + ": " + ls[k];
+      CAPTURE(where);
+      CHECK_FALSE(std::regex_search(ls[k], issue));
+      CHECK_FALSE(std::regex_search(ls[k], date));
+      CHECK_FALSE(std::regex_search(ls[k], outside));
+    }
+  }
+  CHECK(checked > 500);
 }
