@@ -8,12 +8,11 @@
 #include <atomic>
 #include <cmath>
 
-#if defined(__SSE2__) && !defined(SPH2D_NO_SIMD)
-#include <emmintrin.h>
+#include "core/simd.hpp"
+#ifdef SPH2D_SIMD_SSE2
 #define SPH2D_SSE2_NEIGHBOURS 1
 #endif
-#if defined(__GNUC__) && defined(__x86_64__) && !defined(SPH2D_NO_SIMD)
-#include <immintrin.h>
+#ifdef SPH2D_SIMD_X86_DISPATCH
 #define SPH2D_AVX512_NEIGHBOURS 1
 #endif
 

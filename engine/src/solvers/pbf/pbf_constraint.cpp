@@ -11,9 +11,7 @@
 #include <cstring>
 #include <type_traits>
 
-#if defined(__SSE2__) && !defined(SPH2D_NO_SIMD)
-#include <emmintrin.h>
-#endif
+#include "core/simd.hpp"
 
 #include "solvers/pbf/pbf.hpp"
 
@@ -24,7 +22,7 @@ namespace {
 /// scalar operations. Every operation is IEEE single precision, correctly rounded
 /// per lane (add, mul, div, sqrt, max), so both paths give the same bits.
 struct Lane4 {
-#if defined(__SSE2__) && !defined(SPH2D_NO_SIMD)
+#ifdef SPH2D_SIMD_SSE2
   __m128 v;
   static Lane4 load(const float* p) { return {_mm_loadu_ps(p)}; }
   static Lane4 all(float x) { return {_mm_set1_ps(x)}; }
@@ -104,14 +102,14 @@ static_assert(std::is_same<Real, float>::value, "Lane4 is single precision");
 /// one minss(b, a) or maxss(b, a), which return a when either is NaN: the same values,
 /// with no branch on the data (the compiler branched, and compression is no pattern).
 inline float minOf(float a, float b) {
-#if defined(__SSE2__) && !defined(SPH2D_NO_SIMD)
+#ifdef SPH2D_SIMD_SSE2
   return _mm_cvtss_f32(_mm_min_ss(_mm_set_ss(b), _mm_set_ss(a)));
 #else
   return std::min(a, b);
 #endif
 }
 inline float maxOf(float a, float b) {
-#if defined(__SSE2__) && !defined(SPH2D_NO_SIMD)
+#ifdef SPH2D_SIMD_SSE2
   return _mm_cvtss_f32(_mm_max_ss(_mm_set_ss(b), _mm_set_ss(a)));
 #else
   return std::max(a, b);
