@@ -50,8 +50,9 @@ void watchdog() {
   timespec left{0, long(kStopGraceSeconds * 1e9)};
   while (nanosleep(&left, &left) != 0) {
   }
-  static const char msg[] = "sph2d: still busy 0.8 s after SIGINT/SIGTERM: exiting now (exit 130; the files "
-                            "written are whole)\n";
+  static const char msg[] =
+      "sph2d: still busy 0.8 s after SIGINT/SIGTERM: exiting now (exit 130; the files "
+      "written are whole)\n";
   exitNow(msg, sizeof msg - 1);
 }
 void setHandler(int sig, void (*fn)(int)) {
@@ -86,10 +87,14 @@ double parseBytes(const std::string& flag, const std::string& v) {
   std::string unit = end ? std::string(end) : std::string();
   if (!unit.empty() && (unit.back() == 'B' || unit.back() == 'b')) unit.pop_back();
   double scale = 1;
-  if (unit == "K" || unit == "k") scale = 1e3;
-  else if (unit == "M" || unit == "m") scale = 1e6;
-  else if (unit == "G" || unit == "g") scale = 1e9;
-  else if (!unit.empty()) x = -1;
+  if (unit == "K" || unit == "k")
+    scale = 1e3;
+  else if (unit == "M" || unit == "m")
+    scale = 1e6;
+  else if (unit == "G" || unit == "g")
+    scale = 1e9;
+  else if (!unit.empty())
+    x = -1;
   if (v.empty() || errno || !(x > 0) || !std::isfinite(x * scale))
     throw UsageError(flag + " expects a size such as 512M or 2G (bytes, K, M or G), got '" + v + "'");
   return x * scale;
@@ -133,8 +138,9 @@ void checkMemory(const SceneDef& scene, bool images, double limit) {
   o.precision(0);
   o << "the scene would hold about " << need / 1e6 << " MB at its peak (" << peakParticles(scene)
     << " particles: its blocks, emitters and timeline, capped by the particle budget"
-    << (images ? "; the renderer and its images" : "") << "), more than " << (given ? "--max-memory" : "the memory available")
-    << " (" << limit / 1e6 << " MB); use a larger spacing, a lower max_particles or effects.budget"
+    << (images ? "; the renderer and its images" : "") << "), more than "
+    << (given ? "--max-memory" : "the memory available") << " (" << limit / 1e6
+    << " MB); use a larger spacing, a lower max_particles or effects.budget"
     << (given ? ", or raise --max-memory" : "");
   throw UsageError(o.str());
 }
@@ -144,7 +150,8 @@ int parseInt(const std::string& flag, const std::string& v, int lo, int hi) {
   errno = 0;
   const long x = std::strtol(v.c_str(), &end, 10);
   if (v.empty() || *end || errno || x < lo || x > hi)
-    throw UsageError(flag + " expects an integer from " + std::to_string(lo) + " to " + std::to_string(hi) + ", got '" + v + "'");
+    throw UsageError(flag + " expects an integer from " + std::to_string(lo) + " to " + std::to_string(hi) + ", got '" +
+                     v + "'");
   return int(x);
 }
 

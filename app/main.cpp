@@ -57,16 +57,20 @@ int main(int argc, char** argv) {
     if (cmd == "serve") return cmdServe(args);
     if (cmd == "render") return cmdRender(args);
     if (cmd == "bench") {
-      if (!args.empty() && args[0] == "step") return cmdBenchStep(std::vector<std::string>(args.begin() + 1, args.end()));
-      if (!args.empty() && args[0] == "serve") return cmdBenchServe(std::vector<std::string>(args.begin() + 1, args.end()));
-      if (!args.empty() && args[0] == "game") return cmdBenchGame(std::vector<std::string>(args.begin() + 1, args.end()));
+      if (!args.empty() && args[0] == "step")
+        return cmdBenchStep(std::vector<std::string>(args.begin() + 1, args.end()));
+      if (!args.empty() && args[0] == "serve")
+        return cmdBenchServe(std::vector<std::string>(args.begin() + 1, args.end()));
+      if (!args.empty() && args[0] == "game")
+        return cmdBenchGame(std::vector<std::string>(args.begin() + 1, args.end()));
       if (!args.empty() && args[0] == "effects")
         return cmdBenchEffects(std::vector<std::string>(args.begin() + 1, args.end()));
       if (!args.empty() && args[0] == "accuracy")
         return cmdBenchAccuracy(std::vector<std::string>(args.begin() + 1, args.end()));
       return cmdBench(args);
     }
-    throw UsageError("unknown command '" + cmd + "'; commands: run, info, check, render, bench, serve (see sph2d --help)");
+    throw UsageError("unknown command '" + cmd +
+                     "'; commands: run, info, check, render, bench, serve (see sph2d --help)");
   } catch (const UsageError& e) {
     std::fprintf(stderr, "sph2d: %s\n", e.what());
     return 2;

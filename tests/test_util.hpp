@@ -44,9 +44,9 @@ inline const std::vector<std::string>& solvers() {
 /// One doctest TEST_CASE per solver of sph2d::test::solvers(), named "NAME (solver)",
 /// each calling FN(solver) with the solver's name (a std::string): CTest runs, times
 /// and reports every solver on its own, and a failure names the solver.
-#define TEST_CASE_EVERY_SOLVER(NAME, FN)                        \
+#define TEST_CASE_EVERY_SOLVER(NAME, FN)                             \
   TEST_CASE(NAME " (muller2003)") { FN(std::string("muller2003")); } \
   TEST_CASE(NAME " (wcsph)") { FN(std::string("wcsph")); }           \
   TEST_CASE(NAME " (pbf)") { FN(std::string("pbf")); }               \
-  TEST_CASE(NAME " (dfsph)") { FN(std::string("dfsph")); }             \
+  TEST_CASE(NAME " (dfsph)") { FN(std::string("dfsph")); }           \
   TEST_CASE(NAME " (game)") { FN(std::string("game")); }

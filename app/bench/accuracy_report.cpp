@@ -63,9 +63,9 @@ static double parseCell(const std::string& path, const std::string& column, cons
 std::string csvLine(const Run& r) {
   std::ostringstream o;
   o << r.id << ',' << r.caseName << ',' << r.solver << ',' << r.floor << ',' << r.particles << ',' << num(r.cfl) << ','
-    << r.errorName << ',' << num(r.error) << ',' << r.error2Name << ',' << num(r.error2) << ',' << num(r.meanDensityError)
-    << ',' << num(r.maxDensityError) << ',' << num(r.wallPerSim) << ',' << num(r.msPerStep) << ',' << r.status << ','
-    << r.build << ',' << r.settings << ',' << r.params << '\n';
+    << r.errorName << ',' << num(r.error) << ',' << r.error2Name << ',' << num(r.error2) << ','
+    << num(r.meanDensityError) << ',' << num(r.maxDensityError) << ',' << num(r.wallPerSim) << ',' << num(r.msPerStep)
+    << ',' << r.status << ',' << r.build << ',' << r.settings << ',' << r.params << '\n';
   return o.str();
 }
 
@@ -149,13 +149,15 @@ void writeNoted(OutputJournal& journal, const std::string& out, const std::strin
 }
 
 /// The files `sph2d bench accuracy` writes into its --out folder.
-const char* const kOutputs[] = {"accuracy.csv", "accuracy.md", "dam_break.png", "hydrostatic.png", "taylor_green.png",
-                                "poiseuille.png", "surge_long.png"};
+const char* const kOutputs[] = {"accuracy.csv",     "accuracy.md",    "dam_break.png", "hydrostatic.png",
+                                "taylor_green.png", "poiseuille.png", "surge_long.png"};
 
 FolderSpec accuracyFolderSpec() {
   FolderSpec spec;
   spec.command = "bench accuracy";
-  spec.writes = [](const std::string& name) { return std::find(std::begin(kOutputs), std::end(kOutputs), name) != std::end(kOutputs); };
+  spec.writes = [](const std::string& name) {
+    return std::find(std::begin(kOutputs), std::end(kOutputs), name) != std::end(kOutputs);
+  };
   return spec;
 }
 
@@ -197,7 +199,8 @@ void chart(const std::vector<Run>& runs, const std::string& caseName, OutputJour
   fillRect(img, L - 2, T, L, B, axis);
   drawText(img, L, 8, caseName + ": " + rs[0]->errorName + " vs wall s per sim s", 2, axis);
   std::map<std::string, Rgba8> colour;
-  const Rgba8 palette[] = {{200, 40, 40, 255}, {40, 120, 200, 255}, {40, 160, 60, 255}, {200, 140, 0, 255}, {140, 60, 180, 255}};
+  const Rgba8 palette[] = {
+      {200, 40, 40, 255}, {40, 120, 200, 255}, {40, 160, 60, 255}, {200, 140, 0, 255}, {140, 60, 180, 255}};
   for (const Run* r : rs)
     if (!colour.count(r->solver)) colour[r->solver] = palette[colour.size() % 5];
   // Pareto front: runs no other run beats in both error and cost.

@@ -61,7 +61,10 @@ int cmdBench(const std::vector<std::string>& args) {
     std::fputs(kRenderFlagsHelp, stdout);
     return args.empty() ? 2 : 0;
   }
-  if (args[0] != "render") throw UsageError("unknown benchmark '" + args[0] + "'; benchmarks: step, render, accuracy, effects (see sph2d bench step|render|accuracy|effects --help)");
+  if (args[0] != "render")
+    throw UsageError(
+        "unknown benchmark '" + args[0] +
+        "'; benchmarks: step, render, accuracy, effects (see sph2d bench step|render|accuracy|effects --help)");
   int particles = 20000, width = 960, height = 540, frames = 30, level = 1;
   std::string save;
   RenderOptions opt;
@@ -77,17 +80,22 @@ int cmdBench(const std::vector<std::string>& args) {
       return 0;
     }
     if (parseRenderFlag(args, i, opt)) continue;
-    if (s == "--particles") particles = parseInt(s, value(), 1, 4000000);
-    else if (s == "--frames") frames = parseInt(s, value(), 1, 100000);
-    else if (s == "--png-level") level = parseInt(s, value(), 0, 9);
-    else if (s == "--save") save = value();
+    if (s == "--particles")
+      particles = parseInt(s, value(), 1, 4000000);
+    else if (s == "--frames")
+      frames = parseInt(s, value(), 1, 100000);
+    else if (s == "--png-level")
+      level = parseInt(s, value(), 0, 9);
+    else if (s == "--save")
+      save = value();
     else if (s == "--size") {
       const std::string v = value();
       const auto x = v.find('x');
       if (x == std::string::npos) throw UsageError("--size expects WxH, got '" + v + "'");
       width = parseInt(s, v.substr(0, x), 16, 8192);
       height = parseInt(s, v.substr(x + 1), 16, 8192);
-    } else throw UsageError("unknown option '" + s + "' (see sph2d bench --help)");
+    } else
+      throw UsageError("unknown option '" + s + "' (see sph2d bench --help)");
   }
 
   // The dam-break tank (4 m × 3 m) and, on a square lattice, about N particles under a
@@ -107,7 +115,8 @@ int cmdBench(const std::vector<std::string>& args) {
     s.halfSize = Vec2d(hx, hy);
     return s;
   };
-  tank.fixtures = {box(2.0, -0.1, 2.2, 0.1), box(-0.1, 1.5, 0.1, 1.7), box(4.1, 1.5, 0.1, 1.7), box(2.0, 3.1, 2.2, 0.1)};
+  tank.fixtures = {box(2.0, -0.1, 2.2, 0.1), box(-0.1, 1.5, 0.1, 1.7), box(4.1, 1.5, 0.1, 1.7),
+                   box(2.0, 3.1, 2.2, 0.1)};
   scene.bodies.push_back(tank);
   scene.render.width = width;
   scene.render.height = height;
@@ -197,7 +206,8 @@ int cmdBench(const std::vector<std::string>& args) {
   row("CPU: render, no sync", cpuRender);
   row("CPU: PNG encode", cpuPng);
   row("CPU: render + PNG", cpuSum);
-  std::printf("PNG size %.0f KB; sprites as %s\n", pngBytes.mean() / 1024.0, profiled.usedQuads() ? "instanced quads" : "points");
+  std::printf("PNG size %.0f KB; sprites as %s\n", pngBytes.mean() / 1024.0,
+              profiled.usedQuads() ? "instanced quads" : "points");
   return 0;
 }
 

@@ -39,11 +39,11 @@
 #include <string>
 #include <vector>
 
-#include "cli.hpp"
-#include "commands.hpp"
 #include "bench/accuracy_report.hpp"
 #include "bench/sweep.hpp"
 #include "bench/validation.hpp"
+#include "cli.hpp"
+#include "commands.hpp"
 #include "output/output_dir.hpp"
 #include "sph2d/hash.hpp"
 #include "sph2d/render/image.hpp"
@@ -204,9 +204,15 @@ struct Inputs {
 Inputs loadInputs(const std::string& assets) {
   Inputs in;
   const std::string v = assets + "/scenes/validation/", ref = assets + "/reference/";
-  in.files = {v + "dam_break.json", v + "hydrostatic_tank.json", v + "taylor_green.json", v + "poiseuille.json",
-              v + "surge_long.json", ref + "martin_moyce_1952_surge_front.csv", ref + "martin_moyce_1952_surge_front_long.csv",
-              ref + "taylor_green_decay.csv", ref + "channel_flow_transient.csv"};
+  in.files = {v + "dam_break.json",
+              v + "hydrostatic_tank.json",
+              v + "taylor_green.json",
+              v + "poiseuille.json",
+              v + "surge_long.json",
+              ref + "martin_moyce_1952_surge_front.csv",
+              ref + "martin_moyce_1952_surge_front_long.csv",
+              ref + "taylor_green_decay.csv",
+              ref + "channel_flow_transient.csv"};
   in.dam = loadScene(in.files[0]);
   in.hydro = loadScene(in.files[1]);
   in.tg = loadScene(in.files[2]);
@@ -236,11 +242,11 @@ Spec makeSpec(const Inputs& in, const std::string& caseName, const std::string& 
   p.floor = floor;
   p.cflIndex = cflIndex;
   SceneDef& s = p.scene;
-  s = caseName == "hydrostatic" ? in.hydro
-      : caseName == "dam_break"  ? in.dam
+  s = caseName == "hydrostatic"    ? in.hydro
+      : caseName == "dam_break"    ? in.dam
       : caseName == "taylor_green" ? in.tg
-      : caseName == "poiseuille" ? in.channel
-                                 : in.surgeLong;
+      : caseName == "poiseuille"   ? in.channel
+                                   : in.surgeLong;
   p.cfl = setSolver(s, solver, double(cflIndex));
   s.solver.spacing = dx;
   s.solver.maxSubsteps = 100000;
@@ -260,19 +266,18 @@ Spec makeSpec(const Inputs& in, const std::string& caseName, const std::string& 
 }
 
 /// The runs of the sweep, in the order they run (and the CSV's).
-std::vector<Spec> sweep(const Inputs& in, const std::vector<std::string>& solvers, const std::vector<std::string>& cases,
-                        bool quick, int levels) {
+std::vector<Spec> sweep(const Inputs& in, const std::vector<std::string>& solvers,
+                        const std::vector<std::string>& cases, bool quick, int levels) {
   auto spacings = [&](std::vector<double> full, double q, std::size_t cap) {
     if (quick) return std::vector<double>{q};
     full.resize(std::min<std::size_t>(std::size_t(levels), cap));
     return full;
   };
-  const std::map<std::string, std::vector<double>> dx = {
-      {"hydrostatic", spacings({0.05, 0.025, 0.0125}, 0.05, 3)},
-      {"dam_break", spacings({0.02, 0.01, 0.005}, 0.04, 3)},
-      {"taylor_green", spacings({0.04, 0.02, 0.01}, 0.04, 3)},
-      {"poiseuille", spacings({0.1, 0.05, 0.025}, 0.1, 3)},
-      {"surge_long", spacings({0.02, 0.01}, 0.04, 2)}};
+  const std::map<std::string, std::vector<double>> dx = {{"hydrostatic", spacings({0.05, 0.025, 0.0125}, 0.05, 3)},
+                                                         {"dam_break", spacings({0.02, 0.01, 0.005}, 0.04, 3)},
+                                                         {"taylor_green", spacings({0.04, 0.02, 0.01}, 0.04, 3)},
+                                                         {"poiseuille", spacings({0.1, 0.05, 0.025}, 0.1, 3)},
+                                                         {"surge_long", spacings({0.02, 0.01}, 0.04, 2)}};
   std::vector<Spec> out;
   for (const std::string& solver : solvers)
     for (int k = 1; k <= (quick ? 1 : 2); ++k)
@@ -330,12 +335,12 @@ Run execute(const Spec& p, const Inputs& in, int threads) {
       r.msPerStep = 1e3 * wall / double(std::max<std::uint64_t>(1, v.substeps));
     }
   } catch (const SimulationError& e) {
-    std::printf("%-12s %-11s dx %.4f cfl %.3f%s: unstable (%s)\n", p.caseName.c_str(), p.solver.c_str(), s.solver.spacing,
-                p.cfl, p.floor.empty() ? "" : (" floor " + p.floor).c_str(), e.what());
+    std::printf("%-12s %-11s dx %.4f cfl %.3f%s: unstable (%s)\n", p.caseName.c_str(), p.solver.c_str(),
+                s.solver.spacing, p.cfl, p.floor.empty() ? "" : (" floor " + p.floor).c_str(), e.what());
     r = Run{};
     r.status = "unstable";
     r.particles = countBlockParticles(s);
-    r.errorName = p.caseName == "hydrostatic" ? "pressure_profile_max_rel"
+    r.errorName = p.caseName == "hydrostatic"    ? "pressure_profile_max_rel"
                   : p.caseName == "taylor_green" ? "umax_ratio_rms"
                   : p.caseName == "poiseuille"   ? "u_rms_vs_series"
                                                  : "surge_front_rms_Z";
@@ -356,7 +361,8 @@ int cmdBenchAccuracy(const std::vector<std::string>& args) {
   std::string out = "out/accuracy", assets = "assets";
   bool quick = false, list = false, listIds = false, allowMixed = false, filtered = false;
   int threads = 0, levels = 3;
-  std::vector<std::string> solvers, fromCsv, only, mergeDirs, cases(std::begin(kCases), std::begin(kCases) + kDefaultCases);
+  std::vector<std::string> solvers, fromCsv, only, mergeDirs,
+      cases(std::begin(kCases), std::begin(kCases) + kDefaultCases);
   for (std::size_t i = 0; i < args.size(); ++i) {
     const std::string& a = args[i];
     auto value = [&]() -> std::string {
@@ -366,17 +372,26 @@ int cmdBenchAccuracy(const std::vector<std::string>& args) {
     if (a == "--help" || a == "-h") {
       std::fputs(kHelp, stdout);
       return 0;
-    } else if (a == "--out") out = value();
-    else if (a == "--assets") assets = value();
-    else if (a == "--quick") quick = true;
-    else if (a == "--threads") threads = parseInt(a, value(), 1, 256);
-    else if (a == "--levels") levels = parseInt(a, value(), 1, 3);
+    } else if (a == "--out")
+      out = value();
+    else if (a == "--assets")
+      assets = value();
+    else if (a == "--quick")
+      quick = true;
+    else if (a == "--threads")
+      threads = parseInt(a, value(), 1, 256);
+    else if (a == "--levels")
+      levels = parseInt(a, value(), 1, 3);
     else if (a == "--from-csv") {
       for (const std::string& f : splitList(value())) fromCsv.push_back(f);
-    } else if (a == "--merge") mergeDirs.push_back(value());
-    else if (a == "--allow-mixed") allowMixed = true;
-    else if (a == "--list") list = true;
-    else if (a == "--list-ids") listIds = true;
+    } else if (a == "--merge")
+      mergeDirs.push_back(value());
+    else if (a == "--allow-mixed")
+      allowMixed = true;
+    else if (a == "--list")
+      list = true;
+    else if (a == "--list-ids")
+      listIds = true;
     else if (a == "--only") {
       only = splitList(value());
       if (only.empty()) throw UsageError("--only needs a run id (sph2d bench accuracy --list-ids lists them)");
@@ -389,9 +404,10 @@ int cmdBenchAccuracy(const std::vector<std::string>& args) {
       if (cases.size() == 1 && cases[0] == "all") cases.assign(std::begin(kCases), std::end(kCases));
       if (cases.empty()) throw UsageError("--cases needs at least one case (" + caseList() + ", or all)");
       for (const std::string& k : cases)
-        if (indexOf(kCases, k) < 0) throw UsageError("--cases: unknown case '" + k + "' (allowed: " + caseList() + ", or all)");
-    }
-    else throw UsageError("unknown option '" + a + "' (see sph2d bench accuracy --help)");
+        if (indexOf(kCases, k) < 0)
+          throw UsageError("--cases: unknown case '" + k + "' (allowed: " + caseList() + ", or all)");
+    } else
+      throw UsageError("unknown option '" + a + "' (see sph2d bench accuracy --help)");
   }
   const bool merging = !fromCsv.empty() || !mergeDirs.empty();
   if (int(list) + int(listIds) + int(!only.empty()) + int(merging) > 1)
@@ -422,14 +438,15 @@ int cmdBenchAccuracy(const std::vector<std::string>& args) {
       for (Run& r : readRuns(path)) {
         const auto [it, fresh] = seen.emplace(r.id, path);
         if (!fresh)
-          throw UsageError("bench accuracy: run " + r.id + " is in " + it->second + (it->second == path ? " twice" : " and in " + path) +
-                           ": merge each run once");
+          throw UsageError("bench accuracy: run " + r.id + " is in " + it->second +
+                           (it->second == path ? " twice" : " and in " + path) + ": merge each run once");
         origins.push_back(RowOrigin{path, r.build, r.settings});
         runs.push_back(std::move(r));
       }
     const std::vector<RowOrigin> kinds = checkOrigins("bench accuracy", origins, allowMixed);
     for (const RowOrigin& k : kinds)
-      header += "build " + k.build + ", settings " + k.settings + (kinds.size() > 1 ? " (mixed: --allow-mixed)" : "") + "\n";
+      header +=
+          "build " + k.build + ", settings " + k.settings + (kinds.size() > 1 ? " (mixed: --allow-mixed)" : "") + "\n";
     std::printf("bench accuracy: %zu rows from %zu files; %s", runs.size(), fromCsv.size(), header.c_str());
     holdFolder(lock);
   } else {
@@ -445,20 +462,23 @@ int cmdBenchAccuracy(const std::vector<std::string>& args) {
         std::fprintf(stderr, "bench accuracy: solver '%s' is not in this build, skipped\n", s.c_str());
       }
     }
-    std::vector<Spec> specs = sweep(in, known, only.empty() ? cases : std::vector<std::string>(std::begin(kCases), std::end(kCases)),
-                                    quick, levels);
+    std::vector<Spec> specs =
+        sweep(in, known, only.empty() ? cases : std::vector<std::string>(std::begin(kCases), std::end(kCases)), quick,
+              levels);
     const std::string settings = "quick=" + std::string(quick ? "1" : "0") + ";levels=" + std::to_string(levels) +
                                  ";threads=" + (threads ? std::to_string(threads) : std::string("auto")) +
                                  ";assets=" + filesHash(in.files);
     if (list || listIds) {
       // One line per run: a command that runs it alone into its own folder.
-      const std::string exe = shellQuote(selfExe()), root = absolutePath(out), assetsAbs = shellQuote(absolutePath(assets));
+      const std::string exe = shellQuote(selfExe()), root = absolutePath(out),
+                        assetsAbs = shellQuote(absolutePath(assets));
       for (const Spec& p : specs) {
         if (listIds) {
           std::printf("%s\n", p.id.c_str());
           continue;
         }
-        std::string cmd = exe + " bench accuracy --only " + p.id + " --out " + shellQuote(root + "/" + p.id) + " --assets " + assetsAbs;
+        std::string cmd = exe + " bench accuracy --only " + p.id + " --out " + shellQuote(root + "/" + p.id) +
+                          " --assets " + assetsAbs;
         if (quick) cmd += " --quick";
         if (levels != 3) cmd += " --levels " + std::to_string(levels);
         if (threads) cmd += " --threads " + std::to_string(threads);
@@ -471,7 +491,8 @@ int cmdBenchAccuracy(const std::vector<std::string>& args) {
       for (const std::string& id : only) {
         const auto it = std::find_if(specs.begin(), specs.end(), [&](const Spec& p) { return p.id == id; });
         if (it == specs.end()) {
-          const std::string flags = std::string(quick ? " --quick" : "") + (levels != 3 ? " --levels " + std::to_string(levels) : "");
+          const std::string flags =
+              std::string(quick ? " --quick" : "") + (levels != 3 ? " --levels " + std::to_string(levels) : "");
           throw UsageError("--only: no run '" + id + "' in this sweep (" + std::to_string(specs.size()) + " runs" +
                            (quick ? ", --quick" : "") + "); ids are case-solver-particles-cflK[-floor], e.g. " +
                            (specs.empty() ? std::string("dam_break-dfsph-20000-cfl1") : specs.front().id) +
@@ -482,17 +503,17 @@ int cmdBenchAccuracy(const std::vector<std::string>& args) {
       specs = chosen;
     }
     holdFolder(lock);
-    std::printf("%-12s %-11s %9s %6s %-8s %-26s %10s %10s %10s %12s %10s\n", "case", "solver", "particles", "cfl", "floor",
-                "error_name", "error", "mean_rho", "max_rho", "wall/sim_s", "ms/step");
+    std::printf("%-12s %-11s %9s %6s %-8s %-26s %10s %10s %10s %12s %10s\n", "case", "solver", "particles", "cfl",
+                "floor", "error_name", "error", "mean_rho", "max_rho", "wall/sim_s", "ms/step");
     std::fflush(stdout);
     for (const Spec& p : specs) {
       Run r = execute(p, in, threads);
       r.build = buildCommit();
       r.settings = settings;
       if (r.status == "ok") {
-        std::printf("%-12s %-11s %9zu %6.3f %-8s %-26s %10.4f %9.3f%% %9.3f%% %12.3f %10.3f", r.caseName.c_str(), r.solver.c_str(),
-                    r.particles, r.cfl, r.floor.empty() ? "-" : r.floor.c_str(), r.errorName.c_str(), r.error,
-                    100 * r.meanDensityError, 100 * r.maxDensityError, r.wallPerSim, r.msPerStep);
+        std::printf("%-12s %-11s %9zu %6.3f %-8s %-26s %10.4f %9.3f%% %9.3f%% %12.3f %10.3f", r.caseName.c_str(),
+                    r.solver.c_str(), r.particles, r.cfl, r.floor.empty() ? "-" : r.floor.c_str(), r.errorName.c_str(),
+                    r.error, 100 * r.meanDensityError, 100 * r.maxDensityError, r.wallPerSim, r.msPerStep);
         if (!r.error2Name.empty()) std::printf("  %s %.4f", r.error2Name.c_str(), r.error2);
         std::printf("\n");
       }
@@ -520,14 +541,16 @@ int cmdBenchAccuracy(const std::vector<std::string>& args) {
     char line[1024];
     for (const Run& r : runs) {
       if (r.status != "ok") {
-        std::snprintf(line, sizeof line, "| %s | %s | %s | %s | %zu | %.3f | %s | %s | | | | | | |\n", r.id.c_str(), r.caseName.c_str(),
-                      r.solver.c_str(), r.floor.c_str(), r.particles, r.cfl, r.errorName.c_str(), r.status.c_str());
+        std::snprintf(line, sizeof line, "| %s | %s | %s | %s | %zu | %.3f | %s | %s | | | | | | |\n", r.id.c_str(),
+                      r.caseName.c_str(), r.solver.c_str(), r.floor.c_str(), r.particles, r.cfl, r.errorName.c_str(),
+                      r.status.c_str());
       } else {
-        std::snprintf(line, sizeof line, "| %s | %s | %s | %s | %zu | %.3f | %s | %.4f | %s | %s | %.3f %% | %.3f %% | %.3f | %.3f |\n",
+        std::snprintf(line, sizeof line,
+                      "| %s | %s | %s | %s | %zu | %.3f | %s | %.4f | %s | %s | %.3f %% | %.3f %% | %.3f | %.3f |\n",
                       r.id.c_str(), r.caseName.c_str(), r.solver.c_str(), r.floor.c_str(), r.particles, r.cfl,
                       r.errorName.c_str(), r.error, r.error2Name.c_str(),
-                      std::isnan(r.error2) ? "" : num(std::round(r.error2 * 1e4) / 1e4).c_str(), 100 * r.meanDensityError,
-                      100 * r.maxDensityError, r.wallPerSim, r.msPerStep);
+                      std::isnan(r.error2) ? "" : num(std::round(r.error2 * 1e4) / 1e4).c_str(),
+                      100 * r.meanDensityError, 100 * r.maxDensityError, r.wallPerSim, r.msPerStep);
       }
       md << line;
     }

@@ -59,9 +59,9 @@ const char* kHelp =
 
 struct Config {
   std::string name;
-  std::vector<std::string> stages;           ///< the effect's own stages (for its share)
-  std::function<void(SceneDef&)> edit;       ///< applied to the "none" scene
-  bool userForce = false;                    ///< set one user force after construction
+  std::vector<std::string> stages;      ///< the effect's own stages (for its share)
+  std::function<void(SceneDef&)> edit;  ///< applied to the "none" scene
+  bool userForce = false;               ///< set one user force after construction
 };
 
 struct Row {
@@ -129,29 +129,39 @@ int cmdBenchEffects(const std::vector<std::string>& args) {
     if (a == "--help" || a == "-h") {
       std::fputs(kHelp, stdout);
       return 0;
-    } else if (a == "--scene") scenePath = value();
-    else if (a == "--particles") particles = parseInt(a, value(), 1, 50000000);
-    else if (a == "--threads") threads = parseInt(a, value(), 1, 256);
-    else if (a == "--steps") steps = parseInt(a, value(), 1, 100000000);
-    else if (a == "--warmup") warmup = parseInt(a, value(), 0, 100000000);
-    else if (a == "--rounds") rounds = parseInt(a, value(), 1, 100000);
-    else if (a == "--effects") only = splitList(value());
-    else if (a == "--solver") solver = value();
-    else if (a == "--csv") csvPath = value();
+    } else if (a == "--scene")
+      scenePath = value();
+    else if (a == "--particles")
+      particles = parseInt(a, value(), 1, 50000000);
+    else if (a == "--threads")
+      threads = parseInt(a, value(), 1, 256);
+    else if (a == "--steps")
+      steps = parseInt(a, value(), 1, 100000000);
+    else if (a == "--warmup")
+      warmup = parseInt(a, value(), 0, 100000000);
+    else if (a == "--rounds")
+      rounds = parseInt(a, value(), 1, 100000);
+    else if (a == "--effects")
+      only = splitList(value());
+    else if (a == "--solver")
+      solver = value();
+    else if (a == "--csv")
+      csvPath = value();
     else if (a == "--clock") {
       clock = value();
       if (clock != "wall" && clock != "cpu") throw UsageError("--clock expects wall or cpu, got '" + clock + "'");
-    }
-    else throw UsageError("unknown option '" + a + "' (see sph2d bench effects --help)");
+    } else
+      throw UsageError("unknown option '" + a + "' (see sph2d bench effects --help)");
   }
 
-  const std::vector<std::string> known = {"none", "none_again", "viscosity", "xsph",       "force_field", "csf",
-                                          "akinci", "lifetime",  "sink",      "user_force", "all"};
+  const std::vector<std::string> known = {"none",   "none_again", "viscosity", "xsph",       "force_field", "csf",
+                                          "akinci", "lifetime",   "sink",      "user_force", "all"};
   for (const std::string& name : only)
     if (std::find(known.begin(), known.end(), name) == known.end())
-      throw UsageError("--effects: unknown configuration '" + name +
-                       "'; configurations: none, none_again, viscosity, xsph, force_field, csf, akinci, lifetime, sink, "
-                       "user_force, all");
+      throw UsageError(
+          "--effects: unknown configuration '" + name +
+          "'; configurations: none, none_again, viscosity, xsph, force_field, csf, akinci, lifetime, sink, "
+          "user_force, all");
 
   SceneDef base = loadScene(scenePath);
   const std::size_t n0 = countBlockParticles(base);
@@ -184,7 +194,9 @@ int cmdBenchEffects(const std::vector<std::string>& args) {
     s.effects.xsph = true;
     s.effects.xsphC = 0.05;
   };
-  const auto field = [](SceneDef& s) { s.effects.forceFields.push_back(ForceFieldDef{Vec2d(0.1, 0.0), true, RegionDef{}}); };
+  const auto field = [](SceneDef& s) {
+    s.effects.forceFields.push_back(ForceFieldDef{Vec2d(0.1, 0.0), true, RegionDef{}});
+  };
   const auto csf = [](SceneDef& s) {
     s.effects.surfaceTension = true;
     s.effects.tension.model = "csf";
@@ -243,9 +255,10 @@ int cmdBenchEffects(const std::vector<std::string>& args) {
     rows.push_back(std::move(r));
   }
   const std::size_t np = rows.front().world->particleCount();
-  std::printf("bench effects: %s resampled to %zu particles (spacing %.5g m), %s, %d thread%s; %d rounds of %d substeps after %d warm-up; %s clock\n",
-              scenePath.c_str(), np, base.solver.spacing, rows.front().world->scene().solver.type.c_str(), threads,
-              threads == 1 ? "" : "s", rounds, steps, warmup, clock == "cpu" ? "CPU-time" : "wall");
+  std::printf(
+      "bench effects: %s resampled to %zu particles (spacing %.5g m), %s, %d thread%s; %d rounds of %d substeps after %d warm-up; %s clock\n",
+      scenePath.c_str(), np, base.solver.spacing, rows.front().world->scene().solver.type.c_str(), threads,
+      threads == 1 ? "" : "s", rounds, steps, warmup, clock == "cpu" ? "CPU-time" : "wall");
   double (*const now)() = clock == "cpu" ? &cpuSeconds : &wallSeconds;
   std::fflush(stdout);
   for (Row& r : rows)
@@ -285,19 +298,21 @@ int cmdBenchEffects(const std::vector<std::string>& args) {
     const double ms = median(r.ms), best = *std::min_element(r.ms.begin(), r.ms.end());
     const double ratio = median(r.ratio), eff = median(r.effectMs), share = median(r.share);
     const double dt = r.world->stableTimeStep();
-    std::printf("%-12s %10.3f %9.3f %9.3f %12.3f %6.1f%% %11.3f\n", r.cfg.name.c_str(), ms, best, ratio, eff, 100 * share,
-                1e3 * dt);
-    csv << r.cfg.name << ',' << np << ',' << threads << ',' << rounds << ',' << steps << ',' << clock << ',' << ms << ','
-        << best << ',' << ratio << ',' << eff << ',' << share << ',' << dt << '\n';
+    std::printf("%-12s %10.3f %9.3f %9.3f %12.3f %6.1f%% %11.3f\n", r.cfg.name.c_str(), ms, best, ratio, eff,
+                100 * share, 1e3 * dt);
+    csv << r.cfg.name << ',' << np << ',' << threads << ',' << rounds << ',' << steps << ',' << clock << ',' << ms
+        << ',' << best << ',' << ratio << ',' << eff << ',' << share << ',' << dt << '\n';
   }
-  std::printf("(ms/substep and 'vs none' are medians over rounds, 'vs none' taken within each round; 'best' is the\n"
-              " fastest round; 'effect ms' is the wall time of the effect's own stages per substep, 'share' its part of\n"
-              " the round's wall time; 'substep ms' is the longest stable substep at the end: viscosity limits it)\n");
+  std::printf(
+      "(ms/substep and 'vs none' are medians over rounds, 'vs none' taken within each round; 'best' is the\n"
+      " fastest round; 'effect ms' is the wall time of the effect's own stages per substep, 'share' its part of\n"
+      " the round's wall time; 'substep ms' is the longest stable substep at the end: viscosity limits it)\n");
   for (const Row& r : rows)
     if (!r.foldedInto.empty())
-      std::printf("(%s: an effect runs inside the solver stage %s; its 'effect ms' is that stage's time minus the\n"
-                  " same stage's time in none, round by round)\n",
-                  r.cfg.name.c_str(), r.foldedInto.c_str());
+      std::printf(
+          "(%s: an effect runs inside the solver stage %s; its 'effect ms' is that stage's time minus the\n"
+          " same stage's time in none, round by round)\n",
+          r.cfg.name.c_str(), r.foldedInto.c_str());
   if (!csvPath.empty()) {
     const std::filesystem::path out(csvPath);
     if (out.has_parent_path()) std::filesystem::create_directories(out.parent_path());

@@ -23,24 +23,24 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
-#include <optional>
 #include <fstream>
 #include <map>
 #include <memory>
+#include <optional>
 #include <sstream>
 #include <string>
 
-#include "cli.hpp"
-#include "commands.hpp"
 #include "bench/game_runs.hpp"
 #include "bench/sweep.hpp"
+#include "bench/validation.hpp"
+#include "cli.hpp"
+#include "commands.hpp"
 #include "core/kernels.hpp"
 #include "output/output_dir.hpp"
 #include "sph2d/hash.hpp"
 #include "sph2d/render/particle_export.hpp"
 #include "sph2d/scene.hpp"
 #include "sph2d/world.hpp"
-#include "bench/validation.hpp"
 
 namespace sph2d::cli {
 namespace {
@@ -200,8 +200,8 @@ Row runSph2d(const SceneDef& base, const std::string& preset, int threads, doubl
 /// Runs the LiquidFun harness and parses its summary line; false when it cannot run.
 bool runPeer(const std::string& exe, double spacing, double seconds, bool stat, Row& r) {
   const std::string csv = "/tmp/sph2d_bench_game_peer_" + std::to_string(::getpid()) + ".csv";
-  const std::string cmd = "'" + exe + "' --spacing " + std::to_string(spacing) + " --seconds " + std::to_string(seconds) +
-                          (stat ? " --static" : "") + " --csv '" + csv + "' 2>&1";
+  const std::string cmd = "'" + exe + "' --spacing " + std::to_string(spacing) + " --seconds " +
+                          std::to_string(seconds) + (stat ? " --static" : "") + " --csv '" + csv + "' 2>&1";
   FILE* p = ::popen(cmd.c_str(), "r");
   if (!p) return false;
   std::string out;
@@ -211,8 +211,7 @@ bool runPeer(const std::string& exe, double spacing, double seconds, bool stat, 
   int particles = 0;
   double wps = NAN;
   const auto at = out.find("liquidfun: ");
-  if (rc != 0 || at == std::string::npos ||
-      std::sscanf(out.c_str() + at, "liquidfun: %d particles", &particles) != 1)
+  if (rc != 0 || at == std::string::npos || std::sscanf(out.c_str() + at, "liquidfun: %d particles", &particles) != 1)
     throw std::runtime_error("the peer " + exe + " failed: " + out);
   const auto w = out.find(" wall s per simulated s");
   if (w != std::string::npos) {
@@ -244,11 +243,16 @@ void applySet(SolverDef& d, const std::string& kv) {
   if (eq == std::string::npos) throw UsageError("--set expects KEY=VALUE, got '" + kv + "'");
   const std::string k = kv.substr(0, eq);
   const double v = parseNumber("--set " + k, kv.substr(eq + 1));
-  if (k == "viscosity") d.viscosity = v;
-  else if (k == "support_ratio") d.supportRatio = v;
-  else if (k == "cfl") d.cfl = v;
-  else if (k == "max_substeps") d.maxSubsteps = int(v);
-  else if (d.params.count(k)) d.params[k] = v;
+  if (k == "viscosity")
+    d.viscosity = v;
+  else if (k == "support_ratio")
+    d.supportRatio = v;
+  else if (k == "cfl")
+    d.cfl = v;
+  else if (k == "max_substeps")
+    d.maxSubsteps = int(v);
+  else if (d.params.count(k))
+    d.params[k] = v;
   else {
     std::string keys = "viscosity, support_ratio, cfl, max_substeps";
     for (const auto& p : d.params) keys += ", " + p.first;
@@ -262,7 +266,8 @@ int cmdBenchGame(const std::vector<std::string>& args) {
   std::vector<int> particles = {20000};
   std::vector<int> threads = {1, 2};
   double seconds = 4;
-  std::vector<std::string> presets = {"game", "balanced", "accurate"}, sets, floors = {"scene"}, only, fromCsv, mergeDirs;
+  std::vector<std::string> presets = {"game", "balanced", "accurate"}, sets, floors = {"scene"}, only, fromCsv,
+                           mergeDirs;
   std::string peer, csvPath, out, assetsPath = "assets";
   bool list = false, listIds = false, allowMixed = false, shaped = false;
   for (std::size_t i = 0; i < args.size(); ++i) {
@@ -296,32 +301,42 @@ int cmdBenchGame(const std::vector<std::string>& args) {
       shaped = true;
       for (const std::string& f : splitList(value())) floors.push_back(parseFloorVariant(a, f).name);
       if (floors.empty()) throw UsageError("--floors needs at least one floor (scene, free, muX, noslip)");
-    } else if (a == "--set") sets.push_back(value());
+    } else if (a == "--set")
+      sets.push_back(value());
     else if (a == "--peer") {
       // `--peer` alone: the harness this build tree builds (-DSPH2D_PEER_LIQUIDFUN=ON); `--peer PATH`: that one.
       peer = i + 1 < args.size() && args[i + 1].rfind("--", 0) != 0 ? args[++i] : std::string(SPH2D_PEER_EXE);
-    }
-    else if (a == "--assets") assetsPath = value();
-    else if (a == "--csv") csvPath = value();
-    else if (a == "--out") out = value();
-    else if (a == "--list") list = true;
-    else if (a == "--list-ids") listIds = true;
+    } else if (a == "--assets")
+      assetsPath = value();
+    else if (a == "--csv")
+      csvPath = value();
+    else if (a == "--out")
+      out = value();
+    else if (a == "--list")
+      list = true;
+    else if (a == "--list-ids")
+      listIds = true;
     else if (a == "--only") {
       only = splitList(value());
       if (only.empty()) throw UsageError("--only needs a run id (sph2d bench game --list-ids lists them)");
-    } else if (a == "--merge") mergeDirs.push_back(value());
+    } else if (a == "--merge")
+      mergeDirs.push_back(value());
     else if (a == "--from-csv") {
       for (const std::string& f : splitList(value())) fromCsv.push_back(f);
-    } else if (a == "--allow-mixed") allowMixed = true;
-    else throw UsageError("unknown option '" + a + "' (see sph2d bench game --help)");
+    } else if (a == "--allow-mixed")
+      allowMixed = true;
+    else
+      throw UsageError("unknown option '" + a + "' (see sph2d bench game --help)");
   }
   const bool merging = !fromCsv.empty() || !mergeDirs.empty();
   if (int(list) + int(listIds) + int(!only.empty()) + int(merging) > 1)
     throw UsageError("--list, --list-ids, --only and --merge/--from-csv are one each: give one of them");
   if (!only.empty() && shaped)
-    throw UsageError("--only names its runs: not with --presets, --particles, --threads or --floors (they select what --list prints)");
+    throw UsageError(
+        "--only names its runs: not with --presets, --particles, --threads or --floors (they select what --list prints)");
   if (allowMixed && !merging) throw UsageError("--allow-mixed is for --merge and --from-csv");
-  if (merging && out.empty() && csvPath.empty()) throw UsageError("--merge and --from-csv write --out DIR or --csv FILE: give one");
+  if (merging && out.empty() && csvPath.empty())
+    throw UsageError("--merge and --from-csv write --out DIR or --csv FILE: give one");
   if (peer.find('\'') != std::string::npos)  // it goes into a shell command between single quotes
     throw UsageError("--peer " + peer + ": a path with a single quote is not accepted");
   if (!peer.empty() && !list && !listIds && ::access(peer.c_str(), X_OK) != 0)
@@ -347,7 +362,8 @@ int cmdBenchGame(const std::vector<std::string>& args) {
       refuseForeignFiles(out, scan, spec);
       OutputJournal journal(out, spec.command, scan.own);
       const std::string path = out + "/game.csv";
-      journal.note("game.csv", std::filesystem::path(tempPathFor(path)).filename().string(), xxh64(text.data(), text.size()));
+      journal.note("game.csv", std::filesystem::path(tempPathFor(path)).filename().string(),
+                   xxh64(text.data(), text.size()));
       writeFileAtomic(path, text);
       std::printf("wrote %s\n", path.c_str());
     }
@@ -367,8 +383,8 @@ int cmdBenchGame(const std::vector<std::string>& args) {
       for (Row& r : readRows(path)) {
         const auto [it, fresh] = seen.emplace(r.id, path);
         if (!fresh)
-          throw UsageError("bench game: run " + r.id + " is in " + it->second + (it->second == path ? " twice" : " and in " + path) +
-                           ": merge each run once");
+          throw UsageError("bench game: run " + r.id + " is in " + it->second +
+                           (it->second == path ? " twice" : " and in " + path) + ": merge each run once");
         origins.push_back(RowOrigin{path, r.build, r.settings});
         rows.push_back(std::move(r));
       }
@@ -408,11 +424,12 @@ int cmdBenchGame(const std::vector<std::string>& args) {
     for (Spec& p : specs) p.id = specId(p);
   }
   const std::string assets = assetsPath;
-  const std::string scenePath = assets + "/scenes/dam_break.json", surgePath = assets + "/reference/martin_moyce_1952_surge_front.csv";
+  const std::string scenePath = assets + "/scenes/dam_break.json",
+                    surgePath = assets + "/reference/martin_moyce_1952_surge_front.csv";
   std::string setText;
   for (const std::string& kv : sets) setText += (setText.empty() ? "" : "|") + kv;
-  const std::string settings =
-      "seconds=" + fmt(seconds, "%g") + ";set=" + (setText.empty() ? "none" : setText) + ";assets=" + filesHash({scenePath, surgePath});
+  const std::string settings = "seconds=" + fmt(seconds, "%g") + ";set=" + (setText.empty() ? "none" : setText) +
+                               ";assets=" + filesHash({scenePath, surgePath});
   if (list || listIds) {
     const std::string exe = shellQuote(selfExe()), root = absolutePath(out.empty() ? "out/bench_game" : out);
     for (const Spec& p : specs) {
@@ -431,22 +448,25 @@ int cmdBenchGame(const std::vector<std::string>& args) {
   const SceneDef scene = loadScene(scenePath);
   const auto surge = validation::readReferenceCsv(surgePath);
   holdFolder();
-  std::printf("bench game: dam break, 1 m x 2 m column, spacing sqrt(2/N) m, %g simulated s, one stepFrame of 1/%g s per frame\n",
-              seconds, scene.fps);
-  std::printf("%-22s %-18s %9s %3s %9s %8s %8s %8s %8s %8s %7s %8s %5s %8s %8s\n", "id", "run", "particles", "thr", "wall/sim",
-              "vs peer", "substp/f", "iter/f", "mean cmp", "max cmp", "E gain", "surge", "out", "end cmp", "surface");
+  std::printf(
+      "bench game: dam break, 1 m x 2 m column, spacing sqrt(2/N) m, %g simulated s, one stepFrame of 1/%g s per frame\n",
+      seconds, scene.fps);
+  std::printf("%-22s %-18s %9s %3s %9s %8s %8s %8s %8s %8s %7s %8s %5s %8s %8s\n", "id", "run", "particles", "thr",
+              "wall/sim", "vs peer", "substp/f", "iter/f", "mean cmp", "max cmp", "E gain", "surge", "out", "end cmp",
+              "surface");
   std::fflush(stdout);
   std::vector<Row> rows;
   std::map<int, double> peerTime;  // requested particles → liquidfun_static's wall time, this run
   auto print = [&](const Row& r, int n) {
     const auto pt = peerTime.find(n);
-    std::printf("%-22s %-18s %9zu %3d %9s %8s %8s %8s %8s %8s %7s %8s %5s %8s %8s\n", r.id.c_str(), r.name.c_str(), r.particles,
-                r.threads, fmt(r.wallPerSim, "%.3f").c_str(),
+    std::printf("%-22s %-18s %9zu %3d %9s %8s %8s %8s %8s %8s %7s %8s %5s %8s %8s\n", r.id.c_str(), r.name.c_str(),
+                r.particles, r.threads, fmt(r.wallPerSim, "%.3f").c_str(),
                 fmt(pt == peerTime.end() ? NAN : r.wallPerSim / pt->second, "%.2fx").c_str(),
                 fmt(r.substepsPerFrame, "%.2f").c_str(), fmt(r.iterationsPerFrame, "%.1f").c_str(),
                 fmt(100 * r.meanCompression, "%.2f%%").c_str(), fmt(100 * r.maxCompression, "%.1f%%").c_str(),
-                fmt(100 * r.energyGain, "%.2f%%").c_str(), fmt(r.surgeRms, "%.3f").c_str(), fmt(r.outside, "%.0f").c_str(),
-                fmt(100 * r.endCompression, "%.2f%%").c_str(), fmt(r.endSurface, "%.3f").c_str());
+                fmt(100 * r.energyGain, "%.2f%%").c_str(), fmt(r.surgeRms, "%.3f").c_str(),
+                fmt(r.outside, "%.0f").c_str(), fmt(100 * r.endCompression, "%.2f%%").c_str(),
+                fmt(r.endSurface, "%.3f").c_str());
     std::fflush(stdout);
   };
   for (const Spec& p : specs) {

@@ -28,12 +28,18 @@ int cmdBenchServe(const std::vector<std::string>& a) {
       if (i + 1 >= a.size()) throw UsageError(s + " needs a value");
       return a[++i];
     };
-    if (s == "--host") host = value();
-    else if (s == "--port") port = parseInt(s, value(), 1, 65535);
-    else if (s == "--seconds") seconds = parseNumber(s, value());
-    else if (s == "--drops") drops = parseInt(s, value(), 0, 10000);
-    else if (s == "--radius") radius = parseNumber(s, value());
-    else if (s == "--csv") csv = value();
+    if (s == "--host")
+      host = value();
+    else if (s == "--port")
+      port = parseInt(s, value(), 1, 65535);
+    else if (s == "--seconds")
+      seconds = parseNumber(s, value());
+    else if (s == "--drops")
+      drops = parseInt(s, value(), 0, 10000);
+    else if (s == "--radius")
+      radius = parseNumber(s, value());
+    else if (s == "--csv")
+      csv = value();
     else if (s == "--help" || s == "-h") {
       std::printf(
           "Usage: sph2d bench serve [--host H] [--port P] [--seconds S] [--drops N] [--radius R] [--csv FILE]\n"
@@ -42,7 +48,9 @@ int cmdBenchServe(const std::vector<std::string>& a) {
           "prints the latency from each POST to the first frame showing it. --csv FILE: one row per\n"
           "measurement (kind,index,value).\n");
       return 0;
-    } else throw UsageError("unknown option '" + s + "' for bench serve; options: --host, --port, --seconds, --drops, --radius, --csv");
+    } else
+      throw UsageError("unknown option '" + s +
+                       "' for bench serve; options: --host, --port, --seconds, --drops, --radius, --csv");
   }
   if (!(seconds > 0)) throw UsageError("--seconds must be > 0");
   using clock = std::chrono::steady_clock;
@@ -74,10 +82,12 @@ int cmdBenchServe(const std::vector<std::string>& a) {
     const std::uint64_t seq = h.value("seq", std::uint64_t(0));
     if (!firstSeq) firstSeq = seq;
     lastSeq = seq;
-    if (lastAt != clock::time_point{}) gaps.push_back(std::chrono::duration<double, std::milli>(m->at - lastAt).count());
+    if (lastAt != clock::time_point{})
+      gaps.push_back(std::chrono::duration<double, std::milli>(m->at - lastAt).count());
     lastAt = m->at;
     const std::size_t p = h.value("particles", std::size_t(0));
-    if (camera.empty() && h.contains("camera") && h["camera"].size() == 4) camera = h["camera"].get<std::vector<double>>();
+    if (camera.empty() && h.contains("camera") && h["camera"].size() == 4)
+      camera = h["camera"].get<std::vector<double>>();
     if (waiting && p != particles) {
       const double ms = std::chrono::duration<double, std::milli>(m->at - dropAt).count();
       latencies.push_back(ms);
@@ -104,15 +114,21 @@ int cmdBenchServe(const std::vector<std::string>& a) {
   std::sort(gaps.begin(), gaps.end());
   std::vector<double> lat = latencies;
   std::sort(lat.begin(), lat.end());
-  auto pct = [](const std::vector<double>& v, double q) { return v.empty() ? 0.0 : v[std::size_t(q * double(v.size() - 1) + 0.5)]; };
-  std::printf("frames received: %llu in %.1f s = %.1f frames/s (server frames %llu..%llu: %llu skipped for this client)\n",
-              static_cast<unsigned long long>(frames), wall, fps, static_cast<unsigned long long>(firstSeq),
-              static_cast<unsigned long long>(lastSeq),
-              static_cast<unsigned long long>(lastSeq - firstSeq + 1 - std::min<std::uint64_t>(frames, lastSeq - firstSeq + 1)));
+  auto pct = [](const std::vector<double>& v, double q) {
+    return v.empty() ? 0.0 : v[std::size_t(q * double(v.size() - 1) + 0.5)];
+  };
+  std::printf(
+      "frames received: %llu in %.1f s = %.1f frames/s (server frames %llu..%llu: %llu skipped for this client)\n",
+      static_cast<unsigned long long>(frames), wall, fps, static_cast<unsigned long long>(firstSeq),
+      static_cast<unsigned long long>(lastSeq),
+      static_cast<unsigned long long>(lastSeq - firstSeq + 1 -
+                                      std::min<std::uint64_t>(frames, lastSeq - firstSeq + 1)));
   std::printf("frame size: %.1f KB mean; gap between frames: median %.1f ms, 95%% %.1f ms, max %.1f ms\n",
-              frames ? double(bytes) / double(frames) / 1e3 : 0.0, pct(gaps, 0.5), pct(gaps, 0.95), gaps.empty() ? 0.0 : gaps.back());
-  std::printf("input -> frame latency (POST /event drop -> first frame showing it): %zu of %d: min %.1f ms, median %.1f ms, max %.1f ms\n",
-              lat.size(), dropsSent, lat.empty() ? 0.0 : lat.front(), pct(lat, 0.5), lat.empty() ? 0.0 : lat.back());
+              frames ? double(bytes) / double(frames) / 1e3 : 0.0, pct(gaps, 0.5), pct(gaps, 0.95),
+              gaps.empty() ? 0.0 : gaps.back());
+  std::printf(
+      "input -> frame latency (POST /event drop -> first frame showing it): %zu of %d: min %.1f ms, median %.1f ms, max %.1f ms\n",
+      lat.size(), dropsSent, lat.empty() ? 0.0 : lat.front(), pct(lat, 0.5), lat.empty() ? 0.0 : lat.back());
   std::printf("csv: fps,latency_median_ms,latency_max_ms,frame_kb\n%.2f,%.1f,%.1f,%.1f\n", fps, pct(lat, 0.5),
               lat.empty() ? 0.0 : lat.back(), frames ? double(bytes) / double(frames) / 1e3 : 0.0);
   if (out) {

@@ -52,13 +52,20 @@ int cmdBenchStep(const std::vector<std::string>& args) {
     if (a == "--help" || a == "-h") {
       std::fputs(kHelp, stdout);
       return 0;
-    } else if (a == "--scene") scenePath = value();
-    else if (a == "--particles") counts = parseIntList(a, value(), 1, 50000000);
-    else if (a == "--threads") threads = parseIntList(a, value(), 1, 256);
-    else if (a == "--steps") steps = parseInt(a, value(), 1, 100000000);
-    else if (a == "--warmup") warmup = parseInt(a, value(), 0, 100000000);
-    else if (a == "--csv") csv = true;
-    else throw UsageError("unknown option '" + a + "' (see sph2d bench step --help)");
+    } else if (a == "--scene")
+      scenePath = value();
+    else if (a == "--particles")
+      counts = parseIntList(a, value(), 1, 50000000);
+    else if (a == "--threads")
+      threads = parseIntList(a, value(), 1, 256);
+    else if (a == "--steps")
+      steps = parseInt(a, value(), 1, 100000000);
+    else if (a == "--warmup")
+      warmup = parseInt(a, value(), 0, 100000000);
+    else if (a == "--csv")
+      csv = true;
+    else
+      throw UsageError("unknown option '" + a + "' (see sph2d bench step --help)");
   }
   const SceneDef base = loadScene(scenePath);
   const std::size_t n0 = countBlockParticles(base);
@@ -88,7 +95,8 @@ int cmdBenchStep(const std::vector<std::string>& args) {
       for (const auto& st : timings) stageTotal += st.seconds;
       if (!header) {
         if (csv) {
-          std::printf("particles,threads,steps,ms_per_step,particle_steps_per_s,pairs_per_s,bytes_per_particle,rss_bytes_per_particle");
+          std::printf(
+              "particles,threads,steps,ms_per_step,particle_steps_per_s,pairs_per_s,bytes_per_particle,rss_bytes_per_particle");
           for (const auto& st : timings) std::printf(",share_%s", st.name.c_str());
           std::printf("\n");
         } else {
@@ -108,7 +116,8 @@ int cmdBenchStep(const std::vector<std::string>& args) {
         std::printf("\n");
       } else {
         std::printf("%9zu %7d %6d %11.3f %14.3e %12.3e %9.1f %9.1f ", np, w.threads(), k, ms, ps, pairsPerS, bpp, rss);
-        for (const auto& st : timings) std::printf(" %s %.0f%%", st.name.c_str(), stageTotal > 0 ? 100 * st.seconds / stageTotal : 0.0);
+        for (const auto& st : timings)
+          std::printf(" %s %.0f%%", st.name.c_str(), stageTotal > 0 ? 100 * st.seconds / stageTotal : 0.0);
         std::printf("\n");
       }
       std::fflush(stdout);

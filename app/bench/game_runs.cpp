@@ -26,7 +26,8 @@ const char* const kCsvHeader =
 
 std::string specId(const Spec& p) {
   if (!p.peer.empty()) return p.peer + "-" + std::to_string(p.particles);
-  return p.preset + "-" + std::to_string(p.particles) + "-t" + std::to_string(p.threads) + (p.floor == "scene" ? "" : "-" + p.floor);
+  return p.preset + "-" + std::to_string(p.particles) + "-t" + std::to_string(p.threads) +
+         (p.floor == "scene" ? "" : "-" + p.floor);
 }
 
 /// Parses a run id back into its run; throws UsageError saying what an id is.
@@ -41,11 +42,13 @@ Spec parseId(const std::string& id, bool havePeer) {
     if (c == '-') {
       parts.push_back(cur);
       cur.clear();
-    } else cur += c;
+    } else
+      cur += c;
   }
   parts.push_back(cur);
   auto integer = [&](const std::string& v, int lo, int hi) {
-    if (v.empty() || v.size() > 9 || !std::all_of(v.begin(), v.end(), [](char c) { return std::isdigit(static_cast<unsigned char>(c)); }))
+    if (v.empty() || v.size() > 9 ||
+        !std::all_of(v.begin(), v.end(), [](char c) { return std::isdigit(static_cast<unsigned char>(c)); }))
       throw UsageError("--only: '" + id + "' is not a run of bench game" + form);
     const int n = std::atoi(v.c_str());
     if (n < lo || n > hi) throw UsageError("--only: '" + id + "' is not a run of bench game" + form);
@@ -72,7 +75,8 @@ Spec parseId(const std::string& id, bool havePeer) {
   } else {
     throw UsageError("--only: '" + id + "' is not a run of bench game" + form);
   }
-  if (specId(p) != id) throw UsageError("--only: '" + id + "' is not a run of bench game (did you mean " + specId(p) + "?)" + form);
+  if (specId(p) != id)
+    throw UsageError("--only: '" + id + "' is not a run of bench game (did you mean " + specId(p) + "?)" + form);
   p.id = id;
   return p;
 }
@@ -113,10 +117,11 @@ std::string csvText(const std::vector<Row>& rows) {
   for (const Row& r : rows) {
     const auto pt = peerTime.find(idParticles(r.id));
     const double ratio = pt == peerTime.end() ? NAN : r.wallPerSim / pt->second;
-    o << r.id << ',' << r.name << ',' << r.floor << ',' << r.particles << ',' << r.threads << ',' << v(r.wallPerSim) << ','
-      << v(ratio) << ',' << v(r.substepsPerFrame) << ',' << v(r.iterationsPerFrame) << ',' << v(r.meanCompression) << ','
-      << v(r.maxCompression) << ',' << v(r.energyGain) << ',' << v(r.surgeRms) << ',' << v(r.outside) << ','
-      << v(r.endCompression) << ',' << v(r.endSurface) << ',' << r.build << ',' << r.settings << '\n';
+    o << r.id << ',' << r.name << ',' << r.floor << ',' << r.particles << ',' << r.threads << ',' << v(r.wallPerSim)
+      << ',' << v(ratio) << ',' << v(r.substepsPerFrame) << ',' << v(r.iterationsPerFrame) << ','
+      << v(r.meanCompression) << ',' << v(r.maxCompression) << ',' << v(r.energyGain) << ',' << v(r.surgeRms) << ','
+      << v(r.outside) << ',' << v(r.endCompression) << ',' << v(r.endSurface) << ',' << r.build << ',' << r.settings
+      << '\n';
   }
   return o.str();
 }
@@ -133,7 +138,8 @@ std::vector<Row> readRows(const std::string& path) {
   const CsvRows t = readCsvRows(path);
   std::string header;
   for (const std::string& h : t.header) header += (header.empty() ? "" : ",") + h;
-  if (header != kCsvHeader) throw UsageError(path + ": not a game.csv of this sph2d bench game (its header: " + header + ")");
+  if (header != kCsvHeader)
+    throw UsageError(path + ": not a game.csv of this sph2d bench game (its header: " + header + ")");
   std::vector<Row> rows;
   for (std::size_t i = 0; i < t.rows.size(); ++i) {
     Row r;

@@ -91,8 +91,8 @@ CsvRows readCsvRows(const std::string& path) {
     if (line.empty()) continue;
     std::vector<std::string> f = cells(line);
     if (f.size() != t.header.size())
-      throw UsageError(path + ":" + std::to_string(number) + ": " + std::to_string(f.size()) + " cells, the header has " +
-                       std::to_string(t.header.size()));
+      throw UsageError(path + ":" + std::to_string(number) + ": " + std::to_string(f.size()) +
+                       " cells, the header has " + std::to_string(t.header.size()));
     t.rows.push_back(std::move(f));
   }
   return t;
@@ -109,12 +109,15 @@ std::vector<std::string> mergeParts(const std::string& flag, const std::string& 
     if (fs::is_regular_file(p, e2)) parts.push_back(p.string());
   }
   if (ec) throw UsageError(flag + " " + dir + ": cannot be listed (" + ec.message() + ")");
-  if (parts.empty()) throw UsageError(flag + " " + dir + ": no " + dir + "/*/" + name + " (the runs of --list write RUN_ID/" + name + ")");
+  if (parts.empty())
+    throw UsageError(flag + " " + dir + ": no " + dir + "/*/" + name + " (the runs of --list write RUN_ID/" + name +
+                     ")");
   std::sort(parts.begin(), parts.end());
   return parts;
 }
 
-std::vector<RowOrigin> checkOrigins(const std::string& command, const std::vector<RowOrigin>& origins, bool allowMixed) {
+std::vector<RowOrigin> checkOrigins(const std::string& command, const std::vector<RowOrigin>& origins,
+                                    bool allowMixed) {
   std::vector<RowOrigin> distinct;
   for (const RowOrigin& o : origins) {
     const auto same = [&](const RowOrigin& d) { return d.build == o.build && d.settings == o.settings; };
@@ -125,11 +128,13 @@ std::vector<RowOrigin> checkOrigins(const std::string& command, const std::vecto
     const RowOrigin& b = distinct[1];
     std::string what;
     if (a.build != b.build) what = "build " + a.build + " against " + b.build;
-    if (a.settings != b.settings) what += std::string(what.empty() ? "" : ", ") + "settings " + a.settings + " against " + b.settings;
-    throw UsageError(command + ": " + a.file + " and " + b.file + " come from different runs (" + what + "; " +
-                     std::to_string(distinct.size()) +
-                     " kinds in all): their wall times and figures do not belong in one report. Merge each kind on its own, or "
-                     "pass --allow-mixed to merge them anyway (each row keeps its build and settings, and the report names them)");
+    if (a.settings != b.settings)
+      what += std::string(what.empty() ? "" : ", ") + "settings " + a.settings + " against " + b.settings;
+    throw UsageError(
+        command + ": " + a.file + " and " + b.file + " come from different runs (" + what + "; " +
+        std::to_string(distinct.size()) +
+        " kinds in all): their wall times and figures do not belong in one report. Merge each kind on its own, or "
+        "pass --allow-mixed to merge them anyway (each row keeps its build and settings, and the report names them)");
   }
   return distinct;
 }
@@ -158,13 +163,15 @@ FloorVariant parseFloorVariant(const std::string& flag, const std::string& v) {
     const std::string num = v.substr(2);
     char* end = nullptr;
     const double mu = std::strtod(num.c_str(), &end);
-    const bool digits = std::all_of(num.begin(), num.end(), [](char c) { return std::isdigit(static_cast<unsigned char>(c)) || c == '.'; });
+    const bool digits = std::all_of(num.begin(), num.end(),
+                                    [](char c) { return std::isdigit(static_cast<unsigned char>(c)) || c == '.'; });
     if (digits && end && *end == '\0' && mu > 0 && mu <= 10) {
       f.friction = mu;
       return f;
     }
   }
-  throw UsageError(flag + ": unknown floor '" + v + "'; floors: scene, free, muX (Coulomb friction X in (0, 10], e.g. mu0.5), noslip");
+  throw UsageError(flag + ": unknown floor '" + v +
+                   "'; floors: scene, free, muX (Coulomb friction X in (0, 10], e.g. mu0.5), noslip");
 }
 
 void applyFloorVariant(SceneDef& s, const FloorVariant& f) {
@@ -192,9 +199,10 @@ std::string solverParamsText(const SolverDef& d) {
     std::snprintf(b, sizeof b, "%.9g", v);
     return std::string(b);
   };
-  std::string t = "spacing=" + num(d.spacing) + ";support_ratio=" + num(d.supportRatio) + ";rest_density=" + num(d.restDensity) +
-                  ";sound_speed=" + num(d.soundSpeed) + ";viscosity=" + num(d.viscosity) + ";no_slip=" + (d.noSlip ? "1" : "0") +
-                  ";cfl=" + num(d.cfl) + ";max_substeps=" + std::to_string(d.maxSubsteps) +
+  std::string t = "spacing=" + num(d.spacing) + ";support_ratio=" + num(d.supportRatio) +
+                  ";rest_density=" + num(d.restDensity) + ";sound_speed=" + num(d.soundSpeed) +
+                  ";viscosity=" + num(d.viscosity) + ";no_slip=" + (d.noSlip ? "1" : "0") + ";cfl=" + num(d.cfl) +
+                  ";max_substeps=" + std::to_string(d.maxSubsteps) +
                   ";clamp_negative_pressure=" + (d.clampNegativePressure ? "1" : "0");
   for (const auto& p : d.params) t += ";" + p.first + "=" + num(p.second);
   return t;

@@ -45,7 +45,8 @@ inline std::vector<std::vector<double>> readReferenceCsv(const std::string& path
   std::vector<std::vector<double>> rows;
   std::string line;
   while (std::getline(in, line)) {
-    if (line.empty() || line[0] == '#' || !(std::isdigit(static_cast<unsigned char>(line[0])) || line[0] == '-')) continue;
+    if (line.empty() || line[0] == '#' || !(std::isdigit(static_cast<unsigned char>(line[0])) || line[0] == '-'))
+      continue;
     std::vector<double> row;
     std::stringstream ss(line);
     std::string cell;
@@ -66,7 +67,7 @@ struct TaylorGreenResult {
   double simSeconds = 0;
   std::uint64_t substeps = 0;
   double meanDensityError = 0, maxDensityError = 0;  ///< of DensityStats::meanError over the frames
-  std::vector<double> t, amplitude, umax;  ///< per frame (t = 0 included)
+  std::vector<double> t, amplitude, umax;            ///< per frame (t = 0 included)
 };
 
 /// The amplitude of the Taylor–Green mode (wavelength L from `field`) in the particles' velocities.
@@ -85,8 +86,8 @@ inline double taylorGreenAmplitude(const World& w, const VelocityFieldDef& field
 
 /// Runs a Taylor–Green scene (one block with a taylor_green velocity field)
 /// for `seconds`, frame by frame; `table` rows are (Re, t, umax_ratio, ke_ratio).
-inline TaylorGreenResult runTaylorGreen(const SceneDef& s, double seconds, const std::vector<std::vector<double>>& table,
-                                        int threads = 1) {
+inline TaylorGreenResult runTaylorGreen(const SceneDef& s, double seconds,
+                                        const std::vector<std::vector<double>>& table, int threads = 1) {
   if (s.blocks.empty() || s.blocks[0].field.type != VelocityFieldDef::Type::TaylorGreen)
     throw std::runtime_error("a Taylor-Green scene needs a block with a taylor_green velocity field");
   const VelocityFieldDef& f = s.blocks[0].field;

@@ -151,10 +151,11 @@ int main(int argc, char** argv) {
         fluid.forEachContact([&](const b2Fixture& fx, const std::vector<std::uint32_t>& ids) {
           if (fx.GetShape()->GetType() == b2Shape::e_circle) onBumper = ids.size();
         });
-        std::printf("t = %.1f s: %zu particles, %zu in the bucket, density at its bottom %.0f kg/m3, %zu on the bumper, "
-                    "crates at (%.2f, %.2f) m and (%.2f, %.2f) m\n",
-                    fluid.time(), fluid.particleCount(), inBucket, probe.density, onBumper, pine->GetPosition().x,
-                    pine->GetPosition().y, oak->GetPosition().x, oak->GetPosition().y);
+        std::printf(
+            "t = %.1f s: %zu particles, %zu in the bucket, density at its bottom %.0f kg/m3, %zu on the bumper, "
+            "crates at (%.2f, %.2f) m and (%.2f, %.2f) m\n",
+            fluid.time(), fluid.particleCount(), inBucket, probe.density, onBumper, pine->GetPosition().x,
+            pine->GetPosition().y, oak->GetPosition().x, oak->GetPosition().y);
       }
     }
     writer.finish();

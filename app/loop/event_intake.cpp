@@ -75,8 +75,10 @@ std::vector<TimedEvent> EventIntake::takeLive(std::int64_t frame) {
   std::vector<TimedEvent> now, queued;
   queued.swap(liveQueue_);
   for (TimedEvent& t : queued) {
-    if (t.frame > frame) schedule_.add(std::move(t));
-    else now.push_back(std::move(t));
+    if (t.frame > frame)
+      schedule_.add(std::move(t));
+    else
+      now.push_back(std::move(t));
   }
   return now;
 }
@@ -132,8 +134,10 @@ namespace {
 /// A particle count for messages: whole below 10^12, else like 2.5e+15.
 std::string count(double n) {
   char b[32];
-  if (n < 1e12) std::snprintf(b, sizeof b, "%.0f", n);
-  else std::snprintf(b, sizeof b, "%.2g", n);
+  if (n < 1e12)
+    std::snprintf(b, sizeof b, "%.0f", n);
+  else
+    std::snprintf(b, sizeof b, "%.2g", n);
   return b;
 }
 
@@ -176,7 +180,8 @@ LiveRefusal LiveGate::admit(const EventDef& e, double now, double particles) {
             0};
   if (limits_.perSecond && n > double(limits_.perSecond))
     return {422,
-            what(e) + " would add up to " + count(n) + " particles, more than the " + std::to_string(limits_.perSecond) +
+            what(e) + " would add up to " + count(n) + " particles, more than the " +
+                std::to_string(limits_.perSecond) +
                 " live input may add in a second (--max-particles-per-second, default half the scene's " +
                 std::to_string(limits_.sceneCount) + ")",
             0};

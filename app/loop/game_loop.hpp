@@ -31,8 +31,8 @@
 #include <string>
 
 #include "loop/event_intake.hpp"
-#include "loop/input_events.hpp"
 #include "loop/frame_clock.hpp"
+#include "loop/input_events.hpp"
 #include "sph2d/render/renderer.hpp"
 #include "sph2d/world.hpp"
 
@@ -40,11 +40,12 @@ namespace sph2d::cli {
 
 /// How the loop runs.
 struct LoopSettings {
-  std::int64_t frames = 1;                ///< boundaries 0 .. frames − 1 (frames − 1 steps)
-  double fps = 60;                        ///< the scene's frame rate (one step = 1/fps)
-  bool realtime = false;                  ///< pace to the wall clock (else as fast as possible)
-  int catchUp = 4;                        ///< real time: at most this many steps per render
-  const std::atomic<bool>* stop = nullptr;  ///< when set and true, the loop ends (SIGINT/SIGTERM; give the World the same flag)
+  std::int64_t frames = 1;  ///< boundaries 0 .. frames − 1 (frames − 1 steps)
+  double fps = 60;          ///< the scene's frame rate (one step = 1/fps)
+  bool realtime = false;    ///< pace to the wall clock (else as fast as possible)
+  int catchUp = 4;          ///< real time: at most this many steps per render
+  const std::atomic<bool>* stop =
+      nullptr;  ///< when set and true, the loop ends (SIGINT/SIGTERM; give the World the same flag)
   /// Live input's caps: at each boundary a live event (EventIntake::takeLive) that would take
   /// the fluid past `live.budget` is not applied (observer.notApplied); the per-event and
   /// per-second caps are the intake's (LiveGate). Budget 0: no cap.
@@ -53,23 +54,23 @@ struct LoopSettings {
 
 /// Where the loop is, for progress lines and the summary.
 struct LoopStatus {
-  std::int64_t frames = 0;     ///< the frames the loop runs (LoopSettings::frames)
-  std::int64_t frame = 0;      ///< the last frame boundary reached
-  std::int64_t done = 0;       ///< boundaries complete (events applied, observer told)
-  std::uint64_t dropped = 0;   ///< kept frames stepped but not rendered, to keep up
-  std::uint64_t late = 0;      ///< frame periods forgotten: the simulation fell behind the wall clock
-  double behindSeconds = 0;    ///< late × 1/fps
-  double simSeconds = 0;       ///< wall seconds spent in World::stepFrame
-  double renderSeconds = 0;    ///< wall seconds spent in Renderer::render
-  int applied = 0;             ///< events applied
-  bool paused = false;         ///< between a pause and a resume
+  std::int64_t frames = 0;    ///< the frames the loop runs (LoopSettings::frames)
+  std::int64_t frame = 0;     ///< the last frame boundary reached
+  std::int64_t done = 0;      ///< boundaries complete (events applied, observer told)
+  std::uint64_t dropped = 0;  ///< kept frames stepped but not rendered, to keep up
+  std::uint64_t late = 0;     ///< frame periods forgotten: the simulation fell behind the wall clock
+  double behindSeconds = 0;   ///< late × 1/fps
+  double simSeconds = 0;      ///< wall seconds spent in World::stepFrame
+  double renderSeconds = 0;   ///< wall seconds spent in Renderer::render
+  int applied = 0;            ///< events applied
+  bool paused = false;        ///< between a pause and a resume
 };
 
 /// A kept frame's boundary, as the loop captured it before stepping on.
 struct FrameState {
-  std::int64_t frame = 0;        ///< the boundary
-  double time = 0;               ///< World::time() there [s]
-  std::uint64_t stateHash = 0;   ///< World::stateHash() there
+  std::int64_t frame = 0;       ///< the boundary
+  double time = 0;              ///< World::time() there [s]
+  std::uint64_t stateHash = 0;  ///< World::stateHash() there
 };
 
 /// How the loop ended (exceptions from the World, the renderer or the observer propagate).
@@ -159,7 +160,7 @@ class GameLoop {
   struct Pending {
     bool active = false;
     FrameState state;
-    ParticleBuffer particles;         ///< copies of the fields the renderer reads
+    ParticleBuffer particles;  ///< copies of the fields the renderer reads
     std::vector<Collider> colliders;
     RenderInput input;
   } pending_;

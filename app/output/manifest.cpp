@@ -39,7 +39,8 @@ json renderOptionsJson(const RenderOptions& o) {
 
 RunManifest::RunManifest(const RunArgs& a, const SceneDef& scene, const Renderer& renderer, int frames, int threads) {
   std::string exportName = "none";
-  if (a.exportFormat) exportName = exportExtension(*a.exportFormat) + (*a.exportFormat == ExportFormat::VtkAscii ? "-ascii" : "");
+  if (a.exportFormat)
+    exportName = exportExtension(*a.exportFormat) + (*a.exportFormat == ExportFormat::VtkAscii ? "-ascii" : "");
   j_["format"] = "sph2d-frames";
   j_["format_version"] = 1;
   j_["engine_version"] = SPH2D_VERSION;
@@ -47,11 +48,14 @@ RunManifest::RunManifest(const RunArgs& a, const SceneDef& scene, const Renderer
   j_["renderer"] = renderer.rendererString();
   j_["cpu"] = cpuSummary();
   j_["environment"] = environmentJson();
-  j_["image"] = {{"width", scene.render.width}, {"height", scene.render.height}, {"format", "png"},
-                 {"png_level", a.pngLevel}, {"mode", renderer.mode()}};
+  j_["image"] = {{"width", scene.render.width},
+                 {"height", scene.render.height},
+                 {"format", "png"},
+                 {"png_level", a.pngLevel},
+                 {"mode", renderer.mode()}};
   j_["render"] = renderOptionsJson(a.render);
-  j_["run"] = {{"frames", frames}, {"every", a.every}, {"threads", threads}, {"fps", scene.fps}, {"export", exportName},
-               {"video", a.video}, {"realtime", a.realtime}, {"inputs", a.inputs}};
+  j_["run"] = {{"frames", frames},     {"every", a.every}, {"threads", threads},     {"fps", scene.fps},
+               {"export", exportName}, {"video", a.video}, {"realtime", a.realtime}, {"inputs", a.inputs}};
   j_["frames"] = json::array();
   j_["events"] = json::array();
   j_["files"] = json::array();
@@ -73,9 +77,11 @@ void RunManifest::finish(int written, const std::vector<OwnedFile>& files, int s
   while (int(list.size()) > written) list.erase(list.size() - 1);
   for (const OwnedFile& f : files) j_["files"].push_back({{"file", f.name}, {"xxh64", f.xxh64}});
   j_["complete"] = status == 0;
-  j_["stop"] = status == 0 ? json(nullptr)
-                           : json{{"reason", reason}, {"message", message}, {"frames_simulated", simulated},
-                                  {"frames_written", written}};
+  j_["stop"] =
+      status == 0
+          ? json(nullptr)
+          : json{
+                {"reason", reason}, {"message", message}, {"frames_simulated", simulated}, {"frames_written", written}};
 }
 
 void RunManifest::write(const std::string& dir) const { writeFileAtomic(dir + "/manifest.json", j_.dump(1) + "\n"); }

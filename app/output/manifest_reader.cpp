@@ -74,14 +74,16 @@ bool boolAt(const json& obj, const char* key, const std::string& where, bool fal
 }
 
 bool hex16(const std::string& h) {
-  return h.size() == 16 && std::all_of(h.begin(), h.end(), [](char c) { return std::isxdigit(static_cast<unsigned char>(c)); });
+  return h.size() == 16 &&
+         std::all_of(h.begin(), h.end(), [](char c) { return std::isxdigit(static_cast<unsigned char>(c)); });
 }
 
 RenderOptions renderOptions(const json& j) {
   const std::string w = "render.";
   RenderOptions o;
   o.mode = stringAt(j, "mode", w);
-  if (o.mode != "" && o.mode != "liquid" && o.mode != "particles") throw Malformed{w + "mode", "\"\", \"liquid\" or \"particles\""};
+  if (o.mode != "" && o.mode != "liquid" && o.mode != "particles")
+    throw Malformed{w + "mode", "\"\", \"liquid\" or \"particles\""};
   if (!parseColorField(stringAt(j, "color_by", w), o.colorBy))
     throw Malformed{w + "color_by", "\"speed\", \"pressure\", \"density\", \"age\" or \"color\""};
   const json& range = member(j, "range", w, "null or two finite numbers");
@@ -126,7 +128,8 @@ std::vector<ManifestEnv> manifestEnvironment(const json& m) {
   };
   for (const json& e : m["environment"]) {
     ManifestEnv me;
-    if (!e.is_object() || !e.contains("name") || !e["name"].is_string() || (e.contains("value") && !e["value"].is_string())) {
+    if (!e.is_object() || !e.contains("name") || !e["name"].is_string() ||
+        (e.contains("value") && !e["value"].is_string())) {
       me.name = "(malformed)";
       me.problem = "an entry is an object with a string name and value";
       out.push_back(me);
@@ -174,7 +177,8 @@ ManifestView parseManifest(const std::string& text, const std::string& path) {
     int written = -1;  // stop.frames_written, when the manifest says
     if (m.contains("stop") && !m["stop"].is_null()) {
       const json& st = m["stop"];
-      if (!st.is_object()) throw Malformed{"stop", "null or an object with reason and message strings and frames_written"};
+      if (!st.is_object())
+        throw Malformed{"stop", "null or an object with reason and message strings and frames_written"};
       (void)stringAt(st, "reason", "stop.");
       if (st.contains("message")) (void)stringAt(st, "message", "stop.");
       if (st.contains("frames_written")) written = intAt(st, "frames_written", "stop.", 0, 100000000);
@@ -187,14 +191,16 @@ ManifestView parseManifest(const std::string& text, const std::string& path) {
     for (std::size_t k = 0; k < list.size(); ++k) {
       const json& f = list[k];
       const std::string at = "frames[" + std::to_string(k) + "].";
-      if (!f.is_object()) throw Malformed{"frames[" + std::to_string(k) + "]", "an object with frame, file, rgba_xxh64 and state_hash"};
+      if (!f.is_object())
+        throw Malformed{"frames[" + std::to_string(k) + "]", "an object with frame, file, rgba_xxh64 and state_hash"};
       const int frame = intAt(f, "frame", at, 0, 100000000);
       if (frame >= v.frames || frame % v.every != 0 || frame <= last)
-        throw UsageError(path + ": frames[" + std::to_string(k) + "]: frame " + std::to_string(frame) + " is not a kept frame of the run after frame " +
-                         std::to_string(last) + " (frames 0.." + std::to_string(v.frames - 1) + ", every " +
-                         std::to_string(v.every) + ", in order)");
+        throw UsageError(path + ": frames[" + std::to_string(k) + "]: frame " + std::to_string(frame) +
+                         " is not a kept frame of the run after frame " + std::to_string(last) + " (frames 0.." +
+                         std::to_string(v.frames - 1) + ", every " + std::to_string(v.every) + ", in order)");
       if (stringAt(f, "file", at) != frameFileName(frame))
-        throw UsageError(path + ": frames[" + std::to_string(k) + "]: its file must be " + frameFileName(frame) + " (a manifest names only its own frames)");
+        throw UsageError(path + ": frames[" + std::to_string(k) + "]: its file must be " + frameFileName(frame) +
+                         " (a manifest names only its own frames)");
       if (!hex16(stringAt(f, "rgba_xxh64", at)) || !hex16(stringAt(f, "state_hash", at)))
         throw UsageError(path + ": frames[" + std::to_string(k) + "]: rgba_xxh64 and state_hash must be 16 hex digits");
       v.expected[frame] = f;
@@ -208,8 +214,8 @@ ManifestView parseManifest(const std::string& text, const std::string& path) {
     if (!complete) {
       prefix = std::min(keptCount, written >= 0 ? std::size_t(written) : v.expected.size());
       if (!realtime && v.expected.size() != prefix)
-        v.listProblems.push_back("the run stopped after writing " + std::to_string(prefix) + " frames, but the manifest lists " +
-                                 std::to_string(v.expected.size()));
+        v.listProblems.push_back("the run stopped after writing " + std::to_string(prefix) +
+                                 " frames, but the manifest lists " + std::to_string(v.expected.size()));
     }
     if (!realtime) {
       // Listed frames are kept frames in increasing order, so the first k kept frames are
@@ -220,9 +226,10 @@ ManifestView parseManifest(const std::string& text, const std::string& path) {
         ++k;
       }
       if (k < prefix)
-        v.listProblems.push_back(std::string(complete ? "the manifest says the run is complete, but " : "") + "it lists " +
-                                 std::to_string(v.expected.size()) + " of the run's " + std::to_string(prefix) +
-                                 " kept frames (the first missing: frame " + std::to_string(k * std::size_t(v.every)) + ")");
+        v.listProblems.push_back(std::string(complete ? "the manifest says the run is complete, but " : "") +
+                                 "it lists " + std::to_string(v.expected.size()) + " of the run's " +
+                                 std::to_string(prefix) + " kept frames (the first missing: frame " +
+                                 std::to_string(k * std::size_t(v.every)) + ")");
     }
   } catch (const Malformed& bad) {
     throw UsageError(path + ": the key '" + bad.key + "' is missing or not " + bad.want + " (as sph2d run writes it)");

@@ -42,7 +42,8 @@ bool plainName(const std::string& n) {
 }
 
 bool hex16(const std::string& h) {
-  return h.size() == 16 && std::all_of(h.begin(), h.end(), [](char c) { return std::isxdigit(static_cast<unsigned char>(c)); });
+  return h.size() == 16 &&
+         std::all_of(h.begin(), h.end(), [](char c) { return std::isxdigit(static_cast<unsigned char>(c)); });
 }
 
 std::string lower(std::string s) {
@@ -88,12 +89,14 @@ std::string readJournal(const std::string& path, const std::string& command, Rec
       return "not a journal sph2d wrote (line " + std::to_string(number) + " is not JSON)";
     }
     if (number == 1) {
-      if (!j.is_object() || j.value("format", json()) != "sph2d-journal" || !j.contains("command") || !j["command"].is_string())
+      if (!j.is_object() || j.value("format", json()) != "sph2d-journal" || !j.contains("command") ||
+          !j["command"].is_string())
         return "not a journal sph2d wrote (its first line is not {\"format\": \"sph2d-journal\", ...})";
       owner = j["command"].get<std::string>();
       continue;
     }
-    const bool ok = j.is_object() && j.contains("file") && j["file"].is_string() && plainName(j["file"].get<std::string>()) &&
+    const bool ok = j.is_object() && j.contains("file") && j["file"].is_string() &&
+                    plainName(j["file"].get<std::string>()) &&
                     (!j.contains("xxh64") || (j["xxh64"].is_string() && hex16(j["xxh64"].get<std::string>()))) &&
                     (!j.contains("temp") || (j["temp"].is_string() && plainName(j["temp"].get<std::string>())));
     if (!ok) return "not a journal sph2d wrote (line " + std::to_string(number) + " is not a file entry)";
@@ -103,7 +106,8 @@ std::string readJournal(const std::string& path, const std::string& command, Rec
   }
   if (number == 0) return "not a journal sph2d wrote (it is empty)";
   if (owner != command)
-    return "it is the journal of `sph2d " + owner + "`, not of `sph2d " + command + "`: the folder holds another command's outputs";
+    return "it is the journal of `sph2d " + owner + "`, not of `sph2d " + command +
+           "`: the folder holds another command's outputs";
   for (auto& [name, set] : mine.hashes) r.hashes[name].insert(set.begin(), set.end());
   r.temps.insert(mine.temps.begin(), mine.temps.end());
   return "";
@@ -132,7 +136,8 @@ std::string readRunManifest(const std::string& path, Records& r) {
     }
   } else {
     // A manifest from before the "files" list vouches for its frame PNGs by their pixels.
-    for (const auto& [frame, entry] : v.expected) r.pixelHashes[frameFileName(frame)] = lower(entry.value("rgba_xxh64", ""));
+    for (const auto& [frame, entry] : v.expected)
+      r.pixelHashes[frameFileName(frame)] = lower(entry.value("rgba_xxh64", ""));
   }
   return "";
 }
@@ -159,7 +164,8 @@ bool splitTempName(const std::string& name, std::string& target, std::string& pi
 void makeOutputDir(const std::string& dir) {
   std::error_code ec;
   fs::create_directories(dir, ec);
-  if (ec || !fs::is_directory(dir)) throw UsageError("cannot create the output directory '" + dir + "': " + ec.message());
+  if (ec || !fs::is_directory(dir))
+    throw UsageError("cannot create the output directory '" + dir + "': " + ec.message());
   if (::access(dir.c_str(), W_OK) != 0) throw UsageError("the output directory '" + dir + "' is not writable");
 }
 
@@ -168,9 +174,9 @@ OutputLock::OutputLock(const std::string& dir) {
   auto refuse = [&](const std::string& why) {
     if (fd_ >= 0) ::close(fd_);
     fd_ = -1;
-    throw UsageError("the output directory '" + dir + "' holds " + kLock + ", which sph2d cannot take as its lock file (" +
-                     why + "); sph2d never overwrites a file it did not write: choose another --out, or remove " + path +
-                     " yourself");
+    throw UsageError(
+        "the output directory '" + dir + "' holds " + kLock + ", which sph2d cannot take as its lock file (" + why +
+        "); sph2d never overwrites a file it did not write: choose another --out, or remove " + path + " yourself");
   };
   // O_NOFOLLOW: a symbolic link planted as the lock file is never followed (and its target never truncated).
   fd_ = ::open(path.c_str(), O_RDWR | O_CREAT | O_NOFOLLOW | O_CLOEXEC, 0644);
@@ -272,8 +278,9 @@ FolderScan scanOutputFolder(const std::string& dir, const FolderSpec& spec) {
       const auto listed = records.hashes.find(name);
       const auto pixels = records.pixelHashes.find(name);
       if (listed == records.hashes.end() && pixels == records.pixelHashes.end()) {
-        scan.foreign.push_back({name, spec.manifest ? "no manifest.json or journal of an earlier sph2d run there lists it"
-                                                    : "no journal of an earlier sph2d " + spec.command + " there lists it"});
+        scan.foreign.push_back({name, spec.manifest
+                                          ? "no manifest.json or journal of an earlier sph2d run there lists it"
+                                          : "no journal of an earlier sph2d " + spec.command + " there lists it"});
         continue;
       }
       const auto h = hashFile(p.string());
@@ -295,18 +302,23 @@ FolderScan scanOutputFolder(const std::string& dir, const FolderSpec& spec) {
         }
         if (want.empty()) want = "pixels of XXH64 " + pixels->second;
       }
-      if (proven) scan.own.push_back({name, got});
+      if (proven)
+        scan.own.push_back({name, got});
       else
-        scan.foreign.push_back({name, "it changed since sph2d wrote it (its XXH64 is " + got + ", the record says " + want + ")"});
+        scan.foreign.push_back(
+            {name, "it changed since sph2d wrote it (its XXH64 is " + got + ", the record says " + want + ")"});
     } else if (records.temps.count(name) && fs::is_regular_file(st)) {
       scan.ownTemps.push_back(name);
     } else if (splitTempName(name, target, pid) && (spec.writes(target) || (spec.manifest && target == kManifest))) {
-      if (pid == myPid) scan.foreign.push_back({name, "the temporary name this run would write through"});
-      else scan.strayTemps.push_back(name);
+      if (pid == myPid)
+        scan.foreign.push_back({name, "the temporary name this run would write through"});
+      else
+        scan.strayTemps.push_back(name);
     }
   }
   std::sort(scan.own.begin(), scan.own.end(), [](const OwnedFile& a, const OwnedFile& b) { return a.name < b.name; });
-  std::sort(scan.foreign.begin(), scan.foreign.end(), [](const ForeignFile& a, const ForeignFile& b) { return a.name < b.name; });
+  std::sort(scan.foreign.begin(), scan.foreign.end(),
+            [](const ForeignFile& a, const ForeignFile& b) { return a.name < b.name; });
   return scan;
 }
 
@@ -321,8 +333,8 @@ void refuseForeignFiles(const std::string& dir, const FolderScan& scan, const Fo
   }
   throw UsageError("the output directory '" + dir + "' holds " + first.name + ", which sph2d cannot prove it wrote (" +
                    first.why + "); sph2d " + spec.command +
-                   " never removes or overwrites a file it did not write: choose another " + spec.flag + ", or move or remove " +
-                   (fs::path(dir) / first.name).string() + " yourself" + more);
+                   " never removes or overwrites a file it did not write: choose another " + spec.flag +
+                   ", or move or remove " + (fs::path(dir) / first.name).string() + " yourself" + more);
 }
 
 std::vector<std::string> removeOwnFiles(const std::string& dir, const FolderScan& scan,
@@ -330,8 +342,10 @@ std::vector<std::string> removeOwnFiles(const std::string& dir, const FolderScan
   std::vector<std::string> removed;
   auto remove = [&](const std::string& name) {
     const std::string p = (fs::path(dir) / name).string();
-    if (::unlink(p.c_str()) == 0) removed.push_back(name);
-    else if (errno != ENOENT) throw std::runtime_error("cannot remove " + p + ": " + std::strerror(errno));
+    if (::unlink(p.c_str()) == 0)
+      removed.push_back(name);
+    else if (errno != ENOENT)
+      throw std::runtime_error("cannot remove " + p + ": " + std::strerror(errno));
   };
   for (const OwnedFile& f : scan.own)
     if (which(f.name)) remove(f.name);
@@ -349,10 +363,11 @@ void refuseExistingFile(const std::string& path, const std::string& flag) {
   struct stat st {};
   if (::lstat(path.c_str(), &st) != 0) return;
   struct stat target {};
-  if (::stat(path.c_str(), &target) == 0 && (S_ISCHR(target.st_mode) || S_ISBLK(target.st_mode) ||
-                                              S_ISFIFO(target.st_mode) || S_ISSOCK(target.st_mode)))
+  if (::stat(path.c_str(), &target) == 0 &&
+      (S_ISCHR(target.st_mode) || S_ISBLK(target.st_mode) || S_ISFIFO(target.st_mode) || S_ISSOCK(target.st_mode)))
     return;
-  throw UsageError(flag + " " + path + ": the file exists, and sph2d never overwrites a file it cannot prove it wrote; " +
+  throw UsageError(flag + " " + path +
+                   ": the file exists, and sph2d never overwrites a file it cannot prove it wrote; " +
                    "choose another name, or remove " + path + " yourself");
 }
 

@@ -65,10 +65,11 @@ struct FolderSpec {
 
 /// What a command found in its output folder before writing there.
 struct FolderScan {
-  std::vector<OwnedFile> own;          ///< names it writes, proven its own (sorted): it may replace or remove them
-  std::vector<std::string> ownTemps;   ///< temporary files of unfinished writes that its journal names
-  std::vector<ForeignFile> foreign;    ///< names it writes taken by files it cannot prove it wrote (sorted)
-  std::vector<std::string> strayTemps; ///< names like an unfinished write's temporary file that no record names: left alone
+  std::vector<OwnedFile> own;         ///< names it writes, proven its own (sorted): it may replace or remove them
+  std::vector<std::string> ownTemps;  ///< temporary files of unfinished writes that its journal names
+  std::vector<ForeignFile> foreign;   ///< names it writes taken by files it cannot prove it wrote (sorted)
+  std::vector<std::string>
+      strayTemps;  ///< names like an unfinished write's temporary file that no record names: left alone
 };
 
 /// The names `sph2d run` writes into its folder besides manifest.json: frame_NNNNN.png,

@@ -5,9 +5,9 @@
 // frames, so a run driven by input checks like any other.
 #include <algorithm>
 #include <cctype>
-#include <cstring>
-#include <cstdlib>
 #include <cstdio>
+#include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <map>
 #include <regex>
@@ -131,15 +131,18 @@ class FrameCheck : public LoopObserver {
     if (got == want && stateHash == wantState) return true;
     failed = true;
     if (got == want) {  // the pixels agree, the simulation does not: both hashes must match
-      std::printf("check: frame %d: the pixels match but the state hash differs (%s here, %s in the manifest): the "
-                  "simulation changed\n", f, stateHash.c_str(), wantState.c_str());
+      std::printf(
+          "check: frame %d: the pixels match but the state hash differs (%s here, %s in the manifest): the "
+          "simulation changed\n",
+          f, stateHash.c_str(), wantState.c_str());
       std::printf("check: FAILED at frame %d (%d frames matched before it)\n", f, compared - 1);
       return false;
     }
     std::printf("check: frame %d differs: RGBA XXH64 %s here, %s in the manifest\n", f, got.c_str(), want.c_str());
-    std::printf("check: state hash %s\n", stateHash == wantState
-                                             ? "matches: the simulation agrees, the rendering differs"
-                                             : ("differs too (" + stateHash + " vs " + wantState + "): the simulation changed").c_str());
+    std::printf("check: state hash %s\n",
+                stateHash == wantState
+                    ? "matches: the simulation agrees, the rendering differs"
+                    : ("differs too (" + stateHash + " vs " + wantState + "): the simulation changed").c_str());
     // The folder: this check's files replace an earlier check's (proven by its journal); a
     // file there that sph2d cannot prove it wrote stops the check (exit 2), untouched.
     makeOutputDir(out_);
@@ -148,12 +151,15 @@ class FrameCheck : public LoopObserver {
     const FolderScan scan = scanOutputFolder(out_, spec);
     refuseForeignFiles(out_, scan, spec);
     const std::vector<std::string> removed = removeOwnFiles(out_, scan, [](const std::string&) { return true; });
-    if (!removed.empty()) std::printf("check: removed %s that an earlier sph2d check wrote in %s\n", describeFiles(removed).c_str(), out_.c_str());
+    if (!removed.empty())
+      std::printf("check: removed %s that an earlier sph2d check wrote in %s\n", describeFiles(removed).c_str(),
+                  out_.c_str());
     OutputJournal journal(out_, spec.command, {});
     auto write = [&](const std::string& path, const Frame& image) {
       std::vector<std::uint8_t> bytes;
       encodePng(image.width, image.height, image.rgba.data(), pngSettings(1), bytes);
-      journal.note(fs::path(path).filename().string(), fs::path(tempPathFor(path)).filename().string(), xxh64(bytes.data(), bytes.size()));
+      journal.note(fs::path(path).filename().string(), fs::path(tempPathFor(path)).filename().string(),
+                   xxh64(bytes.data(), bytes.size()));
       writeEncodedPngAtomic(path, bytes);
     };
     const std::string name = frameFileName(f);
@@ -170,8 +176,8 @@ class FrameCheck : public LoopObserver {
       return false;
     }
     if (rw != fr.width || rh != fr.height) {
-      std::printf("check: the reference %s is %dx%d, this run renders %dx%d. This run's frame: %s\n", refPath.c_str(), rw,
-                  rh, fr.width, fr.height, mine.c_str());
+      std::printf("check: the reference %s is %dx%d, this run renders %dx%d. This run's frame: %s\n", refPath.c_str(),
+                  rw, rh, fr.width, fr.height, mine.c_str());
       return false;
     }
     if (hex64(xxh64(ref.data(), ref.size())) != want)
@@ -182,9 +188,9 @@ class FrameCheck : public LoopObserver {
     std::snprintf(diffName, sizeof diffName, "diff_%05d.png", f);
     const std::string diffPath = out_ + "/" + diffName;
     write(diffPath, diff);
-    std::printf("check: frame %d: %zu of %d pixels differ (%.4f %%), max channel difference %d (first at x %d, y %d)\n", f,
-                d.differing, fr.width * fr.height, 100.0 * double(d.differing) / double(fr.width * fr.height), d.maxDiff,
-                d.firstX, d.firstY);
+    std::printf("check: frame %d: %zu of %d pixels differ (%.4f %%), max channel difference %d (first at x %d, y %d)\n",
+                f, d.differing, fr.width * fr.height, 100.0 * double(d.differing) / double(fr.width * fr.height),
+                d.maxDiff, d.firstX, d.firstY);
     std::printf("check: wrote %s (this run) and %s (differing pixels in red)\n", mine.c_str(), diffPath.c_str());
     std::printf("check: FAILED at frame %d (%d frames matched before it)\n", f, compared - 1);
     return false;
@@ -233,8 +239,8 @@ bool checkFiles(const ManifestView& mv, const fs::path& dir) {
   }
   std::sort(stale.begin(), stale.end());
   if (!stale.empty()) {
-    std::printf("check: %zu frame file%s beside the manifest %s not listed in it (another run's?): %s%s\n", stale.size(),
-                stale.size() == 1 ? "" : "s", stale.size() == 1 ? "is" : "are", stale.front().c_str(),
+    std::printf("check: %zu frame file%s beside the manifest %s not listed in it (another run's?): %s%s\n",
+                stale.size(), stale.size() == 1 ? "" : "s", stale.size() == 1 ? "is" : "are", stale.front().c_str(),
                 stale.size() > 1 ? " ..." : "");
     bad += int(stale.size());
   }
@@ -279,15 +285,24 @@ int cmdCheck(const std::vector<std::string>& args) {
       std::fputs(kCheckHelp, stdout);
       return 0;
     }
-    if (s == "--against") manifestPath = value();
-    else if (s == "--out") out = value();
-    else if (s == "--threads") threads = parseInt(s, value(), 1, 256);
-    else if (s == "--quiet") quiet = true;
-    else if (s == "--adopt-env") adoptEnv = true;
-    else if (s == "--files") files = true;
-    else if (!s.empty() && s[0] == '-') throw UsageError("unknown option '" + s + "' (see sph2d check --help)");
-    else if (scenePath.empty()) scenePath = s;
-    else throw UsageError("unexpected argument '" + s + "'");
+    if (s == "--against")
+      manifestPath = value();
+    else if (s == "--out")
+      out = value();
+    else if (s == "--threads")
+      threads = parseInt(s, value(), 1, 256);
+    else if (s == "--quiet")
+      quiet = true;
+    else if (s == "--adopt-env")
+      adoptEnv = true;
+    else if (s == "--files")
+      files = true;
+    else if (!s.empty() && s[0] == '-')
+      throw UsageError("unknown option '" + s + "' (see sph2d check --help)");
+    else if (scenePath.empty())
+      scenePath = s;
+    else
+      throw UsageError("unexpected argument '" + s + "'");
   }
   if (scenePath.empty()) throw UsageError("missing the scene file (see sph2d check --help)");
   if (manifestPath.empty()) throw UsageError("missing --against MANIFEST (see sph2d check --help)");
@@ -314,9 +329,10 @@ int cmdCheck(const std::vector<std::string>& args) {
 
   const std::string sceneHash = fileHash(scenePath);
   if (sceneHash != mv.sceneHash)
-    std::printf("note: %s has XXH64 %s but the manifest was made from a file with %s: the scene changed, "
-                "frames will likely differ\n",
-                scenePath.c_str(), sceneHash.c_str(), mv.sceneHash.c_str());
+    std::printf(
+        "note: %s has XXH64 %s but the manifest was made from a file with %s: the scene changed, "
+        "frames will likely differ\n",
+        scenePath.c_str(), sceneHash.c_str(), mv.sceneHash.c_str());
   if (m.value("complete", true) == false && m.contains("stop") && m["stop"].is_object())
     std::printf("note: the manifest's run stopped early (%s: %s); checking the %zu frames it lists\n",
                 m["stop"].value("reason", "?").c_str(), m["stop"].value("message", "").c_str(), mv.expected.size());
@@ -332,7 +348,8 @@ int cmdCheck(const std::vector<std::string>& args) {
     }
     if (!adoptEnv || e.value.empty() || std::getenv(e.name.c_str())) continue;
     setenv(e.name.c_str(), e.value.c_str(), 0);
-    if (!quiet) std::printf("note: using %s=%s as the manifest's run did (--adopt-env)\n", e.name.c_str(), e.value.c_str());
+    if (!quiet)
+      std::printf("note: using %s=%s as the manifest's run did (--adopt-env)\n", e.name.c_str(), e.value.c_str());
   }
   EventIntake input(scene, [](const std::string&) {});
   addManifestEvents(input, m, manifestPath, scene);
@@ -342,9 +359,10 @@ int cmdCheck(const std::vector<std::string>& args) {
   Renderer renderer(scene.render, mv.render);
   const std::string here = renderer.rendererString();
   if (here != mv.renderer)
-    std::printf("note: this machine's renderer is \"%s\" but the manifest was made with \"%s\"; "
-                "pixels may differ for that reason alone\n",
-                here.c_str(), mv.renderer.c_str());
+    std::printf(
+        "note: this machine's renderer is \"%s\" but the manifest was made with \"%s\"; "
+        "pixels may differ for that reason alone\n",
+        here.c_str(), mv.renderer.c_str());
   const std::string cpu = cpuSummary();
   if (!mv.cpu.empty() && cpu != mv.cpu)
     std::printf("note: this CPU is \"%s\"; the manifest's was \"%s\"\n", cpu.c_str(), mv.cpu.c_str());
@@ -356,7 +374,8 @@ int cmdCheck(const std::vector<std::string>& args) {
         std::printf("note: %s is \"%s\" here but was \"%s\" for the manifest%s\n", e.name.c_str(), now[e.name].c_str(),
                     e.value.c_str(), adoptEnv ? "" : " (--adopt-env uses the manifest's value)");
   }
-  if (!quiet) std::printf("check: rerunning %s, %d frames, comparing %zu\n", scenePath.c_str(), mv.frames, mv.expected.size());
+  if (!quiet)
+    std::printf("check: rerunning %s, %d frames, comparing %zu\n", scenePath.c_str(), mv.frames, mv.expected.size());
 
   // The rerun: run's loop, headless, up to the last listed frame.
   FrameCheck check(mv, out, refDir);
@@ -369,7 +388,8 @@ int cmdCheck(const std::vector<std::string>& args) {
   } catch (const SimulationError& e) {
     std::printf("check: the simulation stopped: %s\n", e.what());
     const bool expectedStop = m.contains("stop") && m["stop"].is_object() && m["stop"].value("reason", "") == "guard";
-    std::printf("check: %s after %d matching frames\n", expectedStop ? "as in the manifest's run" : "FAILED", check.compared);
+    std::printf("check: %s after %d matching frames\n", expectedStop ? "as in the manifest's run" : "FAILED",
+                check.compared);
     return expectedStop && check.compared == int(mv.expected.size()) ? 0 : 1;
   }
   if (check.failed) return 1;

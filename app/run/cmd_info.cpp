@@ -55,9 +55,10 @@ int cmdInfo(const std::vector<std::string>& args) {
   // The estimate comes first: info builds the World (its boundary samples, its particles),
   // and a scene too large for the machine is refused before that.
   const double estimate = estimateRunBytes(s, true);
-  std::printf("memory       about %.1f MB at the peak, estimated before allocating (%zu particles at most, "
-              "about %.0f boundary samples, the renderer at %dx%d)\n",
-              estimate / 1e6, peakParticles(s), estimateBoundarySamples(s), s.render.width, s.render.height);
+  std::printf(
+      "memory       about %.1f MB at the peak, estimated before allocating (%zu particles at most, "
+      "about %.0f boundary samples, the renderer at %dx%d)\n",
+      estimate / 1e6, peakParticles(s), estimateBoundarySamples(s), s.render.width, s.render.height);
   checkMemory(s, true, maxMemory);
   World w(s, WorldOptions{threads});
   for (const auto& m : w.takeWarnings()) std::printf("warning: %s\n", m.c_str());
@@ -104,19 +105,22 @@ int cmdInfo(const std::vector<std::string>& args) {
   std::printf("boundaries   %zu static bodies, %zu fixtures, %zu colliders, %zu boundary samples\n",
               s.bodies.size() - kinematic - dynamic, fixtures, w.colliders().size(), w.boundarySamples().size());
   if (kinematic || dynamic)
-    std::printf("moving       %zu kinematic and %zu dynamic bodies (%zu shapes; they push the fluid, stage 'bodies'%s)\n",
-                kinematic, dynamic, w.movingColliders().size(), dynamic ? ", and the fluid pushes the dynamic ones" : "");
+    std::printf(
+        "moving       %zu kinematic and %zu dynamic bodies (%zu shapes; they push the fluid, stage 'bodies'%s)\n",
+        kinematic, dynamic, w.movingColliders().size(), dynamic ? ", and the fluid pushes the dynamic ones" : "");
   const double dt = w.stableTimeStep();
   const int substeps = std::min(s.solver.maxSubsteps, int(std::ceil(1.0 / s.fps / dt - 1e-9)));
-  std::printf("frames       %d at %.4g fps (%.4g s); %d substeps per frame in the initial state (substep %.3g ms, "
-              "at most %d; more once the fluid moves: the CFL limit shrinks with speed)\n",
-              int(std::lround(s.duration * s.fps)), s.fps, s.duration, substeps, 1e3 * dt, s.solver.maxSubsteps);
+  std::printf(
+      "frames       %d at %.4g fps (%.4g s); %d substeps per frame in the initial state (substep %.3g ms, "
+      "at most %d; more once the fluid moves: the CFL limit shrinks with speed)\n",
+      int(std::lround(s.duration * s.fps)), s.fps, s.duration, substeps, 1e3 * dt, s.solver.maxSubsteps);
   std::printf("events       %zu in the timeline\n", s.events.size());
   for (const EventDef& e : s.events)
     std::printf("             frame %lld: %s\n", (long long)eventFrame(e, s.fps), describeEvent(e).c_str());
-  std::printf("engine       %.1f MB held by the World now (particle arrays %.1f MB; grid, neighbour lists, "
-              "boundary samples)\n",
-              double(w.memoryBytes()) / 1e6, double(w.particleBytes()) / 1e6);
+  std::printf(
+      "engine       %.1f MB held by the World now (particle arrays %.1f MB; grid, neighbour lists, "
+      "boundary samples)\n",
+      double(w.memoryBytes()) / 1e6, double(w.particleBytes()) / 1e6);
   std::printf("image        %dx%d, %s mode\n", s.render.width, s.render.height, s.render.mode.c_str());
   return 0;
 }

@@ -40,11 +40,16 @@ int cmdRender(const std::vector<std::string>& args) {
       return 0;
     }
     if (parseRenderFlag(args, i, opt)) continue;
-    if (s == "--particles") csv = value();
-    else if (s == "--out") out = value();
-    else if (!s.empty() && s[0] == '-') throw UsageError("unknown option '" + s + "' (see sph2d render --help)");
-    else if (scenePath.empty()) scenePath = s;
-    else throw UsageError("unexpected argument '" + s + "'");
+    if (s == "--particles")
+      csv = value();
+    else if (s == "--out")
+      out = value();
+    else if (!s.empty() && s[0] == '-')
+      throw UsageError("unknown option '" + s + "' (see sph2d render --help)");
+    else if (scenePath.empty())
+      scenePath = s;
+    else
+      throw UsageError("unexpected argument '" + s + "'");
   }
   if (scenePath.empty() || csv.empty() || out.empty())
     throw UsageError("sph2d render needs SCENE.json, --particles FRAME.csv and --out IMAGE.png");
@@ -60,11 +65,13 @@ int cmdRender(const std::vector<std::string>& args) {
   const Vec2d o = world.origin();
   ParticleBuffer B;
   for (std::size_t k = 0; k < snap.size(); ++k) {
-    B.push(Vec2(Real(snap.x[k] - o.x()), Real(snap.y[k] - o.y())), Vec2(snap.vx[k], snap.vy[k]), snap.id[k], snap.rho[k]);
+    B.push(Vec2(Real(snap.x[k] - o.x()), Real(snap.y[k] - o.y())), Vec2(snap.vx[k], snap.vy[k]), snap.id[k],
+           snap.rho[k]);
     B.p.back() = snap.p[k];
   }
   const Particles P = B.view();
-  if (opt.colorBy == ColorField::Age && snap.age.empty() && (opt.mode == "particles" || (opt.mode.empty() && scene.render.mode == "particles")))
+  if (opt.colorBy == ColorField::Age && snap.age.empty() &&
+      (opt.mode == "particles" || (opt.mode.empty() && scene.render.mode == "particles")))
     throw UsageError(csv + " has no age column, so --color-by age cannot be shown");
   RenderInput in;
   in.particles = P;

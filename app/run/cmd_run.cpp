@@ -55,7 +55,8 @@ class RunOutputs : public LoopObserver {
     console_.say("event at frame " + std::to_string(frame) + ": " + describeEvent(t.event) + " (" + t.where + ")");
   }
   void notApplied(const TimedEvent& t, std::int64_t frame, const std::string& why) override {
-    console_.warn(t.where + ": " + describeEvent(t.event) + " at frame " + std::to_string(frame) + " not applied: " + why);
+    console_.warn(t.where + ": " + describeEvent(t.event) + " at frame " + std::to_string(frame) +
+                  " not applied: " + why);
   }
   void boundary(const World& world, std::int64_t frame, bool rendered) override {
     density.measure(world, frame);
@@ -105,8 +106,10 @@ FolderSpec runFolderSpec(const std::string& video, const std::string& record) {
 std::string nameInFolder(const std::string& path, const std::string& out, const std::string& flag) {
   if (path.empty() || !isInFolder(path, out)) return "";
   const std::string name = fs::path(path).filename().string();
-  if (isRunFileName(name) || name == "manifest.json" || name.rfind(".sph2d.", 0) == 0 || name.empty() || name == "." || name == "..")
-    throw UsageError(flag + " " + path + ": sph2d run writes a file of that name in " + out + " itself; choose another name");
+  if (isRunFileName(name) || name == "manifest.json" || name.rfind(".sph2d.", 0) == 0 || name.empty() || name == "." ||
+      name == "..")
+    throw UsageError(flag + " " + path + ": sph2d run writes a file of that name in " + out +
+                     " itself; choose another name");
   return name;
 }
 
@@ -122,11 +125,13 @@ int cmdRun(const std::vector<std::string>& args) {
   const int frames = a.frames > 0 ? a.frames : std::max(1, int(std::lround(scene.duration * scene.fps)));
   const std::string out = a.out.empty() ? "out/" + scene.name : a.out;
   if (!a.video.empty() && findFfmpeg().empty()) {
-    std::fprintf(stderr, "sph2d: --video needs ffmpeg, which is not installed here (not found on PATH); "
-                         "install it (Debian: apt-get install ffmpeg) or leave out --video\n");
+    std::fprintf(stderr,
+                 "sph2d: --video needs ffmpeg, which is not installed here (not found on PATH); "
+                 "install it (Debian: apt-get install ffmpeg) or leave out --video\n");
     return 2;
   }
-  if (a.images && a.render.colorBy == ColorField::Age && (a.render.mode == "particles" || (a.render.mode.empty() && scene.render.mode == "particles")))
+  if (a.images && a.render.colorBy == ColorField::Age &&
+      (a.render.mode == "particles" || (a.render.mode.empty() && scene.render.mode == "particles")))
     if (!scene.effects.lifetime)
       throw UsageError("--color-by age needs particle ages: enable effects.lifetime in the scene");
   // Memory, before anything is allocated: a scene that cannot fit is refused now, not after
@@ -168,7 +173,8 @@ int cmdRun(const std::vector<std::string>& args) {
   for (const std::string& in : a.inputs) {
     std::error_code ec;
     if (!a.record.empty() && in != "-" && fs::exists(a.record, ec) && fs::equivalent(in, a.record, ec))
-      throw UsageError("--record " + a.record + " is also an --input file: recording would overwrite it; record to another file");
+      throw UsageError("--record " + a.record +
+                       " is also an --input file: recording would overwrite it; record to another file");
   }
   // A record file in the output folder opens once the folder's journal has noted it (below).
   if (!a.record.empty() && recordName.empty()) refuseExistingFile(a.record, "--record");
@@ -194,7 +200,9 @@ int cmdRun(const std::vector<std::string>& args) {
     wo.videoFps = scene.fps / a.every;
     // Each file is noted in the folder's journal (its name, the hash of its bytes, its
     // temporary name) before it is written, so that a later run knows a killed run's files.
-    wo.beforeWrite = [&journal](const std::string& name, std::uint64_t h, const std::string& temp) { journal->note(name, temp, h); };
+    wo.beforeWrite = [&journal](const std::string& name, std::uint64_t h, const std::string& temp) {
+      journal->note(name, temp, h);
+    };
     writer = std::make_unique<FrameWriter>(wo);
     manifest = std::make_unique<RunManifest>(a, scene, *renderer, frames, world.threads());
     // Before the first frame: the frames, exports and manifest an earlier run wrote go (a
@@ -219,7 +227,8 @@ int cmdRun(const std::vector<std::string>& args) {
       record = std::make_unique<EventRecord>(a.record);
       record->beforeWrite([&journal, &recordName](std::uint64_t h) { journal->note(recordName, "", h); });
     }
-    if (!videoName.empty()) journal->note(videoName, fs::path(videoTempPath(a.video)).filename().string(), std::nullopt);
+    if (!videoName.empty())
+      journal->note(videoName, fs::path(videoTempPath(a.video)).filename().string(), std::nullopt);
     manifest->writeRunning(out);
   }
   // Standard input is input from elsewhere: its block and drop events are capped as the network's are.

@@ -89,35 +89,55 @@ RunArgs parseRunArgs(const std::vector<std::string>& a) {
       return a[++i];
     };
     if (parseRenderFlag(a, i, r.render)) continue;
-    if (s == "--out") r.out = value();
-    else if (s == "--frames") r.frames = parseInt(s, value(), 1, 10000000);
-    else if (s == "--every") r.every = parseInt(s, value(), 1, 10000000);
-    else if (s == "--threads") r.threads = parseInt(s, value(), 1, 256);
-    else if (s == "--png-level") r.pngLevel = parseInt(s, value(), 0, 9);
-    else if (s == "--video") r.video = value();
+    if (s == "--out")
+      r.out = value();
+    else if (s == "--frames")
+      r.frames = parseInt(s, value(), 1, 10000000);
+    else if (s == "--every")
+      r.every = parseInt(s, value(), 1, 10000000);
+    else if (s == "--threads")
+      r.threads = parseInt(s, value(), 1, 256);
+    else if (s == "--png-level")
+      r.pngLevel = parseInt(s, value(), 0, 9);
+    else if (s == "--video")
+      r.video = value();
     else if (s == "--export") {
       ExportFormat f;
       const std::string v = value();
       if (!parseExportFormat(v, f)) throw UsageError("--export expects csv, vtk or vtk-ascii, got '" + v + "'");
       r.exportFormat = f;
-    } else if (s == "--realtime") r.realtime = true;
-    else if (s == "--catch-up") r.catchUp = parseInt(s, value(), 1, 1000);
+    } else if (s == "--realtime")
+      r.realtime = true;
+    else if (s == "--catch-up")
+      r.catchUp = parseInt(s, value(), 1, 1000);
     else if (s == "--input") {
       r.inputs.push_back(value());
       if (r.inputs.back() == "-" && std::count(r.inputs.begin(), r.inputs.end(), "-") > 1)
         throw UsageError("--input - may be given once (there is one standard input)");
-    } else if (s == "--record") r.record = value();
-    else if (s == "--max-memory") r.maxMemory = parseBytes(s, value());
-    else if (s == "--max-event-particles") r.maxEventParticles = std::size_t(parseInt(s, value(), 1, 100000000));
-    else if (s == "--max-particles-per-second") r.maxParticlesPerSecond = std::size_t(parseInt(s, value(), 1, 100000000));
-    else if (s == "--max-particles") r.maxParticles = std::size_t(parseInt(s, value(), 1, 100000000));
-    else if (s == "--no-images") r.images = false;
-    else if (s == "--state-hash") r.stateHash = true;
-    else if (s == "--profile") r.profile = true;
-    else if (s == "--quiet") r.quiet = true;
-    else if (!s.empty() && s[0] == '-') throw UsageError("unknown option '" + s + "' (see sph2d run --help)");
-    else if (r.scene.empty()) r.scene = s;
-    else throw UsageError("unexpected argument '" + s + "' (one scene per run)");
+    } else if (s == "--record")
+      r.record = value();
+    else if (s == "--max-memory")
+      r.maxMemory = parseBytes(s, value());
+    else if (s == "--max-event-particles")
+      r.maxEventParticles = std::size_t(parseInt(s, value(), 1, 100000000));
+    else if (s == "--max-particles-per-second")
+      r.maxParticlesPerSecond = std::size_t(parseInt(s, value(), 1, 100000000));
+    else if (s == "--max-particles")
+      r.maxParticles = std::size_t(parseInt(s, value(), 1, 100000000));
+    else if (s == "--no-images")
+      r.images = false;
+    else if (s == "--state-hash")
+      r.stateHash = true;
+    else if (s == "--profile")
+      r.profile = true;
+    else if (s == "--quiet")
+      r.quiet = true;
+    else if (!s.empty() && s[0] == '-')
+      throw UsageError("unknown option '" + s + "' (see sph2d run --help)");
+    else if (r.scene.empty())
+      r.scene = s;
+    else
+      throw UsageError("unexpected argument '" + s + "' (one scene per run)");
   }
   if (r.scene.empty()) throw UsageError("missing the scene file (see sph2d run --help)");
   if (!r.images && (r.exportFormat || !r.video.empty()))

@@ -20,7 +20,9 @@ void WorstDensity::measure(const World& world, std::int64_t frame) {
 
 RunConsole::RunConsole(bool quiet, bool realtime) : quiet_(quiet), realtime_(realtime), tty_(::isatty(STDOUT_FILENO)) {}
 
-double RunConsole::wall() const { return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0_).count(); }
+double RunConsole::wall() const {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0_).count();
+}
 
 void RunConsole::clearBar() {
   if (barShown_) std::printf("\r\033[K");
@@ -55,7 +57,8 @@ void RunConsole::progress(const World& world, const LoopStatus& s, bool force) {
   const double eta = fps > 0 ? double(frames - done) / fps : 0.0;
   char extra[96] = "";
   if (realtime_)
-    std::snprintf(extra, sizeof extra, "  dropped %llu late %llu", (unsigned long long)s.dropped, (unsigned long long)s.late);
+    std::snprintf(extra, sizeof extra, "  dropped %llu late %llu", (unsigned long long)s.dropped,
+                  (unsigned long long)s.late);
   if (s.paused) std::snprintf(extra + std::strlen(extra), sizeof extra - std::strlen(extra), "  PAUSED");
   if (tty_) {
     const int width = 24, fill = int(std::lround(double(width) * done / frames));
@@ -72,25 +75,30 @@ void RunConsole::progress(const World& world, const LoopStatus& s, bool force) {
 void RunConsole::summary(const World& world, const RunReport& r) const {
   const int done = int(r.loop.done), applied = r.loop.applied;
   if (r.status == 130)
-    std::fprintf(stderr, "sph2d: interrupted after %d of %d frames; %d whole PNG files kept in %s (manifest.json says so)\n",
+    std::fprintf(stderr,
+                 "sph2d: interrupted after %d of %d frames; %d whole PNG files kept in %s (manifest.json says so)\n",
                  done, r.frames, r.written, r.out.c_str());
-  std::printf("sph2d: %d frames, %zu particles, %.3f simulated s, %.2f wall s (simulation %.2f s, rendering %.2f s), "
-              "%d PNG files in %s\n",
-              done, world.particleCount(), world.time(), r.wall, r.loop.simSeconds,
-              r.loop.renderSeconds + r.exportSeconds, r.written, r.images ? r.out.c_str() : "(none)");
-  std::printf("sph2d: worst density error %.3f %% (the largest per-frame mean compression, at frame %lld); "
-              "largest single-particle compression %.3f %% (frame %lld)\n",
-              100 * r.density.mean, (long long)r.density.meanFrame, 100 * r.density.max, (long long)r.density.maxFrame);
+  std::printf(
+      "sph2d: %d frames, %zu particles, %.3f simulated s, %.2f wall s (simulation %.2f s, rendering %.2f s), "
+      "%d PNG files in %s\n",
+      done, world.particleCount(), world.time(), r.wall, r.loop.simSeconds, r.loop.renderSeconds + r.exportSeconds,
+      r.written, r.images ? r.out.c_str() : "(none)");
+  std::printf(
+      "sph2d: worst density error %.3f %% (the largest per-frame mean compression, at frame %lld); "
+      "largest single-particle compression %.3f %% (frame %lld)\n",
+      100 * r.density.mean, (long long)r.density.meanFrame, 100 * r.density.max, (long long)r.density.maxFrame);
   std::printf("sph2d: %d event%s applied, %d warning%s%s%s\n", applied, applied == 1 ? "" : "s", warnings_,
               warnings_ == 1 ? "" : "s", r.record.empty() ? "" : "; events recorded in ", r.record.c_str());
   if (r.pending && r.status == 0)
     std::printf("sph2d: %zu event%s never applied: stamped after the last frame (%d)\n", r.pending,
                 r.pending == 1 ? " was" : "s were", r.frames - 1);
   if (r.realtime)
-    std::printf("sph2d: realtime at %.4g fps: %llu frames dropped (stepped but not rendered, to keep up), %llu frames late "
-                "(the simulation fell %.3f s behind the wall clock)\n",
-                r.fps, (unsigned long long)r.loop.dropped, (unsigned long long)r.loop.late, r.loop.behindSeconds);
-  if (r.exports) std::printf("sph2d: %d particle files (%s) in %s\n", r.exports, r.exportExtension.c_str(), r.out.c_str());
+    std::printf(
+        "sph2d: realtime at %.4g fps: %llu frames dropped (stepped but not rendered, to keep up), %llu frames late "
+        "(the simulation fell %.3f s behind the wall clock)\n",
+        r.fps, (unsigned long long)r.loop.dropped, (unsigned long long)r.loop.late, r.loop.behindSeconds);
+  if (r.exports)
+    std::printf("sph2d: %d particle files (%s) in %s\n", r.exports, r.exportExtension.c_str(), r.out.c_str());
   if (r.videoFrames) std::printf("sph2d: %d frames encoded into %s\n", r.videoFrames, r.video.c_str());
   if (r.profile) printProfile(world);
   if (r.stateHash) {

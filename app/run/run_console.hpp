@@ -19,8 +19,8 @@ namespace sph2d::cli {
 
 /// The density figures of the summary: the worst per-frame mean and single-particle compression.
 struct WorstDensity {
-  double mean = 0, max = 0;                    ///< fractions of ρ0
-  std::int64_t meanFrame = 0, maxFrame = 0;    ///< where they were measured
+  double mean = 0, max = 0;                  ///< fractions of ρ0
+  std::int64_t meanFrame = 0, maxFrame = 0;  ///< where they were measured
   /// Measures the state of boundary `frame`.
   void measure(const World& world, std::int64_t frame);
 };

@@ -92,13 +92,13 @@ const char* kServeHelp =
 
 /// The options of one `sph2d serve`.
 struct ServeArgs {
-  std::string scene;      ///< the scene file
-  ServeConfig server;     ///< --port, --bind, --max-clients, --format, --quality
-  std::string record;     ///< --record FILE ("" : none)
-  int threads = 0;        ///< --threads (0: all cores)
-  int catchUp = 4;        ///< --catch-up
-  RenderOptions render;   ///< the render flags
-  bool quiet = false;     ///< --quiet
+  std::string scene;                      ///< the scene file
+  ServeConfig server;                     ///< --port, --bind, --max-clients, --format, --quality
+  std::string record;                     ///< --record FILE ("" : none)
+  int threads = 0;                        ///< --threads (0: all cores)
+  int catchUp = 4;                        ///< --catch-up
+  RenderOptions render;                   ///< the render flags
+  bool quiet = false;                     ///< --quiet
   std::size_t maxEventParticles = 0;      ///< --max-event-particles (0: the scene's default)
   std::size_t maxParticlesPerSecond = 0;  ///< --max-particles-per-second (0: the scene's default)
   std::size_t maxParticles = 0;           ///< --max-particles (0: the scene's default)
@@ -113,31 +113,48 @@ ServeArgs parseServeArgs(const std::vector<std::string>& a) {
       return a[++i];
     };
     if (parseRenderFlag(a, i, r.render)) continue;
-    if (s == "--port") r.server.port = parseInt(s, value(), 0, 65535);
+    if (s == "--port")
+      r.server.port = parseInt(s, value(), 0, 65535);
     else if (s == "--bind") {
       r.server.bind = value();
       if (r.server.bind.empty()) throw UsageError("--bind expects an IP address (127.0.0.1, 0.0.0.0, ::1), got ''");
-    } else if (s == "--record") r.record = value();
-    else if (s == "--threads") r.threads = parseInt(s, value(), 1, 256);
-    else if (s == "--max-clients") r.server.maxClients = parseInt(s, value(), 1, 64);
-    else if (s == "--quality") r.server.jpegQuality = parseInt(s, value(), 1, 100);
-    else if (s == "--catch-up") r.catchUp = parseInt(s, value(), 1, 1000);
-    else if (s == "--max-event-particles") r.maxEventParticles = std::size_t(parseInt(s, value(), 1, 100000000));
-    else if (s == "--max-particles-per-second") r.maxParticlesPerSecond = std::size_t(parseInt(s, value(), 1, 100000000));
-    else if (s == "--max-particles") r.maxParticles = std::size_t(parseInt(s, value(), 1, 100000000));
+    } else if (s == "--record")
+      r.record = value();
+    else if (s == "--threads")
+      r.threads = parseInt(s, value(), 1, 256);
+    else if (s == "--max-clients")
+      r.server.maxClients = parseInt(s, value(), 1, 64);
+    else if (s == "--quality")
+      r.server.jpegQuality = parseInt(s, value(), 1, 100);
+    else if (s == "--catch-up")
+      r.catchUp = parseInt(s, value(), 1, 1000);
+    else if (s == "--max-event-particles")
+      r.maxEventParticles = std::size_t(parseInt(s, value(), 1, 100000000));
+    else if (s == "--max-particles-per-second")
+      r.maxParticlesPerSecond = std::size_t(parseInt(s, value(), 1, 100000000));
+    else if (s == "--max-particles")
+      r.maxParticles = std::size_t(parseInt(s, value(), 1, 100000000));
     else if (s == "--format") {
       const std::string v = value();
-      if (v == "jpeg" || v == "jpg") r.server.format = ImageFormat::Jpeg;
-      else if (v == "png") r.server.format = ImageFormat::Png;
-      else throw UsageError("--format expects jpeg or png, got '" + v + "'");
-    } else if (s == "--quiet") r.quiet = true;
+      if (v == "jpeg" || v == "jpg")
+        r.server.format = ImageFormat::Jpeg;
+      else if (v == "png")
+        r.server.format = ImageFormat::Png;
+      else
+        throw UsageError("--format expects jpeg or png, got '" + v + "'");
+    } else if (s == "--quiet")
+      r.quiet = true;
     else if (!s.empty() && s[0] == '-')
-      throw UsageError("unknown option '" + s + "' for serve; options: --port, --bind, --record, --threads, "
-                       "--max-clients, --format, --quality, --catch-up, --max-event-particles, --max-particles-per-second, "
-                       "--max-particles, --mode, --color-by, --range, --overlay, "
-                       "--foam-speed, --depth-scale, --quiet (see sph2d serve --help)");
-    else if (r.scene.empty()) r.scene = s;
-    else throw UsageError("serve takes one scene file; got '" + r.scene + "' and '" + s + "'");
+      throw UsageError(
+          "unknown option '" + s +
+          "' for serve; options: --port, --bind, --record, --threads, "
+          "--max-clients, --format, --quality, --catch-up, --max-event-particles, --max-particles-per-second, "
+          "--max-particles, --mode, --color-by, --range, --overlay, "
+          "--foam-speed, --depth-scale, --quiet (see sph2d serve --help)");
+    else if (r.scene.empty())
+      r.scene = s;
+    else
+      throw UsageError("serve takes one scene file; got '" + r.scene + "' and '" + s + "'");
   }
   if (r.scene.empty()) throw UsageError("serve needs a scene file: sph2d serve SCENE.json [options]");
   return r;
@@ -155,8 +172,15 @@ class ServeOutputs : public LoopObserver {
  public:
   ServeOutputs(const SceneDef& scene, const ServeArgs& a, EventRecord& record, ServeServer& server, ServeStatus& status,
                Renderer& renderer, std::map<std::string, bool>& effects, int reset, std::atomic<std::size_t>& liveCount)
-      : scene_(scene), a_(a), record_(record), server_(server), status_(status), renderer_(renderer), effects_(effects),
-        reset_(reset), liveCount_(liveCount) {}
+      : scene_(scene),
+        a_(a),
+        record_(record),
+        server_(server),
+        status_(status),
+        renderer_(renderer),
+        effects_(effects),
+        reset_(reset),
+        liveCount_(liveCount) {}
 
   void warn(const std::string& m) override { std::fprintf(stderr, "warning: %s\n", m.c_str()); }
   void note(const std::string& m) override {
@@ -291,11 +315,14 @@ int cmdServe(const std::vector<std::string>& args) {
   const auto clock0 = std::chrono::steady_clock::now();
   ServeEventHandler onEvent = [&](const std::string& text, const std::string& where) -> EventReply {
     const int n = ++received;
-    auto refuse = [](std::string why, int status = 400, double retry = 0) { return EventReply{status, std::move(why), retry}; };
+    auto refuse = [](std::string why, int status = 400, double retry = 0) {
+      return EventReply{status, std::move(why), retry};
+    };
     // "reset" is the page's own message (not an event of the format: a replay cannot reset).
     const nlohmann::json j = nlohmann::json::parse(text, nullptr, false);
     if (!j.is_discarded() && j.is_object() && j.contains("type") && j["type"] == "reset") {
-      if (j.size() != 1) return refuse(where + ":" + std::to_string(n) + ": {\"type\": \"reset\"} takes no other keys; nothing reset");
+      if (j.size() != 1)
+        return refuse(where + ":" + std::to_string(n) + ": {\"type\": \"reset\"} takes no other keys; nothing reset");
       resetRequested.store(true);
       stopRequested.store(true);
       return {};
@@ -305,8 +332,9 @@ int cmdServe(const std::vector<std::string>& args) {
       // A stamp would park the event in the schedule until its frame (unbounded for a
       // client that sends far-future stamps): the network's events apply at the next boundary.
       if (t.event.frame >= 0 || t.event.t >= 0)
-        return refuse(t.where + ": keys 'frame' and 't' are not allowed in events from the network (they apply at the "
-                                "next frame boundary); nothing applied");
+        return refuse(t.where +
+                      ": keys 'frame' and 't' are not allowed in events from the network (they apply at the "
+                      "next frame boundary); nothing applied");
       // The caps, before anything is allocated: the event's particles are counted from its numbers.
       const double now = std::chrono::duration<double>(std::chrono::steady_clock::now() - clock0).count();
       const double adds = liveEventParticles(t.event, scene);
@@ -334,7 +362,8 @@ int cmdServe(const std::vector<std::string>& args) {
     std::lock_guard<std::mutex> lock(status.mutex);
     nlohmann::json s = status.state;
     s["events_waiting"] = queue->size();
-    s["limits"] = {{"event_particles", limits.perEvent}, {"particles_per_second", limits.perSecond},
+    s["limits"] = {{"event_particles", limits.perEvent},
+                   {"particles_per_second", limits.perSecond},
                    {"max_particles", limits.budget}};
     return s;
   });
@@ -350,9 +379,10 @@ int cmdServe(const std::vector<std::string>& args) {
               server.port(), scene.name.c_str(), scene.solver.type.c_str(), scene.render.width, scene.render.height,
               imageFormatName(a.server.format));
   if (!a.quiet)
-    std::printf("sph2d serve: events from the network add at most %zu particles each, %zu a second, and take the "
-                "fluid to at most %zu (--max-event-particles, --max-particles-per-second, --max-particles)\n",
-                limits.perEvent, limits.perSecond, limits.budget);
+    std::printf(
+        "sph2d serve: events from the network add at most %zu particles each, %zu a second, and take the "
+        "fluid to at most %zu (--max-event-particles, --max-particles-per-second, --max-particles)\n",
+        limits.perEvent, limits.perSecond, limits.budget);
   std::fflush(stdout);
 
   std::map<std::string, bool> effects;
@@ -423,21 +453,22 @@ int cmdServe(const std::vector<std::string>& args) {
     queue->take();  // events sent to the old World do not carry over
     for (auto& e : effects) e.second = true;
     ++resets;
-    if (!a.quiet) std::printf("sph2d serve: reset: the scene starts again at frame 0%s\n",
-                              a.record.empty() ? "" : (" (" + a.record + " starts over)").c_str());
+    if (!a.quiet)
+      std::printf("sph2d serve: reset: the scene starts again at frame 0%s\n",
+                  a.record.empty() ? "" : (" (" + a.record + " starts over)").c_str());
     std::fflush(stdout);
   }
   server.stop();
   const ServeCounters c = server.counters();
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (!failure.empty()) std::fprintf(stderr, "error: %s\n", failure.c_str());
-  std::printf("sph2d serve: stopped after %.1f s: %lld frames stepped, %d events applied, %d resets; "
-              "%llu frames encoded (%.1f ms each), %llu sent to %llu clients, %llu refused, %llu messages rejected%s\n",
-              wall, static_cast<long long>(framesTotal), appliedTotal, resets, static_cast<unsigned long long>(c.encoded),
-              c.encoded ? 1e3 * c.encodeSeconds / double(c.encoded) : 0.0, static_cast<unsigned long long>(c.sent),
-              static_cast<unsigned long long>(c.clients), static_cast<unsigned long long>(c.refused),
-              static_cast<unsigned long long>(c.rejected),
-              a.record.empty() ? "" : ("; record " + a.record).c_str());
+  std::printf(
+      "sph2d serve: stopped after %.1f s: %lld frames stepped, %d events applied, %d resets; "
+      "%llu frames encoded (%.1f ms each), %llu sent to %llu clients, %llu refused, %llu messages rejected%s\n",
+      wall, static_cast<long long>(framesTotal), appliedTotal, resets, static_cast<unsigned long long>(c.encoded),
+      c.encoded ? 1e3 * c.encodeSeconds / double(c.encoded) : 0.0, static_cast<unsigned long long>(c.sent),
+      static_cast<unsigned long long>(c.clients), static_cast<unsigned long long>(c.refused),
+      static_cast<unsigned long long>(c.rejected), a.record.empty() ? "" : ("; record " + a.record).c_str());
   std::fflush(stdout);
   return code;
 }

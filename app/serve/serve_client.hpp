@@ -27,10 +27,10 @@ using tcp = net::ip::tcp;
 
 /// An HTTP answer.
 struct HttpResult {
-  int status = 0;          ///< the status code (0: no answer)
-  std::string body;        ///< the body
-  std::string contentType; ///< the Content-Type header
-  std::string retryAfter;  ///< the Retry-After header ("" when absent)
+  int status = 0;           ///< the status code (0: no answer)
+  std::string body;         ///< the body
+  std::string contentType;  ///< the Content-Type header
+  std::string retryAfter;   ///< the Retry-After header ("" when absent)
 };
 
 /// One HTTP/1.1 request to host:port (a new connection), waiting at most `timeout`. Throws
@@ -68,10 +68,10 @@ inline HttpResult httpRequest(const std::string& host, int port, http::verb meth
 
 /// A message from the server: a frame (header + image) or a text reply.
 struct ServeMessage {
-  bool frame = false;        ///< a binary frame message (else a text reply)
-  nlohmann::json header;     ///< the frame's overlay data, or the parsed reply
-  std::string image;         ///< the frame's JPEG or PNG bytes
-  std::string text;          ///< the reply's text
+  bool frame = false;                        ///< a binary frame message (else a text reply)
+  nlohmann::json header;                     ///< the frame's overlay data, or the parsed reply
+  std::string image;                         ///< the frame's JPEG or PNG bytes
+  std::string text;                          ///< the reply's text
   std::chrono::steady_clock::time_point at;  ///< when it was read
 };
 
@@ -122,8 +122,9 @@ class WsClient {
     }
     m.frame = true;
     if (data.size() < 4) throw std::runtime_error("frame message shorter than its length prefix");
-    const std::uint32_t n = (std::uint32_t(std::uint8_t(data[0])) << 24) | (std::uint32_t(std::uint8_t(data[1])) << 16) |
-                            (std::uint32_t(std::uint8_t(data[2])) << 8) | std::uint32_t(std::uint8_t(data[3]));
+    const std::uint32_t n = (std::uint32_t(std::uint8_t(data[0])) << 24) |
+                            (std::uint32_t(std::uint8_t(data[1])) << 16) | (std::uint32_t(std::uint8_t(data[2])) << 8) |
+                            std::uint32_t(std::uint8_t(data[3]));
     if (4 + std::size_t(n) > data.size()) throw std::runtime_error("frame header longer than the message");
     m.header = nlohmann::json::parse(data.substr(4, n));
     m.image = data.substr(4 + n);

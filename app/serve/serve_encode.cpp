@@ -40,8 +40,10 @@ void appendPng(int width, int height, const std::uint8_t* rgba, std::string& out
 }
 
 void appendImage(ImageFormat format, int width, int height, const std::uint8_t* rgba, int quality, std::string& out) {
-  if (format == ImageFormat::Jpeg) appendJpeg(width, height, rgba, quality, out);
-  else appendPng(width, height, rgba, out);
+  if (format == ImageFormat::Jpeg)
+    appendJpeg(width, height, rgba, quality, out);
+  else
+    appendPng(width, height, rgba, out);
 }
 
 }  // namespace sph2d::cli

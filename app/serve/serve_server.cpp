@@ -217,7 +217,8 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
     parser_->header_limit(8192);
     parser_->body_limit(s_.cfg.maxEventBytes);
     stream_.expires_after(std::chrono::seconds(30));
-    http::async_read(stream_, buf_, *parser_, [self = shared_from_this()](beast::error_code ec, std::size_t) { self->onRead(ec); });
+    http::async_read(stream_, buf_, *parser_,
+                     [self = shared_from_this()](beast::error_code ec, std::size_t) { self->onRead(ec); });
   }
 
  private:
@@ -238,7 +239,8 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
     std::string target(req.target());
     target = target.substr(0, target.find('?'));
     if (websocket::is_upgrade(req)) {
-      if (target != "/ws") return send(make(http::status::not_found, "application/json", errorJson("WebSocket at /ws only")), true);
+      if (target != "/ws")
+        return send(make(http::status::not_found, "application/json", errorJson("WebSocket at /ws only")), true);
       if (s_.wsCount.load() >= s_.cfg.maxClients) {
         s_.count(&ServeCounters::refused);
         return send(make(http::status::service_unavailable, "application/json",
@@ -272,8 +274,7 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
     const auto method = req.method();
     const bool get = method == http::verb::get || method == http::verb::head;
     auto wrongMethod = [&](const char* allowed) {
-      Response r = make(http::status::method_not_allowed, "application/json",
-                        errorJson(target + " allows " + allowed));
+      Response r = make(http::status::method_not_allowed, "application/json", errorJson(target + " allows " + allowed));
       r.set(http::field::allow, allowed);
       return r;
     };
@@ -284,7 +285,8 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
     if (target == "/snapshot.png") {
       if (!get) return wrongMethod("GET");
       const std::string& png = s_.snapshot();
-      if (png.empty()) return make(http::status::service_unavailable, "application/json", errorJson("no frame rendered yet"));
+      if (png.empty())
+        return make(http::status::service_unavailable, "application/json", errorJson("no frame rendered yet"));
       return make(http::status::ok, "image/png", png);
     }
     if (target == "/state") {

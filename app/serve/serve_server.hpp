@@ -32,22 +32,22 @@ namespace sph2d::cli {
 
 /// How the server listens and what it sends.
 struct ServeConfig {
-  std::string bind = "127.0.0.1";     ///< the address to listen on
-  int port = 8080;                    ///< the TCP port (0: any free port; port() says which)
-  int maxClients = 4;                 ///< WebSocket clients at once (more are answered 503)
-  std::size_t maxEventBytes = 16384;  ///< an event (POST body, WebSocket message) at most this long
+  std::string bind = "127.0.0.1";          ///< the address to listen on
+  int port = 8080;                         ///< the TCP port (0: any free port; port() says which)
+  int maxClients = 4;                      ///< WebSocket clients at once (more are answered 503)
+  std::size_t maxEventBytes = 16384;       ///< an event (POST body, WebSocket message) at most this long
   ImageFormat format = ImageFormat::Jpeg;  ///< the live frames' format
-  int jpegQuality = 80;               ///< JPEG quality 1..100
+  int jpegQuality = 80;                    ///< JPEG quality 1..100
 };
 
 /// Counters of the server's work (for the summary; read from any thread).
 struct ServeCounters {
-  std::uint64_t encoded = 0;    ///< frames compressed for the clients
-  std::uint64_t sent = 0;       ///< frame messages written to clients
-  std::uint64_t clients = 0;    ///< WebSocket clients accepted so far
-  std::uint64_t refused = 0;    ///< connections refused (too many clients)
-  std::uint64_t rejected = 0;   ///< messages answered with an error
-  double encodeSeconds = 0;     ///< wall seconds compressing frames
+  std::uint64_t encoded = 0;   ///< frames compressed for the clients
+  std::uint64_t sent = 0;      ///< frame messages written to clients
+  std::uint64_t clients = 0;   ///< WebSocket clients accepted so far
+  std::uint64_t refused = 0;   ///< connections refused (too many clients)
+  std::uint64_t rejected = 0;  ///< messages answered with an error
+  double encodeSeconds = 0;    ///< wall seconds compressing frames
 };
 
 /// The answer to a client's event: accepted (`error` empty), or refused with why (sent back

@@ -50,11 +50,16 @@ int main(int argc, char** argv) {
       std::fputs(kHelp, stdout);
       return 0;
     }
-    if (a == "--out") out = value();
-    else if (a == "--cols") cols = std::max(1, std::atoi(value().c_str()));
-    else if (a == "--shrink") shrink = std::max(1, std::atoi(value().c_str()));
-    else if (a == "--fps") fps = std::atof(value().c_str());
-    else inputs.push_back(a);
+    if (a == "--out")
+      out = value();
+    else if (a == "--cols")
+      cols = std::max(1, std::atoi(value().c_str()));
+    else if (a == "--shrink")
+      shrink = std::max(1, std::atoi(value().c_str()));
+    else if (a == "--fps")
+      fps = std::atof(value().c_str());
+    else
+      inputs.push_back(a);
   }
   if (out.empty() || inputs.empty()) {
     std::fputs(kHelp, stderr);
@@ -83,8 +88,10 @@ int main(int argc, char** argv) {
       const int f = frameNumber(inputs[std::size_t(k)]);
       if (f >= 0) {
         char label[64];
-        if (fps > 0) std::snprintf(label, sizeof label, "%d  T %.2f S", f, f / fps);
-        else std::snprintf(label, sizeof label, "FRAME %d", f);
+        if (fps > 0)
+          std::snprintf(label, sizeof label, "%d  T %.2f S", f, f / fps);
+        else
+          std::snprintf(label, sizeof label, "FRAME %d", f);
         fillRect(sheet, x, y, x + textWidth(label, 1) + 4, y + textHeight(1) + 4, Rgba8{0, 0, 0, 150});
         drawText(sheet, x + 2, y + 2, label, 1, Rgba8{230, 230, 230, 255});
       }

@@ -26,7 +26,8 @@ struct Rgb {
 };
 
 // The kernels in plot and table order, with their plot colours (docs/KERNELS.md lists them).
-constexpr Rgb kPoly6{31, 119, 180}, kSpiky{255, 127, 14}, kVisc{44, 160, 44}, kCubic{214, 39, 40}, kWendland{148, 103, 189};
+constexpr Rgb kPoly6{31, 119, 180}, kSpiky{255, 127, 14}, kVisc{44, 160, 44}, kCubic{214, 39, 40},
+    kWendland{148, 103, 189};
 
 /// An RGBA8 image, rows top-down, with clipped drawing.
 struct Canvas {
@@ -126,7 +127,8 @@ void text(Canvas& c, int x, int y, const std::string& s, Rgb col, int scale = 2,
       if (g.c != ch) continue;
       for (int r = 0; r < 7; ++r)
         for (int k = 0; k < 5; ++k)
-          if (g.rows[r][k] == '#') c.fill(x0 + k * scale, y + r * scale, x0 + (k + 1) * scale - 1, y + (r + 1) * scale - 1, col);
+          if (g.rows[r][k] == '#')
+            c.fill(x0 + k * scale, y + r * scale, x0 + (k + 1) * scale - 1, y + (r + 1) * scale - 1, col);
     }
     x0 += adv;
   }
@@ -257,7 +259,8 @@ void tableRows(double jitter) {
 }
 
 void table(double jitter) {
-  std::printf("| kernel | n | sample | Shepard | ∇ difference | ∇ symmetric | ∇ corrected | ∇² kernel | ∇² Brookshaw | ∇² renormalised |\n");
+  std::printf(
+      "| kernel | n | sample | Shepard | ∇ difference | ∇ symmetric | ∇ corrected | ∇² kernel | ∇² Brookshaw | ∇² renormalised |\n");
   std::printf("|---|---|---|---|---|---|---|---|---|---|\n");
   tableRows<Poly6<double>>(jitter);
   tableRows<Spiky<double>>(jitter);
@@ -285,7 +288,8 @@ int main(int argc, char** argv) {
       drawKernels(png);
       std::fprintf(stderr, "wrote %s\n", png.c_str());
     }
-    std::printf("Max-norm error (observed order against the row above) of A = sin(3x + 0.5) cos(2y − 0.3) on [0, 2]²,\n");
+    std::printf(
+        "Max-norm error (observed order against the row above) of A = sin(3x + 0.5) cos(2y − 0.3) on [0, 2]²,\n");
     std::printf("n × n particles (dx = 2/n, volume dx², R = 3 dx), at points in [0.5, 1.5]².\n\n");
     std::printf("Regular lattice:\n\n");
     table(0.0);

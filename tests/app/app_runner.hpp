@@ -35,7 +35,8 @@ inline std::string scratch(const std::string& name) {
 inline Result runShell(const std::string& command) {
   static int calls = 0;
   std::filesystem::create_directories(SPH2D_TEST_TMP);
-  const std::string log = std::string(SPH2D_TEST_TMP) + "/cmd_" + std::to_string(::getpid()) + "_" + std::to_string(++calls) + ".log";
+  const std::string log =
+      std::string(SPH2D_TEST_TMP) + "/cmd_" + std::to_string(::getpid()) + "_" + std::to_string(++calls) + ".log";
   const int status = std::system(("{ " + command + " ; } > \"" + log + "\" 2>&1").c_str());
   std::ifstream in(log);
   std::stringstream ss;

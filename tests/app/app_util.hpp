@@ -45,8 +45,8 @@ inline std::string readText(const std::string& path) {
 inline Result run(const std::string& args, const std::string& envPrefix = "") {
   static std::atomic<int> counter{0};
   fs::create_directories(SPH2D_TEST_TMP);
-  const std::string log = std::string(SPH2D_TEST_TMP) + "/cmd_" + std::to_string(::getpid()) + "_" +
-                          std::to_string(counter++) + ".log";
+  const std::string log =
+      std::string(SPH2D_TEST_TMP) + "/cmd_" + std::to_string(::getpid()) + "_" + std::to_string(counter++) + ".log";
   const std::string cmd = envPrefix + " \"" + std::string(SPH2D_EXE) + "\" " + args + " > \"" + log + "\" 2>&1";
   const int status = std::system(cmd.c_str());
   Result r{WIFEXITED(status) ? WEXITSTATUS(status) : -1, readText(log)};

@@ -4,9 +4,9 @@
 #pragma once
 
 #define GL_GLEXT_PROTOTYPES 1
-#include <GL/osmesa.h>
 #include <GL/gl.h>
 #include <GL/glext.h>
+#include <GL/osmesa.h>
 #include <doctest/doctest.h>
 
 #include <array>
@@ -18,16 +18,15 @@
 #include <vector>
 
 #include "app_runner.hpp"
-#include "support/game_scene.hpp"
 #include "sph2d/hash.hpp"
 #include "sph2d/render/renderer.hpp"
 #include "sph2d/scene.hpp"
 #include "sph2d/world.hpp"
+#include "support/game_scene.hpp"
 
 namespace rctest {
 
 using namespace sph2d;
-
 
 constexpr int W = 160, H = 120;  // the frame; the tests' viewports are this size unless said
 
@@ -47,8 +46,10 @@ inline RenderOptions optionsFor(const std::string& mode) {
 inline void dye(World& world) {
   for (std::size_t i = 0; i < world.particleCount(); ++i) {
     const double x = world.worldPosition(i).x();
-    if (x < 0.4) world.setParticleColor(world.particles().id[i], 0xE03020u);
-    else if (x < 0.8) world.setParticleColor(world.particles().id[i], 0x30C040u);
+    if (x < 0.4)
+      world.setParticleColor(world.particles().id[i], 0xE03020u);
+    else if (x < 0.8)
+      world.setParticleColor(world.particles().id[i], 0x30C040u);
   }
 }
 
@@ -70,9 +71,21 @@ struct GameContext {
     if (compatibility) {
       ctx = OSMesaCreateContextExt(OSMESA_RGBA, 0, 0, 0, nullptr);
     } else {
-      const int attribs[] = {OSMESA_FORMAT, OSMESA_RGBA, OSMESA_DEPTH_BITS, 0, OSMESA_STENCIL_BITS, 0,
-                             OSMESA_ACCUM_BITS, 0, OSMESA_PROFILE, OSMESA_CORE_PROFILE,
-                             OSMESA_CONTEXT_MAJOR_VERSION, 3, OSMESA_CONTEXT_MINOR_VERSION, 3, 0};
+      const int attribs[] = {OSMESA_FORMAT,
+                             OSMESA_RGBA,
+                             OSMESA_DEPTH_BITS,
+                             0,
+                             OSMESA_STENCIL_BITS,
+                             0,
+                             OSMESA_ACCUM_BITS,
+                             0,
+                             OSMESA_PROFILE,
+                             OSMESA_CORE_PROFILE,
+                             OSMESA_CONTEXT_MAJOR_VERSION,
+                             3,
+                             OSMESA_CONTEXT_MINOR_VERSION,
+                             3,
+                             0};
       ctx = OSMesaCreateContextAttribs(attribs, nullptr);
     }
     REQUIRE(ctx);
@@ -152,11 +165,13 @@ struct GameObjects {
       glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, 4, 4, 0, GL_RGBA, GL_UNSIGNED_BYTE, nullptr);
     }
     glGenSamplers(1, &sampler);
-    glSamplerParameteri(sampler, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);  // textures without mipmaps: incomplete
+    glSamplerParameteri(sampler, GL_TEXTURE_MIN_FILTER,
+                        GL_LINEAR_MIPMAP_LINEAR);  // textures without mipmaps: incomplete
     glSamplerParameteri(sampler, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
     glSamplerParameteri(sampler, GL_TEXTURE_WRAP_S, GL_REPEAT);
-    const GLuint vs = compile(GL_VERTEX_SHADER, "#version 330 core\nlayout(location = 0) in vec2 p;\n"
-                                                "void main() { gl_Position = vec4(p, 0.0, 1.0); }\n");
+    const GLuint vs = compile(GL_VERTEX_SHADER,
+                              "#version 330 core\nlayout(location = 0) in vec2 p;\n"
+                              "void main() { gl_Position = vec4(p, 0.0, 1.0); }\n");
     const GLuint fs = compile(GL_FRAGMENT_SHADER, "#version 330 core\nout vec4 c;\nvoid main() { c = vec4(1.0); }\n");
     prog = glCreateProgram();
     glAttachShader(prog, vs);
@@ -264,11 +279,11 @@ inline void setGameState(const GameObjects& g, bool compatibility = false) {
   glProvokingVertex(GL_FIRST_VERTEX_CONVENTION);
   if (compatibility) {
     glEnable(GL_ALPHA_TEST);
-    glAlphaFunc(GL_GREATER, 0.99f);  // would drop the discs' soft edges
-    glDisable(GL_POINT_SPRITE);      // gl_PointCoord would be undefined
+    glAlphaFunc(GL_GREATER, 0.99f);                  // would drop the discs' soft edges
+    glDisable(GL_POINT_SPRITE);                      // gl_PointCoord would be undefined
     glClampColor(GL_CLAMP_FRAGMENT_COLOR, GL_TRUE);  // the float splat would stop at 1
-    glEnable(GL_POLYGON_STIPPLE);                  // would punch holes in every triangle
-    glPixelTransferf(GL_RED_SCALE, 0.5f);          // would halve the red of every upload
+    glEnable(GL_POLYGON_STIPPLE);                    // would punch holes in every triangle
+    glPixelTransferf(GL_RED_SCALE, 0.5f);            // would halve the red of every upload
     glPixelTransferf(GL_GREEN_BIAS, 0.25f);
     glPixelTransferf(GL_DEPTH_SCALE, 2.0f);
     glPixelTransferi(GL_INDEX_SHIFT, 1);
@@ -342,12 +357,16 @@ inline std::vector<Item> snapshot(bool compatibility = false) {
   ints("point sprite coord origin", GL_POINT_SPRITE_COORD_ORIGIN);
   on("program point size", GL_PROGRAM_POINT_SIZE);
   floats("point size", GL_POINT_SIZE);
-  for (const auto& [name, e] :
-       {std::pair{"pack alignment", GL_PACK_ALIGNMENT}, {"pack row length", GL_PACK_ROW_LENGTH},
-        {"pack skip rows", GL_PACK_SKIP_ROWS}, {"pack skip pixels", GL_PACK_SKIP_PIXELS},
-        {"unpack alignment", GL_UNPACK_ALIGNMENT}, {"unpack row length", GL_UNPACK_ROW_LENGTH},
-        {"unpack skip rows", GL_UNPACK_SKIP_ROWS}, {"unpack skip pixels", GL_UNPACK_SKIP_PIXELS},
-        {"unpack image height", GL_UNPACK_IMAGE_HEIGHT}, {"unpack swap bytes", GL_UNPACK_SWAP_BYTES}})
+  for (const auto& [name, e] : {std::pair{"pack alignment", GL_PACK_ALIGNMENT},
+                                {"pack row length", GL_PACK_ROW_LENGTH},
+                                {"pack skip rows", GL_PACK_SKIP_ROWS},
+                                {"pack skip pixels", GL_PACK_SKIP_PIXELS},
+                                {"unpack alignment", GL_UNPACK_ALIGNMENT},
+                                {"unpack row length", GL_UNPACK_ROW_LENGTH},
+                                {"unpack skip rows", GL_UNPACK_SKIP_ROWS},
+                                {"unpack skip pixels", GL_UNPACK_SKIP_PIXELS},
+                                {"unpack image height", GL_UNPACK_IMAGE_HEIGHT},
+                                {"unpack swap bytes", GL_UNPACK_SWAP_BYTES}})
     ints(name, e);
   on("framebuffer sRGB", GL_FRAMEBUFFER_SRGB);
   on("dither", GL_DITHER);
@@ -394,8 +413,9 @@ inline void checkSame(const std::vector<Item>& before, const std::vector<Item>& 
 inline std::vector<unsigned char> flipRows(const std::vector<unsigned char>& p, int w, int h) {
   std::vector<unsigned char> out(p.size());
   const std::size_t row = std::size_t(w) * 4;
-  for (int y = 0; y < h; ++y) std::copy_n(p.begin() + std::ptrdiff_t(row * std::size_t(y)), row,
-                                          out.begin() + std::ptrdiff_t(row * std::size_t(h - 1 - y)));
+  for (int y = 0; y < h; ++y)
+    std::copy_n(p.begin() + std::ptrdiff_t(row * std::size_t(y)), row,
+                out.begin() + std::ptrdiff_t(row * std::size_t(h - 1 - y)));
   return out;
 }
 
@@ -432,6 +452,5 @@ inline apptest::Result runChild(const std::string& name, const std::string& env)
 }
 
 inline bool isChild() { return std::getenv("SPH2D_RENDER_CONTEXT_CHILD") != nullptr; }
-
 
 }  // namespace rctest

@@ -46,59 +46,79 @@ TEST_CASE("app bad input: invalid JSON exits 2 naming file, line and column") {
 
 TEST_CASE("app bad input: an empty file and a whitespace-only file exit 2") {
   expectBadScene("empty", "", ":1:1: invalid JSON: the file is empty; a scene is a JSON object such as {}");
-  expectBadScene("blank", "\n\n   \n", ":1:1: invalid JSON: the file holds only whitespace; a scene is a JSON object such as {}");
+  expectBadScene("blank", "\n\n   \n",
+                 ":1:1: invalid JSON: the file holds only whitespace; a scene is a JSON object such as {}");
 }
 
 TEST_CASE("app bad input: a top level that is not an object exits 2") {
-  expectBadScene("array", "[{\"fps\": 60}]", ":1:1: a scene is a JSON object ({ ... }) at the top level, got an array of 1 element");
+  expectBadScene("array", "[{\"fps\": 60}]",
+                 ":1:1: a scene is a JSON object ({ ... }) at the top level, got an array of 1 element");
 }
 
 TEST_CASE("app bad input: a wrong type and a wrong-length vector exit 2 at their key") {
-  expectBadScene("type", "{\"render\": {\"width\": \"wide\"}}", ":1:13: key 'render.width': expected an integer from 16 to 8192, got a string");
-  expectBadScene("vector", "{\"gravity\": [0, -9.81, 0]}", ":1:2: key 'gravity': expected [x, y] (two numbers), got an array of 3 elements");
+  expectBadScene("type", "{\"render\": {\"width\": \"wide\"}}",
+                 ":1:13: key 'render.width': expected an integer from 16 to 8192, got a string");
+  expectBadScene("vector", "{\"gravity\": [0, -9.81, 0]}",
+                 ":1:2: key 'gravity': expected [x, y] (two numbers), got an array of 3 elements");
 }
 
 TEST_CASE("app bad input: non-UTF-8 bytes exit 2 at the byte") {
-  expectBadScene("latin1", "{\"name\": \"d\xE9mo\"}", ":1:12: invalid JSON: byte 0xE9 is not valid UTF-8; scene files are UTF-8 text (save the file as UTF-8)");
+  expectBadScene(
+      "latin1", "{\"name\": \"d\xE9mo\"}",
+      ":1:12: invalid JSON: byte 0xE9 is not valid UTF-8; scene files are UTF-8 text (save the file as UTF-8)");
 }
 
 TEST_CASE("app bad input: 1e400 and NaN exit 2 where they stand") {
-  expectBadScene("huge", "{\"duration\": 1e400}", ":1:14: invalid JSON: number 1e400 is too large (a double holds magnitudes up to about 1.8e308)");
-  expectBadScene("nan", "{\"duration\": NaN}", ":1:14: invalid JSON: unexpected character 'N', expected a value; NaN and Infinity are not JSON numbers");
+  expectBadScene("huge", "{\"duration\": 1e400}",
+                 ":1:14: invalid JSON: number 1e400 is too large (a double holds magnitudes up to about 1.8e308)");
+  expectBadScene(
+      "nan", "{\"duration\": NaN}",
+      ":1:14: invalid JSON: unexpected character 'N', expected a value; NaN and Infinity are not JSON numbers");
 }
 
 TEST_CASE("app bad input: deep nesting and duplicate keys exit 2") {
-  expectBadScene("deep", std::string(5000, '[') + std::string(5000, ']'), ":1:201: invalid JSON: nested deeper than 200 levels");
+  expectBadScene("deep", std::string(5000, '[') + std::string(5000, ']'),
+                 ":1:201: invalid JSON: nested deeper than 200 levels");
   expectBadScene("duplicate", "{\"fps\": 60, \"fps\": 30}", ":1:13: invalid JSON: duplicate key 'fps'");
 }
 
 TEST_CASE("app bad input: geometry Box2D would abort on exits 2 instead") {
   // Without the loader's checks each of these reaches a Box2D assertion (SIGABRT).
-  expectBadScene("weld", "{\"boundaries\": [{\"fixtures\": [{\"shape\": \"polygon\", \"vertices\": [[0,0],[0.001,0],[0,1]]}]}]}",
-                 ":1:52: key 'boundaries[0].fixtures[0].vertices': vertices [0] and [1] are closer than 0.005 m (Box2D's linear slop)");
-  expectBadScene("sliver", "{\"boundaries\": [{\"fixtures\": [{\"shape\": \"polygon\", \"vertices\": [[0,0],[1,0],[0.5,1e-7]]}]}]}",
-                 ":1:52: key 'boundaries[0].fixtures[0].vertices': the polygon is too thin");
-  expectBadScene("chain", "{\"boundaries\": [{\"fixtures\": [{\"shape\": \"chain\", \"vertices\": [[0,0],[0.004,0],[1,1]]}]}]}",
-                 ":1:69: key 'boundaries[0].fixtures[0].vertices[1]': chain vertices [0] and [1] are closer than 0.005 m (Box2D's linear slop)");
-  expectBadScene("concave", "{\"boundaries\": [{\"fixtures\": [{\"shape\": \"polygon\", \"vertices\": [[0,0],[2,0],[1,0.2],[2,2],[0,2]]}]}]}",
-                 ":1:52: key 'boundaries[0].fixtures[0].vertices': the polygon must be convex");
+  expectBadScene(
+      "weld", "{\"boundaries\": [{\"fixtures\": [{\"shape\": \"polygon\", \"vertices\": [[0,0],[0.001,0],[0,1]]}]}]}",
+      ":1:52: key 'boundaries[0].fixtures[0].vertices': vertices [0] and [1] are closer than 0.005 m (Box2D's linear slop)");
+  expectBadScene(
+      "sliver",
+      "{\"boundaries\": [{\"fixtures\": [{\"shape\": \"polygon\", \"vertices\": [[0,0],[1,0],[0.5,1e-7]]}]}]}",
+      ":1:52: key 'boundaries[0].fixtures[0].vertices': the polygon is too thin");
+  expectBadScene(
+      "chain", "{\"boundaries\": [{\"fixtures\": [{\"shape\": \"chain\", \"vertices\": [[0,0],[0.004,0],[1,1]]}]}]}",
+      ":1:69: key 'boundaries[0].fixtures[0].vertices[1]': chain vertices [0] and [1] are closer than 0.005 m (Box2D's linear slop)");
+  expectBadScene(
+      "concave",
+      "{\"boundaries\": [{\"fixtures\": [{\"shape\": \"polygon\", \"vertices\": [[0,0],[2,0],[1,0.2],[2,2],[0,2]]}]}]}",
+      ":1:52: key 'boundaries[0].fixtures[0].vertices': the polygon must be convex");
 }
 
 TEST_CASE("app bad input: a fluid block that would hold no particle exits 2") {
-  expectBadScene("inside", "{\"boundaries\": [{\"fixtures\": [{\"shape\": \"box\", \"half_size\": [3, 3]}]}], \"fluid\": [{\"min\": [0, 0], \"max\": [1, 1]}]}",
-                 ":1:83: key 'fluid[0]': the block lies entirely inside boundaries[0].fixtures[0] (a box): every particle would be dropped");
+  expectBadScene(
+      "inside",
+      "{\"boundaries\": [{\"fixtures\": [{\"shape\": \"box\", \"half_size\": [3, 3]}]}], \"fluid\": [{\"min\": [0, 0], \"max\": [1, 1]}]}",
+      ":1:83: key 'fluid[0]': the block lies entirely inside boundaries[0].fixtures[0] (a box): every particle would be dropped");
 }
 
 TEST_CASE("app bad input: a spacing too small for the particle budget exits 2 before allocating") {
-  expectBadScene("budget", "{\"solver\": {\"spacing\": 0.0001}, \"fluid\": [{\"min\": [0, 0], \"max\": [1, 1]}]}",
-                 ":1:13: key 'solver.spacing': spacing 0.0001 fills the fluid blocks with 100000000 particles, more than max_particles = 4000000");
+  expectBadScene(
+      "budget", "{\"solver\": {\"spacing\": 0.0001}, \"fluid\": [{\"min\": [0, 0], \"max\": [1, 1]}]}",
+      ":1:13: key 'solver.spacing': spacing 0.0001 fills the fluid blocks with 100000000 particles, more than max_particles = 4000000");
 }
 
 TEST_CASE("app bad input: a missing scene file and a directory exit 2 naming the path") {
   const std::string dir = scratch("bad_missing");
   Result r = runSph2d("run " + q(dir + "/nope.json") + " --out " + q(dir + "/frames"));
   CHECK(r.code == 2);
-  CHECK(r.out.find("sph2d: bad scene: " + dir + "/nope.json: cannot open the scene file: No such file or directory") != std::string::npos);
+  CHECK(r.out.find("sph2d: bad scene: " + dir + "/nope.json: cannot open the scene file: No such file or directory") !=
+        std::string::npos);
   r = runSph2d("info " + q(dir));
   CHECK(r.code == 2);
   CHECK(r.out.find("sph2d: bad scene: " + dir + ": is a directory, not a scene file") != std::string::npos);
@@ -133,7 +153,8 @@ TEST_CASE("bad input: a scene whose estimated peak memory exceeds the limit is r
     CHECK(info.out.find("memory       about ") != std::string::npos);
   }
   CHECK(runSph2d("info " + q(huge) + " --max-memory 1G").out.find("50000000 particles at most") != std::string::npos);
-  CHECK(runSph2d("info " + q(emitter) + " --max-memory 1G").out.find("100000000 particles at most") != std::string::npos);
+  CHECK(runSph2d("info " + q(emitter) + " --max-memory 1G").out.find("100000000 particles at most") !=
+        std::string::npos);
   CHECK(runSph2d("run " + q(huge) + " --max-memory lots").code == 2);
   fs::remove_all(dir);
 }

@@ -44,11 +44,12 @@ EventRun eventRun(const std::string& name, const std::string& extra = "") {
   r.dir = freshDir(name);
   r.record = r.dir + "/run.jsonl";
   const std::string events = r.dir + "/events.jsonl";
-  std::ofstream(events) << "{\"frame\": 4, \"type\": \"drop\", \"center\": [2, 2.5], \"radius\": 0.15}\n"
-                        << "{\"frame\": 6, \"type\": \"gravity\", \"gravity\": [3, -9.5]}\n"
-                        << "{\"frame\": 9, \"type\": \"force\", \"point\": [1, 0.4], \"radius\": 0.4, \"strength\": -40}\n"
-                        << "{\"frame\": 10, \"type\": \"pause\"}\n"
-                        << "{\"frame\": 12, \"type\": \"release\"}\n";
+  std::ofstream(events)
+      << "{\"frame\": 4, \"type\": \"drop\", \"center\": [2, 2.5], \"radius\": 0.15}\n"
+      << "{\"frame\": 6, \"type\": \"gravity\", \"gravity\": [3, -9.5]}\n"
+      << "{\"frame\": 9, \"type\": \"force\", \"point\": [1, 0.4], \"radius\": 0.4, \"strength\": -40}\n"
+      << "{\"frame\": 10, \"type\": \"pause\"}\n"
+      << "{\"frame\": 12, \"type\": \"release\"}\n";
   const Result run1 = run("run " + q(kSmall) + " --frames 16 --threads 2 --quiet --input " + q(events) + " --record " +
                           q(r.record) + " --out " + q(r.dir) + extra);
   INFO(run1.out);
@@ -80,13 +81,16 @@ TEST_CASE("check of a run driven by an events file matches, and so does the repl
   REQUIRE(withEvents.size() == 16);
   for (int f = 0; f < 16; ++f) {
     CAPTURE(f);
-    if (f < 4) CHECK(withEvents[f] == without[f]);
-    else CHECK(withEvents[f] != without[f]);
+    if (f < 4)
+      CHECK(withEvents[f] == without[f]);
+    else
+      CHECK(withEvents[f] != without[f]);
   }
 
   // Replaying the record (another thread count) gives the same frames, states and events.
   const std::string replay = freshDir("check_events_replay");
-  const Result b = run("run " + q(kSmall) + " --frames 16 --threads 1 --quiet --input " + q(r.record) + " --out " + q(replay));
+  const Result b =
+      run("run " + q(kSmall) + " --frames 16 --threads 1 --quiet --input " + q(r.record) + " --out " + q(replay));
   INFO(b.out);
   REQUIRE(b.code == 0);
   const json mb = readManifest(replay);
@@ -151,7 +155,8 @@ TEST_CASE("check of a manifest whose events were changed, dropped or moved fails
 
   // An event that cannot be applied is a note, changes nothing, and the frames match.
   m = original;
-  m["events"].insert(m["events"].begin(), json{{"frame", 2}, {"type", "effect"}, {"name", "user_force"}, {"enabled", false}});
+  m["events"].insert(m["events"].begin(),
+                     json{{"frame", 2}, {"type", "effect"}, {"name", "user_force"}, {"enabled", false}});
   writeManifest(r.dir, m);
   c = check(r.dir);
   INFO(c.out);
@@ -177,7 +182,8 @@ TEST_CASE("check of a real-time run that dropped frames compares the frames it r
   std::ofstream(events) << "{\"frame\": 10, \"type\": \"drop\", \"center\": [2, 2.5], \"radius\": 0.15}\n"
                         << "{\"frame\": 20, \"type\": \"gravity\", \"tilt\": 0.3}\n";
   const std::string out = dir + "/out";
-  const Result r = run("run " + q(scene) + " --frames 60 --threads 2 --quiet --realtime --input " + q(events) + " --out " + q(out));
+  const Result r =
+      run("run " + q(scene) + " --frames 60 --threads 2 --quiet --realtime --input " + q(events) + " --out " + q(out));
   INFO(r.out);
   REQUIRE(r.code == 0);
   std::smatch match;

@@ -64,7 +64,8 @@ TEST_CASE("cli misuse: an unknown flag exits 2 naming it") {
   }
   const Result r = runSph2d("frobnicate");
   CHECK(r.code == 2);
-  CHECK(r.out.find("sph2d: unknown command 'frobnicate'; commands: run, info, check, render, bench") != std::string::npos);
+  CHECK(r.out.find("sph2d: unknown command 'frobnicate'; commands: run, info, check, render, bench") !=
+        std::string::npos);
 }
 
 TEST_CASE("cli misuse: a flag without its value exits 2 naming the flag") {
@@ -102,8 +103,8 @@ TEST_CASE("cli misuse: numbers out of range or not numbers exit 2 with the allow
     INFO(c.flag << " " << c.value);
     const Result r = runSph2d("run " + q(kScene) + " " + c.flag + " " + q(c.value));
     CHECK(r.code == 2);
-    CHECK(r.out.find(std::string("sph2d: ") + c.flag + " expects an integer from " + c.range + ", got '" + c.value + "'") !=
-          std::string::npos);
+    CHECK(r.out.find(std::string("sph2d: ") + c.flag + " expects an integer from " + c.range + ", got '" + c.value +
+                     "'") != std::string::npos);
   }
 }
 
@@ -129,7 +130,8 @@ TEST_CASE("cli misuse: a write failing mid-run (test hook) exits 1 naming the fi
   // SPH2D_TEST_FAIL_WRITE_AFTER=N: the first N PNG writes succeed, the next fails as on a full disk.
   const std::string dir = scratch("cli_failwrite");
   const std::string out = dir + "/frames";
-  const Result r = runSph2d("run " + q(kScene) + " --frames 30 --threads 2 --out " + q(out), "SPH2D_TEST_FAIL_WRITE_AFTER=5");
+  const Result r =
+      runSph2d("run " + q(kScene) + " --frames 30 --threads 2 --out " + q(out), "SPH2D_TEST_FAIL_WRITE_AFTER=5");
   INFO(r.out);
   CHECK(r.code == 1);
   CHECK(r.out.find("cannot write " + out + "/frame_00005.png: No space left on device") != std::string::npos);
@@ -148,8 +150,9 @@ TEST_CASE("cli misuse: a full disk (a 200 KiB tmpfs) exits 1 naming the file, ea
   const std::string mnt = dir + "/mnt", copy = dir + "/copy";
   fs::create_directories(mnt);
   fs::create_directories(copy);
-  const std::string script = "mount -t tmpfs -o size=200k tmpfs " + q(mnt) + " || exit 97; \"" + SPH2D_EXE + "\" run " + q(kScene) +
-                             " --frames 200 --quiet --out " + q(mnt) + "; rc=$?; cp -a " + q(mnt) + "/. " + q(copy) + "/; exit $rc";
+  const std::string script = "mount -t tmpfs -o size=200k tmpfs " + q(mnt) + " || exit 97; \"" + SPH2D_EXE + "\" run " +
+                             q(kScene) + " --frames 200 --quiet --out " + q(mnt) + "; rc=$?; cp -a " + q(mnt) + "/. " +
+                             q(copy) + "/; exit $rc";
   const Result r = runShell("unshare -rm sh -c " + q(script));
   INFO(r.out);
   if (r.code == 97) {

@@ -69,8 +69,8 @@ TEST_CASE("a run fed live events through a pipe is recorded, and replaying the r
       "printf '%s\\n' '{\"type\": \"pause\"}'; sleep 0.3; "
       "printf '%s\\n' '{\"type\": \"resume\"}' '{\"type\": \"effect\", \"name\": \"user_force\", \"enabled\": false}' "
       "'{\"type\": \"release\"}') | ";
-  const Result a = run("run " + q(kSmall) + " --frames 20 --threads 2 --input - --record " + q(rec) + " --out " + q(dir) +
-                           " --state-hash",
+  const Result a = run("run " + q(kSmall) + " --frames 20 --threads 2 --input - --record " + q(rec) + " --out " +
+                           q(dir) + " --state-hash",
                        feed);
   INFO(a.out);
   REQUIRE(a.code == 0);
@@ -101,8 +101,8 @@ TEST_CASE("a run fed live events through a pipe is recorded, and replaying the r
   CHECK(column(ma, "rgba_xxh64").size() == 20);
   CHECK(ma.at("events") == mb.at("events"));
   // sph2d check applies the events the manifest lists.
-  const Result c = run("check " + q(kSmall) + " --against " + q(dir + "/manifest.json") + " --threads 2 --out " +
-                       q(dir + "/check"));
+  const Result c =
+      run("check " + q(kSmall) + " --against " + q(dir + "/manifest.json") + " --threads 2 --out " + q(dir + "/check"));
   INFO(c.out);
   CHECK(c.code == 0);
   CHECK(c.out.find("OK, 20 frames match") != std::string::npos);
@@ -112,9 +112,12 @@ TEST_CASE("the timeline applies each event at its frame, before that frame is re
   // 60 fps: t = 0.25 s is frame 15. Gravity changes the state only from the step after it;
   // a drop is part of the frame it is applied at.
   const std::string plain = freshDir("timeline_plain");
-  const std::string gravity = sceneWithEvents("timeline_gravity", R"([ { "t": 0.25, "type": "gravity", "gravity": [4, -9.81] } ])");
-  const std::string drop = sceneWithEvents("timeline_drop", R"([ { "frame": 10, "type": "drop", "center": [3, 2], "radius": 0.2 } ])");
-  const std::string outG = fs::path(gravity).parent_path().string() + "/out", outD = fs::path(drop).parent_path().string() + "/out";
+  const std::string gravity =
+      sceneWithEvents("timeline_gravity", R"([ { "t": 0.25, "type": "gravity", "gravity": [4, -9.81] } ])");
+  const std::string drop =
+      sceneWithEvents("timeline_drop", R"([ { "frame": 10, "type": "drop", "center": [3, 2], "radius": 0.2 } ])");
+  const std::string outG = fs::path(gravity).parent_path().string() + "/out",
+                    outD = fs::path(drop).parent_path().string() + "/out";
   const std::string common = " --frames 20 --threads 2 --quiet --out ";
   Result r = run("run " + q(kSmall) + common + q(plain));
   REQUIRE(r.code == 0);
@@ -131,10 +134,14 @@ TEST_CASE("the timeline applies each event at its frame, before that frame is re
   REQUIRE(d.size() == 20);
   for (int f = 0; f < 20; ++f) {
     CAPTURE(f);
-    if (f <= 15) CHECK(g[f] == p[f]);  // through frame 15: gravity has not acted yet
-    else CHECK(g[f] != p[f]);
-    if (f < 10) CHECK(d[f] == p[f]);
-    else CHECK(d[f] != p[f]);  // the drop is in frame 10 already
+    if (f <= 15)
+      CHECK(g[f] == p[f]);  // through frame 15: gravity has not acted yet
+    else
+      CHECK(g[f] != p[f]);
+    if (f < 10)
+      CHECK(d[f] == p[f]);
+    else
+      CHECK(d[f] != p[f]);  // the drop is in frame 10 already
   }
   const json m = readManifest(outG);
   REQUIRE(m.at("events").size() == 1);
@@ -218,13 +225,15 @@ TEST_CASE("--input - is held to the caps of live input: a block over the per-eve
   CHECK(r.out.find("--max-event-particles N") != std::string::npos);
 }
 
-TEST_CASE("--record: a write error stops the run with exit 1 naming the file, and an --input file is never the record") {
+TEST_CASE(
+    "--record: a write error stops the run with exit 1 naming the file, and an --input file is never the record") {
   // Before (issue 18): --record on a full disk wrote 0 bytes, exited 0 and the summary said the
   // events were recorded; --input F --record F truncated F.
   const std::string dir = freshDir("record_errors");
   const std::string events = dir + "/events.jsonl";
-  const std::string text = "{\"frame\": 1, \"type\": \"drop\", \"center\": [2, 2], \"radius\": 0.1}\n"
-                           "{\"frame\": 2, \"type\": \"gravity\", \"tilt\": 0.2}\n";
+  const std::string text =
+      "{\"frame\": 1, \"type\": \"drop\", \"center\": [2, 2], \"radius\": 0.1}\n"
+      "{\"frame\": 2, \"type\": \"gravity\", \"tilt\": 0.2}\n";
   std::ofstream(events) << text;
   if (fs::exists("/dev/full")) {
     const Result r = run("run " + q(kSmall) + " --frames 4 --no-images --input " + q(events) + " --record /dev/full");
@@ -252,7 +261,8 @@ TEST_CASE("a live input line over 1 MiB is skipped with a warning naming its lin
   const Result r = run("run " + q(kSmall) + " --frames 30 --realtime --no-images --input -", feed);
   INFO(r.out);
   CHECK(r.code == 0);
-  CHECK(r.out.find("warning: stdin:1: a line of 3000000 bytes, more than the 1048576 an event line may hold, was skipped") !=
+  CHECK(r.out.find(
+            "warning: stdin:1: a line of 3000000 bytes, more than the 1048576 an event line may hold, was skipped") !=
         std::string::npos);
   CHECK(r.out.find("drop at (2, 2), radius 0.15 m (stdin:2)") != std::string::npos);
   CHECK(r.out.find("1 event applied, 1 warning") != std::string::npos);
@@ -267,7 +277,8 @@ TEST_CASE("bad input sources and timeline events exit 2 with a message") {
   CHECK(r.out.find("--input - may be given once") != std::string::npos);
   r = run("run " + q(kSmall) + " --frames 2 --no-images --record /nonexistent/dir/run.jsonl");
   CHECK(r.code == 2);
-  const std::string bad = sceneWithEvents("timeline_bad", R"([ { "t": 1, "type": "emitter", "index": 0, "enabled": true } ])");
+  const std::string bad =
+      sceneWithEvents("timeline_bad", R"([ { "t": 1, "type": "emitter", "index": 0, "enabled": true } ])");
   r = run("run " + q(bad) + " --frames 2 --no-images");
   CHECK(r.code == 2);
   CHECK(r.out.find(bad + ":17:25: key 'events[0].type': the scene has no emitters") != std::string::npos);

@@ -29,7 +29,6 @@ const std::string kSmall = asset("scenes/tests/small_dam_break.json");
 
 json readManifest(const std::string& dir) { return json::parse(readText(dir + "/manifest.json")); }
 
-
 /// The rows of a bodies_NNNNN.csv (body, x, y, angle, vx, vy, omega), after its comment and header.
 std::vector<std::vector<double>> bodyRows(const std::string& path) {
   std::vector<std::vector<double>> out;
@@ -52,8 +51,9 @@ std::vector<std::vector<double>> bodyRows(const std::string& path) {
 
 TEST_CASE("--export csv writes bodies_NNNNN.csv with each kinematic body's pose and velocity, in scene order") {
   const std::string dir = freshDir("export_bodies");
-  REQUIRE(run("run " + q(asset("scenes/tests/kinematic_paddle.json")) + " --frames 31 --every 30 --quiet --export csv --out " +
-              q(dir)).code == 0);
+  REQUIRE(run("run " + q(asset("scenes/tests/kinematic_paddle.json")) +
+              " --frames 31 --every 30 --quiet --export csv --out " + q(dir))
+              .code == 0);
   CHECK(filesEnding(dir, ".csv") ==
         std::vector<std::string>{"bodies_00000.csv", "bodies_00030.csv", "frame_00000.csv", "frame_00030.csv"});
   // body, x, y, angle, vx, vy, omega per row; boundaries[1] the paddle, boundaries[2] the turning arm.
@@ -73,7 +73,8 @@ TEST_CASE("--export csv writes the dynamic crates of floating_crates.json too, e
   // so it matches the origin's move over the frame (Box2D moves a body by its new velocity:
   // x(n+1) = x(n) + dt v(n+1), the rotation's part included up to its second order).
   const std::string dir = freshDir("export_crates");
-  REQUIRE(run("run " + q(asset("scenes/floating_crates.json")) + " --frames 40 --quiet --export csv --out " + q(dir)).code == 0);
+  REQUIRE(run("run " + q(asset("scenes/floating_crates.json")) + " --frames 40 --quiet --export csv --out " + q(dir))
+              .code == 0);
   const auto a = bodyRows(dir + "/bodies_00038.csv"), b = bodyRows(dir + "/bodies_00039.csv");
   REQUIRE(a.size() == 5);  // the turning bar and four crates, boundaries[1..5]
   REQUIRE(b.size() == 5);
@@ -175,15 +176,16 @@ TEST_CASE("--png-level changes the file size, never the pixels, and bad render f
 TEST_CASE("sph2d render redraws an exported CSV frame bit-identically to the run's frame") {
   const std::string dir = freshDir("rerender");
   REQUIRE(run("run " + q(kSmall) + " --frames 11 --every 10 --quiet --export csv --out " + q(dir)).code == 0);
-  const Result r = run("render " + q(kSmall) + " --particles " + q(dir + "/frame_00010.csv") + " --out " +
-                       q(dir + "/again.png"));
+  const Result r =
+      run("render " + q(kSmall) + " --particles " + q(dir + "/frame_00010.csv") + " --out " + q(dir + "/again.png"));
   INFO(r.out);
   REQUIRE(r.code == 0);
   CHECK(r.out.find("1250 particles of frame 10") != std::string::npos);
   CHECK(pngHash(dir + "/again.png") == readManifest(dir)["frames"][1]["rgba_xxh64"].get<std::string>());
   // Another mode from the same file: a different image of the same size.
   REQUIRE(run("render " + q(kSmall) + " --particles " + q(dir + "/frame_00010.csv") + " --out " +
-              q(dir + "/discs.png") + " --mode particles --color-by density").code == 0);
+              q(dir + "/discs.png") + " --mode particles --color-by density")
+              .code == 0);
   CHECK(pngHash(dir + "/discs.png") != pngHash(dir + "/again.png"));
 }
 
@@ -203,7 +205,8 @@ TEST_CASE("sph2d render refuses a CSV with a NaN or infinite value, naming the l
     const char* value;
     const char* name;
   };
-  for (const Bad b : {Bad{1, "nan", "x"}, Bad{2, "inf", "y"}, Bad{4, "-inf", "vy"}, Bad{1, "1e999", "x"}, Bad{4, "1e300", "vy"}}) {
+  for (const Bad b :
+       {Bad{1, "nan", "x"}, Bad{2, "inf", "y"}, Bad{4, "-inf", "vy"}, Bad{1, "1e999", "x"}, Bad{4, "1e300", "vy"}}) {
     std::string t = text;
     std::size_t at = lineStart(4);
     for (int c = 0; c < b.column; ++c) at = t.find(',', at) + 1;
@@ -219,7 +222,8 @@ TEST_CASE("sph2d render refuses a CSV with a NaN or infinite value, naming the l
   }
 }
 
-TEST_CASE("an image written to a device is written in place: /dev/full says No space left on device and stays a device") {
+TEST_CASE(
+    "an image written to a device is written in place: /dev/full says No space left on device and stays a device") {
   // Before: the atomic writer renamed its temporary file over the target, so as root
   // `--out /dev/full` replaced the device node with a PNG file and reported success.
   if (!fs::exists("/dev/full") || !fs::is_character_file("/dev/full")) return;

@@ -28,10 +28,14 @@ std::map<std::string, std::string> snapshot(const std::string& dir) {
   std::map<std::string, std::string> s;
   for (const auto& e : fs::directory_iterator(dir)) {
     const std::string name = e.path().filename().string();
-    if (e.is_symlink()) s[name] = "-> " + fs::read_symlink(e.path()).string();
-    else if (name == ".sph2d.lock") s[name] = "<lock>";  // sph2d's own: the pid of whichever run held it last
-    else if (e.is_directory()) s[name] = "<dir>";
-    else s[name] = readText(e.path().string());
+    if (e.is_symlink())
+      s[name] = "-> " + fs::read_symlink(e.path()).string();
+    else if (name == ".sph2d.lock")
+      s[name] = "<lock>";  // sph2d's own: the pid of whichever run held it last
+    else if (e.is_directory())
+      s[name] = "<dir>";
+    else
+      s[name] = readText(e.path().string());
   }
   return s;
 }
@@ -56,7 +60,8 @@ bool has(const std::string& text, const std::string& part) { return text.find(pa
 
 }  // namespace
 
-TEST_CASE("output folder: run refuses frame and manifest files it did not write, exit 2 naming the first, and changes nothing") {
+TEST_CASE(
+    "output folder: run refuses frame and manifest files it did not write, exit 2 naming the first, and changes nothing") {
   // Before: into this folder a 3-frame run exited 0, deleted frame_00005.png and overwrote manifest.json.
   const std::string dir = freshDir("of_foreign");
   write(dir + "/frame_00005.png", "someone's picture, not a PNG sph2d wrote\n");
@@ -67,8 +72,9 @@ TEST_CASE("output folder: run refuses frame and manifest files it did not write,
   Result r = run("run " + q(kSmall) + " --frames 3 --quiet --out " + q(dir));
   INFO(r.out);
   CHECK(r.code == 2);
-  CHECK(has(r.out, "the output directory '" + dir + "' holds frame_00005.png, which sph2d cannot prove it wrote (no "
-                   "manifest.json or journal of an earlier sph2d run there lists it)"));
+  CHECK(has(r.out, "the output directory '" + dir +
+                       "' holds frame_00005.png, which sph2d cannot prove it wrote (no "
+                       "manifest.json or journal of an earlier sph2d run there lists it)"));
   CHECK(has(r.out, "choose another --out, or move or remove " + dir + "/frame_00005.png yourself"));
   CHECK(has(r.out, "also in the way: 1 file (manifest.json)"));
   CHECK(snapshot(dir) == before);
@@ -96,14 +102,16 @@ TEST_CASE("output folder: run refuses frame and manifest files it did not write,
   r = run("run " + q(kSmall) + " --frames 3 --quiet --out " + q(link));
   INFO(r.out);
   CHECK(r.code == 0);
-  CHECK(filesEnding(dir, ".png") == std::vector<std::string>{"frame_00000.png", "frame_00001.png", "frame_00002.png", "holiday.png"});
+  CHECK(filesEnding(dir, ".png") ==
+        std::vector<std::string>{"frame_00000.png", "frame_00001.png", "frame_00002.png", "holiday.png"});
   CHECK(readText(dir + "/holiday.png") == "holiday photo");
   CHECK(readText(dir + "/notes.txt") == "notes");
   CHECK_FALSE(has(r.out, "removed"));
   fs::remove(link);
 }
 
-TEST_CASE("output folder: a rerun removes only what the earlier run's manifest lists with matching hashes, and says so") {
+TEST_CASE(
+    "output folder: a rerun removes only what the earlier run's manifest lists with matching hashes, and says so") {
   const std::string dir = freshDir("of_rerun");
   Result r = run("run " + q(kSmall) + " --frames 6 --quiet --export csv --out " + q(dir));
   REQUIRE(r.code == 0);
@@ -124,9 +132,12 @@ TEST_CASE("output folder: a rerun removes only what the earlier run's manifest l
   r = run("run " + q(kSmall) + " --frames 3 --quiet --out " + q(dir));
   INFO(r.out);
   CHECK(r.code == 0);
-  CHECK(has(r.out, "sph2d: removed 13 files (frame_00000.csv, frame_00000.png, frame_00001.csv, ...) that an earlier sph2d "
-                   "run wrote in " + dir));
-  CHECK(filesEnding(dir, ".png") == std::vector<std::string>{"frame_00000.png", "frame_00001.png", "frame_00002.png", "holiday.png"});
+  CHECK(has(r.out,
+            "sph2d: removed 13 files (frame_00000.csv, frame_00000.png, frame_00001.csv, ...) that an earlier sph2d "
+            "run wrote in " +
+                dir));
+  CHECK(filesEnding(dir, ".png") ==
+        std::vector<std::string>{"frame_00000.png", "frame_00001.png", "frame_00002.png", "holiday.png"});
   CHECK(filesEnding(dir, ".csv").empty());
   CHECK(readText(dir + "/holiday.png") == "holiday photo");
 
@@ -136,8 +147,9 @@ TEST_CASE("output folder: a rerun removes only what the earlier run's manifest l
   r = run("run " + q(kSmall) + " --frames 2 --quiet --out " + q(dir));
   INFO(r.out);
   CHECK(r.code == 2);
-  CHECK(has(r.out, "holds frame_00001.png, which sph2d cannot prove it wrote (it changed since sph2d wrote it (its XXH64 is " +
-                   fileXxh64(dir + "/frame_00001.png")));
+  CHECK(has(r.out,
+            "holds frame_00001.png, which sph2d cannot prove it wrote (it changed since sph2d wrote it (its XXH64 is " +
+                fileXxh64(dir + "/frame_00001.png")));
   CHECK(snapshot(dir) == before);
 }
 
@@ -150,7 +162,9 @@ TEST_CASE("output folder: symbolic links are never written through: a frame or l
   Result r = run("run " + q(kSmall) + " --frames 3 --quiet --out " + q(dir));
   INFO(r.out);
   CHECK(r.code == 2);
-  CHECK(has(r.out, "holds frame_00001.png, which sph2d cannot prove it wrote (a symbolic link: sph2d never writes through one)"));
+  CHECK(has(
+      r.out,
+      "holds frame_00001.png, which sph2d cannot prove it wrote (a symbolic link: sph2d never writes through one)"));
   CHECK(fs::is_symlink(dir + "/frame_00001.png"));
   CHECK(readText(elsewhere + "/victim.png") == "precious");
   CHECK_FALSE(fs::exists(dir + "/frame_00000.png"));
@@ -166,21 +180,24 @@ TEST_CASE("output folder: symbolic links are never written through: a frame or l
   CHECK(fs::is_symlink(dir + "/.sph2d.lock"));
 }
 
-TEST_CASE("output folder: --record and --video replace no file sph2d did not write, and in the run's folder its own are replaced") {
+TEST_CASE(
+    "output folder: --record and --video replace no file sph2d did not write, and in the run's folder its own are replaced") {
   const std::string dir = freshDir("of_record"), elsewhere = freshDir("of_record_elsewhere");
   // Outside any output folder, an existing record file has no record that could vouch for it.
   write(elsewhere + "/mine.jsonl", "my own notes\n");
   Result r = run("run " + q(kSmall) + " --frames 2 --no-images --record " + q(elsewhere + "/mine.jsonl"));
   INFO(r.out);
   CHECK(r.code == 2);
-  CHECK(has(r.out, "--record " + elsewhere + "/mine.jsonl: the file exists, and sph2d never overwrites a file it cannot prove it wrote"));
+  CHECK(has(r.out, "--record " + elsewhere +
+                       "/mine.jsonl: the file exists, and sph2d never overwrites a file it cannot prove it wrote"));
   CHECK(readText(elsewhere + "/mine.jsonl") == "my own notes\n");
 
   // In the run's folder: the manifest lists the record with its hash, and a rerun replaces it.
   const std::string events = elsewhere + "/events.jsonl";
   write(events, "{\"frame\": 1, \"type\": \"drop\", \"center\": [2, 2.5], \"radius\": 0.15}\n");
   for (int k = 0; k < 2; ++k) {
-    r = run("run " + q(kSmall) + " --frames 3 --quiet --input " + q(events) + " --record " + q(dir + "/run.jsonl") + " --out " + q(dir));
+    r = run("run " + q(kSmall) + " --frames 3 --quiet --input " + q(events) + " --record " + q(dir + "/run.jsonl") +
+            " --out " + q(dir));
     INFO(k, r.out);
     CHECK(r.code == 0);
     CHECK(listedFiles(manifestOf(dir)).at("run.jsonl") == fileXxh64(dir + "/run.jsonl"));
@@ -254,19 +271,24 @@ TEST_CASE("output folder: sph2d check --out replaces only the images an earlier 
   r = run("check " + q(kSmall) + " --against " + q(ref + "/manifest.json") + " --out " + q(ref));
   INFO(r.out);
   CHECK(r.code == 2);
-  CHECK(has(r.out, "holds .sph2d.journal, which sph2d cannot prove it wrote (it is the journal of `sph2d run`, not of `sph2d check`"));
+  CHECK(has(
+      r.out,
+      "holds .sph2d.journal, which sph2d cannot prove it wrote (it is the journal of `sph2d run`, not of `sph2d check`"));
   CHECK(snapshot(ref) == refBefore);
 }
 
 TEST_CASE("output folder: bench accuracy --out replaces only the files an earlier bench accuracy wrote") {
   const std::string dir = freshDir("of_accuracy"), in = freshDir("of_accuracy_in");
   write(in + "/runs.csv", readText(std::string(SPH2D_SOURCE_DIR) + "/docs/accuracy/accuracy.csv"));
-  const std::string args = "bench accuracy --from-csv " + q(in + "/runs.csv") + " --assets " + q(SPH2D_ASSETS) + " --out " + q(dir);
+  const std::string args =
+      "bench accuracy --from-csv " + q(in + "/runs.csv") + " --assets " + q(SPH2D_ASSETS) + " --out " + q(dir);
   write(dir + "/accuracy.md", "my own table");
   Result r = run(args);
   INFO(r.out);
   CHECK(r.code == 2);
-  CHECK(has(r.out, "holds accuracy.md, which sph2d cannot prove it wrote (no journal of an earlier sph2d bench accuracy there lists it)"));
+  CHECK(has(
+      r.out,
+      "holds accuracy.md, which sph2d cannot prove it wrote (no journal of an earlier sph2d bench accuracy there lists it)"));
   CHECK(readText(dir + "/accuracy.md") == "my own table");
   CHECK_FALSE(fs::exists(dir + "/accuracy.csv"));
   fs::remove(dir + "/accuracy.md");
@@ -279,9 +301,12 @@ TEST_CASE("output folder: bench accuracy --out replaces only the files an earlie
     CHECK(r.code == 0);
     const std::string csv = readText(dir + "/accuracy.csv");
     CHECK(std::count(csv.begin(), csv.end(), '\n') == std::count(legacy.begin(), legacy.end(), '\n'));
-    CHECK(has(csv, "\nhydrostatic-muller2003-800-cfl1,hydrostatic,muller2003,,800,0.25,pressure_profile_max_rel,0.21387,"));
-    if (k == 0) first = csv;
-    else CHECK(csv == first);
+    CHECK(has(csv,
+              "\nhydrostatic-muller2003-800-cfl1,hydrostatic,muller2003,,800,0.25,pressure_profile_max_rel,0.21387,"));
+    if (k == 0)
+      first = csv;
+    else
+      CHECK(csv == first);
   }
 }
 

@@ -237,8 +237,7 @@ TEST_CASE("frames are bit-identical across runs and across 1 and 2 simulation th
   CHECK(frameHashes(ma).size() == 4);
   CHECK(frameHashes(ma) == frameHashes(mb));
   CHECK(frameHashes(ma) == frameHashes(mc));
-  for (std::size_t k = 0; k < 4; ++k)
-    CHECK(ma["frames"][k]["state_hash"] == mc["frames"][k]["state_hash"]);
+  for (std::size_t k = 0; k < 4; ++k) CHECK(ma["frames"][k]["state_hash"] == mc["frames"][k]["state_hash"]);
   // The frames move: the 4 hashes are all different.
   auto h = frameHashes(ma);
   std::sort(h.begin(), h.end());
@@ -324,8 +323,9 @@ TEST_CASE("sph2d check checks both hashes of every frame, the frame list against
     const Result r = check(m);
     INFO(r.out);
     CHECK(r.code == 1);
-    CHECK(r.out.find("FAILED: the manifest says the run is complete, but it lists 2 of the run's 3 kept frames (the first "
-                     "missing: frame 2)") != std::string::npos);
+    CHECK(r.out.find(
+              "FAILED: the manifest says the run is complete, but it lists 2 of the run's 3 kept frames (the first "
+              "missing: frame 2)") != std::string::npos);
   }
   {
     json m = good;
@@ -369,7 +369,8 @@ TEST_CASE("sph2d check checks both hashes of every frame, the frame list against
   }
 }
 
-TEST_CASE("sph2d check never takes a variable from a manifest that sph2d does not record, and adopts its own only with --adopt-env") {
+TEST_CASE(
+    "sph2d check never takes a variable from a manifest that sph2d does not record, and adopts its own only with --adopt-env") {
   // Before (issue 18): every entry was set with setenv; GALLIUM_TRACE=victim.txt overwrote
   // that file with Mesa trace XML and check hung; LD_PRELOAD and the like were adopted.
   const std::string dir = freshDir("check_env"), out = freshDir("check_env_out");
@@ -391,14 +392,17 @@ TEST_CASE("sph2d check never takes a variable from a manifest that sph2d does no
     CHECK(r.out.find("OK, 2 frames match") != std::string::npos);
     CHECK(readText(victim) == "keep me\n");
     CHECK_FALSE(fs::exists(dir + "/owned"));
-    CHECK(r.out.find("entry GALLIUM_TRACE is ignored: sph2d records only its renderer's settings") != std::string::npos);
+    CHECK(r.out.find("entry GALLIUM_TRACE is ignored: sph2d records only its renderer's settings") !=
+          std::string::npos);
     CHECK(r.out.find("entry LD_PRELOAD is ignored") != std::string::npos);
     CHECK(r.out.find("entry LP_DEBUG is ignored: its value is not a plain setting") != std::string::npos);
     CHECK(r.out.find("entry (malformed) is ignored") != std::string::npos);
     // A setting sph2d records, with a plain value: compared and named; used only with the flag.
     if (flag.empty()) {
-      CHECK(r.out.find("LP_PERF is \"\" here but was \"no_mipmap\" for the manifest (--adopt-env uses the manifest's value)") !=
-            std::string::npos);
+      CHECK(
+          r.out.find(
+              "LP_PERF is \"\" here but was \"no_mipmap\" for the manifest (--adopt-env uses the manifest's value)") !=
+          std::string::npos);
       CHECK(r.out.find("note: using LP_PERF") == std::string::npos);
     } else {
       CHECK(r.out.find("note: using LP_PERF=no_mipmap as the manifest's run did (--adopt-env)") != std::string::npos);

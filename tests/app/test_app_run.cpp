@@ -21,8 +21,8 @@ using namespace sph2d::apptest;
 TEST_CASE("sph2d run writes the expected number of PNG frames, of the scene's size, not blank") {
   const std::string dir = std::string(SPH2D_TEST_TMP) + "/run_small";
   fs::remove_all(dir);
-  const Result r = run("run \"" + asset("scenes/tests/small_dam_break.json") + "\" --frames 12 --threads 2 --out \"" + dir +
-                       "\" --state-hash");
+  const Result r = run("run \"" + asset("scenes/tests/small_dam_break.json") + "\" --frames 12 --threads 2 --out \"" +
+                       dir + "\" --state-hash");
   INFO(r.out);
   REQUIRE(r.code == 0);
   CHECK(r.out.find("sph2d: 12 frames") != std::string::npos);
@@ -46,7 +46,8 @@ TEST_CASE("sph2d run writes the expected number of PNG frames, of the scene's si
       colours.insert(std::uint32_t(rgba[p]) << 16 | std::uint32_t(rgba[p + 1]) << 8 | rgba[p + 2]);
     }
     const double waterShare = double(blue) / double(w * h);
-    MESSAGE("frame " << f << ": water covers " << 100 * waterShare << " % of the image, " << colours.size() << " colours");
+    MESSAGE("frame " << f << ": water covers " << 100 * waterShare << " % of the image, " << colours.size()
+                     << " colours");
     CHECK(waterShare > 0.03);
     CHECK(waterShare < 0.5);
     CHECK(colours.size() > 20);

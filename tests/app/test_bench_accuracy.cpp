@@ -22,9 +22,10 @@ TEST_CASE("bench accuracy --quick writes the CSV, the table and the charts, with
   std::istringstream in(csv);
   std::string header;
   std::getline(in, header);
-  CHECK(header ==
-        "run_id,case,solver,floor,particles,cfl,error_name,error,error2_name,error2,mean_density_error,max_density_error,"
-        "wall_s_per_sim_s,ms_per_step,status,build,settings,solver_params");
+  CHECK(
+      header ==
+      "run_id,case,solver,floor,particles,cfl,error_name,error,error2_name,error2,mean_density_error,max_density_error,"
+      "wall_s_per_sim_s,ms_per_step,status,build,settings,solver_params");
   std::set<std::string> cases, solvers;
   std::string line;
   int rows = 0;
@@ -42,7 +43,8 @@ TEST_CASE("bench accuracy --quick writes the CSV, the table and the charts, with
     const double err = std::stod(f[7]);
     CHECK(std::isfinite(err));
     CHECK(err >= 0);
-    if (f[1] == "dam_break") CHECK(err < 1.0);  // the surge front within one column width (RMS of Z) at the coarse resolution
+    if (f[1] == "dam_break")
+      CHECK(err < 1.0);  // the surge front within one column width (RMS of Z) at the coarse resolution
     if (f[1] == "poiseuille") CHECK(err < 0.1);  // u/u_c against the series: every solver within 10 % RMS, even coarse
     // The settings that made it, and the solver's parameters.
     CHECK(!f[15].empty());

@@ -48,8 +48,8 @@ TEST_CASE("bench effects with a tiny dam break writes the CSV with one row per c
     if (f[0] == "viscosity") CHECK(std::stod(f[9]) != 0.0);
   }
   CHECK(r.out.find("runs inside the solver stage pressure_force+viscosity") != std::string::npos);
-  CHECK(names == std::vector<std::string>{"none", "none_again", "viscosity", "xsph", "force_field", "csf", "akinci", "lifetime",
-                                           "sink", "user_force", "all"});
+  CHECK(names == std::vector<std::string>{"none", "none_again", "viscosity", "xsph", "force_field", "csf", "akinci",
+                                          "lifetime", "sink", "user_force", "all"});
 }
 
 TEST_CASE("bench effects --effects runs only the listed configurations and none, and refuses an unknown one") {

@@ -24,7 +24,8 @@ std::vector<std::vector<std::string>> rows(const std::string& csv, std::string& 
 }
 }  // namespace
 
-TEST_CASE("bench game writes one row per preset and thread count, fractions in range, the same physics on 1 and 2 threads") {
+TEST_CASE(
+    "bench game writes one row per preset and thread count, fractions in range, the same physics on 1 and 2 threads") {
   const std::string dir = freshDir("bench_game");
   const std::string csvPath = dir + "/game.csv";
   const Result r = run("bench game --particles 600 --seconds 0.25 --presets game,accurate --threads 1,2 --assets " +
@@ -43,17 +44,17 @@ TEST_CASE("bench game writes one row per preset and thread count, fractions in r
     CHECK(f[0] == f[1].substr(6) + "-600-t" + f[4]);  // the run id: preset-particles-tthreads
     CHECK(f[2] == "scene");
     CHECK(std::stoul(f[3]) > 400);
-    CHECK(std::stod(f[5]) > 0);             // wall seconds per simulated second: measured
-    CHECK(std::stod(f[7]) >= 1);            // at least one substep a frame
+    CHECK(std::stod(f[5]) > 0);   // wall seconds per simulated second: measured
+    CHECK(std::stod(f[7]) >= 1);  // at least one substep a frame
     const double mean = std::stod(f[9]), mx = std::stod(f[10]);
     CHECK(mean >= 0);
-    CHECK(mean < 0.05);                     // a fraction, not percent
+    CHECK(mean < 0.05);  // a fraction, not percent
     CHECK(mx >= mean);
     CHECK(mx < 0.5);
-    CHECK(std::stod(f[11]) >= 0);           // energy gain: a fraction of the initial energy
+    CHECK(std::stod(f[11]) >= 0);            // energy gain: a fraction of the initial energy
     CHECK(std::isfinite(std::stod(f[12])));  // surge RMS against Martin & Moyce
-    CHECK(std::stod(f[13]) == 0);           // nothing outside the tank
-    CHECK(!f[16].empty());                  // the build's commit
+    CHECK(std::stod(f[13]) == 0);            // nothing outside the tank
+    CHECK(!f[16].empty());                   // the build's commit
     CHECK(f[17].find("seconds=0.25;") == 0);
   }
   // Rows come per preset, thread counts in order: the physics columns agree.
@@ -62,7 +63,8 @@ TEST_CASE("bench game writes one row per preset and thread count, fractions in r
 }
 
 TEST_CASE("bench game refuses a peer that is not an executable, and less than one frame") {
-  const Result p = run("bench game --particles 600 --seconds 0.25 --presets game --threads 1 --peer /nonexistent/lf_dam_break");
+  const Result p =
+      run("bench game --particles 600 --seconds 0.25 --presets game --threads 1 --peer /nonexistent/lf_dam_break");
   CHECK(p.code == 2);
   CHECK(p.out.find("--peer /nonexistent/lf_dam_break") != std::string::npos);
   // `--peer` alone looks for the harness this build tree builds; without -DSPH2D_PEER_LIQUIDFUN=ON

@@ -132,7 +132,8 @@ TEST_CASE("bench accuracy --only: an id the sweep lacks exits 2 saying how to li
   CHECK(other.code == 2);
   CHECK(run("bench accuracy --only dam_break-game-1250-cfl1 --solvers game --quick" + assets).code == 2);
 
-  const Result good = run("bench accuracy --quick --threads 1 --only dam_break-game-1250-cfl1 --out " + q(dir + "/good") + assets);
+  const Result good =
+      run("bench accuracy --quick --threads 1 --only dam_break-game-1250-cfl1 --out " + q(dir + "/good") + assets);
   INFO(good.out);
   REQUIRE(good.code == 0);
   const Table t = readTable(dir + "/good/accuracy.csv");
@@ -144,8 +145,11 @@ TEST_CASE("bench accuracy --only: an id the sweep lacks exits 2 saying how to li
 TEST_CASE("bench accuracy --merge refuses rows of different builds or settings unless --allow-mixed, and a run twice") {
   const std::string dir = freshDir("sweep_mixed");
   const std::string assets = " --assets " + q(std::string(SPH2D_ASSETS));
-  REQUIRE(run("bench accuracy --quick --threads 1 --only dam_break-game-1250-cfl1 --out " + q(dir + "/runs/a") + assets).code == 0);
-  REQUIRE(run("bench accuracy --quick --threads 2 --only hydrostatic-game-800-cfl1 --out " + q(dir + "/runs/b") + assets).code == 0);
+  REQUIRE(run("bench accuracy --quick --threads 1 --only dam_break-game-1250-cfl1 --out " + q(dir + "/runs/a") + assets)
+              .code == 0);
+  REQUIRE(
+      run("bench accuracy --quick --threads 2 --only hydrostatic-game-800-cfl1 --out " + q(dir + "/runs/b") + assets)
+          .code == 0);
   // Settings differ (threads): refused, naming both files and what differs.
   const Result mixed = run("bench accuracy --merge " + q(dir + "/runs") + " --out " + q(dir + "/merged"));
   CHECK(mixed.code == 2);
@@ -156,7 +160,8 @@ TEST_CASE("bench accuracy --merge refuses rows of different builds or settings u
   CHECK(mixed.out.find("--allow-mixed") != std::string::npos);
   CHECK(!std::filesystem::exists(dir + "/merged/accuracy.csv"));
   // With --allow-mixed: merged, each row keeps its settings, and the report names both kinds.
-  const Result allowed = run("bench accuracy --merge " + q(dir + "/runs") + " --allow-mixed --out " + q(dir + "/merged"));
+  const Result allowed =
+      run("bench accuracy --merge " + q(dir + "/runs") + " --allow-mixed --out " + q(dir + "/merged"));
   INFO(allowed.out);
   REQUIRE(allowed.code == 0);
   const Table m = readTable(dir + "/merged/accuracy.csv");
@@ -175,21 +180,21 @@ TEST_CASE("bench accuracy --merge refuses rows of different builds or settings u
   csv.replace(csv.find("dam_break-game-1250-cfl1"), 24, "dam_break-game-1250-cfl2");
   std::filesystem::create_directories(dir + "/c");
   { std::ofstream(dir + "/c/accuracy.csv") << csv; }
-  const Result builds = run("bench accuracy --from-csv " + q(dir + "/runs/a/accuracy.csv") + "," + q(dir + "/c/accuracy.csv") +
-                            " --out " + q(dir + "/merged2"));
+  const Result builds = run("bench accuracy --from-csv " + q(dir + "/runs/a/accuracy.csv") + "," +
+                            q(dir + "/c/accuracy.csv") + " --out " + q(dir + "/merged2"));
   CHECK(builds.code == 2);
   CHECK(builds.out.find("build " + build + " against 0123456789ab") != std::string::npos);
   // One run twice.
-  const Result twice = run("bench accuracy --from-csv " + q(dir + "/runs/a/accuracy.csv") + "," + q(dir + "/runs/a/accuracy.csv") +
-                           " --out " + q(dir + "/merged3"));
+  const Result twice = run("bench accuracy --from-csv " + q(dir + "/runs/a/accuracy.csv") + "," +
+                           q(dir + "/runs/a/accuracy.csv") + " --out " + q(dir + "/merged3"));
   CHECK(twice.code == 2);
   CHECK(twice.out.find("dam_break-game-1250-cfl1") != std::string::npos);
 }
 
 TEST_CASE("bench accuracy surge_long: one row per floor, both errors measured, each floor's settings in its row") {
   const std::string dir = freshDir("sweep_surge_long");
-  const Result r = run("bench accuracy --quick --threads 1 --cases surge_long --solvers game --out " + q(dir) + " --assets " +
-                       q(std::string(SPH2D_ASSETS)));
+  const Result r = run("bench accuracy --quick --threads 1 --cases surge_long --solvers game --out " + q(dir) +
+                       " --assets " + q(std::string(SPH2D_ASSETS)));
   INFO(r.out);
   REQUIRE(r.code == 0);
   const Table t = readTable(dir + "/accuracy.csv");
@@ -216,11 +221,13 @@ TEST_CASE("bench accuracy surge_long: one row per floor, both errors measured, e
   CHECK(std::filesystem::file_size(dir + "/surge_long.png") > 1000);
 }
 
-TEST_CASE("bench game: --list run by parallel -j2 and merged gives the one-process CSV, wall times apart, --only checks ids") {
+TEST_CASE(
+    "bench game: --list run by parallel -j2 and merged gives the one-process CSV, wall times apart, --only checks ids") {
   requireParallel();
   const std::string dir = freshDir("sweep_game");
-  const std::string sweep = "bench game --particles 600 --seconds 0.25 --presets game --threads 1,2 --floors scene,noslip --assets " +
-                            q(std::string(SPH2D_ASSETS));
+  const std::string sweep =
+      "bench game --particles 600 --seconds 0.25 --presets game --threads 1,2 --floors scene,noslip --assets " +
+      q(std::string(SPH2D_ASSETS));
   const Result one = run(sweep + " --out " + q(dir + "/one"));
   INFO(one.out);
   REQUIRE(one.code == 0);

@@ -16,7 +16,8 @@ using namespace sph2d::apptest;
 TEST_CASE("the example game runs, its crates float, and it writes non-blank frames") {
   const std::string dir = freshDir("example_game");
   const std::string log = dir + ".log";
-  const int status = std::system((std::string("\"") + SPH2D_EXAMPLE_GAME_EXE + "\" " + q(dir) + " 150 > " + q(log) + " 2>&1").c_str());
+  const int status =
+      std::system((std::string("\"") + SPH2D_EXAMPLE_GAME_EXE + "\" " + q(dir) + " 150 > " + q(log) + " 2>&1").c_str());
   const std::string out = readText(log);
   INFO(out);
   REQUIRE(status == 0);

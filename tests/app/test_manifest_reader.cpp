@@ -113,8 +113,9 @@ TEST_CASE("manifest reader: a huge run.frames is counted, not listed, and the fi
   m["run"]["frames"] = 100000000;
   ManifestView v = parseManifest(m.dump(), "m.json");
   REQUIRE(v.listProblems.size() == 1);
-  CHECK(v.listProblems[0] ==
-        "the manifest says the run is complete, but it lists 3 of the run's 100000000 kept frames (the first missing: frame 3)");
+  CHECK(
+      v.listProblems[0] ==
+      "the manifest says the run is complete, but it lists 3 of the run's 100000000 kept frames (the first missing: frame 3)");
   m["run"]["every"] = 2;
   m["run"]["frames"] = 9;
   m["frames"].erase(1);  // frames 0 and 2 of 0, 2, 4, 6, 8
@@ -133,10 +134,10 @@ TEST_CASE("manifest reader: a huge run.frames is counted, not listed, and the fi
 TEST_CASE("manifest reader: only the variables sph2d records, with plain values, pass the environment check") {
   json m = realManifest();
   m["environment"] = json::array({{{"name", "LD_PRELOAD"}, {"value", "/tmp/x.so"}},
-                                   {{"name", "GALLIUM_DRIVER"}, {"value", "llvmpipe"}},
-                                   {{"name", "LP_NUM_THREADS"}, {"value", "$(rm -rf ~)"}},
-                                   {{"name", "LP\x01X"}, {"value", "1"}},
-                                   {{"name", 5}}});
+                                  {{"name", "GALLIUM_DRIVER"}, {"value", "llvmpipe"}},
+                                  {{"name", "LP_NUM_THREADS"}, {"value", "$(rm -rf ~)"}},
+                                  {{"name", "LP\x01X"}, {"value", "1"}},
+                                  {{"name", 5}}});
   const std::vector<ManifestEnv> env = manifestEnvironment(parseManifest(m.dump(), "m.json").json);
   REQUIRE(env.size() == 5);
   CHECK(env[0].problem.find("records only its renderer's settings") != std::string::npos);

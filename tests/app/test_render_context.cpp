@@ -20,7 +20,8 @@
 using namespace sph2d;
 using namespace rctest;
 
-TEST_CASE("draw() into the game's framebuffer: every piece of GL state the game set is given back and the pixels are the OSMesa path's") {
+TEST_CASE(
+    "draw() into the game's framebuffer: every piece of GL state the game set is given back and the pixels are the OSMesa path's") {
   for (const std::string mode : {"liquid", "particles"}) {
     CAPTURE(mode);
     const SceneDef s = gameScene(mode);
@@ -100,8 +101,11 @@ TEST_CASE("draw() over a sub-viewport leaves every pixel outside it as the game 
     for (int y = 0; y < FH; ++y)
       for (int x = 0; x < FW; ++x) {
         const std::size_t p = (std::size_t(y) * FW + std::size_t(x)) * 4;
-        if (x >= X && x < X + VW && y >= Y && y < Y + VH) inside.insert(inside.end(), after.begin() + std::ptrdiff_t(p), after.begin() + std::ptrdiff_t(p + 4));
-        else outsideChanged += !std::equal(after.begin() + std::ptrdiff_t(p), after.begin() + std::ptrdiff_t(p + 4), gameDrawing.begin() + std::ptrdiff_t(p));
+        if (x >= X && x < X + VW && y >= Y && y < Y + VH)
+          inside.insert(inside.end(), after.begin() + std::ptrdiff_t(p), after.begin() + std::ptrdiff_t(p + 4));
+        else
+          outsideChanged += !std::equal(after.begin() + std::ptrdiff_t(p), after.begin() + std::ptrdiff_t(p + 4),
+                                        gameDrawing.begin() + std::ptrdiff_t(p));
       }
     CHECK(outsideChanged == 0);
     const double full = waterShare(reference), half = waterShare(inside);
@@ -118,7 +122,8 @@ TEST_CASE("draw() over a sub-viewport leaves every pixel outside it as the game 
   }
 }
 
-TEST_CASE("draw() into the default framebuffer (the game's window) at a viewport: the OSMesa path's pixels there and the window's own elsewhere") {
+TEST_CASE(
+    "draw() into the default framebuffer (the game's window) at a viewport: the OSMesa path's pixels there and the window's own elsewhere") {
   const SceneDef s = gameScene("particles", W, H);
   const RenderOptions o = optionsFor("particles");
   const auto world = steppedWorld(s, 12);
@@ -148,7 +153,8 @@ TEST_CASE("draw() into the default framebuffer (the game's window) at a viewport
   CHECK(std::count(gameDrawing.begin(), gameDrawing.end(), 0) == 0);  // the clear colour, not OSMesa's zeros
 }
 
-TEST_CASE("draw() frame after frame with a floating crate and a turning paddle, interleaved with the OSMesa path: the same pixels every frame") {
+TEST_CASE(
+    "draw() frame after frame with a floating crate and a turning paddle, interleaved with the OSMesa path: the same pixels every frame") {
   const SceneDef s = gameScene("liquid");
   auto world = steppedWorld(s, 2);
   Renderer own(s.render);  // the OSMesa path, alive beside the game's context
@@ -172,7 +178,8 @@ TEST_CASE("draw() frame after frame with a floating crate and a turning paddle, 
   CHECK(std::unique(hashes.begin(), hashes.end()) == hashes.end());  // the paddle turns: every frame differs
 }
 
-TEST_CASE("render() in the game's context reads back the OSMesa path's frame (overlay and colour bar included) and gives the state back") {
+TEST_CASE(
+    "render() in the game's context reads back the OSMesa path's frame (overlay and colour bar included) and gives the state back") {
   SceneDef s = gameScene("particles");
   RenderOptions o;  // colour by speed: a colour bar
   o.overlay = true;
@@ -191,7 +198,8 @@ TEST_CASE("render() in the game's context reads back the OSMesa path's frame (ov
   CHECK(renderer.lastTimings().readback > 0);
 }
 
-TEST_CASE("draw() in a compatibility-profile context: the game's alpha test, point sprites off, colour clamping, polygon stipple and pixel transfer change nothing and are given back") {
+TEST_CASE(
+    "draw() in a compatibility-profile context: the game's alpha test, point sprites off, colour clamping, polygon stipple and pixel transfer change nothing and are given back") {
   for (const std::string mode : {"liquid", "particles"}) {
     CAPTURE(mode);
     const SceneDef s = gameScene(mode);
@@ -263,7 +271,8 @@ TEST_CASE("the renderer on the game's context refuses bad use with a clear error
   glDeleteFramebuffers(1, &empty);
 }
 
-TEST_CASE("draw() into a framebuffer with two colour attachments writes the first and leaves the second as the game drew it") {
+TEST_CASE(
+    "draw() into a framebuffer with two colour attachments writes the first and leaves the second as the game drew it") {
   const SceneDef s = gameScene("liquid");
   const RenderOptions o = optionsFor("liquid");
   const auto world = steppedWorld(s, 12);
@@ -300,7 +309,8 @@ TEST_CASE("draw() into a framebuffer with two colour attachments writes the firs
   glDeleteTextures(1, &second);
 }
 
-TEST_CASE("another context current (an OSMesa renderer's) is refused by draw(), and destroying the game's renderer there leaves that context's objects alone") {
+TEST_CASE(
+    "another context current (an OSMesa renderer's) is refused by draw(), and destroying the game's renderer there leaves that context's objects alone") {
   const SceneDef s = gameScene("liquid");
   const auto world = steppedWorld(s, 6);
   GameContext game;
@@ -343,13 +353,16 @@ TEST_CASE("a context below OpenGL 3.3 is refused naming the version found") {
 }
 
 TEST_CASE("an OpenGL 3.3 core context without GL_ARB_copy_image gets the same pixels (background rows blitted)") {
-  const char* name = "an OpenGL 3.3 core context without GL_ARB_copy_image gets the same pixels (background rows blitted)";
+  const char* name =
+      "an OpenGL 3.3 core context without GL_ARB_copy_image gets the same pixels (background rows blitted)";
   const SceneDef s = gameScene("liquid");
   const auto world = steppedWorld(s, 12);
   if (!isChild()) {
     const std::vector<unsigned char> reference = osmesaFrame(*world, s, {});  // glCopyImageSubData here
-    const apptest::Result r = runChild(name, "MESA_GL_VERSION_OVERRIDE=3.3 MESA_EXTENSION_OVERRIDE=-GL_ARB_copy_image "
-                                             "SPH2D_EXPECT_RGBA_XXH64=" + hex64(xxh64(reference.data(), reference.size())));
+    const apptest::Result r = runChild(name,
+                                       "MESA_GL_VERSION_OVERRIDE=3.3 MESA_EXTENSION_OVERRIDE=-GL_ARB_copy_image "
+                                       "SPH2D_EXPECT_RGBA_XXH64=" +
+                                           hex64(xxh64(reference.data(), reference.size())));
     INFO(r.out);
     CHECK(r.code == 0);
     CHECK(r.out.find("child: 3.3 without GL_ARB_copy_image: same pixels") != std::string::npos);

@@ -55,9 +55,11 @@ std::uint64_t hashOf(const Frame& f) { return xxh64(f.rgba.data(), f.rgba.size()
 /// Pixels of `def`'s solid colour in the 5 × 7 box around world point (wx, wy) of frame f,
 /// seen through camera rectangle `cam` (Renderer::cameraRect: aspect-fitted).
 int solidAround(const Frame& f, const RenderDef& def, const std::vector<double>& cam, double wx, double wy) {
-  const std::array<std::uint8_t, 3> solid{std::uint8_t(std::lround(def.solid[0] * 255)), std::uint8_t(std::lround(def.solid[1] * 255)),
+  const std::array<std::uint8_t, 3> solid{std::uint8_t(std::lround(def.solid[0] * 255)),
+                                          std::uint8_t(std::lround(def.solid[1] * 255)),
                                           std::uint8_t(std::lround(def.solid[2] * 255))};
-  const int cx = int((wx - cam[0]) / (cam[2] - cam[0]) * f.width), cy = int((cam[3] - wy) / (cam[3] - cam[1]) * f.height);
+  const int cx = int((wx - cam[0]) / (cam[2] - cam[0]) * f.width),
+            cy = int((cam[3] - wy) / (cam[3] - cam[1]) * f.height);
   int n = 0;
   for (int y = cy - 3; y <= cy + 3; ++y)
     for (int x = cx - 2; x <= cx + 2; ++x) {
@@ -151,7 +153,8 @@ TEST_CASE("moving bodies are drawn where they are in each frame, with no trace w
   s.solver = solverDefaults("wcsph");
   s.solver.spacing = 0.04;
   BodyDef tank;
-  for (const auto& [c, h] : {std::pair<Vec2d, Vec2d>{{1, -0.1}, {1.2, 0.1}}, {{-0.1, 0.5}, {0.1, 0.7}}, {{2.1, 0.5}, {0.1, 0.7}}}) {
+  for (const auto& [c, h] :
+       {std::pair<Vec2d, Vec2d>{{1, -0.1}, {1.2, 0.1}}, {{-0.1, 0.5}, {0.1, 0.7}}, {{2.1, 0.5}, {0.1, 0.7}}}) {
     ShapeDef box;
     box.center = c;
     box.halfSize = h;
@@ -182,7 +185,9 @@ TEST_CASE("moving bodies are drawn where they are in each frame, with no trace w
   }
   const Frame& a = seq.render(world);
   const std::uint64_t sequential = hashOf(a);
-  auto solidAround = [&](const Frame& f, double wx, double wy) { return ::solidAround(f, s.render, seq.cameraRect(), wx, wy); };
+  auto solidAround = [&](const Frame& f, double wx, double wy) {
+    return ::solidAround(f, s.render, seq.cameraRect(), wx, wy);
+  };
   CHECK(solidAround(a, 0.9, 0.7) == 35);  // the paddle now (it moved 0.5 m)
   CHECK(solidAround(a, 0.4, 0.7) == 0);   // nothing left where it started
   Renderer fresh(s.render);
@@ -284,7 +289,7 @@ TEST_CASE("particles mode: the colour range is the field's min..max and the colo
   for (int y = 0; y < f.height; ++y)
     for (int x = f.width / 2; x < f.width; ++x) {
       const std::uint8_t* p = &f.rgba[(std::size_t(y) * std::size_t(f.width) + std::size_t(x)) * 4];
-      red = red || (p[0] == 128 && p[1] == 0 && p[2] == 0);  // colorRamp(1) = (0.5, 0, 0)
+      red = red || (p[0] == 128 && p[1] == 0 && p[2] == 0);    // colorRamp(1) = (0.5, 0, 0)
       blue = blue || (p[0] == 0 && p[1] == 0 && p[2] == 128);  // colorRamp(0) = (0, 0, 0.5)
     }
   CHECK(red);
@@ -301,7 +306,8 @@ TEST_CASE("particles mode: the colour range is the field's min..max and the colo
   CHECK(fixed.lastRange()[1] == 1000.0);
 }
 
-TEST_CASE("particles mode: color_by color draws each particle in its own colour, the rest in the fluid's, and no colour bar") {
+TEST_CASE(
+    "particles mode: color_by color draws each particle in its own colour, the rest in the fluid's, and no colour bar") {
   const SceneDef s = blockScene(240, 180, Vec2d(-0.1, -0.1), Vec2d(0.3, 0.3));
   World world(s, WorldOptions{1});
   // Left half of the block red, right half green, the top rows (y > 0.15) left uncoloured.
@@ -352,7 +358,8 @@ TEST_CASE("particles mode: color_by color draws each particle in its own colour,
   CHECK(ax < gx);
   // No colour bar: nothing on the ramp's dark-red end anywhere.
   bool barRed = false;
-  for (std::size_t k = 0; k + 3 < f.rgba.size(); k += 4) barRed = barRed || (f.rgba[k] == 128 && f.rgba[k + 1] == 0 && f.rgba[k + 2] == 0);
+  for (std::size_t k = 0; k + 3 < f.rgba.size(); k += 4)
+    barRed = barRed || (f.rgba[k] == 128 && f.rgba[k + 1] == 0 && f.rgba[k + 2] == 0);
   CHECK_FALSE(barRed);
   // Without any colour set, every particle is the fluid's colour.
   World plain(s, WorldOptions{1});

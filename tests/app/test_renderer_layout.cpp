@@ -24,9 +24,11 @@ std::uint64_t hashOf(const Frame& f) { return xxh64(f.rgba.data(), f.rgba.size()
 /// Pixels of `def`'s solid colour in the 5 × 7 box around world point (wx, wy) of frame f,
 /// seen through camera rectangle `cam` (Renderer::cameraRect: aspect-fitted).
 int solidAround(const Frame& f, const RenderDef& def, const std::vector<double>& cam, double wx, double wy) {
-  const std::array<std::uint8_t, 3> solid{std::uint8_t(std::lround(def.solid[0] * 255)), std::uint8_t(std::lround(def.solid[1] * 255)),
+  const std::array<std::uint8_t, 3> solid{std::uint8_t(std::lround(def.solid[0] * 255)),
+                                          std::uint8_t(std::lround(def.solid[1] * 255)),
                                           std::uint8_t(std::lround(def.solid[2] * 255))};
-  const int cx = int((wx - cam[0]) / (cam[2] - cam[0]) * f.width), cy = int((cam[3] - wy) / (cam[3] - cam[1]) * f.height);
+  const int cx = int((wx - cam[0]) / (cam[2] - cam[0]) * f.width),
+            cy = int((cam[3] - wy) / (cam[3] - cam[1]) * f.height);
   int n = 0;
   for (int y = cy - 3; y <= cy + 3; ++y)
     for (int x = cx - 2; x <= cx + 2; ++x) {
@@ -35,7 +37,6 @@ int solidAround(const Frame& f, const RenderDef& def, const std::vector<double>&
     }
   return n;
 }
-
 
 /// A pool 0.6 m deep from a wall at x = 0 to beyond the view's right edge, with a block 0.3 m
 /// high and 0.2 m wide standing on its surface at x = 0.8 .. 1.0 (a bump), as a square lattice
@@ -101,8 +102,8 @@ TEST_CASE("liquid depth shading has no vertical seams under a bump and does not 
         }
       }
   }
-  MESSAGE("largest step between neighbouring pixels inside the water: " << worst << " levels at x " << worstX
-                                                                          << ", y " << worstY);
+  MESSAGE("largest step between neighbouring pixels inside the water: " << worst << " levels at x " << worstX << ", y "
+                                                                        << worstY);
   CHECK(worst <= 3);
   // The shading is still there: deeper water is darker, and so is the water under the bump.
   const int yDeep = py(0.15), yShallow = py(0.55), xFar = px(1.6), xBump = px(0.9);
@@ -125,13 +126,15 @@ TEST_CASE("the colour bar goes where it covers no solid or fluid: the right midd
     f.width = 400;
     f.height = 300;
     f.rgba.assign(std::size_t(f.width) * std::size_t(f.height) * 4, 0);
-    for (std::size_t i = 0; i < f.rgba.size(); i += 4) f.rgba[i] = 14, f.rgba[i + 1] = 16, f.rgba[i + 2] = 22, f.rgba[i + 3] = 255;
+    for (std::size_t i = 0; i < f.rgba.size(); i += 4)
+      f.rgba[i] = 14, f.rgba[i + 1] = 16, f.rgba[i + 2] = 22, f.rgba[i + 3] = 255;
     return f;
   };
   auto paint = [](Frame& f, int x0, int y0, int x1, int y1, std::array<std::uint8_t, 3> c) {
     for (int y = y0; y < y1; ++y)
       for (int x = x0; x < x1; ++x)
-        for (int k = 0; k < 3; ++k) f.rgba[(std::size_t(y) * std::size_t(f.width) + std::size_t(x)) * 4 + std::size_t(k)] = c[std::size_t(k)];
+        for (int k = 0; k < 3; ++k)
+          f.rgba[(std::size_t(y) * std::size_t(f.width) + std::size_t(x)) * 4 + std::size_t(k)] = c[std::size_t(k)];
   };
   auto barOver = [](const Frame& f, int x0, int y0, int x1, int y1) {  // ramp-end pixels in the box
     int n = 0;
@@ -147,7 +150,7 @@ TEST_CASE("the colour bar goes where it covers no solid or fluid: the right midd
   Frame wall = frame();
   paint(wall, 270, 0, 400, 300, {138, 128, 112});
   const int x = drawColorBar(wall, 0, 1, "SPEED M/S", 1);
-  CHECK(x < 200);                          // moved to the left edge
+  CHECK(x < 200);  // moved to the left edge
   CHECK(barOver(wall, 270, 0, 400, 300) == 0);
   CHECK(barOver(wall, 0, 0, 270, 300) > 0);
   Frame both = frame();
@@ -194,7 +197,9 @@ TEST_CASE("static solids a game moves are drawn where they are: a teleported wal
     s.render.camera.max = Vec2d(2.2, 1.2);
     World world(s, level, WorldOptions{1});
     Renderer seq(s.render);
-    auto solidAround = [&](const Frame& f, double wx, double wy) { return ::solidAround(f, s.render, seq.cameraRect(), wx, wy); };
+    auto solidAround = [&](const Frame& f, double wx, double wy) {
+      return ::solidAround(f, s.render, seq.cameraRect(), wx, wy);
+    };
     auto sameAsFresh = [&](const Frame& f) {
       Renderer fresh(s.render);
       return hashOf(fresh.render(world)) == hashOf(f);

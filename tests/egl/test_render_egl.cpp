@@ -69,8 +69,9 @@ struct EglContext {
     EGLint count = 0;
     REQUIRE(eglChooseConfig(dpy, configAttribs, &config, 1, &count));
     REQUIRE_MESSAGE(count > 0, "no EGL config renders OpenGL");
-    const EGLint contextAttribs[] = {EGL_CONTEXT_MAJOR_VERSION, 3, EGL_CONTEXT_MINOR_VERSION, 3,
-                                     EGL_CONTEXT_OPENGL_PROFILE_MASK, EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT, EGL_NONE};
+    const EGLint contextAttribs[] = {
+        EGL_CONTEXT_MAJOR_VERSION,           3,       EGL_CONTEXT_MINOR_VERSION, 3, EGL_CONTEXT_OPENGL_PROFILE_MASK,
+        EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT, EGL_NONE};
     ctx = eglCreateContext(dpy, config, EGL_NO_CONTEXT, contextAttribs);
     REQUIRE_MESSAGE(ctx != EGL_NO_CONTEXT, "eglCreateContext (3.3 core): error 0x" << std::hex << eglGetError());
     makeCurrentOnly();
@@ -144,13 +145,15 @@ double waterShare(const std::vector<unsigned char>& p) {
 
 }  // namespace
 
-TEST_CASE("draw() into a framebuffer of the game's EGL context (surfaceless, 3.3 core), frame after frame: the OSMesa path's pixels, and the game's state given back") {
+TEST_CASE(
+    "draw() into a framebuffer of the game's EGL context (surfaceless, 3.3 core), frame after frame: the OSMesa path's pixels, and the game's state given back") {
   const SceneDef s = gameScene();
   World world(s, WorldOptions{1});
   for (int f = 0; f < 2; ++f) world.stepFrame();
   EglContext game;
   const std::string version = reinterpret_cast<const char*>(glGetString(GL_VERSION));
-  MESSAGE("the game's context: OpenGL " << version << " on " << std::string(reinterpret_cast<const char*>(glGetString(GL_RENDERER))));
+  MESSAGE("the game's context: OpenGL " << version << " on "
+                                        << std::string(reinterpret_cast<const char*>(glGetString(GL_RENDERER))));
   GameFramebuffer target;
   Renderer renderer(currentGlContext, s.render);
   CHECK(renderer.usesCurrentContext());
@@ -189,7 +192,8 @@ TEST_CASE("draw() into a framebuffer of the game's EGL context (surfaceless, 3.3
   CHECK(std::unique(hashes.begin(), hashes.end()) == hashes.end());  // the paddle turns: every frame differs
 }
 
-TEST_CASE("after an OSMesa Renderer's render(), an eglMakeCurrent that Mesa skips leaves the OSMesa context current: draw() refuses and says what to do, and the released-then-made context draws") {
+TEST_CASE(
+    "after an OSMesa Renderer's render(), an eglMakeCurrent that Mesa skips leaves the OSMesa context current: draw() refuses and says what to do, and the released-then-made context draws") {
   const SceneDef s = gameScene();
   World world(s, WorldOptions{1});
   for (int f = 0; f < 3; ++f) world.stepFrame();
@@ -207,7 +211,7 @@ TEST_CASE("after an OSMesa Renderer's render(), an eglMakeCurrent that Mesa skip
   }
   CHECK(error.find("another OpenGL context is current") != std::string::npos);
   CHECK(error.find("EGL_NO_CONTEXT") != std::string::npos);  // names the fix
-  game.makeCurrent();  // released, then made current: now it is
+  game.makeCurrent();                                        // released, then made current: now it is
   renderer.draw(world, GlTarget{target.fbo, std::array<int, 4>{0, 0, W, H}});
   CHECK(glGetError() == GL_NO_ERROR);
   CHECK(differing(target.pixels(), reference) == 0);

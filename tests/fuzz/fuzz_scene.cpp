@@ -59,7 +59,8 @@ double worldCost(const sph2d::SceneDef& s) {
 void checkError(const sph2d::SceneError& e, const char* file) {
   if (e.message.empty()) finding("SceneError without a message", e.what());
   if (e.file != file) finding("SceneError names another file", e.what());
-  if (e.line < 0 || e.column < 0 || (e.line == 0) != (e.column == 0)) finding("SceneError with a bad position", e.what());
+  if (e.line < 0 || e.column < 0 || (e.line == 0) != (e.column == 0))
+    finding("SceneError with a bad position", e.what());
   if (std::string(e.what()).rfind(file, 0) != 0) finding("what() does not start with the file", e.what());
 }
 
@@ -95,14 +96,17 @@ void fuzzManifest(const std::string& text) {
   try {
     v = sph2d::cli::parseManifest(text, "fuzz_manifest.json");
   } catch (const sph2d::cli::UsageError& e) {
-    if (std::string(e.what()).rfind("fuzz_manifest.json", 0) != 0) finding("a manifest error does not name the file", e.what());
+    if (std::string(e.what()).rfind("fuzz_manifest.json", 0) != 0)
+      finding("a manifest error does not name the file", e.what());
     return;
   }
   if (v.frames < 0 || v.every < 1) finding("accepted manifest with a bad run", text);
   int last = -1;
   for (const auto& [frame, entry] : v.expected) {
-    if (frame <= last || frame >= v.frames || frame % v.every != 0) finding("accepted manifest lists a frame the run did not keep", text);
-    if (entry.at("file").get<std::string>() != sph2d::cli::frameFileName(frame)) finding("accepted manifest names another file", text);
+    if (frame <= last || frame >= v.frames || frame % v.every != 0)
+      finding("accepted manifest lists a frame the run did not keep", text);
+    if (entry.at("file").get<std::string>() != sph2d::cli::frameFileName(frame))
+      finding("accepted manifest names another file", text);
     last = frame;
   }
   for (const std::string& p : v.listProblems)
@@ -114,9 +118,11 @@ void fuzzManifest(const std::string& text) {
         if (ch < 0x20 || ch == 0x7f) finding("an ignored environment name is printed with a control character", text);
       continue;
     }
-    if (std::find(known.begin(), known.end(), e.name) == known.end()) finding("a manifest variable sph2d does not record is accepted", e.name);
+    if (std::find(known.begin(), known.end(), e.name) == known.end())
+      finding("a manifest variable sph2d does not record is accepted", e.name);
     for (const char ch : e.value)
-      if (!std::isalnum(static_cast<unsigned char>(ch)) && !std::strchr("_.,:=+-", ch)) finding("a manifest value is not plain", e.value);
+      if (!std::isalnum(static_cast<unsigned char>(ch)) && !std::strchr("_.,:=+-", ch))
+        finding("a manifest value is not plain", e.value);
   }
 }
 

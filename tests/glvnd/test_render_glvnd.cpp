@@ -10,9 +10,9 @@
 // checks in CTest (golden/liquid_dam_break). A first test asserts that the link is the one the
 // build says, so that glvnd_first cannot pass by binding to libOSMesa.
 #define GL_GLEXT_PROTOTYPES 1
-#include <GL/osmesa.h>
 #include <GL/gl.h>
 #include <GL/glext.h>
+#include <GL/osmesa.h>
 #include <dlfcn.h>
 #include <doctest/doctest.h>
 
@@ -69,8 +69,10 @@ double waterShare(const std::vector<unsigned char>& p) {
 TEST_CASE("the link is the one this build is named for") {
   const std::string lib = glGetStringLibrary();
   MESSAGE("glGetString binds to " << lib);
-  if (std::string(SPH2D_GL_LINK) == "glvnd_first") CHECK(lib.find("libOpenGL") != std::string::npos);
-  else CHECK(lib.find("libOSMesa") != std::string::npos);
+  if (std::string(SPH2D_GL_LINK) == "glvnd_first")
+    CHECK(lib.find("libOpenGL") != std::string::npos);
+  else
+    CHECK(lib.find("libOSMesa") != std::string::npos);
 }
 
 TEST_CASE("Renderer(def).render() in its own OSMesa context: the golden frames of the plain link, hash for hash") {
@@ -108,8 +110,15 @@ TEST_CASE("Renderer(currentGlContext) in a game's own OSMesa context: the frame 
   const std::vector<unsigned char> reference = own.render(world).rgba;
   // The game's context: OSMesa, 3.3 core, with a buffer of its own, made current (the game's
   // own gl* calls would need OSMesaGetProcAddress too in the glvnd_first link; it makes none).
-  const int attribs[] = {OSMESA_FORMAT, OSMESA_RGBA, OSMESA_PROFILE, OSMESA_CORE_PROFILE,
-                         OSMESA_CONTEXT_MAJOR_VERSION, 3, OSMESA_CONTEXT_MINOR_VERSION, 3, 0};
+  const int attribs[] = {OSMESA_FORMAT,
+                         OSMESA_RGBA,
+                         OSMESA_PROFILE,
+                         OSMESA_CORE_PROFILE,
+                         OSMESA_CONTEXT_MAJOR_VERSION,
+                         3,
+                         OSMESA_CONTEXT_MINOR_VERSION,
+                         3,
+                         0};
   OSMesaContext game = OSMesaCreateContextAttribs(attribs, nullptr);
   REQUIRE(game != nullptr);
   std::vector<unsigned char> buffer(std::size_t(scene.render.width) * scene.render.height * 4);
@@ -134,7 +143,7 @@ TEST_CASE("Renderer(currentGlContext) with no context current: the message names
   }
   MESSAGE(error);
   CHECK(error.find("no OpenGL context is current") != std::string::npos);
-  CHECK(error.find("currentGlContext") != std::string::npos);    // the path in use
-  CHECK(error.find("make the game's") != std::string::npos);      // what to do
+  CHECK(error.find("currentGlContext") != std::string::npos);           // the path in use
+  CHECK(error.find("make the game's") != std::string::npos);            // what to do
   CHECK(error.find("OSMesa context of its own") != std::string::npos);  // and the other path needs none
 }

@@ -55,11 +55,12 @@ TEST_CASE("repository: no source file of ours is over 600 lines") {
   CHECK(checked > 100);
 }
 
-TEST_CASE("repository: engine includes follow the folder order core < particles < boundary < bodies < step < effects < solvers < scene < world") {
+TEST_CASE(
+    "repository: engine includes follow the folder order core < particles < boundary < bodies < step < effects < solvers < scene < world") {
   // A folder may include its own headers, lower folders' and the public API (sph2d/...);
   // never a higher folder's. docs/ARCHITECTURE.md draws the same order.
-  const std::vector<std::string> order = {"core", "particles", "boundary", "bodies", "step",
-                                          "effects", "solvers", "scene", "world"};
+  const std::vector<std::string> order = {"core",    "particles", "boundary", "bodies", "step",
+                                          "effects", "solvers",   "scene",    "world"};
   auto rank = [&](const std::string& folder) {
     const auto it = std::find(order.begin(), order.end(), folder);
     return it == order.end() ? -1 : int(it - order.begin());
@@ -93,7 +94,8 @@ TEST_CASE("repository: reference docs name no issue, session or date, and no pat
   std::vector<fs::path> docs = {kRoot / "README.md", kRoot / "CONTRIBUTING.md"};
   for (const auto& e : fs::recursive_directory_iterator(kRoot / "docs")) {
     const std::string rel = fs::relative(e.path(), kRoot).generic_string();
-    if (e.is_regular_file() && e.path().extension() == ".md" && rel.rfind("docs/notes/", 0) != 0) docs.push_back(e.path());
+    if (e.is_regular_file() && e.path().extension() == ".md" && rel.rfind("docs/notes/", 0) != 0)
+      docs.push_back(e.path());
   }
   const std::regex issue(
       R"(\b[Ii]ssues? #?\d+|\b(first|second|third|fourth|fifth|sixth|seventh|eighth|ninth|tenth|\d+(st|nd|rd|th)) session\b)");

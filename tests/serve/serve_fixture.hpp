@@ -118,7 +118,8 @@ inline double blueFraction(const std::vector<std::uint8_t>& rgba, int width, int
 }
 
 /// Decodes PNG bytes (through a file: the renderer's readPng).
-inline void decodePng(const std::string& bytes, const std::string& tmpPath, int& w, int& h, std::vector<std::uint8_t>& rgba) {
+inline void decodePng(const std::string& bytes, const std::string& tmpPath, int& w, int& h,
+                      std::vector<std::uint8_t>& rgba) {
   {
     std::ofstream out(tmpPath, std::ios::binary);
     out << bytes;
@@ -130,7 +131,8 @@ inline void decodePng(const std::string& bytes, const std::string& tmpPath, int&
 inline std::map<std::int64_t, std::pair<std::string, std::string>> manifestHashes(const std::string& path) {
   std::map<std::int64_t, std::pair<std::string, std::string>> out;
   const nlohmann::json m = nlohmann::json::parse(slurp(path));
-  for (const auto& f : m.at("frames")) out[f.at("frame").get<std::int64_t>()] = {f.at("rgba_xxh64"), f.at("state_hash")};
+  for (const auto& f : m.at("frames"))
+    out[f.at("frame").get<std::int64_t>()] = {f.at("rgba_xxh64"), f.at("state_hash")};
   return out;
 }
 
@@ -140,9 +142,9 @@ inline void checkReplay(const std::string& scene, const std::string& record, con
                         const std::string& dir) {
   REQUIRE(!live.empty());
   const std::int64_t last = live.back()["frame"].get<std::int64_t>();
-  const auto r = apptest::runSph2d("run " + apptest::q(scene) + " --input " + apptest::q(record) + " --frames " +
-                                   std::to_string(last + 1) + " --out " + apptest::q(dir + "/replay") +
-                                   " --threads 2 --quiet");
+  const auto r =
+      apptest::runSph2d("run " + apptest::q(scene) + " --input " + apptest::q(record) + " --frames " +
+                        std::to_string(last + 1) + " --out " + apptest::q(dir + "/replay") + " --threads 2 --quiet");
   REQUIRE_MESSAGE(r.code == 0, r.out);
   const auto replay = manifestHashes(dir + "/replay/manifest.json");
   for (const auto& f : live) {

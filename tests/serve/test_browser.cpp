@@ -55,9 +55,17 @@ struct Chromium {
       ::dup2(fd, 1);
       ::dup2(fd, 2);
       const std::string profile = "--user-data-dir=" + dir + "/profile";
-      std::vector<std::string> args{exe, "--headless", "--no-sandbox", "--disable-gpu", "--disable-background-networking",
-                                    "--no-first-run", "--remote-debugging-port=0", "--window-size=1000,760",
-                                    "--disable-extensions", profile, "about:blank"};
+      std::vector<std::string> args{exe,
+                                    "--headless",
+                                    "--no-sandbox",
+                                    "--disable-gpu",
+                                    "--disable-background-networking",
+                                    "--no-first-run",
+                                    "--remote-debugging-port=0",
+                                    "--window-size=1000,760",
+                                    "--disable-extensions",
+                                    profile,
+                                    "about:blank"};
       std::vector<char*> argv;
       for (auto& a : args) argv.push_back(a.data());
       argv.push_back(nullptr);
@@ -66,12 +74,14 @@ struct Chromium {
     }
     setpgid(pid, pid);
     const std::regex re("DevTools listening on ws://127\\.0\\.0\\.1:([0-9]+)/");
-    waitFor([&] {
-      std::smatch m;
-      const std::string text = slurp(log);
-      if (std::regex_search(text, m, re)) port = std::stoi(m[1]);
-      return port != 0;
-    }, 60000ms);
+    waitFor(
+        [&] {
+          std::smatch m;
+          const std::string text = slurp(log);
+          if (std::regex_search(text, m, re)) port = std::stoi(m[1]);
+          return port != 0;
+        },
+        60000ms);
   }
   ~Chromium() {
     if (pid > 0) {
@@ -122,8 +132,8 @@ class Cdp {
   }
   /// One mouse event at (x, y) in CSS pixels.
   void mouse(const std::string& type, double x, double y, int buttons) {
-    call("Input.dispatchMouseEvent", {{"type", type}, {"x", x}, {"y", y}, {"button", "left"}, {"buttons", buttons},
-                                      {"clickCount", 1}});
+    call("Input.dispatchMouseEvent",
+         {{"type", type}, {"x", x}, {"y", y}, {"button", "left"}, {"buttons", buttons}, {"clickCount", 1}});
   }
 
  private:
@@ -134,12 +144,14 @@ class Cdp {
 
 }  // namespace
 
-TEST_CASE("browser: headless Chromium shows the liquid, a mouse drag is recorded as force, the record replays the live hashes") {
+TEST_CASE(
+    "browser: headless Chromium shows the liquid, a mouse drag is recorded as force, the record replays the live hashes") {
   const char* envExe = std::getenv("SPH2D_CHROMIUM");
   const std::string exe = envExe ? envExe : "/usr/bin/chromium";
   REQUIRE_MESSAGE(std::filesystem::exists(exe),
-                  "Chromium is missing (" << exe << "): install Debian's chromium (apt-get install chromium; "
-                  "./test.sh installs it through .ci/setup.sh) or set SPH2D_CHROMIUM");
+                  "Chromium is missing (" << exe
+                                          << "): install Debian's chromium (apt-get install chromium; "
+                                             "./test.sh installs it through .ci/setup.sh) or set SPH2D_CHROMIUM");
   const std::string dir = scratch("browser");
   const char* envScene = std::getenv("SPH2D_BROWSER_SCENE");
   const std::string scene = envScene ? envScene : asset("scenes/tests/small_dam_break.json");
@@ -149,7 +161,8 @@ TEST_CASE("browser: headless Chromium shows the liquid, a mouse drag is recorded
 
   Chromium browser(exe, dir);
   REQUIRE_MESSAGE(browser.port > 0, slurp(dir + "/chromium.log"));
-  const auto list = nlohmann::json::parse(sc::httpRequest("127.0.0.1", browser.port, sc::http::verb::get, "/json/list").body);
+  const auto list =
+      nlohmann::json::parse(sc::httpRequest("127.0.0.1", browser.port, sc::http::verb::get, "/json/list").body);
   std::string pagePath;
   for (const auto& t : list)
     if (t.value("type", "") == "page") {
@@ -167,13 +180,15 @@ TEST_CASE("browser: headless Chromium shows the liquid, a mouse drag is recorded
     return v.is_number() && v.get<int>() > 0;
   }));
   // SPH2D_BROWSER_SETTLE: seconds more before the screenshot (for the documentation's picture).
-  if (const char* settle = std::getenv("SPH2D_BROWSER_SETTLE")) std::this_thread::sleep_for(std::chrono::duration<double>(std::atof(settle)));
+  if (const char* settle = std::getenv("SPH2D_BROWSER_SETTLE"))
+    std::this_thread::sleep_for(std::chrono::duration<double>(std::atof(settle)));
   const auto rect = cdp.eval("JSON.stringify(view.getBoundingClientRect())");
   REQUIRE(rect.is_string());
   const auto r = nlohmann::json::parse(rect.get<std::string>());
   const double cx = r["x"], cy = r["y"], cw = r["width"], ch = r["height"];
   CHECK(cw > 100);
-  CHECK(cdp.eval("document.getElementById('overlay').textContent").get<std::string>().find("particles") != std::string::npos);
+  CHECK(cdp.eval("document.getElementById('overlay').textContent").get<std::string>().find("particles") !=
+        std::string::npos);
 
   // The screenshot: the page, with the water's blue in the frame's rectangle.
   const auto shot = cdp.call("Page.captureScreenshot", {{"format", "png"}});
@@ -185,7 +200,8 @@ TEST_CASE("browser: headless Chromium shows the liquid, a mouse drag is recorded
   const double blue = blueFraction(rgba, w, int(cx), int(cy), int(cx + cw), int(cy + ch));
   MESSAGE("blue (water) fraction of the frame's rectangle in the screenshot: " << blue);
   CHECK(blue > 0.05);
-  if (const char* copy = std::getenv("SPH2D_BROWSER_SHOT")) std::filesystem::copy_file(dir + "/screenshot.png", copy, std::filesystem::copy_options::overwrite_existing);
+  if (const char* copy = std::getenv("SPH2D_BROWSER_SHOT"))
+    std::filesystem::copy_file(dir + "/screenshot.png", copy, std::filesystem::copy_options::overwrite_existing);
 
   // A synthetic drag across the lower half of the frame: mouse down, moves, up.
   const double y = cy + 0.75 * ch;
@@ -205,8 +221,10 @@ TEST_CASE("browser: headless Chromium shows the liquid, a mouse drag is recorded
   const std::size_t before = s.state().value("particles", std::size_t(0));
   cdp.mouse("mousePressed", cx + 0.6 * cw, cy + 0.3 * ch, 1);
   cdp.mouse("mouseReleased", cx + 0.6 * cw, cy + 0.3 * ch, 0);
-  cdp.call("Input.dispatchKeyEvent", {{"type", "keyDown"}, {"key", "ArrowLeft"}, {"code", "ArrowLeft"}, {"windowsVirtualKeyCode", 37}});
-  cdp.call("Input.dispatchKeyEvent", {{"type", "keyUp"}, {"key", "ArrowLeft"}, {"code", "ArrowLeft"}, {"windowsVirtualKeyCode", 37}});
+  cdp.call("Input.dispatchKeyEvent",
+           {{"type", "keyDown"}, {"key", "ArrowLeft"}, {"code", "ArrowLeft"}, {"windowsVirtualKeyCode", 37}});
+  cdp.call("Input.dispatchKeyEvent",
+           {{"type", "keyUp"}, {"key", "ArrowLeft"}, {"code", "ArrowLeft"}, {"windowsVirtualKeyCode", 37}});
   REQUIRE(waitFor([&] {
     const std::string t = slurp(rec);
     return t.find("\"type\":\"drop\"") != std::string::npos && t.find("\"type\":\"gravity\"") != std::string::npos;

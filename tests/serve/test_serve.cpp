@@ -12,9 +12,9 @@
 
 using namespace sph2d::servetest;
 using sph2d::apptest::asset;
+using sph2d::apptest::q;
 using sph2d::apptest::runSph2d;
 using sph2d::apptest::scratch;
-using sph2d::apptest::q;
 
 namespace {
 
@@ -202,7 +202,8 @@ TEST_CASE("serve: GET /snapshot.png decodes and POST /event with a drop raises t
     boost::asio::io_context ioc;
     boost::asio::ip::tcp::socket sock(ioc);
     sock.connect({boost::asio::ip::make_address("127.0.0.1"), static_cast<unsigned short>(s.port)});
-    boost::asio::write(sock, boost::asio::buffer(std::string("HEAD / HTTP/1.1\r\nHost: 127.0.0.1\r\nConnection: close\r\n\r\n")));
+    boost::asio::write(
+        sock, boost::asio::buffer(std::string("HEAD / HTTP/1.1\r\nHost: 127.0.0.1\r\nConnection: close\r\n\r\n")));
     std::string answer;
     boost::system::error_code ec;
     boost::asio::read(sock, boost::asio::dynamic_buffer(answer), ec);  // until the server closes
@@ -225,10 +226,11 @@ TEST_CASE("serve: SIGTERM ends it with exit 130 and a whole record that replays 
   Server s(kScene, {"--record", rec, "--threads", "1"}, dir + "/serve.log");
   REQUIRE_MESSAGE(s.port > 0, slurp(s.log));
   sc::WsClient c("127.0.0.1", s.port);
-  for (const char* ev : {R"({"type": "force", "point": [1.0, 0.4], "radius": 0.4, "strength": -40})",
-                         R"({"type": "force", "point": [1.5, 0.5], "radius": 0.4, "strength": -40})",
-                         R"({"type": "release"})", R"({"type": "gravity", "tilt": -0.3})",
-                         R"({"type": "drop", "center": [3, 2.2], "radius": 0.12})", R"({"type": "effect", "name": "viscosity", "enabled": false})"}) {
+  for (const char* ev :
+       {R"({"type": "force", "point": [1.0, 0.4], "radius": 0.4, "strength": -40})",
+        R"({"type": "force", "point": [1.5, 0.5], "radius": 0.4, "strength": -40})", R"({"type": "release"})",
+        R"({"type": "gravity", "tilt": -0.3})", R"({"type": "drop", "center": [3, 2.2], "radius": 0.12})",
+        R"({"type": "effect", "name": "viscosity", "enabled": false})"}) {
     c.send(ev);
     auto r = c.readReply();
     REQUIRE(r);
@@ -285,8 +287,10 @@ TEST_CASE("serve: pause holds the frame, resume goes on, reset starts frame 0 an
     c.send(R"({"type": "gravity", "tilt": 0.01})");
     auto r = c.readReply();
     REQUIRE(r);
-    if (r->header.value("ok", false)) ++ok;
-    else if (r->header.value("error", "").find("too many events waiting") != std::string::npos) ++refused;
+    if (r->header.value("ok", false))
+      ++ok;
+    else if (r->header.value("error", "").find("too many events waiting") != std::string::npos)
+      ++refused;
   }
   CHECK(ok == 256);
   CHECK(refused == 44);
@@ -340,7 +344,8 @@ std::int64_t frameOf(const Server& s) { return s.state().value("frame", std::int
 
 }  // namespace
 
-TEST_CASE("serve: a block or drop over the per-event cap is refused 422 naming the cap, and the frames keep advancing") {
+TEST_CASE(
+    "serve: a block or drop over the per-event cap is refused 422 naming the cap, and the frames keep advancing") {
   // Before: {"type":"block","min":[-1e6,-1e6],"max":[1e6,1e6]} was accepted (200) and added
   // 3,998,750 particles (the 4,000,000 budget); the loop never finished the next frame.
   const std::string dir = scratch("serve_event_cap");
@@ -378,10 +383,13 @@ TEST_CASE("serve: a block or drop over the per-event cap is refused 422 naming t
   CHECK(s.stop() == 130);
 }
 
-TEST_CASE("serve: particles per second and in all are capped: 429 with Retry-After, then taken again, and 409 at the budget") {
+TEST_CASE(
+    "serve: particles per second and in all are capped: 429 with Retry-After, then taken again, and 409 at the budget") {
   const std::string dir = scratch("serve_rate_cap");
-  Server s(kScene, {"--threads", "1", "--max-event-particles", "100", "--max-particles-per-second", "100",
-                    "--max-particles", "1400"}, dir + "/serve.log");
+  Server s(kScene,
+           {"--threads", "1", "--max-event-particles", "100", "--max-particles-per-second", "100", "--max-particles",
+            "1400"},
+           dir + "/serve.log");
   REQUIRE_MESSAGE(s.port > 0, slurp(s.log));
   REQUIRE(waitFor([&] { return frameOf(s) >= 0; }));
   const std::string drop = R"({"type": "drop", "center": [2.5, 2.2], "radius": 0.15})";  // 44 particles
@@ -417,8 +425,10 @@ TEST_CASE("serve: SIGTERM and SIGINT inside a step of many seconds end it with e
   for (const int sig : {SIGTERM, SIGINT}) {
     CAPTURE(sig);
     const std::string dir = scratch("serve_long_step");
-    Server s(kScene, {"--threads", "1", "--max-event-particles", "1000000", "--max-particles-per-second", "1000000",
-                      "--max-particles", "1100000"}, dir + "/serve.log");
+    Server s(kScene,
+             {"--threads", "1", "--max-event-particles", "1000000", "--max-particles-per-second", "1000000",
+              "--max-particles", "1100000"},
+             dir + "/serve.log");
     REQUIRE_MESSAGE(s.port > 0, slurp(s.log));
     REQUIRE(waitFor([&] { return frameOf(s) >= 0; }));
     CHECK(s.post(R"({"type":"block","min":[-20000,-1000],"max":[20000,-999.95]})").status == 200);

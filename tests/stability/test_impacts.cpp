@@ -41,7 +41,8 @@ bool inside(const std::vector<Vec2d>& poly, const Vec2d& p) {
   for (std::size_t i = 0, j = poly.size() - 1; i < poly.size(); j = i++) {
     const Vec2d& a = poly[i];
     const Vec2d& b = poly[j];
-    if ((a.y() > p.y()) != (b.y() > p.y()) && p.x() < (b.x() - a.x()) * (p.y() - a.y()) / (b.y() - a.y()) + a.x()) in = !in;
+    if ((a.y() > p.y()) != (b.y() > p.y()) && p.x() < (b.x() - a.x()) * (p.y() - a.y()) / (b.y() - a.y()) + a.x())
+      in = !in;
   }
   return in;
 }
@@ -64,8 +65,10 @@ void zigzagFunnel(const std::string& solver, const JetCase& jc) {
   s.solver.maxSpeed = 400;
   if (solver == "wcsph") s.solver.params["alpha"] = 0.1;
   s.bodies.push_back(arena());
-  const std::vector<Vec2d> left = zigzagWall({0.3, 3.0}, {1.75, 1.0}, Vec2d(1, 0.725).normalized(), 12, jc.leftAngle, 0.1);
-  const std::vector<Vec2d> right = zigzagWall({3.7, 3.0}, {2.25, 1.0}, Vec2d(-1, 0.725).normalized(), 12, jc.rightAngle, 0.1);
+  const std::vector<Vec2d> left =
+      zigzagWall({0.3, 3.0}, {1.75, 1.0}, Vec2d(1, 0.725).normalized(), 12, jc.leftAngle, 0.1);
+  const std::vector<Vec2d> right =
+      zigzagWall({3.7, 3.0}, {2.25, 1.0}, Vec2d(-1, 0.725).normalized(), 12, jc.rightAngle, 0.1);
   BodyDef walls;
   walls.fixtures = {pointsShape(ShapeDef::Type::Chain, left, true), pointsShape(ShapeDef::Type::Chain, right, true)};
   s.bodies.push_back(walls);
@@ -103,9 +106,11 @@ void zigzagFunnel(const std::string& solver, const JetCase& jc) {
     }
     if (w.particleCount() > 0) totalWorst = std::max(totalWorst, total / (double(w.particleCount()) * eJet));
   }
-  MESSAGE(solver << " (teeth " << jc.leftAngle << "° and " << jc.rightAngle << "°, " << jc.speed << " m/s): "
-                 << w.particleCount() << " particles, " << inWall << " particle-frames inside a wall, the most energetic particle at "
-                 << eWorst << " of the jet's specific energy (frame " << worstFrame << ", at " << worstAt << "), " << above << " particle-frames above 1.2, total at most " << totalWorst);
+  MESSAGE(solver << " (teeth " << jc.leftAngle << "° and " << jc.rightAngle << "°, " << jc.speed
+                 << " m/s): " << w.particleCount() << " particles, " << inWall
+                 << " particle-frames inside a wall, the most energetic particle at " << eWorst
+                 << " of the jet's specific energy (frame " << worstFrame << ", at " << worstAt << "), " << above
+                 << " particle-frames above 1.2, total at most " << totalWorst);
   CHECK(w.particleCount() > 1000);
   CHECK(inWall == 0);
   CHECK(totalWorst <= 1.0);
@@ -120,9 +125,12 @@ void funnelSlowerSharper(const std::string& solver) { zigzagFunnel(solver, JetCa
 
 }  // namespace
 
-TEST_CASE_EVERY_SOLVER("a 50 m/s jet down a funnel of 25 degree zigzag chains: finite, none inside a wall, no particle above the jet's energy",
-                       funnelHeadOn)
-TEST_CASE_EVERY_SOLVER("a 50 m/s jet into 20 degree chain teeth: finite, none inside a wall, no particle above the jet's energy",
-                       funnelIntoTeeth)
-TEST_CASE_EVERY_SOLVER("a 35 m/s jet into 15 and 40 degree chain teeth: finite, none inside a wall, no particle above the jet's energy",
-                       funnelSlowerSharper)
+TEST_CASE_EVERY_SOLVER(
+    "a 50 m/s jet down a funnel of 25 degree zigzag chains: finite, none inside a wall, no particle above the jet's energy",
+    funnelHeadOn)
+TEST_CASE_EVERY_SOLVER(
+    "a 50 m/s jet into 20 degree chain teeth: finite, none inside a wall, no particle above the jet's energy",
+    funnelIntoTeeth)
+TEST_CASE_EVERY_SOLVER(
+    "a 35 m/s jet into 15 and 40 degree chain teeth: finite, none inside a wall, no particle above the jet's energy",
+    funnelSlowerSharper)

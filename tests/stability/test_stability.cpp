@@ -137,7 +137,8 @@ TEST_CASE("stability: a fluid block overlapping a static polygon at start is cut
   }
 }
 
-TEST_CASE("stability: viscosity far beyond its explicit limit shrinks the step to the substep cap and says so, or is refused") {
+TEST_CASE(
+    "stability: viscosity far beyond its explicit limit shrinks the step to the substep cap and says so, or is refused") {
   for (const auto& solver : test::solvers()) {
     CAPTURE(solver);
     SceneDef s = tank(solver, 1, 1, 0.04);
@@ -170,7 +171,8 @@ TEST_CASE("stability: viscosity far beyond its explicit limit shrinks the step t
 
 TEST_CASE("stability: stiffness far beyond its explicit limit (c = 5000 m/s) stays stable at the substep cap") {
   for (const auto& solver : test::solvers()) {
-    if (solver == "pbf" || solver == "game" || solver == "dfsph") continue;  // no sound speed: incompressible by projection or solve
+    if (solver == "pbf" || solver == "game" || solver == "dfsph")
+      continue;  // no sound speed: incompressible by projection or solve
     CAPTURE(solver);
     SceneDef s = tank(solver, 1, 1, 0.04);
     s.solver.soundSpeed = 5000;
@@ -202,7 +204,8 @@ void surfaceTensionBeyondLimit(const std::string& solver) {
   blk.min = Vec2d(0.3, 0.3);
   blk.max = Vec2d(0.7, 0.7);
   s.blocks.push_back(blk);
-  if (solver == "pbf" || solver == "game") {  // the smallest position-based substep (max_dt/32) is above the limit: refused
+  if (solver == "pbf" ||
+      solver == "game") {  // the smallest position-based substep (max_dt/32) is above the limit: refused
     try {
       World w(s, WorldOptions{2});
       FAIL(solver << " accepted a surface-tension step limit it cannot follow");
@@ -221,8 +224,9 @@ void surfaceTensionBeyondLimit(const std::string& solver) {
 }
 }  // namespace
 
-TEST_CASE_EVERY_SOLVER("stability: surface tension far beyond its step limit shrinks the step and stays finite, or is refused",
-                       surfaceTensionBeyondLimit)
+TEST_CASE_EVERY_SOLVER(
+    "stability: surface tension far beyond its step limit shrinks the step and stays finite, or is refused",
+    surfaceTensionBeyondLimit)
 
 namespace {
 /// Issue 18, hard case 11: a free square drop (no gravity, no walls, 0.1 m wide,
@@ -251,7 +255,8 @@ void strainedDropEnergy(const std::string& solver) {
                                "velocity_field": {"type": "strain", "rate": 100}}]})",
                             "strained_drop.json");
     s.solver.clampNegativePressure = clamp;
-    if (solver == "pbf") s.solver.viscosity = 0;  // its step limit at this spacing is below pbf's smallest substep (refused)
+    if (solver == "pbf")
+      s.solver.viscosity = 0;  // its step limit at this spacing is below pbf's smallest substep (refused)
     World w(s, WorldOptions{2});
     const Particles& P = w.particles();
     const double m = double(w.particleMass()), rho0 = s.solver.restDensity;
@@ -270,8 +275,8 @@ void strainedDropEnergy(const std::string& solver) {
       w.stepFrame();
       keMax = std::max(keMax, w.kineticEnergy());
     }
-    MESSAGE(solver << std::string(clamp ? "" : " (tension)") << ": KE0 " << ke0 << " J/m, stored " << stored << " J/m, largest KE "
-                   << keMax << " J/m, fastest " << test::maxSpeed(w) << " m/s");
+    MESSAGE(solver << std::string(clamp ? "" : " (tension)") << ": KE0 " << ke0 << " J/m, stored " << stored
+                   << " J/m, largest KE " << keMax << " J/m, fastest " << test::maxSpeed(w) << " m/s");
     CHECK(test::allFiniteState(w));
     CHECK(keMax <= bound);
   }
@@ -296,7 +301,8 @@ TEST_CASE("stability: a frame time of 1 s holds the substep cap, stays stable an
     w.stepFrame();
     CHECK(w.lastFrameSubsteps() <= 300);
     const auto warnings = w.takeWarnings();
-    if (w.lastFrameSubsteps() == 300) {  // the explicit solvers hit the cap and say so (pbf needs 60 substeps of 1/60 s)
+    if (w.lastFrameSubsteps() ==
+        300) {  // the explicit solvers hit the cap and say so (pbf needs 60 substeps of 1/60 s)
       REQUIRE(warnings.size() == 1);
       CHECK(warnings[0].find("frame 0") != std::string::npos);
     } else {
@@ -308,7 +314,8 @@ TEST_CASE("stability: a frame time of 1 s holds the substep cap, stays stable an
   }
 }
 
-TEST_CASE("stability: a sink that drains everything leaves an empty, working world, and a scene with zero particles runs") {
+TEST_CASE(
+    "stability: a sink that drains everything leaves an empty, working world, and a scene with zero particles runs") {
   for (const auto& solver : test::solvers()) {
     CAPTURE(solver);
     SceneDef s = tank(solver, 1, 1, 0.04);
@@ -376,7 +383,8 @@ void longRest(const std::string& solver, int substeps) {
   }
   const Vec2d c2 = test::centroid(w);
   const double ke2 = w.kineticEnergy();
-  const double pe = double(w.particleMass()) * 9.81 * 0.45 / 2 * double(w.particleCount());  // potential energy scale of the column
+  const double pe =
+      double(w.particleMass()) * 9.81 * 0.45 / 2 * double(w.particleCount());  // potential energy scale of the column
   MESSAGE(solver << ": " << w.time() << " s simulated; KE after " << settle << " substeps (" << t1 << " s) " << ke1
                  << ", max later " << keMax << ", final " << ke2 << " J/m (mgH/2 = " << pe << "); COM drift "
                  << (c2 - c1).norm() << " m; mean compression at most " << 100 * errMax << " %, final "
@@ -389,7 +397,7 @@ void longRest(const std::string& solver, int substeps) {
   // where pbf (1e-9 J/m) and dfsph (its solve tolerance, ~0.006 J/m) wander.
   const double floor = 0.5 * double(w.particleMass()) * double(w.particleCount()) * 0.01 * 0.01;
   CHECK(ke2 < std::max(ke1, floor));
-  CHECK(ke2 < 5e-4 * pe);     // and stays small: under 0.05 % of the column's potential energy
+  CHECK(ke2 < 5e-4 * pe);  // and stays small: under 0.05 % of the column's potential energy
   CHECK(keMax < 1e-3 * pe);
   CHECK((c2 - c1).norm() < 0.1 * s.solver.spacing);
   CHECK(errMax <= restBand(s, 0.45));  // the density within the solver's stated band throughout
@@ -399,7 +407,9 @@ void longRest20000(const std::string& solver) { longRest(solver, 20000); }
 
 }  // namespace
 
-TEST_CASE_EVERY_SOLVER("stability: a long rest, 20000 substeps of a tank at rest: energy decays and stays small, no creep, no drift", longRest20000)
+TEST_CASE_EVERY_SOLVER(
+    "stability: a long rest, 20000 substeps of a tank at rest: energy decays and stays small, no creep, no drift",
+    longRest20000)
 
 TEST_CASE("stability: the dam break 10 km from the origin matches the one at the origin within a spacing after 1 s") {
   for (const auto& solver : test::solvers()) {

@@ -13,8 +13,8 @@
 // crateScene, dynamicBody, crateSurface, bottomOf, insideMovingCount.
 #pragma once
 
-#include <Eigen/Eigenvalues>
 #include <box2d/box2d.h>
+#include <Eigen/Eigenvalues>
 
 #include <algorithm>
 #include <cmath>
@@ -315,7 +315,8 @@ struct PressureProbe {
     for (std::size_t i = 0; i < w.particleCount(); ++i) {
       const Vec2d q = w.worldPosition(i);
       const long k = std::lround(q.y() / band);
-      if (k < 0 || k >= long(sum.size()) || std::fabs(q.x() - xc) >= halfWidth || std::fabs(q.y() - band * double(k)) >= 0.3 * band)
+      if (k < 0 || k >= long(sum.size()) || std::fabs(q.x() - xc) >= halfWidth ||
+          std::fabs(q.y() - band * double(k)) >= 0.3 * band)
         continue;
       sum[std::size_t(k)] += double(w.particles().p[i]);
       ++count[std::size_t(k)];
@@ -364,7 +365,8 @@ inline Vec2d centroid(const World& w) {
 inline double minPairDistance(const World& w) {
   double m = 1e300;
   for (std::size_t i = 0; i < w.particleCount(); ++i)
-    for (std::size_t j = i + 1; j < w.particleCount(); ++j) m = std::min(m, (w.worldPosition(i) - w.worldPosition(j)).norm());
+    for (std::size_t j = i + 1; j < w.particleCount(); ++j)
+      m = std::min(m, (w.worldPosition(i) - w.worldPosition(j)).norm());
   return m;
 }
 
@@ -474,9 +476,11 @@ inline std::size_t insideMovingCount(const World& w, double floorBand = -1e300) 
     if (w.worldPosition(i).y() < floorBand) continue;
     for (const Collider& c : shapes) {
       Real depth = 1e30f;
-      if (c.kind == Collider::Kind::Circle) depth = c.radius - (x - c.center).norm();
+      if (c.kind == Collider::Kind::Circle)
+        depth = c.radius - (x - c.center).norm();
       else
-        for (std::size_t f = 0; f < c.vertices.size(); ++f) depth = std::min(depth, -c.normals[f].dot(x - c.vertices[f]));
+        for (std::size_t f = 0; f < c.vertices.size(); ++f)
+          depth = std::min(depth, -c.normals[f].dot(x - c.vertices[f]));
       if (depth > Real(0.1) * w.spacing()) ++n;
     }
   }

@@ -18,9 +18,9 @@ inline SceneDef gameScene(const std::string& mode, int w, int h) {
   s.solver = solverDefaults("game");
   s.solver.spacing = 0.03;
   BodyDef tank;
-  for (const auto& [c, half] : {std::pair{Vec2d(0.6, -0.05), Vec2d(0.75, 0.05)},
-                                std::pair{Vec2d(-0.1, 0.4), Vec2d(0.05, 0.45)},
-                                std::pair{Vec2d(1.3, 0.4), Vec2d(0.05, 0.45)}}) {
+  for (const auto& [c, half] :
+       {std::pair{Vec2d(0.6, -0.05), Vec2d(0.75, 0.05)}, std::pair{Vec2d(-0.1, 0.4), Vec2d(0.05, 0.45)},
+        std::pair{Vec2d(1.3, 0.4), Vec2d(0.05, 0.45)}}) {
     ShapeDef box;
     box.center = c;
     box.halfSize = half;

@@ -8,9 +8,9 @@
 #include <cmath>
 #include <string>
 
+#include "bench/validation.hpp"
 #include "sph2d/scene.hpp"
 #include "test_util.hpp"
-#include "bench/validation.hpp"
 
 namespace sph2d::test {
 
@@ -32,8 +32,8 @@ inline void taylorGreenRe100(const std::string& solver) {
   REQUIRE(s.effects.shifting);
   const auto r = validation::runTaylorGreen(s, 1.0, table, 2);
   MESSAGE(solver << ": decay rate " << r.rate << " /s against " << r.analyticRate << " /s (" << 100 * r.rateError
-                 << " %); RMS of |u|max/U against the table " << r.umaxRms << ", of the mode amplitude " << r.amplitudeRms
-                 << "; mean density error " << r.meanDensityError);
+                 << " %); RMS of |u|max/U against the table " << r.umaxRms << ", of the mode amplitude "
+                 << r.amplitudeRms << "; mean density error " << r.meanDensityError);
   CHECK(r.analyticRate == doctest::Approx(-8 * 3.14159265358979 * 3.14159265358979 / 100));
   CHECK(r.rateError < 0.10);
   // dfsph measured 1.8 %: a looser divergence solve (0.1 ρ0/s) gave 7 %, which this catches.

@@ -24,14 +24,14 @@ struct Collider {
     Chain,    ///< one segment of a b2ChainShape
   };
   Kind kind = Kind::Polygon;
-  std::vector<Vec2> vertices;  ///< polygon (counter-clockwise) or segment end points
-  std::vector<Vec2> normals;   ///< polygon outward face normals (normals[k] for edge k→k+1)
-  Vec2 center = Vec2::Zero();  ///< circle centre
-  Real radius = 0;             ///< circle radius
-  Real friction = 0.2f;        ///< Coulomb friction used against the fluid
-  Real restitution = 0.0f;     ///< normal restitution used against the fluid
-  Vec2 lo = Vec2::Zero();      ///< bounding box, low corner
-  Vec2 hi = Vec2::Zero();      ///< bounding box, high corner
+  std::vector<Vec2> vertices;                      ///< polygon (counter-clockwise) or segment end points
+  std::vector<Vec2> normals;                       ///< polygon outward face normals (normals[k] for edge k→k+1)
+  Vec2 center = Vec2::Zero();                      ///< circle centre
+  Real radius = 0;                                 ///< circle radius
+  Real friction = 0.2f;                            ///< Coulomb friction used against the fluid
+  Real restitution = 0.0f;                         ///< normal restitution used against the fluid
+  Vec2 lo = Vec2::Zero();                          ///< bounding box, low corner
+  Vec2 hi = Vec2::Zero();                          ///< bounding box, high corner
   SourceShape sourceShape = SourceShape::Polygon;  ///< the Box2D shape it came from
 };
 

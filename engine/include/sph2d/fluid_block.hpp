@@ -21,12 +21,12 @@ struct VelocityFieldDef {
   /// (any gradient A: strain, shear, rotation, expansion). x, y from the field's origin.
   enum class Type { None, TaylorGreen, Strain, Linear };
   Type type = Type::None;
-  double amplitude = 1;          ///< U [m/s] (Taylor–Green)
-  double wavelength = 1;         ///< L [m] (Taylor–Green)
-  double rate = 0;               ///< s [1/s] (strain)
+  double amplitude = 1;   ///< U [m/s] (Taylor–Green)
+  double wavelength = 1;  ///< L [m] (Taylor–Green)
+  double rate = 0;        ///< s [1/s] (strain)
   /// A [1/s] (linear), row-major: u = a[0] x + a[1] y, v = a[2] x + a[3] y.
   std::array<double, 4> gradient{0, 0, 0, 0};
-  Vec2d origin{0, 0};            ///< where x = y = 0 [m]
+  Vec2d origin{0, 0};  ///< where x = y = 0 [m]
 
   /// The field's velocity at world point `p` [m/s] (zero for None).
   Vec2d at(const Vec2d& p) const {
@@ -37,10 +37,12 @@ struct VelocityFieldDef {
         return Vec2d(-amplitude * std::cos(k * q.x()) * std::sin(k * q.y()),
                      amplitude * std::sin(k * q.x()) * std::cos(k * q.y()));
       }
-      case Type::Strain: return Vec2d(-rate * q.x(), rate * q.y());
+      case Type::Strain:
+        return Vec2d(-rate * q.x(), rate * q.y());
       case Type::Linear:
         return Vec2d(gradient[0] * q.x() + gradient[1] * q.y(), gradient[2] * q.x() + gradient[3] * q.y());
-      case Type::None: break;
+      case Type::None:
+        break;
     }
     return Vec2d(0, 0);
   }
@@ -51,14 +53,14 @@ struct VelocityFieldDef {
 struct FluidBlockDef {
   /// What the region is inside its bounding rectangle.
   enum class Shape { Box, Circle, Polygon };
-  Vec2d min{0, 0};               ///< lower-left corner [m] (of the bounding box for a circle or polygon)
-  Vec2d max{1, 1};               ///< upper-right corner [m]
-  Vec2d velocity{0, 0};          ///< initial velocity [m/s]
-  VelocityFieldDef field;        ///< initial velocity field added to `velocity`
+  Vec2d min{0, 0};         ///< lower-left corner [m] (of the bounding box for a circle or polygon)
+  Vec2d max{1, 1};         ///< upper-right corner [m]
+  Vec2d velocity{0, 0};    ///< initial velocity [m/s]
+  VelocityFieldDef field;  ///< initial velocity field added to `velocity`
   Shape shape = Shape::Box;
-  Vec2d center{0, 0};            ///< circle centre [m]
-  double radius = 0;             ///< circle radius [m]
-  std::vector<Vec2d> vertices;   ///< polygon corners [m], either orientation; filled by the even-odd rule
+  Vec2d center{0, 0};           ///< circle centre [m]
+  double radius = 0;            ///< circle radius [m]
+  std::vector<Vec2d> vertices;  ///< polygon corners [m], either orientation; filled by the even-odd rule
 
   /// The x where the polygon's edges cross the horizontal line at `y`, ascending (empty
   /// for a box or circle). A point (x, y) is inside the polygon when an odd number of

@@ -23,7 +23,7 @@ namespace sph2d {
 /// A 2D vector of T: two values, no padding (std::vector<Vector2<float>> is x0 y0 x1 y1 ...).
 template <class T>
 struct Vector2 {
-  using Scalar = T;  ///< the component type
+  using Scalar = T;       ///< the component type
   T v[2] = {T(0), T(0)};  ///< x, y
 
   /// The zero vector.
@@ -73,13 +73,29 @@ struct Vector2 {
   /// Each component divided by s (a division each, not a multiplication by 1/s).
   constexpr Vector2 operator/(T s) const { return Vector2(v[0] / s, v[1] / s); }
   /// Adds o.
-  constexpr Vector2& operator+=(const Vector2& o) { v[0] += o.v[0]; v[1] += o.v[1]; return *this; }
+  constexpr Vector2& operator+=(const Vector2& o) {
+    v[0] += o.v[0];
+    v[1] += o.v[1];
+    return *this;
+  }
   /// Subtracts o.
-  constexpr Vector2& operator-=(const Vector2& o) { v[0] -= o.v[0]; v[1] -= o.v[1]; return *this; }
+  constexpr Vector2& operator-=(const Vector2& o) {
+    v[0] -= o.v[0];
+    v[1] -= o.v[1];
+    return *this;
+  }
   /// Multiplies each component by s.
-  constexpr Vector2& operator*=(T s) { v[0] *= s; v[1] *= s; return *this; }
+  constexpr Vector2& operator*=(T s) {
+    v[0] *= s;
+    v[1] *= s;
+    return *this;
+  }
   /// Divides each component by s.
-  constexpr Vector2& operator/=(T s) { v[0] /= s; v[1] /= s; return *this; }
+  constexpr Vector2& operator/=(T s) {
+    v[0] /= s;
+    v[1] /= s;
+    return *this;
+  }
   /// Both components equal.
   constexpr bool operator==(const Vector2& o) const { return v[0] == o.v[0] && v[1] == o.v[1]; }
   /// Some component differs.
@@ -117,12 +133,16 @@ struct Vector2 {
   constexpr T maxCoeff() const { return v[1] > v[0] ? v[1] : v[0]; }
   /// The same vector in another scalar type.
   template <class U>
-  constexpr Vector2<U> cast() const { return Vector2<U>(U(v[0]), U(v[1])); }
+  constexpr Vector2<U> cast() const {
+    return Vector2<U>(U(v[0]), U(v[1]));
+  }
 };
 
 /// s times each component of a.
 template <class T>
-constexpr Vector2<T> operator*(typename Vector2<T>::Scalar s, const Vector2<T>& a) { return Vector2<T>(s * a.v[0], s * a.v[1]); }
+constexpr Vector2<T> operator*(typename Vector2<T>::Scalar s, const Vector2<T>& a) {
+  return Vector2<T>(s * a.v[0], s * a.v[1]);
+}
 
 /// Scalar of the per-particle arrays.
 using Real = float;

@@ -59,13 +59,14 @@ class ArrayView {
 /// A fluid's particles, one read-only array per field, indexed by storage slot.
 /// Optional fields are empty when the World has none of them.
 struct Particles {
-  ArrayView<Vec2> x;                  ///< position, relative to World::origin() [m]
-  ArrayView<Vec2> v;                  ///< velocity [m/s]
-  ArrayView<Real> rho;                ///< density [kg/m³]
-  ArrayView<Real> p;                  ///< pressure [Pa]
-  ArrayView<std::uint32_t> id;        ///< stable identifier
-  ArrayView<Real> age;                ///< optional: time since emission [s] (scenes with lifetimes)
-  ArrayView<std::uint32_t> color;     ///< optional: each particle's own colour 0xRRGGBB (World::setParticleColor; 0 = none)
+  ArrayView<Vec2> x;            ///< position, relative to World::origin() [m]
+  ArrayView<Vec2> v;            ///< velocity [m/s]
+  ArrayView<Real> rho;          ///< density [kg/m³]
+  ArrayView<Real> p;            ///< pressure [Pa]
+  ArrayView<std::uint32_t> id;  ///< stable identifier
+  ArrayView<Real> age;          ///< optional: time since emission [s] (scenes with lifetimes)
+  ArrayView<std::uint32_t>
+      color;  ///< optional: each particle's own colour 0xRRGGBB (World::setParticleColor; 0 = none)
   ArrayView<std::uint32_t> userData;  ///< optional: the game's value per particle (World::setParticleUserData)
   /// optional: 1 + the index of the emitter that made the particle, 0 for one no emitter made
   /// (World::setEmitterTracking; World::particleEmitter gives the index itself)

@@ -35,15 +35,15 @@ struct ShapeDef {
   /// Box2D shape kinds that scenes may use.
   enum class Type { Box, Polygon, Circle, Edge, Chain };
   Type type = Type::Box;
-  Vec2d center{0, 0};            ///< box / circle centre in body coordinates
-  double angle = 0;              ///< box rotation in the body [rad]
-  Vec2d halfSize{0.5, 0.5};      ///< box half extents
-  std::vector<Vec2d> vertices;   ///< polygon / edge (2) / chain vertices in body coordinates
-  double radius = 0.5;           ///< circle radius
-  bool loop = false;             ///< chain closes on itself
-  double friction = 0.2;         ///< fixture friction (Box2D and fluid)
-  double restitution = 0.0;      ///< fixture restitution (Box2D and fluid)
-  double density = 1000.0;       ///< dynamic bodies: mass per area [kg/m²] (the fluid's rest density floats at the surface)
+  Vec2d center{0, 0};           ///< box / circle centre in body coordinates
+  double angle = 0;             ///< box rotation in the body [rad]
+  Vec2d halfSize{0.5, 0.5};     ///< box half extents
+  std::vector<Vec2d> vertices;  ///< polygon / edge (2) / chain vertices in body coordinates
+  double radius = 0.5;          ///< circle radius
+  bool loop = false;            ///< chain closes on itself
+  double friction = 0.2;        ///< fixture friction (Box2D and fluid)
+  double restitution = 0.0;     ///< fixture restitution (Box2D and fluid)
+  double density = 1000.0;  ///< dynamic bodies: mass per area [kg/m²] (the fluid's rest density floats at the surface)
 };
 
 /// A Box2D body with its fixtures: static (a wall), kinematic (moved at a set velocity
@@ -53,10 +53,11 @@ struct BodyDef {
   /// How the body moves.
   enum class Type { Static, Kinematic, Dynamic };
   Type type = Type::Static;
-  Vec2d position{0, 0};          ///< body origin in world coordinates [m]
-  double angle = 0;              ///< body rotation [rad]
-  Vec2d velocity{0, 0};          ///< kinematic: velocity; dynamic: initial velocity of its centre of mass [m/s]
-  double angularVelocity = 0;    ///< kinematic: [rad/s], about `position` (Box2D turns a kinematic body about its origin); dynamic: initial, about its centre of mass
+  Vec2d position{0, 0};        ///< body origin in world coordinates [m]
+  double angle = 0;            ///< body rotation [rad]
+  Vec2d velocity{0, 0};        ///< kinematic: velocity; dynamic: initial velocity of its centre of mass [m/s]
+  double angularVelocity = 0;  ///< kinematic: [rad/s], about `position` (Box2D turns a kinematic body about its
+                               ///< origin); dynamic: initial, about its centre of mass
   std::vector<ShapeDef> fixtures;
 };
 
@@ -66,26 +67,26 @@ struct BodyDef {
 /// must extend at least one support radius beyond it (docs/SCENES.md).
 struct PeriodicDef {
   bool x = false, y = false;
-  Vec2d min{0, 0};               ///< lower corner of the periodic box (used per periodic axis)
-  Vec2d max{0, 0};               ///< upper corner
+  Vec2d min{0, 0};  ///< lower corner of the periodic box (used per periodic axis)
+  Vec2d max{0, 0};  ///< upper corner
   /// True when some axis wraps.
   bool any() const { return x || y; }
 };
 
 /// Pressure solver and its numerical parameters.
 struct SolverDef {
-  std::string type = "muller2003";  ///< pressure solver
-  double spacing = 0.02;            ///< particle spacing dx [m]
-  double supportRatio = 2.5;        ///< kernel support R = supportRatio · dx
-  double restDensity = 1000;        ///< ρ0 [kg/m³]
-  double soundSpeed = 25;           ///< c: p = c²(ρ − ρ0) (stiffness K = c²) [m/s]
-  double viscosity = 0.01;          ///< kinematic viscosity ν [m²/s] (muller2003 heats up below ~0.005)
-  bool noSlip = false;              ///< viscosity also acts between the fluid and the walls (no-slip walls)
-  double cfl = 0.25;                ///< dt ≤ cfl · R / (c + v_max)
-  int maxSubsteps = 400;            ///< cap per frame; beyond it the frame advances less time
-  bool clampNegativePressure = true;///< p = max(p, 0): no tension at the free surface
-  int reorderInterval = 1;          ///< reorder particles along the grid every N substeps (0: never)
-  double maxSpeed = 500;            ///< the guard stops a run above this speed [m/s]
+  std::string type = "muller2003";    ///< pressure solver
+  double spacing = 0.02;              ///< particle spacing dx [m]
+  double supportRatio = 2.5;          ///< kernel support R = supportRatio · dx
+  double restDensity = 1000;          ///< ρ0 [kg/m³]
+  double soundSpeed = 25;             ///< c: p = c²(ρ − ρ0) (stiffness K = c²) [m/s]
+  double viscosity = 0.01;            ///< kinematic viscosity ν [m²/s] (muller2003 heats up below ~0.005)
+  bool noSlip = false;                ///< viscosity also acts between the fluid and the walls (no-slip walls)
+  double cfl = 0.25;                  ///< dt ≤ cfl · R / (c + v_max)
+  int maxSubsteps = 400;              ///< cap per frame; beyond it the frame advances less time
+  bool clampNegativePressure = true;  ///< p = max(p, 0): no tension at the free surface
+  int reorderInterval = 1;            ///< reorder particles along the grid every N substeps (0: never)
+  double maxSpeed = 500;              ///< the guard stops a run above this speed [m/s]
   /// Solver-specific parameters (each solver declares its keys, defaults and
   /// ranges; the loader fills every declared key, with its default when absent).
   std::map<std::string, double> params;
@@ -111,18 +112,18 @@ SolverDef solverDefaults(const std::string& type);
 struct CameraDef {
   Vec2d min{0, 0};
   Vec2d max{0, 0};
-  bool automatic = true;            ///< fit the boundaries when no camera is given
+  bool automatic = true;  ///< fit the boundaries when no camera is given
 };
 
 /// Renderer settings (used by sph2d::render; the engine ignores them).
 struct RenderDef {
   int width = 960;
   int height = 540;
-  std::string mode = "liquid";      ///< "liquid" or "particles"
+  std::string mode = "liquid";  ///< "liquid" or "particles"
   std::array<double, 3> background{0.06, 0.07, 0.09};
   std::array<double, 3> water{0.10, 0.45, 0.85};
   std::array<double, 3> solid{0.55, 0.52, 0.48};
-  double splatRadius = 2.0;         ///< splat radius in particle spacings
+  double splatRadius = 2.0;  ///< splat radius in particle spacings
   CameraDef camera;
 };
 
@@ -131,13 +132,15 @@ struct RegionDef {
   Vec2d min{0, 0};
   Vec2d max{0, 0};
   /// True when p lies inside (boundary included).
-  bool contains(const Vec2d& p) const { return p.x() >= min.x() && p.y() >= min.y() && p.x() <= max.x() && p.y() <= max.y(); }
+  bool contains(const Vec2d& p) const {
+    return p.x() >= min.x() && p.y() >= min.y() && p.x() <= max.x() && p.y() <= max.y();
+  }
 };
 
 /// A constant acceleration, everywhere or in a region (wind, currents).
 struct ForceFieldDef {
-  Vec2d acceleration{0, 0};   ///< m/s²
-  bool everywhere = true;     ///< false: only inside `region`
+  Vec2d acceleration{0, 0};  ///< m/s²
+  bool everywhere = true;    ///< false: only inside `region`
   RegionDef region;
 };
 
@@ -145,9 +148,9 @@ struct ForceFieldDef {
 /// "akinci": cohesion + curvature of Akinci, Akinci & Teschner 2013.
 struct SurfaceTensionDef {
   std::string model = "akinci";
-  double sigma = 0.0728;      ///< csf: surface tension coefficient [N/m]
-  double gamma = 1.0;         ///< akinci: cohesion/curvature strength (dimensionless scale of σ)
-  double threshold = 0.1;     ///< csf: |∇c| below threshold·(1/R) is not surface
+  double sigma = 0.0728;   ///< csf: surface tension coefficient [N/m]
+  double gamma = 1.0;      ///< akinci: cohesion/curvature strength (dimensionless scale of σ)
+  double threshold = 0.1;  ///< csf: |∇c| below threshold·(1/R) is not surface
 };
 
 /// An emitter of the particle system (emitters, lifetimes, forces, as in the
@@ -155,16 +158,16 @@ struct SurfaceTensionDef {
 /// of `width`, shooting along `direction`.
 struct EmitterDef {
   Vec2d position{0, 0};
-  Vec2d direction{0, -1};     ///< normalised by the loader
-  double width = 0;           ///< nozzle width across the direction [m] (0: a point)
-  double rate = 100;          ///< particles per second
-  double speed = 2;           ///< m/s along the direction
-  double spread = 0;          ///< full cone angle of random directions [rad]
-  double jitter = 0;          ///< random speed variation, fraction of speed
-  double start = 0;           ///< s
-  double stop = 1e30;         ///< s
-  std::uint64_t seed = 1;     ///< per-emitter random seed: same seed, same particles
-  bool enabled = true;        ///< input events may switch it
+  Vec2d direction{0, -1};  ///< normalised by the loader
+  double width = 0;        ///< nozzle width across the direction [m] (0: a point)
+  double rate = 100;       ///< particles per second
+  double speed = 2;        ///< m/s along the direction
+  double spread = 0;       ///< full cone angle of random directions [rad]
+  double jitter = 0;       ///< random speed variation, fraction of speed
+  double start = 0;        ///< s
+  double stop = 1e30;      ///< s
+  std::uint64_t seed = 1;  ///< per-emitter random seed: same seed, same particles
+  bool enabled = true;     ///< input events may switch it
   // The ranges a scene's `effects.emitters[]` and World::addEmitter accept (0 up to these).
   static constexpr double kMaxWidth = 1e4, kMaxRate = 1e8, kMaxSpeed = 1e4, kMaxSpread = 6.2832, kMaxJitter = 1;
   static constexpr double kMaxStart = 1e9, kMaxStop = 1e30;
@@ -180,24 +183,24 @@ enum class BudgetPolicy {
 /// The effects a scene calls for. Absent effects cost nothing.
 struct EffectsDef {
   bool xsph = false;
-  double xsphC = 0.05;                      ///< XSPH velocity smoothing factor
-  bool shifting = false;                    ///< particle shifting (Lind et al. 2012)
-  double shiftingStrength = 2;              ///< A in D = A h v_max dt
+  double xsphC = 0.05;          ///< XSPH velocity smoothing factor
+  bool shifting = false;        ///< particle shifting (Lind et al. 2012)
+  double shiftingStrength = 2;  ///< A in D = A h v_max dt
   std::vector<ForceFieldDef> forceFields;
   bool surfaceTension = false;
   SurfaceTensionDef tension;
   bool lifetime = false;
-  double maxAge = 10;                       ///< s: older particles are removed
+  double maxAge = 10;  ///< s: older particles are removed
   std::vector<RegionDef> sinks;
   std::vector<EmitterDef> emitters;
-  std::size_t budget = 0;                   ///< particle budget (0: max_particles)
+  std::size_t budget = 0;  ///< particle budget (0: max_particles)
   BudgetPolicy budgetPolicy = BudgetPolicy::StopEmitting;
 };
 
 /// A whole scene: the solids, the fluid, the solver, the clock and the camera.
 struct SceneDef {
   std::string name = "scene";
-  std::string path;                 ///< file it came from ("" when built in code)
+  std::string path;  ///< file it came from ("" when built in code)
   Vec2d gravity{0, -9.81};
   /// Real time unless the program names another: the game preset (qualityPreset("game")). To
   /// name a solver, start from its own defaults (`solver = solverDefaults("wcsph")` or
@@ -206,13 +209,13 @@ struct SceneDef {
   SolverDef solver = qualityPreset("game");
   std::vector<BodyDef> bodies;
   std::vector<FluidBlockDef> blocks;
-  PeriodicDef periodic;             ///< periodic axes (none by default)
-  double fps = 60;                  ///< frames per simulated second
-  double duration = 4;              ///< simulated seconds the app renders
-  std::size_t maxParticles = 4000000;///< refuse scenes with more particles than this
+  PeriodicDef periodic;                ///< periodic axes (none by default)
+  double fps = 60;                     ///< frames per simulated second
+  double duration = 4;                 ///< simulated seconds the app renders
+  std::size_t maxParticles = 4000000;  ///< refuse scenes with more particles than this
   EffectsDef effects;
   RenderDef render;
-  std::vector<EventDef> events;     ///< the timeline (`events`), in file order, each stamped
+  std::vector<EventDef> events;  ///< the timeline (`events`), in file order, each stamped
 };
 
 /// Loads and validates a scene file. Throws SceneError.

@@ -12,15 +12,16 @@
 #include <atomic>
 #include <cstdint>
 #include <functional>
-#include <type_traits>
 #include <iosfwd>
 #include <iterator>
 #include <memory>
 #include <stdexcept>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include "sph2d/boundary.hpp"
+#include "sph2d/id_range.hpp"
 #include "sph2d/particles.hpp"
 #include "sph2d/scene.hpp"
 
@@ -38,10 +39,10 @@ class SimulationError : public std::runtime_error {
   /// Builds the error with a full diagnosis in what().
   SimulationError(const std::string& what, std::string stage, std::uint32_t particleId, std::uint64_t step,
                   double time);
-  std::string stage;          ///< stage that produced the bad value
-  std::uint32_t particleId;   ///< id of the first bad particle
-  std::uint64_t step;         ///< substep counter
-  double time;                ///< simulated time [s]
+  std::string stage;         ///< stage that produced the bad value
+  std::uint32_t particleId;  ///< id of the first bad particle
+  std::uint64_t step;        ///< substep counter
+  double time;               ///< simulated time [s]
 };
 
 /// The World was asked to stop (its stop flag, WorldOptions::stop or World::setStopFlag, was
@@ -58,7 +59,7 @@ class Interrupted : public std::runtime_error {
 
 /// Options of a World that are not part of the scene.
 struct WorldOptions {
-  int threads = 0;            ///< job-system threads; 0 = all hardware threads
+  int threads = 0;  ///< job-system threads; 0 = all hardware threads
   /// A flag the caller may set from any thread or a signal handler (an atomic<bool> is
   /// lock-free here) to make the World stop what it is doing within milliseconds: it is read
   /// between the stages of a substep, before each block of the job system's work and every
@@ -78,60 +79,9 @@ struct StageTiming {
 
 /// A push/pull at a point, set at run time (the mouse of a game).
 struct UserForce {
-  Vec2d point{0, 0};   ///< world coordinates [m]
-  double radius = 0.5; ///< reach [m]
-  double strength = 0; ///< acceleration at the centre [m/s²]; > 0 pulls towards the point, < 0 pushes away
-};
-
-/// The ids of the particles one call added (World::addBlock, addDrop, addShape, addParticles):
-/// `count` consecutive ids from `first`. A World gives each particle it makes the next id, one
-/// after the other, so those one call adds are consecutive, the budget cutting it short or not
-/// (the points it skips take no id). A range of ids: `for (std::uint32_t id : added)`,
-/// `added[k]`, `added.contains(id)`; `ids()` copies them into a vector.
-struct IdRange {
-  std::uint32_t first = 0;  ///< the first id added (when none was: the id the next particle will get)
-  std::size_t count = 0;    ///< how many were added
-
-  /// True when the call added nothing.
-  bool empty() const { return count == 0; }
-  /// How many were added (count).
-  std::size_t size() const { return count; }
-  /// The k-th id added (k < count).
-  std::uint32_t operator[](std::size_t k) const { return first + std::uint32_t(k); }
-  /// True when `id` is one of the ids added.
-  bool contains(std::uint32_t id) const { return id >= first && std::size_t(id - first) < count; }
-  /// The same ids.
-  bool operator==(const IdRange& o) const { return first == o.first && count == o.count; }
-  /// Other ids.
-  bool operator!=(const IdRange& o) const { return !(*this == o); }
-  /// The ids, in increasing order, as a vector (for removeParticles, setVelocities, ...).
-  std::vector<std::uint32_t> ids() const {
-    std::vector<std::uint32_t> out(count);
-    for (std::size_t k = 0; k < count; ++k) out[k] = (*this)[k];
-    return out;
-  }
-  /// Walks the ids in increasing order.
-  class iterator {
-   public:
-    using iterator_category = std::forward_iterator_tag;
-    using value_type = std::uint32_t;
-    using difference_type = std::ptrdiff_t;
-    using pointer = const std::uint32_t*;
-    using reference = std::uint32_t;
-    iterator() = default;
-    explicit iterator(std::uint32_t id) : id_(id) {}
-    std::uint32_t operator*() const { return id_; }
-    iterator& operator++() { ++id_; return *this; }
-    iterator operator++(int) { iterator t = *this; ++id_; return t; }
-    bool operator==(const iterator& o) const { return id_ == o.id_; }
-    bool operator!=(const iterator& o) const { return id_ != o.id_; }
-   private:
-    std::uint32_t id_ = 0;
-  };
-  /// The first id.
-  iterator begin() const { return iterator(first); }
-  /// One past the last id.
-  iterator end() const { return iterator(first + std::uint32_t(count)); }
+  Vec2d point{0, 0};    ///< world coordinates [m]
+  double radius = 0.5;  ///< reach [m]
+  double strength = 0;  ///< acceleration at the centre [m/s²]; > 0 pulls towards the point, < 0 pushes away
 };
 
 /// A saved state that World::load refuses: not a save, another scene's, or damaged.
@@ -166,10 +116,10 @@ struct SaveReport {
 
 /// What an iterative pressure solver did in its last substep (all zero for explicit solvers).
 struct SolverStats {
-  int pressureIterations = 0;     ///< constant-density (pressure) solve iterations
-  int divergenceIterations = 0;   ///< divergence-free solve iterations (0 when disabled)
-  double densityError = 0;        ///< mean predicted density error /ρ0 after the pressure solve (solver-defined residual)
-  double divergenceError = 0;     ///< mean |Dρ/Dt|·dt/ρ0 after the divergence solve (solver-defined residual)
+  int pressureIterations = 0;    ///< constant-density (pressure) solve iterations
+  int divergenceIterations = 0;  ///< divergence-free solve iterations (0 when disabled)
+  double densityError = 0;     ///< mean predicted density error /ρ0 after the pressure solve (solver-defined residual)
+  double divergenceError = 0;  ///< mean |Dρ/Dt|·dt/ρ0 after the divergence solve (solver-defined residual)
 };
 
 /// Density error of the fluid, relative to ρ0.

@@ -10,7 +10,9 @@
 namespace sph2d {
 
 template <class B2, World::IfB2<B2>>
-inline void World::setGravity(const B2& g) { setGravity(Vec2d(g.x, g.y)); }
+inline void World::setGravity(const B2& g) {
+  setGravity(Vec2d(g.x, g.y));
+}
 
 template <class B2, World::IfB2<B2>>
 inline IdRange World::addDrop(const B2& center, double radius, const B2& velocity) {
@@ -68,7 +70,9 @@ inline std::vector<std::size_t> World::particlesInBox(const B2& lo, const B2& hi
 }
 
 template <class B2, World::IfB2<B2>>
-inline World::FieldSample World::sampleAt(const B2& point) const { return sampleAt(Vec2d(point.x, point.y)); }
+inline World::FieldSample World::sampleAt(const B2& point) const {
+  return sampleAt(Vec2d(point.x, point.y));
+}
 
 template <class B2, World::IfB2<B2>>
 inline void World::moveEmitter(std::size_t index, const B2& position, const B2& direction) {
@@ -96,7 +100,8 @@ inline std::size_t World::setPositions(const std::vector<std::uint32_t>& ids, co
 }
 
 template <class B2, World::IfB2<B2>>
-inline std::size_t World::getParticles(const std::vector<std::uint32_t>& ids, std::vector<B2>& positions, std::vector<B2>& velocities) const {
+inline std::size_t World::getParticles(const std::vector<std::uint32_t>& ids, std::vector<B2>& positions,
+                                       std::vector<B2>& velocities) const {
   std::vector<Vec2d> p, v;
   const std::size_t found = getParticles(ids, p, v);
   positions.resize(p.size());
@@ -104,7 +109,7 @@ inline std::size_t World::getParticles(const std::vector<std::uint32_t>& ids, st
   for (std::size_t k = 0; k < p.size(); ++k) {
     positions[k].Set(float(p[k].x()), float(p[k].y()));
     velocities[k].Set(float(v[k].x()), float(v[k].y()));
-}
+  }
   return found;
 }
 

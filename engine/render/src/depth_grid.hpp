@@ -47,10 +47,10 @@ class DepthGrid {
 
   int w_ = 0, h_ = 0, cell_ = 0;
   bool solidsStale_ = true;
-  std::vector<float> cover_, aux_;         // coverage per cell; RG = depth above, local fill
-  std::vector<float> carry_, above_;       // one row each: depth carried down, blurred along the row
-  std::vector<float> open_;                // one row: 1 where the cell is not solid
-  std::vector<std::uint8_t> solid_;        // 1 where a cell's centre lies in a solid
+  std::vector<float> cover_, aux_;    // coverage per cell; RG = depth above, local fill
+  std::vector<float> carry_, above_;  // one row each: depth carried down, blurred along the row
+  std::vector<float> open_;           // one row: 1 where the cell is not solid
+  std::vector<std::uint8_t> solid_;   // 1 where a cell's centre lies in a solid
   std::vector<std::uint8_t> active_, activeTmp_;
 };
 

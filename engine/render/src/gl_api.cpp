@@ -15,7 +15,7 @@ const Api kLinked = {
 #define SPH2D_GL_LINKED(name) &::gl##name,
     SPH2D_GL_FUNCTIONS(SPH2D_GL_LINKED)
 #undef SPH2D_GL_LINKED
-    "linked"};
+        "linked"};
 
 Api resolveOsmesa() {
   Api a{};

@@ -9,18 +9,18 @@ namespace sph2d::gl {
 namespace {
 
 const GLenum kPixelStore[] = {
-    GL_UNPACK_SWAP_BYTES, GL_UNPACK_LSB_FIRST,  GL_UNPACK_ROW_LENGTH, GL_UNPACK_IMAGE_HEIGHT, GL_UNPACK_SKIP_ROWS,
-    GL_UNPACK_SKIP_PIXELS, GL_UNPACK_SKIP_IMAGES, GL_UNPACK_ALIGNMENT,
-    GL_PACK_SWAP_BYTES,   GL_PACK_LSB_FIRST,    GL_PACK_ROW_LENGTH,   GL_PACK_IMAGE_HEIGHT,   GL_PACK_SKIP_ROWS,
-    GL_PACK_SKIP_PIXELS,  GL_PACK_SKIP_IMAGES,  GL_PACK_ALIGNMENT};
+    GL_UNPACK_SWAP_BYTES, GL_UNPACK_LSB_FIRST,   GL_UNPACK_ROW_LENGTH,  GL_UNPACK_IMAGE_HEIGHT,
+    GL_UNPACK_SKIP_ROWS,  GL_UNPACK_SKIP_PIXELS, GL_UNPACK_SKIP_IMAGES, GL_UNPACK_ALIGNMENT,
+    GL_PACK_SWAP_BYTES,   GL_PACK_LSB_FIRST,     GL_PACK_ROW_LENGTH,    GL_PACK_IMAGE_HEIGHT,
+    GL_PACK_SKIP_ROWS,    GL_PACK_SKIP_PIXELS,   GL_PACK_SKIP_IMAGES,   GL_PACK_ALIGNMENT};
 
 /// The value setDrawState() gives a pixel-store parameter: GL's initial one.
 GLint pixelStoreDefault(GLenum p) { return p == GL_UNPACK_ALIGNMENT || p == GL_PACK_ALIGNMENT ? 4 : 0; }
 
 /// Capabilities the passes want off (glDisable), in both profiles.
-const GLenum kOff[] = {GL_DEPTH_TEST,        GL_STENCIL_TEST,      GL_CULL_FACE,       GL_SCISSOR_TEST,
-                       GL_RASTERIZER_DISCARD, GL_COLOR_LOGIC_OP,    GL_FRAMEBUFFER_SRGB, GL_SAMPLE_ALPHA_TO_COVERAGE,
-                       GL_SAMPLE_COVERAGE,   GL_SAMPLE_MASK,       GL_POLYGON_SMOOTH};
+const GLenum kOff[] = {GL_DEPTH_TEST,         GL_STENCIL_TEST,   GL_CULL_FACE,        GL_SCISSOR_TEST,
+                       GL_RASTERIZER_DISCARD, GL_COLOR_LOGIC_OP, GL_FRAMEBUFFER_SRGB, GL_SAMPLE_ALPHA_TO_COVERAGE,
+                       GL_SAMPLE_COVERAGE,    GL_SAMPLE_MASK,    GL_POLYGON_SMOOTH};
 /// Capabilities the passes want on (glEnable): sprite sizes from the shader; dithering as in a
 /// fresh context (llvmpipe does not dither; a driver that does dithers both paths alike).
 const GLenum kOn[] = {GL_PROGRAM_POINT_SIZE, GL_DITHER};
@@ -47,7 +47,8 @@ ContextInfo currentContext() {
     throw std::runtime_error("the current context is " + c.version + " (" + c.renderer +
                              "); sph2d's renderer needs desktop OpenGL 3.3 or later");
   if (std::sscanf(version, "%d.%d", &c.major, &c.minor) != 2)
-    throw std::runtime_error("the current context's GL_VERSION '" + c.version + "' does not start with a version number");
+    throw std::runtime_error("the current context's GL_VERSION '" + c.version +
+                             "' does not start with a version number");
   if (c.major < 3 || (c.major == 3 && c.minor < 3))
     throw std::runtime_error("sph2d's renderer needs OpenGL 3.3 or later; the current context is OpenGL " + c.version +
                              " (" + c.renderer + ")");
@@ -74,10 +75,10 @@ void setDrawState(const ContextInfo& ctx) {
   glDisable(GL_BLEND);  // every draw buffer; a pass enables it around its own draws
   for (GLenum cap : kOn) glEnable(cap);
   if (ctx.compatibility) {
-    glDisable(GL_ALPHA_TEST);    // would drop the discs' soft edges
-    glEnable(GL_POINT_SPRITE);   // gl_PointCoord is undefined without it
+    glDisable(GL_ALPHA_TEST);                              // would drop the discs' soft edges
+    glEnable(GL_POINT_SPRITE);                             // gl_PointCoord is undefined without it
     glClampColor(GL_CLAMP_FRAGMENT_COLOR, GL_FIXED_ONLY);  // the float splat target must not clamp at 1
-    glDisable(GL_POLYGON_STIPPLE);  // would punch holes in every triangle
+    glDisable(GL_POLYGON_STIPPLE);                         // would punch holes in every triangle
     for (GLenum p : kTransferScale) glPixelTransferf(p, 1.0f);
     for (GLenum p : kTransferBias) glPixelTransferf(p, 0.0f);
     for (GLenum p : kTransferInt) glPixelTransferi(p, 0);

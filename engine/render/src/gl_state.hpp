@@ -24,14 +24,14 @@ namespace sph2d::gl {
 
 /// What a Renderer needs to know of the context it draws in.
 struct ContextInfo {
-  std::string renderer;       ///< GL_RENDERER
-  std::string version;        ///< GL_VERSION, e.g. "4.5 (Core Profile) Mesa 22.3.6"
-  int major = 0, minor = 0;   ///< the version's numbers
-  bool compatibility = false; ///< a compatibility-profile context (alpha test, point sprites, colour clamping exist)
-  bool copyImage = false;     ///< glCopyImageSubData (OpenGL 4.3 or GL_ARB_copy_image); else rows are blitted
-  bool perBufferBlend = false;///< blend functions and equations per draw buffer (OpenGL 4.0)
-  int clipDistances = 0;      ///< GL_MAX_CLIP_DISTANCES
-  int drawBuffers = 1;        ///< GL_MAX_DRAW_BUFFERS
+  std::string renderer;         ///< GL_RENDERER
+  std::string version;          ///< GL_VERSION, e.g. "4.5 (Core Profile) Mesa 22.3.6"
+  int major = 0, minor = 0;     ///< the version's numbers
+  bool compatibility = false;   ///< a compatibility-profile context (alpha test, point sprites, colour clamping exist)
+  bool copyImage = false;       ///< glCopyImageSubData (OpenGL 4.3 or GL_ARB_copy_image); else rows are blitted
+  bool perBufferBlend = false;  ///< blend functions and equations per draw buffer (OpenGL 4.0)
+  int clipDistances = 0;        ///< GL_MAX_CLIP_DISTANCES
+  int drawBuffers = 1;          ///< GL_MAX_DRAW_BUFFERS
 };
 
 /// Probes the context current on the calling thread. Throws std::runtime_error when no context
@@ -75,13 +75,13 @@ class GlStateGuard {
   GLfloat clearColor_[4] = {};
   GLint polygonMode_[2] = {};
   GLint spriteOrigin_ = 0;
-  GLint clampFragment_ = 0;               // compatibility profile only
+  GLint clampFragment_ = 0;                           // compatibility profile only
   std::vector<std::pair<GLenum, GLfloat>> transfer_;  // compatibility: pixel-transfer scales and biases
   std::vector<std::pair<GLenum, GLint>> transferI_;   // compatibility: colour/stencil maps, index shift and offset
-  std::vector<Cap> caps_;                 // glIsEnabled items
-  std::vector<GLboolean> blendOn_;        // GL_BLEND per draw buffer
-  std::vector<BlendFunc> blend_;          // per draw buffer (OpenGL 4.0), else one
-  std::vector<GLboolean> colorMask_;      // 4 per draw buffer
+  std::vector<Cap> caps_;                             // glIsEnabled items
+  std::vector<GLboolean> blendOn_;                    // GL_BLEND per draw buffer
+  std::vector<BlendFunc> blend_;                      // per draw buffer (OpenGL 4.0), else one
+  std::vector<GLboolean> colorMask_;                  // 4 per draw buffer
   std::vector<std::pair<GLenum, GLint>> pixelStore_;
 };
 

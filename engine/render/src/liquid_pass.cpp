@@ -91,8 +91,10 @@ class LiquidPass final : public RenderPass {
   std::pair<int, int> changedRows() const override { return changedRows_; }
   void restoreRows(std::pair<int, int> rows) override {
     if (rows.first >= rows.second) return;
-    if (drawnRows_.first >= drawnRows_.second) drawnRows_ = rows;
-    else drawnRows_ = {std::min(drawnRows_.first, rows.first), std::max(drawnRows_.second, rows.second)};
+    if (drawnRows_.first >= drawnRows_.second)
+      drawnRows_ = rows;
+    else
+      drawnRows_ = {std::min(drawnRows_.first, rows.first), std::max(drawnRows_.second, rows.second)};
   }
 
   void draw(const PassFrame& f, StageTimer& timer, RenderTimings& timings) override {
@@ -143,8 +145,8 @@ class LiquidPass final : public RenderPass {
     f.color.startFrameRows(drawnRows_.first, std::min(drawnRows_.second, EH));
     changedRows_ = drawnRows_;
     if (tileRows_.first < tileRows_.second) {
-      changedRows_.first = changedRows_.first < changedRows_.second ? std::min(changedRows_.first, tileRows_.first)
-                                                                    : tileRows_.first;
+      changedRows_.first =
+          changedRows_.first < changedRows_.second ? std::min(changedRows_.first, tileRows_.first) : tileRows_.first;
       changedRows_.second = std::max(changedRows_.second, tileRows_.second);
     }
     drawnRows_ = tileRows_;
@@ -192,10 +194,10 @@ class LiquidPass final : public RenderPass {
   GLuint fieldTex_ = 0, fieldFbo_ = 0, auxTex_ = 0, tileVao_ = 0, tileVbo_ = 0;
   int fieldW_ = 0, fieldH_ = 0;  // the splat target: full resolution, or half when sprites are wide
   GLsizei tileVertices_ = 0;
-  std::pair<int, int> tileRows_{0, 0};              // target rows this frame's tiles cover
-  std::pair<int, int> drawnRows_{0, 1 << 30};       // rows of the colour target that are not background
-  std::pair<int, int> changedRows_{0, 1 << 30};     // rows the last composite restored or drew
-  std::vector<float> packed_, tiles_;  // particles (x, y, speed, weight) in id order; tile quads
+  std::pair<int, int> tileRows_{0, 0};           // target rows this frame's tiles cover
+  std::pair<int, int> drawnRows_{0, 1 << 30};    // rows of the colour target that are not background
+  std::pair<int, int> changedRows_{0, 1 << 30};  // rows the last composite restored or drew
+  std::vector<float> packed_, tiles_;            // particles (x, y, speed, weight) in id order; tile quads
   DepthGrid grid_;
 };
 

@@ -7,16 +7,16 @@
 #include <unistd.h>
 
 #include <algorithm>
-#include <cstdarg>
-#include <type_traits>
 #include <cerrno>
 #include <cmath>
+#include <cstdarg>
 #include <cstdio>
 #include <cstring>
 #include <fstream>
 #include <numeric>
 #include <sstream>
 #include <stdexcept>
+#include <type_traits>
 
 #include "sph2d/world.hpp"
 
@@ -86,7 +86,9 @@ ParticleSnapshot snapshotOf(const World& world, const Real* age) {
   return s;
 }
 
-void writeBodiesCsvAtomic(const std::string& path, const ParticleSnapshot& s) { writeFileAtomic(path, encodeBodiesCsv(s)); }
+void writeBodiesCsvAtomic(const std::string& path, const ParticleSnapshot& s) {
+  writeFileAtomic(path, encodeBodiesCsv(s));
+}
 
 std::string encodeBodiesCsv(const ParticleSnapshot& s) {
   std::string out;
@@ -99,10 +101,14 @@ std::string encodeBodiesCsv(const ParticleSnapshot& s) {
 }
 
 bool parseExportFormat(const std::string& s, ExportFormat& out) {
-  if (s == "csv") out = ExportFormat::Csv;
-  else if (s == "vtk") out = ExportFormat::VtkBinary;
-  else if (s == "vtk-ascii") out = ExportFormat::VtkAscii;
-  else return false;
+  if (s == "csv")
+    out = ExportFormat::Csv;
+  else if (s == "vtk")
+    out = ExportFormat::VtkBinary;
+  else if (s == "vtk-ascii")
+    out = ExportFormat::VtkAscii;
+  else
+    return false;
   return true;
 }
 
@@ -111,7 +117,8 @@ std::string exportExtension(ExportFormat f) { return f == ExportFormat::Csv ? "c
 std::string tempPathFor(const std::string& path) { return path + ".tmp" + std::to_string(::getpid()); }
 
 void writeFileAtomic(const std::string& path, const std::string& bytes) {
-  if (isSpecialFile(path)) return writeInPlace(path, bytes.data(), bytes.size());  // a device, a FIFO: no rename over it
+  if (isSpecialFile(path))
+    return writeInPlace(path, bytes.data(), bytes.size());  // a device, a FIFO: no rename over it
   const std::string tmp = tempPathFor(path);
   FILE* f = createTempFile(tmp);
   bool ok = std::fwrite(bytes.data(), 1, bytes.size(), f) == bytes.size();
@@ -184,9 +191,12 @@ std::string encodeParticles(const ParticleSnapshot& s, ExportFormat f) {
       appendf(out, "SCALARS %s %s 1\nLOOKUP_TABLE default\n", name, type);
       for (std::size_t k = 0; k < n; ++k) {
         const auto v = get(k);
-        if (bin) putBigEndian(out, v);
-        else if constexpr (std::is_integral_v<decltype(v)>) appendf(out, "%d\n", int(v));
-        else appendf(out, "%.9g\n", double(v));
+        if (bin)
+          putBigEndian(out, v);
+        else if constexpr (std::is_integral_v<decltype(v)>)
+          appendf(out, "%d\n", int(v));
+        else
+          appendf(out, "%.9g\n", double(v));
       }
       if (bin) out += '\n';
     };

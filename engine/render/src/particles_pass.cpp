@@ -102,11 +102,16 @@ class ParticlesPass final : public RenderPass {
   double valueOf(const RenderInput& in, std::size_t i) const {
     const Particles& P = in.particles;
     switch (opt_.colorBy) {
-      case ColorField::Speed: return double(P.v[i].norm());
-      case ColorField::Pressure: return double(P.p[i]);
-      case ColorField::Density: return double(P.rho[i]);
-      case ColorField::Age: return agesOf(in) ? double(agesOf(in)[i]) : 0.0;
-      case ColorField::Color: return 0.0;
+      case ColorField::Speed:
+        return double(P.v[i].norm());
+      case ColorField::Pressure:
+        return double(P.p[i]);
+      case ColorField::Density:
+        return double(P.rho[i]);
+      case ColorField::Age:
+        return agesOf(in) ? double(agesOf(in)[i]) : 0.0;
+      case ColorField::Color:
+        return 0.0;
     }
     return 0.0;
   }

@@ -6,8 +6,8 @@
 #include "sph2d/render/particle_export.hpp"
 
 #include <png.h>
-#include <zlib.h>
 #include <unistd.h>
+#include <zlib.h>
 
 #include <atomic>
 #include <cerrno>
@@ -39,8 +39,8 @@ void flushNothing(png_structp) {}
 
 /// Encodes with `s` into `out`; `rows` points at each row libpng is given (RGBA, or packed RGB
 /// with Input::PackedRgb).
-bool encodeRaw(std::vector<std::uint8_t>* out, int width, int height, png_bytepp rows, const PngSettings& s,
-               char* err, std::size_t errLen) {
+bool encodeRaw(std::vector<std::uint8_t>* out, int width, int height, png_bytepp rows, const PngSettings& s, char* err,
+               std::size_t errLen) {
   png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, nullptr, nullptr, nullptr);
   if (!png) {
     std::snprintf(err, errLen, "png_create_write_struct failed");
@@ -170,7 +170,8 @@ void writePngAtomic(const std::string& path, int width, int height, const std::u
 }
 
 void writeEncodedPngAtomic(const std::string& path, const std::vector<std::uint8_t>& bytes) {
-  if (isSpecialFile(path)) return writeInPlace(path, bytes.data(), bytes.size());  // a device, a FIFO: no rename over it
+  if (isSpecialFile(path))
+    return writeInPlace(path, bytes.data(), bytes.size());  // a device, a FIFO: no rename over it
   const std::string tmp = tempPathFor(path);
   FILE* f = createTempFile(tmp);
   char err[256] = {0};

@@ -31,8 +31,8 @@ void Presenter::check(GLuint fbo, const GLint viewport[4]) {
   if (status != GL_FRAMEBUFFER_COMPLETE) {
     char code[16];
     std::snprintf(code, sizeof code, "0x%x", status);
-    throw std::runtime_error("Renderer::draw: framebuffer " + std::to_string(fbo) + " is not complete (status " +
-                             code + ")");
+    throw std::runtime_error("Renderer::draw: framebuffer " + std::to_string(fbo) + " is not complete (status " + code +
+                             ")");
   }
 }
 

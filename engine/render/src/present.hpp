@@ -5,10 +5,10 @@
 // (shaders/present.frag) fetches the colour target, flipping its top-down rows into GL's
 // bottom-up ones. A draw rather than glBlitFramebuffer: it works into any framebuffer a game
 // has (multisampled, sRGB, several colour attachments: it writes colour output 0 to the first
-// draw buffer, the others masked so they keep what the game drew), and it scales bilinearly when the viewport is not the
-// image's size. At the image's size it copies texels, so the caller gets the very pixels the
-// OSMesa path reads back. It runs with setDrawState()'s state (no blending, depth, stencil,
-// scissor, sRGB conversion), which the GlStateGuard around it gives back afterwards.
+// draw buffer, the others masked so they keep what the game drew), and it scales bilinearly when the viewport is not
+// the image's size. At the image's size it copies texels, so the caller gets the very pixels the OSMesa path reads
+// back. It runs with setDrawState()'s state (no blending, depth, stencil, scissor, sRGB conversion), which the
+// GlStateGuard around it gives back afterwards.
 #pragma once
 
 #include "gl_util.hpp"

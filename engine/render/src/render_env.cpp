@@ -19,14 +19,14 @@ struct EnvPin {
   const char* pinned;  // nullptr: record only
 };
 const EnvPin kEnv[] = {
-    {"GALLIUM_DRIVER", "llvmpipe"},  // softpipe rasterises point sprites differently
+    {"GALLIUM_DRIVER", "llvmpipe"},         // softpipe rasterises point sprites differently
     {"MESA_SHADER_CACHE_DISABLE", "true"},  // hermetic runs: nothing read from or written to ~/.cache
     // Pixels are identical for 0, 1, 2 and 8 (docs/RENDERING.md). 0 rasterises on the GL
     // thread: the simulation's threads already hold the cores, and llvmpipe's own threads
     // only add hand-offs (the demo on 2 cores, median of paired rounds: 4.2 s with 0, 4.5 s
     // with 2; the figures in docs/RENDERING.md).
     {"LP_NUM_THREADS", "0"},
-    {"LP_NATIVE_VECTOR_WIDTH", nullptr},  // measured: 128 and 256 give identical pixels
+    {"LP_NATIVE_VECTOR_WIDTH", nullptr},     // measured: 128 and 256 give identical pixels
     {"GALLIUM_OVERRIDE_CPU_CAPS", nullptr},  // changes pixels when it removes AVX/FMA (measured)
     {"LP_DEBUG", nullptr},
     {"LP_PERF", nullptr},
@@ -42,7 +42,8 @@ std::vector<EnvSetting> pinRenderEnvironment() {
   if (record.empty()) {
     for (const EnvPin& e : kEnv) {
       const char* v = std::getenv(e.name);
-      if (v) record.push_back({e.name, v, "user"});
+      if (v)
+        record.push_back({e.name, v, "user"});
       else if (e.pinned) {
         setenv(e.name, e.pinned, 1);
         record.push_back({e.name, e.pinned, "sph2d"});

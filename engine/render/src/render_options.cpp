@@ -8,22 +8,33 @@
 namespace sph2d {
 
 bool parseColorField(const std::string& s, ColorField& out) {
-  if (s == "speed") out = ColorField::Speed;
-  else if (s == "pressure") out = ColorField::Pressure;
-  else if (s == "density") out = ColorField::Density;
-  else if (s == "age") out = ColorField::Age;
-  else if (s == "color") out = ColorField::Color;
-  else return false;
+  if (s == "speed")
+    out = ColorField::Speed;
+  else if (s == "pressure")
+    out = ColorField::Pressure;
+  else if (s == "density")
+    out = ColorField::Density;
+  else if (s == "age")
+    out = ColorField::Age;
+  else if (s == "color")
+    out = ColorField::Color;
+  else
+    return false;
   return true;
 }
 
 std::string colorFieldName(ColorField f) {
   switch (f) {
-    case ColorField::Speed: return "speed";
-    case ColorField::Pressure: return "pressure";
-    case ColorField::Density: return "density";
-    case ColorField::Age: return "age";
-    case ColorField::Color: return "color";
+    case ColorField::Speed:
+      return "speed";
+    case ColorField::Pressure:
+      return "pressure";
+    case ColorField::Density:
+      return "density";
+    case ColorField::Age:
+      return "age";
+    case ColorField::Color:
+      return "color";
   }
   return "?";
 }

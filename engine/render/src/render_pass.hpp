@@ -18,8 +18,8 @@
 
 #include "camera.hpp"
 #include "gl_util.hpp"
-#include "sprites.hpp"
 #include "sph2d/render/renderer.hpp"
+#include "sprites.hpp"
 
 namespace sph2d {
 
@@ -69,8 +69,8 @@ struct PassFrame {
   const std::vector<std::uint32_t>& order;  ///< particle slots in id order
   const std::vector<float>& weight;         ///< age fade per particle, in id order
   const FrameGeometry& geo;
-  double pxPerM = 0;                        ///< image pixels per metre
-  double spacingPx = 0;                     ///< particle spacing [px]
+  double pxPerM = 0;                            ///< image pixels per metre
+  double spacingPx = 0;                         ///< particle spacing [px]
   float scale[2] = {0, 0}, offset[2] = {0, 0};  ///< local frame → NDC of the targets
   const ColorTarget& color;
 };

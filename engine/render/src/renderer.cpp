@@ -60,7 +60,7 @@ std::vector<double> resolveCamera(const RenderDef& def, const World& world) {
 struct Renderer::Impl {
   RenderDef def;
   RenderOptions opt;
-  bool ownContext = false;                     // an OSMesa context of the Renderer's, else the caller's
+  bool ownContext = false;  // an OSMesa context of the Renderer's, else the caller's
   OSMesaContext ctx = nullptr;
   // The GL functions every call uses (made the thread's by a gl::UseApi at its top): OSMesa's in
   // the own context; in the caller's, the linked ones, or OSMesa's when the linked ones (then
@@ -77,7 +77,7 @@ struct Renderer::Impl {
   SpriteBatch sprites;
   Scenery scenery;
   std::unique_ptr<RenderPass> pass;
-  Presenter presenter;                         // the caller's context only
+  Presenter presenter;  // the caller's context only
   FrameGeometry geo;
   ColorTarget color;
   double spacingSeen = -1;
@@ -138,11 +138,12 @@ struct Renderer::Impl {
                                "thread: make the game's context it was created in current first");
     }
     if (OSMesaGetCurrentContext() != callerOsmesa)
-      throw std::runtime_error(std::string("Renderer::") + call +
-                               ": another OpenGL context is current than the one this Renderer was created in "
-                               "(an OSMesa Renderer's render() leaves its own current); make the game's current (with EGL, "
-                               "eglMakeCurrent(display, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT) first: Mesa's "
-                               "EGL skips making current the context it believes is current already)");
+      throw std::runtime_error(
+          std::string("Renderer::") + call +
+          ": another OpenGL context is current than the one this Renderer was created in "
+          "(an OSMesa Renderer's render() leaves its own current); make the game's current (with EGL, "
+          "eglMakeCurrent(display, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT) first: Mesa's "
+          "EGL skips making current the context it believes is current already)");
     const GLenum err = glGetError();
     if (err != GL_NO_ERROR) {
       char code[16];
@@ -301,9 +302,21 @@ Renderer::Renderer(const RenderDef& def, const RenderOptions& options) : impl_(s
   r.ownContext = true;
   const std::string mode = checkedMode(def, options);
   pinRenderEnvironment();
-  const int attribs[] = {OSMESA_FORMAT, OSMESA_RGBA, OSMESA_DEPTH_BITS, 0, OSMESA_STENCIL_BITS, 0, OSMESA_ACCUM_BITS, 0,
-                         OSMESA_PROFILE, OSMESA_CORE_PROFILE, OSMESA_CONTEXT_MAJOR_VERSION, 3,
-                         OSMESA_CONTEXT_MINOR_VERSION, 3, 0};
+  const int attribs[] = {OSMESA_FORMAT,
+                         OSMESA_RGBA,
+                         OSMESA_DEPTH_BITS,
+                         0,
+                         OSMESA_STENCIL_BITS,
+                         0,
+                         OSMESA_ACCUM_BITS,
+                         0,
+                         OSMESA_PROFILE,
+                         OSMESA_CORE_PROFILE,
+                         OSMESA_CONTEXT_MAJOR_VERSION,
+                         3,
+                         OSMESA_CONTEXT_MINOR_VERSION,
+                         3,
+                         0};
   r.api = &gl::osmesaApi();
   const gl::UseApi use(*r.api);
   r.ctx = OSMesaCreateContextAttribs(attribs, nullptr);

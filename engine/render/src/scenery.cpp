@@ -61,38 +61,38 @@ std::vector<float> solidTriangles(const FrameGeometry& geo, const Vec2d& o, cons
   };
   const double pxX = 2.0 / geo.EW, pxY = 2.0 / geo.EH;
   for (const Collider& c : colliders) {
-      if (c.kind == Collider::Kind::Polygon) {
-        for (std::size_t k = 1; k + 1 < c.vertices.size(); ++k) {
-          put(ndc(c.vertices[0]));
-          put(ndc(c.vertices[k]));
-          put(ndc(c.vertices[k + 1]));
-        }
-      } else if (c.kind == Collider::Kind::Circle) {
-        const int n = 64;
-        for (int k = 0; k < n; ++k) {
-          const Real a0 = 2 * kPi<Real> * Real(k) / n, a1 = 2 * kPi<Real> * Real(k + 1) / n;
-          put(ndc(c.center));
-          put(ndc(c.center + c.radius * Vec2(std::cos(a0), std::sin(a0))));
-          put(ndc(c.center + c.radius * Vec2(std::cos(a1), std::sin(a1))));
-        }
-      } else {
-        // A zero-thickness segment drawn 3 px wide.
-        const auto a = ndc(c.vertices[0]), b = ndc(c.vertices[1]);
-        const double dxp = (b[0] - a[0]) / pxX, dyp = (b[1] - a[1]) / pxY;
-        const double len = std::sqrt(dxp * dxp + dyp * dyp);
-        if (len <= 0) continue;
-        const double nxp = -dyp / len * 1.5, nyp = dxp / len * 1.5;
-        const float ox = float(nxp * pxX), oy = float(nyp * pxY);
-        const std::array<float, 2> p0{a[0] + ox, a[1] + oy}, p1{a[0] - ox, a[1] - oy}, p2{b[0] + ox, b[1] + oy},
-            p3{b[0] - ox, b[1] - oy};
-        put(p0);
-        put(p1);
-        put(p2);
-        put(p2);
-        put(p1);
-        put(p3);
+    if (c.kind == Collider::Kind::Polygon) {
+      for (std::size_t k = 1; k + 1 < c.vertices.size(); ++k) {
+        put(ndc(c.vertices[0]));
+        put(ndc(c.vertices[k]));
+        put(ndc(c.vertices[k + 1]));
       }
+    } else if (c.kind == Collider::Kind::Circle) {
+      const int n = 64;
+      for (int k = 0; k < n; ++k) {
+        const Real a0 = 2 * kPi<Real> * Real(k) / n, a1 = 2 * kPi<Real> * Real(k + 1) / n;
+        put(ndc(c.center));
+        put(ndc(c.center + c.radius * Vec2(std::cos(a0), std::sin(a0))));
+        put(ndc(c.center + c.radius * Vec2(std::cos(a1), std::sin(a1))));
+      }
+    } else {
+      // A zero-thickness segment drawn 3 px wide.
+      const auto a = ndc(c.vertices[0]), b = ndc(c.vertices[1]);
+      const double dxp = (b[0] - a[0]) / pxX, dyp = (b[1] - a[1]) / pxY;
+      const double len = std::sqrt(dxp * dxp + dyp * dyp);
+      if (len <= 0) continue;
+      const double nxp = -dyp / len * 1.5, nyp = dxp / len * 1.5;
+      const float ox = float(nxp * pxX), oy = float(nyp * pxY);
+      const std::array<float, 2> p0{a[0] + ox, a[1] + oy}, p1{a[0] - ox, a[1] - oy}, p2{b[0] + ox, b[1] + oy},
+          p3{b[0] - ox, b[1] - oy};
+      put(p0);
+      put(p1);
+      put(p2);
+      put(p2);
+      put(p1);
+      put(p3);
     }
+  }
   return tri;
 }
 

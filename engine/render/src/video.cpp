@@ -49,16 +49,33 @@ VideoPipe::VideoPipe(const std::string& path, int width, int height, double fps)
   std::string target = path;
   if (!special) {
     temp_ = videoTempPath(path);
-    if (::lstat(temp_.c_str(), &st) == 0) throw std::runtime_error("cannot create " + temp_ + ": " + std::strerror(EEXIST));
+    if (::lstat(temp_.c_str(), &st) == 0)
+      throw std::runtime_error("cannot create " + temp_ + ": " + std::strerror(EEXIST));
     target = temp_;
   }
   char size[32], rate[32];
   std::snprintf(size, sizeof size, "%dx%d", width, height);
   std::snprintf(rate, sizeof rate, "%.9g", fps);
-  std::vector<std::string> args = {exe,        "-hide_banner", "-loglevel", "error",      "-y",
-                                   "-f",       "rawvideo",     "-pixel_format", "rgba",   "-video_size",
-                                   size,       "-framerate",   rate,        "-i",         "pipe:0",
-                                   "-vf",      "pad=ceil(iw/2)*2:ceil(ih/2)*2", "-pix_fmt", "yuv420p", target};
+  std::vector<std::string> args = {exe,
+                                   "-hide_banner",
+                                   "-loglevel",
+                                   "error",
+                                   "-y",
+                                   "-f",
+                                   "rawvideo",
+                                   "-pixel_format",
+                                   "rgba",
+                                   "-video_size",
+                                   size,
+                                   "-framerate",
+                                   rate,
+                                   "-i",
+                                   "pipe:0",
+                                   "-vf",
+                                   "pad=ceil(iw/2)*2:ceil(ih/2)*2",
+                                   "-pix_fmt",
+                                   "yuv420p",
+                                   target};
   for (const auto& a : args) command_ += (command_.empty() ? "" : " ") + a;
   int fds[2];
   if (::pipe(fds) != 0) throw std::runtime_error(std::string("pipe: ") + std::strerror(errno));

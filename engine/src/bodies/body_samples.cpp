@@ -5,7 +5,6 @@
 #include <algorithm>
 #include <cmath>
 
-
 namespace sph2d {
 namespace {
 
@@ -21,7 +20,8 @@ bool sameShapes(const std::vector<Collider>& a, const std::vector<Collider>& b) 
 
 }  // namespace
 
-void BodySamples::place(double time, Real dx, Real R, std::size_t particles, ThreadPool& pool, const MovingSolids& solids) {
+void BodySamples::place(double time, Real dx, Real R, std::size_t particles, ThreadPool& pool,
+                        const MovingSolids& solids) {
   const double tau = time - solids.time0;
   for (Sampled& s : cache) s.used = false;
   placed.assign(solids.bodies.size(), Placed{});

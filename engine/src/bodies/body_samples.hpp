@@ -56,17 +56,17 @@ struct BodySamples {
   struct Placed {
     std::uint32_t first = 0, count = 0;
     const Sampled* sampled = nullptr;
-    double c = 1, s = 0;          ///< the rotation at the substep's start
-    Vec2d origin{0, 0};           ///< the body origin there (local frame)
-    Vec2 com = Vec2::Zero();      ///< its centre of mass there
-    Real reach2 = 0;              ///< (the samples' reach from com + R)²: a particle farther sees none
-    bool dynamic = false;         ///< the fluid's force on it is gathered
+    double c = 1, s = 0;      ///< the rotation at the substep's start
+    Vec2d origin{0, 0};       ///< the body origin there (local frame)
+    Vec2 com = Vec2::Zero();  ///< its centre of mass there
+    Real reach2 = 0;          ///< (the samples' reach from com + R)²: a particle farther sees none
+    bool dynamic = false;     ///< the fluid's force on it is gathered
   };
-  std::vector<Placed> placed;     ///< per moving body, in MovingSolids order (empty: none placed)
-  std::vector<Vec2> x;            ///< sample positions (local frame) at the substep's start
-  std::vector<Vec2> v;            ///< sample velocities v + ω × r
-  std::vector<Vec2> arm;          ///< sample position − the body's centre of mass
-  std::vector<Real> volume;       ///< Ψ_b [m²]
+  std::vector<Placed> placed;       ///< per moving body, in MovingSolids order (empty: none placed)
+  std::vector<Vec2> x;              ///< sample positions (local frame) at the substep's start
+  std::vector<Vec2> v;              ///< sample velocities v + ω × r
+  std::vector<Vec2> arm;            ///< sample position − the body's centre of mass
+  std::vector<Real> volume;         ///< Ψ_b [m²]
   std::vector<std::uint32_t> body;  ///< the sample's body (index into placed)
 
   /// What the fluid of one block felt from one body's samples: Σ m a and Σ arm × m a.
@@ -83,7 +83,6 @@ struct BodySamples {
   std::vector<std::uint8_t> touched_;  ///< … and whether any block met the body
 
  public:
-
   /// Calls f(k, first, last) for each body k's run [first, last) of a particle's list of moving
   /// samples ml[0, count) (nbr.movingOf: the neighbours stage lists each body's samples together),
   /// in list order.

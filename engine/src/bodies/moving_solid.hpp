@@ -27,26 +27,27 @@ namespace sph2d {
 /// One non-static body of the b2World during a step.
 struct MovingSolid {
   b2Body* body = nullptr;
-  std::vector<Collider> shapes;  ///< polygons (with Box2D's skin) and circles in body coordinates: where the fluid meets the body
+  std::vector<Collider>
+      shapes;  ///< polygons (with Box2D's skin) and circles in body coordinates: where the fluid meets the body
   std::vector<const void*> fixtures;  ///< the b2Fixture of each of `shapes`
-  std::vector<Collider> cores;   ///< the fixtures as Box2D weighs them (polygons without the skin), body coordinates
-  Vec2d com0{0, 0};              ///< centre of mass at the step's start (World's local frame)
-  Vec2d localCenter{0, 0};       ///< centre of mass in body coordinates
-  double angle0 = 0;             ///< angle at the step's start [rad]
-  Vec2d v{0, 0};                 ///< velocity of the centre of mass now [m/s]
-  double omega = 0;              ///< angular velocity now [rad/s]
-  Vec2d drift{0, 0};             ///< position offset that keeps the path continuous across velocity changes
-  double turn = 0;               ///< angle offset, likewise
-  double radius = 0;             ///< the shapes' reach from the centre of mass [m]
-  double area = 0;               ///< the area of its shapes' union [m²]
-  Vec2d centroid{0, 0};          ///< the union's centroid, body coordinates from the centre of mass
-  double invMass = 0;            ///< 1/mass: 0 for a kinematic body (the fluid does not move it)
-  double invInertia = 0;         ///< 1/(rotational inertia about the centre of mass), 0 when it cannot turn
-  Vec2d gravity{0, 0};           ///< the b2World's gravity times the body's gravity scale (dynamic only)
-  double sweptTheta = 0;         ///< the pose the particles last saw it at (the last substep's end; the
-  Vec2d sweptOrigin{0, 0};       ///< capture, or the last step's end when Box2D then moved it elsewhere)
-  Vec2d impulse{0, 0};           ///< the fluid's linear impulse on it during this step [kg m/s]
-  double angularImpulse = 0;     ///< … and angular impulse about the centre of mass [kg m²/s]
+  std::vector<Collider> cores;  ///< the fixtures as Box2D weighs them (polygons without the skin), body coordinates
+  Vec2d com0{0, 0};             ///< centre of mass at the step's start (World's local frame)
+  Vec2d localCenter{0, 0};      ///< centre of mass in body coordinates
+  double angle0 = 0;            ///< angle at the step's start [rad]
+  Vec2d v{0, 0};                ///< velocity of the centre of mass now [m/s]
+  double omega = 0;             ///< angular velocity now [rad/s]
+  Vec2d drift{0, 0};            ///< position offset that keeps the path continuous across velocity changes
+  double turn = 0;              ///< angle offset, likewise
+  double radius = 0;            ///< the shapes' reach from the centre of mass [m]
+  double area = 0;              ///< the area of its shapes' union [m²]
+  Vec2d centroid{0, 0};         ///< the union's centroid, body coordinates from the centre of mass
+  double invMass = 0;           ///< 1/mass: 0 for a kinematic body (the fluid does not move it)
+  double invInertia = 0;        ///< 1/(rotational inertia about the centre of mass), 0 when it cannot turn
+  Vec2d gravity{0, 0};          ///< the b2World's gravity times the body's gravity scale (dynamic only)
+  double sweptTheta = 0;        ///< the pose the particles last saw it at (the last substep's end; the
+  Vec2d sweptOrigin{0, 0};      ///< capture, or the last step's end when Box2D then moved it elsewhere)
+  Vec2d impulse{0, 0};          ///< the fluid's linear impulse on it during this step [kg m/s]
+  double angularImpulse = 0;    ///< … and angular impulse about the centre of mass [kg m²/s]
 
   /// True for a body the fluid pushes (dynamic, with mass).
   bool dynamic() const { return invMass > 0; }

@@ -156,8 +156,8 @@ bool segmentSweep(const Collider& c, const Vec2& p0, const Vec2& p1, Vec2& hit, 
   const Vec2 d = p1 - p0;
   const Real den = cross2(d, e);
   if (den == 0) return false;
-  const Real t = cross2(a - p0, e) / den;   // along the path
-  const Real u = cross2(a - p0, d) / den;   // along the segment
+  const Real t = cross2(a - p0, e) / den;  // along the path
+  const Real u = cross2(a - p0, d) / den;  // along the segment
   if (t < 0 || t > 1 || u < 0 || u > 1) return false;
   hit = p0 + d * t;
   Vec2 n(-e.y(), e.x());
@@ -249,7 +249,8 @@ void BoundarySet::collect(b2World& world, const Vec2d& origin, const std::vector
           }
           break;
         }
-        default: break;
+        default:
+          break;
       }
       colliderFixture.resize(colliders.size(), fx);
     }
@@ -263,7 +264,8 @@ Real colliderSeparation(const Collider& c, const Vec2& p) {
       for (std::size_t k = 0; k < c.vertices.size(); ++k) s = std::max(s, c.normals[k].dot(p - c.vertices[k]));
       return s;
     }
-    case Collider::Kind::Circle: return (p - c.center).norm() - c.radius;
+    case Collider::Kind::Circle:
+      return (p - c.center).norm() - c.radius;
     case Collider::Kind::Segment: {
       const Vec2 a = c.vertices[0], e = c.vertices[1] - a;
       const Real len2 = e.squaredNorm();
@@ -350,7 +352,8 @@ void sampleColliders(const std::vector<Collider>& colliders, Real dx, Real depth
       for (int side = -1; side <= 1; side += 2)
         for (int j = 0; j < layers; ++j)
           for (int i = 0; i < count; ++i) {
-            const Vec2 p = a + (b - a) * ((Real(i) + Real(0.5)) / Real(count)) + n * (Real(side) * dx * (Real(j) + Real(0.5)));
+            const Vec2 p =
+                a + (b - a) * ((Real(i) + Real(0.5)) / Real(count)) + n * (Real(side) * dx * (Real(j) + Real(0.5)));
             // Visible only from the other side: normal pointing away from the sample.
             const Vec2 vn = n * Real(-side);
             add(p, step * dx, vn, vn.dot(a));
@@ -427,8 +430,10 @@ void BoundarySet::buildBins(Real hint) {
   std::vector<std::vector<std::uint32_t>> bins(std::size_t(bnx) * bny);
   for (std::uint32_t k = 0; k < colliders.size(); ++k) {
     const Collider& c = colliders[k];
-    const int x0 = int(std::floor((c.lo.x() - binLo.x()) * invBin)), x1 = int(std::floor((c.hi.x() - binLo.x()) * invBin));
-    const int y0 = int(std::floor((c.lo.y() - binLo.y()) * invBin)), y1 = int(std::floor((c.hi.y() - binLo.y()) * invBin));
+    const int x0 = int(std::floor((c.lo.x() - binLo.x()) * invBin)),
+              x1 = int(std::floor((c.hi.x() - binLo.x()) * invBin));
+    const int y0 = int(std::floor((c.lo.y() - binLo.y()) * invBin)),
+              y1 = int(std::floor((c.hi.y() - binLo.y()) * invBin));
     for (int y = std::max(y0, 0); y <= std::min(y1, bny - 1); ++y)
       for (int x = std::max(x0, 0); x <= std::min(x1, bnx - 1); ++x) bins[std::size_t(y) * bnx + x].push_back(k);
   }
@@ -471,9 +476,15 @@ bool BoundarySet::blocks(const Vec2& a, const Vec2& b) const {
     Vec2 hit, n;
     bool crossed = false;
     switch (c.kind) {
-      case Collider::Kind::Polygon: crossed = polygonSweep(c, a, b, hit, n); break;
-      case Collider::Kind::Circle: crossed = circleSweep(c, a, b, hit, n); break;
-      case Collider::Kind::Segment: crossed = segmentSweep(c, a, b, hit, n); break;
+      case Collider::Kind::Polygon:
+        crossed = polygonSweep(c, a, b, hit, n);
+        break;
+      case Collider::Kind::Circle:
+        crossed = circleSweep(c, a, b, hit, n);
+        break;
+      case Collider::Kind::Segment:
+        crossed = segmentSweep(c, a, b, hit, n);
+        break;
     }
     if (crossed) return true;
   }
@@ -529,9 +540,15 @@ bool BoundarySet::resolve(Vec2& x, Vec2& v, const Vec2& xOld, Real clearance) co
       Vec2 hit, n;
       bool swept = false;
       switch (c.kind) {
-        case Collider::Kind::Polygon: swept = polygonSweep(c, from, x, hit, n); break;
-        case Collider::Kind::Circle: swept = circleSweep(c, from, x, hit, n); break;
-        case Collider::Kind::Segment: swept = segmentSweep(c, from, x, hit, n); break;
+        case Collider::Kind::Polygon:
+          swept = polygonSweep(c, from, x, hit, n);
+          break;
+        case Collider::Kind::Circle:
+          swept = circleSweep(c, from, x, hit, n);
+          break;
+        case Collider::Kind::Segment:
+          swept = segmentSweep(c, from, x, hit, n);
+          break;
       }
       if (swept) {
         x = hit + n * clearance;
@@ -540,9 +557,15 @@ bool BoundarySet::resolve(Vec2& x, Vec2& v, const Vec2& xOld, Real clearance) co
       }
       bool pushed = false;
       switch (c.kind) {
-        case Collider::Kind::Polygon: pushed = polygonPush(c, x, clearance, n); break;
-        case Collider::Kind::Circle: pushed = circlePush(c, x, clearance, n); break;
-        case Collider::Kind::Segment: pushed = segmentPush(c, x, from, clearance, n); break;
+        case Collider::Kind::Polygon:
+          pushed = polygonPush(c, x, clearance, n);
+          break;
+        case Collider::Kind::Circle:
+          pushed = circlePush(c, x, clearance, n);
+          break;
+        case Collider::Kind::Segment:
+          pushed = segmentPush(c, x, from, clearance, n);
+          break;
       }
       if (pushed) {
         respond(v, n, c.friction, c.restitution);

@@ -25,9 +25,9 @@
 #include <string>
 #include <vector>
 
+#include "core/kernels.hpp"
 #include "particles/neighbour_grid.hpp"
 #include "sph2d/boundary.hpp"
-#include "core/kernels.hpp"
 
 class b2World;
 
@@ -55,8 +55,8 @@ Real colliderSeparation(const Collider& c, const Vec2& p);
 struct BoundarySet {
   std::vector<Collider> colliders;
   std::vector<const void*> colliderFixture;  ///< the b2Fixture each collider came from (collect)
-  std::vector<Vec2> samples;   ///< boundary sample positions (local frame)
-  std::vector<Real> volume;    ///< Ψ_b [m²]: the area the sample stands for
+  std::vector<Vec2> samples;                 ///< boundary sample positions (local frame)
+  std::vector<Real> volume;                  ///< Ψ_b [m²]: the area the sample stands for
   /// For samples of a two-sided segment: the segment's unit normal n and offset
   /// c (n·x = c), signed so that the sample is on the negative side. A particle
   /// counts the sample only when n·x_i − c > 0. Zero normal for solid samples.
@@ -129,7 +129,8 @@ struct BoundarySet {
   /// The colliders whose bounding box meets the box [lo, hi], each once, into out[0, cap)
   /// in bin order (the bins the box covers): returns how many. `overflow` is set when more
   /// than cap meet it (those are left out). No bin for a non-finite box: 0.
-  std::size_t collidersMeeting(const Vec2& lo, const Vec2& hi, std::uint32_t* out, std::size_t cap, bool& overflow) const;
+  std::size_t collidersMeeting(const Vec2& lo, const Vec2& hi, std::uint32_t* out, std::size_t cap,
+                               bool& overflow) const;
   /// Calls f(k) once for every collider k whose bounding box, grown by `reach`, holds x.
   template <class F>
   void forCollidersNear(const Vec2& x, Real reach, F&& f) const {

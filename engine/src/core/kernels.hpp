@@ -22,8 +22,7 @@ namespace sph2d {
 
 /// Gradient helper: dW/dr times the unit vector d/r, zero at r = 0.
 template <class T>
-inline Vector2<T> radialGradient(const Vector2<T>& d,
-                                                              T r, T dWdr) {
+inline Vector2<T> radialGradient(const Vector2<T>& d, T r, T dWdr) {
   if (!(r > T(0))) return Vector2<T>::Zero();
   return (d / r) * dWdr;  // unit vector first: no overflow for tiny r
 }
@@ -199,7 +198,10 @@ struct WendlandC2 {
   T gradientScale;
   /// Builds the kernel with support radius `support`.
   explicit WendlandC2(T support)
-      : R(support), invR(T(1) / support), s(T(7) / (kPi<T> * support * support)), gradientScale(T(-20) * s * invR * invR) {}
+      : R(support),
+        invR(T(1) / support),
+        s(T(7) / (kPi<T> * support * support)),
+        gradientScale(T(-20) * s * invR * invR) {}
   /// W(r).
   T value(T r) const {
     const T q = r * invR;

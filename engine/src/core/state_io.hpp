@@ -65,8 +65,9 @@ class StateIn {
   template <class T>
   void getVector(std::vector<T>& v, std::size_t most, const char* what) {
     const std::uint64_t n = get<std::uint64_t>(what);
-    if (n > most) throw SaveError(std::string("the saved state is malformed: ") + what + " holds " + std::to_string(n) +
-                                  " entries, at most " + std::to_string(most) + " allowed");
+    if (n > most)
+      throw SaveError(std::string("the saved state is malformed: ") + what + " holds " + std::to_string(n) +
+                      " entries, at most " + std::to_string(most) + " allowed");
     need(std::size_t(n) * sizeof(T), what);
     v.resize(std::size_t(n));
     if (n) std::memcpy(v.data(), p_, std::size_t(n) * sizeof(T));

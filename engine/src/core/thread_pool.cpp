@@ -104,8 +104,7 @@ void ThreadPool::workerLoop(std::size_t self) {
     unsigned spins = 0;
     while (epoch_.load(std::memory_order_acquire) == seen) {
       SPH2D_PAUSE();
-      if (++spins % 256 == 0 &&
-          std::chrono::steady_clock::now() - start > std::chrono::microseconds(100)) {
+      if (++spins % 256 == 0 && std::chrono::steady_clock::now() - start > std::chrono::microseconds(100)) {
         std::unique_lock<std::mutex> lock(mutex_);
         wake_.wait(lock, [&] { return epoch_.load(std::memory_order_acquire) != seen; });
         break;
@@ -152,8 +151,10 @@ void ThreadPool::parallelFor(std::size_t n, std::size_t block,
   runBlocks(0);
   // Wait for blocks other threads hold: spin briefly, then yield the core.
   for (unsigned spins = 0; done_.load(std::memory_order_acquire) != blocks; ++spins) {
-    if (spins < 2048) SPH2D_PAUSE();
-    else std::this_thread::yield();
+    if (spins < 2048)
+      SPH2D_PAUSE();
+    else
+      std::this_thread::yield();
   }
   fn_ = nullptr;
   if (error_) {

@@ -71,13 +71,13 @@ class ThreadPool {
   std::mutex mutex_;
   std::condition_variable wake_;
   std::atomic<unsigned long long> epoch_{0};
-  std::vector<Share> shares_;             ///< per thread (0: the caller), the job's unclaimed blocks
+  std::vector<Share> shares_;                     ///< per thread (0: the caller), the job's unclaimed blocks
   alignas(64) std::atomic<std::size_t> done_{0};  ///< blocks of the job finished
   std::atomic<bool> stop_{false};
   const std::function<void(std::size_t, std::size_t)>* fn_ = nullptr;
   std::size_t n_ = 0, block_ = 1;
   const std::atomic<bool>* cancel_ = nullptr;  ///< setCancel's flag (read after a claim, like fn_)
-  std::atomic<bool> cancelled_{false};          ///< a block of this job was skipped
+  std::atomic<bool> cancelled_{false};         ///< a block of this job was skipped
   /// True when the cancel flag is set (then the job is marked cancelled).
   bool cancelNow() {
     if (!cancel_ || !cancel_->load(std::memory_order_relaxed)) return false;

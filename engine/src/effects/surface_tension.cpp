@@ -113,7 +113,7 @@ class SurfaceTension final : public Effect {
         if (!(n2 > thresh2)) continue;
         const Real inv = Real(1) / std::sqrt(n2);
         const Real hx = nx[i] * inv, hy = ny[i] * inv;  // n̂_i
-        const Real tx = -hy, ty = hx;                     // t̂_i
+        const Real tx = -hy, ty = hx;                   // t̂_i
         Real tgt = 0, tmt = 0;
         const std::uint32_t* nb = c.nbr.of(i);
         for (std::uint32_t q = 0; q < c.nbr.count[i]; ++q) {
@@ -125,9 +125,9 @@ class SurfaceTension final : public Effect {
           c.periodic.nearest(dx, dy);
           const Real a = W.R2 - (dx * dx + dy * dy);
           const Real w = Real(6) * W.c * a * a;  // −W'(r)/r (the volume V0 cancels in κ)
-          const Real tx_ij = tx * dx + ty * dy;                 // t̂·x_ij
+          const Real tx_ij = tx * dx + ty * dy;  // t̂·x_ij
           const Real tdn = tx * (nx[j] * invj - hx) + ty * (ny[j] * invj - hy);
-          tgt -= w * tdn * tx_ij;   // t̂ᵀ Σ V_j (n̂_j − n̂_i) ⊗ ∇W_ij t̂ (without m)
+          tgt -= w * tdn * tx_ij;    // t̂ᵀ Σ V_j (n̂_j − n̂_i) ⊗ ∇W_ij t̂ (without m)
           tmt += w * tx_ij * tx_ij;  // t̂ᵀ Σ V_j (−W'/r) x_ij x_ijᵀ t̂ (without m)
         }
         // The tangential moment is about 1/2 for a particle on a flat surface

@@ -84,8 +84,8 @@ class LaplacianViscosity final : public Effect {
       for (std::size_t i = b; i < e; ++i) {
         const Real xix = X[i].x(), xiy = X[i].y(), vix = V[i].x(), viy = V[i].y();
         Real fx = 0, fy = 0;
-        const Real capI = t.pairCap / IR[i];          // ViscosityTerm::pairCap · ρ_i
-        const Real capWall = capI * c.rho0;          // … · ρ0, for a wall sample's ∇²W
+        const Real capI = t.pairCap / IR[i];  // ViscosityTerm::pairCap · ρ_i
+        const Real capWall = capI * c.rho0;   // … · ρ0, for a wall sample's ∇²W
         const std::uint32_t* nb = c.nbr.of(i);
         const std::uint32_t cnt = c.nbr.count[i];
         for (std::uint32_t k = 0; k < cnt; ++k) {
@@ -124,14 +124,16 @@ class LaplacianViscosity final : public Effect {
             for (const std::uint32_t* p = run; p != runEnd; ++p) {
               const std::uint32_t s = *p;
               const Real rr = (xi - moving->x[s]).squaredNorm();
-              const Vec2 u = (Vec2(vix, viy) - moving->v[s]) * (moving->volume[s] * std::min(W.laplacianR2(rr), capWall));
+              const Vec2 u =
+                  (Vec2(vix, viy) - moving->v[s]) * (moving->volume[s] * std::min(W.laplacianR2(rr), capWall));
               lv += u;
               tv += BodySamples::torque(moving->arm[s], u);
             }
             const Vec2 aBody = -lv * vK;
             acc += aBody;
             if (moving->placed[body].dynamic)
-              moving->addReaction(b / kBlock, body, aBody.cast<double>() * double(c.mass), -double(tv) * double(vK) * double(c.mass));
+              moving->addReaction(b / kBlock, body, aBody.cast<double>() * double(c.mass),
+                                  -double(tv) * double(vK) * double(c.mass));
           });
         }
         P.a[i] += acc;

@@ -147,10 +147,10 @@ struct FieldOperatorOptions {
 template <class K>
 class FieldOperators {
  public:
-  using V = typename K::V;             ///< 2D vector of the kernel's scalar
-  using T = typename V::Scalar;        ///< float or double
-  using M2 = Eigen::Matrix<T, 2, 2>;   ///< 2×2 matrix (fixed size)
-  using E2 = Eigen::Matrix<T, 2, 1>;   ///< V as an Eigen column, for the 2×2 algebra
+  using V = typename K::V;            ///< 2D vector of the kernel's scalar
+  using T = typename V::Scalar;       ///< float or double
+  using M2 = Eigen::Matrix<T, 2, 2>;  ///< 2×2 matrix (fixed size)
+  using E2 = Eigen::Matrix<T, 2, 1>;  ///< V as an Eigen column, for the 2×2 algebra
   static E2 col(const V& a) { return E2(a.x(), a.y()); }
 
   /// Throws std::invalid_argument when the view is incomplete or the search does
@@ -228,7 +228,8 @@ class FieldOperators {
   V gradient(std::size_t i, const T* field) const {
     V g = V::Zero();
     const T ai = field[i];
-    forNeighbours(p_.x[i], [&](std::size_t j, const V& d, T r) { g += k_.gradient(d, r) * (p_.volumeOf(j) * (field[j] - ai)); });
+    forNeighbours(p_.x[i],
+                  [&](std::size_t j, const V& d, T r) { g += k_.gradient(d, r) * (p_.volumeOf(j) * (field[j] - ai)); });
     return g;
   }
 
@@ -311,9 +312,8 @@ class FieldOperators {
     checkField<A>();
     A sum = zero<A>();
     const A ai = field[i];
-    forNeighbours(p_.x[i], [&](std::size_t j, const V&, T r) {
-      sum += A(field[j] - ai) * (p_.volumeOf(j) * k_.laplacian(r));
-    });
+    forNeighbours(p_.x[i],
+                  [&](std::size_t j, const V&, T r) { sum += A(field[j] - ai) * (p_.volumeOf(j) * k_.laplacian(r)); });
     return sum;
   }
 

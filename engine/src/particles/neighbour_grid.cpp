@@ -28,7 +28,9 @@ void Grid::build(const Vec2* x, std::size_t n, Real support, ThreadPool& pool, i
         }
         return bx;
       },
-      [](Box a, Box b) { return Box{std::min(a.x0, b.x0), std::min(a.y0, b.y0), std::max(a.x1, b.x1), std::max(a.y1, b.y1)}; });
+      [](Box a, Box b) {
+        return Box{std::min(a.x0, b.x0), std::min(a.y0, b.y0), std::max(a.x1, b.x1), std::max(a.y1, b.y1)};
+      });
 
   cell = minCell;
   if (n == 0) {
@@ -104,7 +106,8 @@ void Grid::countingSort(std::size_t cells, ThreadPool& pool) {
   constexpr std::size_t kMaxBands = 64;  // on the stack: no allocation in the step
   const std::size_t bands = std::max<std::size_t>(1, std::min({std::size_t(pool.size()), n / 4096, kMaxBands}));
   std::array<std::size_t, kMaxBands + 1> band{};  // band t: cells band[t] .. band[t + 1] − 1
-  for (std::size_t t = 1; t < bands; ++t) band[t] = std::max<std::size_t>(band[t - 1], std::min<std::size_t>(cellOf[t * n / bands], cells));
+  for (std::size_t t = 1; t < bands; ++t)
+    band[t] = std::max<std::size_t>(band[t - 1], std::min<std::size_t>(cellOf[t * n / bands], cells));
   band[bands] = cells;
   std::array<std::uint32_t, kMaxBands> total{}, edge{};
   // cellStart[c + 1] counts cell c, then (a prefix within the band) ends it within the band.

@@ -22,8 +22,8 @@
 #include <cstdint>
 #include <vector>
 
-#include "sph2d/math.hpp"
 #include "core/thread_pool.hpp"
+#include "sph2d/math.hpp"
 
 namespace sph2d {
 
@@ -59,22 +59,23 @@ struct PeriodicBox {
     const Real before = v;
     if (v >= l && v < l + L) return 0;
     v -= L * std::floor((v - l) / L);
-    if (!(v < l + L)) v = l;   // rounding put it on the upper edge
+    if (!(v < l + L)) v = l;  // rounding put it on the upper edge
     if (!(v >= l)) v = l;
     return v - before;
   }
 };
 
 struct Grid {
-  Real cell = 1, invCell = 1;      ///< cell width (x); also the height unless y is periodic
-  Real invCellY = 1;               ///< 1 / cell height
-  int reach = 1;  ///< cells per support radius: a query spans (2·reach + 1)² cells
+  Real cell = 1, invCell = 1;  ///< cell width (x); also the height unless y is periodic
+  Real invCellY = 1;           ///< 1 / cell height
+  int reach = 1;               ///< cells per support radius: a query spans (2·reach + 1)² cells
   Vec2 lo = Vec2::Zero();
   int nx = 1, ny = 1;
-  bool wrapX = false, wrapY = false;  ///< periodic axes
+  bool wrapX = false, wrapY = false;     ///< periodic axes
   std::vector<std::uint32_t> cellStart;  ///< nx·ny + 1 offsets into sorted
   std::vector<std::uint32_t> sorted;     ///< particle indices in cell order (stable)
-  std::vector<std::uint32_t> cellOf;     ///< cell of each slot at the build (stageGrid does not permute it: only the next build reads it)
+  std::vector<std::uint32_t>
+      cellOf;  ///< cell of each slot at the build (stageGrid does not permute it: only the next build reads it)
   bool inOrder = false;  ///< sorted[k] == k: the particles were just reordered along the grid (stageGrid)
 
   /// Rebuilds the grid over positions x[0..n) for neighbours within `support`,

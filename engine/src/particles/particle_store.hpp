@@ -137,8 +137,7 @@ struct ParticleStore {
     std::size_t out = 0;
     for (std::size_t i = 0; i < n; ++i) {
       if (remove[i]) continue;
-      if (out != i)
-        forEachField([&](const char*, auto& field) { field[out] = field[i]; });
+      if (out != i) forEachField([&](const char*, auto& field) { field[out] = field[i]; });
       ++out;
     }
     forEachField([&](const char*, auto& field) { field.resize(out); });

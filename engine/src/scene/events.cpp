@@ -34,8 +34,9 @@ EventDef readEvent(const Reader& r, const nlohmann::json& j, const std::string& 
                    EventStamp stamp, bool allowSource) {
   using T = EventDef::Type;
   static const std::vector<std::pair<std::string, T>> kTypes = {
-      {"force", T::Force},     {"release", T::Release}, {"block", T::Block},   {"drop", T::Drop},    {"emitter", T::Emitter},
-      {"gravity", T::Gravity}, {"effect", T::Effect},   {"pause", T::Pause},   {"resume", T::Resume}};
+      {"force", T::Force},   {"release", T::Release}, {"block", T::Block},
+      {"drop", T::Drop},     {"emitter", T::Emitter}, {"gravity", T::Gravity},
+      {"effect", T::Effect}, {"pause", T::Pause},     {"resume", T::Resume}};
   std::vector<std::string> typeNames;
   for (const auto& t : kTypes) typeNames.push_back(t.first);
   r.requireObject(j, path);
@@ -48,20 +49,38 @@ EventDef readEvent(const Reader& r, const nlohmann::json& j, const std::string& 
   std::vector<std::string> keys = {"type", "t", "frame"};
   if (allowSource) keys.push_back("source");
   switch (e.type) {
-    case T::Force: keys.insert(keys.end(), {"id", "point", "radius", "strength"}); break;
-    case T::Release: keys.insert(keys.end(), {"id"}); break;
-    case T::Block: keys.insert(keys.end(), {"min", "max", "velocity"}); break;
-    case T::Drop: keys.insert(keys.end(), {"center", "radius", "velocity"}); break;
-    case T::Emitter: keys.insert(keys.end(), {"index", "enabled", "position", "direction"}); break;
-    case T::Gravity: keys.insert(keys.end(), {"gravity", "tilt"}); break;
-    case T::Effect: keys.insert(keys.end(), {"name", "enabled"}); break;
-    case T::Pause: keys.insert(keys.end(), {"seconds"}); break;
-    case T::Resume: break;
+    case T::Force:
+      keys.insert(keys.end(), {"id", "point", "radius", "strength"});
+      break;
+    case T::Release:
+      keys.insert(keys.end(), {"id"});
+      break;
+    case T::Block:
+      keys.insert(keys.end(), {"min", "max", "velocity"});
+      break;
+    case T::Drop:
+      keys.insert(keys.end(), {"center", "radius", "velocity"});
+      break;
+    case T::Emitter:
+      keys.insert(keys.end(), {"index", "enabled", "position", "direction"});
+      break;
+    case T::Gravity:
+      keys.insert(keys.end(), {"gravity", "tilt"});
+      break;
+    case T::Effect:
+      keys.insert(keys.end(), {"name", "enabled"});
+      break;
+    case T::Pause:
+      keys.insert(keys.end(), {"seconds"});
+      break;
+    case T::Resume:
+      break;
   }
   r.checkKeys(j, path, keys);
 
   // The stamp.
-  if (j.contains("t") && j.contains("frame")) r.fail(Reader::sub(path, "frame"), "give either \"t\" or \"frame\", not both");
+  if (j.contains("t") && j.contains("frame"))
+    r.fail(Reader::sub(path, "frame"), "give either \"t\" or \"frame\", not both");
   if (j.contains("t")) e.t = r.number(j, path, "t", 0, 0, 1e9);
   if (j.contains("frame")) e.frame = r.integer(j, path, "frame", 0, 0, 1000000000);
   if (stamp == EventStamp::Required && e.t < 0 && e.frame < 0)
@@ -101,7 +120,7 @@ EventDef readEvent(const Reader& r, const nlohmann::json& j, const std::string& 
       e.index = std::size_t(r.integer(j, path, "index", 0, 0, 1000000000));
       if (e.index >= n)
         r.fail(Reader::sub(path, "index"), "emitter " + std::to_string(e.index) + " does not exist; the scene has " +
-                                              std::to_string(n) + " (0 to " + std::to_string(n - 1) + ")");
+                                               std::to_string(n) + " (0 to " + std::to_string(n - 1) + ")");
       e.hasEnabled = j.contains("enabled");
       e.enabled = r.boolean(j, path, "enabled", true);
       e.hasPoint = j.contains("position");
@@ -109,15 +128,18 @@ EventDef readEvent(const Reader& r, const nlohmann::json& j, const std::string& 
       e.hasDirection = j.contains("direction");
       e.direction = r.vec2(j, path, "direction", e.direction);
       // Kept as written (World::moveEmitter normalises): a record then replays the same bits.
-      if (e.hasDirection && e.direction.norm() < 1e-12) r.fail(Reader::sub(path, "direction"), "direction must not be zero");
+      if (e.hasDirection && e.direction.norm() < 1e-12)
+        r.fail(Reader::sub(path, "direction"), "direction must not be zero");
       if (!e.hasEnabled && !e.hasPoint && !e.hasDirection)
-        r.fail(Reader::sub(path, "enabled"), "missing; an emitter event needs \"enabled\", \"position\" or \"direction\"");
+        r.fail(Reader::sub(path, "enabled"),
+               "missing; an emitter event needs \"enabled\", \"position\" or \"direction\"");
       break;
     }
     case T::Gravity:
       if (j.contains("gravity") == j.contains("tilt"))
-        r.fail(Reader::sub(path, "gravity"), "give either \"gravity\": [x, y] (m/s²) or \"tilt\": angle (radians, "
-                                             "rotates the scene's gravity counter-clockwise)");
+        r.fail(Reader::sub(path, "gravity"),
+               "give either \"gravity\": [x, y] (m/s²) or \"tilt\": angle (radians, "
+               "rotates the scene's gravity counter-clockwise)");
       if (j.contains("gravity")) {
         e.gravity = r.vec2(j, path, "gravity", e.gravity);
       } else {
@@ -147,7 +169,8 @@ EventDef readEvent(const Reader& r, const nlohmann::json& j, const std::string& 
 void readEvents(const Reader& r, const nlohmann::json& root, SceneDef& s) {
   if (!root.contains("events")) return;
   const nlohmann::json& arr = root.at("events");
-  if (!arr.is_array()) r.fail("events", "expected an array of events {\"t\": seconds, \"type\": ...}, got " + typeName(arr));
+  if (!arr.is_array())
+    r.fail("events", "expected an array of events {\"t\": seconds, \"type\": ...}, got " + typeName(arr));
   for (std::size_t k = 0; k < arr.size(); ++k)
     s.events.push_back(readEvent(r, arr[k], "events[" + std::to_string(k) + "]", s, EventStamp::Required, false));
 }
@@ -161,15 +184,24 @@ std::vector<std::string> switchableEffects(const SceneDef& scene) {
 
 const char* eventTypeName(EventDef::Type type) {
   switch (type) {
-    case EventDef::Type::Force: return "force";
-    case EventDef::Type::Release: return "release";
-    case EventDef::Type::Block: return "block";
-    case EventDef::Type::Drop: return "drop";
-    case EventDef::Type::Emitter: return "emitter";
-    case EventDef::Type::Gravity: return "gravity";
-    case EventDef::Type::Effect: return "effect";
-    case EventDef::Type::Pause: return "pause";
-    case EventDef::Type::Resume: return "resume";
+    case EventDef::Type::Force:
+      return "force";
+    case EventDef::Type::Release:
+      return "release";
+    case EventDef::Type::Block:
+      return "block";
+    case EventDef::Type::Drop:
+      return "drop";
+    case EventDef::Type::Emitter:
+      return "emitter";
+    case EventDef::Type::Gravity:
+      return "gravity";
+    case EventDef::Type::Effect:
+      return "effect";
+    case EventDef::Type::Pause:
+      return "pause";
+    case EventDef::Type::Resume:
+      return "resume";
   }
   return "?";
 }
@@ -191,7 +223,8 @@ std::int64_t eventFrame(const EventDef& e, double fps) {
   return std::int64_t(std::ceil(e.t * fps - 1e-9));
 }
 
-EventDef parseEvent(const std::string& text, const std::string& file, int line, const SceneDef& scene, EventStamp stamp) {
+EventDef parseEvent(const std::string& text, const std::string& file, int line, const SceneDef& scene,
+                    EventStamp stamp) {
   try {
     const JsonDoc doc = parseJsonWithPositions(text, file);
     const Reader r(doc, file);
@@ -206,8 +239,10 @@ std::string eventToJson(const EventDef& e) {
   using T = EventDef::Type;
   nlohmann::ordered_json j;
   auto vec = [](const Vec2d& v) { return nlohmann::ordered_json::array({v.x(), v.y()}); };
-  if (e.frame >= 0) j["frame"] = e.frame;
-  else if (e.t >= 0) j["t"] = e.t;
+  if (e.frame >= 0)
+    j["frame"] = e.frame;
+  else if (e.t >= 0)
+    j["t"] = e.t;
   j["type"] = eventTypeName(e.type);
   switch (e.type) {
     case T::Force:
@@ -235,7 +270,9 @@ std::string eventToJson(const EventDef& e) {
       if (e.hasPoint) j["position"] = vec(e.point);
       if (e.hasDirection) j["direction"] = vec(e.direction);
       break;
-    case T::Gravity: j["gravity"] = vec(e.gravity); break;
+    case T::Gravity:
+      j["gravity"] = vec(e.gravity);
+      break;
     case T::Effect:
       j["name"] = e.effect;
       j["enabled"] = e.enabled;
@@ -243,7 +280,8 @@ std::string eventToJson(const EventDef& e) {
     case T::Pause:
       if (e.seconds > 0) j["seconds"] = e.seconds;
       break;
-    case T::Resume: break;
+    case T::Resume:
+      break;
   }
   if (!e.source.empty()) j["source"] = e.source;
   return j.dump();

@@ -30,7 +30,7 @@ std::size_t utf8Length(const std::string& s, std::size_t i) {
   }
   if (c >= 0xF0 && c <= 0xF4) {
     const unsigned c1 = b(i + 1);
-    if (c == 0xF0 && c1 < 0x90) return 0;  // overlong
+    if (c == 0xF0 && c1 < 0x90) return 0;   // overlong
     if (c == 0xF4 && c1 >= 0x90) return 0;  // above U+10FFFF
     return cont(i + 1) && cont(i + 2) && cont(i + 3) ? 4 : 0;
   }
@@ -235,10 +235,14 @@ class Parser {
     for (int k = 0; k < 4; ++k) {
       const char h = s_[i_];
       cp <<= 4;
-      if (h >= '0' && h <= '9') cp |= unsigned(h - '0');
-      else if (h >= 'a' && h <= 'f') cp |= unsigned(h - 'a' + 10);
-      else if (h >= 'A' && h <= 'F') cp |= unsigned(h - 'A' + 10);
-      else fail("bad hex digit in a \\u escape");
+      if (h >= '0' && h <= '9')
+        cp |= unsigned(h - '0');
+      else if (h >= 'a' && h <= 'f')
+        cp |= unsigned(h - 'a' + 10);
+      else if (h >= 'A' && h <= 'F')
+        cp |= unsigned(h - 'A' + 10);
+      else
+        fail("bad hex digit in a \\u escape");
       ++i_;
     }
     return cp;
@@ -255,7 +259,8 @@ class Parser {
       }
       if (static_cast<unsigned char>(c) < 0x20) {
         if (c == '\n') failAt(open, "unterminated string (a string ends on its line)");
-        fail("control character " + hexByte(static_cast<unsigned char>(c)) + " inside a string (write it as an escape)");
+        fail("control character " + hexByte(static_cast<unsigned char>(c)) +
+             " inside a string (write it as an escape)");
       }
       ++i_;
       if (c != '\\') {
@@ -265,14 +270,30 @@ class Parser {
       if (i_ >= s_.size()) break;
       const char e = s_[i_];
       switch (e) {
-        case '"': out += '"'; break;
-        case '\\': out += '\\'; break;
-        case '/': out += '/'; break;
-        case 'b': out += '\b'; break;
-        case 'f': out += '\f'; break;
-        case 'n': out += '\n'; break;
-        case 'r': out += '\r'; break;
-        case 't': out += '\t'; break;
+        case '"':
+          out += '"';
+          break;
+        case '\\':
+          out += '\\';
+          break;
+        case '/':
+          out += '/';
+          break;
+        case 'b':
+          out += '\b';
+          break;
+        case 'f':
+          out += '\f';
+          break;
+        case 'n':
+          out += '\n';
+          break;
+        case 'r':
+          out += '\r';
+          break;
+        case 't':
+          out += '\t';
+          break;
         case 'u': {
           const std::size_t esc = i_ - 1;
           ++i_;
@@ -289,7 +310,12 @@ class Parser {
           appendUtf8(out, cp);
           continue;
         }
-        default: fail(std::string("bad escape '\\") + (static_cast<unsigned char>(e) >= 0x20 && static_cast<unsigned char>(e) < 0x7F ? std::string(1, e) : hexByte(static_cast<unsigned char>(e))) + "'");
+        default:
+          fail(std::string("bad escape '\\") +
+               (static_cast<unsigned char>(e) >= 0x20 && static_cast<unsigned char>(e) < 0x7F
+                    ? std::string(1, e)
+                    : hexByte(static_cast<unsigned char>(e))) +
+               "'");
       }
       ++i_;
     }
@@ -318,7 +344,8 @@ class Parser {
       unexpected("a digit");
     }
     if (s_[i_] == '0' && i_ + 1 < s_.size() && s_[i_ + 1] >= '0' && s_[i_ + 1] <= '9') fail("leading zero in a number");
-    std::size_t intDigits = 0, leadingZeros = 0;  // significant digits before '.', zeros after '.' before the first digit
+    std::size_t intDigits = 0,
+                leadingZeros = 0;  // significant digits before '.', zeros after '.' before the first digit
     while (i_ < s_.size() && s_[i_] >= '0' && s_[i_] <= '9') {
       if (intDigits > 0 || s_[i_] != '0') ++intDigits;
       ++i_;
@@ -329,8 +356,10 @@ class Parser {
       if (i_ >= s_.size() || !(s_[i_] >= '0' && s_[i_] <= '9')) fail("expected a digit after '.'");
       bool seen = false;
       while (i_ < s_.size() && s_[i_] >= '0' && s_[i_] <= '9') {
-        if (!seen && s_[i_] == '0') ++leadingZeros;
-        else seen = true;
+        if (!seen && s_[i_] == '0')
+          ++leadingZeros;
+        else
+          seen = true;
         ++i_;
       }
     }

@@ -33,7 +33,9 @@ SceneDef parseScene(const std::string& text, const std::string& file) {
   const Reader r(doc, file);
   const nlohmann::json& root = doc.root;
   r.requireObject(root, "");
-  r.checkKeys(root, "", {"name", "gravity", "fps", "duration", "max_particles", "solver", "boundaries", "fluid", "periodic", "effects", "render", "events"});
+  r.checkKeys(root, "",
+              {"name", "gravity", "fps", "duration", "max_particles", "solver", "boundaries", "fluid", "periodic",
+               "effects", "render", "events"});
   SceneDef s;
   s.path = file;
   // In this order: each section may check what it reads against those before it.
@@ -44,7 +46,7 @@ SceneDef parseScene(const std::string& text, const std::string& file) {
   readPeriodic(r, root, s);  // periods against the support radius
   readEffects(r, root, s);
   readRender(r, root, s);
-  readEvents(r, root, s);    // the timeline last: against the emitters, effects and gravity
+  readEvents(r, root, s);  // the timeline last: against the emitters, effects and gravity
   checkParticleBudget(r, s);
   return s;
 }
@@ -56,14 +58,16 @@ SceneDef loadScene(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) {
     const int err = errno;
-    throw SceneError(path, 0, 0, "", std::string("cannot open the scene file") + (err ? std::string(": ") + std::strerror(err) : ""));
+    throw SceneError(path, 0, 0, "",
+                     std::string("cannot open the scene file") + (err ? std::string(": ") + std::strerror(err) : ""));
   }
   std::string text;
   char buf[65536];
   while (in.read(buf, sizeof buf) || in.gcount() > 0) {
     text.append(buf, static_cast<std::size_t>(in.gcount()));
     if (text.size() > kMaxSceneBytes)
-      throw SceneError(path, 0, 0, "", "the file is larger than " + std::to_string(kMaxSceneBytes >> 20) + " MiB; is it a scene file?");
+      throw SceneError(path, 0, 0, "",
+                       "the file is larger than " + std::to_string(kMaxSceneBytes >> 20) + " MiB; is it a scene file?");
   }
   if (in.bad()) throw SceneError(path, 0, 0, "", "cannot read the scene file");
   return parseScene(text, path);

@@ -11,8 +11,8 @@
 
 #include <algorithm>
 #include <cmath>
-#include <sstream>
 #include <limits>
+#include <sstream>
 #include <utility>
 
 namespace sph2d {
@@ -92,8 +92,8 @@ std::string box2dPolygonProblem(const std::vector<Vec2d>& vertices) {
   }
   // Box2D asserts area > FLT_EPSILON; keep a margin for rounding.
   if (!(area > 16 * epsilon))
-    return "the polygon is too thin: its area in Box2D's float arithmetic is " + fmt(area) + " m^2, Box2D needs more than " +
-           fmt(16 * epsilon) + " m^2";
+    return "the polygon is too thin: its area in Box2D's float arithmetic is " + fmt(area) +
+           " m^2, Box2D needs more than " + fmt(16 * epsilon) + " m^2";
   return "";
 }
 
@@ -103,7 +103,6 @@ std::string box2dPolygonProblem(const std::vector<Vec2d>& vertices) {
 std::pair<double, double> blockLattice(const FluidBlockDef& b, double dx) {
   return {std::floor((b.max.x() - b.min.x()) / dx + 1e-9), std::floor((b.max.y() - b.min.y()) / dx + 1e-9)};
 }
-
 
 Vec2d rotate(const Vec2d& v, double angle) {
   const double c = std::cos(angle), s = std::sin(angle);
@@ -140,11 +139,16 @@ double depthInside(const BodyDef& b, const ShapeDef& f, const Vec2d& p) {
 
 const char* shapeName(ShapeDef::Type t) {
   switch (t) {
-    case ShapeDef::Type::Box: return "a box";
-    case ShapeDef::Type::Polygon: return "a polygon";
-    case ShapeDef::Type::Circle: return "a circle";
-    case ShapeDef::Type::Edge: return "an edge";
-    case ShapeDef::Type::Chain: return "a chain";
+    case ShapeDef::Type::Box:
+      return "a box";
+    case ShapeDef::Type::Polygon:
+      return "a polygon";
+    case ShapeDef::Type::Circle:
+      return "a circle";
+    case ShapeDef::Type::Edge:
+      return "an edge";
+    case ShapeDef::Type::Chain:
+      return "a chain";
   }
   return "a solid";
 }
@@ -152,15 +156,20 @@ const char* shapeName(ShapeDef::Type t) {
 }  // namespace
 
 void checkMaxAboveMin(const Reader& r, const Vec2d& min, const Vec2d& max, const std::string& path) {
-  if (!(max.x() > min.x() && max.y() > min.y())) r.fail(Reader::sub(path, "max"), "max must be greater than min in x and in y");
+  if (!(max.x() > min.x() && max.y() > min.y()))
+    r.fail(Reader::sub(path, "max"), "max must be greater than min in x and in y");
 }
 
 void checkName(const Reader& r, const std::string& name) {
   std::string why;
-  if (name.empty()) why = "the name is empty";
-  else if (name.size() > 200) why = "the name is longer than 200 bytes";
-  else if (name == "." || name == "..") why = "'" + name + "' is not a directory name";
-  else if (name.find_first_of("/\\") != std::string::npos) why = "the name contains a slash";
+  if (name.empty())
+    why = "the name is empty";
+  else if (name.size() > 200)
+    why = "the name is longer than 200 bytes";
+  else if (name == "." || name == "..")
+    why = "'" + name + "' is not a directory name";
+  else if (name.find_first_of("/\\") != std::string::npos)
+    why = "the name contains a slash";
   else
     for (const char c : name)
       if (static_cast<unsigned char>(c) < 0x20 || c == 0x7F) why = "the name contains a control character";
@@ -170,21 +179,26 @@ void checkName(const Reader& r, const std::string& name) {
 
 void checkFrameCount(const Reader& r, double duration, double fps, const std::string& key) {
   if (duration * fps > kMaxFrames)
-    r.fail(key, "duration x fps = " + fmt(duration) + " s x " + fmt(fps) + " = " + fmt(duration * fps) + " frames, more than " +
-                    fmt(kMaxFrames) + "; shorten the duration (sph2d run --frames N renders fewer frames)");
+    r.fail(key, "duration x fps = " + fmt(duration) + " s x " + fmt(fps) + " = " + fmt(duration * fps) +
+                    " frames, more than " + fmt(kMaxFrames) +
+                    "; shorten the duration (sph2d run --frames N renders fewer frames)");
 }
 
 void checkBoxHalfSize(const Reader& r, const Vec2d& halfSize, const std::string& path) {
   if (!(halfSize.x() > 0 && halfSize.y() > 0))
-    r.fail(Reader::sub(path, "half_size"), "both half sizes must be > 0, got [" + fmt(halfSize.x()) + ", " + fmt(halfSize.y()) + "]");
+    r.fail(Reader::sub(path, "half_size"),
+           "both half sizes must be > 0, got [" + fmt(halfSize.x()) + ", " + fmt(halfSize.y()) + "]");
   if (!(halfSize.x() >= kLinearSlop / 2 && halfSize.y() >= kLinearSlop / 2))
-    r.fail(Reader::sub(path, "half_size"), "both half sizes must be >= 0.0025 (a box at least 0.005 m across, Box2D's linear slop), got [" +
-                                              fmt(halfSize.x()) + ", " + fmt(halfSize.y()) + "]");
+    r.fail(Reader::sub(path, "half_size"),
+           "both half sizes must be >= 0.0025 (a box at least 0.005 m across, Box2D's linear slop), got [" +
+               fmt(halfSize.x()) + ", " + fmt(halfSize.y()) + "]");
 }
 
 void checkCircleRadius(const Reader& r, double radius, const std::string& path) {
   if (radius < kLinearSlop / 2)
-    r.fail(Reader::sub(path, "radius"), "value " + fmt(radius) + " is too small; a circle is at least 0.005 m across (radius >= 0.0025, Box2D's linear slop)");
+    r.fail(Reader::sub(path, "radius"),
+           "value " + fmt(radius) +
+               " is too small; a circle is at least 0.005 m across (radius >= 0.0025, Box2D's linear slop)");
 }
 
 void checkPolygon(const Reader& r, const std::vector<Vec2d>& vertices, const std::string& p) {
@@ -211,11 +225,13 @@ void checkPolygon(const Reader& r, const std::vector<Vec2d>& vertices, const std
     if (sg == 0 && u.dot(v) < 0)
       r.fail(p, "the polygon must be convex: its outline doubles back at vertex [" + std::to_string((i + 1) % n) + "]");
     if (sg != 0) {
-      if (sign != 0 && sg != sign) r.fail(p, "the polygon must be convex (split a concave shape into several fixtures)");
+      if (sign != 0 && sg != sign)
+        r.fail(p, "the polygon must be convex (split a concave shape into several fixtures)");
       sign = sg;
     }
   }
-  if (std::fabs(turning) > 3 * 3.14159265358979) r.fail(p, "the polygon must be convex: its edges cross (the outline winds around more than once)");
+  if (std::fabs(turning) > 3 * 3.14159265358979)
+    r.fail(p, "the polygon must be convex: its edges cross (the outline winds around more than once)");
   if (std::fabs(area) < 1e-10) r.fail(p, "the polygon has no area");
   const std::string problem = box2dPolygonProblem(vertices);
   if (!problem.empty()) r.fail(p, problem);
@@ -233,11 +249,13 @@ void checkChain(const Reader& r, const std::vector<Vec2d>& vertices, bool loop, 
                   " vertices, got " + std::to_string(vertices.size()));
   for (std::size_t i = 1; i < vertices.size(); ++i)
     if (closerThanSlop(vertices[i], vertices[i - 1]))
-      r.fail(p + "[" + std::to_string(i) + "]",
-             "chain vertices [" + std::to_string(i - 1) + "] and [" + std::to_string(i) + "] are closer than 0.005 m (Box2D's linear slop)");
+      r.fail(p + "[" + std::to_string(i) + "]", "chain vertices [" + std::to_string(i - 1) + "] and [" +
+                                                    std::to_string(i) +
+                                                    "] are closer than 0.005 m (Box2D's linear slop)");
   if (loop && closerThanSlop(vertices.back(), vertices.front()))
-    r.fail(p + "[" + std::to_string(vertices.size() - 1) + "]",
-           "the last vertex of a looped chain is closer than 0.005 m to the first (the loop closes itself: do not repeat the first vertex)");
+    r.fail(
+        p + "[" + std::to_string(vertices.size() - 1) + "]",
+        "the last vertex of a looped chain is closer than 0.005 m to the first (the loop closes itself: do not repeat the first vertex)");
 }
 
 void checkFluidPolygon(const Reader& r, const std::vector<Vec2d>& v, const std::string& p) {
@@ -305,9 +323,9 @@ void checkBlock(const Reader& r, const SceneDef& s, const FluidBlockDef& blk, co
     r.fail(Reader::sub(p, blk.shape == FluidBlockDef::Shape::Circle ? "radius" : "vertices"),
            "the region holds no point of the particle lattice (spacing " + fmt(dx) + " m): it would hold no particle");
   if (nx < 1 || ny < 1)
-    r.fail(Reader::sub(p, "max"), "the block is " + fmt(blk.max.x() - blk.min.x()) + " m x " + fmt(blk.max.y() - blk.min.y()) +
-                                      " m, less than one particle spacing (" + fmt(dx) + " m) " + (nx < 1 ? "wide" : "high") +
-                                      ": it would hold no particle");
+    r.fail(Reader::sub(p, "max"), "the block is " + fmt(blk.max.x() - blk.min.x()) + " m x " +
+                                      fmt(blk.max.y() - blk.min.y()) + " m, less than one particle spacing (" +
+                                      fmt(dx) + " m) " + (nx < 1 ? "wide" : "high") + ": it would hold no particle");
   // The lattice spans x in [min + dx/2, min + (nx - 1/2) dx]; the rows, compressed
   // downwards at most, y in [min, min + (ny - 1/2) dx]. A convex solid holding
   // the four corners holds every particle.
@@ -319,10 +337,11 @@ void checkBlock(const Reader& r, const SceneDef& s, const FluidBlockDef& blk, co
       const BodyDef& b = s.bodies[bi];
       const ShapeDef& f = b.fixtures[fi];
       bool all = true;
-      for (const Vec2d& c : {Vec2d(x0, y0), Vec2d(x1, y0), Vec2d(x0, y1), Vec2d(x1, y1)}) all = all && depthInside(b, f, c) > margin;
+      for (const Vec2d& c : {Vec2d(x0, y0), Vec2d(x1, y0), Vec2d(x0, y1), Vec2d(x1, y1)})
+        all = all && depthInside(b, f, c) > margin;
       if (all)
-        r.fail(p, "the block lies entirely inside boundaries[" + std::to_string(bi) + "].fixtures[" + std::to_string(fi) + "] (" +
-                      shapeName(f.type) + "): every particle would be dropped");
+        r.fail(p, "the block lies entirely inside boundaries[" + std::to_string(bi) + "].fixtures[" +
+                      std::to_string(fi) + "] (" + shapeName(f.type) + "): every particle would be dropped");
     }
 }
 
@@ -353,17 +372,17 @@ void checkCamera(const Reader& r, const CameraDef& camera, const std::string& p)
 void checkParticleBudget(const Reader& r, const SceneDef& s) {
   const std::size_t n = countBlockParticles(s);
   if (n > s.maxParticles)
-    r.fail("solver.spacing", "spacing " + fmt(s.solver.spacing) + " fills the fluid blocks with " +
-                                 (n >= std::numeric_limits<std::size_t>::max() / 2 ? std::string("too many") : std::to_string(n)) +
-                                 " particles, more than max_particles = " + std::to_string(s.maxParticles) +
-                                 "; use a larger spacing or raise max_particles");
+    r.fail("solver.spacing",
+           "spacing " + fmt(s.solver.spacing) + " fills the fluid blocks with " +
+               (n >= std::numeric_limits<std::size_t>::max() / 2 ? std::string("too many") : std::to_string(n)) +
+               " particles, more than max_particles = " + std::to_string(s.maxParticles) +
+               "; use a larger spacing or raise max_particles");
   const double samples = estimateBoundarySamples(s);
   const std::size_t sampleBudget = std::max<std::size_t>(s.maxParticles, kMinSampleBudget);
   if (samples > double(sampleBudget))
     r.fail("solver.spacing", "spacing " + fmt(s.solver.spacing) + " lines the solids with about " + fmt(samples) +
                                  " boundary samples, more than max(max_particles, " + std::to_string(kMinSampleBudget) +
-                                 ") = " + std::to_string(sampleBudget) +
-                                 "; use a larger spacing or smaller solids");
+                                 ") = " + std::to_string(sampleBudget) + "; use a larger spacing or smaller solids");
 }
 
 /// An upper estimate of the boundary samples the World will lay in the solids
@@ -388,7 +407,8 @@ double estimateBoundarySamples(const SceneDef& s) {
           break;
         case ShapeDef::Type::Edge:
         case ShapeDef::Type::Chain:
-          for (std::size_t i = 0; i + 1 < f.vertices.size(); ++i) total += 2 * layers * along((f.vertices[i + 1] - f.vertices[i]).norm());
+          for (std::size_t i = 0; i + 1 < f.vertices.size(); ++i)
+            total += 2 * layers * along((f.vertices[i + 1] - f.vertices[i]).norm());
           if (f.loop) total += 2 * layers * along((f.vertices.front() - f.vertices.back()).norm());
           break;
       }

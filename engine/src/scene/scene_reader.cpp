@@ -33,15 +33,23 @@ SceneError::SceneError(std::string file_, int line_, int column_, std::string ke
 
 std::string typeName(const json& j) {
   switch (j.type()) {
-    case json::value_t::null: return "null";
-    case json::value_t::boolean: return "a boolean";
+    case json::value_t::null:
+      return "null";
+    case json::value_t::boolean:
+      return "a boolean";
     case json::value_t::number_integer:
-    case json::value_t::number_unsigned: return "an integer";
-    case json::value_t::number_float: return "a number";
-    case json::value_t::string: return "a string";
-    case json::value_t::array: return "an array";
-    case json::value_t::object: return "an object";
-    default: return "something else";
+    case json::value_t::number_unsigned:
+      return "an integer";
+    case json::value_t::number_float:
+      return "a number";
+    case json::value_t::string:
+      return "a string";
+    case json::value_t::array:
+      return "an array";
+    case json::value_t::object:
+      return "an object";
+    default:
+      return "something else";
   }
 }
 
@@ -89,7 +97,8 @@ std::size_t editDistance(const std::string& a, const std::string& b) {
   for (std::size_t i = 1; i <= a.size(); ++i)
     for (std::size_t j = 1; j <= b.size(); ++j) {
       d[i][j] = std::min({d[i - 1][j] + 1, d[i][j - 1] + 1, d[i - 1][j - 1] + (a[i - 1] == b[j - 1] ? 0 : 1)});
-      if (i > 1 && j > 1 && a[i - 1] == b[j - 2] && a[i - 2] == b[j - 1]) d[i][j] = std::min(d[i][j], d[i - 2][j - 2] + 1);
+      if (i > 1 && j > 1 && a[i - 1] == b[j - 2] && a[i - 2] == b[j - 1])
+        d[i][j] = std::min(d[i][j], d[i - 2][j - 2] + 1);
     }
   return d[a.size()][b.size()];
 }
@@ -111,7 +120,9 @@ void Reader::fail(const std::string& path, const std::string& msg) const {
   throw SceneError(file_, 0, 0, path, msg);
 }
 
-std::string Reader::sub(const std::string& path, const std::string& key) { return path.empty() ? key : path + "." + key; }
+std::string Reader::sub(const std::string& path, const std::string& key) {
+  return path.empty() ? key : path + "." + key;
+}
 
 void Reader::requireObject(const json& j, const std::string& path) const {
   if (!j.is_object())
@@ -138,8 +149,8 @@ void Reader::checkKeys(const json& obj, const std::string& path, const std::vect
   }
 }
 
-double Reader::number(const json& obj, const std::string& path, const std::string& key, double def, double lo, double hi,
-                      bool loOpen) const {
+double Reader::number(const json& obj, const std::string& path, const std::string& key, double def, double lo,
+                      double hi, bool loOpen) const {
   if (!obj.contains(key)) return def;
   const json& j = obj.at(key);
   const std::string p = sub(path, key);
@@ -147,12 +158,13 @@ double Reader::number(const json& obj, const std::string& path, const std::strin
   const double v = j.get<double>();
   const bool below = loOpen ? !(v > lo) : !(v >= lo);
   if (!std::isfinite(v) || below || v > hi)
-    fail(p, "value " + fmt(v) + " is out of range; allowed: " + (loOpen ? "> " : ">= ") + fmt(lo) + " and <= " + fmt(hi));
+    fail(p,
+         "value " + fmt(v) + " is out of range; allowed: " + (loOpen ? "> " : ">= ") + fmt(lo) + " and <= " + fmt(hi));
   return v;
 }
 
-long long Reader::integer64(const json& obj, const std::string& path, const std::string& key, long long def, long long lo,
-                            long long hi) const {
+long long Reader::integer64(const json& obj, const std::string& path, const std::string& key, long long def,
+                            long long lo, long long hi) const {
   if (!obj.contains(key)) return def;
   const json& j = obj.at(key);
   const std::string p = sub(path, key);
@@ -196,11 +208,13 @@ std::string Reader::string(const json& obj, const std::string& path, const std::
 Vec2d Reader::vec2(const json& j, const std::string& p) const {
   if (!j.is_array() || j.size() != 2) fail(p, "expected [x, y] (two numbers), got " + describe(j));
   for (std::size_t k = 0; k < 2; ++k)
-    if (!j[k].is_number()) fail(p, "expected [x, y] (two numbers), got " + typeName(j[k]) + " at [" + std::to_string(k) + "]");
+    if (!j[k].is_number())
+      fail(p, "expected [x, y] (two numbers), got " + typeName(j[k]) + " at [" + std::to_string(k) + "]");
   const Vec2d v(j[0].get<double>(), j[1].get<double>());
   if (!std::isfinite(v.x()) || !std::isfinite(v.y())) fail(p, "coordinates must be finite");
   if (std::fabs(v.x()) > kMaxCoordinate || std::fabs(v.y()) > kMaxCoordinate)
-    fail(p, "[" + fmt(v.x()) + ", " + fmt(v.y()) + "] is out of range; each component must be within +-" + fmt(kMaxCoordinate));
+    fail(p, "[" + fmt(v.x()) + ", " + fmt(v.y()) + "] is out of range; each component must be within +-" +
+                fmt(kMaxCoordinate));
   return v;
 }
 
@@ -222,9 +236,11 @@ std::array<double, 3> Reader::color(const json& obj, const std::string& path, co
   if (!j.is_array() || j.size() != 3) fail(p, "expected [r, g, b] with components in 0..1, got " + describe(j));
   std::array<double, 3> c{};
   for (std::size_t k = 0; k < 3; ++k) {
-    if (!j[k].is_number()) fail(p, "expected [r, g, b] with components in 0..1, got " + typeName(j[k]) + " at [" + std::to_string(k) + "]");
+    if (!j[k].is_number())
+      fail(p, "expected [r, g, b] with components in 0..1, got " + typeName(j[k]) + " at [" + std::to_string(k) + "]");
     c[k] = j[k].get<double>();
-    if (!(c[k] >= 0 && c[k] <= 1)) fail(p, "colour components must be in 0..1, got " + fmt(c[k]) + " at [" + std::to_string(k) + "]");
+    if (!(c[k] >= 0 && c[k] <= 1))
+      fail(p, "colour components must be in 0..1, got " + fmt(c[k]) + " at [" + std::to_string(k) + "]");
   }
   return c;
 }

@@ -70,7 +70,8 @@ class Reader {
                       long long lo, long long hi) const;
 
   /// integer64 for values that fit an int.
-  int integer(const nlohmann::json& obj, const std::string& path, const std::string& key, int def, int lo, int hi) const;
+  int integer(const nlohmann::json& obj, const std::string& path, const std::string& key, int def, int lo,
+              int hi) const;
 
   /// true or false; `def` when absent.
   bool boolean(const nlohmann::json& obj, const std::string& path, const std::string& key, bool def) const;

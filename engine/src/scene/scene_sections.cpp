@@ -21,7 +21,8 @@ namespace {
 ShapeDef readFixture(const Reader& r, const json& j, const std::string& path) {
   r.requireObject(j, path);
   ShapeDef s;
-  if (!j.contains("shape")) r.fail(Reader::sub(path, "shape"), "missing; allowed values: box, polygon, circle, edge, chain");
+  if (!j.contains("shape"))
+    r.fail(Reader::sub(path, "shape"), "missing; allowed values: box, polygon, circle, edge, chain");
   const std::string shape = r.string(j, path, "shape", "", {"box", "polygon", "circle", "edge", "chain"});
   std::vector<std::string> keys = {"shape", "friction", "restitution", "density"};
   if (shape == "box") {
@@ -62,14 +63,16 @@ ShapeDef readFixture(const Reader& r, const json& j, const std::string& path) {
   }
   s.friction = r.number(j, path, "friction", s.friction, 0, 10);
   s.restitution = r.number(j, path, "restitution", s.restitution, 0, 1);
-  s.density = r.number(j, path, "density", s.density, 1, 1e6);  // below 1 kg/m² the coupled grid solve is ill-conditioned
+  s.density =
+      r.number(j, path, "density", s.density, 1, 1e6);  // below 1 kg/m² the coupled grid solve is ill-conditioned
   return s;
 }
 
 BodyDef readBody(const Reader& r, const json& j, const std::string& p) {
   r.requireObject(j, p);
   BodyDef body;
-  const std::string type = j.contains("type") ? r.string(j, p, "type", "static", {"static", "kinematic", "dynamic"}) : "static";
+  const std::string type =
+      j.contains("type") ? r.string(j, p, "type", "static", {"static", "kinematic", "dynamic"}) : "static";
   if (type == "kinematic" || type == "dynamic") {
     body.type = type == "dynamic" ? BodyDef::Type::Dynamic : BodyDef::Type::Kinematic;
     r.checkKeys(j, p, {"type", "position", "angle", "velocity", "angular_velocity", "fixtures"});
@@ -91,7 +94,8 @@ BodyDef readBody(const Reader& r, const json& j, const std::string& p) {
     if (body.type != BodyDef::Type::Static && (t == ShapeDef::Type::Edge || t == ShapeDef::Type::Chain))
       r.fail(Reader::sub(pf, "shape"), "a " + type + " body's fixtures enclose an area: box, polygon or circle");
     if (body.type != BodyDef::Type::Dynamic && fx[f].is_object() && fx[f].contains("density"))
-      r.fail(Reader::sub(pf, "density"), "only a dynamic body's fixtures have a density (a " + type + " body is not moved by forces)");
+      r.fail(Reader::sub(pf, "density"),
+             "only a dynamic body's fixtures have a density (a " + type + " body is not moved by forces)");
   }
   return body;
 }
@@ -120,7 +124,8 @@ VelocityFieldDef readVelocityField(const Reader& r, const json& f, const std::st
   } else if (type == "strain") {
     r.checkKeys(f, pf, {"type", "rate", "origin"});
     field.type = VelocityFieldDef::Type::Strain;
-    if (!f.contains("rate")) r.fail(Reader::sub(pf, "rate"), "missing; expected the strain rate s in 1/s (u = -s x, v = s y)");
+    if (!f.contains("rate"))
+      r.fail(Reader::sub(pf, "rate"), "missing; expected the strain rate s in 1/s (u = -s x, v = s y)");
     field.rate = r.number(f, pf, "rate", 0, -1e4, 1e4);
   } else {
     r.checkKeys(f, pf, {"type", "amplitude", "wavelength", "origin"});
@@ -155,7 +160,8 @@ FluidBlockDef readBlock(const Reader& r, const json& j, const std::string& p, co
     checkMaxAboveMin(r, blk.min, blk.max, p);
   }
   blk.velocity = r.vec2(j, p, "velocity", blk.velocity);
-  if (j.contains("velocity_field")) blk.field = readVelocityField(r, j.at("velocity_field"), Reader::sub(p, "velocity_field"));
+  if (j.contains("velocity_field"))
+    blk.field = readVelocityField(r, j.at("velocity_field"), Reader::sub(p, "velocity_field"));
   checkBlock(r, s, blk, p);
   return blk;
 }
@@ -246,7 +252,9 @@ void readSinks(const Reader& r, const json& j, EffectsDef& e) {
 
 EmitterDef readEmitter(const Reader& r, const json& j, const std::string& q) {
   r.requireObject(j, q);
-  r.checkKeys(j, q, {"position", "direction", "width", "rate", "speed", "spread", "jitter", "start", "stop", "seed", "enabled"});
+  r.checkKeys(
+      j, q,
+      {"position", "direction", "width", "rate", "speed", "spread", "jitter", "start", "stop", "seed", "enabled"});
   EmitterDef m;
   m.position = r.requiredVec2(j, q, "position");
   m.direction = r.vec2(j, q, "direction", m.direction);
@@ -270,7 +278,8 @@ void readEmitters(const Reader& r, const json& j, EffectsDef& e) {
   if (!j.contains("emitters")) return;
   const auto& a = j.at("emitters");
   if (!a.is_array()) r.fail("effects.emitters", "expected an array of emitters, got " + describe(a));
-  for (std::size_t k = 0; k < a.size(); ++k) e.emitters.push_back(readEmitter(r, a[k], "effects.emitters[" + std::to_string(k) + "]"));
+  for (std::size_t k = 0; k < a.size(); ++k)
+    e.emitters.push_back(readEmitter(r, a[k], "effects.emitters[" + std::to_string(k) + "]"));
 }
 
 void readBudget(const Reader& r, const json& j, EffectsDef& e) {
@@ -306,7 +315,8 @@ void readTopLevel(const Reader& r, const json& root, SceneDef& s) {
   s.fps = r.number(root, "", "fps", s.fps, 1, 1000);
   s.duration = r.number(root, "", "duration", s.duration, 0, 1e5);
   checkFrameCount(r, s.duration, s.fps, root.contains("duration") ? "duration" : "fps");
-  s.maxParticles = static_cast<std::size_t>(r.integer64(root, "", "max_particles", static_cast<long long>(s.maxParticles), 0, 100000000));
+  s.maxParticles = static_cast<std::size_t>(
+      r.integer64(root, "", "max_particles", static_cast<long long>(s.maxParticles), 0, 100000000));
 }
 
 void readSolver(const Reader& r, const json& root, SceneDef& s) {
@@ -322,10 +332,13 @@ void readSolver(const Reader& r, const json& root, SceneDef& s) {
   // that names neither is real time: the game preset (issue 15).
   if (j.contains("quality") && j.contains("type"))
     r.fail(Reader::sub(p, "quality"), "give either solver.type or solver.quality, not both");
-  if (j.contains("type")) d = solverDefaults(r.string(j, p, "type", "game", solverNames()));
-  else d = qualityPreset(r.string(j, p, "quality", "game", qualityPresets()));
-  std::vector<std::string> keys = {"type", "quality", "spacing", "support_ratio", "rest_density", "sound_speed", "viscosity", "no_slip", "cfl",
-                                   "max_substeps", "clamp_negative_pressure", "reorder_interval", "max_speed"};
+  if (j.contains("type"))
+    d = solverDefaults(r.string(j, p, "type", "game", solverNames()));
+  else
+    d = qualityPreset(r.string(j, p, "quality", "game", qualityPresets()));
+  std::vector<std::string> keys = {
+      "type",    "quality", "spacing",      "support_ratio",           "rest_density",     "sound_speed", "viscosity",
+      "no_slip", "cfl",     "max_substeps", "clamp_negative_pressure", "reorder_interval", "max_speed"};
   for (const SolverParam& sp : solverParams(d.type)) keys.push_back(sp.key);
   r.checkKeys(j, p, keys);
   // A preset's parameter values are the defaults a scene may change.
@@ -348,14 +361,16 @@ void readBoundaries(const Reader& r, const json& root, SceneDef& s) {
   if (!root.contains("boundaries")) return;
   const json& arr = root.at("boundaries");
   if (!arr.is_array()) r.fail("boundaries", "expected an array of static bodies, got " + describe(arr));
-  for (std::size_t b = 0; b < arr.size(); ++b) s.bodies.push_back(readBody(r, arr[b], "boundaries[" + std::to_string(b) + "]"));
+  for (std::size_t b = 0; b < arr.size(); ++b)
+    s.bodies.push_back(readBody(r, arr[b], "boundaries[" + std::to_string(b) + "]"));
 }
 
 void readFluid(const Reader& r, const json& root, SceneDef& s) {
   if (!root.contains("fluid")) return;
   const json& arr = root.at("fluid");
   if (!arr.is_array()) r.fail("fluid", "expected an array of blocks, got " + describe(arr));
-  for (std::size_t b = 0; b < arr.size(); ++b) s.blocks.push_back(readBlock(r, arr[b], "fluid[" + std::to_string(b) + "]", s));
+  for (std::size_t b = 0; b < arr.size(); ++b)
+    s.blocks.push_back(readBlock(r, arr[b], "fluid[" + std::to_string(b) + "]", s));
 }
 
 void readPeriodic(const Reader& r, const json& root, SceneDef& s) {

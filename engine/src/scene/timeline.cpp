@@ -50,11 +50,17 @@ std::string EventApplier::apply(World& w, const EventDef& e) {
         break;
       }
       case T::Release:
-        if (e.id < 0) forces_.clear();
-        else forces_.erase(e.id);
+        if (e.id < 0)
+          forces_.clear();
+        else
+          forces_.erase(e.id);
         break;
-      case T::Block: w.addBlock(e.block); break;
-      case T::Drop: w.addDrop(e.point, e.radius, e.velocity); break;
+      case T::Block:
+        w.addBlock(e.block);
+        break;
+      case T::Drop:
+        w.addDrop(e.point, e.radius, e.velocity);
+        break;
       case T::Emitter:
         if (e.hasPoint || e.hasDirection) {
           const EmitterDef& cur = w.emitter(e.index);
@@ -62,13 +68,19 @@ std::string EventApplier::apply(World& w, const EventDef& e) {
         }
         if (e.hasEnabled) w.setEmitterEnabled(e.index, e.enabled);
         break;
-      case T::Gravity: w.setGravity(e.gravity); break;
-      case T::Effect: w.setEffectEnabled(e.effect, e.enabled); break;
+      case T::Gravity:
+        w.setGravity(e.gravity);
+        break;
+      case T::Effect:
+        w.setEffectEnabled(e.effect, e.enabled);
+        break;
       case T::Pause:
         paused_ = true;
         pauseSeconds_ = e.seconds;
         break;
-      case T::Resume: paused_ = false; break;
+      case T::Resume:
+        paused_ = false;
+        break;
     }
     if (e.type == T::Force || e.type == T::Release) {
       std::vector<UserForce> list;
@@ -98,21 +110,32 @@ std::string describeEvent(const EventDef& e) {
     case T::Force:
       o << " " << e.id << " at " << v(e.point) << ", radius " << e.radius << " m, " << e.strength << " m/s²";
       break;
-    case T::Release: o << (e.id < 0 ? " all forces" : " force " + std::to_string(e.id)); break;
-    case T::Block: o << " " << v(e.block.min) << " – " << v(e.block.max); break;
-    case T::Drop: o << " at " << v(e.point) << ", radius " << e.radius << " m"; break;
+    case T::Release:
+      o << (e.id < 0 ? " all forces" : " force " + std::to_string(e.id));
+      break;
+    case T::Block:
+      o << " " << v(e.block.min) << " – " << v(e.block.max);
+      break;
+    case T::Drop:
+      o << " at " << v(e.point) << ", radius " << e.radius << " m";
+      break;
     case T::Emitter:
       o << " " << e.index;
       if (e.hasEnabled) o << (e.enabled ? " on" : " off");
       if (e.hasPoint) o << " at " << v(e.point);
       if (e.hasDirection) o << " towards " << v(e.direction);
       break;
-    case T::Gravity: o << " " << v(e.gravity) << " m/s²"; break;
-    case T::Effect: o << " " << e.effect << (e.enabled ? " on" : " off"); break;
+    case T::Gravity:
+      o << " " << v(e.gravity) << " m/s²";
+      break;
+    case T::Effect:
+      o << " " << e.effect << (e.enabled ? " on" : " off");
+      break;
     case T::Pause:
       if (e.seconds > 0) o << " " << e.seconds << " s";
       break;
-    case T::Resume: break;
+    case T::Resume:
+      break;
   }
   return o.str();
 }

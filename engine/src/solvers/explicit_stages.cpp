@@ -32,7 +32,8 @@ void limitStepByForce(StepContext& c) {
 
 }  // namespace
 
-std::vector<Stage> explicitStages(Stage::Fn density, std::function<void(StepContext&)> pressure, Stage::Fn pressureForce) {
+std::vector<Stage> explicitStages(Stage::Fn density, std::function<void(StepContext&)> pressure,
+                                  Stage::Fn pressureForce) {
   // Density, pressure, the pressure force and integrate write these for every particle before
   // anything reads them (p stays: a bad density reports each particle's last pressure).
   constexpr unsigned kRewritten = kRewritesRho | kRewritesInvRho | kRewritesPOverRho | kRewritesA | kRewritesXPrev;

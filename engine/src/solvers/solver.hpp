@@ -81,21 +81,22 @@ class Solver {
 /// neighbours → density → pressure → pressure_force → effects → force_limit →
 /// integrate (force_limit shortens the substep to its own forces' limit).
 /// density and pressureForce return the first bad slot; pressure returns nothing.
-std::vector<Stage> explicitStages(Stage::Fn density, std::function<void(StepContext&)> pressure, Stage::Fn pressureForce);
+std::vector<Stage> explicitStages(Stage::Fn density, std::function<void(StepContext&)> pressure,
+                                  Stage::Fn pressureForce);
 
 /// One solver-specific scene key (under "solver").
 struct SolverParam {
-  std::string key;   ///< scene key
-  double def;        ///< default
-  double lo, hi;     ///< allowed range (inclusive)
-  std::string doc;   ///< one line for docs/SCENES.md and errors
+  std::string key;  ///< scene key
+  double def;       ///< default
+  double lo, hi;    ///< allowed range (inclusive)
+  std::string doc;  ///< one line for docs/SCENES.md and errors
 };
 
 /// A solver's registration: its scene name, its parameters and how to make it.
 struct SolverInfo {
-  const char* name;                                      ///< solver.type
-  std::vector<SolverParam> params;                       ///< its solver.* keys
-  std::unique_ptr<Solver> (*make)(const SolverDef& def); ///< builds it (params filled)
+  const char* name;                                       ///< solver.type
+  std::vector<SolverParam> params;                        ///< its solver.* keys
+  std::unique_ptr<Solver> (*make)(const SolverDef& def);  ///< builds it (params filled)
   /// Sets the shared keys (viscosity, support ratio...) this solver wants
   /// different from SolverDef's defaults when the scene leaves them out (may be null).
   void (*tune)(SolverDef& def) = nullptr;

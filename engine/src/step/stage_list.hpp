@@ -24,9 +24,9 @@ namespace sph2d {
 struct Stage {
   /// Runs the stage; returns the lowest slot with a non-finite or runaway value, or kNone.
   using Fn = std::function<std::size_t(StepContext&)>;
-  std::string name;             ///< shown by --profile, World::stages() and the guard's errors
-  Fn run;                       ///< the work (empty for the effects marker)
-  bool effectsMarker = false;   ///< true: not a stage, the place in a solver's list where effects run
+  std::string name;            ///< shown by --profile, World::stages() and the guard's errors
+  Fn run;                      ///< the work (empty for the effects marker)
+  bool effectsMarker = false;  ///< true: not a stage, the place in a solver's list where effects run
   /// The marker a solver puts where the scene's effects run.
   static Stage effects() { return Stage{"", nullptr, true}; }
 };

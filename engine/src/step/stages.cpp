@@ -37,8 +37,9 @@ constexpr std::uint8_t kBitCount[16] = {0, 1, 1, 2, 1, 2, 2, 3, 1, 2, 2, 3, 2, 3
 #if defined(__GNUC__)
 __attribute__((always_inline))  // called per row of cells with a few candidates: the call cost more than the row
 #endif
-inline std::size_t nearInOrder(const Vec2* X, std::size_t n, std::uint32_t kb, std::uint32_t ke, std::size_t i, const Vec2& xi,
-                               Real R2, std::uint32_t* dst, std::size_t used, bool vector) {
+inline std::size_t
+nearInOrder(const Vec2* X, std::size_t n, std::uint32_t kb, std::uint32_t ke, std::size_t i, const Vec2& xi, Real R2,
+            std::uint32_t* dst, std::size_t used, bool vector) {
   std::uint32_t k = kb;
 #ifdef SPH2D_SSE2_NEIGHBOURS
   const std::uint32_t kv = vector ? ke : kb;  // without `vector`, the scalar loop takes every candidate
@@ -52,7 +53,7 @@ inline std::size_t nearInOrder(const Vec2* X, std::size_t n, std::uint32_t kb, s
     const __m128 r2 = _mm_add_ps(_mm_mul_ps(dx, dx), _mm_mul_ps(dy, dy));
     unsigned mask = unsigned(_mm_movemask_ps(_mm_cmplt_ps(r2, r24)));
     mask &= (1u << std::min<std::uint32_t>(ke - k, 4)) - 1;  // no branches on the row's length
-    const std::size_t self = i - k;                             // wraps around when i < k
+    const std::size_t self = i - k;                          // wraps around when i < k
     mask &= ~(unsigned(self < 4) << (self & 3));
     const __m128i lanes = _mm_load_si128(reinterpret_cast<const __m128i*>(kCompactLanes[mask]));
     _mm_storeu_si128(reinterpret_cast<__m128i*>(dst + used), _mm_add_epi32(_mm_set1_epi32(int(k)), lanes));
@@ -109,9 +110,10 @@ constexpr int kGroupSlots = 4;
 /// and `usedOut` becomes the last one. False, with nothing written, when N > 1 and the rows
 /// hold more candidates than a buffer (a pile-up: the caller then searches slot by slot).
 template <int N>
-__attribute__((target("avx512f,popcnt"))) bool nearInOrder16(const Grid& g, const Vec2* X, std::size_t i, int cx, int cy,
-                                                             const int* shift, Real R2, std::vector<std::uint32_t>& out,
-                                                             std::size_t& usedOut, std::size_t* ends) {
+__attribute__((target("avx512f,popcnt"))) bool nearInOrder16(const Grid& g, const Vec2* X, std::size_t i, int cx,
+                                                             int cy, const int* shift, Real R2,
+                                                             std::vector<std::uint32_t>& out, std::size_t& usedOut,
+                                                             std::size_t* ends) {
   std::size_t used = usedOut;  // a local: through the reference it would go through memory every chunk
   const float* xy = reinterpret_cast<const float*>(X);
   const __m512 r216 = _mm512_set1_ps(R2);
@@ -166,8 +168,7 @@ __attribute__((target("avx512f,popcnt"))) bool nearInOrder16(const Grid& g, cons
       const __m512i ks = _mm512_add_epi32(_mm512_set1_epi32(int(k)), iota);
       for (int q = 0; q < N; ++q) {
         // Slot i + q's kept lanes: its own columns, within R, not itself.
-        const __mmask16 mine =
-            __mmask16(lanes & below(std::int64_t(hi[q]) - k) & ~below(std::int64_t(lo[q]) - k));
+        const __mmask16 mine = __mmask16(lanes & below(std::int64_t(hi[q]) - k) & ~below(std::int64_t(lo[q]) - k));
         const __m512 dx = _mm512_sub_ps(px[q], xs), dy = _mm512_sub_ps(py[q], ys);
         const __m512 r2 = _mm512_add_ps(_mm512_mul_ps(dx, dx), _mm512_mul_ps(dy, dy));
         const std::size_t self = i + q - k;  // wraps around when i + q < k
@@ -340,10 +341,17 @@ void stageNeighbours(StepContext& c) {
           const Vec2* X = P.x.data();
           bool done = false;
           switch (slots) {
-            case 4: done = nearInOrder16<4>(g, X, i, cx, cy, shift, R2, out, used, ends); break;
-            case 3: done = nearInOrder16<3>(g, X, i, cx, cy, shift, R2, out, used, ends); break;
-            case 2: done = nearInOrder16<2>(g, X, i, cx, cy, shift, R2, out, used, ends); break;
-            default: break;
+            case 4:
+              done = nearInOrder16<4>(g, X, i, cx, cy, shift, R2, out, used, ends);
+              break;
+            case 3:
+              done = nearInOrder16<3>(g, X, i, cx, cy, shift, R2, out, used, ends);
+              break;
+            case 2:
+              done = nearInOrder16<2>(g, X, i, cx, cy, shift, R2, out, used, ends);
+              break;
+            default:
+              break;
           }
           if (!done) {
             slots = 1;  // alone, or a pile-up: one slot (always true)

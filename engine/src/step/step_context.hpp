@@ -19,12 +19,12 @@
 
 #include "boundary/boundary_set.hpp"
 #include "core/constants.hpp"
-#include "particles/neighbour_grid.hpp"
 #include "core/kernels.hpp"
+#include "core/thread_pool.hpp"
+#include "particles/neighbour_grid.hpp"
 #include "particles/particle_store.hpp"
 #include "sph2d/scene.hpp"
 #include "sph2d/world.hpp"
-#include "core/thread_pool.hpp"
 
 namespace sph2d {
 
@@ -37,15 +37,15 @@ constexpr std::size_t kNone = std::numeric_limits<std::size_t>::max();  ///< "no
 /// them in parallel without sharing; buffers keep their capacity, so after
 /// warm-up a substep allocates nothing.
 struct NeighbourLists {
-  std::vector<std::vector<std::uint32_t>> perBlock;  ///< fluid neighbour slots, block by block
-  std::vector<std::uint32_t> start;                  ///< offset of particle i's fluid list in its block
-  std::vector<std::uint32_t> count;                  ///< number of fluid neighbours of particle i
+  std::vector<std::vector<std::uint32_t>> perBlock;          ///< fluid neighbour slots, block by block
+  std::vector<std::uint32_t> start;                          ///< offset of particle i's fluid list in its block
+  std::vector<std::uint32_t> count;                          ///< number of fluid neighbours of particle i
   std::vector<std::vector<std::uint32_t>> boundaryPerBlock;  ///< boundary sample indices, block by block
-  std::vector<std::uint32_t> boundaryStart;          ///< offset of particle i's boundary list in its block
-  std::vector<std::uint32_t> boundaryCount;          ///< number of boundary samples near particle i
-  std::vector<std::vector<std::uint32_t>> movingPerBlock;  ///< moving bodies' samples (BodySamples), block by block
-  std::vector<std::uint32_t> movingStart;            ///< offset of particle i's moving-sample list in its block
-  std::vector<std::uint32_t> movingCount;            ///< number of moving bodies' samples near particle i
+  std::vector<std::uint32_t> boundaryStart;                  ///< offset of particle i's boundary list in its block
+  std::vector<std::uint32_t> boundaryCount;                  ///< number of boundary samples near particle i
+  std::vector<std::vector<std::uint32_t>> movingPerBlock;    ///< moving bodies' samples (BodySamples), block by block
+  std::vector<std::uint32_t> movingStart;                    ///< offset of particle i's moving-sample list in its block
+  std::vector<std::uint32_t> movingCount;                    ///< number of moving bodies' samples near particle i
   /// First fluid neighbour slot of particle i.
   const std::uint32_t* of(std::size_t i) const { return perBlock[i / kBlock].data() + start[i]; }
   /// First boundary sample index near particle i.
@@ -94,28 +94,29 @@ struct StepContext {
   ThreadPool& pool;
   Scratch& scratch;
   const SolverDef& def;
-  Real R = 0;                   ///< kernel support
-  Real dx = 0;                  ///< particle spacing
-  Real dt = 0;                  ///< this substep
+  Real R = 0;   ///< kernel support
+  Real dx = 0;  ///< particle spacing
+  Real dt = 0;  ///< this substep
   /// The largest |a| of the particles, when a stage has just measured it and nothing has
   /// changed a since (force_limit; integrate reads a only), else −1: the `max_acceleration`
   /// stage then need not measure it again.
   Real accelMeasured = -1;
-  Real mass = 0;                ///< particle mass
-  Real rho0 = 1000;             ///< rest density
+  Real mass = 0;     ///< particle mass
+  Real rho0 = 1000;  ///< rest density
   Vec2 gravity = Vec2::Zero();
-  Real clearance = 0;           ///< distance kept from solid surfaces
-  Real maxSpeed = 0;            ///< the guard's runaway limit
+  Real clearance = 0;  ///< distance kept from solid surfaces
+  Real maxSpeed = 0;   ///< the guard's runaway limit
   /// The fastest particle an emitter may add in this frame (its speed × (1 + jitter)): the
   /// substep is set for it as for the particles already there (World::Impl::sourceSpeed).
   Real sourceSpeed = 0;
-  std::uint64_t step = 0;       ///< substep counter
-  double time = 0;              ///< simulated time at the start of the substep
-  Vec2d origin{0, 0};           ///< local frame offset (world = local + origin)
-  PeriodicBox periodic{};       ///< periodic axes: every pair difference takes the nearest image
-  std::uint64_t boundaryVersion = 0;  ///< counts the times the colliders were read: changes whenever they are read again
-  MovingSolids* solids = nullptr;     ///< the kinematic and dynamic bodies this step (moving_solid.hpp); null when none
-  WallAccount* wall = nullptr;        ///< where stages add the static solids' impulse (null: not counted, e.g. prepare)
+  std::uint64_t step = 0;  ///< substep counter
+  double time = 0;         ///< simulated time at the start of the substep
+  Vec2d origin{0, 0};      ///< local frame offset (world = local + origin)
+  PeriodicBox periodic{};  ///< periodic axes: every pair difference takes the nearest image
+  std::uint64_t boundaryVersion =
+      0;                           ///< counts the times the colliders were read: changes whenever they are read again
+  MovingSolids* solids = nullptr;  ///< the kinematic and dynamic bodies this step (moving_solid.hpp); null when none
+  WallAccount* wall = nullptr;     ///< where stages add the static solids' impulse (null: not counted, e.g. prepare)
   /// The moving bodies' boundary samples (body_samples.hpp), for a solver that takes them
   /// (Solver::movingSamples) in a scene with moving bodies; else null. The neighbour lists
   /// hold them only while bodySamples->active().

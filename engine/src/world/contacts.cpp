@@ -19,7 +19,7 @@ void World::Impl::recordContacts(StepContext& c) {
   contactBlocks.resize(blocks);
   const Real reach = dx;
   const double tau = c.time - moving.time0 + double(c.dt);  // the moving bodies at the substep's end
-  std::vector<ContactPose>& placed = contactPoses;  // kept: no allocation in the step
+  std::vector<ContactPose>& placed = contactPoses;          // kept: no allocation in the step
   placed.resize(moving.bodies.size());
   for (std::size_t k = 0; k < placed.size(); ++k) {
     moving.bodies[k].pose(tau, placed[k].theta, placed[k].o);
@@ -32,7 +32,8 @@ void World::Impl::recordContacts(StepContext& c) {
       const Vec2 x = P.x[i];
       if (!boundary.clearOf(x, x, reach))
         boundary.forCollidersNear(x, reach, [&](std::uint32_t k) {
-          if (colliderSeparation(boundary.colliders[k], x) <= reach) out.emplace_back(std::uintptr_t(boundary.colliderFixture[k]), P.id[i]);
+          if (colliderSeparation(boundary.colliders[k], x) <= reach)
+            out.emplace_back(std::uintptr_t(boundary.colliderFixture[k]), P.id[i]);
         });
       for (std::size_t k = 0; k < placed.size(); ++k) {
         const MovingSolid& m = moving.bodies[k];
@@ -43,12 +44,14 @@ void World::Impl::recordContacts(StepContext& c) {
         const Vec2d d = p - placed[k].o, q(cs * d.x() + sn * d.y(), -sn * d.x() + cs * d.y());  // body frame
         for (std::size_t s = 0; s < m.shapes.size(); ++s) {
           Vec2d normal;
-          if (outsideCollider(m.shapes[s], q, q, normal) <= double(reach)) out.emplace_back(std::uintptr_t(m.fixtures[s]), P.id[i]);
+          if (outsideCollider(m.shapes[s], q, q, normal) <= double(reach))
+            out.emplace_back(std::uintptr_t(m.fixtures[s]), P.id[i]);
         }
       }
     }
   });
-  for (std::size_t k = 0; k < blocks; ++k) frameContacts.insert(frameContacts.end(), contactBlocks[k].begin(), contactBlocks[k].end());
+  for (std::size_t k = 0; k < blocks; ++k)
+    frameContacts.insert(frameContacts.end(), contactBlocks[k].begin(), contactBlocks[k].end());
 }
 
 void World::Impl::finishContacts() {

@@ -8,19 +8,15 @@
 // within the step), and its shapes as the fluid meets them: a polygon with Box2D's skin
 // (b2_polygonRadius, 1 cm: withSkin, faces moved out, corners mitred), a circle as it is
 // (its radius is its skin); for a solver that samples moving bodies (body_samples.hpp:
-// wcsph, muller2003) the fixtures themselves, which its samples stand for. Box2D rests a polygon on another at about two skins less the
-// slop, core to core: seen without its skin, a crate on the floor left a 1.5 cm gap that
-// the fluid entered and was squeezed in. Everything that reads a body's shape (the
-// collision below, the grid's body cells and faces, its reach, movingColliders() for
-// drawing) reads these; the body's area and centroid are its fixtures' (below). Static
-// bodies' shapes stay cores (boundary_set.cpp; their skins would move every tank's walls and
-// water level): a skinned
-// crate resting on a core floor leaves 0.5 cm, room for a particle kept the clearance
-// (0.25 spacing) off both only at a spacing of 1 cm or less, and then for one layer, which
-// is not squeezed. Box2D's mass is the core's, and so is the area the grid's buoyancy is
-// scaled to (shapeMoments of the cores): the skin keeps water out without making a body
-// lighter than its density says (density 1000 stays neutral).
-// Per substep:
+// wcsph, muller2003) the fixtures themselves, which its samples stand for. Box2D rests a polygon on another at about
+// two skins less the slop, core to core: seen without its skin, a crate on the floor left a 1.5 cm gap that the fluid
+// entered and was squeezed in. Everything that reads a body's shape (the collision below, the grid's body cells and
+// faces, its reach, movingColliders() for drawing) reads these; the body's area and centroid are its fixtures' (below).
+// Static bodies' shapes stay cores (boundary_set.cpp; their skins would move every tank's walls and water level): a
+// skinned crate resting on a core floor leaves 0.5 cm, room for a particle kept the clearance (0.25 spacing) off both
+// only at a spacing of 1 cm or less, and then for one layer, which is not squeezed. Box2D's mass is the core's, and so
+// is the area the grid's buoyancy is scaled to (shapeMoments of the cores): the skin keeps water out without making a
+// body lighter than its density says (density 1000 stays neutral). Per substep:
 //  - `body_gravity` (after `emit`, with a dynamic body): its velocity takes g·dt;
 //  - `body_walls` (after it): where its shapes would overlap a static fixture by the substep's
 //    end deeper than Box2D's contact distance, its velocity into the fixture is removed
@@ -178,7 +174,7 @@ void withSkin(const b2PolygonShape& poly, Collider& c) {
   auto at = [&](int i) { return Vec2d(poly.m_vertices[(i + n) % n].x, poly.m_vertices[(i + n) % n].y); };
   auto normal = [&](int i) { return Vec2d(poly.m_normals[(i + n) % n].x, poly.m_normals[(i + n) % n].y); };
   auto add = [&](const Vec2d& v, const Vec2d& na, const Vec2d& nb) {  // faces na (in) and nb (out) at core vertex v
-    const Vec2d p = v + r / (1.0 + na.dot(nb)) * (na + nb);       // on both moved faces: nₐ·(p − v) = n_b·(p − v) = r
+    const Vec2d p = v + r / (1.0 + na.dot(nb)) * (na + nb);  // on both moved faces: nₐ·(p − v) = n_b·(p − v) = r
     c.vertices.push_back(Vec2(Real(p.x()), Real(p.y())));
     c.normals.push_back(Vec2(Real(nb.x()), Real(nb.y())));
   };
@@ -352,7 +348,8 @@ void World::Impl::moveOwnBodies(double dt) {
   moving.last.clear();
   for (const MovingSolid& m : moving.bodies) moving.last.push_back({m.body, m.sweptTheta, m.sweptOrigin});
   for (const MovingSolid& m : moving.bodies) {
-    const bool noImpulse = std::abs(m.impulse.x()) <= kNegligibleImpulse && std::abs(m.impulse.y()) <= kNegligibleImpulse;
+    const bool noImpulse =
+        std::abs(m.impulse.x()) <= kNegligibleImpulse && std::abs(m.impulse.y()) <= kNegligibleImpulse;
     if (!m.dynamic() || (noImpulse && m.angularImpulse == 0)) continue;
     m.body->ApplyLinearImpulse(b2Vec2(float(m.impulse.x()), float(m.impulse.y())), m.body->GetWorldCenter(), true);
     m.body->ApplyAngularImpulse(float(m.angularImpulse), true);

@@ -62,21 +62,25 @@ bool collideWithStatic(const b2Shape* a, const b2Transform& xa, const b2Shape* b
       if (aPoly) {
         b2CollidePolygons(&m, static_cast<const b2PolygonShape*>(a), xa, static_cast<const b2PolygonShape*>(other), xb);
       } else {
-        b2CollidePolygonAndCircle(&m, static_cast<const b2PolygonShape*>(other), xb, static_cast<const b2CircleShape*>(a), xa);
+        b2CollidePolygonAndCircle(&m, static_cast<const b2PolygonShape*>(other), xb,
+                                  static_cast<const b2CircleShape*>(a), xa);
         flip = true;
       }
       break;
     case b2Shape::e_circle:
       if (aPoly)
-        b2CollidePolygonAndCircle(&m, static_cast<const b2PolygonShape*>(a), xa, static_cast<const b2CircleShape*>(other), xb);
+        b2CollidePolygonAndCircle(&m, static_cast<const b2PolygonShape*>(a), xa,
+                                  static_cast<const b2CircleShape*>(other), xb);
       else
         b2CollideCircles(&m, static_cast<const b2CircleShape*>(a), xa, static_cast<const b2CircleShape*>(other), xb);
       break;
     case b2Shape::e_edge:
       if (aPoly)
-        b2CollideEdgeAndPolygon(&m, static_cast<const b2EdgeShape*>(other), xb, static_cast<const b2PolygonShape*>(a), xa);
+        b2CollideEdgeAndPolygon(&m, static_cast<const b2EdgeShape*>(other), xb, static_cast<const b2PolygonShape*>(a),
+                                xa);
       else
-        b2CollideEdgeAndCircle(&m, static_cast<const b2EdgeShape*>(other), xb, static_cast<const b2CircleShape*>(a), xa);
+        b2CollideEdgeAndCircle(&m, static_cast<const b2EdgeShape*>(other), xb, static_cast<const b2CircleShape*>(a),
+                               xa);
       flip = true;
       break;
     default:
@@ -127,7 +131,8 @@ void World::Impl::bodyWalls(StepContext& c) {
             if (!b2TestOverlap(boxA, boxB)) continue;
             b2WorldManifold wm;
             int points = 0;
-            if (!collideWithStatic(fa->GetShape(), xa, shape, child, sb->GetTransform(), wm, points) || points == 0) continue;
+            if (!collideWithStatic(fa->GetShape(), xa, shape, child, sb->GetTransform(), wm, points) || points == 0)
+              continue;
             double deepest = 0;
             for (int k = 0; k < points; ++k) deepest = std::min(deepest, double(wm.separations[k]));
             if (deepest > -kRunInto) continue;
@@ -177,7 +182,9 @@ void World::Impl::collideMoving(StepContext& c, bool atStart) {
     hitNormal.resize(c.P.size());
   }
   // Body frame from the local frame: rotate by −θ about the body origin.
-  auto toBody = [](double co, double si, const Vec2d& p) { return Vec2d(co * p.x() + si * p.y(), -si * p.x() + co * p.y()); };
+  auto toBody = [](double co, double si, const Vec2d& p) {
+    return Vec2d(co * p.x() + si * p.y(), -si * p.x() + co * p.y());
+  };
   // A particle body k has just put at x (local) with world normal n: a dynamic body's contact
   // is solved below with its other contacts; a kinematic one carries the particle along.
   auto settle = [&](std::size_t i, std::size_t k, const Vec2d& x, const Vec2d& n) {
@@ -259,7 +266,9 @@ void World::Impl::collideMoving(StepContext& c, bool atStart) {
           hit = true;
         }
         if (!hit) continue;
-        auto toLocal = [&](const Vec2d& p) { return q.o1 + Vec2d(q.c1 * p.x() - q.s1 * p.y(), q.s1 * p.x() + q.c1 * p.y()); };
+        auto toLocal = [&](const Vec2d& p) {
+          return q.o1 + Vec2d(q.c1 * p.x() - q.s1 * p.y(), q.s1 * p.x() + q.c1 * p.y());
+        };
         Vec2d x = toLocal(b);
         {
           // Pushed into a static solid: the particle is in a gap between the body and a static
@@ -296,8 +305,10 @@ void World::Impl::collideMoving(StepContext& c, bool atStart) {
               Vec2d way;
               if (last && squeezeDirection(*last, b, way)) {
                 const Vec2d tw = double(c.dx) * Vec2d(q.c1 * way.x() - q.s1 * way.y(), q.s1 * way.x() + q.c1 * way.y());
-                if (!intoStatic(xw + tw)) x = xw + tw;
-                else if (!intoStatic(xw - tw)) x = xw - tw;
+                if (!intoStatic(xw + tw))
+                  x = xw + tw;
+                else if (!intoStatic(xw - tw))
+                  x = xw - tw;
               }
             }
           }
@@ -317,7 +328,9 @@ void World::Impl::collideMoving(StepContext& c, bool atStart) {
       const Vec2 from = c.P.x[i];
       if (!moved || !insideAny(Vec2d(from.x(), from.y()), in)) continue;
       const Pose& q = poses[in.k];
-      auto toLocal = [&](const Vec2d& p) { return q.o1 + Vec2d(q.c1 * p.x() - q.s1 * p.y(), q.s1 * p.x() + q.c1 * p.y()); };
+      auto toLocal = [&](const Vec2d& p) {
+        return q.o1 + Vec2d(q.c1 * p.x() - q.s1 * p.y(), q.s1 * p.x() + q.c1 * p.y());
+      };
       auto turn = [&](const Vec2d& p) { return Vec2d(q.c1 * p.x() - q.s1 * p.y(), q.s1 * p.x() + q.c1 * p.y()); };
       Vec2d x = toLocal(in.at + (clearance - in.d) * in.n);
       Inside other;

@@ -60,7 +60,8 @@ std::size_t find(const std::vector<std::pair<std::uint32_t, std::uint32_t>>& ind
 
 /// The bulk calls' argument check: as many values as ids.
 template <class T>
-void checkLengths(const char* call, const std::vector<std::uint32_t>& ids, const std::vector<T>& values, const char* what) {
+void checkLengths(const char* call, const std::vector<std::uint32_t>& ids, const std::vector<T>& values,
+                  const char* what) {
   if (ids.size() != values.size())
     throw std::invalid_argument(std::string(call) + ": " + std::to_string(ids.size()) + " ids but " +
                                 std::to_string(values.size()) + " " + what);
@@ -199,8 +200,10 @@ std::uint32_t World::particleUserData(std::uint32_t id) const { return getU32(*t
 
 void World::setEmitterTracking(bool on) {
   Impl& w = *impl_;
-  if (on) w.P.fieldU32(ParticleStore::kEmitter);  // every particle there now: none
-  else w.P.dropU32(ParticleStore::kEmitter);
+  if (on)
+    w.P.fieldU32(ParticleStore::kEmitter);  // every particle there now: none
+  else
+    w.P.dropU32(ParticleStore::kEmitter);
   w.refreshView();
 }
 

@@ -50,7 +50,7 @@ IdRange World::Impl::fillBlock(const FluidBlockDef& b, bool hydrostaticStart) {
     throw Interrupted("stopped by the stop flag", "");
   };
   const bool disc = b.shape == FluidBlockDef::Shape::Circle;  // a circle or a drop: row chords
-  std::vector<double> crossings;  // a polygon's edges across the current row
+  std::vector<double> crossings;                              // a polygon's edges across the current row
   const SolverDef& sd = scene.solver;
   const double hydroFactor = solver->hydrostaticFactor();
   const bool hydrostatic = hydrostaticStart && hydroFactor > 0 && scene.gravity.x() == 0 && scene.gravity.y() < 0;
@@ -73,7 +73,7 @@ IdRange World::Impl::fillBlock(const FluidBlockDef& b, bool hydrostaticStart) {
     const double scale = hydrostatic ? 1.0 / (1.0 + hydroFactor * gz * depth) : 1.0;
     y = j == 0 ? b.min.y() + 0.5 * sd.spacing * scale : y + 0.5 * sd.spacing * (prevScale + scale);
     prevScale = scale;
-    long i0 = 0, i1 = nx;  // the row's lattice points [i0, i1)
+    long i0 = 0, i1 = nx;          // the row's lattice points [i0, i1)
     b.rowCrossings(y, crossings);  // a polygon's edges across this row (none otherwise)
     if (disc) {
       const double dy = y - b.center.y(), r2 = b.radius * b.radius;
@@ -118,8 +118,9 @@ IdRange World::Impl::fillBlock(const FluidBlockDef& b, bool hydrostaticStart) {
   if (refused) {
     const double lattice = disc ? 3.14159265358979323846 * b.radius * b.radius / (sd.spacing * sd.spacing) : nxd * nyd;
     std::ostringstream o;
-    o << "particle budget of " << budget << " (" << budgetKey() << ") reached: added " << added << " of the " << (disc ? "drop" : "block") << "'s about " << lattice
-      << " and refused the rest (raise " << budgetKey() << " or add less)";
+    o << "particle budget of " << budget << " (" << budgetKey() << ") reached: added " << added << " of the "
+      << (disc ? "drop" : "block") << "'s about " << lattice << " and refused the rest (raise " << budgetKey()
+      << " or add less)";
     warnings.push_back(o.str());
   }
   ++edits;  // the query grid is stale
@@ -167,17 +168,28 @@ std::string World::Impl::emitterProblem(const EmitterDef& d) {
   auto in = [](double v, double lo, double hi) { return v >= lo && v <= hi; };  // false for NaN
   std::ostringstream o;
   using E = EmitterDef;  // the scene format's ranges
-  if (!finite(d.position)) o << "position must be finite";
-  else if (!finite(d.direction) || !(d.direction.norm() > 1e-12)) o << "direction must be finite and not zero";
-  else if (!in(d.width, 0, E::kMaxWidth)) o << "width must be in 0.." << E::kMaxWidth << " m, got " << d.width;
-  else if (!in(d.rate, 0, E::kMaxRate)) o << "rate must be in 0.." << E::kMaxRate << " per s, got " << d.rate;
-  else if (!in(d.speed, 0, E::kMaxSpeed)) o << "speed must be in 0.." << E::kMaxSpeed << " m/s, got " << d.speed;
-  else if (!in(d.spread, 0, E::kMaxSpread)) o << "spread must be in 0.." << E::kMaxSpread << " rad, got " << d.spread;
-  else if (!in(d.jitter, 0, E::kMaxJitter)) o << "jitter must be in 0.." << E::kMaxJitter << ", got " << d.jitter;
-  else if (!in(d.start, 0, E::kMaxStart)) o << "start must be in 0.." << E::kMaxStart << " s, got " << d.start;
-  else if (!in(d.stop, 0, E::kMaxStop)) o << "stop must be in 0.." << E::kMaxStop << " s, got " << d.stop;
-  else if (d.stop < d.start) o << "stop must not be before start";
-  else if (d.seed > E::kMaxSeed) o << "seed must be at most 2^53";
+  if (!finite(d.position))
+    o << "position must be finite";
+  else if (!finite(d.direction) || !(d.direction.norm() > 1e-12))
+    o << "direction must be finite and not zero";
+  else if (!in(d.width, 0, E::kMaxWidth))
+    o << "width must be in 0.." << E::kMaxWidth << " m, got " << d.width;
+  else if (!in(d.rate, 0, E::kMaxRate))
+    o << "rate must be in 0.." << E::kMaxRate << " per s, got " << d.rate;
+  else if (!in(d.speed, 0, E::kMaxSpeed))
+    o << "speed must be in 0.." << E::kMaxSpeed << " m/s, got " << d.speed;
+  else if (!in(d.spread, 0, E::kMaxSpread))
+    o << "spread must be in 0.." << E::kMaxSpread << " rad, got " << d.spread;
+  else if (!in(d.jitter, 0, E::kMaxJitter))
+    o << "jitter must be in 0.." << E::kMaxJitter << ", got " << d.jitter;
+  else if (!in(d.start, 0, E::kMaxStart))
+    o << "start must be in 0.." << E::kMaxStart << " s, got " << d.start;
+  else if (!in(d.stop, 0, E::kMaxStop))
+    o << "stop must be in 0.." << E::kMaxStop << " s, got " << d.stop;
+  else if (d.stop < d.start)
+    o << "stop must not be before start";
+  else if (d.seed > E::kMaxSeed)
+    o << "seed must be at most 2^53";
   return o.str();
 }
 
@@ -208,7 +220,8 @@ void World::Impl::emit(Real dt) {
       const std::uint64_t rngBefore = s.rng;
       const double uSpread = uniform(s.rng), uSpeed = uniform(s.rng);
       const double ang = (uSpread - 0.5) * d.spread;
-      const Vec2d vdir(dir.x() * std::cos(ang) - dir.y() * std::sin(ang), dir.x() * std::sin(ang) + dir.y() * std::cos(ang));
+      const Vec2d vdir(dir.x() * std::cos(ang) - dir.y() * std::sin(ang),
+                       dir.x() * std::sin(ang) + dir.y() * std::cos(ang));
       const double speed = d.speed * (1.0 + d.jitter * (2.0 * uSpeed - 1.0));
       const Vec2d vel = vdir * speed;
       // Placed where a particle emitted at te would be at the substep start,
@@ -246,7 +259,8 @@ void World::Impl::emit(Real dt) {
           break;
         }
       }
-      P.push(Vec2(Real(pw.x() - origin.x()), Real(pw.y() - origin.y())), Vec2(Real(vel.x()), Real(vel.y())), nextId++, rho0);
+      P.push(Vec2(Real(pw.x() - origin.x()), Real(pw.y() - origin.y())), Vec2(Real(vel.x()), Real(vel.y())), nextId++,
+             rho0);
       if (tag) tag->back() = std::uint32_t(e + 1);
     }
   }

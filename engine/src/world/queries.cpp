@@ -69,7 +69,8 @@ std::vector<std::size_t> collect(const World::Impl& w, const Vec2d& lo, const Ve
 
 std::vector<std::size_t> World::particlesInRadius(const Vec2d& c, double radius) const {
   const Vec2d r(radius, radius);
-  return collect(*impl_, c - r, c + r, [&](std::size_t i) { return (worldPosition(i) - c).squaredNorm() <= radius * radius; });
+  return collect(*impl_, c - r, c + r,
+                 [&](std::size_t i) { return (worldPosition(i) - c).squaredNorm() <= radius * radius; });
 }
 
 std::vector<std::size_t> World::particlesInBox(const Vec2d& lo, const Vec2d& hi) const {
@@ -83,8 +84,10 @@ std::vector<std::size_t> World::particlesInShape(const b2Shape& shape, const b2T
   for (int c = 0; c < shape.GetChildCount(); ++c) {
     b2AABB a;
     shape.ComputeAABB(&a, xf, c);
-    if (c == 0) box = a;
-    else box.Combine(a);
+    if (c == 0)
+      box = a;
+    else
+      box.Combine(a);
   }
   const Vec2d lo(box.lowerBound.x, box.lowerBound.y), hi(box.upperBound.x, box.upperBound.y);
   return collect(*impl_, lo, hi, [&](std::size_t i) {
@@ -102,7 +105,8 @@ std::vector<std::uint32_t> World::particlesTouching(const b2Fixture& fixture) co
   for (int child = 0; child < shape.GetChildCount(); ++child) {
     b2AABB box;
     shape.ComputeAABB(&box, xf, child);
-    const Vec2d lo(box.lowerBound.x - reach, box.lowerBound.y - reach), hi(box.upperBound.x + reach, box.upperBound.y + reach);
+    const Vec2d lo(box.lowerBound.x - reach, box.lowerBound.y - reach),
+        hi(box.upperBound.x + reach, box.upperBound.y + reach);
     b2DistanceProxy part;
     part.Set(&shape, child);
     // Distances are to the core shape, less the radius the fluid meets it at: a circle's own, a
@@ -145,7 +149,8 @@ std::vector<std::uint32_t> World::particlesTouching(const b2Fixture& fixture) co
       if (slotOf(it->second) != npos) ids.push_back(it->second);
     merged = b != e;
   }
-  if (shape.GetChildCount() > 1 || merged) {  // a particle found twice (two links, or now and before) once, in slot order
+  if (shape.GetChildCount() > 1 ||
+      merged) {  // a particle found twice (two links, or now and before) once, in slot order
     std::vector<std::pair<std::size_t, std::uint32_t>> bySlot;
     for (const std::uint32_t id : ids) bySlot.push_back({slotOf(id), id});
     std::sort(bySlot.begin(), bySlot.end());
@@ -273,7 +278,7 @@ std::size_t World::memoryBytes() const {
   for (const auto& v : w.nbr.boundaryPerBlock) b += cap(v);
   b += cap(w.scratch.v) + cap(w.scratch.r) + cap(w.scratch.u);
   b += cap(w.boundary.samples) + cap(w.boundary.volume) + cap(w.boundary.sideNormal) + cap(w.boundary.sideOffset);
-  b += cap(w.idIndex);  // only once a game looked a particle up by id
+  b += cap(w.idIndex);                                   // only once a game looked a particle up by id
   b += cap(w.queryGrid.start) + cap(w.queryGrid.items);  // only once a game searched
   return b;
 }

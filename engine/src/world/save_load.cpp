@@ -30,8 +30,8 @@
 
 #include <box2d/box2d.h>
 
-#include "sph2d/hash.hpp"
 #include "core/state_io.hpp"
+#include "sph2d/hash.hpp"
 #include "world/world_impl.hpp"
 
 namespace sph2d {
@@ -109,8 +109,8 @@ SaveReport unsaved(b2World& world) {
     if (r.sleepTimers) o << ", and ";
   }
   if (r.sleepTimers)
-    o << r.sleepTimers << " bod" << (r.sleepTimers == 1 ? "y" : "ies") << " at rest " << (r.sleepTimers == 1 ? "has a" : "have")
-      << " sleep timer" << (r.sleepTimers == 1 ? "" : "s") << " running";
+    o << r.sleepTimers << " bod" << (r.sleepTimers == 1 ? "y" : "ies") << " at rest "
+      << (r.sleepTimers == 1 ? "has a" : "have") << " sleep timer" << (r.sleepTimers == 1 ? "" : "s") << " running";
   o << "; a World loaded from this save steps on close to this one, not bit for bit. For replays that match bit for bit, call ";
   if (r.warmStartedContacts || r.warmStartedJoints) o << "SetWarmStarting(false)" << (r.sleepTimers ? " and " : "");
   if (r.sleepTimers) o << "SetAllowSleeping(false)";
@@ -234,7 +234,8 @@ void World::load(std::istream& input) {
   const Real lastAccel = in.get<Real>("the clock");
   const double lastDt = in.get<double>("the clock");
   const std::uint32_t nextId = in.get<std::uint32_t>("the counters");
-  const std::uint64_t iterations = in.get<std::uint64_t>("the counters"), removed = in.get<std::uint64_t>("the counters");
+  const std::uint64_t iterations = in.get<std::uint64_t>("the counters"),
+                      removed = in.get<std::uint64_t>("the counters");
   const Vec2d gravity = getVec(in, "gravity");
   if (!std::isfinite(time) || !std::isfinite(lastDt) || !std::isfinite(gravity.x()) || !std::isfinite(gravity.y()))
     throw SaveError("the saved state is malformed: its clock or gravity is not finite");
@@ -250,16 +251,19 @@ void World::load(std::istream& input) {
     e.def.position = getVec(in, "an emitter");
     e.def.direction = getVec(in, "an emitter");
     e.def.enabled = in.get<std::uint8_t>("an emitter") != 0;
-    double* shape[] = {&e.def.width, &e.def.rate, &e.def.speed, &e.def.spread, &e.def.jitter, &e.def.start, &e.def.stop};
+    double* shape[] = {&e.def.width,  &e.def.rate,  &e.def.speed, &e.def.spread,
+                       &e.def.jitter, &e.def.start, &e.def.stop};
     for (double* v : shape) *v = in.get<double>("an emitter");
     e.def.seed = in.get<std::uint64_t>("an emitter");
     const std::string problem = Impl::emitterProblem(e.def);
     if (!problem.empty() || !(std::abs(e.def.direction.norm() - 1) < 1e-6))
-      throw SaveError("the saved state is malformed: an emitter's " + (problem.empty() ? std::string("direction") : problem));
+      throw SaveError("the saved state is malformed: an emitter's " +
+                      (problem.empty() ? std::string("direction") : problem));
   }
   const bool userForceEffect = in.get<std::uint8_t>("the user forces") != 0;
   const std::uint64_t forces = in.get<std::uint64_t>("the user forces");
-  if (forces > 4096) throw SaveError("the saved state is malformed: " + std::to_string(forces) + " user forces (at most 4096)");
+  if (forces > 4096)
+    throw SaveError("the saved state is malformed: " + std::to_string(forces) + " user forces (at most 4096)");
   std::vector<UserForce> userForces(static_cast<std::size_t>(forces));
   for (UserForce& f : userForces) {
     f.point = getVec(in, "a user force");
@@ -282,7 +286,8 @@ void World::load(std::istream& input) {
     throw SaveError("the saved state holds " + std::to_string(n) + " particles, beyond the scene's budget of " +
                     std::to_string(w.budget) + " (" + w.budgetKey() + ")");
   const std::uint64_t fieldCount = in.get<std::uint64_t>("the field count");
-  if (fieldCount > kMaxFields) throw SaveError("the saved state is malformed: " + std::to_string(fieldCount) + " particle fields");
+  if (fieldCount > kMaxFields)
+    throw SaveError("the saved state is malformed: " + std::to_string(fieldCount) + " particle fields");
   struct Field {
     std::string name;
     std::uint32_t element = 0;
@@ -292,7 +297,8 @@ void World::load(std::istream& input) {
   for (Field& f : saved) {
     f.name = in.getString(kMaxName, "a field's name");
     f.element = in.get<std::uint32_t>("a field");
-    if (f.element != 4 && f.element != 8) throw SaveError("the saved state is malformed: field " + f.name + "'s element size");
+    if (f.element != 4 && f.element != 8)
+      throw SaveError("the saved state is malformed: field " + f.name + "'s element size");
     in.getVector(f.data, std::size_t(n) * f.element, "a field's values");
     if (f.data.size() != std::size_t(n) * f.element)
       throw SaveError("the saved state is malformed: field " + f.name + " does not hold one value per particle");
@@ -313,7 +319,8 @@ void World::load(std::istream& input) {
   for (const Field& f : saved) {
     bool fixed = false;
     w.P.forEachField([&](const char* name, const auto&) { fixed = fixed || f.name == name; });
-    if (!fixed && f.element != sizeof(Real)) throw SaveError("the saved state is malformed: field " + f.name + "'s element size");
+    if (!fixed && f.element != sizeof(Real))
+      throw SaveError("the saved state is malformed: field " + f.name + "'s element size");
   }
   std::vector<std::uint32_t> ids(static_cast<std::size_t>(n));
   if (n) std::memcpy(ids.data(), find("id")->data.data(), ids.size() * sizeof(std::uint32_t));
@@ -361,8 +368,8 @@ void World::load(std::istream& input) {
     b.lastTheta = in.get<double>("a body");
     b.lastX = in.get<double>("a body");
     b.lastY = in.get<double>("a body");
-    if (!b.p.IsValid() || !b.v.IsValid() || !std::isfinite(b.angle) || !std::isfinite(b.omega) || b.hasLast > 1 || b.awake > 1 ||
-        !std::isfinite(b.lastTheta) || !std::isfinite(b.lastX) || !std::isfinite(b.lastY))
+    if (!b.p.IsValid() || !b.v.IsValid() || !std::isfinite(b.angle) || !std::isfinite(b.omega) || b.hasLast > 1 ||
+        b.awake > 1 || !std::isfinite(b.lastTheta) || !std::isfinite(b.lastX) || !std::isfinite(b.lastY))
       throw SaveError("the saved state is malformed: a body's pose or velocity is not finite");
   }
   // The solver's state is the stream's tail. Its own loadState reads all before it assigns;

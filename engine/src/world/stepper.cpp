@@ -66,7 +66,8 @@ void World::Impl::buildStages() {
     // A particle a body's Box2D step moved onto would read as a compression the solve must
     // remove within one substep (kicks of 50 m/s and more under a crate): put back first.
     stages.add(plainStage("body_jump", [this](StepContext& c) { collideMoving(c, true); }));
-    stages.add(plainStage("body_samples", [this](StepContext& c) { bodySamples.place(c.time, c.dx, c.R, c.P.size(), c.pool, moving); }));
+    stages.add(plainStage(
+        "body_samples", [this](StepContext& c) { bodySamples.place(c.time, c.dx, c.R, c.P.size(), c.pool, moving); }));
   }
   bool anyEffect = false;
   Effect* first = nullptr;  // the first enabled effect: the solver may fold it into its pressure force
@@ -89,12 +90,13 @@ void World::Impl::buildStages() {
       stages.add(Stage{fx->name(), [fx](StepContext& c) { return fx->apply(c); }});
     }
   }
-  if (!marker)
-    throw std::logic_error(std::string("solver ") + solver->name() + " has no effects marker in its stages");
+  if (!marker) throw std::logic_error(std::string("solver ") + solver->name() + " has no effects marker in its stages");
   stages.add(plainStage("max_acceleration", [this](StepContext& c) {
-    lastAccel = c.accelMeasured >= 0 ? c.accelMeasured : maxAccelOf(c.P, c.pool);  // the explicit solvers' force_limit measured it
+    lastAccel = c.accelMeasured >= 0 ? c.accelMeasured
+                                     : maxAccelOf(c.P, c.pool);  // the explicit solvers' force_limit measured it
   }));
-  if (bodySamplesOn()) stages.add(plainStage("body_forces", [this](StepContext& c) { bodySamples.react(c.time, double(c.dt), moving); }));
+  if (bodySamplesOn())
+    stages.add(plainStage("body_forces", [this](StepContext& c) { bodySamples.react(c.time, double(c.dt), moving); }));
   addParticleSystemStages(stages);
 
   drift.clear();
@@ -152,7 +154,9 @@ Real World::Impl::substep(Real dt, bool driftOnly) {
   StepContext c = context(dt);
   c.wall = &wall;
   wall.force = Vec2d(0, 0);
-  (driftOnly ? drift : stages).run(c, [this](const std::string& stage, std::size_t slot) { fail(stage, slot); }, stop);
+  (driftOnly ? drift : stages)
+      .run(
+          c, [this](const std::string& stage, std::size_t slot) { fail(stage, slot); }, stop);
   dt = c.dt;
   wall.sum.samples += wall.force * double(dt);  // the explicit solvers' wall force, over the substep taken
   wall.force = Vec2d(0, 0);

@@ -82,7 +82,8 @@ void World::Impl::warnLowSoundSpeed() {
   }
   for (std::size_t k = 0; k < scene.events.size(); ++k) {
     const EventDef& e = scene.events[k];
-    if (e.type == EventDef::Type::Block) consider(e.block.velocity.norm(), "events[" + std::to_string(k) + "].velocity");
+    if (e.type == EventDef::Type::Block)
+      consider(e.block.velocity.norm(), "events[" + std::to_string(k) + "].velocity");
     if (e.type == EventDef::Type::Drop) consider(e.velocity.norm(), "events[" + std::to_string(k) + "].velocity");
   }
   if (!(c0 < 10 * fastest)) return;  // 10 x is the usual choice (Monaghan 1994), kept by the validation cases
@@ -135,7 +136,8 @@ void World::Impl::warnMovingBodiesInPeriodic() {
   if (ownWorld) return;
   for (const b2Body* b = b2->GetBodyList(); b; b = b->GetNext())  // a game's b2World, as it is now
     if (b->GetType() != b2_staticBody) {
-      warnings.push_back(std::string("the game's b2World has a ") + (b->GetType() == b2_kinematicBody ? "kinematic" : "dynamic") +
+      warnings.push_back(std::string("the game's b2World has a ") +
+                         (b->GetType() == b2_kinematicBody ? "kinematic" : "dynamic") +
                          " body and the scene a periodic axis: " + what);
       return;
     }
@@ -290,7 +292,7 @@ void World::step(double dt) {
     // as a kinematic one; other changes are re-read (the particles a new solid covers dropped).
     w.readStatics(dt);
     w.frameContacts.clear();  // the contacts stage's record is this step's
-    w.captureBodies();  // the moving bodies' pose and velocity for this step
+    w.captureBodies();        // the moving bodies' pose and velocity for this step
     const double t0 = w.time;
     const bool everySubstep = w.bodiesEverySubstep();  // then advance() stepped the bodies
     w.advance(dt);
@@ -343,7 +345,8 @@ std::size_t World::addEmitter(const EmitterDef& def) {
   const std::string problem = Impl::emitterProblem(def);
   if (!problem.empty()) throw std::invalid_argument("addEmitter: " + problem);
   if (w.emitters.size() >= Impl::kMaxEmitters)
-    throw std::invalid_argument("addEmitter: the world has " + std::to_string(Impl::kMaxEmitters) + " emitters, the most it holds");
+    throw std::invalid_argument("addEmitter: the world has " + std::to_string(Impl::kMaxEmitters) +
+                                " emitters, the most it holds");
   Impl::EmitterState st;
   st.def = def;
   st.def.direction = def.direction.normalized();
@@ -424,9 +427,7 @@ const Particles& World::particles() const {
 }
 std::size_t World::particleCount() const { return impl_->P.size(); }
 Vec2d World::origin() const { return impl_->origin; }
-Vec2d World::worldPosition(std::size_t i) const {
-  return Vec2d(impl_->P.x[i].x(), impl_->P.x[i].y()) + impl_->origin;
-}
+Vec2d World::worldPosition(std::size_t i) const { return Vec2d(impl_->P.x[i].x(), impl_->P.x[i].y()) + impl_->origin; }
 const std::vector<Collider>& World::colliders() const { return impl_->boundary.colliders; }
 const std::vector<Vec2>& World::boundarySamples() const { return impl_->boundary.samples; }
 b2World& World::box2d() { return *impl_->b2; }
@@ -463,8 +464,8 @@ auto& effectNamed(Effects& effects, const std::string& name) {
     if (name == e->name()) return *e;
     names += (names.empty() ? "" : ", ") + std::string(e->name());
   }
-  throw std::invalid_argument("the scene does not enable the effect '" + name + "'; its effects: " +
-                              (names.empty() ? std::string("none") : names));
+  throw std::invalid_argument("the scene does not enable the effect '" + name +
+                              "'; its effects: " + (names.empty() ? std::string("none") : names));
 }
 
 }  // namespace

@@ -21,8 +21,8 @@
 #include <vector>
 
 #include "bodies/body_samples.hpp"
-#include "effects/effect.hpp"
 #include "bodies/moving_solid.hpp"
+#include "effects/effect.hpp"
 #include "solvers/solver.hpp"
 #include "sph2d/world.hpp"
 #include "step/stage_list.hpp"
@@ -50,20 +50,20 @@ struct World::Impl {
   Scratch scratch;
   std::unique_ptr<Solver> solver;
   EffectList effects;
-  StageList stages;                   ///< the substep, built by buildStages()
-  StageList drift;                    ///< a sliver of a step: drift and the particle system (buildStages())
+  StageList stages;  ///< the substep, built by buildStages()
+  StageList drift;   ///< a sliver of a step: drift and the particle system (buildStages())
   Real dx = 0, R = 0, mass = 0;
-  PeriodicBox periodic;               ///< the scene's periodic box in the local frame
+  PeriodicBox periodic;  ///< the scene's periodic box in the local frame
   double time = 0;
   std::uint64_t frames = 0, steps = 0;
   int lastSubsteps = 0;
-  Real lastAccel = 0;                 ///< largest acceleration of the last substep (the force limit)
-  double lastDt = 0;                  ///< the last full substep's length (0 before the first)
+  Real lastAccel = 0;  ///< largest acceleration of the last substep (the force limit)
+  double lastDt = 0;   ///< the last full substep's length (0 before the first)
   std::uint32_t nextId = 0;
-  std::uint64_t iterations = 0;       ///< solver iterations summed over the substeps
-  WallAccount wall;                   ///< World::wallImpulse(): the stages of each substep add to it (substep())
+  std::uint64_t iterations = 0;  ///< solver iterations summed over the substeps
+  WallAccount wall;              ///< World::wallImpulse(): the stages of each substep add to it (substep())
   std::vector<std::string> warnings;
-  bool warnedSave = false;  ///< save() has warned of the b2World's state it cannot hold (once per World)
+  bool warnedSave = false;              ///< save() has warned of the b2World's state it cannot hold (once per World)
   std::uint64_t boundarySignature = 0;  ///< staticSignature() when the colliders were last read
   std::uint64_t boundaryVersion = 0;    ///< how many times the colliders were read (StepContext::boundaryVersion)
 
@@ -149,9 +149,9 @@ struct World::Impl {
     double reach2;  ///< beyond this from com1, a particle's whole path misses the body (squared)
   };
   std::vector<BodyPose> bodyPoses;
-  std::vector<int> contactCount;        ///< … its approaching contacts
-  std::vector<Vec2d> contactImpulse;    ///< … the contacts' impulse on it
-  std::vector<double> contactTorque;    ///< … and their angular impulse
+  std::vector<int> contactCount;      ///< … its approaching contacts
+  std::vector<Vec2d> contactImpulse;  ///< … the contacts' impulse on it
+  std::vector<double> contactTorque;  ///< … and their angular impulse
 
   /// The moving bodies' boundary samples (body_samples.hpp), when the solver takes them.
   BodySamples bodySamples;
@@ -295,7 +295,7 @@ struct World::Impl {
   bool contactsOn = false;  ///< the `contacts` stage runs
   /// (fixture, particle id) of every contact at the end of a substep of the current (or last)
   /// step, sorted by fixture then id after the step (finishContacts).
-  std::vector<std::pair<std::uintptr_t, std::uint32_t>> frameContacts;  ///< the fixture by its address
+  std::vector<std::pair<std::uintptr_t, std::uint32_t>> frameContacts;               ///< the fixture by its address
   std::vector<std::vector<std::pair<std::uintptr_t, std::uint32_t>>> contactBlocks;  ///< the stage's per-block scratch
   /// A moving body as the contacts stage sees it: its pose and centre at the substep's end.
   struct ContactPose {

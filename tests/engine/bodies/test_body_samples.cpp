@@ -51,8 +51,8 @@ Float floatCrate(const std::string& solver, double density, double y0) {
 /// draught 0.2·500/1000 = 0.1 m, within `band` (5 %, or the issue's 10 %).
 void floatsAtArchimedes(const std::string& solver, double band = 0.05) {
   const Float r = floatCrate(solver, 500, 0.62);
-  MESSAGE(solver << ", density 500: draught over the third second " << r.draught << " m (Archimedes 0.1 m), farthest from the start "
-                 << r.farthest << " m");
+  MESSAGE(solver << ", density 500: draught over the third second " << r.draught
+                 << " m (Archimedes 0.1 m), farthest from the start " << r.farthest << " m");
   CHECK(r.entered == 0);
   CHECK(r.outside == 0);
   CHECK(std::fabs(r.draught - 0.1) <= band * 0.1);
@@ -92,7 +92,8 @@ void sameBitsOnThreads(const std::string& solver) {
     const b2Vec2 pose = crate->GetPosition();
     if (threads == 1) first = w.stateHash(), pose0 = pose, angle0 = crate->GetAngle();
     CHECK_MESSAGE(w.stateHash() == first, solver << ", threads " << threads);
-    CHECK_MESSAGE((pose.x == pose0.x && pose.y == pose0.y && crate->GetAngle() == angle0), solver << ", threads " << threads);
+    CHECK_MESSAGE((pose.x == pose0.x && pose.y == pose0.y && crate->GetAngle() == angle0),
+                  solver << ", threads " << threads);
   }
 }
 
@@ -100,7 +101,9 @@ void sameBitsOnThreads(const std::string& solver) {
 
 // With contacts alone (no samples) a density-500 crate floated 0.1107 m deep (wcsph) and
 // 0.1113 m (muller2003): a particle beside it saw less density than in the bulk.
-TEST_CASE("body samples: a wcsph crate of density 500 floats at Archimedes' draught within 5 %") { floatsAtArchimedes("wcsph"); }
+TEST_CASE("body samples: a wcsph crate of density 500 floats at Archimedes' draught within 5 %") {
+  floatsAtArchimedes("wcsph");
+}
 TEST_CASE("body samples: a muller2003 crate of density 500 floats at Archimedes' draught within 5 %") {
   floatsAtArchimedes("muller2003");
 }
@@ -127,19 +130,25 @@ TEST_CASE("body samples: a dfsph crate of density 2000 sinks to the floor") { si
 // nothing holds it where it was put: the flows that start the run moved it 4.5 cm with wcsph
 // (2.8 cm with contacts alone) and 2.0 cm with muller2003 (3.8 cm); since Box2D steps with the
 // substeps (24 Nov), 0.57 cm and 1.8 cm.
-TEST_CASE("body samples: a neutrally buoyant wcsph crate stays within 5 cm of where it was put") { staysPut("wcsph", 5); }
+TEST_CASE("body samples: a neutrally buoyant wcsph crate stays within 5 cm of where it was put") {
+  staysPut("wcsph", 5);
+}
 TEST_CASE("body samples: a neutrally buoyant muller2003 crate stays within 3 cm of where it was put") {
   staysPut("muller2003", 3);
 }
-// dfsph: 0.28 cm (0.48 cm with the signed body row; 7.6 cm with the Box2D skin alone; the crate sank away when the solves
-// counted its samples without giving it their reaction).
-TEST_CASE("body samples: a neutrally buoyant dfsph crate stays within 1 cm of where it was put") { staysPut("dfsph", 1); }
+// dfsph: 0.28 cm (0.48 cm with the signed body row; 7.6 cm with the Box2D skin alone; the crate sank away when the
+// solves counted its samples without giving it their reaction).
+TEST_CASE("body samples: a neutrally buoyant dfsph crate stays within 1 cm of where it was put") {
+  staysPut("dfsph", 1);
+}
 
-TEST_CASE("body samples: a floating crate gives the same bits on 1 2 and 3 threads crate included (wcsph muller2003 and dfsph)") {
+TEST_CASE(
+    "body samples: a floating crate gives the same bits on 1 2 and 3 threads crate included (wcsph muller2003 and dfsph)") {
   for (const char* solver : {"wcsph", "muller2003", "dfsph"}) sameBitsOnThreads(solver);
 }
 
-TEST_CASE("body samples: beside a kinematic box at rest each particle has the density it has beside the same box static to 1 % (wcsph muller2003 and dfsph)") {
+TEST_CASE(
+    "body samples: beside a kinematic box at rest each particle has the density it has beside the same box static to 1 % (wcsph muller2003 and dfsph)") {
   // A 0.4 m × 0.12 m box in a 2 m × 0.6 m block of water at rest (no gravity: the lattice stays
   // square, half a spacing off every face), once static (the static solids' samples), once
   // kinematic at rest (its own samples, sampled in its frame and placed at its pose). After a
@@ -158,7 +167,8 @@ TEST_CASE("body samples: beside a kinematic box at rest each particle has the de
       for (std::size_t i = 0; i < w.particleCount(); ++i) {
         const Vec2d x = w.worldPosition(i);
         const double ex = std::fabs(x.x() - 1.0) - 0.2, ey = std::fabs(x.y() - 0.3) - 0.06;
-        if (std::max(ex, ey) > 0 && ex < d && ey < d) rho[kinematic][w.particles().id[i]] = double(w.particles().rho[i]);
+        if (std::max(ex, ey) > 0 && ex < d && ey < d)
+          rho[kinematic][w.particles().id[i]] = double(w.particles().rho[i]);
       }
     }
     REQUIRE(rho[0].size() > 20);
@@ -171,12 +181,13 @@ TEST_CASE("body samples: beside a kinematic box at rest each particle has the de
       lowest = std::min(lowest, r);
     }
     MESSAGE(std::string(solver) << ": " << rho[0].size() << " particles beside the box, the least density " << lowest
-                   << " kg/m³, the largest relative difference kinematic against static " << worst);
+                                << " kg/m³, the largest relative difference kinematic against static " << worst);
     CHECK(worst <= 0.01);
   }
 }
 
-TEST_CASE("body samples: five dfsph crates in the dam break's surge fling no particle and keep every particle out of them (1 s)") {
+TEST_CASE(
+    "body samples: five dfsph crates in the dam break's surge fling no particle and keep every particle out of them (1 s)") {
   // The default dam break at spacing 0.01 (20k particles, the accurate preset: dfsph) with five
   // dynamic crates on the floor in the surge's way (benchmarks/bodies_cost.sh: boxes and a circle,
   // densities 300 to 2500), its first second: the surge reaches every crate and the far wall. A

@@ -5,7 +5,6 @@
 
 #include <box2d/box2d.h>
 
-
 #include <cmath>
 
 #include "boundary/boundary_set.hpp"
@@ -64,8 +63,8 @@ TEST_CASE("boundary samples fill a solid's rim down to the kernel's depth: their
     deepest = std::max(deepest, d);
   }
   const double rim = 1.0 * 0.4 - (1.0 - 0.12) * (0.4 - 0.12);
-  MESSAGE("box: " << bb.samples.size() << " samples, volume " << area << " m² against the rim's " << rim << " m², deepest "
-                  << deepest / dx << " dx");
+  MESSAGE("box: " << bb.samples.size() << " samples, volume " << area << " m² against the rim's " << rim
+                  << " m², deepest " << deepest / dx << " dx");
   CHECK(outside == 0);
   CHECK(deepest <= 2.5 * dx + 1e-5);
   CHECK(area == doctest::Approx(rim).epsilon(0.02));
@@ -77,7 +76,8 @@ TEST_CASE("boundary samples fill a solid's rim down to the kernel's depth: their
   double ring = 0;
   for (Real v : cb.volume) ring += v;
   const double annulus = test::kPi * (0.3 * 0.3 - 0.24 * 0.24);
-  MESSAGE("circle: " << cb.samples.size() << " samples, volume " << ring << " m² against the annulus's " << annulus << " m²");
+  MESSAGE("circle: " << cb.samples.size() << " samples, volume " << ring << " m² against the annulus's " << annulus
+                     << " m²");
   CHECK(ring == doctest::Approx(annulus).epsilon(1e-4));
 }
 
@@ -93,8 +93,8 @@ TEST_CASE("the collision's early-out skips only particles the swept collision le
   circle.m_radius = 0.2f;
   b2EdgeShape edge;
   edge.SetTwoSided(b2Vec2(-0.5f, 1.5f), b2Vec2(0.5f, 1.8f));
-  for (const b2Shape* shape : {static_cast<const b2Shape*>(&box), static_cast<const b2Shape*>(&circle),
-                               static_cast<const b2Shape*>(&edge)}) {
+  for (const b2Shape* shape :
+       {static_cast<const b2Shape*>(&box), static_cast<const b2Shape*>(&circle), static_cast<const b2Shape*>(&edge)}) {
     b2FixtureDef fd;
     fd.shape = shape;
     fd.friction = 0.1f;
@@ -132,7 +132,8 @@ TEST_CASE("the collision's early-out skips only particles the swept collision le
   CHECK(skippedLong > 20000);  // long moves too
 }
 
-TEST_CASE("the swept collision puts a particle that crossed an edge back on its side at the clearance, with the fixture's restitution and friction") {
+TEST_CASE(
+    "the swept collision puts a particle that crossed an edge back on its side at the clearance, with the fixture's restitution and friction") {
   b2EdgeShape edge;
   edge.SetTwoSided(b2Vec2(0, 0), b2Vec2(1, 0));
   const Real clearance = 0.005f;
@@ -145,7 +146,7 @@ TEST_CASE("the swept collision puts a particle that crossed an edge back on its 
     CHECK(b.resolve(x, v, Vec2(0.5f, 0.1f), clearance));
     CHECK(x.y() == doctest::Approx(clearance));  // back above, the clearance away
     CHECK(x.x() == doctest::Approx(0.5f).epsilon(1e-5));
-    CHECK(v.x() == doctest::Approx(0.3f));        // no friction: the tangential velocity kept
+    CHECK(v.x() == doctest::Approx(0.3f));  // no friction: the tangential velocity kept
     CHECK(v.y() == doctest::Approx(4.0f * restitution));
     // From below the same: the edge is two-sided.
     Vec2 y(0.5f, 0.1f), u(0, 4.0f);
@@ -273,7 +274,8 @@ namespace {
 /// above the apex).
 void wedge(const std::string& solver) {
   const double half = 5.0 * 3.14159265358979323846 / 180.0, L = 2.8, g = 9.81;
-  const Vec2d apex(2, 0.5), a = apex + L * Vec2d(-std::sin(half), std::cos(half)), b = apex + L * Vec2d(std::sin(half), std::cos(half));
+  const Vec2d apex(2, 0.5), a = apex + L * Vec2d(-std::sin(half), std::cos(half)),
+                            b = apex + L * Vec2d(std::sin(half), std::cos(half));
   SceneDef s = wallScene(0.03, solver);
   s.bodies.push_back(arena());
   BodyDef wedgeBody;
@@ -312,8 +314,9 @@ void wedge(const std::string& solver) {
       excessFrame = f;
     }
   }
-  MESSAGE(solver << ": " << n0 << " particles, at most " << worst << " outside the wedge in any frame, KE − released PE at most "
-                 << excess << " of the PE above the apex (frame " << excessFrame << "), mean compression "
+  MESSAGE(solver << ": " << n0 << " particles, at most " << worst
+                 << " outside the wedge in any frame, KE − released PE at most " << excess
+                 << " of the PE above the apex (frame " << excessFrame << "), mean compression "
                  << 100 * w.densityStats().meanError << " %");
   CHECK(n0 >= 160);
   CHECK(w.particleCount() == n0);
@@ -326,7 +329,8 @@ void wedge(const std::string& solver) {
 /// kinetic + potential energy ≤ what the emitter put in.
 void funnel(const std::string& solver) {
   const double g = 9.81;
-  SceneDef s = pourScene({boxShape({1.45, 2.0}, {0.6, 0.05}, -0.6), boxShape({2.55, 2.0}, {0.6, 0.05}, 0.6)}, 2.0, 1.0, solver);
+  SceneDef s =
+      pourScene({boxShape({1.45, 2.0}, {0.6, 0.05}, -0.6), boxShape({2.55, 2.0}, {0.6, 0.05}, 0.6)}, 2.0, 1.0, solver);
   World w(s, WorldOptions{2});
   const EmitterDef& e = s.effects.emitters[0];
   double eWorst = 0;  // the largest share of the energy put in
@@ -339,7 +343,8 @@ void funnel(const std::string& solver) {
       out += !(p.x() > 0 && p.x() < 4 && p.y() > 0 && p.y() < 4);
     }
     // Each particle enters at most a substep upstream of the nozzle (≤ 2 m/s · 1/60 s < 5 cm).
-    const double in = double(w.particleCount()) * double(w.particleMass()) * (0.5 * e.speed * e.speed + g * (e.position.y() + 0.05));
+    const double in =
+        double(w.particleCount()) * double(w.particleMass()) * (0.5 * e.speed * e.speed + g * (e.position.y() + 0.05));
     if (w.particleCount() > 0) eWorst = std::max(eWorst, (w.kineticEnergy() + potentialEnergy(w, g)) / in);
   }
   std::size_t below = 0;  // passed the neck
@@ -354,7 +359,8 @@ void funnel(const std::string& solver) {
 }  // namespace
 
 TEST_CASE_EVERY_SOLVER("a 10 degree wedge: fluid dropped into its sharp end stays in, no NaN", wedge)
-TEST_CASE_EVERY_SOLVER("a funnel that jams: fluid poured in stays above or passes the neck, no NaN, nothing leaves the arena", funnel)
+TEST_CASE_EVERY_SOLVER(
+    "a funnel that jams: fluid poured in stays above or passes the neck, no NaN, nothing leaves the arena", funnel)
 
 TEST_CASE("every shape type, rotated by an arbitrary angle, holds fluid with zero escapes") {
   const double ang = 0.37;  // radians, arbitrary
@@ -374,19 +380,23 @@ TEST_CASE("every shape type, rotated by an arbitrary angle, holds fluid with zer
   cases.push_back({"boxes",
                    {boxShape(R({2, 0.9}), {0.9, 0.1}, ang), boxShape(R({1.1, 1.8}), {0.1, 0.9}, ang),
                     boxShape(R({2.9, 1.8}), {0.1, 0.9}, ang), boxShape(R({2, 2.8}), {0.9, 0.1}, ang)}});
-  cases.push_back({"polygons",
-                   {pointsShape(ShapeDef::Type::Polygon, {R({1.0, 0.8}), R({3.0, 0.8}), R({3.0, 1.0}), R({1.0, 1.0})}),
-                    pointsShape(ShapeDef::Type::Polygon, {R({1.0, 1.0}), R({1.2, 1.0}), R({1.2, 2.7}), R({1.0, 2.7})}),
-                    pointsShape(ShapeDef::Type::Polygon, {R({2.8, 1.0}), R({3.0, 1.0}), R({3.0, 2.7}), R({2.8, 2.7})}),
-                    pointsShape(ShapeDef::Type::Polygon, {R({1.0, 2.7}), R({3.0, 2.7}), R({3.0, 2.9}), R({1.0, 2.9})})}});
+  cases.push_back(
+      {"polygons",
+       {pointsShape(ShapeDef::Type::Polygon, {R({1.0, 0.8}), R({3.0, 0.8}), R({3.0, 1.0}), R({1.0, 1.0})}),
+        pointsShape(ShapeDef::Type::Polygon, {R({1.0, 1.0}), R({1.2, 1.0}), R({1.2, 2.7}), R({1.0, 2.7})}),
+        pointsShape(ShapeDef::Type::Polygon, {R({2.8, 1.0}), R({3.0, 1.0}), R({3.0, 2.7}), R({2.8, 2.7})}),
+        pointsShape(ShapeDef::Type::Polygon, {R({1.0, 2.7}), R({3.0, 2.7}), R({3.0, 2.9}), R({1.0, 2.9})})}});
   cases.push_back({"edges",
                    {pointsShape(ShapeDef::Type::Edge, {R({1.2, 1.0}), R({2.8, 1.0})}),
                     pointsShape(ShapeDef::Type::Edge, {R({1.2, 1.0}), R({1.2, 2.7})}),
                     pointsShape(ShapeDef::Type::Edge, {R({2.8, 1.0}), R({2.8, 2.7})}),
                     pointsShape(ShapeDef::Type::Edge, {R({1.2, 2.7}), R({2.8, 2.7})})}});
-  cases.push_back({"open chains", {pointsShape(ShapeDef::Type::Chain, {R({1.2, 2.7}), R({1.2, 1.0}), R({2.8, 1.0}), R({2.8, 2.7})}),
-                                   pointsShape(ShapeDef::Type::Chain, {R({1.2, 2.7}), R({2.0, 2.7}), R({2.8, 2.7})})}});
-  cases.push_back({"looped chain", {pointsShape(ShapeDef::Type::Chain, {R({1.2, 2.7}), R({1.2, 1.0}), R({2.8, 1.0}), R({2.8, 2.7}), R({2.0, 3.4})}, true)}});
+  cases.push_back({"open chains",
+                   {pointsShape(ShapeDef::Type::Chain, {R({1.2, 2.7}), R({1.2, 1.0}), R({2.8, 1.0}), R({2.8, 2.7})}),
+                    pointsShape(ShapeDef::Type::Chain, {R({1.2, 2.7}), R({2.0, 2.7}), R({2.8, 2.7})})}});
+  cases.push_back({"looped chain",
+                   {pointsShape(ShapeDef::Type::Chain,
+                                {R({1.2, 2.7}), R({1.2, 1.0}), R({2.8, 1.0}), R({2.8, 2.7}), R({2.0, 3.4})}, true)}});
   ShapeDef circle;
   circle.type = ShapeDef::Type::Circle;
   circle.center = R({2.0, 1.0});
@@ -416,7 +426,8 @@ TEST_CASE("every shape type, rotated by an arbitrary angle, holds fluid with zer
       // Back into the cup's frame; inside means within the cup's inner rectangle (and outside the circle).
       const Vec2d q = turn(w.worldPosition(i), -ang);
       bool inside = q.x() > 1.2 - 1e-3 && q.x() < 2.8 + 1e-3 && q.y() > 1.0 - 1e-3 && q.y() < 2.7 + 1e-3;
-      if (std::string(c.name) == "circle in a cup") inside = inside && (w.worldPosition(i) - circle.center).norm() > circle.radius - 1e-3;
+      if (std::string(c.name) == "circle in a cup")
+        inside = inside && (w.worldPosition(i) - circle.center).norm() > circle.radius - 1e-3;
       escaped += !inside;
     }
     MESSAGE(c.name << ": " << w.particleCount() << " particles, " << escaped << " escaped");

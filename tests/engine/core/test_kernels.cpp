@@ -50,8 +50,8 @@ TEST_CASE_TEMPLATE("kernel is non-negative, radially decreasing, zero at and bey
   CHECK(k.derivative(k.R) == doctest::Approx(0).epsilon(1e-12));
 }
 
-TEST_CASE_TEMPLATE("kernel derivative and Laplacian agree with finite differences of W", K, Poly6<double>, Spiky<double>,
-                   ViscosityKernel<double>, CubicSpline<double>, WendlandC2<double>) {
+TEST_CASE_TEMPLATE("kernel derivative and Laplacian agree with finite differences of W", K, Poly6<double>,
+                   Spiky<double>, ViscosityKernel<double>, CubicSpline<double>, WendlandC2<double>) {
   const K k(0.9);
   const double e = 1e-5 * k.R;
   for (int i = 1; i < 19; ++i) {
@@ -91,8 +91,8 @@ TEST_CASE_TEMPLATE("kernel gradient is antisymmetric and sums to zero at an inte
   CHECK(sum.norm() <= 1e-12 * scale);
 }
 
-TEST_CASE_TEMPLATE("kernel is finite at r = 0 and r = R in float", K, Poly6<float>, Spiky<float>, ViscosityKernel<float>,
-                   CubicSpline<float>, WendlandC2<float>) {
+TEST_CASE_TEMPLATE("kernel is finite at r = 0 and r = R in float", K, Poly6<float>, Spiky<float>,
+                   ViscosityKernel<float>, CubicSpline<float>, WendlandC2<float>) {
   const K k(0.035f);
   using V = typename K::V;
   for (float r : {0.0f, k.R, 1e-30f}) {

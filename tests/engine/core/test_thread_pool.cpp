@@ -6,8 +6,8 @@
 // blocks not started.
 #include <doctest/doctest.h>
 
-#include <atomic>
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <memory>
@@ -23,7 +23,8 @@
 using namespace sph2d;
 
 // Block k is [k·block, min(n, (k+1)·block)).
-TEST_CASE("parallelFor calls each block of the fixed split once, begin to end, and covers every index once, for 1 to 4 threads") {
+TEST_CASE(
+    "parallelFor calls each block of the fixed split once, begin to end, and covers every index once, for 1 to 4 threads") {
   for (int threads = 1; threads <= 4; ++threads) {
     ThreadPool pool(threads);
     CHECK(pool.size() == threads);
@@ -54,7 +55,8 @@ TEST_CASE("parallelFor calls each block of the fixed split once, begin to end, a
   }
 }
 
-TEST_CASE("reduce combines the blocks' results in block order: a non-associative float sum is bit-identical for 1 to 4 threads") {
+TEST_CASE(
+    "reduce combines the blocks' results in block order: a non-associative float sum is bit-identical for 1 to 4 threads") {
   // Values of both signs over nine decades: their float sum depends on the order.
   const std::size_t n = 10000, block = 256;
   std::vector<float> x(n);
@@ -164,7 +166,8 @@ std::vector<std::size_t> blocksTakenFromHeldShare(bool holdCaller, bool& once, b
 }
 }  // namespace
 
-TEST_CASE("work stealing: the blocks of a thread held up in one block are run by the other thread, each once, from its share's back") {
+TEST_CASE(
+    "work stealing: the blocks of a thread held up in one block are run by the other thread, each once, from its share's back") {
   // Each thread starts on its own share; when it is used up it takes the others' blocks from
   // their back. A thread stuck in one block must not hold up the rest of its share, and what
   // the other takes is the share's end (the held thread keeps the front it will reach first).
@@ -182,7 +185,8 @@ TEST_CASE("work stealing: the blocks of a thread held up in one block are run by
   }
 }
 
-TEST_CASE("many short jobs in a row, up to more threads than cores: each block of each job runs once (late workers claim nothing stale)") {
+TEST_CASE(
+    "many short jobs in a row, up to more threads than cores: each block of each job runs once (late workers claim nothing stale)") {
   // Oversubscribed pools get their workers descheduled mid-claim: a worker that wakes after its
   // job ended must not run a block of it again, nor a block of the next job twice.
   const int over = int(std::thread::hardware_concurrency()) + 1;  // more threads than this machine has cores

@@ -11,7 +11,9 @@ using namespace sph2d;
 
 namespace {
 
-bool has(const std::vector<std::string>& v, const std::string& s) { return std::find(v.begin(), v.end(), s) != v.end(); }
+bool has(const std::vector<std::string>& v, const std::string& s) {
+  return std::find(v.begin(), v.end(), s) != v.end();
+}
 
 }  // namespace
 
@@ -94,8 +96,8 @@ TEST_CASE("a force field everywhere alone accelerates a free block's mean veloci
   for (int f = 0; f < 30; ++f) w.stepFrame();
   const Vec2d mean = test::momentum(w) / (double(w.particleMass()) * double(w.particleCount()));
   const Vec2d expected = a * w.time();
-  MESSAGE("mean velocity (" << mean.x() << ", " << mean.y() << ") m/s at t = " << w.time() << " s, a t = (" << expected.x()
-                            << ", " << expected.y() << ")");
+  MESSAGE("mean velocity (" << mean.x() << ", " << mean.y() << ") m/s at t = " << w.time() << " s, a t = ("
+                            << expected.x() << ", " << expected.y() << ")");
   CHECK(w.time() == doctest::Approx(0.5));
   CHECK((mean - expected).norm() <= 1e-4 * expected.norm());
   CHECK(test::allFiniteState(w));

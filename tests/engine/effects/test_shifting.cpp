@@ -11,7 +11,8 @@
 
 using namespace sph2d;
 
-TEST_CASE("particle shifting alone separates the pairs a Taylor-Green vortex makes: the closest pair grows past 0.5 dx") {
+TEST_CASE(
+    "particle shifting alone separates the pairs a Taylor-Green vortex makes: the closest pair grows past 0.5 dx") {
   // dfsph (3 substeps a frame) pairs particles in the vortex's straining flow
   // without shifting (docs/STABILITY.md). The vortex runs 0.3 s without it (the
   // closest pair at 0.19 dx), then shifting is switched on: measured 0.74 dx at
@@ -39,7 +40,8 @@ TEST_CASE("particle shifting alone separates the pairs a Taylor-Green vortex mak
   CHECK(test::allFiniteState(w));
 }
 
-TEST_CASE("particle shifting beside a kinematic box at rest moves each particle as beside the same box static (wcsph)") {
+TEST_CASE(
+    "particle shifting beside a kinematic box at rest moves each particle as beside the same box static (wcsph)") {
   // Water streaming at 0.3 m/s past a 0.4 m × 0.12 m box (no gravity, shifting strength 8),
   // once static (the static solids' samples), once kinematic at rest (its own samples). The
   // box's samples count in ∇C either way, so after 10 substeps the particles within 2
@@ -71,6 +73,7 @@ TEST_CASE("particle shifting beside a kinematic box at rest moves each particle 
     REQUIRE(k != at[1].end());
     worst = std::max(worst, (k->second - x).norm());
   }
-  MESSAGE(at[0].size() << " particles beside the box, the farthest apart kinematic against static " << worst / dx << " dx");
+  MESSAGE(at[0].size() << " particles beside the box, the farthest apart kinematic against static " << worst / dx
+                       << " dx");
   CHECK(worst <= 0.05 * dx);
 }

@@ -49,8 +49,10 @@ SceneDef freeFluid(const std::string& model, double strength) {
   s.gravity = Vec2d(0, 0);
   s.effects.surfaceTension = true;
   s.effects.tension.model = model;
-  if (model == "csf") s.effects.tension.sigma = strength;
-  else s.effects.tension.gamma = strength;
+  if (model == "csf")
+    s.effects.tension.sigma = strength;
+  else
+    s.effects.tension.gamma = strength;
   return s;
 }
 
@@ -168,7 +170,8 @@ TEST_CASE("csf surface tension rounds a 2:1 block in zero gravity (inertia aspec
 // σ = 2–3 N/m on the 0.05 m drop the outermost ring of particles is pressed
 // inwards and carries part of the load as a compressed arch: the jump drifts to
 // 0.8–0.86 σ/R within 2–3 s (measured, not tested).
-TEST_CASE("csf surface tension: the pressure jump across a drop is sigma/R within 20 % (2D Laplace law, two radii, two sigma)") {
+TEST_CASE(
+    "csf surface tension: the pressure jump across a drop is sigma/R within 20 % (2D Laplace law, two radii, two sigma)") {
   struct Case {
     double sigma, radius;
   };
@@ -198,7 +201,8 @@ TEST_CASE("akinci surface tension rounds a square of fluid in zero gravity (corn
 // R the kernel support, A ≈ 0.157 γρ0²R and σ ≈ 0.021 γρ0²R², so σ/r_drop is a
 // fraction 0.13 R/r_drop of A: the pressure inside an akinci drop is A, nearly
 // independent of its radius, not σ/r. This tests that relation.
-TEST_CASE("akinci surface tension: the pressure inside a drop is the cohesion's internal pressure A within 20 % (two radii, two gamma)") {
+TEST_CASE(
+    "akinci surface tension: the pressure inside a drop is the cohesion's internal pressure A within 20 % (two radii, two gamma)") {
   struct Case {
     double gamma, radius;
   };

@@ -7,9 +7,9 @@
 #include <string>
 #include <vector>
 
+#include "bench/validation.hpp"
 #include "sph2d/world.hpp"
 #include "support/fixture.hpp"
-#include "bench/validation.hpp"
 
 using namespace sph2d;
 
@@ -43,7 +43,8 @@ TEST_CASE("viscosity alone diffuses a shear layer at the rate of the diffusion e
     w.stepFrame();
     if (f % 15) continue;
     const double ratio = test::layerVelocityDifference(w, firstUpper) / d0, exact = shearLayerDecay(nu, k, w.time());
-    MESSAGE("t = " << w.time() << " s: velocity difference " << ratio << " of the start, the diffusion series " << exact);
+    MESSAGE("t = " << w.time() << " s: velocity difference " << ratio << " of the start, the diffusion series "
+                   << exact);
     CHECK(ratio == doctest::Approx(exact).epsilon(0.10));
   }
   CHECK(test::allFiniteState(w));
@@ -58,7 +59,8 @@ TEST_CASE("viscosity conserves linear momentum to rounding (no walls, no gravity
   CHECK(r.finite);
 }
 
-TEST_CASE("viscosity: two particles pressed to 0.1 R with opposite velocities neither swap nor grow their shear, at the solvers' own substeps") {
+TEST_CASE(
+    "viscosity: two particles pressed to 0.1 R with opposite velocities neither swap nor grow their shear, at the solvers' own substeps") {
   // The Laplacian's coupling grows as 1/r³: at 0.1 R the game solver's substep (1/120 s,
   // ν = 0.001 m²/s) would take 3.5 times the pair's relative velocity away per substep, so
   // that it reverses and grows sixfold (the 20k game dam break ran away so at 0.72 s).
@@ -92,15 +94,18 @@ TEST_CASE("viscosity: two particles pressed to 0.1 R with opposite velocities ne
       REQUIRE(w.getParticle(ids[0], x0, v0));
       REQUIRE(w.getParticle(ids[1], x1, v1));
       const double shear = v0.y() - v1.y();
-      MESSAGE(std::string(solver) << " (support " << R / 0.01 << " dx), frame " << f + 1 << ": shear " << shear << " m/s (start " << 2 * U << "), pair at " << (x1 - x0).norm() / R << " R");
-      CHECK(shear > 0);          // not reversed
-      CHECK(shear <= 2 * U);     // not grown
-      CHECK(std::fabs(v0.y() + v1.y()) <= 1e-4 * U);  // momentum (pbf's velocities are position differences over dt: float rounding)
+      MESSAGE(std::string(solver) << " (support " << R / 0.01 << " dx), frame " << f + 1 << ": shear " << shear
+                                  << " m/s (start " << 2 * U << "), pair at " << (x1 - x0).norm() / R << " R");
+      CHECK(shear > 0);       // not reversed
+      CHECK(shear <= 2 * U);  // not grown
+      CHECK(std::fabs(v0.y() + v1.y()) <=
+            1e-4 * U);  // momentum (pbf's velocities are position differences over dt: float rounding)
     }
   }
 }
 
-TEST_CASE("viscosity: with no_slip a kinematic plate sliding along itself drags the water beside it as Stokes' first problem says (wcsph)") {
+TEST_CASE(
+    "viscosity: with no_slip a kinematic plate sliding along itself drags the water beside it as Stokes' first problem says (wcsph)") {
   // A 1.6 m × 0.04 m plate in still water (no gravity) set sliding along itself at U: the
   // water beside it follows u(y, t) = U erfc(y / (2 sqrt(ν t))) (Stokes 1851). Only the
   // no-slip wall term acts on the sliding shear (wcsph's artificial viscosity takes only
@@ -134,12 +139,14 @@ TEST_CASE("viscosity: with no_slip a kinematic plate sliding along itself drags 
     }
     REQUIRE(n > 10);
     const double u = sum / n, y = ysum / n, exact = U * std::erfc(y / (2 * std::sqrt(nu * t)));
-    MESSAGE("layer " << layer << " (" << n << " particles, mean distance " << y << " m): u = " << u << " m/s, Stokes " << exact);
+    MESSAGE("layer " << layer << " (" << n << " particles, mean distance " << y << " m): u = " << u << " m/s, Stokes "
+                     << exact);
     CHECK(u == doctest::Approx(exact).epsilon(0.05));
   }
 }
 
-TEST_CASE("start-up Poiseuille flow (viscosity, no-slip walls) follows the series at every tabulated time and reaches the steady parabola, for every solver") {
+TEST_CASE(
+    "start-up Poiseuille flow (viscosity, no-slip walls) follows the series at every tabulated time and reaches the steady parabola, for every solver") {
   const auto table = validation::readReferenceCsv(test::asset("reference/channel_flow_transient.csv"));
   for (const std::string solver : {"muller2003", "wcsph", "dfsph", "pbf"}) {
     CAPTURE(solver);
@@ -150,7 +157,8 @@ TEST_CASE("start-up Poiseuille flow (viscosity, no-slip walls) follows the serie
     }
     const auto r = validation::runPoiseuille(s, 0.0, 1.0, table, 2);
     MESSAGE(solver << ": " << r.points.size() << " points of the series, worst |u - u_ref| = " << 100 * r.worstError
-                   << " % of the centre speed, RMS " << 100 * r.rmsError << " %, at tau = 0.5 " << 100 * r.steadyError << " %");
+                   << " % of the centre speed, RMS " << 100 * r.rmsError << " %, at tau = 0.5 " << 100 * r.steadyError
+                   << " %");
     CHECK(r.points.size() == 63);
     // pbf's first row sits farther from the walls (its density constraint,
     // not a wall pressure, holds it), so its walls slip: 7.7 % measured.
@@ -160,7 +168,8 @@ TEST_CASE("start-up Poiseuille flow (viscosity, no-slip walls) follows the serie
   }
 }
 
-TEST_CASE("viscosity: with no_slip a free disc at the centre of a turning pool of water is spun the way the water turns (wcsph, dfsph, muller2003)") {
+TEST_CASE(
+    "viscosity: with no_slip a free disc at the centre of a turning pool of water is spun the way the water turns (wcsph, dfsph, muller2003)") {
   // Water in rigid rotation at Ω = 2 rad/s (a disc of it, radius 0.4 m, no gravity) around a free
   // disc of radius 0.1 m and density 1000 at rest at its centre. Pressure on a circle passes
   // through its centre, so only the no-slip wall term's reaction (the viscosity effect's for
@@ -201,10 +210,10 @@ TEST_CASE("viscosity: with no_slip a free disc at the centre of a turning pool o
       most = std::max(most, double(body->GetAngularVelocity()));
     }
     const double spin = body->GetAngularVelocity();
-    MESSAGE(std::string(solver) << ": the disc turns at " << spin << " rad/s after 0.2 s (the water at " << omega << "; between " << least
-                   << " and " << most << " over the frames), centre moved "
-                   << std::hypot(body->GetPosition().x - 0.6, body->GetPosition().y - 0.6) << " m");
-    CHECK(spin >= 0.1 * omega);  // turned the water's way, clearly
+    MESSAGE(std::string(solver) << ": the disc turns at " << spin << " rad/s after 0.2 s (the water at " << omega
+                                << "; between " << least << " and " << most << " over the frames), centre moved "
+                                << std::hypot(body->GetPosition().x - 0.6, body->GetPosition().y - 0.6) << " m");
+    CHECK(spin >= 0.1 * omega);     // turned the water's way, clearly
     CHECK(least >= -0.01 * omega);  // never against it
     CHECK(most <= 1.05 * omega);    // and not past it
   }

@@ -8,7 +8,8 @@
 
 using namespace sph2d;
 
-TEST_CASE("xsph alone smooths a shear layer: less velocity variance than without it, and a smaller velocity difference") {
+TEST_CASE(
+    "xsph alone smooths a shear layer: less velocity variance than without it, and a smaller velocity difference") {
   // dfsph, U = 0.1 m/s, XSPH's default c = 0.05; 1 s. Measured: variance 1.25 U²
   // with XSPH, 3.33 U² without (the sliding layers' noise); the halves' velocity
   // difference 0.887 and 1.007 of the start.
@@ -24,8 +25,8 @@ TEST_CASE("xsph alone smooths a shear layer: less velocity variance than without
     REQUIRE(test::allFiniteState(w));
     variance[on] = test::velocityVariance(w) / (U * U);
     difference[on] = test::layerVelocityDifference(w, firstUpper) / (2 * U);
-    MESSAGE(std::string(on ? "with" : "without") << " xsph: velocity variance " << variance[on] << " U², velocity difference "
-                                      << difference[on] << " of the start");
+    MESSAGE(std::string(on ? "with" : "without") << " xsph: velocity variance " << variance[on]
+                                                 << " U², velocity difference " << difference[on] << " of the start");
   }
   CHECK(variance[1] < 0.5 * variance[0]);
   CHECK(difference[1] < 0.95);

@@ -10,8 +10,8 @@
 #include <type_traits>
 #include <vector>
 
-#include "particles/field_operators.hpp"
 #include "core/kernels.hpp"
+#include "particles/field_operators.hpp"
 #include "support/field_study.hpp"
 
 using namespace sph2d;
@@ -52,7 +52,8 @@ TEST_CASE_TEMPLATE("NeighbourSearch returns exactly the points within the radius
     std::size_t pairs = 0;
     for (int q = 0; q < 300; ++q) {
       // Queries inside and up to 2R outside the particles' box.
-      const Vec<T> p(T(offset - 2 * R + (3 + 4 * R) * study::uniform01(g)), T(offset - 1 - 2 * R + (2 + 4 * R) * study::uniform01(g)));
+      const Vec<T> p(T(offset - 2 * R + (3 + 4 * R) * study::uniform01(g)),
+                     T(offset - 1 - 2 * R + (2 + 4 * R) * study::uniform01(g)));
       std::vector<char> seen(x.size(), 0);
       std::vector<std::size_t> order;
       s.forCandidates(p, [&](std::size_t j) {
@@ -126,8 +127,8 @@ TEST_CASE("NeighbourSearch and FieldOperators reject bad input") {
   CHECK_NOTHROW(FieldOperators<CubicSpline<double>>(k, ParticleView<double>::withVolumes(x.data(), vol.data(), 2), s));
 }
 
-TEST_CASE_TEMPLATE("Shepard sampling reproduces a constant to rounding on a jittered lattice, the plain sum does not", K,
-                   CubicSpline<float>, CubicSpline<double>, WendlandC2<float>, WendlandC2<double>, Poly6<double>,
+TEST_CASE_TEMPLATE("Shepard sampling reproduces a constant to rounding on a jittered lattice, the plain sum does not",
+                   K, CubicSpline<float>, CubicSpline<double>, WendlandC2<float>, WendlandC2<double>, Poly6<double>,
                    Spiky<double>) {
   using T = typename K::V::Scalar;
   const int n = 30;
@@ -156,8 +157,9 @@ TEST_CASE_TEMPLATE("Shepard sampling reproduces a constant to rounding on a jitt
   CHECK(worstPlain > 0.05);  // kernel-sum deficit (edges, jitter) that Shepard removes
 }
 
-TEST_CASE_TEMPLATE("Shepard sampling of a linear field: exact at symmetric lattice sites, off by at most |g|·jitter on a jittered lattice",
-                   K, CubicSpline<double>, WendlandC2<double>, Poly6<double>) {
+TEST_CASE_TEMPLATE(
+    "Shepard sampling of a linear field: exact at symmetric lattice sites, off by at most |g|·jitter on a jittered lattice",
+    K, CubicSpline<double>, WendlandC2<double>, Poly6<double>) {
   const int n = 30;
   const double dx = 0.1, jitter = 0.2;
   const Vec2d g0(0.7, -1.3);
@@ -186,9 +188,10 @@ TEST_CASE_TEMPLATE("Shepard sampling of a linear field: exact at symmetric latti
   }
 }
 
-TEST_CASE_TEMPLATE("corrected gradient, divergence and curl are exact for linear fields on a jittered lattice, edges included",
-                   K, CubicSpline<float>, CubicSpline<double>, WendlandC2<float>, WendlandC2<double>, Spiky<double>,
-                   ViscosityKernel<double>) {
+TEST_CASE_TEMPLATE(
+    "corrected gradient, divergence and curl are exact for linear fields on a jittered lattice, edges included", K,
+    CubicSpline<float>, CubicSpline<double>, WendlandC2<float>, WendlandC2<double>, Spiky<double>,
+    ViscosityKernel<double>) {
   using T = typename K::V::Scalar;
   const int n = 24;
   const double dx = 0.05;
@@ -228,7 +231,8 @@ TEST_CASE("the correction falls back to the uncorrected operators where M is sin
   const CubicSpline<double> k(0.35);
   NeighbourSearch s;
   s.build(x.data(), x.size(), k.R);
-  const FieldOperators<CubicSpline<double>> ops(k, ParticleView<double>::withVolumes(x.data(), vol.data(), x.size()), s);
+  const FieldOperators<CubicSpline<double>> ops(k, ParticleView<double>::withVolumes(x.data(), vol.data(), x.size()),
+                                                s);
   Eigen::Matrix2d L;
   CHECK_FALSE(ops.correctionMatrix(4, L));
   CHECK(L == Eigen::Matrix2d::Identity());
@@ -314,7 +318,10 @@ TEST_CASE_TEMPLATE("Laplacian of x^2 + y^2 at interior points of a regular latti
   if constexpr (K::hasLaplacian) {
     // The seed's kernel-Laplacian form is much further off on the same lattice
     // (measured poly6 0.926, viscosity 0.782, cubic 0.445, Wendland 0.0375), ±10 %.
-    const double kernelLapErr = name == "poly6" ? 0.926 : name == "viscosity" ? 0.782 : name == "cubic" ? 0.445 : 0.0375;
+    const double kernelLapErr = name == "poly6"       ? 0.926
+                                : name == "viscosity" ? 0.782
+                                : name == "cubic"     ? 0.445
+                                                      : 0.0375;
     CHECK(worstKernelLap <= 1.1 * kernelLapErr);
     CHECK(worstKernelLap >= 0.9 * kernelLapErr);
   }
@@ -352,8 +359,9 @@ Orders measureOrders(double jitter) {
 
 }  // namespace
 
-TEST_CASE_TEMPLATE("convergence on a regular lattice at fixed R/dx = 3: Shepard sample, corrected gradient and renormalised Laplacian are second order",
-                   K, Poly6<double>, Spiky<double>, ViscosityKernel<double>, CubicSpline<double>, WendlandC2<double>) {
+TEST_CASE_TEMPLATE(
+    "convergence on a regular lattice at fixed R/dx = 3: Shepard sample, corrected gradient and renormalised Laplacian are second order",
+    K, Poly6<double>, Spiky<double>, ViscosityKernel<double>, CubicSpline<double>, WendlandC2<double>) {
   const Orders o = measureOrders<K>(0.0);
   // Measured (docs/KERNELS.md): 1.97–2.00 for all three, every kernel, both steps.
   for (int r = 0; r < 2; ++r) {

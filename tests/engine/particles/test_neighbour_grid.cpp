@@ -8,8 +8,8 @@
 #include <set>
 #include <vector>
 
-#include "particles/neighbour_grid.hpp"
 #include "core/thread_pool.hpp"
+#include "particles/neighbour_grid.hpp"
 
 using namespace sph2d;
 
@@ -54,7 +54,8 @@ TEST_CASE("grid neighbours equal brute force: random, clustered and degenerate i
     x.clear();
     for (int c = 0; c < 5; ++c) {
       const double cx = unit(rng), cy = unit(rng);
-      for (int i = 0; i < 300; ++i) x.emplace_back(Real(cx + 0.02 * (unit(rng) - 0.5)), Real(cy + 0.02 * (unit(rng) - 0.5)));
+      for (int i = 0; i < 300; ++i)
+        x.emplace_back(Real(cx + 0.02 * (unit(rng) - 0.5)), Real(cy + 0.02 * (unit(rng) - 0.5)));
     }
     expectSameAsBruteForce(x, R, cps, pool);
     // All particles in one cell, many coincident.
@@ -75,18 +76,21 @@ TEST_CASE("grid neighbours equal brute force: random, clustered and degenerate i
   }
 }
 
-TEST_CASE("grid counting sort: the one stable order by cell for 1 to 4 threads, sorted, shuffled and clustered inputs") {
+TEST_CASE(
+    "grid counting sort: the one stable order by cell for 1 to 4 threads, sorted, shuffled and clustered inputs") {
   // The sort cuts the cells into one band per thread (at the cells of evenly spaced slots) and
   // each thread places only its band's particles: any cut must give the same order, and that
   // order is the stable sort by cell (cells ascending, slots ascending within a cell).
   std::mt19937_64 rng(777);
   std::vector<Vec2> sortedInput, shuffled, clustered;
   for (int j = 0; j < 120; ++j)
-    for (int i = 0; i < 100; ++i) sortedInput.emplace_back(Real(0.01 * i + 0.001 * unit(rng)), Real(0.01 * j + 0.001 * unit(rng)));
+    for (int i = 0; i < 100; ++i)
+      sortedInput.emplace_back(Real(0.01 * i + 0.001 * unit(rng)), Real(0.01 * j + 0.001 * unit(rng)));
   shuffled = sortedInput;
   std::shuffle(shuffled.begin(), shuffled.end(), rng);
   for (int i = 0; i < 12000; ++i)  // most particles in one corner: uneven bands
-    clustered.emplace_back(Real(i < 10000 ? 0.05 * unit(rng) : unit(rng)), Real(i < 10000 ? 0.05 * unit(rng) : unit(rng)));
+    clustered.emplace_back(Real(i < 10000 ? 0.05 * unit(rng) : unit(rng)),
+                           Real(i < 10000 ? 0.05 * unit(rng) : unit(rng)));
   for (const std::vector<Vec2>* x : {&sortedInput, &shuffled, &clustered}) {
     std::vector<std::uint32_t> order, starts;
     for (int threads = 1; threads <= 4; ++threads) {

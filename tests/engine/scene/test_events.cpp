@@ -89,7 +89,8 @@ TEST_CASE("a bad timeline event names the file, line, column and key") {
   SceneError e = sceneError("[\n  { \"t\": 1, \"type\": \"jump\" } ]");
   CHECK(e.key == "events[0].type");
   CHECK(e.line == 9);  // the line of the event in tank.json
-  CHECK(e.message == "'jump' is not allowed; allowed values: force, release, block, drop, emitter, gravity, effect, pause, resume");
+  CHECK(e.message ==
+        "'jump' is not allowed; allowed values: force, release, block, drop, emitter, gravity, effect, pause, resume");
 
   e = sceneError("[ { \"type\": \"resume\" } ]");
   CHECK(e.key == "events[0].t");
@@ -97,7 +98,8 @@ TEST_CASE("a bad timeline event names the file, line, column and key") {
 
   e = sceneError("[ { \"t\": 1, \"type\": \"force\", \"point\": [0, 0], \"strenght\": 3 } ]");
   CHECK(e.key == "events[0].strenght");
-  CHECK(e.message == "unknown key 'strenght' (did you mean 'strength'?); allowed keys: type, t, frame, id, point, radius, strength");
+  CHECK(e.message ==
+        "unknown key 'strenght' (did you mean 'strength'?); allowed keys: type, t, frame, id, point, radius, strength");
 
   // "source" belongs to recorded lines, not to a scene's timeline.
   e = sceneError("[ { \"t\": 1, \"type\": \"resume\", \"source\": \"live\" } ]");
@@ -163,7 +165,8 @@ TEST_CASE("eventToJson writes what parseEvent reads back bit for bit") {
     CHECK(back.velocity == e.velocity);
     CHECK(back.block.min == e.block.min);
   }
-  CHECK(eventToJson(s.events[0]) == R"({"t":0.1,"type":"force","id":0,"point":[0.1,0.7],"radius":0.3,"strength":12.345678901234567})");
+  CHECK(eventToJson(s.events[0]) ==
+        R"({"t":0.1,"type":"force","id":0,"point":[0.1,0.7],"radius":0.3,"strength":12.345678901234567})");
 }
 
 TEST_CASE("an event applies at the first frame boundary at or after its time") {

@@ -63,7 +63,8 @@ TEST_CASE("the JSON reader gives the line and byte column of every key and array
   CHECK(d.where.size() == 1 + 3 + 1 + 1 + 2 + 4 + 1 + 1 + 2 + 2);
 }
 
-TEST_CASE("the JSON reader's positions: a byte order mark is no column, CRLF line ends and blank lines shift only lines") {
+TEST_CASE(
+    "the JSON reader's positions: a byte order mark is no column, CRLF line ends and blank lines shift only lines") {
   // A BOM on line 1: columns there are counted after it.
   const JsonDoc bom = parseJsonWithPositions("\xEF\xBB\xBF{\"a\": 1, \"b\": [true]}", "bom.json");
   CHECK(bom.where.at("a") == LineCol(1, 2));

@@ -77,7 +77,8 @@ TEST_CASE("a wrong type, a bad range and a bad choice are each reported at their
   e = errorOf("{\"boundaries\": [{\"fixtures\": [{\"shape\": \"box\", \"half_size\": [1, 0]}]}]}");
   CHECK(e.key == "boundaries[0].fixtures[0].half_size");
 
-  e = errorOf("{\"boundaries\": [{\"fixtures\": [{\"shape\": \"polygon\", \"vertices\": [[0,0],[2,0],[1,0.2],[2,2],[0,2]]}]}]}");
+  e = errorOf(
+      "{\"boundaries\": [{\"fixtures\": [{\"shape\": \"polygon\", \"vertices\": [[0,0],[2,0],[1,0.2],[2,2],[0,2]]}]}]}");
   CHECK(e.message.find("convex") != std::string::npos);
 
   e = errorOf("{\"fluid\": [{\"min\": [0, 0], \"max\": [1]}]}");
@@ -92,7 +93,8 @@ TEST_CASE("invalid JSON reports the line and column of the fault") {
 }
 
 TEST_CASE("a spacing too small for the particle budget is refused with the count") {
-  const SceneError e = errorOf("{\"max_particles\": 1000, \"solver\": {\"spacing\": 0.01}, \"fluid\": [{\"min\": [0,0], \"max\": [1,1]}]}");
+  const SceneError e = errorOf(
+      "{\"max_particles\": 1000, \"solver\": {\"spacing\": 0.01}, \"fluid\": [{\"min\": [0,0], \"max\": [1,1]}]}");
   CHECK(e.key == "solver.spacing");
   CHECK(e.message.find("10000 particles") != std::string::npos);
 }
@@ -125,7 +127,8 @@ TEST_CASE("solver.quality presets pick a solver, and cannot be combined with sol
   }
 }
 
-TEST_CASE("a scene or a program that names no solver is real time (the game preset), and a named solver starts from its own defaults") {
+TEST_CASE(
+    "a scene or a program that names no solver is real time (the game preset), and a named solver starts from its own defaults") {
   // Issue 15: "real time by default". The game preset's values (its viscosity 0, support 2 and
   // its parameters), not muller2003's as before 24 Nov.
   const SolverDef game = qualityPreset("game");

@@ -77,11 +77,14 @@ TEST_CASE("bad input: an unknown key lists the allowed keys and suggests the nea
 
   e = errorOf(withFixture("{\"shape\": \"circle\", \"radius\": 1, \"centre\": [0, 0]}"));
   CHECK(e.key == "boundaries[0].fixtures[0].centre");
-  CHECK(has(e, "unknown key 'centre' (did you mean 'center'?); allowed keys: shape, friction, restitution, density, center, radius"));
+  CHECK(has(
+      e,
+      "unknown key 'centre' (did you mean 'center'?); allowed keys: shape, friction, restitution, density, center, radius"));
 
   // Nothing close: no suggestion, still the list.
   e = errorOf("{\"render\": {\"zoom\": 2}}");
-  CHECK(e.message == "unknown key 'zoom'; allowed keys: width, height, mode, background, water, solid, splat_radius, camera");
+  CHECK(e.message ==
+        "unknown key 'zoom'; allowed keys: width, height, mode, background, water, solid, splat_radius, camera");
 
   // A key with a control character is shown escaped.
   e = errorOf("{\"a\\u0001b\": 1}");
@@ -97,7 +100,8 @@ TEST_CASE("bad input: zero or negative sizes are refused at their key with the v
   CHECK(e.message == "both half sizes must be > 0, got [-1, 2]");
 
   e = errorOf(withFixture("{\"shape\": \"box\", \"half_size\": [1, 0.001]}"));
-  CHECK(has(e, "both half sizes must be >= 0.0025 (a box at least 0.005 m across, Box2D's linear slop), got [1, 0.001]"));
+  CHECK(
+      has(e, "both half sizes must be >= 0.0025 (a box at least 0.005 m across, Box2D's linear slop), got [1, 0.001]"));
 
   e = errorOf(withFixture("{\"shape\": \"circle\", \"radius\": 0}"));
   CHECK(e.key == "boundaries[0].fixtures[0].radius");
@@ -122,13 +126,15 @@ TEST_CASE("bad input: zero or negative sizes are refused at their key with the v
 }
 
 TEST_CASE("bad input: a spacing too small for the budget is refused with the particle or sample count") {
-  SceneError e = errorOf("{\"max_particles\": 1000, \"solver\": {\"spacing\": 0.01}, \"fluid\": [{\"min\": [0,0], \"max\": [1,1]}]}");
+  SceneError e = errorOf(
+      "{\"max_particles\": 1000, \"solver\": {\"spacing\": 0.01}, \"fluid\": [{\"min\": [0,0], \"max\": [1,1]}]}");
   CHECK(e.key == "solver.spacing");
   CHECK(e.line == 1);
   CHECK(e.column == 36);
-  CHECK(e.message ==
-        "spacing 0.01 fills the fluid blocks with 10000 particles, more than max_particles = 1000; use a larger spacing "
-        "or raise max_particles");
+  CHECK(
+      e.message ==
+      "spacing 0.01 fills the fluid blocks with 10000 particles, more than max_particles = 1000; use a larger spacing "
+      "or raise max_particles");
 
   // Absurdly many particles: no overflow, still the same error.
   e = errorOf("{\"solver\": {\"spacing\": 1e-300}, \"fluid\": [{\"min\": [0,0], \"max\": [1e7,1e7]}]}");
@@ -136,9 +142,12 @@ TEST_CASE("bad input: a spacing too small for the budget is refused with the par
   CHECK(has(e, "spacing 1e-300 fills the fluid blocks with too many particles, more than max_particles = 4000000"));
 
   // Boundary samples cost memory like particles: a 4 m box at 1e-5 m needs about 4.8 million.
-  e = errorOf("{\"solver\": {\"type\": \"muller2003\", \"spacing\": 1e-5}, \"boundaries\": [{\"fixtures\": [{\"shape\": \"box\", \"half_size\": [2, 2]}]}]}");
+  e = errorOf(
+      "{\"solver\": {\"type\": \"muller2003\", \"spacing\": 1e-5}, \"boundaries\": [{\"fixtures\": [{\"shape\": \"box\", \"half_size\": [2, 2]}]}]}");
   CHECK(e.key == "solver.spacing");
-  CHECK(has(e, "spacing 1e-05 lines the solids with about 4800000 boundary samples, more than max(max_particles, 4000000) = 4000000"));
+  CHECK(has(
+      e,
+      "spacing 1e-05 lines the solids with about 4800000 boundary samples, more than max(max_particles, 4000000) = 4000000"));
 }
 
 TEST_CASE("bad input: a missing file, a directory and an oversized file name the path and the reason") {
@@ -180,7 +189,8 @@ TEST_CASE("bad input: invalid JSON names the line and column of the fault and wh
   CHECK(e.column == 17);
   CHECK(e.key.empty());
   CHECK(e.message == "invalid JSON: unexpected character ',', expected a key in double quotes");
-  CHECK(std::string(e.what()) == "bad.json:3:17: invalid JSON: unexpected character ',', expected a key in double quotes");
+  CHECK(std::string(e.what()) ==
+        "bad.json:3:17: invalid JSON: unexpected character ',', expected a key in double quotes");
 
   e = errorOf("{\n  \"fps\": 60,\n}");
   CHECK(e.line == 3);
@@ -202,8 +212,12 @@ TEST_CASE("bad input: invalid JSON names the line and column of the fault and wh
   e = errorOf("{'fps': 60}");
   CHECK(has(e, "JSON strings and keys use double quotes"));
 
-  e = errorOf("{\xE2\x80\x9C" "fps\xE2\x80\x9D: 60}");
-  CHECK(e.message == "invalid JSON: unexpected character '\xE2\x80\x9C', expected a key in double quotes; typographic quotes: use plain double quotes \"");
+  e = errorOf(
+      "{\xE2\x80\x9C"
+      "fps\xE2\x80\x9D: 60}");
+  CHECK(
+      e.message ==
+      "invalid JSON: unexpected character '\xE2\x80\x9C', expected a key in double quotes; typographic quotes: use plain double quotes \"");
 
   e = errorOf("{\"name\": \"dam\n\"}");
   CHECK(e.line == 1);
@@ -293,8 +307,10 @@ TEST_CASE("bad input: a non-convex polygon is refused: concave, doubling back, o
   CHECK(e.message == "vertices [2] and [3] are closer than 0.005 m (Box2D's linear slop)");
 
   // Both orientations of a convex polygon are fine.
-  CHECK(parseScene(withFixture("{\"shape\": \"polygon\", \"vertices\": [[0,0],[0,1],[1,1],[1,0]]}"), "ok.json").bodies.size() == 1);
-  CHECK(parseScene(withFixture("{\"shape\": \"polygon\", \"vertices\": [[0,0],[1,0],[1,1],[0,1]]}"), "ok.json").bodies.size() == 1);
+  CHECK(parseScene(withFixture("{\"shape\": \"polygon\", \"vertices\": [[0,0],[0,1],[1,1],[1,0]]}"), "ok.json")
+            .bodies.size() == 1);
+  CHECK(parseScene(withFixture("{\"shape\": \"polygon\", \"vertices\": [[0,0],[1,0],[1,1],[0,1]]}"), "ok.json")
+            .bodies.size() == 1);
 }
 
 TEST_CASE("bad input: chain and edge vertices closer than Box2D's linear slop are refused at the vertex") {
@@ -340,7 +356,8 @@ TEST_CASE("bad input: a top level that is not an object names what it is, at its
   CHECK(e.column == 1);
   CHECK(e.key.empty());
   CHECK(e.message == "a scene is a JSON object ({ ... }) at the top level, got an array of 2 elements");
-  CHECK(std::string(e.what()) == "bad.json:1:1: a scene is a JSON object ({ ... }) at the top level, got an array of 2 elements");
+  CHECK(std::string(e.what()) ==
+        "bad.json:1:1: a scene is a JSON object ({ ... }) at the top level, got an array of 2 elements");
   e = errorOf("\n  42");
   CHECK(e.line == 2);
   CHECK(e.column == 3);
@@ -437,23 +454,29 @@ TEST_CASE("bad input: a fluid block that would hold no particle is refused") {
   // Thinner than one spacing.
   SceneError e = errorOf("{\"solver\": {\"spacing\": 0.02}, \"fluid\": [{\"min\": [0, 0], \"max\": [0.015, 1]}]}");
   CHECK(e.key == "fluid[0].max");
-  CHECK(e.message == "the block is 0.015 m x 1 m, less than one particle spacing (0.02 m) wide: it would hold no particle");
+  CHECK(e.message ==
+        "the block is 0.015 m x 1 m, less than one particle spacing (0.02 m) wide: it would hold no particle");
 
   // Entirely inside one solid (a rotated body, a box and a circle).
-  e = errorOf("{\"boundaries\": [{\"position\": [1, 1], \"angle\": 0.3, \"fixtures\": ["
-              "{\"shape\": \"circle\", \"radius\": 0.1}, {\"shape\": \"box\", \"half_size\": [2, 2]}]}],"
-              " \"fluid\": [{\"min\": [0.5, 0.5], \"max\": [1.5, 1.5]}]}");
+  e = errorOf(
+      "{\"boundaries\": [{\"position\": [1, 1], \"angle\": 0.3, \"fixtures\": ["
+      "{\"shape\": \"circle\", \"radius\": 0.1}, {\"shape\": \"box\", \"half_size\": [2, 2]}]}],"
+      " \"fluid\": [{\"min\": [0.5, 0.5], \"max\": [1.5, 1.5]}]}");
   CHECK(e.key == "fluid[0]");
-  CHECK(e.message == "the block lies entirely inside boundaries[0].fixtures[1] (a box): every particle would be dropped");
-  e = errorOf("{\"boundaries\": [{\"fixtures\": [{\"shape\": \"polygon\", \"vertices\": [[-5,-5],[5,-5],[0,5]]}]}],"
-              " \"fluid\": [{\"min\": [-1, -1], \"max\": [1, 1]}]}");
-  CHECK(e.message == "the block lies entirely inside boundaries[0].fixtures[0] (a polygon): every particle would be dropped");
+  CHECK(e.message ==
+        "the block lies entirely inside boundaries[0].fixtures[1] (a box): every particle would be dropped");
+  e = errorOf(
+      "{\"boundaries\": [{\"fixtures\": [{\"shape\": \"polygon\", \"vertices\": [[-5,-5],[5,-5],[0,5]]}]}],"
+      " \"fluid\": [{\"min\": [-1, -1], \"max\": [1, 1]}]}");
+  CHECK(e.message ==
+        "the block lies entirely inside boundaries[0].fixtures[0] (a polygon): every particle would be dropped");
 
   // Partly inside: accepted; the World drops the particles inside with one warning.
   // (No gravity: rows are not pre-compressed, so exactly the 25 x 25 lattice points in the box drop.)
-  const SceneDef s = parseScene("{\"gravity\": [0, 0], \"boundaries\": [{\"fixtures\": [{\"shape\": \"box\", \"half_size\": [0.5, 0.5]}]}],"
-                                " \"fluid\": [{\"min\": [0, 0], \"max\": [1, 1]}]}",
-                                "ok.json");
+  const SceneDef s = parseScene(
+      "{\"gravity\": [0, 0], \"boundaries\": [{\"fixtures\": [{\"shape\": \"box\", \"half_size\": [0.5, 0.5]}]}],"
+      " \"fluid\": [{\"min\": [0, 0], \"max\": [1, 1]}]}",
+      "ok.json");
   World w(s, WorldOptions{1});
   CHECK(w.particleCount() == 2500 - 625);
   const auto warnings = w.takeWarnings();
@@ -478,9 +501,10 @@ TEST_CASE("bad input: a degenerate camera is refused") {
 TEST_CASE("bad input: more than a million frames (duration x fps) is refused at duration") {
   SceneError e = errorOf("{\"fps\": 1000, \"duration\": 1001}");
   CHECK(e.key == "duration");
-  CHECK(e.message ==
-        "duration x fps = 1001 s x 1000 = 1001000 frames, more than 1000000; shorten the duration (sph2d run --frames N "
-        "renders fewer frames)");
+  CHECK(
+      e.message ==
+      "duration x fps = 1001 s x 1000 = 1001000 frames, more than 1000000; shorten the duration (sph2d run --frames N "
+      "renders fewer frames)");
   CHECK(parseScene("{\"fps\": 1000, \"duration\": 1000}", "ok.json").duration == 1000);
 }
 
@@ -516,16 +540,21 @@ TEST_CASE("bad input: scenes at the limits the loader accepts build a World (no 
   };
   const Case cases[] = {
       // Chain vertices just over Box2D's slop, on a far-away body; a loop.
-      {"{\"boundaries\": [{\"position\": [10000, -10000], \"fixtures\": [{\"shape\": \"chain\", \"vertices\": [[0,0],[0.0051,0],[1,1]]}]}]}", 2, 0},
-      {"{\"boundaries\": [{\"fixtures\": [{\"shape\": \"chain\", \"loop\": true, \"vertices\": [[0,0],[1,0],[1,1]]}]}]}", 3, 0},
+      {"{\"boundaries\": [{\"position\": [10000, -10000], \"fixtures\": [{\"shape\": \"chain\", \"vertices\": [[0,0],[0.0051,0],[1,1]]}]}]}",
+       2, 0},
+      {"{\"boundaries\": [{\"fixtures\": [{\"shape\": \"chain\", \"loop\": true, \"vertices\": [[0,0],[1,0],[1,1]]}]}]}",
+       3, 0},
       // The thinnest polygon and the smallest box and circle accepted (thinner
       // than the spacing, they get no boundary samples; collisions still work).
       {"{\"boundaries\": [{\"fixtures\": [{\"shape\": \"polygon\", \"vertices\": [[0,0],[1,0],[0.5,4e-6]]}]}]}", 1, 3},
-      {"{\"boundaries\": [{\"fixtures\": [{\"shape\": \"box\", \"half_size\": [0.0025, 0.0025]}, {\"shape\": \"circle\", \"radius\": 0.0025}]}]}", 2, 0},
+      {"{\"boundaries\": [{\"fixtures\": [{\"shape\": \"box\", \"half_size\": [0.0025, 0.0025]}, {\"shape\": \"circle\", \"radius\": 0.0025}]}]}",
+       2, 0},
       // A collinear middle vertex (Box2D's hull drops it); 8 vertices.
-      {"{\"boundaries\": [{\"fixtures\": [{\"shape\": \"polygon\", \"vertices\": [[0,0],[0.5,0],[1,0],[1,1],[0,1]]}]}]}", 1, 4},
+      {"{\"boundaries\": [{\"fixtures\": [{\"shape\": \"polygon\", \"vertices\": [[0,0],[0.5,0],[1,0],[1,1],[0,1]]}]}]}",
+       1, 4},
       {"{\"boundaries\": [{\"fixtures\": [{\"shape\": \"polygon\", \"vertices\": "
-       "[[1,0],[0.7,0.7],[0,1],[-0.7,0.7],[-1,0],[-0.7,-0.7],[0,-1],[0.7,-0.7]]}]}]}", 1, 8},
+       "[[1,0],[0.7,0.7],[0,1],[-0.7,0.7],[-1,0],[-0.7,-0.7],[0,-1],[0.7,-0.7]]}]}]}",
+       1, 8},
   };
   for (const Case& c : cases) {
     INFO(c.text);

@@ -29,7 +29,8 @@ SceneError errorFrom(Fn fn) {
 }  // namespace
 
 TEST_CASE("SceneError writes file, position and key only when it has them") {
-  CHECK(std::string(SceneError("a.json", 3, 7, "solver.cfl", "too big").what()) == "a.json:3:7: key 'solver.cfl': too big");
+  CHECK(std::string(SceneError("a.json", 3, 7, "solver.cfl", "too big").what()) ==
+        "a.json:3:7: key 'solver.cfl': too big");
   CHECK(std::string(SceneError("a.json", 0, 0, "solver.cfl", "too big").what()) == "a.json: key 'solver.cfl': too big");
   CHECK(std::string(SceneError("a.json", 2, 1, "", "invalid JSON").what()) == "a.json:2:1: invalid JSON");
   const SceneError e("f", 4, 5, "k", "m");
@@ -57,7 +58,8 @@ TEST_CASE("the message helpers name types, numbers and keys as the messages need
   CHECK(fmt(0.5) == "0.5");
   CHECK(fmt(1e300) == "1e+300");
   CHECK(fmt(1.0 / 3) == "0.333333");
-  CHECK(printable("a\x01" "b\x7F") == "a\\x01b\\x7F");
+  CHECK(printable("a\x01"
+                  "b\x7F") == "a\\x01b\\x7F");
   CHECK(printable("caf\xC3\xA9") == "caf\xC3\xA9");  // UTF-8 is shown as it is
 }
 
@@ -86,7 +88,8 @@ TEST_CASE("Reader::fail reports the position of the deepest key along the path t
 
 TEST_CASE("Reader's accessors return the default when the key is absent and check type and range when present") {
   const JsonDoc doc = parseJsonWithPositions(
-      "{\"n\": 0.5, \"i\": 1e3, \"f\": 2.5, \"big\": 1e30, \"b\": 1, \"s\": \"a\\u0001\", \"v\": [1, 2], \"c\": [0, 0.5, 1]}", "r.json");
+      "{\"n\": 0.5, \"i\": 1e3, \"f\": 2.5, \"big\": 1e30, \"b\": 1, \"s\": \"a\\u0001\", \"v\": [1, 2], \"c\": [0, 0.5, 1]}",
+      "r.json");
   const Reader r(doc, "r.json");
   const json& o = doc.root;
   // Absent: the default, unchecked.
@@ -97,28 +100,35 @@ TEST_CASE("Reader's accessors return the default when the key is absent and chec
   CHECK(r.vec2(o, "", "absent", Vec2d(3, 4)) == Vec2d(3, 4));
   // Present.
   CHECK(r.number(o, "", "n", 0, 0, 1) == 0.5);
-  CHECK(errorFrom([&] { r.number(o, "", "n", 0, 0.5, 1, true); }).message == "value 0.5 is out of range; allowed: > 0.5 and <= 1");
-  CHECK(errorFrom([&] { r.number(o, "", "n", 0, 0.6, 1); }).message == "value 0.5 is out of range; allowed: >= 0.6 and <= 1");
+  CHECK(errorFrom([&] { r.number(o, "", "n", 0, 0.5, 1, true); }).message ==
+        "value 0.5 is out of range; allowed: > 0.5 and <= 1");
+  CHECK(errorFrom([&] { r.number(o, "", "n", 0, 0.6, 1); }).message ==
+        "value 0.5 is out of range; allowed: >= 0.6 and <= 1");
   CHECK(errorFrom([&] { r.number(o, "", "s", 0, 0, 1); }).message == "expected a number, got a string");
   CHECK(r.integer(o, "", "i", 0, 0, 5000) == 1000);
   CHECK(errorFrom([&] { r.integer(o, "", "f", 0, 0, 10); }).message == "expected an integer from 0 to 10, got 2.5");
-  CHECK(errorFrom([&] { r.integer64(o, "", "big", 0, 0, 10); }).message == "value 1e+30 is out of range; allowed: an integer from 0 to 10");
+  CHECK(errorFrom([&] { r.integer64(o, "", "big", 0, 0, 10); }).message ==
+        "value 1e+30 is out of range; allowed: an integer from 0 to 10");
   CHECK(errorFrom([&] { r.boolean(o, "", "b", false); }).message == "expected true or false, got an integer");
   // An empty list allows any string; otherwise the value is shown printable.
   CHECK(r.string(o, "", "s", "", {}) == "a\x01");
-  CHECK(errorFrom([&] { r.string(o, "", "s", "", {"x", "y"}); }).message == "'a\\x01' is not allowed; allowed values: x, y");
+  CHECK(errorFrom([&] {
+          r.string(o, "", "s", "", {"x", "y"});
+        }).message == "'a\\x01' is not allowed; allowed values: x, y");
   CHECK(r.requiredVec2(o, "", "v") == Vec2d(1, 2));
   const SceneError missing = errorFrom([&] { r.requiredVec2(o, "", "w"); });
   CHECK(missing.key == "w");
   CHECK(missing.message == "missing; expected [x, y]");
   const std::array<double, 3> rgb{0, 0.5, 1};
   CHECK(r.color(o, "", "c", {}) == rgb);
-  CHECK(errorFrom([&] { r.color(o, "", "v", {}); }).message == "expected [r, g, b] with components in 0..1, got an array of 2 elements");
+  CHECK(errorFrom([&] { r.color(o, "", "v", {}); }).message ==
+        "expected [r, g, b] with components in 0..1, got an array of 2 elements");
 }
 
 TEST_CASE("Reader's vectors stay within the coordinate limit and points name the element that is wrong") {
   const JsonDoc doc = parseJsonWithPositions(
-      "{\"edge\": [10000000, -10000000], \"over\": [10000001, 0], \"pts\": [[0, 0], [1, \"y\"]], \"one\": 1}", "r.json");
+      "{\"edge\": [10000000, -10000000], \"over\": [10000001, 0], \"pts\": [[0, 0], [1, \"y\"]], \"one\": 1}",
+      "r.json");
   const Reader r(doc, "r.json");
   const json& o = doc.root;
   CHECK(r.vec2(o, "", "edge", Vec2d(0, 0)) == Vec2d(kMaxCoordinate, -kMaxCoordinate));
@@ -141,7 +151,8 @@ TEST_CASE("Reader::checkKeys suggests an allowed key only when the typo is small
     CHECK(e.column == 2);
     return e.message;
   };
-  CHECK(hintFor("sapcing", {"spacing", "cfl"}) == "unknown key 'sapcing' (did you mean 'spacing'?); allowed keys: spacing, cfl");
+  CHECK(hintFor("sapcing", {"spacing", "cfl"}) ==
+        "unknown key 'sapcing' (did you mean 'spacing'?); allowed keys: spacing, cfl");
   CHECK(hintFor("velocty_fild", {"min", "velocity_field"}) ==
         "unknown key 'velocty_fild' (did you mean 'velocity_field'?); allowed keys: min, velocity_field");
   // Three edits away from a 7-letter key: no suggestion.
@@ -149,11 +160,14 @@ TEST_CASE("Reader::checkKeys suggests an allowed key only when the typo is small
   // Two edits are too many for a short key.
   CHECK(hintFor("fxx", {"fps"}) == "unknown key 'fxx'; allowed keys: fps");
   // The nearest of several.
-  CHECK(hintFor("widht", {"width", "height"}) == "unknown key 'widht' (did you mean 'width'?); allowed keys: width, height");
+  CHECK(hintFor("widht", {"width", "height"}) ==
+        "unknown key 'widht' (did you mean 'width'?); allowed keys: width, height");
   // Allowed keys pass; a non-object has no keys to check.
   const JsonDoc ok = parseJsonWithPositions("{\"a\": 1, \"b\": 2}", "k.json");
   const Reader r(ok, "k.json");
   r.checkKeys(ok.root, "", {"b", "a"});
-  CHECK(errorFrom([&] { r.requireObject(json::array(), "render"); }).message == "expected an object, got an array of 0 elements");
-  CHECK(errorFrom([&] { r.requireObject(json(7), ""); }).message == "a scene is a JSON object ({ ... }) at the top level, got an integer");
+  CHECK(errorFrom([&] { r.requireObject(json::array(), "render"); }).message ==
+        "expected an object, got an array of 0 elements");
+  CHECK(errorFrom([&] { r.requireObject(json(7), ""); }).message ==
+        "a scene is a JSON object ({ ... }) at the top level, got an integer");
 }

@@ -69,7 +69,8 @@ TEST_CASE("readSolver fills every parameter the solver declares, with or without
   CHECK(s.solver.param("max_iterations") == 100);
   // Another solver's parameter is an unknown key.
   SceneDef w;
-  CHECK(failure("{\"solver\": {\"type\": \"wcsph\", \"iterations\": 4}}", w, readSolver).rfind("solver.iterations: unknown key", 0) == 0);
+  CHECK(failure("{\"solver\": {\"type\": \"wcsph\", \"iterations\": 4}}", w, readSolver)
+            .rfind("solver.iterations: unknown key", 0) == 0);
 }
 
 TEST_CASE("a section reader leaves the scene's defaults when its key is absent") {
@@ -156,7 +157,9 @@ TEST_CASE("a section is checked against the sections read before it") {
   CHECK(failure(scene, before, readFluid) == "");
   SceneDef after;
   CHECK(failure(scene, after, readBoundaries) == "");
-  CHECK(failure(scene, after, readFluid) == "fluid[0]: the block lies entirely inside boundaries[0].fixtures[0] (a circle): every particle would be dropped");
+  CHECK(
+      failure(scene, after, readFluid) ==
+      "fluid[0]: the block lies entirely inside boundaries[0].fixtures[0] (a circle): every particle would be dropped");
 
   // A period against the support radius of the solver read before.
   const std::string periodic = R"({"solver": {"spacing": 0.01}, "periodic": {"x": [0, 0.1]}})";

@@ -54,7 +54,8 @@ TEST_CASE("dfsph: a resting tank settles incompressible and calm") {
   CHECK(outside(w, 0, 0, 0.6, 1.3) == 0);
 }
 
-TEST_CASE("dfsph: the 2 m x 1 m tank at dx = 12.5 mm (12,800 particles) rests: no eruption, floor pressure near rho0 g H") {
+TEST_CASE(
+    "dfsph: the 2 m x 1 m tank at dx = 12.5 mm (12,800 particles) rests: no eruption, floor pressure near rho0 g H") {
   // Before the hydrostatic time-step limit (dt ≤ 0.35·R/sqrt(|g| D), dfsph.cpp's
   // header) the floor rows oscillated in alternation with a growing amplitude
   // from the first substep, were crushed at the collision clearance (single
@@ -87,14 +88,14 @@ TEST_CASE("dfsph: the 2 m x 1 m tank at dx = 12.5 mm (12,800 particles) rests: n
   REQUIRE(test::allFiniteState(w));
   REQUIRE(pCount > 0);
   const double pFloor = pSum / pCount / (rho0 * g * H);
-  MESSAGE("0–0.5 s: max speed " << vMax << " m/s, mean compression " << meanErrSum / 30 << " on average, ≤ " << meanErrMax
-                                << ", max ≤ " << maxErrMax
-                                << "; floor rows' pressure (0.25–0.5 s) " << pFloor << " rho0 g H");
-  CHECK(vMax < 1.5);                // measured 0.84 m/s (sqrt(gH) = 3.1 m/s); before: 10 m/s at t = 0.08 s
-  CHECK(meanErrSum / 30 <= tol);    // the pressure solve's tolerance (0.1 %); measured 0.05 %
-  CHECK(meanErrMax <= 2 * tol);     // as the resting-column test; measured 0.08 %; before: 1.2 %
-  CHECK(maxErrMax <= 0.1);          // measured 3.5 %; before: 50 %
-  CHECK(pFloor > 0.8);              // measured 1.08 (the wall row reads above ρ0 g H, see dfsph.cpp)
+  MESSAGE("0–0.5 s: max speed " << vMax << " m/s, mean compression " << meanErrSum / 30 << " on average, ≤ "
+                                << meanErrMax << ", max ≤ " << maxErrMax << "; floor rows' pressure (0.25–0.5 s) "
+                                << pFloor << " rho0 g H");
+  CHECK(vMax < 1.5);              // measured 0.84 m/s (sqrt(gH) = 3.1 m/s); before: 10 m/s at t = 0.08 s
+  CHECK(meanErrSum / 30 <= tol);  // the pressure solve's tolerance (0.1 %); measured 0.05 %
+  CHECK(meanErrMax <= 2 * tol);   // as the resting-column test; measured 0.08 %; before: 1.2 %
+  CHECK(maxErrMax <= 0.1);        // measured 3.5 %; before: 50 %
+  CHECK(pFloor > 0.8);            // measured 1.08 (the wall row reads above ρ0 g H, see dfsph.cpp)
   CHECK(pFloor < 1.5);
   CHECK(outside(w, 0, 0, 2, 1.2) == 0);
 }
@@ -159,8 +160,7 @@ TEST_CASE("dfsph: the state hash is bit-identical for 1, 2 and 3 threads") {
 }
 
 TEST_CASE("dfsph: scene keys are read, defaulted and range-checked") {
-  const std::string base =
-      R"({"solver": {"type": "dfsph", "spacing": 0.05, "tolerance": 0.0005, "max_iterations": 50)";
+  const std::string base = R"({"solver": {"type": "dfsph", "spacing": 0.05, "tolerance": 0.0005, "max_iterations": 50)";
   const SceneDef s = parseScene(base + R"(}, "fluid": [{"min": [0, 0], "max": [1, 1]}]})", "inline.json");
   CHECK(s.solver.param("tolerance") == doctest::Approx(0.0005));
   CHECK(s.solver.param("max_iterations") == 50);
@@ -178,7 +178,8 @@ TEST_CASE("Taylor-Green vortex at Re = 100 (dfsph, 2500 particles): the decay ra
   test::taylorGreenRe100("dfsph");
 }
 
-TEST_CASE("Taylor-Green vortex at Re = 5 (dfsph, bilateral pressure in a closed periodic box): the decay rate within 10 %") {
+TEST_CASE(
+    "Taylor-Green vortex at Re = 5 (dfsph, bilateral pressure in a closed periodic box): the decay rate within 10 %") {
   // At U = 0.05 m/s the lattice barely distorts within the run, so this checks
   // the solver's pressure and viscosity alone: no shifting, no particle disorder.
   const auto table = validation::readReferenceCsv(test::asset("reference/taylor_green_decay.csv"));

@@ -89,7 +89,8 @@ DropResult drop(const std::string& solver, double dx, double rate, double r0, co
 TEST_CASE("muller2003 with viscosity 0 is warned about at load, naming the key, and not with viscosity") {
   auto warningsOf = [](const std::string& solver, double nu) {
     std::ostringstream o;
-    o << R"({"gravity": [0, 0], "solver": {"type": ")" << solver << R"(", "spacing": 0.05, "sound_speed": 50, "viscosity": )" << nu
+    o << R"({"gravity": [0, 0], "solver": {"type": ")" << solver
+      << R"(", "spacing": 0.05, "sound_speed": 50, "viscosity": )" << nu
       << R"(}, "fluid": [{"min": [0, 0], "max": [0.5, 0.5]}]})";
     World w(parseScene(o.str(), "inviscid.json"), WorldOptions{1});
     return w.takeWarnings();
@@ -101,7 +102,8 @@ TEST_CASE("muller2003 with viscosity 0 is warned about at load, naming the key, 
   CHECK(warningsOf("wcsph", 0).empty());
 }
 
-TEST_CASE("muller2003: Monaghan's elliptical drop with nu = 0 keeps the exact kinetic energy within 5 % with shifting") {
+TEST_CASE(
+    "muller2003: Monaghan's elliptical drop with nu = 0 keeps the exact kinetic energy within 5 % with shifting") {
   // Without any dissipation muller2003 ends at 2.33 x the exact kinetic energy (40 spacings a
   // radius) and is stopped by the guard at 80 (docs/SOLVERS.md): its pressure force is not the
   // gradient of an energy and feeds on the arrangement the strain makes anisotropic. Particle
@@ -112,8 +114,9 @@ TEST_CASE("muller2003: Monaghan's elliptical drop with nu = 0 keeps the exact ki
     const double r0 = 40.0 / rate, dx = r0 / n;
     const DropResult plain = drop("muller2003", dx, rate, r0, "");
     const DropResult shifted = drop("muller2003", dx, rate, r0, "", R"(, "effects": {"shifting": {"strength": 2}})");
-    MESSAGE("rate " << rate << "/s, r0 " << r0 << " m, " << n << " spacings a radius: KE against the exact, worst " << plain.worst
-                    << " without (" << (plain.finite ? "finite" : plain.error) << "), " << shifted.worst << " with shifting");
+    MESSAGE("rate " << rate << "/s, r0 " << r0 << " m, " << n << " spacings a radius: KE against the exact, worst "
+                    << plain.worst << " without (" << (plain.finite ? "finite" : plain.error) << "), " << shifted.worst
+                    << " with shifting");
     CHECK(plain.worst > 0.3);  // the heating the load warning names
     CHECK(shifted.finite);
     CHECK(shifted.worst <= 0.05);

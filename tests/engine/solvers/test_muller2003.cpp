@@ -28,10 +28,10 @@ TEST_CASE("muller2003: a resting column settles: density within 5 % of rho0, its
   const DensityStats d = w.densityStats();
   MESSAGE("mean density " << d.meanDensity << ", mean compression " << d.meanError);
   CHECK(std::fabs(d.meanDensity - 1000.0) / 1000.0 < 0.05);
-  MESSAGE("mean speed " << first << " m/s over the first second, " << second << " m/s over the second, against sqrt(gH) = "
-                        << std::sqrt(g * H));
-  CHECK(second < first);                        // it settles
-  CHECK(second < 0.025 * std::sqrt(g * H));     // to a small fraction of the collapse speed
+  MESSAGE("mean speed " << first << " m/s over the first second, " << second
+                        << " m/s over the second, against sqrt(gH) = " << std::sqrt(g * H));
+  CHECK(second < first);                     // it settles
+  CHECK(second < 0.025 * std::sqrt(g * H));  // to a small fraction of the collapse speed
   CHECK(outside(w, 0, 0, 0.6, 1.3) == 0);
 }
 
@@ -76,7 +76,8 @@ TEST_CASE("muller2003: the state hash is the same for 1, 2 and 3 threads and for
   CHECK(w.stateHash() != hashes[0]);
 }
 
-TEST_CASE("muller2003: a resting column's pressure grows by 2 rho0 g per metre (within 20 %) and vanishes at its surface") {
+TEST_CASE(
+    "muller2003: a resting column's pressure grows by 2 rho0 g per metre (within 20 %) and vanishes at its surface") {
   // p = c²(ρ − ρ0) and the symmetric force m(p_i + p_j)/(2ρ_j)∇W recover ∇p/2
   // (muller2003.cpp), so at rest p = 2ρ0g(H − y), not ρ0g(H − y). Probed at x =
   // 0.3 ± 0.2 m in 5 cm bands over the second second, above the two rows at the
@@ -95,8 +96,8 @@ TEST_CASE("muller2003: a resting column's pressure grows by 2 rho0 g per metre (
   const auto bands = probe.profile(0.1, H - 3 * dx);
   REQUIRE(bands.size() >= 7);
   const test::Line l = test::fitLine(bands);
-  MESSAGE("surface " << H << " m; over " << bands.size() << " bands dp/dy = " << l.slope << " Pa/m = "
-                     << l.slope / (-2 * rho0 * g) << " × (−2 rho0 g), p = 0 at " << l.zero() << " m");
+  MESSAGE("surface " << H << " m; over " << bands.size() << " bands dp/dy = " << l.slope
+                     << " Pa/m = " << l.slope / (-2 * rho0 * g) << " × (−2 rho0 g), p = 0 at " << l.zero() << " m");
   CHECK(l.slope / (-2 * rho0 * g) == doctest::Approx(1.0).epsilon(0.2));
   CHECK(std::fabs(l.zero() - H) < 2 * dx);
 }

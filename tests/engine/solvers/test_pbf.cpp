@@ -30,7 +30,8 @@ SceneDef pbfScene(const std::string& rel) {
 
 }  // namespace
 
-TEST_CASE("pbf: a resting tank at the longest substep its limits allow settles within 2 % of rho0, at rest, nothing escapes") {
+TEST_CASE(
+    "pbf: a resting tank at the longest substep its limits allow settles within 2 % of rho0, at rest, nothing escapes") {
   const SceneDef s = pbfScene("tests/resting_column.json");
   World w(s, WorldOptions{2});
   const double H = 0.6, g = 9.81;
@@ -77,8 +78,8 @@ TEST_CASE("pbf: a 1 m deep tank at 12,800 particles holds at rest whatever max_m
         worstFrame = f;
       }
     }
-    MESSAGE("max_move " << maxMove << ": fastest particle over frames 10-45 " << worst << " m/s (frame " << worstFrame << "), "
-                        << w.substeps() << " substeps");
+    MESSAGE("max_move " << maxMove << ": fastest particle over frames 10-45 " << worst << " m/s (frame " << worstFrame
+                        << "), " << w.substeps() << " substeps");
     CHECK(worst < 1.0);
     CHECK(outside(w, 0, 0, 2, 1.2) == 0);
   }

@@ -5,10 +5,10 @@
 #include <cmath>
 #include <vector>
 
+#include "bench/validation.hpp"
 #include "sph2d/world.hpp"
 #include "support/fixture.hpp"
 #include "support/taylor_green.hpp"
-#include "bench/validation.hpp"
 
 using namespace sph2d;
 using test::boxShape;
@@ -38,7 +38,8 @@ TEST_CASE("hydrostatic tank 2 m x 1 m (wcsph): linear pressure, no gap at the fl
   int checked = 0, empty = 0;
   const double worst = profile.worstError(H, rho0, g, dx, 1.0, checked, empty);
   CHECK(empty == 0);
-  MESSAGE("surface at " << H << " m, worst pressure error " << 100 * worst << " % of rho0 g H over " << checked << " bands");
+  MESSAGE("surface at " << H << " m, worst pressure error " << 100 * worst << " % of rho0 g H over " << checked
+                        << " bands");
   CHECK(checked >= 15);
   CHECK(worst <= 0.05);
   double minY = 1e9, maxBottom = 0;

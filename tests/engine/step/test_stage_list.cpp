@@ -60,7 +60,8 @@ TEST_CASE("the stage list runs its stages in the order they were added, each onc
   for (const char* name : {"grid", "neighbours", "density", "pressure", "integrate"}) CHECK(callsOf(list, name) == 2);
 }
 
-TEST_CASE("the stage list keeps its timings by name across rebuilds, in the order names first entered, and resets them") {
+TEST_CASE(
+    "the stage list keeps its timings by name across rebuilds, in the order names first entered, and resets them") {
   Context k;
   std::vector<std::string> log;
   StageList list;
@@ -95,7 +96,8 @@ TEST_CASE("the stage list keeps its timings by name across rebuilds, in the orde
   CHECK(list.timings().size() == 3);
 }
 
-TEST_CASE("a stage that reports a bad particle makes the list call fail with the stage's name and the slot, and stop there") {
+TEST_CASE(
+    "a stage that reports a bad particle makes the list call fail with the stage's name and the slot, and stop there") {
   Context k;
   std::vector<std::string> log;
   StageList list;
@@ -113,7 +115,7 @@ TEST_CASE("a stage that reports a bad particle makes the list call fail with the
   CHECK(failedStage == "pressure_force");
   CHECK(failedSlot == 17);
   CHECK(log == std::vector<std::string>{"density", "pressure_force"});  // integrate did not run
-  CHECK(callsOf(list, "pressure_force") == 1);                           // the failing run is counted
+  CHECK(callsOf(list, "pressure_force") == 1);                          // the failing run is counted
   CHECK(callsOf(list, "integrate") == 0);
   // plainStage never reports a particle.
   StageList plain;

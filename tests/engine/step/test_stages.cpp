@@ -9,8 +9,8 @@
 #include <map>
 #include <string>
 
-#include "step/stages.hpp"
 #include "sph2d/world.hpp"
+#include "step/stages.hpp"
 #include "support/fixture.hpp"
 
 using namespace sph2d;
@@ -44,7 +44,8 @@ TEST_CASE("a uniform flow through a periodic box stays uniform across the seams 
         worstRho = std::max(worstRho, std::fabs(double(w.particles().rho[i]) / 1000.0 - 1));
       }
     }
-    MESSAGE(solver << ": largest velocity deviation " << worst << " m/s, largest density deviation " << 100 * worstRho << " %");
+    MESSAGE(solver << ": largest velocity deviation " << worst << " m/s, largest density deviation " << 100 * worstRho
+                   << " %");
     CHECK(w.particleCount() == n);
     CHECK(worst < 0.01);      // 1 % of the speed (dfsph's solve tolerance leaves ~0.3 %)
     CHECK(worstRho < 0.001);  // a lattice that moves as a whole keeps its density
@@ -81,13 +82,14 @@ TEST_CASE("reordering changes physics by rounding only: every step vs never, 20 
   CHECK(a.kineticEnergy() > 0);
 }
 
-TEST_CASE("tieBreakDirection gives each coincident pair a unit direction, opposite for the two particles, spread over the circle") {
+TEST_CASE(
+    "tieBreakDirection gives each coincident pair a unit direction, opposite for the two particles, spread over the circle") {
   int sectors[8] = {0, 0, 0, 0, 0, 0, 0, 0};
   for (std::uint32_t i = 0; i < 40; ++i)
     for (std::uint32_t j = i + 1; j < 40; ++j) {
       const Vec2 d = tieBreakDirection(i, j), e = tieBreakDirection(j, i);
       CHECK(d.norm() == doctest::Approx(1.0f).epsilon(1e-6));
-      CHECK(e == Vec2(-d));  // antisymmetric: the pair forces built on it cancel
+      CHECK(e == Vec2(-d));                 // antisymmetric: the pair forces built on it cancel
       CHECK(tieBreakDirection(i, j) == d);  // fixed
       const double a = std::atan2(double(d.y()), double(d.x())) + test::kPi;
       ++sectors[std::min(7, int(a / (2 * test::kPi) * 8))];
@@ -122,14 +124,15 @@ struct TwoParticles {
 
 }  // namespace
 
-TEST_CASE("integration is symplectic Euler (v += a dt, then x += v dt) and moves no particle more than half a support") {
+TEST_CASE(
+    "integration is symplectic Euler (v += a dt, then x += v dt) and moves no particle more than half a support") {
   TwoParticles t;
-  t.P.a[0] = Vec2(0, -10);      // ordinary: Δv = (0, −0.1), |v dt| = 0.01 m < R/2
-  t.P.a[1] = Vec2(0, 1e4);      // a jump: v = 100 m/s would move it 1 m
+  t.P.a[0] = Vec2(0, -10);  // ordinary: Δv = (0, −0.1), |v dt| = 0.01 m < R/2
+  t.P.a[1] = Vec2(0, 1e4);  // a jump: v = 100 m/s would move it 1 m
   REQUIRE(stageIntegrate(t.c) == kNone);
   CHECK(t.P.v[0].x() == doctest::Approx(1.0f));
   CHECK(t.P.v[0].y() == doctest::Approx(-0.1f));
-  CHECK(t.P.x[0].x() == doctest::Approx(0.01f));     // with the new velocity
+  CHECK(t.P.x[0].x() == doctest::Approx(0.01f));  // with the new velocity
   CHECK(t.P.x[0].y() == doctest::Approx(-0.001f));
   CHECK(t.P.xPrev[0] == Vec2(0, 0));
   // The clamp: R/2 in this substep, along the velocity, and the velocity to match.
@@ -142,7 +145,8 @@ TEST_CASE("integration is symplectic Euler (v += a dt, then x += v dt) and moves
   CHECK(stageIntegrate(g.c) == 1);
 }
 
-TEST_CASE("neighbour lists: every path (AVX-512 with up to four near slots of one row of cells searched together, SSE2, scalar) finds exactly the particles within R, in slot order") {
+TEST_CASE(
+    "neighbour lists: every path (AVX-512 with up to four near slots of one row of cells searched together, SSE2, scalar) finds exactly the particles within R, in slot order") {
   // A lattice, a random cloud (groups of one to four slots of varied spread), a pile-up too
   // dense for the AVX-512 path's buffers (its slots are searched one at a time), and a few
   // isolated particles with no neighbour.

@@ -35,9 +35,11 @@ TEST_CASE("the walls are real Box2D fixtures of the world's b2World") {
 
 TEST_CASE("a game-owned b2World: the fluid collides with its level, and the game's world is unchanged") {
   b2World game(b2Vec2(0, -9.81f));
-  auto addBox = [&](float cx, float cy, float hx, float hy, float angle) { test::addStaticBox(game, cx, cy, hx, hy, angle); };
-  addBox(2, -0.2f, 2.4f, 0.2f, 0);    // floor
-  addBox(-0.2f, 2, 0.2f, 2.4f, 0);    // walls
+  auto addBox = [&](float cx, float cy, float hx, float hy, float angle) {
+    test::addStaticBox(game, cx, cy, hx, hy, angle);
+  };
+  addBox(2, -0.2f, 2.4f, 0.2f, 0);  // floor
+  addBox(-0.2f, 2, 0.2f, 2.4f, 0);  // walls
   addBox(4.2f, 2, 0.2f, 2.4f, 0);
   addBox(1.5f, 1.5f, 0.8f, 0.05f, -0.3f);  // a tilted platform
   b2BodyDef dyn;
@@ -76,7 +78,8 @@ TEST_CASE("a game-owned b2World: the fluid collides with its level, and the game
     const Vec2d p = w.worldPosition(i);
     for (b2Body* b = game.GetBodyList(); b; b = b->GetNext())
       if (b->GetType() == b2_staticBody)
-        for (b2Fixture* f = b->GetFixtureList(); f; f = f->GetNext()) inside += f->TestPoint(b2Vec2(float(p.x()), float(p.y())));
+        for (b2Fixture* f = b->GetFixtureList(); f; f = f->GetNext())
+          inside += f->TestPoint(b2Vec2(float(p.x()), float(p.y())));
     out += !(p.x() > 0 && p.x() < 4 && p.y() > 0);
   }
   CHECK(inside == 0);
@@ -114,7 +117,7 @@ TEST_CASE("a static body the game slides through still water at 1 m/s pushes it 
     addBox(-0.2f, 0.5f, 0.2f, 0.9f);
     addBox(2.2f, 0.5f, 0.2f, 0.9f);
     b2Body* door = addBox(0.3f, 0.3f, 0.03f, 0.25f);  // its foot 0.05 m above the floor
-    addBox(1.9f, 0.7f, 0.1f, 0.02f);  // a shelf made after the door: before it in Box2D's body list
+    addBox(1.9f, 0.7f, 0.1f, 0.02f);                  // a shelf made after the door: before it in Box2D's body list
     SceneDef s = test::tank(solver, 2.0, 1.0, 0.02);
     s.bodies.clear();
     s.blocks.push_back(test::block({0, 0}, {2.0, 0.4}));
@@ -138,7 +141,8 @@ TEST_CASE("a static body the game slides through still water at 1 m/s pushes it 
     const double front = door->GetPosition().x + 0.03;
     const test::MeanVx ahead = test::meanVxIn(w, front, front + 0.06, 0.1, 0.35);
     REQUIRE(ahead.count > 10);
-    MESSAGE(std::string(solver) << ": " << ahead.count << " particles just ahead of the door, mean vx " << ahead.mean << " m/s");
+    MESSAGE(std::string(solver) << ": " << ahead.count << " particles just ahead of the door, mean vx " << ahead.mean
+                                << " m/s");
     CHECK(ahead.mean >= 0.5);
     // Nothing leaves the tank, over its walls or above its 1 m (the level has no lid). Until
     // the fluid blocks left out lattice points on a static face (25 Nov), wcsph threw the row

@@ -51,19 +51,22 @@ TEST_CASE("moving bodies: a kinematic paddle at 1 m/s pushes the water ahead of 
     CHECK(std::abs(front - (0.83)) < 0.01);  // it moved with its velocity
     const test::MeanVx ahead = test::meanVxIn(w, front, front + 0.06, 0.1, 0.35);
     REQUIRE(ahead.count > 10);
-    MESSAGE(std::string(solver) << ": " << ahead.count << " particles just ahead of the paddle, mean vx " << ahead.mean << " m/s");
+    MESSAGE(std::string(solver) << ": " << ahead.count << " particles just ahead of the paddle, mean vx " << ahead.mean
+                                << " m/s");
     CHECK(ahead.mean >= 0.5);
     CHECK(test::outside(w, 2.0, 1.0) == 0);
   }
 }
 
-TEST_CASE("moving bodies: a turning bar in a game's b2World stirs the water, never entered, the same bits on 1, 2 and 3 threads") {
+TEST_CASE(
+    "moving bodies: a turning bar in a game's b2World stirs the water, never entered, the same bits on 1, 2 and 3 threads") {
   std::uint64_t first = 0;
   for (int threads = 1; threads <= 3; ++threads) {
     b2World level(b2Vec2(0, -9.81f));
     b2BodyDef wallsDef;
     b2Body* walls = level.CreateBody(&wallsDef);
-    for (const auto& [c, h] : {std::pair<b2Vec2, b2Vec2>{{0.5f, -0.1f}, {0.7f, 0.1f}}, {{-0.1f, 0.5f}, {0.1f, 0.7f}},
+    for (const auto& [c, h] : {std::pair<b2Vec2, b2Vec2>{{0.5f, -0.1f}, {0.7f, 0.1f}},
+                               {{-0.1f, 0.5f}, {0.1f, 0.7f}},
                                {{1.1f, 0.5f}, {0.1f, 0.7f}}}) {
       b2PolygonShape box;
       box.SetAsBox(h.x, h.y, c, 0);
@@ -95,7 +98,8 @@ TEST_CASE("moving bodies: a turning bar in a game's b2World stirs the water, nev
   }
 }
 
-TEST_CASE("moving bodies: the scene format takes kinematic and dynamic bodies, and refuses open moving shapes and misplaced keys by key") {
+TEST_CASE(
+    "moving bodies: the scene format takes kinematic and dynamic bodies, and refuses open moving shapes and misplaced keys by key") {
   const SceneDef s = parseScene(R"({"boundaries": [{"type": "kinematic", "position": [1, 1], "velocity": [0.5, 0],
       "angular_velocity": 2, "fixtures": [{"shape": "circle", "radius": 0.1}]},
       {"type": "dynamic", "position": [2, 1], "velocity": [0, -1], "fixtures": [{"shape": "box", "half_size": [0.1, 0.1], "density": 500}]}]})",
@@ -123,7 +127,8 @@ TEST_CASE("moving bodies: the scene format takes kinematic and dynamic bodies, a
        "boundaries[0].fixtures[0].density"},  // a massless body: Box2D would give it 1 kg
       {R"({"boundaries": [{"fixtures": [{"shape": "circle", "radius": 0.1, "density": 500}]}]})",
        "boundaries[0].fixtures[0].density"},  // only dynamic bodies have one
-      {R"({"boundaries": [{"velocity": [1, 0], "fixtures": []}]})", "boundaries[0].velocity"}};  // a static body has none
+      {R"({"boundaries": [{"velocity": [1, 0], "fixtures": []}]})",
+       "boundaries[0].velocity"}};  // a static body has none
   for (const auto& [text, key] : bad) {
     try {
       parseScene(text, "bad.json");
@@ -167,7 +172,8 @@ double archimedesDraught(double density, double h) { return h * density / 1000.0
 
 }  // namespace
 
-TEST_CASE("moving bodies: in the game solver a crate of density 500 floats at Archimedes' draught, 2000 sinks to the floor, 1000 stays where it was put") {
+TEST_CASE(
+    "moving bodies: in the game solver a crate of density 500 floats at Archimedes' draught, 2000 sinks to the floor, 1000 stays where it was put") {
   // Archimedes: a 0.2 m tall crate of density ρ_b floats with draught 0.2·ρ_b/ρ0 (its fixture's
   // bottom under the surface; the fluid meets it at its skin, 1 cm out, which the grid's
   // pressure does not count as body: archimedesDraught). The light crate is put on the surface
@@ -211,7 +217,8 @@ TEST_CASE("moving bodies: in the game solver a crate of density 500 floats at Ar
   }
 }
 
-TEST_CASE("moving bodies: water thrown at a free crate in zero gravity keeps the momentum of water and crate together") {
+TEST_CASE(
+    "moving bodies: water thrown at a free crate in zero gravity keeps the momentum of water and crate together") {
   // No gravity, nothing reaches the walls: the only impulse is between the water and the
   // crate (pressure on the grid and contacts), so their momenta must sum to the start's.
   for (const char* solver : {"game", "wcsph", "dfsph"}) {
@@ -243,10 +250,10 @@ TEST_CASE("moving bodies: water thrown at a free crate in zero gravity keeps the
     const Vec2d p0 = test::momentum(w) + bodyMomentum();
     for (int f = 0; f < 36; ++f) w.stepFrame();  // 0.6 s: the drop meets the crate at about 0.15 s
     const Vec2d pBody = bodyMomentum(), p1 = test::momentum(w) + pBody;
-    MESSAGE(std::string(solver) << ": momentum of water and crate from (" << p0.x() << ", " << p0.y() << ") to (" << p1.x() << ", "
-                   << p1.y() << ") kg m/s; the crate's " << pBody.x() << " kg m/s");
+    MESSAGE(std::string(solver) << ": momentum of water and crate from (" << p0.x() << ", " << p0.y() << ") to ("
+                                << p1.x() << ", " << p1.y() << ") kg m/s; the crate's " << pBody.x() << " kg m/s");
     CHECK(test::outside(w, 0.3, 0.3, 3.7, 3.7) == 0);  // nothing reached the walls
-    CHECK(pBody.x() > 0.05 * p0.x());                   // the water threw the crate
+    CHECK(pBody.x() > 0.05 * p0.x());                  // the water threw the crate
     CHECK((p1 - p0).norm() <= 0.05 * p0.norm());
   }
 }
@@ -264,8 +271,10 @@ TEST_CASE("moving bodies: a 50 m/s jet against a game's dynamic box never passes
     b2World level(b2Vec2(0, -9.81f));
     b2BodyDef wallsDef;
     b2Body* walls = level.CreateBody(&wallsDef);
-    for (const auto& [c, h] : {std::pair<b2Vec2, b2Vec2>{{1.0f, -0.1f}, {1.2f, 0.1f}}, {{1.0f, 1.1f}, {1.2f, 0.1f}},
-                               {{-0.1f, 0.5f}, {0.1f, 0.7f}}, {{2.1f, 0.5f}, {0.1f, 0.7f}}}) {
+    for (const auto& [c, h] : {std::pair<b2Vec2, b2Vec2>{{1.0f, -0.1f}, {1.2f, 0.1f}},
+                               {{1.0f, 1.1f}, {1.2f, 0.1f}},
+                               {{-0.1f, 0.5f}, {0.1f, 0.7f}},
+                               {{2.1f, 0.5f}, {0.1f, 0.7f}}}) {
       b2PolygonShape box;
       box.SetAsBox(h.x, h.y, c, 0);
       walls->CreateFixture(&box, 0);
@@ -305,7 +314,8 @@ TEST_CASE("moving bodies: a 50 m/s jet against a game's dynamic box never passes
         const Vec2d x = w.worldPosition(i);
         const auto it = last.find(w.particles().id[i]);
         auto through = [](double y) { return y > 0.03 && y < 0.3; };
-        if (it != last.end() && it->second.x() < frontPrev && x.x() > back && through(it->second.y()) && through(x.y())) ++crossed;
+        if (it != last.end() && it->second.x() < frontPrev && x.x() > back && through(it->second.y()) && through(x.y()))
+          ++crossed;
         last[w.particles().id[i]] = x;
       }
       frontPrev = front;
@@ -319,7 +329,8 @@ TEST_CASE("moving bodies: a 50 m/s jet against a game's dynamic box never passes
   }
 }
 
-TEST_CASE("moving bodies: a crate resting on the floor leaves no water under it, and none squeezed there, in the game solver") {
+TEST_CASE(
+    "moving bodies: a crate resting on the floor leaves no water under it, and none squeezed there, in the game solver") {
   // Box2D rests a polygon on the floor's polygon at two skins (b2_polygonRadius, 1 cm each)
   // less the slop: its core 1.5 cm over the floor's. Seen without its skin the crate left a
   // gap the water entered and was squeezed in; the fluid meets it at its skin, 0.5 cm over
@@ -404,7 +415,8 @@ TEST_CASE("moving bodies: crates stacked on each other in a game's b2World never
     const std::size_t n = insideMoving(w);
     if (n > worst) worst = n, worstFrame = f;
   }
-  MESSAGE("stacked crates: at most " << worst << " particles inside a crate after a frame (frame " << worstFrame << ")");
+  MESSAGE("stacked crates: at most " << worst << " particles inside a crate after a frame (frame " << worstFrame
+                                     << ")");
   CHECK(worst == 0);
   CHECK(double(light->GetPosition().y) > 0.25);  // still resting across the heavy ones
 }
@@ -427,7 +439,8 @@ TEST_CASE("moving bodies: a floating crate gives the same bits on 1, 2 and 3 thr
   }
 }
 
-TEST_CASE("assets/scenes/floating_crates.json: the light crates float, the heavy one sinks, the turning bar stirs the water") {
+TEST_CASE(
+    "assets/scenes/floating_crates.json: the light crates float, the heavy one sinks, the turning bar stirs the water") {
   World w(test::scene("floating_crates.json"), WorldOptions{2});
   std::vector<const b2Body*> dyn;  // scene order: box 500, circle 300, box 800, box 2500
   for (const b2Body* b = w.box2d().GetBodyList(); b; b = b->GetNext())
@@ -457,7 +470,8 @@ TEST_CASE("assets/scenes/floating_crates.json: the light crates float, the heavy
   CHECK(test::meanSpeed(w) > 0.05);       // the bar keeps the water moving
 }
 
-TEST_CASE("moving bodies: save, load and step a floating crate: the same state hashes and crate as the World not interrupted") {
+TEST_CASE(
+    "moving bodies: save, load and step a floating crate: the same state hashes and crate as the World not interrupted") {
   SceneDef s = crateScene("game", 500, 0.62);
   s.solver.spacing = 0.02;
   World a(s, WorldOptions{2});
@@ -519,7 +533,8 @@ TEST_CASE("moving bodies: a periodic scene with a moving body loads with one war
       if (m.find("periodic seam") != std::string::npos) seam.push_back(m);
     return seam;
   };
-  for (const auto& [type, tail] : {std::pair<std::string, std::string>{"kinematic", ""}, {"dynamic", R"(, "density": 500)"}}) {
+  for (const auto& [type, tail] :
+       {std::pair<std::string, std::string>{"kinematic", ""}, {"dynamic", R"(, "density": 500)"}}) {
     CAPTURE(type);
     const std::vector<std::string> seam = warningsFor(type, tail);
     REQUIRE(seam.size() == 1);
@@ -536,9 +551,12 @@ TEST_CASE("moving bodies: a periodic scene with a moving body loads with one war
   box.SetAsBox(0.1f, 0.2f);
   game.CreateBody(&bd)->CreateFixture(&box, 0);
   World w(parseScene(R"({"solver": {"quality": "game", "spacing": 0.04}, "periodic": {"x": [0, 2]},
-      "fluid": [{"min": [0, 0], "max": [2, 0.4]}]})", "periodic.json"), game);
+      "fluid": [{"min": [0, 0], "max": [2, 0.4]}]})",
+                     "periodic.json"),
+          game);
   int seam = 0;
-  for (const std::string& m : w.takeWarnings()) seam += m.find("game's b2World has a kinematic body") != std::string::npos;
+  for (const std::string& m : w.takeWarnings())
+    seam += m.find("game's b2World has a kinematic body") != std::string::npos;
   CHECK(seam == 1);
 }
 

@@ -19,12 +19,12 @@ using test::dynamicBody;
 /// The momentum balance of water in a 2 m × 1 m tank (0.4 m deep, spacing 0.02) over one
 /// simulated second (what the tests below measure and print).
 struct TankBalance {
-  Vec2d p0{0, 0};          ///< P_fluid + P_crate at the start
-  Vec2d dp{0, 0};          ///< Δ(P_fluid + P_crate)
-  Vec2d gravity{0, 0};     ///< (M_fluid + M_crate) g T
-  WallImpulse wall;        ///< World::wallImpulse() over the second
-  Vec2d crate{0, 0};       ///< the crate's momentum at the end
-  bool touched = false;    ///< the crate touched a static fixture (a Box2D contact) at a frame's end
+  Vec2d p0{0, 0};        ///< P_fluid + P_crate at the start
+  Vec2d dp{0, 0};        ///< Δ(P_fluid + P_crate)
+  Vec2d gravity{0, 0};   ///< (M_fluid + M_crate) g T
+  WallImpulse wall;      ///< World::wallImpulse() over the second
+  Vec2d crate{0, 0};     ///< the crate's momentum at the end
+  bool touched = false;  ///< the crate touched a static fixture (a Box2D contact) at a frame's end
   Vec2d residual() const { return dp - gravity - wall.total(); }
 };
 
@@ -66,7 +66,8 @@ TankBalance tankBalance(const std::string& solver, bool slosh, bool crate, int t
   const b2Body* body = dynamicBody(w);
   REQUIRE(bool(body) == crate);
   auto crateMomentum = [&] {
-    return body ? Vec2d(Vec2d(body->GetLinearVelocity().x, body->GetLinearVelocity().y) * double(body->GetMass())) : Vec2d(0, 0);
+    return body ? Vec2d(Vec2d(body->GetLinearVelocity().x, body->GetLinearVelocity().y) * double(body->GetMass()))
+                : Vec2d(0, 0);
   };
   const std::size_t n = w.particleCount();
   const double t0 = w.time();
@@ -94,15 +95,16 @@ std::string describe(const TankBalance& b) {
   o << "Δp (" << b.dp.x() << ", " << b.dp.y() << "), gravity (" << b.gravity.x() << ", " << b.gravity.y() << "), wall ("
     << w.x() << ", " << w.y() << ") = samples (" << b.wall.samples.x() << ", " << b.wall.samples.y() << ") + grid ("
     << b.wall.grid.x() << ", " << b.wall.grid.y() << ") + collision (" << b.wall.collision.x() << ", "
-    << b.wall.collision.y() << ") kg m/s; residual (" << r.x() << ", " << r.y() << ") = " << 100 * r.norm() / b.gravity.norm()
-    << " % of |gravity|";
+    << b.wall.collision.y() << ") kg m/s; residual (" << r.x() << ", " << r.y()
+    << ") = " << 100 * r.norm() / b.gravity.norm() << " % of |gravity|";
   if (w.x() != 0) o << ", x: " << 100 * std::fabs(r.x()) / std::fabs(w.x()) << " % of the walls' x";
   return o.str();
 }
 
 }  // namespace
 
-TEST_CASE("moving bodies: over a second of a crate in a sloshing tank, the change of water-plus-crate momentum is gravity's impulse plus the walls' within 5 %") {
+TEST_CASE(
+    "moving bodies: over a second of a crate in a sloshing tank, the change of water-plus-crate momentum is gravity's impulse plus the walls' within 5 %") {
   // Issue 16: Δ(P_fluid + P_crate) = Σ m g T + World::wallImpulse() (the crate never touches a
   // wall, so no Box2D contact impulse enters). The residual is normalised by |gravity's impulse|
   // (both axes), and the horizontal balance, where gravity does not act, separately by the
@@ -114,7 +116,8 @@ TEST_CASE("moving bodies: over a second of a crate in a sloshing tank, the chang
   // smallest). muller2003 counts its wall pressure and, with no_slip, the viscosity's wall term
   // (folded into its pressure force; wcsph+no_slip: the viscosity effect's own stage).
   // docs/STABILITY.md, "Momentum balance", has the figures.
-  for (const std::string solver : {"game", "wcsph", "dfsph", "pbf", "muller2003", "muller2003+no_slip", "wcsph+no_slip"}) {
+  for (const std::string solver :
+       {"game", "wcsph", "dfsph", "pbf", "muller2003", "muller2003+no_slip", "wcsph+no_slip"}) {
     INFO(solver);
     const TankBalance b = tankBalance(solver, true, true);
     const Vec2d r = b.residual(), w = b.wall.total();
@@ -122,7 +125,7 @@ TEST_CASE("moving bodies: over a second of a crate in a sloshing tank, the chang
     MESSAGE(solver << ": " << describe(b) << "; crate (" << b.crate.x() << ", " << b.crate.y() << ")");
     CHECK_FALSE(b.touched);
     CHECK(std::fabs(w.x()) > std::fabs(b.p0.x()));  // the walls turned the slosh back
-    CHECK(b.crate.norm() > 5.0);                      // the water moved the crate
+    CHECK(b.crate.norm() > 5.0);                    // the water moved the crate
     const double tol = solver == "game" ? 0.05 : solver == "pbf" ? 1e-4 : 1e-6;
     CHECK(r.norm() <= tol * G);
     CHECK(std::fabs(r.x()) <= tol * std::fabs(w.x()));
@@ -130,7 +133,8 @@ TEST_CASE("moving bodies: over a second of a crate in a sloshing tank, the chang
   }
 }
 
-TEST_CASE("moving bodies: water at rest in a tank: over a second the walls' impulse is the water's weight, within 1 % for the game solver") {
+TEST_CASE(
+    "moving bodies: water at rest in a tank: over a second the walls' impulse is the water's weight, within 1 % for the game solver") {
   // At rest the game solver's grid attribution is exact but for the particles' density
   // (0.19 % measured); it holds the two grid parts apart: without the closed faces' own
   // velocity change (the half cell between the floor and the lowest cell centres) it is 4.9 %

@@ -105,7 +105,8 @@ TEST_CASE("particle access: setParticle teleports a particle over a wall, and a 
   CHECK(x.x() < 1.0);
 }
 
-TEST_CASE("particle access: getParticles reads many ids as getParticle does one, and setPositions teleports many, refusing solids") {
+TEST_CASE(
+    "particle access: getParticles reads many ids as getParticle does one, and setPositions teleports many, refusing solids") {
   SceneDef s = test::tank("wcsph", 1.0, 1.0, 0.02);
   s.bodies[0].fixtures.push_back(test::boxShape({0.5, 0.5}, {0.05, 0.5}));  // a wall at x in [0.45, 0.55]
   s.blocks.push_back(test::block({0, 0}, {0.2, 0.2}));
@@ -131,14 +132,15 @@ TEST_CASE("particle access: getParticles reads many ids as getParticle does one,
   const std::vector<std::uint32_t> movers = {ids[0], ids[2], absent};
   const std::vector<Vec2d> to = {Vec2d(0.8, 0.3), Vec2d(0.5, 0.3), Vec2d(0.8, 0.5)};
   CHECK_THROWS_AS(w.setPositions(movers, {Vec2d(0.8, 0.3)}), std::invalid_argument);
-  CHECK_THROWS_AS(w.setPositions(movers, {Vec2d(0.8, 0.3), Vec2d(std::nan(""), 0), Vec2d(0.8, 0.5)}), std::invalid_argument);
+  CHECK_THROWS_AS(w.setPositions(movers, {Vec2d(0.8, 0.3), Vec2d(std::nan(""), 0), Vec2d(0.8, 0.5)}),
+                  std::invalid_argument);
   std::vector<Vec2d> before, vBefore;
   w.getParticles(movers, before, vBefore);
   CHECK(w.setPositions(movers, to) == 1);
   w.getParticles(movers, x, v);
   CHECK((x[0] - to[0]).norm() < 1e-6);  // stored in float, relative to the World's origin
   CHECK(v[0] == vBefore[0]);            // the velocity is kept
-  CHECK(x[1] == before[1]);   // refused inside the wall
+  CHECK(x[1] == before[1]);             // refused inside the wall
   for (int f = 0; f < 30; ++f) w.stepFrame();
   w.getParticles(movers, x, v);
   MESSAGE("the moved particle after 0.5 s at " << x[0].x() << ", " << x[0].y());
@@ -161,7 +163,8 @@ TEST_CASE("particle access: addParticles places particles that fall freely, skip
   const std::vector<std::string> warn = w.takeWarnings();
   REQUIRE(warn.size() == 2);
   CHECK(warn[0] == "addParticles: skipped 2 points inside solids");
-  CHECK(warn[1].find("particle budget of " + std::to_string(n0 + 3) + " (max_particles) reached: addParticles added 3 and refused the last 1 points") == 0);
+  CHECK(warn[1].find("particle budget of " + std::to_string(n0 + 3) +
+                     " (max_particles) reached: addParticles added 3 and refused the last 1 points") == 0);
   Vec2d x, v;
   REQUIRE(w.getParticle(ids[1], x, v));
   CHECK((x - Vec2d(0.5, 1.8)).norm() <= 1e-6 * Vec2d(0.5, 1.8).norm());
@@ -261,7 +264,8 @@ TEST_CASE("particle access: writes by id give the same state hash for 1, 2 and 3
   }
 }
 
-TEST_CASE("particle colour and user data: allocated by the first set, kept by id through steps, removals and save/load") {
+TEST_CASE(
+    "particle colour and user data: allocated by the first set, kept by id through steps, removals and save/load") {
   SceneDef s = test::tank("game", 1.0, 1.0, 0.02);
   s.blocks.push_back(test::block({0, 0}, {1, 0.4}));
   World w(s, WorldOptions{2});
@@ -283,10 +287,11 @@ TEST_CASE("particle colour and user data: allocated by the first set, kept by id
     }
   const std::uint64_t before = w.stateHash();
   CHECK(w.setParticleColors(left, red) == left.size());
-  for (std::size_t k = 0; k < w.particleCount(); k += 3) CHECK(w.setParticleUserData(w.particles().id[k], w.particles().id[k] * 7u));
+  for (std::size_t k = 0; k < w.particleCount(); k += 3)
+    CHECK(w.setParticleUserData(w.particles().id[k], w.particles().id[k] * 7u));
   CHECK(has("color"));
   CHECK(has("user_data"));
-  CHECK(w.stateHash() == before);  // not part of the state hash
+  CHECK(w.stateHash() == before);                   // not part of the state hash
   CHECK_FALSE(w.setParticleColor(0xFFFFFFF0u, 1));  // no such id
   CHECK_THROWS_AS(w.setParticleColors(left, {}), std::invalid_argument);
   // Steps reorder the slots; removals compact them; new particles hold 0.
@@ -331,7 +336,8 @@ TEST_CASE("particle colour and user data: allocated by the first set, kept by id
   CHECK(r.particleColor(r.particles().id[0]) == 0u);
 }
 
-TEST_CASE("particle access: the b2Vec2 overloads do what the Vec2d calls do, and braced pairs still pick the Vec2d calls") {
+TEST_CASE(
+    "particle access: the b2Vec2 overloads do what the Vec2d calls do, and braced pairs still pick the Vec2d calls") {
   SceneDef s = smallDamBreak();
   World a(s, WorldOptions{1}), b(s, WorldOptions{1});
   const std::uint32_t id = a.particles().id[3];
@@ -383,7 +389,8 @@ TEST_CASE("particle access: the b2Vec2 overloads do what the Vec2d calls do, and
   CHECK(pb.x == float(pa.x()));
   CHECK(vb.y == float(va.y()));
   CHECK(b.particlesInRadius(b2Vec2(0.125f, 0.1875f), 0.1) == a.particlesInRadius({0.125, 0.1875}, 0.1));
-  CHECK(b.particlesInBox(b2Vec2(0.0f, 0.0f), b2Vec2(0.1875f, 0.1875f)) == a.particlesInBox({0.0, 0.0}, {0.1875, 0.1875}));
+  CHECK(b.particlesInBox(b2Vec2(0.0f, 0.0f), b2Vec2(0.1875f, 0.1875f)) ==
+        a.particlesInBox({0.0, 0.0}, {0.1875, 0.1875}));
   CHECK(b.sampleAt(b2Vec2(0.125f, 0.125f)).density == a.sampleAt({0.125, 0.125}).density);
   CHECK(b.particlesInRadius(b2Vec2(0.125f, 0.1875f), 0.1).size() > 10);
   // The bulk calls, the box removal and the shape fill.
@@ -412,7 +419,8 @@ TEST_CASE("particle access: the b2Vec2 overloads do what the Vec2d calls do, and
   CHECK(std::isnan(pb2[2].x));
 }
 
-TEST_CASE("particles(): views of the World own arrays, colour and user data appear once set, a ParticleBuffer copy keeps a frame") {
+TEST_CASE(
+    "particles(): views of the World own arrays, colour and user data appear once set, a ParticleBuffer copy keeps a frame") {
   World w(smallDamBreak(), WorldOptions{1});
   const std::size_t n = w.particleCount();
   {

@@ -16,7 +16,9 @@ using namespace sph2d;
 
 namespace {
 
-bool has(const std::vector<std::string>& v, const std::string& s) { return std::find(v.begin(), v.end(), s) != v.end(); }
+bool has(const std::vector<std::string>& v, const std::string& s) {
+  return std::find(v.begin(), v.end(), s) != v.end();
+}
 
 /// The closed tank [0, 2]² (wcsph, no viscosity), no fluid.
 SceneDef box(double spacing = 0.04) {
@@ -27,7 +29,8 @@ SceneDef box(double spacing = 0.04) {
 
 }  // namespace
 
-TEST_CASE("emitters added and removed at run time: nothing owed for the past, seeded, saved, and the emit stage only while one exists") {
+TEST_CASE(
+    "emitters added and removed at run time: nothing owed for the past, seeded, saved, and the emit stage only while one exists") {
   const SceneDef s = box();
   EmitterDef e;
   e.position = Vec2d(1.0, 1.8);
@@ -118,7 +121,8 @@ std::vector<std::uint32_t> newIds(const std::vector<std::uint32_t>& before, cons
 
 }  // namespace
 
-TEST_CASE("every add returns the ids it made: addBlock, addDrop, addShape, addParticles, the budget cutting a block short too") {
+TEST_CASE(
+    "every add returns the ids it made: addBlock, addDrop, addShape, addParticles, the budget cutting a block short too") {
   SceneDef s = box();
   s.blocks.push_back(test::block({0.1, 0.1}, {0.5, 0.5}));
   EmitterDef e;  // emitted particles take ids between the adds
@@ -141,7 +145,7 @@ TEST_CASE("every add returns the ids it made: addBlock, addDrop, addShape, addPa
   for (int f = 0; f < 10; ++f) w.stepFrame();
   std::vector<std::uint32_t> before = allIds(w);
   const IdRange block = w.addBlock(test::block({1.0, 0.1}, {1.3, 0.3}));
-  CHECK(block.count == 35);  // 7 × 5 lattice points at spacing 0.04 (the floor's face left out: none here)
+  CHECK(block.count == 35);            // 7 × 5 lattice points at spacing 0.04 (the floor's face left out: none here)
   CHECK(block.first > before.back());  // after every id given out, the emitted ones included
   expectAdded(before, block);
   for (int f = 0; f < 5; ++f) w.stepFrame();
@@ -158,7 +162,8 @@ TEST_CASE("every add returns the ids it made: addBlock, addDrop, addShape, addPa
   expectAdded(before, shape);
   // addParticles: points inside a solid take no id, so the ids stay consecutive.
   before = allIds(w);
-  const IdRange points = w.addParticles({Vec2d(0.3, 1.0), Vec2d(0.3, -0.1), Vec2d(0.4, 1.0), Vec2d(-0.1, 1.0), Vec2d(0.5, 1.0)});
+  const IdRange points =
+      w.addParticles({Vec2d(0.3, 1.0), Vec2d(0.3, -0.1), Vec2d(0.4, 1.0), Vec2d(-0.1, 1.0), Vec2d(0.5, 1.0)});
   CHECK(points.count == 3);
   expectAdded(before, points);
   CHECK(w.takeWarnings().size() == 1);  // the two points in the walls
@@ -185,7 +190,8 @@ TEST_CASE("every add returns the ids it made: addBlock, addDrop, addShape, addPa
   CHECK(allIds(full) == cut.ids());
 }
 
-TEST_CASE("emitter tracking: each particle an emitter makes carries its index, only when asked, with no cost or change when off") {
+TEST_CASE(
+    "emitter tracking: each particle an emitter makes carries its index, only when asked, with no cost or change when off") {
   SceneDef s = box();
   s.blocks.push_back(test::block({0.1, 0.1}, {0.5, 0.3}));
   EmitterDef left;
@@ -226,7 +232,8 @@ TEST_CASE("emitter tracking: each particle an emitter makes carries its index, o
   const Particles& P = on.particles();
   REQUIRE(P.emitter.size() == P.size());
   for (std::size_t i = 0; i < P.size(); ++i)
-    CHECK(P.emitter[i] == (on.particleEmitter(P.id[i]) == World::npos ? 0u : std::uint32_t(on.particleEmitter(P.id[i]) + 1)));
+    CHECK(P.emitter[i] ==
+          (on.particleEmitter(P.id[i]) == World::npos ? 0u : std::uint32_t(on.particleEmitter(P.id[i]) + 1)));
   CHECK(off.particles().emitter.empty());
   CHECK_FALSE(has(off.particleFields(), "emitter"));
   CHECK(has(on.particleFields(), "emitter"));

@@ -16,7 +16,9 @@ using namespace sph2d;
 
 namespace {
 
-bool has(const std::vector<std::string>& v, const std::string& s) { return std::find(v.begin(), v.end(), s) != v.end(); }
+bool has(const std::vector<std::string>& v, const std::string& s) {
+  return std::find(v.begin(), v.end(), s) != v.end();
+}
 
 /// The closed tank [0, 2]² (wcsph, no viscosity), no fluid.
 SceneDef box(double spacing = 0.04) {
@@ -226,15 +228,17 @@ TEST_CASE("a block leaves out the lattice points on a static solid's face, so no
       onFace += std::fabs(p.x() - 0.5) < 0.2 && std::fabs(p.y() - 0.05) < 0.004;
     }
     CHECK(onFace == 0);
-    CHECK(w.particleCount() == 50u * 20u - 20u * 14u - 2u * 20u);  // the tank's lattice less the shelf's and its two face rows
-    double densest = 0;  // the solver's density at the start (prepare)
+    CHECK(w.particleCount() ==
+          50u * 20u - 20u * 14u - 2u * 20u);  // the tank's lattice less the shelf's and its two face rows
+    double densest = 0;                       // the solver's density at the start (prepare)
     for (std::size_t i = 0; i < w.particleCount(); ++i) densest = std::max(densest, double(w.particles().rho[i]));
     MESSAGE(std::string(solver) << ": densest particle at the start " << densest / 1000 << " rho0");
     CHECK(densest < 1.1 * 1000);
   }
 }
 
-TEST_CASE("a weakly compressible solver whose sound speed is below 10x the fastest emitter or block warns, naming the key") {
+TEST_CASE(
+    "a weakly compressible solver whose sound speed is below 10x the fastest emitter or block warns, naming the key") {
   // Before (issue 18): a free 50 m/s jet at c0 = 500 spread to 22–98 m/s and gained 5.5 %
   // energy within 0.07 s, without a word.
   auto warningsOf = [](const SceneDef& s) {
@@ -257,7 +261,8 @@ TEST_CASE("a weakly compressible solver whose sound speed is below 10x the faste
     REQUIRE(w.size() == 1);
     CHECK(w[0].find("the sound speed 400 m/s is below 10 x the fastest speed the scene sets (50 m/s at "
                     "effects.emitters[0].speed)") != std::string::npos);
-    CHECK(w[0].find("raise solver.sound_speed (or set solver.expected_speed) to at least 500 m/s") != std::string::npos);
+    CHECK(w[0].find("raise solver.sound_speed (or set solver.expected_speed) to at least 500 m/s") !=
+          std::string::npos);
   }
   s.solver.soundSpeed = 500;  // 10 x: the usual choice, no warning
   CHECK(warningsOf(s).empty());
@@ -308,7 +313,8 @@ TEST_CASE("an emitter never places a particle inside or beyond a solid, whatever
   }
 }
 
-TEST_CASE("a strain velocity field starts each particle at u = -s x, v = s y from its origin, and a missing rate is refused") {
+TEST_CASE(
+    "a strain velocity field starts each particle at u = -s x, v = s y from its origin, and a missing rate is refused") {
   // A free drop squeezed along x and stretched along y (issue 18's hard case 11 is posed in it).
   SceneDef s = parseScene(R"({"gravity": [0, 0], "solver": {"type": "wcsph", "spacing": 0.02, "sound_speed": 300},
     "fluid": [{"min": [0.8, 0.8], "max": [1.2, 1.2],
@@ -359,8 +365,9 @@ TEST_CASE("a linear velocity field u = A x + b gives a rigidly rotating disc the
   CHECK(std::abs(double(w.particleCount()) - expected) < 0.03 * expected);
   CHECK(double(countBlockParticles(s)) == double(w.particleCount()));
   try {
-    parseScene(R"({"fluid": [{"min": [0, 0], "max": [1, 1], "velocity_field": {"type": "linear", "gradient": [[0, 1], [2]]}}]})",
-               "bad.json");
+    parseScene(
+        R"({"fluid": [{"min": [0, 0], "max": [1, 1], "velocity_field": {"type": "linear", "gradient": [[0, 1], [2]]}}]})",
+        "bad.json");
     FAIL("a gradient with a short row was accepted");
   } catch (const SceneError& e) {
     CHECK(e.key.rfind("fluid[0].velocity_field.gradient", 0) == 0);

@@ -19,11 +19,11 @@ using namespace sph2d;
 namespace {
 
 struct Pinned {
-  const char* scene;    ///< under assets/scenes/
-  const char* solver;   ///< solver type, overriding the scene's
-  int frames;           ///< frames stepped
-  bool userForce;       ///< a push at frame 10 (the user_force stage)
-  std::uint64_t hash;   ///< expected World::stateHash()
+  const char* scene;   ///< under assets/scenes/
+  const char* solver;  ///< solver type, overriding the scene's
+  int frames;          ///< frames stepped
+  bool userForce;      ///< a push at frame 10 (the user_force stage)
+  std::uint64_t hash;  ///< expected World::stateHash()
 };
 
 // To regenerate after a change that moves bits on purpose: run the test, copy

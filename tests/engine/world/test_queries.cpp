@@ -57,7 +57,7 @@ TEST_CASE("searches see every change made between steps: a moved, an added and a
   // a grid kept across a change would miss these.
   World w(test::scene("tests/small_dam_break.json"), WorldOptions{1});
   for (int f = 0; f < 5; ++f) w.stepFrame();
-  const Vec2d spot(3.5, 2.5);  // empty air, far from the water
+  const Vec2d spot(3.5, 2.5);                        // empty air, far from the water
   REQUIRE(w.particlesInRadius(spot, 0.05).empty());  // builds the grid
   const std::uint32_t id = w.particles().id[0];
   REQUIRE(w.setParticle(id, spot, Vec2d(0, 0)));
@@ -72,7 +72,8 @@ TEST_CASE("searches see every change made between steps: a moved, an added and a
   CHECK(w.particlesInRadius(spot, 0.25).size() == 1);  // the added one
 }
 
-TEST_CASE("shapes: particlesInShape matches b2Shape::TestPoint over every particle, and addShape and removeParticlesInShape fill and empty a rotated box") {
+TEST_CASE(
+    "shapes: particlesInShape matches b2Shape::TestPoint over every particle, and addShape and removeParticlesInShape fill and empty a rotated box") {
   SceneDef s = test::tank("wcsph", 2, 2, 0.02);
   s.gravity = Vec2d(0, 0);
   World w(s, WorldOptions{2});
@@ -113,7 +114,8 @@ TEST_CASE("shapes: particlesInShape matches b2Shape::TestPoint over every partic
   CHECK(w.particlesInShape(edge, xf).empty());
 }
 
-TEST_CASE("sampleAt inside a uniform moving block returns rho0 and the block's velocity, with weight 1, and nothing far from it") {
+TEST_CASE(
+    "sampleAt inside a uniform moving block returns rho0 and the block's velocity, with weight 1, and nothing far from it") {
   const Vec2d u(0.7, -0.3);
   World w(periodicBlock("wcsph", u), WorldOptions{1});
   for (const Vec2d& p : {Vec2d(0.5, 0.5), Vec2d(0.13, 0.71), Vec2d(0.021, 0.978)}) {
@@ -125,8 +127,10 @@ TEST_CASE("sampleAt inside a uniform moving block returns rho0 and the block's v
     CHECK(f.velocity.y() == doctest::Approx(u.y()).epsilon(1e-6));
     // Σ V W of a full lattice under Wendland C2 at R = 2.5 dx is 1 to within the
     // kernel's lattice error; sampleAt does not wrap, so near a seam only one side counts.
-    if (p.x() > 0.1 && p.y() < 0.9) CHECK(f.weight == doctest::Approx(1.0).epsilon(0.02));
-    else CHECK(f.weight < 0.8);
+    if (p.x() > 0.1 && p.y() < 0.9)
+      CHECK(f.weight == doctest::Approx(1.0).epsilon(0.02));
+    else
+      CHECK(f.weight < 0.8);
   }
   // Beyond the support of every particle: no fluid there.
   const World::FieldSample far = w.sampleAt(Vec2d(5, 5));
@@ -135,7 +139,8 @@ TEST_CASE("sampleAt inside a uniform moving block returns rho0 and the block's v
   CHECK(far.velocity == Vec2d(0, 0));
 }
 
-TEST_CASE("kineticEnergy is half m v squared summed, densityStats the mean and largest compression and the mean density") {
+TEST_CASE(
+    "kineticEnergy is half m v squared summed, densityStats the mean and largest compression and the mean density") {
   const Vec2d u(0.7, -0.3);
   World w(periodicBlock("wcsph", u), WorldOptions{1});
   const double N = double(w.particleCount()), m = double(w.particleMass());
@@ -153,8 +158,8 @@ TEST_CASE("kineticEnergy is half m v squared summed, densityStats the mean and l
   const double doubled = 2.0 * double(added) / double(w.particleCount());  // the share of particles in the overlap
   MESSAGE(added << " added; mean compression " << d.meanError << ", largest " << d.maxError << ", mean density "
                 << d.meanDensity << " (" << doubled << " of the particles in the overlap)");
-  CHECK(d.maxError == doctest::Approx(1.0).epsilon(0.01));                          // 2 ρ0: compression 1
-  CHECK(d.meanError == doctest::Approx(doubled).epsilon(0.1));                      // ≈ 1 × the overlap's share
+  CHECK(d.maxError == doctest::Approx(1.0).epsilon(0.01));      // 2 ρ0: compression 1
+  CHECK(d.meanError == doctest::Approx(doubled).epsilon(0.1));  // ≈ 1 × the overlap's share
   CHECK(d.meanDensity == doctest::Approx(1000.0 * (1 + doubled)).epsilon(0.1));
 }
 
@@ -182,7 +187,8 @@ TEST_CASE("the state hash is the same for the same state and changes with any pa
   CHECK(a.stateHash() == b.stateHash());
 }
 
-TEST_CASE("queries: particlesTouching finds the particles within one spacing of a fixture, and forEachContact visits the fixtures the water touches") {
+TEST_CASE(
+    "queries: particlesTouching finds the particles within one spacing of a fixture, and forEachContact visits the fixtures the water touches") {
   SceneDef s = test::tank("game", 1.0, 1.0, 0.02);
   s.blocks.push_back(test::block({0, 0}, {1, 0.4}));
   BodyDef pole;  // a submerged circle, r = 0.06 m, at (0.5, 0.2)
@@ -200,9 +206,12 @@ TEST_CASE("queries: particlesTouching finds the particles within one spacing of 
   for (const b2Body* b = w.box2d().GetBodyList(); b; b = b->GetNext())
     for (const b2Fixture* fx = b->GetFixtureList(); fx; fx = fx->GetNext()) {
       const b2AABB a = fx->GetAABB(0);
-      if (fx->GetShape()->GetType() == b2Shape::e_circle) circle = fx;
-      else if (a.upperBound.y < 0.02f) floor = fx;  // AABBs hold the polygon skin (0.01 m)
-      else if (a.lowerBound.y > 0.98f) ceiling = fx;
+      if (fx->GetShape()->GetType() == b2Shape::e_circle)
+        circle = fx;
+      else if (a.upperBound.y < 0.02f)
+        floor = fx;  // AABBs hold the polygon skin (0.01 m)
+      else if (a.lowerBound.y > 0.98f)
+        ceiling = fx;
     }
   REQUIRE(floor);
   REQUIRE(ceiling);
@@ -222,7 +231,7 @@ TEST_CASE("queries: particlesTouching finds the particles within one spacing of 
   MESSAGE(onFloor.size() << " particles on the floor, " << onPole.size() << " around the pole");
   CHECK(onFloor == floorScan);
   CHECK(onPole == poleScan);
-  CHECK(onFloor.size() >= std::size_t(0.9 / dx));      // the whole bottom layer
+  CHECK(onFloor.size() >= std::size_t(0.9 / dx));                // the whole bottom layer
   CHECK(onPole.size() >= std::size_t(2 * 3.14159 * 0.06 / dx));  // a ring around it
   CHECK(w.particlesTouching(*ceiling).empty());
   // forEachContact: the floor, the side walls and the pole, never the ceiling; the same lists.
@@ -242,73 +251,75 @@ TEST_CASE("queries: particlesTouching finds the particles within one spacing of 
   CHECK_FALSE(sawCeiling);
 }
 
-TEST_CASE("queries: with contact tracking a particle that passed a fixture during the step is reported, without it only those touching at its end") {
+TEST_CASE(
+    "queries: with contact tracking a particle that passed a fixture during the step is reported, without it only those touching at its end") {
   // One particle shot at 8 m/s along a line 1 cm above a circle (r = 0.05 m at (0.5, 0.3)),
   // static or a kinematic body at rest: within one frame (wcsph: many substeps) it passes the
   // circle and ends 5 cm beyond it. The snapshot at the frame's end misses it; the contacts
   // stage, which looks at the end of every substep, records it, for that step only.
   for (const bool kinematic : {false, true}) {
-  INFO(std::string(kinematic ? "kinematic" : "static"));
-  auto run = [kinematic](bool tracking, std::vector<std::uint32_t>& touching, std::vector<std::uint32_t>& after,
-                double& endGap, std::uint32_t& id, int& visits, bool& stagePresent) {
-    SceneDef s = test::tank("wcsph", 1.0, 1.0, 0.02);
-    BodyDef pole;
-    ShapeDef c;
-    c.type = ShapeDef::Type::Circle;
-    c.center = Vec2d(0.5, 0.3);
-    c.radius = 0.05;
-    if (kinematic) {
-      pole.type = BodyDef::Type::Kinematic;
-      pole.position = c.center;
-      c.center = Vec2d(0, 0);
-    }
-    pole.fixtures.push_back(c);
-    s.bodies.push_back(pole);
-    World w(s, WorldOptions{2});
-    w.setContactTracking(tracking);
-    CHECK(w.contactTracking() == tracking);
-    const auto names = w.stages();
-    stagePresent = std::find(names.begin(), names.end(), "contacts") != names.end();
-    const b2Fixture* circle = nullptr;
-    for (const b2Body* b = w.box2d().GetBodyList(); b; b = b->GetNext())
-      for (const b2Fixture* fx = b->GetFixtureList(); fx; fx = fx->GetNext())
-        if (fx->GetShape()->GetType() == b2Shape::e_circle) circle = fx;
-    REQUIRE(circle);
-    const auto ids = w.addParticles({Vec2d(0.45, 0.36)}, {Vec2d(8, 0)});
-    REQUIRE(ids.size() == 1);
-    id = ids[0];
-    w.stepFrame();
-    REQUIRE(w.substeps() > 5);
-    endGap = (w.worldPosition(0) - Vec2d(0.5, 0.3)).norm() - 0.05;
-    touching = w.particlesTouching(*circle);
-    visits = 0;
-    w.forEachContact([&](const b2Fixture& fx, const std::vector<std::uint32_t>& l) {
-      if (&fx == circle) visits += l == touching;
-    });
-    w.stepFrame();  // on, far from the circle: this step's record is empty
-    after = w.particlesTouching(*circle);
-  };
-  std::vector<std::uint32_t> offNow, offAfter, onNow, onAfter;
-  double gapOff = 0, gapOn = 0;
-  std::uint32_t idOff = 0, idOn = 0;
-  int visitsOff = 0, visitsOn = 0;
-  bool stageOff = true, stageOn = false;
-  run(false, offNow, offAfter, gapOff, idOff, visitsOff, stageOff);
-  run(true, onNow, onAfter, gapOn, idOn, visitsOn, stageOn);
-  MESSAGE("the particle ends the frame " << gapOn << " m from the circle");
-  CHECK(gapOff == gapOn);         // tracking changes nothing of the motion
-  CHECK(gapOn > 0.04);            // it passed and left (the reach is one spacing, 0.02 m)
-  CHECK(offNow.empty());          // the snapshot misses it
-  CHECK(visitsOff == 0);
-  CHECK(onNow == std::vector<std::uint32_t>{idOn});  // the stage saw it pass
-  CHECK(visitsOn == 1);
-  CHECK(onAfter.empty());
-  CHECK_FALSE(stageOff);
-  CHECK(stageOn);
+    INFO(std::string(kinematic ? "kinematic" : "static"));
+    auto run = [kinematic](bool tracking, std::vector<std::uint32_t>& touching, std::vector<std::uint32_t>& after,
+                           double& endGap, std::uint32_t& id, int& visits, bool& stagePresent) {
+      SceneDef s = test::tank("wcsph", 1.0, 1.0, 0.02);
+      BodyDef pole;
+      ShapeDef c;
+      c.type = ShapeDef::Type::Circle;
+      c.center = Vec2d(0.5, 0.3);
+      c.radius = 0.05;
+      if (kinematic) {
+        pole.type = BodyDef::Type::Kinematic;
+        pole.position = c.center;
+        c.center = Vec2d(0, 0);
+      }
+      pole.fixtures.push_back(c);
+      s.bodies.push_back(pole);
+      World w(s, WorldOptions{2});
+      w.setContactTracking(tracking);
+      CHECK(w.contactTracking() == tracking);
+      const auto names = w.stages();
+      stagePresent = std::find(names.begin(), names.end(), "contacts") != names.end();
+      const b2Fixture* circle = nullptr;
+      for (const b2Body* b = w.box2d().GetBodyList(); b; b = b->GetNext())
+        for (const b2Fixture* fx = b->GetFixtureList(); fx; fx = fx->GetNext())
+          if (fx->GetShape()->GetType() == b2Shape::e_circle) circle = fx;
+      REQUIRE(circle);
+      const auto ids = w.addParticles({Vec2d(0.45, 0.36)}, {Vec2d(8, 0)});
+      REQUIRE(ids.size() == 1);
+      id = ids[0];
+      w.stepFrame();
+      REQUIRE(w.substeps() > 5);
+      endGap = (w.worldPosition(0) - Vec2d(0.5, 0.3)).norm() - 0.05;
+      touching = w.particlesTouching(*circle);
+      visits = 0;
+      w.forEachContact([&](const b2Fixture& fx, const std::vector<std::uint32_t>& l) {
+        if (&fx == circle) visits += l == touching;
+      });
+      w.stepFrame();  // on, far from the circle: this step's record is empty
+      after = w.particlesTouching(*circle);
+    };
+    std::vector<std::uint32_t> offNow, offAfter, onNow, onAfter;
+    double gapOff = 0, gapOn = 0;
+    std::uint32_t idOff = 0, idOn = 0;
+    int visitsOff = 0, visitsOn = 0;
+    bool stageOff = true, stageOn = false;
+    run(false, offNow, offAfter, gapOff, idOff, visitsOff, stageOff);
+    run(true, onNow, onAfter, gapOn, idOn, visitsOn, stageOn);
+    MESSAGE("the particle ends the frame " << gapOn << " m from the circle");
+    CHECK(gapOff == gapOn);  // tracking changes nothing of the motion
+    CHECK(gapOn > 0.04);     // it passed and left (the reach is one spacing, 0.02 m)
+    CHECK(offNow.empty());   // the snapshot misses it
+    CHECK(visitsOff == 0);
+    CHECK(onNow == std::vector<std::uint32_t>{idOn});  // the stage saw it pass
+    CHECK(visitsOn == 1);
+    CHECK(onAfter.empty());
+    CHECK_FALSE(stageOff);
+    CHECK(stageOn);
   }
 }
 
-TEST_CASE("queries: particlesTouching a kinematic box measures from where the fluid meets it: the skin for the game solver, the fixture for wcsph") {
+TEST_CASE(
+    "queries: particlesTouching a kinematic box measures from where the fluid meets it: the skin for the game solver, the fixture for wcsph") {
   // A 0.3 m × 0.1 m kinematic box at rest in the water. The game solver meets a moving polygon
   // at Box2D's skin (1 cm out), wcsph at the fixture itself (its moving samples stand for it):
   // the particles touching it are those within one spacing of that surface.
@@ -332,7 +343,8 @@ TEST_CASE("queries: particlesTouching a kinematic box measures from where the fl
     std::vector<std::uint32_t> scan;
     for (std::size_t i = 0; i < w.particleCount(); ++i) {
       const Vec2d p = w.worldPosition(i);
-      const double ox = std::max(0.0, std::fabs(p.x() - 0.5) - 0.15), oy = std::max(0.0, std::fabs(p.y() - 0.25) - 0.05);
+      const double ox = std::max(0.0, std::fabs(p.x() - 0.5) - 0.15),
+                   oy = std::max(0.0, std::fabs(p.y() - 0.25) - 0.05);
       if (std::sqrt(ox * ox + oy * oy) - skin <= dx) scan.push_back(w.particles().id[i]);
     }
     const std::vector<std::uint32_t> touching = w.particlesTouching(*fixture);

@@ -82,7 +82,8 @@ TEST_CASE("save and load: every solver steps on to the same state hashes as the 
   }
 }
 
-TEST_CASE("save and load: a save of another scene, a damaged or an inflated save is refused and the World is unchanged") {
+TEST_CASE(
+    "save and load: a save of another scene, a damaged or an inflated save is refused and the World is unchanged") {
   const SceneDef s = busyScene("game");
   World a(s, WorldOptions{1});
   for (int f = 0; f < 10; ++f) a.stepFrame();
@@ -176,8 +177,10 @@ TEST_CASE("save and load: crates resting on each other and on the floor follow t
     const b2Body* qa = a.box2d().GetBodyList();
     const b2Body* qb = b.box2d().GetBodyList();
     for (; qa && qb; qa = qa->GetNext(), qb = qb->GetNext())
-      if (qa->GetType() == b2_dynamicBody) worst = std::max(worst, double((qa->GetPosition() - qb->GetPosition()).Length()));
-    MESSAGE(std::string(solver) << ": the crates 20 frames after the load, at most " << 1000 * worst << " mm from the uninterrupted run");
+      if (qa->GetType() == b2_dynamicBody)
+        worst = std::max(worst, double((qa->GetPosition() - qb->GetPosition()).Length()));
+    MESSAGE(std::string(solver) << ": the crates 20 frames after the load, at most " << 1000 * worst
+                                << " mm from the uninterrupted run");
     CHECK(worst < 1e-3);
   }
 }
@@ -216,7 +219,8 @@ SceneDef gameLevelFluid(const char* solver) {
 
 }  // namespace
 
-TEST_CASE("save and load: with a game's own b2World and a dynamic crate, every solver steps on to the same state hashes") {
+TEST_CASE(
+    "save and load: with a game's own b2World and a dynamic crate, every solver steps on to the same state hashes") {
   // The game saves and restores its own bodies; the save holds where the particles last saw
   // each of them (the first substep after the load sweeps the particles from there).
   for (const char* solver : {"muller2003", "wcsph", "pbf", "dfsph", "game"}) {
@@ -314,8 +318,8 @@ struct CrateLevel {
   std::uint64_t hash() const {
     Xxh64 h;
     for (const b2Body* b : crates) {
-      const float v[6] = {b->GetPosition().x, b->GetPosition().y, b->GetAngle(), b->GetLinearVelocity().x,
-                          b->GetLinearVelocity().y, b->GetAngularVelocity()};
+      const float v[6] = {b->GetPosition().x,       b->GetPosition().y,       b->GetAngle(),
+                          b->GetLinearVelocity().x, b->GetLinearVelocity().y, b->GetAngularVelocity()};
       h.update(v, sizeof v);
     }
     return h.digest();
@@ -330,11 +334,11 @@ struct CrateLevel {
 };
 
 /// A heavy crate on the floor in the water with another on it, and a light one floating.
-const std::vector<CrateLevel::Crate> kStack = {{0.3f, 0.1f, 0.1f, 0.08f, 2500}, {0.32f, 0.28f, 0.1f, 0.08f, 2500},
-                                               {0.9f, 0.45f, 0.2f, 0.08f, 500}};
+const std::vector<CrateLevel::Crate> kStack = {
+    {0.3f, 0.1f, 0.1f, 0.08f, 2500}, {0.32f, 0.28f, 0.1f, 0.08f, 2500}, {0.9f, 0.45f, 0.2f, 0.08f, 500}};
 /// Three heavy crates on the floor, apart: they come to rest.
-const std::vector<CrateLevel::Crate> kApart = {{0.3f, 0.1f, 0.1f, 0.08f, 2500}, {0.9f, 0.1f, 0.1f, 0.08f, 2500},
-                                               {1.6f, 0.1f, 0.1f, 0.08f, 2500}};
+const std::vector<CrateLevel::Crate> kApart = {
+    {0.3f, 0.1f, 0.1f, 0.08f, 2500}, {0.9f, 0.1f, 0.1f, 0.08f, 2500}, {1.6f, 0.1f, 0.1f, 0.08f, 2500}};
 
 /// The game's loop to frame `saveAt`, a save of the fluid (its report in `report`) and of the
 /// game's bodies, a fresh level and World loaded from them, then both on to frame 300. Returns
@@ -379,7 +383,8 @@ int replayFrom(const std::vector<CrateLevel::Crate>& crates, bool warmStarting, 
 
 }  // namespace
 
-TEST_CASE("save and load: in a game's b2World without warm starting, a replay from frame 100 is bit-identical through frame 300") {
+TEST_CASE(
+    "save and load: in a game's b2World without warm starting, a replay from frame 100 is bit-identical through frame 300") {
   // Crates in contact with the floor and with each other, moving: with SetWarmStarting(false)
   // on the saved and the rebuilt b2World, nothing Box2D keeps privately carries over from one
   // step to the next, and save() says the save is complete.
@@ -389,7 +394,8 @@ TEST_CASE("save and load: in a game's b2World without warm starting, a replay fr
   CHECK(report.warning.empty());
 }
 
-TEST_CASE("save and load: with warm starting on, save() says the contact state cannot be restored, and the replay parts at once") {
+TEST_CASE(
+    "save and load: with warm starting on, save() says the contact state cannot be restored, and the replay parts at once") {
   // Box2D's default: each contact warm-starts from its impulses of the last step, which no
   // save holds; the rebuilt b2World solves its first step from zero, and the crates part at
   // the first Box2D step after the load (frame 101).
@@ -415,7 +421,8 @@ TEST_CASE("save and load: with warm starting on, save() says the contact state c
   CHECK(first.warmStartedContacts == touching);
   CHECK(first.warmStartedJoints == 0);
   CHECK(first.sleepTimers == 0);  // every crate moves faster than the sleep tolerances
-  CHECK(first.warning.find(std::to_string(touching) + " touching contacts of dynamic bodies warm-start") != std::string::npos);
+  CHECK(first.warning.find(std::to_string(touching) + " touching contacts of dynamic bodies warm-start") !=
+        std::string::npos);
   CHECK(first.warning.find("SetWarmStarting(false)") != std::string::npos);
   const std::vector<std::string> warnings = w.takeWarnings();
   REQUIRE(warnings.size() == 1);
@@ -440,7 +447,8 @@ TEST_CASE("save and load: with warm starting on, save() says the contact state c
   MESSAGE("warm-started replay from frame 100: the crates " << 1000 * farthest << " mm apart at frame 300");
 }
 
-TEST_CASE("save and load: bodies at rest have sleep timers no save holds: save() says so, and without sleeping the replay is bit-identical") {
+TEST_CASE(
+    "save and load: bodies at rest have sleep timers no save holds: save() says so, and without sleeping the replay is bit-identical") {
   // Three crates come to rest on the floor: slower than Box2D's sleep tolerances, their sleep
   // timers run, and a rebuilt body's starts at 0, so it falls asleep later than the saved one.
   SaveReport report;
@@ -522,7 +530,8 @@ TEST_CASE("save and load: a version-4 save still loads, and older and newer vers
       b.load(in);
       FAIL("version " << v << " loaded");
     } catch (const SaveError& e) {
-      CHECK(std::string(e.what()) == "the saved state has version " + std::to_string(v) + "; this sph2d reads versions 4 to 5");
+      CHECK(std::string(e.what()) ==
+            "the saved state has version " + std::to_string(v) + "; this sph2d reads versions 4 to 5");
     }
   }
 }

@@ -27,8 +27,9 @@ TEST_CASE("the stage list exists from construction: the solver's stages, the eff
   const SceneDef s = test::scene("tests/resting_column.json");  // muller2003 with viscosity
   World w(s, WorldOptions{1});
   // muller2003 folds the viscosity (the first effect) into its pressure force's pair loop.
-  const std::vector<std::string> expected = {"grid",        "neighbours", "density",          "pressure", "pressure_force+viscosity",
-                                             "force_limit", "integrate",  "max_acceleration", "collide"};
+  const std::vector<std::string> expected = {
+      "grid",        "neighbours", "density",          "pressure", "pressure_force+viscosity",
+      "force_limit", "integrate",  "max_acceleration", "collide"};
   CHECK(w.stages() == expected);
   w.stepFrame();
   CHECK(w.stages() == expected);  // running it does not change it

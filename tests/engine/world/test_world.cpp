@@ -37,7 +37,8 @@ TEST_CASE("the particle mass makes a full square lattice exactly rho0 under each
         lo = std::min(lo, double(w.particles().rho[i]));
         hi = std::max(hi, double(w.particles().rho[i]));
       }
-      MESSAGE(solver << " at dx = " << dx << ": density from " << lo << " to " << hi << " kg/m³, mass " << w.particleMass());
+      MESSAGE(solver << " at dx = " << dx << ": density from " << lo << " to " << hi << " kg/m³, mass "
+                     << w.particleMass());
       CHECK(lo == doctest::Approx(1000.0).epsilon(1e-5));
       CHECK(hi == doctest::Approx(1000.0).epsilon(1e-5));
     }
@@ -276,7 +277,8 @@ TEST_CASE("an interrupted World steps again after load(): to the same hash as th
   CHECK(w->stateHash() == ref.stateHash());
 }
 
-TEST_CASE("every setter has a getter: gravity, user forces, an emitter's and an effect's switch read back what was set, and steer the step") {
+TEST_CASE(
+    "every setter has a getter: gravity, user forces, an emitter's and an effect's switch read back what was set, and steer the step") {
   SceneDef s = test::scene("tests/resting_column.json");  // muller2003 with viscosity
   EmitterDef e;
   e.position = Vec2d(0.1, 0.9);

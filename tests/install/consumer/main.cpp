@@ -9,16 +9,16 @@
 // uninterrupted World's state hash, both views show what they should and the game's GL state
 // is as it left it. Writes the game's framebuffer to OUT.png.
 #define GL_GLEXT_PROTOTYPES 1
-#include <GL/osmesa.h>
 #include <GL/gl.h>
 #include <GL/glext.h>
+#include <GL/osmesa.h>
 #include <box2d/box2d.h>
 
 #include <algorithm>
 #include <array>
 #include <chrono>
-#include <cstdlib>
 #include <cstdio>
+#include <cstdlib>
 #include <map>
 #include <sstream>
 #include <vector>
@@ -144,8 +144,15 @@ int main(int argc, char** argv) {
 
   // The game's own OpenGL context, framebuffer and state.
   std::vector<unsigned char> window(64 * 64 * 4);
-  const int attribs[] = {OSMESA_FORMAT, OSMESA_RGBA, OSMESA_PROFILE, OSMESA_CORE_PROFILE,
-                         OSMESA_CONTEXT_MAJOR_VERSION, 3, OSMESA_CONTEXT_MINOR_VERSION, 3, 0};
+  const int attribs[] = {OSMESA_FORMAT,
+                         OSMESA_RGBA,
+                         OSMESA_PROFILE,
+                         OSMESA_CORE_PROFILE,
+                         OSMESA_CONTEXT_MAJOR_VERSION,
+                         3,
+                         OSMESA_CONTEXT_MINOR_VERSION,
+                         3,
+                         0};
   OSMesaContext ctx = OSMesaCreateContextAttribs(attribs, nullptr);
   if (!ctx || !OSMesaMakeCurrent(ctx, window.data(), GL_UNSIGNED_BYTE, 64, 64)) {
     std::fprintf(stderr, "consumer: no OpenGL 3.3 core context\n");
@@ -206,13 +213,14 @@ int main(int argc, char** argv) {
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 
   const double waterShare = double(water) / double(kViewW * kViewH);
-  std::printf("consumer: %zu particles, state %s, water %.1f %% of the liquid view (%dx%d)\n",
-              reloaded.particleCount(), sph2d::hex64(reloaded.stateHash()).c_str(), 100.0 * waterShare, kViewW, kViewH);
+  std::printf("consumer: %zu particles, state %s, water %.1f %% of the liquid view (%dx%d)\n", reloaded.particleCount(),
+              sph2d::hex64(reloaded.stateHash()).c_str(), 100.0 * waterShare, kViewW, kViewH);
   std::printf("consumer: crate at y = %.3f m after %d frames: %s\n", crateY, kFrames, afloat ? "afloat" : "NOT afloat");
   std::printf("consumer: the paddle stirs the %zu particles within 0.2 m of its axis at a mean %.3f m/s: %s\n",
               around.size(), stirred, pushed ? "pushed" : "NOT pushed");
-  std::printf("consumer: saved at frame %d and reloaded: state %s the uninterrupted World's; %zu of %zu particles keep their team colour\n",
-              kSaveAt, sameState ? "equal to" : "DIFFERENT from", dyed, reloaded.particleCount());
+  std::printf(
+      "consumer: saved at frame %d and reloaded: state %s the uninterrupted World's; %zu of %zu particles keep their team colour\n",
+      kSaveAt, sameState ? "equal to" : "DIFFERENT from", dyed, reloaded.particleCount());
   std::printf("consumer: drawn into the game's own context (%s): team pixels red %zu, yellow %zu; game state %s\n",
               renderer.c_str(), red, yellow, stateKept ? "kept" : "CHANGED");
   std::printf("consumer: %.2f s\n", seconds);

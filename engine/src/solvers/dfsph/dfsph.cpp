@@ -286,19 +286,22 @@ std::size_t Dfsph::integrate(StepContext& c) {
 
 /// dfsph's registration (solvers.def) and its parameters.
 SolverInfo dfsphSolver() {
-  return {"dfsph",
-          {{"tolerance", 0.001, 1e-6, 0.1,
-            "largest mean predicted density error |ρ* − ρ0|/ρ0 the pressure solve accepts (compression only where κ = 0)"},
-           {"divergence_tolerance", 1e-4, 1e-8, 1,
-            "largest mean |Dρ/Dt|·dt/ρ0 (the density change one substep's divergence error makes) the divergence-free solve accepts (compression only where κ_v = 0)"},
-           {"max_iterations", 100, 1, 10000, "iterations per solve at most (each solve separately)"},
-           {"min_iterations", 2, 0, 10000, "iterations per solve at least"},
-           {"relaxation", 0.5, 0.05, 1, "Jacobi relaxation ω of both solves (κ increments are ω times the diagonal estimate)"},
-           {"chebyshev_rho", 0.98, 0, 0.999,
-            "Chebyshev acceleration of both solves (Wang 2015) with this spectral radius estimate; 0: plain relaxed Jacobi"},
-           {"velocity_cfl", 0.4, 0.01, 1, "dt ≤ velocity_cfl·R/v_max (dfsph does not read solver.cfl, the CFL number on c + v_max)"},
-           {"divergence_solve", 1, 0, 1, "1: run the divergence-free solve each substep; 0: constant-density solve only"}},
-          [](const SolverDef& d) -> std::unique_ptr<Solver> { return std::make_unique<Dfsph>(d); }};
+  return {
+      "dfsph",
+      {{"tolerance", 0.001, 1e-6, 0.1,
+        "largest mean predicted density error |ρ* − ρ0|/ρ0 the pressure solve accepts (compression only where κ = 0)"},
+       {"divergence_tolerance", 1e-4, 1e-8, 1,
+        "largest mean |Dρ/Dt|·dt/ρ0 (the density change one substep's divergence error makes) the divergence-free solve accepts (compression only where κ_v = 0)"},
+       {"max_iterations", 100, 1, 10000, "iterations per solve at most (each solve separately)"},
+       {"min_iterations", 2, 0, 10000, "iterations per solve at least"},
+       {"relaxation", 0.5, 0.05, 1,
+        "Jacobi relaxation ω of both solves (κ increments are ω times the diagonal estimate)"},
+       {"chebyshev_rho", 0.98, 0, 0.999,
+        "Chebyshev acceleration of both solves (Wang 2015) with this spectral radius estimate; 0: plain relaxed Jacobi"},
+       {"velocity_cfl", 0.4, 0.01, 1,
+        "dt ≤ velocity_cfl·R/v_max (dfsph does not read solver.cfl, the CFL number on c + v_max)"},
+       {"divergence_solve", 1, 0, 1, "1: run the divergence-free solve each substep; 0: constant-density solve only"}},
+      [](const SolverDef& d) -> std::unique_ptr<Solver> { return std::make_unique<Dfsph>(d); }};
 }
 
 }  // namespace sph2d

@@ -205,13 +205,13 @@ class Dfsph final : public Solver {
   int maxIt_, minIt_;
   bool divSolve_;
   Real omega_;
-  Real cheb_;                            ///< Chebyshev ρ (0: plain relaxed Jacobi)
-  Real cfl_;                             ///< dt ≤ cfl_·R/v_max
-  static constexpr int kChebDelay = 5;   ///< plain iterations before the acceleration starts
-  static constexpr Real kKneeDensity = Real(1.1);   ///< beyond ρ = 1.1 ρ0 the Jacobi step shrinks as 1.1 ρ0/ρ
-  static constexpr Real kPushoutSpeed = Real(3);    ///< [m/s] existing compression is removed at most this fast
-  std::vector<Vec2> vPrev_;              ///< velocity before the last iteration (Chebyshev)
-  std::vector<Real> kPrev_;              ///< κ before the last iteration (Chebyshev)
+  Real cheb_;                                      ///< Chebyshev ρ (0: plain relaxed Jacobi)
+  Real cfl_;                                       ///< dt ≤ cfl_·R/v_max
+  static constexpr int kChebDelay = 5;             ///< plain iterations before the acceleration starts
+  static constexpr Real kKneeDensity = Real(1.1);  ///< beyond ρ = 1.1 ρ0 the Jacobi step shrinks as 1.1 ρ0/ρ
+  static constexpr Real kPushoutSpeed = Real(3);   ///< [m/s] existing compression is removed at most this fast
+  std::vector<Vec2> vPrev_;                        ///< velocity before the last iteration (Chebyshev)
+  std::vector<Real> kPrev_;                        ///< κ before the last iteration (Chebyshev)
   /// One neighbour entry of an iteration: the neighbour's slot and m∇W_ij.
   struct Pair {
     std::uint32_t j;
@@ -226,27 +226,28 @@ class Dfsph final : public Solver {
     std::uint32_t body;
     Real gx, gy, t;
   };
-  double bodyErr_ = 0;                    ///< sourceMean(): the mean residual beside the dynamic bodies (0: none)
-  bool moving_ = false;                   ///< this substep has moving bodies' samples (BodySamples::active)
+  double bodyErr_ = 0;                          ///< sourceMean(): the mean residual beside the dynamic bodies (0: none)
+  bool moving_ = false;                         ///< this substep has moving bodies' samples (BodySamples::active)
   std::vector<std::vector<MovTerm>> movTerms_;  ///< per block, particles in order
   std::vector<std::uint32_t> movStart_, movCount_;  ///< particle i's MovTerms in its block
-  std::vector<Real> movSrc_;              ///< Σ_b ρ0Ψ_b∇W_ib·v_b over the moving samples
-  std::vector<double> qAcc_, qAccPrev_;   ///< Q_i of this solve so far (and at the previous iterate)
-  std::vector<double> invMass_, invInertia_;  ///< per placed body (0: kinematic)
-  std::vector<Vec2d> dv_, dvBase_;        ///< per body: ΔV so far in the substep, and before this solve
-  std::vector<double> dw_, dwBase_;       ///< … and Δω
-  std::vector<double> sumG_;              ///< lumpBodies(): Σ_i |G_ik| per body
-  std::vector<double> sumT_;              ///< … and Σ_i |T_ik|
-  std::vector<Vec2d> blockG_;             ///< per block and body: Σ_i Q_i G_ik (block-major)
-  std::vector<double> blockT_;            ///< … and Σ_i Q_i T_ik
-  std::vector<Real> alpha_;              ///< the DFSPH factor α_i
-  std::vector<Real> dk_;                 ///< this iteration's κ increment
-  std::vector<Real> q_;                  ///< dk_/ρ
+  std::vector<Real> movSrc_;                        ///< Σ_b ρ0Ψ_b∇W_ib·v_b over the moving samples
+  std::vector<double> qAcc_, qAccPrev_;             ///< Q_i of this solve so far (and at the previous iterate)
+  std::vector<double> invMass_, invInertia_;        ///< per placed body (0: kinematic)
+  std::vector<Vec2d> dv_, dvBase_;                  ///< per body: ΔV so far in the substep, and before this solve
+  std::vector<double> dw_, dwBase_;                 ///< … and Δω
+  std::vector<double> sumG_;                        ///< lumpBodies(): Σ_i |G_ik| per body
+  std::vector<double> sumT_;                        ///< … and Σ_i |T_ik|
+  std::vector<Vec2d> blockG_;                       ///< per block and body: Σ_i Q_i G_ik (block-major)
+  std::vector<double> blockT_;                      ///< … and Σ_i Q_i T_ik
+  std::vector<Real> alpha_;                         ///< the DFSPH factor α_i
+  std::vector<Real> dk_;                            ///< this iteration's κ increment
+  std::vector<Real> q_;                             ///< dk_/ρ
   SolverStats stats_;
-  mutable std::vector<Real> topScratch_;  ///< depths(): the highest particle per strip (reused: maxTimeStep runs it every substep)
+  mutable std::vector<Real>
+      topScratch_;       ///< depths(): the highest particle per strip (reused: maxTimeStep runs it every substep)
   bool closed_ = false;  ///< set per substep: no wall, no free surface (both axes periodic, κ of either sign)
-  bool unilateral_;  ///< solver.clamp_negative_pressure: κ ≥ 0 (a free surface); false: κ of either sign
-  Real kMin_;        ///< 0, or −∞ without the clamp
+  bool unilateral_;      ///< solver.clamp_negative_pressure: κ ≥ 0 (a free surface); false: κ of either sign
+  Real kMin_;            ///< 0, or −∞ without the clamp
 };
 
 }  // namespace sph2d

@@ -170,7 +170,9 @@ Dfsph::Sums Dfsph::sourcePass(StepContext& c, const std::vector<Real>& kappa, bo
         }
         return Sums{errSum, srcSum, bodyErr, bodyN};
       },
-      [](Sums a, Sums b) { return Sums{a.err + b.err, a.src + b.src, a.bodyErr + b.bodyErr, a.bodyN + b.bodyN}; });
+      [](Sums a, Sums b) {
+        return Sums{a.err + b.err, a.src + b.src, a.bodyErr + b.bodyErr, a.bodyN + b.bodyN};
+      });
 }
 
 /// Pass B: v_i −= dt [Σ_j (q_i + q_j) m∇W_ij + q_i Σ_b ρ0Ψ_b∇W_ib]; κ_i += dk_i

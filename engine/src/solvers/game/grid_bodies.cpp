@@ -1,8 +1,8 @@
 // The coarse-grid projection's moving bodies (grid_projection.hpp): their cells and faces on
 // the grid, the body across a face, and a dynamic body's row of the coupled pressure system.
-#include "solvers/game/grid_projection.hpp"
 #include "bodies/moving_solid.hpp"
 #include "core/state_io.hpp"
+#include "solvers/game/grid_projection.hpp"
 
 #include <algorithm>
 #include <array>

@@ -1,9 +1,9 @@
 // The coarse-grid projection's pressure system (grid_projection.hpp): assembly, sealed pockets
 // grounded, the right-hand side balanced, and its solve by conjugate gradients preconditioned
 // by MIC(0) on vertical strips (the pressure and the compression-shift systems).
-#include "solvers/game/grid_projection.hpp"
 #include "bodies/moving_solid.hpp"
 #include "core/state_io.hpp"
+#include "solvers/game/grid_projection.hpp"
 
 #include <algorithm>
 #include <array>
@@ -55,7 +55,8 @@ void GridProjection::assemble() {
         // layer its reading differs by a tenth of a cell, and that difference drives a flow).
         const double ya = (double(J0_ + j) + 0.5) * double(h_);
         const Real ytop = std::max(top_[std::size_t(k)], top_[std::size_t(nb[q])]);
-        const Real theta = std::clamp(Real((double(ytop) + 0.5 * double(dx_) - ya) * double(invH_)), kMinSurfaceFraction, Real(1));
+        const Real theta =
+            std::clamp(Real((double(ytop) + 0.5 * double(dx_) - ya) * double(invH_)), kMinSurfaceFraction, Real(1));
         dg += Real(1) / theta;
         thetaUp_[std::size_t(k)] = theta;
         vented_[a] = 1;
@@ -266,7 +267,8 @@ void GridProjection::apply(const std::vector<Real>& in, std::vector<Real>& out, 
   // impulse Gᵀκ moves a body by M⁻¹Gᵀκ, which changes the flux through its faces by G·that.
   bodySum_.assign(3 * bodies_.size(), 0.0);
   for (const Coupling& e : coupling_)
-    for (int q = 0; q < 3; ++q) bodySum_[3 * std::size_t(e.body) + std::size_t(q)] += e.g[q] * double(in[std::size_t(e.unknown)]);
+    for (int q = 0; q < 3; ++q)
+      bodySum_[3 * std::size_t(e.body) + std::size_t(q)] += e.g[q] * double(in[std::size_t(e.unknown)]);
   for (std::size_t b = 0; b < bodies_.size(); ++b) {
     bodySum_[3 * b + 0] *= couplingScale_ * bodies_[b].invMass;
     bodySum_[3 * b + 1] *= couplingScale_ * bodies_[b].invMass;
@@ -437,7 +439,8 @@ void GridProjection::solve(const StepContext& c) {
     std::vector<double>& J = bodyImpulse_;
     J.assign(3 * bodies_.size(), 0.0);
     for (const Coupling& e : coupling_)
-      for (int q = 0; q < 3; ++q) J[3 * std::size_t(e.body) + std::size_t(q)] += e.g[q] * double(x[std::size_t(e.unknown)]);
+      for (int q = 0; q < 3; ++q)
+        J[3 * std::size_t(e.body) + std::size_t(q)] += e.g[q] * double(x[std::size_t(e.unknown)]);
     const double f = double(c.rho0) * double(h_) * double(dt);
     const double tau0 = c.time - c.solids->time0;
     for (std::size_t b = 0; b < bodies_.size(); ++b) {

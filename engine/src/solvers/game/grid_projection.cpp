@@ -43,7 +43,9 @@ void GridProjection::layout(const StepContext& c) {
         }
         return r;
       },
-      [](Box a, Box q) { return Box{std::min(a.x0, q.x0), std::min(a.y0, q.y0), std::max(a.x1, q.x1), std::max(a.y1, q.y1)}; });
+      [](Box a, Box q) {
+        return Box{std::min(a.x0, q.x0), std::min(a.y0, q.y0), std::max(a.x1, q.x1), std::max(a.y1, q.y1)};
+      });
   h_ = cellRatio_ * c.dx;
   // Spray far from the bulk must not make the grid huge: above the budget the cells grow.
   const double budget = std::max(16.0 * double(n), 4096.0);
@@ -74,7 +76,8 @@ void GridProjection::resetCells() {
 
 void GridProjection::resetFaces(int axis) {
   // One axis's face velocities, weights and changes.
-  const std::size_t faces = axis == 0 ? std::size_t(nx_ + 1) * std::size_t(ny_) : std::size_t(nx_) * std::size_t(ny_ + 1);
+  const std::size_t faces =
+      axis == 0 ? std::size_t(nx_ + 1) * std::size_t(ny_) : std::size_t(nx_) * std::size_t(ny_ + 1);
   for (std::vector<Real>* f : axis == 0 ? std::array<std::vector<Real>*, 4>{&u_, &uw_, &du_, &uNew_}
                                         : std::array<std::vector<Real>*, 4>{&v_, &vw_, &dv_, &vNew_})
     f->assign(faces, 0);
@@ -96,8 +99,8 @@ std::uint8_t GridProjection::cacheEntry(const StepContext& c, long I, long J) {
 void GridProjection::classify(const StepContext& c) {
   // The cache covers the grid plus one cell (the right and top faces of the last cells).
   const std::uint64_t version = c.boundaryVersion ^ std::uint64_t(std::lround(double(h_) * 1e9));
-  const bool covers = cacheValid_ && I0_ >= cI0_ && J0_ >= cJ0_ && I0_ + nx_ + 1 <= cI0_ + cnx_ &&
-                      J0_ + ny_ + 1 <= cJ0_ + cny_;
+  const bool covers =
+      cacheValid_ && I0_ >= cI0_ && J0_ >= cJ0_ && I0_ + nx_ + 1 <= cI0_ + cnx_ && J0_ + ny_ + 1 <= cJ0_ + cny_;
   if (!cacheValid_ || version != cacheVersion_) {
     cacheValid_ = true;
     cacheVersion_ = version;
@@ -108,7 +111,8 @@ void GridProjection::classify(const StepContext& c) {
     cache_.assign(std::size_t(cnx_) * cny_, 0);
   } else if (!covers) {  // grow to the union (with room), keeping what is known
     const long nI0 = std::min(cI0_, I0_ - nx_ / 2), nJ0 = std::min(cJ0_, J0_ - ny_ / 2);
-    const long nI1 = std::max(cI0_ + cnx_, I0_ + nx_ + 1 + nx_ / 2), nJ1 = std::max(cJ0_ + cny_, J0_ + ny_ + 1 + ny_ / 2);
+    const long nI1 = std::max(cI0_ + cnx_, I0_ + nx_ + 1 + nx_ / 2),
+               nJ1 = std::max(cJ0_ + cny_, J0_ + ny_ + 1 + ny_ / 2);
     std::vector<std::uint8_t> grown(std::size_t(nI1 - nI0) * std::size_t(nJ1 - nJ0), 0);
     for (int j = 0; j < cny_; ++j)
       for (int i = 0; i < cnx_; ++i)
@@ -127,7 +131,7 @@ void GridProjection::classify(const StepContext& c) {
     return (e & 1) ? e : cacheEntry(c, I0_ + i, J0_ + j);
   };
   const Real full = cellRatio_ * cellRatio_;  // particle weight of a full cell
-  for (int j = 1; j + 1 < ny_; ++j)  // border cells stay air (solid neighbours are marked below)
+  for (int j = 1; j + 1 < ny_; ++j)           // border cells stay air (solid neighbours are marked below)
     for (int i = 1; i + 1 < nx_; ++i) {
       const std::size_t k = std::size_t(j) * nx_ + i;
       if (!(w_[k] > 0)) continue;  // empty cells stay air
@@ -194,8 +198,10 @@ void GridProjection::splatFaces(const StepContext& c, int axis) {
   std::vector<Real>& fw = axis == 0 ? uw_ : vw_;
   for (std::size_t p = 0; p < P.size(); ++p) {
     const Real px = P.x[p].x() * invH_ - Real(I0_), py = P.x[p].y() * invH_ - Real(J0_);
-    if (axis == 0) splat(f.data(), fw, nx_ + 1, px, py - Real(0.5), P.v[p].x());  // u faces at (i, j + 1/2)
-    else splat(f.data(), fw, nx_, px - Real(0.5), py, P.v[p].y());                 // v faces at (i + 1/2, j)
+    if (axis == 0)
+      splat(f.data(), fw, nx_ + 1, px, py - Real(0.5), P.v[p].x());  // u faces at (i, j + 1/2)
+    else
+      splat(f.data(), fw, nx_, px - Real(0.5), py, P.v[p].y());  // v faces at (i + 1/2, j)
   }
   for (std::size_t k = 0; k < f.size(); ++k)
     if (fw[k] > 0) f[k] /= fw[k];

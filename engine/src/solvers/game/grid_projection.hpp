@@ -53,7 +53,8 @@ class StateIn;
 /// conserving liquids", IEEE TVCG: a second Poisson solve whose gradient moves positions, not
 /// velocities): off when `rate` is 0.
 struct GridShift {
-  Real rate = 0;   ///< share of a cell's compression (particle weight over a full cell's, − 1, above `above`) removed per substep
+  Real rate = 0;   ///< share of a cell's compression (particle weight over a full cell's, − 1, above `above`) removed
+                   ///< per substep
   Real above = 0;  ///< compression a cell keeps (left to the particle solve)
   Real tolerance = 0.01;  ///< the solve stops when its largest residual stands for this density change
   /// Share of an interior cell's deficit (1 − its particle weight over a full cell's, above
@@ -67,10 +68,10 @@ struct GridShift {
 
 /// What one projection did.
 struct GridProjectionStats {
-  int iterations = 0;       ///< conjugate-gradient iterations (the pressure's and the shift's solves)
-  int fluidCells = 0;       ///< unknowns
-  double residual = 0;      ///< largest |Δρ/ρ0| the pressure solve's remaining residual stands for over the substep
-  int pockets = 0;          ///< sealed pockets grounded (fluid regions with no open face to air and no dynamic body)
+  int iterations = 0;   ///< conjugate-gradient iterations (the pressure's and the shift's solves)
+  int fluidCells = 0;   ///< unknowns
+  double residual = 0;  ///< largest |Δρ/ρ0| the pressure solve's remaining residual stands for over the substep
+  int pockets = 0;      ///< sealed pockets grounded (fluid regions with no open face to air and no dynamic body)
 };
 
 class GridProjection {
@@ -159,7 +160,7 @@ class GridProjection {
   Vec2 clampToFaces(const Vec2& vp, const Vec2& v0, const FaceWeights& w) const;
 
  public:
-  Real pic_ = 0;  ///< share of the projected grid velocity given to the particles (PIC; the rest FLIP)
+  Real pic_ = 0;          ///< share of the projected grid velocity given to the particles (PIC; the rest FLIP)
   bool surface_ = false;  ///< ghost-fluid free surface at the fill level (else at the air cells' centres)
   /// grid_flip_clamp: a particle's new speed stays within its old one or what the projected
   /// velocities of the faces it samples reach (grid_projection.cpp, clampToFaces).
@@ -181,29 +182,30 @@ class GridProjection {
   Real h_ = 0, invH_ = 0;
   long I0_ = 0, J0_ = 0;  ///< anchored index of cell (0, 0)
   int nx_ = 0, ny_ = 0;
-  std::vector<std::uint8_t> type_;          ///< per cell
-  std::vector<std::uint8_t> uOpen_, vOpen_;  ///< per face: flow may cross it
+  std::vector<std::uint8_t> type_;             ///< per cell
+  std::vector<std::uint8_t> uOpen_, vOpen_;    ///< per face: flow may cross it
   std::vector<std::uint8_t> fluidU_, fluidV_;  ///< per face: next to a fluid cell (its change is known)
-  std::vector<Real> w_, comp_;              ///< per cell: particle weight, weighted compression
-  std::vector<Real> top_;                   ///< per cell: its highest particle's y (the ghost surface only)
-  std::vector<Real> thetaUp_;               ///< per cell: where the ghost surface lies above it, in cells (1: none)
-  Real dx_ = 0;                             ///< the particle spacing
-  std::vector<Real> u_, uw_, v_, vw_;       ///< face velocities and weights
-  std::vector<Real> du_, dv_;               ///< face velocity changes
-  std::vector<Real> uNew_, vNew_;           ///< projected face velocities (for the PIC share)
+  std::vector<Real> w_, comp_;                 ///< per cell: particle weight, weighted compression
+  std::vector<Real> top_;                      ///< per cell: its highest particle's y (the ghost surface only)
+  std::vector<Real> thetaUp_;                  ///< per cell: where the ghost surface lies above it, in cells (1: none)
+  Real dx_ = 0;                                ///< the particle spacing
+  std::vector<Real> u_, uw_, v_, vw_;          ///< face velocities and weights
+  std::vector<Real> du_, dv_;                  ///< face velocity changes
+  std::vector<Real> uNew_, vNew_;              ///< projected face velocities (for the PIC share)
   std::vector<Real> kappa_, rhs_, x_, diag_;
   CgWork cgMain_, cgShift_;
   GridShift shiftDef_;
-  std::vector<Real> kappaS_, rhsS_, xs_, su_, sv_;  ///< the shift's potential (per cell; right-hand side and unknowns) and face moves
-  std::vector<Vec2> shift_;                 ///< per particle
-  std::vector<std::int32_t> index_;         ///< cell → unknown (−1: none)
-  std::vector<std::int32_t> cells_;         ///< unknown → cell
-  std::vector<std::int32_t> adj_;           ///< per unknown: left, right, down, up unknown (−1: none)
-  std::vector<std::int32_t> nbrPad_;        ///< adj_ with m for none (applyDot reads a 0 there)
-  std::vector<Real> precon_, precon2_;      ///< MIC(0) factor: 1/diag(L), and its square
-  std::vector<std::int32_t> rowStart_;      ///< per grid row: its first unknown (ny + 1 entries, the last m)
-  std::vector<std::uint8_t> vented_;        ///< per unknown: an open face to air (then per region root: the region has one)
-  std::vector<std::int32_t> pocketOf_;      ///< per unknown: its sealed pocket (−1: a vented region)
+  std::vector<Real> kappaS_, rhsS_, xs_, su_,
+      sv_;                            ///< the shift's potential (per cell; right-hand side and unknowns) and face moves
+  std::vector<Vec2> shift_;           ///< per particle
+  std::vector<std::int32_t> index_;   ///< cell → unknown (−1: none)
+  std::vector<std::int32_t> cells_;   ///< unknown → cell
+  std::vector<std::int32_t> adj_;     ///< per unknown: left, right, down, up unknown (−1: none)
+  std::vector<std::int32_t> nbrPad_;  ///< adj_ with m for none (applyDot reads a 0 there)
+  std::vector<Real> precon_, precon2_;  ///< MIC(0) factor: 1/diag(L), and its square
+  std::vector<std::int32_t> rowStart_;  ///< per grid row: its first unknown (ny + 1 entries, the last m)
+  std::vector<std::uint8_t> vented_;    ///< per unknown: an open face to air (then per region root: the region has one)
+  std::vector<std::int32_t> pocketOf_;  ///< per unknown: its sealed pocket (−1: a vented region)
   std::vector<std::int32_t> pocketCells_, pocketLast_;  ///< per pocket: its cell count, its grounded (last) unknown
   // Warm start: the last substep's κ by anchored cell.
   Real pH_ = 0;  ///< the cell size of prevKappa_
@@ -232,10 +234,10 @@ class GridProjection {
   struct Coupling {
     std::int32_t unknown;  ///< the fluid cell's unknown
     std::int32_t body;
-    double g[3];           ///< Σ over its faces into the body of (n_x, n_y, r × n)
+    double g[3];  ///< Σ over its faces into the body of (n_x, n_y, r × n)
   };
-  std::vector<Coupling> coupling_;  ///< in unknown order
-  double couplingScale_ = 0;        ///< ρ0 h²
+  std::vector<Coupling> coupling_;       ///< in unknown order
+  double couplingScale_ = 0;             ///< ρ0 h²
   mutable std::vector<double> bodySum_;  ///< apply()'s scratch: Gᵀ·in per body (the main solve only)
   std::vector<std::uint8_t> bodyCells_;  ///< markBodies' scratch: one body's cells over its box
   std::vector<double> bodyImpulse_;      ///< solve()'s scratch: each body's impulse Gᵀκ

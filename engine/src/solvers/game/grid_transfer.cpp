@@ -1,9 +1,9 @@
 // The coarse-grid projection's way back to the particles (grid_projection.hpp): face weights
 // and samples, extrapolation past the fluid, the compression shift's moves, and the FLIP/PIC
 // transfer of the velocity change (with the static walls' impulse and the optional clamp).
-#include "solvers/game/grid_projection.hpp"
 #include "bodies/moving_solid.hpp"
 #include "core/state_io.hpp"
+#include "solvers/game/grid_projection.hpp"
 
 #include <algorithm>
 #include <array>
@@ -130,11 +130,12 @@ std::size_t GridProjection::transferToParticles(StepContext& c) {
             const std::size_t kl = std::size_t(j) * nx_ + i - 1, kr = kl + 1;
             const bool solidSide = type_[kl] == kSolid || type_[kr] == kSolid;
             const int body = solidSide ? -1 : bodyAcross(kl, kr);
-            du_[f] = body >= 0                    ? bodyFaceVelocity(body, 0, i, j) - u_[f]  // a moving body's face
+            du_[f] = body >= 0                 ? bodyFaceVelocity(body, 0, i, j) - u_[f]  // a moving body's face
                      : uOpen_[f] && !solidSide ? -dt * (kap(i, j) - kap(i - 1, j)) * invH_
                                                : -u_[f];
             if (countWall && body < 0 && !(uOpen_[f] && !solidSide))
-              wallAxis[0] += wallP * (double(kap(i, j)) - double(kap(i - 1, j))) + wallM * double(uw_[f]) * double(du_[f]);
+              wallAxis[0] +=
+                  wallP * (double(kap(i, j)) - double(kap(i - 1, j))) + wallM * double(uw_[f]) * double(du_[f]);
           }
         extrapolate(du_, nu, ny_, fluidU_);
         if (pic_ > 0)  // the projected face velocities (closed faces: 0)
@@ -149,11 +150,12 @@ std::size_t GridProjection::transferToParticles(StepContext& c) {
             const int body = solidSide ? -1 : bodyAcross(kd, ku);
             // Under the ghost surface the gradient spans θ of a cell (the matrix's 1/θ).
             const Real span = surface_ && type_[ku] == kAir ? thetaUp_[kd] : Real(1);
-            dv_[f] = body >= 0                    ? bodyFaceVelocity(body, 1, i, j) - v_[f]
+            dv_[f] = body >= 0                 ? bodyFaceVelocity(body, 1, i, j) - v_[f]
                      : vOpen_[f] && !solidSide ? -dt * (kap(i, j) - kap(i, j - 1)) * invH_ / span
                                                : -v_[f];
             if (countWall && body < 0 && !(vOpen_[f] && !solidSide))
-              wallAxis[1] += wallP * (double(kap(i, j)) - double(kap(i, j - 1))) + wallM * double(vw_[f]) * double(dv_[f]);
+              wallAxis[1] +=
+                  wallP * (double(kap(i, j)) - double(kap(i, j - 1))) + wallM * double(vw_[f]) * double(dv_[f]);
           }
         extrapolate(dv_, nx_, ny_ + 1, fluidV_);
         if (pic_ > 0)
@@ -164,8 +166,10 @@ std::size_t GridProjection::transferToParticles(StepContext& c) {
   if (countWall) c.wall->sum.grid += Vec2d(wallAxis[0], wallAxis[1]);
   ParticleStore& P = c.P;
   const Real vmax2 = c.maxSpeed * c.maxSpeed;
-  if (shifting) shift_.resize(P.size());
-  else shift_.clear();
+  if (shifting)
+    shift_.resize(P.size());
+  else
+    shift_.clear();
   return firstBad(c.pool, P.size(), [&](std::size_t b, std::size_t e) {
     std::size_t bad = kNone;
     for (std::size_t p = b; p < e; ++p) {

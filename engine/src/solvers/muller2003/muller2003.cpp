@@ -52,7 +52,7 @@ std::size_t density(StepContext& c, const Poly6<Real>& W) {
       } else
 #endif
 #ifdef SPH2D_SSE2_PAIRS
-      if (simd) {
+          if (simd) {
         // Four kernel values at a time (the scalar expressions, lane-wise); lanes 0–3 in lo, 4–7 in hi.
         const __m128 xi4 = _mm_set1_ps(xi.x()), yi4 = _mm_set1_ps(xi.y());
         __m128 lo = _mm_setzero_ps(), hi = _mm_setzero_ps();
@@ -67,8 +67,10 @@ std::size_t density(StepContext& c, const Poly6<Real>& W) {
           __m128 w = _mm_mul_ps(_mm_mul_ps(_mm_mul_ps(c4, a), a), a);
           w = _mm_and_ps(_mm_cmpnge_ps(r2, R24), w);  // valueR2: 0 for r² ≥ R²
           w = _mm_and_ps(w, _mm_load_ps(reinterpret_cast<const float*>(kLive4[n])));
-          if (k & 4) hi = _mm_add_ps(hi, w);
-          else lo = _mm_add_ps(lo, w);
+          if (k & 4)
+            hi = _mm_add_ps(hi, w);
+          else
+            lo = _mm_add_ps(lo, w);
         }
         total = laneTotal1(lo, hi);
       } else
@@ -122,8 +124,8 @@ void pressure(StepContext& c) {
 }
 
 template <bool Visc>
-std::size_t pressureForce(StepContext& c, const Spiky<Real>& spiky, const ViscosityTerm& vt, const ImpactViscosity& impact,
-                          std::vector<Vec2d>& wallBlock) {
+std::size_t pressureForce(StepContext& c, const Spiky<Real>& spiky, const ViscosityTerm& vt,
+                          const ImpactViscosity& impact, std::vector<Vec2d>& wallBlock) {
   ParticleStore& P = c.P;
   const BoundarySet& B = c.boundary;
   const bool hasBoundary = !B.samples.empty();
@@ -168,9 +170,9 @@ std::size_t pressureForce(StepContext& c, const Spiky<Real>& spiky, const Viscos
 #ifdef SPH2D_SSE2_PAIRS
     const struct {
       __m128 R, spikyK, halfMass, one, thr, vR2, vR3, lapK, rMin, rMin2, invRMin, nine;
-    } K4 = {_mm_set1_ps(k.R),    _mm_set1_ps(k.spikyK), _mm_set1_ps(k.halfMass), _mm_set1_ps(Real(1)),
-            _mm_set1_ps(k.coincident2), _mm_set1_ps(k.vR2), _mm_set1_ps(k.vR3), _mm_set1_ps(k.lapK),
-            _mm_set1_ps(k.rMin), _mm_set1_ps(k.rMin2), _mm_set1_ps(k.invRMin), _mm_set1_ps(Real(9))};
+    } K4 = {_mm_set1_ps(k.R),           _mm_set1_ps(k.spikyK), _mm_set1_ps(k.halfMass), _mm_set1_ps(Real(1)),
+            _mm_set1_ps(k.coincident2), _mm_set1_ps(k.vR2),    _mm_set1_ps(k.vR3),      _mm_set1_ps(k.lapK),
+            _mm_set1_ps(k.rMin),        _mm_set1_ps(k.rMin2),  _mm_set1_ps(k.invRMin),  _mm_set1_ps(Real(9))};
 #endif
 #ifdef SPH2D_AVX2_PAIRS
     alignas(16) Real runSums[kRun][4];
@@ -197,7 +199,7 @@ std::size_t pressureForce(StepContext& c, const Spiky<Real>& spiky, const Viscos
       } else
 #endif
 #ifdef SPH2D_SSE2_PAIRS
-      if (simd) {
+          if (simd) {
         // Pair k in lane k mod 8 (kSumLanes): lanes 0–3 in lo, 4–7 in hi.
         __m128 lo[4] = {_mm_setzero_ps(), _mm_setzero_ps(), _mm_setzero_ps(), _mm_setzero_ps()};
         __m128 hi[4] = {lo[0], lo[0], lo[0], lo[0]};
@@ -240,7 +242,8 @@ std::size_t pressureForce(StepContext& c, const Spiky<Real>& spiky, const Viscos
             const __m128 fast = _mm_cmpgt_ps(w, _mm_set1_ps(k.impW0));
             if (_mm_movemask_ps(fast) & ((1 << n) - 1)) {
               const __m128 rhoi = _mm_set1_ps(Real(1) / IR[i]);
-              const __m128 sw = _mm_min_ps(_mm_mul_ps(_mm_sub_ps(w, _mm_set1_ps(k.impW0)), _mm_set1_ps(k.impInvW0)), K4.one);
+              const __m128 sw =
+                  _mm_min_ps(_mm_mul_ps(_mm_sub_ps(w, _mm_set1_ps(k.impW0)), _mm_set1_ps(k.impInvW0)), K4.one);
               const __m128 mu = _mm_div_ps(_mm_mul_ps(_mm_set1_ps(k.impH), nv), _mm_add_ps(r2, _mm_set1_ps(k.impEta2)));
               const __m128 f = _mm_div_ps(_mm_mul_ps(_mm_mul_ps(_mm_mul_ps(_mm_set1_ps(k.impK), rhoi), sw), mu),
                                           _mm_add_ps(rhoi, _mm_div_ps(K4.one, irj)));
@@ -252,13 +255,14 @@ std::size_t pressureForce(StepContext& c, const Spiky<Real>& spiky, const Viscos
             const __m128 big = _mm_cmpgt_ps(r2, K4.rMin2);
             const __m128 q = _mm_or_ps(_mm_and_ps(big, sq), _mm_andnot_ps(big, K4.rMin));
             const __m128 iq = _mm_or_ps(_mm_and_ps(big, invr), _mm_andnot_ps(big, K4.invRMin));
-            const __m128 poly = _mm_add_ps(
-                _mm_add_ps(_mm_add_ps(K4.vR3, _mm_mul_ps(K4.vR2, q)), _mm_mul_ps(_mm_mul_ps(K4.R, q), q)),
-                _mm_mul_ps(_mm_mul_ps(_mm_mul_ps(K4.nine, q), q), q));
+            const __m128 poly =
+                _mm_add_ps(_mm_add_ps(_mm_add_ps(K4.vR3, _mm_mul_ps(K4.vR2, q)), _mm_mul_ps(_mm_mul_ps(K4.R, q), q)),
+                           _mm_mul_ps(_mm_mul_ps(_mm_mul_ps(K4.nine, q), q), q));
             __m128 lap = _mm_mul_ps(_mm_mul_ps(K4.lapK, _mm_sub_ps(K4.R, q)), poly);
             lap = _mm_mul_ps(_mm_mul_ps(_mm_mul_ps(lap, iq), iq), iq);
             lap = _mm_and_ps(_mm_cmpnge_ps(r2, K4.vR2), lap);  // r² ≥ R²: 0
-            const __m128 w = _mm_min_ps(_mm_mul_ps(lap, irj), capI4);  // the stability cap (std::min's value for finite lanes)
+            const __m128 w =
+                _mm_min_ps(_mm_mul_ps(lap, irj), capI4);  // the stability cap (std::min's value for finite lanes)
             t[2] = _mm_mul_ps(_mm_sub_ps(vxj, vix4), w);
             t[3] = _mm_mul_ps(_mm_sub_ps(vyj, viy4), w);
           }
@@ -401,11 +405,11 @@ class Muller2003 final : public Solver {
   /// grid → neighbours → density (poly6) → pressure → pressure_force (spiky) → effects → force_limit → integrate;
   /// with a folded viscosity, pressure_force+viscosity and the effects without it.
   std::vector<Stage> stages(bool) override {
-    std::vector<Stage> s = explicitStages([](StepContext& c) { return density(c, Poly6<Real>(c.R)); }, pressure,
-                                          [this](StepContext& c) {
-                                            return pressureForce<false>(c, Spiky<Real>(c.R), ViscosityTerm{}, impact_,
-                                                                        wallBlock_);
-                                          });
+    std::vector<Stage> s =
+        explicitStages([](StepContext& c) { return density(c, Poly6<Real>(c.R)); }, pressure,
+                       [this](StepContext& c) {
+                         return pressureForce<false>(c, Spiky<Real>(c.R), ViscosityTerm{}, impact_, wallBlock_);
+                       });
     if (Effect* v = viscosity_) {
       for (Stage& st : s)
         if (st.name == "pressure_force") {
@@ -421,7 +425,7 @@ class Muller2003 final : public Solver {
  private:
   double c_;
   ImpactViscosity impact_;        ///< impact_alpha, impact_speed (impact_viscosity.hpp)
-  Effect* viscosity_ = nullptr;  ///< the folded viscosity effect (foldViscosity), or null
+  Effect* viscosity_ = nullptr;   ///< the folded viscosity effect (foldViscosity), or null
   std::vector<Vec2d> wallBlock_;  ///< per block of kBlock particles, Σ of the walls' acceleration
 };
 
@@ -430,8 +434,9 @@ class Muller2003 final : public Solver {
 /// muller2003's registration (solvers.def): its parameters are the impact viscosity's
 /// (solver.sound_speed is its stiffness).
 SolverInfo muller2003Solver() {
-  return {"muller2003", {kImpactAlphaParam, kImpactSpeedParam},
-          [](const SolverDef& d) -> std::unique_ptr<Solver> { return std::make_unique<Muller2003>(d); }};
+  return {"muller2003", {kImpactAlphaParam, kImpactSpeedParam}, [](const SolverDef& d) -> std::unique_ptr<Solver> {
+            return std::make_unique<Muller2003>(d);
+          }};
 }
 
 }  // namespace sph2d

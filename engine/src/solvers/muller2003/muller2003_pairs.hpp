@@ -80,7 +80,7 @@ inline Real laneTotal(const Real s[kSumLanes]) {
 #ifdef SPH2D_SSE2_PAIRS
 /// laneTotal of one sum whose lanes 0–3 are lo and 4–7 hi.
 inline Real laneTotal1(__m128 lo, __m128 hi) {
-  const __m128 a = _mm_add_ps(lo, hi);                // a_q = s_q + s_{q+4}
+  const __m128 a = _mm_add_ps(lo, hi);                  // a_q = s_q + s_{q+4}
   const __m128 b = _mm_add_ps(a, _mm_movehl_ps(a, a));  // a0 + a2, a1 + a3
   return _mm_cvtss_f32(_mm_add_ss(b, _mm_shuffle_ps(b, b, _MM_SHUFFLE(1, 1, 1, 1))));
 }
@@ -89,8 +89,8 @@ inline Real laneTotal1(__m128 lo, __m128 hi) {
 #ifdef SPH2D_AVX2_PAIRS
 /// Σ_j W(|x_i − x_j|) over slot i's list, eight pairs at a time (AVX2, chosen at run time):
 /// the scalar valueR2 lane for lane, pair k in lane k mod 8 (kSumLanes); no periodic axis.
-__attribute__((target("avx2"))) Real densitySum8(const Vec2* X, const Vec2& xi, const std::uint32_t* nb, std::uint32_t cnt,
-                                                 const Poly6<Real>& W) {
+__attribute__((target("avx2"))) Real densitySum8(const Vec2* X, const Vec2& xi, const std::uint32_t* nb,
+                                                 std::uint32_t cnt, const Poly6<Real>& W) {
   const __m256 xi8 = _mm256_set1_ps(xi.x()), yi8 = _mm256_set1_ps(xi.y());
   const __m256 R28 = _mm256_set1_ps(W.R2), c8 = _mm256_set1_ps(W.c);
   const __m256i iota = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
@@ -98,7 +98,8 @@ __attribute__((target("avx2"))) Real densitySum8(const Vec2* X, const Vec2& xi, 
   for (std::uint32_t k = 0; k < cnt; k += 8) {
     const std::uint32_t n = std::min<std::uint32_t>(8, cnt - k);
     std::uint32_t j[8];
-    for (std::uint32_t l = 0; l < 8; ++l) j[l] = nb[std::min(k + l, cnt - 1)];  // missing lanes repeat the last (zeroed)
+    for (std::uint32_t l = 0; l < 8; ++l)
+      j[l] = nb[std::min(k + l, cnt - 1)];  // missing lanes repeat the last (zeroed)
     __m256 xj, yj;
     gather8(X, j, xj, yj);
     const __m256 dx = _mm256_sub_ps(xi8, xj), dy = _mm256_sub_ps(yi8, yj);
@@ -139,8 +140,8 @@ struct PairConstants {
 /// pressure part, Π = α(w) c μ̄ 2/(ρ_i + ρ_j), μ̄ = h (−v_ij·x_ij)/(r² + 0.01h²), written into
 /// the force density as ρ_i m Π ∇W (impK = 2 m α c, so ρ_i impK s μ̄/(ρ_i + ρ_j)).
 template <bool Visc>
-inline void pairTermScalar(const StepContext& c, const PairConstants& k, std::size_t i, std::uint32_t j, Real pi, Real vix,
-                           Real viy, Real out[4]) {
+inline void pairTermScalar(const StepContext& c, const PairConstants& k, std::size_t i, std::uint32_t j, Real pi,
+                           Real vix, Real viy, Real out[4]) {
   const Real* IR = c.P.invRho.data();
   const Real* POR = c.P.pOverRho.data();
   Real dx, dy, r2;
@@ -157,7 +158,7 @@ inline void pairTermScalar(const StepContext& c, const PairConstants& k, std::si
   if (k.impact) {
     const Vec2* V = c.P.v.data();
     const Real nv = -((vix - V[j].x()) * dx + (viy - V[j].y()) * dy);  // −v_ij·x_ij
-    const Real w = nv * invr;                                            // approach speed
+    const Real w = nv * invr;                                          // approach speed
     if (w > k.impW0) {
       const Real rhoi = Real(1) / IR[i];
       const Real s = std::min((w - k.impW0) * k.impInvW0, Real(1));
@@ -208,7 +209,7 @@ void pairSumsScalar(const StepContext& c, const PairConstants& k, std::size_t i,
 /// laneTotal of four sums at once: lo holds lanes 0–3 and hi lanes 4–7 of {fpx, fpy, fvx, fvy}.
 inline void laneTotals4(__m128 lo[4], const __m128 hi[4], Real* sums) {
   for (int l = 0; l < 4; ++l) lo[l] = _mm_add_ps(lo[l], hi[l]);  // a_q = s_q + s_{q+4}
-  _MM_TRANSPOSE4_PS(lo[0], lo[1], lo[2], lo[3]);                // row q = a_q of the four sums
+  _MM_TRANSPOSE4_PS(lo[0], lo[1], lo[2], lo[3]);                 // row q = a_q of the four sums
   _mm_store_ps(sums, _mm_add_ps(_mm_add_ps(lo[0], lo[2]), _mm_add_ps(lo[1], lo[3])));
 }
 #endif
@@ -237,7 +238,8 @@ __attribute__((target("avx2"))) void pairSums8(const StepContext& c, const PairC
     for (std::uint32_t kk = 0; kk < cnt; kk += 8) {
       const std::uint32_t n = std::min<std::uint32_t>(8, cnt - kk);
       std::uint32_t j[8];
-      for (std::uint32_t l = 0; l < 8; ++l) j[l] = nb[std::min(kk + l, cnt - 1)];  // missing lanes repeat the last (zeroed)
+      for (std::uint32_t l = 0; l < 8; ++l)
+        j[l] = nb[std::min(kk + l, cnt - 1)];  // missing lanes repeat the last (zeroed)
       __m256 xj, yj;
       gather8(c.P.x.data(), j, xj, yj);
       const __m256 dx = _mm256_sub_ps(xi8, xj), dy = _mm256_sub_ps(yi8, yj);
@@ -276,8 +278,9 @@ __attribute__((target("avx2"))) void pairSums8(const StepContext& c, const PairC
       __m256 vxj = _mm256_setzero_ps(), vyj = _mm256_setzero_ps();
       if (Visc || k.impact) gather8(c.P.v.data(), j, vxj, vyj);
       if (k.impact) {  // pairTermScalar's impact term, lane-wise
-        const __m256 nv = _mm256_sub_ps(_mm256_setzero_ps(), _mm256_add_ps(_mm256_mul_ps(_mm256_sub_ps(vix8, vxj), dx),
-                                                                           _mm256_mul_ps(_mm256_sub_ps(viy8, vyj), dy)));
+        const __m256 nv = _mm256_sub_ps(
+            _mm256_setzero_ps(),
+            _mm256_add_ps(_mm256_mul_ps(_mm256_sub_ps(vix8, vxj), dx), _mm256_mul_ps(_mm256_sub_ps(viy8, vyj), dy)));
         const __m256 w = _mm256_mul_ps(nv, invr);
         const __m256 fast = _mm256_cmp_ps(w, _mm256_set1_ps(k.impW0), _CMP_GT_OQ);
         if (_mm256_movemask_ps(fast) & ((1 << n) - 1)) {
@@ -286,8 +289,9 @@ __attribute__((target("avx2"))) void pairSums8(const StepContext& c, const PairC
               _mm256_min_ps(_mm256_mul_ps(_mm256_sub_ps(w, _mm256_set1_ps(k.impW0)), _mm256_set1_ps(k.impInvW0)), one);
           const __m256 mu =
               _mm256_div_ps(_mm256_mul_ps(_mm256_set1_ps(k.impH), nv), _mm256_add_ps(r2, _mm256_set1_ps(k.impEta2)));
-          const __m256 f = _mm256_div_ps(_mm256_mul_ps(_mm256_mul_ps(_mm256_mul_ps(_mm256_set1_ps(k.impK), rhoi), sw), mu),
-                                         _mm256_add_ps(rhoi, _mm256_div_ps(one, irj)));
+          const __m256 f =
+              _mm256_div_ps(_mm256_mul_ps(_mm256_mul_ps(_mm256_mul_ps(_mm256_set1_ps(k.impK), rhoi), sw), mu),
+                            _mm256_add_ps(rhoi, _mm256_div_ps(one, irj)));
           wp = _mm256_blendv_ps(wp, _mm256_add_ps(wp, _mm256_mul_ps(gs, f)), fast);
         }
       }
@@ -297,9 +301,10 @@ __attribute__((target("avx2"))) void pairSums8(const StepContext& c, const PairC
         const __m256 big = _mm256_cmp_ps(r2, _mm256_set1_ps(k.rMin2), _CMP_GT_OQ);
         const __m256 q = _mm256_blendv_ps(_mm256_set1_ps(k.rMin), sq, big);
         const __m256 iq = _mm256_blendv_ps(_mm256_set1_ps(k.invRMin), invr, big);
-        const __m256 poly = _mm256_add_ps(
-            _mm256_add_ps(_mm256_add_ps(_mm256_set1_ps(k.vR3), _mm256_mul_ps(vR2, q)), _mm256_mul_ps(_mm256_mul_ps(R8, q), q)),
-            _mm256_mul_ps(_mm256_mul_ps(_mm256_mul_ps(_mm256_set1_ps(Real(9)), q), q), q));
+        const __m256 poly =
+            _mm256_add_ps(_mm256_add_ps(_mm256_add_ps(_mm256_set1_ps(k.vR3), _mm256_mul_ps(vR2, q)),
+                                        _mm256_mul_ps(_mm256_mul_ps(R8, q), q)),
+                          _mm256_mul_ps(_mm256_mul_ps(_mm256_mul_ps(_mm256_set1_ps(Real(9)), q), q), q));
         __m256 lap = _mm256_mul_ps(_mm256_mul_ps(_mm256_set1_ps(k.lapK), _mm256_sub_ps(R8, q)), poly);
         lap = _mm256_mul_ps(_mm256_mul_ps(_mm256_mul_ps(lap, iq), iq), iq);
         lap = _mm256_and_ps(_mm256_cmp_ps(r2, vR2, _CMP_NGE_UQ), lap);  // r² ≥ R²: 0

@@ -10,9 +10,9 @@
 #include <cmath>
 #include <limits>
 
+#include "core/state_io.hpp"
 #include "solvers/pbf/pbf.hpp"
 #include "step/stages.hpp"
-#include "core/state_io.hpp"
 
 namespace sph2d {
 
@@ -35,14 +35,16 @@ Pbf::Pbf(const SolverDef& d)
       pushoutSpeed_(Real(d.param("pushout_speed"))),
       maxApproach_(Real(d.param("max_approach"))),
       adaptiveDt_(d.param("adaptive_dt") != 0),
-      quantile_(Real(d.param("speed_quantile"))), moveCap_(Real(d.param("move_cap"))),
-      localIterations_(int(std::lround(d.param("local_iterations")))), resolveEach_(d.param("resolve_each") != 0) {
+      quantile_(Real(d.param("speed_quantile"))),
+      moveCap_(Real(d.param("move_cap"))),
+      localIterations_(int(std::lround(d.param("local_iterations")))),
+      resolveEach_(d.param("resolve_each") != 0) {
   if (d.param("grid_cell") > 0)
-    projection_ = std::make_unique<GridProjection>(Real(d.param("grid_cell")), Real(d.param("grid_fluid_fraction")),
-                                                   Real(d.param("grid_compression_rate")), Real(d.param("grid_tolerance")),
-                                                   int(std::lround(d.param("grid_max_iterations"))),
-                                                   GridShift{Real(d.param("grid_shift")), Real(d.param("grid_shift_above")),
-                                                             Real(d.param("grid_shift_tolerance")), Real(d.param("grid_fill"))});
+    projection_ = std::make_unique<GridProjection>(
+        Real(d.param("grid_cell")), Real(d.param("grid_fluid_fraction")), Real(d.param("grid_compression_rate")),
+        Real(d.param("grid_tolerance")), int(std::lround(d.param("grid_max_iterations"))),
+        GridShift{Real(d.param("grid_shift")), Real(d.param("grid_shift_above")), Real(d.param("grid_shift_tolerance")),
+                  Real(d.param("grid_fill"))});
   if (projection_) projection_->pic_ = Real(d.param("grid_pic"));
   if (projection_) projection_->surface_ = d.param("grid_surface") > 0;
   if (projection_) projection_->flipClamp_ = d.param("grid_flip_clamp") > 0;
@@ -218,8 +220,10 @@ std::size_t Pbf::solve(StepContext& c) {
                 bool a = c.P.rho[i] > limit;
                 const std::uint32_t* nb = c.nbr.of(i);
                 for (std::uint32_t k = 0; k < c.nbr.count[i] && !a; ++k) a = c.P.rho[nb[k]] > limit;
-                if (a) bits |= std::uint64_t(1) << (i - w0);
-                else dLambda_[i] = 0;  // only the listed particles take their step of the full pass
+                if (a)
+                  bits |= std::uint64_t(1) << (i - w0);
+                else
+                  dLambda_[i] = 0;  // only the listed particles take their step of the full pass
               }
               active_.setWord(w0 / 64, bits);
             }
@@ -370,7 +374,8 @@ std::size_t Pbf::predict(StepContext& c, std::vector<Real>& lambda) {
       if (carried) (*carried)[i] = std::max(Real(0), P.rho[i] / c.rho0 - Real(1) - pushout);
       // A move longer than the speed limit allows over the substep is a runaway too (the
       // shift and the sweep move positions without a velocity the speed check would see).
-      if (bad == kNone && (!allFinite(x) || !allFinite(v) || v.squaredNorm() > vmax2 || (x - x0).squaredNorm() > moveMax2))
+      if (bad == kNone &&
+          (!allFinite(x) || !allFinite(v) || v.squaredNorm() > vmax2 || (x - x0).squaredNorm() > moveMax2))
         bad = i;
     }
     if (countWall) wallBlock_[2 * (b / kBlock) + 1] = push;
@@ -389,8 +394,10 @@ void Pbf::addWallMoves(std::size_t blocks, Real omega, bool rotate) {
   }
   for (int q = 0; q < 2; ++q) {
     // Chebyshev (omega ≠ 1): x = x_old + (x_k + d − x_old)·ω, then the sweep's push.
-    const Vec2d combined = omega != Real(1) ? Vec2d(wallMovePrev_[q] + (wallMove_[q] + (q == 0 ? part[0] : Vec2d(0, 0)) - wallMovePrev_[q]) * double(omega))
-                                            : Vec2d(wallMove_[q] + (q == 0 ? part[0] : Vec2d(0, 0)));
+    const Vec2d combined =
+        omega != Real(1) ? Vec2d(wallMovePrev_[q] +
+                                 (wallMove_[q] + (q == 0 ? part[0] : Vec2d(0, 0)) - wallMovePrev_[q]) * double(omega))
+                         : Vec2d(wallMove_[q] + (q == 0 ? part[0] : Vec2d(0, 0)));
     const Vec2d next = combined + (q == 1 ? part[1] : Vec2d(0, 0));
     if (rotate) wallMovePrev_[q] = wallMove_[q];
     wallMove_[q] = next;
@@ -555,7 +562,8 @@ void Pbf::saveState(StateOut& out) const {
 void Pbf::loadState(StateIn& in) {
   const Real limit = in.get<Real>("the solver's step limit");
   const bool grid = in.get<std::uint8_t>("the solver's grid flag") != 0;
-  if (grid != bool(projection_) || !(limit > 0)) throw SaveError("the saved state is malformed: its solver state is not this solver's");
+  if (grid != bool(projection_) || !(limit > 0))
+    throw SaveError("the saved state is malformed: its solver state is not this solver's");
   if (projection_) projection_->loadState(in, std::size_t(1) << 26);  // reads all, then assigns
   dtLimit_ = limit;
 }

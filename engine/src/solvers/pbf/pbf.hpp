@@ -165,14 +165,16 @@ class Pbf final : public Solver {
   /// mean compression. Caches the spiky gradient factor per pair (∇W = gK g d) and
   /// the wall part of ∇_i C_i for correct() (same positions).
   /// With `list` (a local iteration), only the listed particles; the mean is then not updated.
-  std::size_t constraint(StepContext& c, const std::vector<Real>& lambda, const std::vector<std::uint32_t>* list = nullptr);
+  std::size_t constraint(StepContext& c, const std::vector<Real>& lambda,
+                         const std::vector<std::uint32_t>* list = nullptr);
 
   /// x*_i += (m/ρ0) Σ_j (Δλ_i + Δλ_j + s_corr) ∇W_ij + Δλ_i Σ_b Ψ_b ∇W_ib (a gather into
   /// a second buffer), combined with the previous iterate by the Chebyshev weight ω and
   /// swept out of the solids; λ follows the same combination.
   /// With `list` (a local iteration): only the listed particles move, in place (the
   /// pass reads no neighbour position), and without Chebyshev.
-  std::size_t correct(StepContext& c, std::vector<Real>& lambda, Real omega, const std::vector<std::uint32_t>* list = nullptr);
+  std::size_t correct(StepContext& c, std::vector<Real>& lambda, Real omega,
+                      const std::vector<std::uint32_t>* list = nullptr);
 
   /// The pressure reported for particle i: −ρ0 λ_i/dt² of the constraint, plus ρ0 κ of the
   /// grid projection when there is one (it carries the hydrostatic part).
@@ -202,7 +204,8 @@ class Pbf final : public Solver {
   Real tolerance_, toleranceMax_, relaxation_, chebyshev_, tensileK_;
   int tensileN_;
   Real tensileDq_, xsph_, maxDt_, maxMove_, toVelocity_;
-  /// pushout_speed (pbf.hpp, step 4): compression a substep starts with becomes velocity at most this fast [m/s] (0: off).
+  /// pushout_speed (pbf.hpp, step 4): compression a substep starts with becomes velocity at most this fast [m/s] (0:
+  /// off).
   Real pushoutSpeed_;
   /// max_approach: dt ≤ max_approach · R / w, w the fastest approach of two neighbours (field "pbf.approach").
   Real maxApproach_;
@@ -214,15 +217,15 @@ class Pbf final : public Solver {
   /// neighbours to `out`; costs in proportion to the list, not to the particle count.
   void neighbourhood(const StepContext& c, const std::vector<std::uint32_t>& list, const Real* limit,
                      SlotSet& out) const;
-  SlotSet active_;                           ///< the next local iteration's particles, as they are found
-  SlotSet moved_;                            ///< every particle the local phase moved
-  std::vector<std::uint32_t> activeList_;    ///< the particles of a local iteration (sorted)
-  std::vector<std::uint32_t> lastList_;      ///< the particles the last constraint pass of the local phase wrote Δλ for
-  std::vector<std::uint32_t> movedList_;     ///< moved_ listed for the halo pass (sorted)
-  static constexpr std::size_t kLocalBlock = 32;  ///< particles per job of a local iteration (few, clustered)
+  SlotSet active_;                         ///< the next local iteration's particles, as they are found
+  SlotSet moved_;                          ///< every particle the local phase moved
+  std::vector<std::uint32_t> activeList_;  ///< the particles of a local iteration (sorted)
+  std::vector<std::uint32_t> lastList_;    ///< the particles the last constraint pass of the local phase wrote Δλ for
+  std::vector<std::uint32_t> movedList_;   ///< moved_ listed for the halo pass (sorted)
+  static constexpr std::size_t kLocalBlock = 32;       ///< particles per job of a local iteration (few, clustered)
   mutable std::vector<Real> speedScratch_, speedTop_;  ///< robustSpeed(): squared speeds, each block's largest
-  mutable std::vector<Real> depthScratch_;  ///< maxTimeStep(): the highest particle per strip (columnDepths)
-  std::unique_ptr<GridProjection> projection_;  ///< the coarse-grid projection (grid_cell > 0)
+  mutable std::vector<Real> depthScratch_;             ///< maxTimeStep(): the highest particle per strip (columnDepths)
+  std::unique_ptr<GridProjection> projection_;         ///< the coarse-grid projection (grid_cell > 0)
 
   Real d0_ = 0, eps_ = 0, invWdq_ = 0, sCorrScale_ = 0;
   Real meanCompression_ = 0, maxCompression_ = 0;
@@ -238,16 +241,17 @@ class Pbf final : public Solver {
   SolverStats stats_;
   Real dtLimit_ = std::numeric_limits<Real>::infinity();  ///< shortened while the iterations do not converge
   std::vector<Real> dLambda_, lOld_;
-  std::vector<Vec2> wallGrad_;             ///< the boundary part of ∇_i C_i
-  std::vector<double> blockErr_;           ///< compression per block (fixed-order sum)
-  std::vector<Real> blockMax_;             ///< largest compression per block
-  std::vector<double> blockPlainErr_;      ///< … of the plain constraint (pushout_speed's first solve)
+  std::vector<Vec2> wallGrad_;         ///< the boundary part of ∇_i C_i
+  std::vector<double> blockErr_;       ///< compression per block (fixed-order sum)
+  std::vector<Real> blockMax_;         ///< largest compression per block
+  std::vector<double> blockPlainErr_;  ///< … of the plain constraint (pushout_speed's first solve)
   std::vector<Real> blockPlainMax_;
   std::vector<std::vector<Real>> gCache_;  ///< per pair W/wK (final density, XSPH), laid out like NeighbourLists
   struct Grad {
     Real x, y;
   };
-  static_assert(sizeof(Grad) == 2 * sizeof(Real), "a Grad is two packed reals (the constraint stores four pairs at a time)");
+  static_assert(sizeof(Grad) == 2 * sizeof(Real),
+                "a Grad is two packed reals (the constraint stores four pairs at a time)");
   std::vector<std::vector<Grad>> gradCache_;  ///< per pair G_ij = (m/ρ0)∇W_ij of the last constraint pass
   std::vector<Vec2> xNew_, vNew_, xOld_;
   // World::wallImpulse when the moves become velocity (correction_to_velocity > 0; game: 0, so
@@ -257,7 +261,7 @@ class Pbf final : public Solver {
   // velocity() turns them into m·kc·D/dt.
   Vec2d wallMove_[2] = {Vec2d(0, 0), Vec2d(0, 0)};
   Vec2d wallMovePrev_[2] = {Vec2d(0, 0), Vec2d(0, 0)};  ///< … at the iterate xOld_ holds
-  std::vector<Vec2d> wallBlock_;  ///< per block: (wall term, push) partials of the last pass
+  std::vector<Vec2d> wallBlock_;                        ///< per block: (wall term, push) partials of the last pass
   /// Adds the last pass's partials (wallBlock_, `blocks` of them) to wallMove_ through the
   /// Chebyshev weight `omega`; `rotate`: the pass rotated the position buffers (a full pass).
   void addWallMoves(std::size_t blocks, Real omega, bool rotate);

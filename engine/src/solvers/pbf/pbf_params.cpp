@@ -13,7 +13,8 @@ std::vector<SolverParam> pbfParams(bool game) {
   return {
       {"iterations", g(4, 1), 1, 1000, "Jacobi iterations of the density constraint per substep, at least (integer)"},
       {"max_iterations", g(100, 4), 1, 1000, "iterations over all particles per substep, at most (integer)"},
-      {"tolerance", 0.01, 0, 1, "stop once mean(max(ρ/ρ0 − 1, 0)) ≤ this … (0: only when nothing is compressed, so usually `max_iterations`)"},
+      {"tolerance", 0.01, 0, 1,
+       "stop once mean(max(ρ/ρ0 − 1, 0)) ≤ this … (0: only when nothing is compressed, so usually `max_iterations`)"},
       {"tolerance_max", g(0.05, 0.08), 0.001, 10, "… and the largest compression max(ρ/ρ0 − 1) ≤ this"},
       {"local_iterations", g(0, 100), 0, 1000,
        "then at most this many iterations on the particles near a compression above tolerance_max (and their neighbours)"},
@@ -30,7 +31,8 @@ std::vector<SolverParam> pbfParams(bool game) {
       {"max_move", g(1, 6), 0.05, 10, "dt ≤ max_move · R / v_speed: largest move per substep, in support radii"},
       {"speed_quantile", g(0, 0.002), 0, 0.1,
        "v_speed is the speed this share of the particles exceeds (0: the largest): spray does not set the substep"},
-      {"move_cap", g(0, 1.5), 0, 100, "> 0: no particle moves more than move_cap · max_move · R in a substep (its speed is cut)"},
+      {"move_cap", g(0, 1.5), 0, 100,
+       "> 0: no particle moves more than move_cap · max_move · R in a substep (its speed is cut)"},
       {"adaptive_dt", g(1, 0), 0, 1, "1: shorter substeps while max_iterations end above the tolerances"},
       {"correction_to_velocity", g(1, 0), 0, 1, "share of the density correction's move that becomes velocity"},
       {"pushout_speed", g(0.3, 0), 0, 1000,
@@ -38,23 +40,26 @@ std::vector<SolverParam> pbfParams(bool game) {
        "rest is pushed out moving positions only (with correction_to_velocity > 0; 0: no limit)"},
       {"max_approach", g(0.5, 0), 0, 10,
        "dt ≤ max_approach · R / w, w the fastest approach of two neighbours (m/s) at the end of the last substep (0: off)"},
-      {"resolve_each", 1, 0, 1, "1: every correction is swept out of the solids (0: the World's collision after the substep)"},
+      {"resolve_each", 1, 0, 1,
+       "1: every correction is swept out of the solids (0: the World's collision after the substep)"},
       {"grid_cell", g(0, 2), 0, 16, "coarse-grid projection (Hybrid SPH): cell size in spacings (0: none)"},
       {"grid_fluid_fraction", g(0.5, 0.15), 0.01, 1,
        "a grid cell is fluid above this fraction of a full cell's particle weight (low: the surface's cells count, and a pool comes to rest)"},
       {"grid_compression_rate", 0, 0, 1, "share of a grid cell's mean compression its velocity removes per substep"},
       {"grid_shift", g(0, 0.5), 0, 1,
        "share of a grid cell's compression (particle weight over a full cell's, − 1, above grid_shift_above) removed per substep by moving its particles (positions only; Kugelstadt et al. 2019)"},
-      {"grid_shift_above", 0.005, 0, 1,
-       "the compression a cell keeps from the shift (left to the density solve)"},
+      {"grid_shift_above", 0.005, 0, 1, "the compression a cell keeps from the shift (left to the density solve)"},
       {"grid_fill", g(0, 0.5), 0, 1,
        "share of an interior grid cell's deficit (1 − particle weight over a full cell's, above grid_shift_above) closed per substep by the shift's moves: air pockets rise out (interior: four fluid neighbours)"},
-      {"grid_shift_tolerance", 0.01, 1e-7, 1, "the shift's solve: the density change its largest residual may stand for (a correction: looser than grid_tolerance)"},
+      {"grid_shift_tolerance", 0.01, 1e-7, 1,
+       "the shift's solve: the density change its largest residual may stand for (a correction: looser than grid_tolerance)"},
       {"grid_surface", g(0, 1), 0, 1,
        "1: the grid's free surface lies half a spacing above the highest particle (ghost fluid, Gibou et al. 2002: a floating body's draught by Archimedes), 0: at the air cells' centres"},
-      {"grid_tolerance", 1e-3, 1e-7, 1, "grid solve: the density change per substep its largest residual may stand for"},
+      {"grid_tolerance", 1e-3, 1e-7, 1,
+       "grid solve: the density change per substep its largest residual may stand for"},
       {"grid_max_iterations", 200, 1, 10000, "grid solve: conjugate-gradient iterations at most"},
-      {"grid_pic", g(0, 0.05), 0, 1, "share of the projected grid velocity the particles take (PIC; the rest is the FLIP change)"},
+      {"grid_pic", g(0, 0.05), 0, 1,
+       "share of the projected grid velocity the particles take (PIC; the rest is the FLIP change)"},
       {"grid_flip_clamp", 0, 0, 1,
        "1: the transfer makes no particle faster than it was or than the projected velocities of the faces it samples "
        "reach (no new extreme of speed)"},
@@ -66,8 +71,9 @@ namespace {
 /// (correction_to_velocity > 0) would turn the shift into velocity too.
 std::pair<std::string, std::string> pbfCheck(const SolverDef& d) {
   if (d.param("grid_cell") > 0 && d.param("grid_shift") > 0 && d.param("correction_to_velocity") > 0)
-    return {"solver.grid_shift",
-            "the grid's compression shift needs correction_to_velocity 0 (it would become velocity): set one of them to 0"};
+    return {
+        "solver.grid_shift",
+        "the grid's compression shift needs correction_to_velocity 0 (it would become velocity): set one of them to 0"};
   if (d.param("grid_cell") > 0 && d.param("grid_fill") > 0 && d.param("correction_to_velocity") > 0)
     return {"solver.grid_fill",
             "the grid's fill shift needs correction_to_velocity 0 (it would become velocity): set one of them to 0"};
@@ -77,17 +83,18 @@ std::pair<std::string, std::string> pbfCheck(const SolverDef& d) {
 
 /// pbf's registration (solvers.def): classic Position Based Fluids.
 SolverInfo pbfSolver() {
-  return {"pbf", pbfParams(false), [](const SolverDef& d) -> std::unique_ptr<Solver> { return std::make_unique<Pbf>(d); },
-          nullptr, pbfCheck};
+  return {"pbf", pbfParams(false),
+          [](const SolverDef& d) -> std::unique_ptr<Solver> { return std::make_unique<Pbf>(d); }, nullptr, pbfCheck};
 }
 
 /// game's registration (solvers.def): pbf with the coarse-grid projection, local
 /// iterations and a robust substep, the real-time end (docs/PERFORMANCE.md).
 SolverInfo gameSolver() {
-  return {"game", pbfParams(true), [](const SolverDef& d) -> std::unique_ptr<Solver> { return std::make_unique<Pbf>(d); },
+  return {"game", pbfParams(true),
+          [](const SolverDef& d) -> std::unique_ptr<Solver> { return std::make_unique<Pbf>(d); },
           [](SolverDef& d) {
-            d.viscosity = 0;      // XSPH smooths; an explicit viscosity would limit the substep
-            d.supportRatio = 2;   // 8 neighbours at rest: measured as accurate as 2.5 here, at half the pairs
+            d.viscosity = 0;     // XSPH smooths; an explicit viscosity would limit the substep
+            d.supportRatio = 2;  // 8 neighbours at rest: measured as accurate as 2.5 here, at half the pairs
           },
           pbfCheck};
 }

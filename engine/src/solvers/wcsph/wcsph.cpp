@@ -169,8 +169,9 @@ class Wcsph final : public Solver {
     const Real gradK = W.gradientScale;
     const Real aFlat = Real(1) - kFlatGradientQ;
     const Real gradFlat = gradK * aFlat * aFlat * aFlat * (kFlatGradientQ * R);  // |∇W| at its peak, times r/|d|
-    const Real pScale = Real(1.0 / latticeGradientMoment(WendlandC2<double>(double(c.R)), double(c.dx), double(c.mass / c.rho0)));
-    const Real avK = alpha_ * c0_;  // Π = −α c μ / ρ̄ with μ = h v·x / (r² + 0.01h²)
+    const Real pScale =
+        Real(1.0 / latticeGradientMoment(WendlandC2<double>(double(c.R)), double(c.dx), double(c.mass / c.rho0)));
+    const Real avK = alpha_ * c0_;         // Π = −α c μ / ρ̄ with μ = h v·x / (r² + 0.01h²)
     const ImpactViscosity& imp = impact_;  // + the impact share for fast approaches
     const Real eta2 = Real(0.01) * h * h;
     const Vec2* X = P.x.data();
@@ -322,7 +323,8 @@ SolverInfo wcsphSolver() {
           {{"gamma", 7, 1, 10, "Tait exponent γ in p = B((ρ/ρ0)^γ − 1), B = ρ0c²/γ"},
            {"alpha", 0.05, 0, 2, "Monaghan artificial viscosity α (Π = −α c h μ/ρ̄ for approaching pairs)"},
            {"expected_speed", 0, 0, 1e4, "when > 0, the sound speed is 10 × this (m/s) instead of sound_speed"},
-           kImpactAlphaParam, kImpactSpeedParam},
+           kImpactAlphaParam,
+           kImpactSpeedParam},
           [](const SolverDef& d) -> std::unique_ptr<Solver> { return std::make_unique<Wcsph>(d); }};
 }
 

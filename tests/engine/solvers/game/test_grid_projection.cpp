@@ -10,14 +10,15 @@
 
 #include <box2d/box2d.h>
 
+#include "bench/validation.hpp"
 #include "sph2d/world.hpp"
 #include "support/fixture.hpp"
-#include "bench/validation.hpp"
 
 using namespace sph2d;
 using test::boxShape;
 
-TEST_CASE("grid projection: a resting 2 m x 1 m tank reports a hydrostatic pressure, and stays at rest beside the walls") {
+TEST_CASE(
+    "grid projection: a resting 2 m x 1 m tank reports a hydrostatic pressure, and stays at rest beside the walls") {
   SceneDef s = test::wallScene(0.025, "game");
   s.bodies.push_back(test::tankWalls(2, 1.6));
   FluidBlockDef blk;
@@ -52,7 +53,8 @@ TEST_CASE("grid projection: a resting 2 m x 1 m tank reports a hydrostatic press
   CHECK(vmaxWall < 0.05);
 }
 
-TEST_CASE("grid projection: a wall the game replaces (same body, a new fixture in the old one's memory) stops holding water") {
+TEST_CASE(
+    "grid projection: a wall the game replaces (same body, a new fixture in the old one's memory) stops holding water") {
   // A gate at x = 0.5 m holds a column on the left of a 2 m tank; the game destroys it and
   // creates a small box under the floor on the same body (Box2D's allocator hands the new
   // fixture the gate's block), then refreshes the boundaries. The water must flow as if the
@@ -92,12 +94,14 @@ TEST_CASE("grid projection: a wall the game replaces (same body, a new fixture i
   // A 0.8 m column released at x = 0.5 m: its front moves at ~2 sqrt(g h) ≈ 5.6 m/s, so a
   // quarter of the water is past x = 0.6 m within 0.5 s.
   for (int f = 0; f < 30; ++f) gated.stepFrame();
-  MESSAGE("new fixture at the old one's address: " << (static_cast<const void*>(replaced) == old) << "; particles past the gate "
-                                                   << rightOf(gated) << " of " << gated.particleCount());
+  MESSAGE("new fixture at the old one's address: " << (static_cast<const void*>(replaced) == old)
+                                                   << "; particles past the gate " << rightOf(gated) << " of "
+                                                   << gated.particleCount());
   CHECK(rightOf(gated) > int(gated.particleCount() / 4));
 }
 
-TEST_CASE("grid projection: a sealed pocket (a lidded box filled past its volume) stays finite and spreads its compression") {
+TEST_CASE(
+    "grid projection: a sealed pocket (a lidded box filled past its volume) stays finite and spreads its compression") {
   // Fluid with no open face to air has a pure Neumann pressure system: singular, solvable only
   // when its right-hand side sums to zero. Here the whole box is one sealed pocket and 16 % more
   // fluid than it holds (a second block on top of the first: 2,900 particles for 2,500 places),
@@ -179,10 +183,10 @@ TEST_CASE("grid projection: the compression shift moves a compressed block apart
     moving = moving && vOn[i].x() > 0.4;
   }
   CHECK(same);
-  CHECK(moving);               // the velocities compared are the block's, not zeros
-  CHECK(cOff > 0.05);          // the single iteration leaves most of the packing
-  CHECK(cOn < 0.85 * cOff);    // half of the cells' compression is removed per substep
-  CHECK(wOn > wOff + 0.002);   // by moving the particles apart
+  CHECK(moving);              // the velocities compared are the block's, not zeros
+  CHECK(cOff > 0.05);         // the single iteration leaves most of the packing
+  CHECK(cOn < 0.85 * cOff);   // half of the cells' compression is removed per substep
+  CHECK(wOn > wOff + 0.002);  // by moving the particles apart
 }
 
 TEST_CASE("game: air held in the water rises out (grid_fill), and the pool settles to its particles' volume") {
@@ -271,7 +275,8 @@ TEST_CASE("game: the local iterations go on while any particle is above toleranc
     w.stepFrame();
     worst = std::max(worst, w.densityStats().maxError);
   }
-  MESSAGE(w.particleCount() << " particles, " << w.substeps() << " substeps in 90 frames; largest single-particle compression "
-                            << 100 * worst << " % (tolerance_max " << 100 * limit << " %)");
+  MESSAGE(w.particleCount() << " particles, " << w.substeps()
+                            << " substeps in 90 frames; largest single-particle compression " << 100 * worst
+                            << " % (tolerance_max " << 100 * limit << " %)");
   CHECK(worst <= limit + 1e-6);
 }

@@ -30,13 +30,13 @@ class VideoPipe;
 
 /// What a FrameWriter writes.
 struct FrameWriterOptions {
-  std::string dir;                          ///< output directory (must exist)
-  bool png = true;                          ///< write frame_NNNNN.png
-  int pngLevel = 1;                         ///< zlib level 0..9 (1 = fast)
-  std::optional<ExportFormat> exportFormat; ///< also write frame_NNNNN.csv / .vtk
-  std::string videoPath;                    ///< "" = no video; else pipe frames to ffmpeg
-  double videoFps = 60;                     ///< frame rate of the video
-  std::size_t capacity = 6;                 ///< frames that may wait in the queue
+  std::string dir;                           ///< output directory (must exist)
+  bool png = true;                           ///< write frame_NNNNN.png
+  int pngLevel = 1;                          ///< zlib level 0..9 (1 = fast)
+  std::optional<ExportFormat> exportFormat;  ///< also write frame_NNNNN.csv / .vtk
+  std::string videoPath;                     ///< "" = no video; else pipe frames to ffmpeg
+  double videoFps = 60;                      ///< frame rate of the video
+  std::size_t capacity = 6;                  ///< frames that may wait in the queue
   /// Called on the writer thread before each file is written (before its temporary file is
   /// created): the file's name in `dir`, the XXH64 of the bytes it will hold and the name of
   /// the temporary file it is written through. A throw stops the writer as a write error does.

@@ -24,19 +24,19 @@ class World;
 /// One frame's particles, sorted by id, positions in world coordinates.
 /// A kinematic or dynamic Box2D body in a snapshot (world coordinates).
 struct BodySnapshot {
-  int body = 0;                   ///< its index among all bodies of the b2World in creation order (a scene's: boundaries[] index)
-  double x = 0, y = 0, angle = 0; ///< the body origin [m] and angle [rad]
+  int body = 0;  ///< its index among all bodies of the b2World in creation order (a scene's: boundaries[] index)
+  double x = 0, y = 0, angle = 0;    ///< the body origin [m] and angle [rad]
   double vx = 0, vy = 0, omega = 0;  ///< velocity of its origin [m/s] (of x, y), angular velocity [rad/s]
 };
 
 struct ParticleSnapshot {
-  std::uint64_t frame = 0;        ///< frames stepped
-  double time = 0;                ///< simulated time [s]
-  std::vector<std::uint32_t> id;  ///< stable ids, ascending
-  std::vector<double> x, y;       ///< world position [m]
-  std::vector<float> vx, vy;      ///< velocity [m/s]
-  std::vector<float> rho, p;      ///< density [kg/m³], pressure [Pa]
-  std::vector<float> age;         ///< age [s]; empty when the particles have no age
+  std::uint64_t frame = 0;           ///< frames stepped
+  double time = 0;                   ///< simulated time [s]
+  std::vector<std::uint32_t> id;     ///< stable ids, ascending
+  std::vector<double> x, y;          ///< world position [m]
+  std::vector<float> vx, vy;         ///< velocity [m/s]
+  std::vector<float> rho, p;         ///< density [kg/m³], pressure [Pa]
+  std::vector<float> age;            ///< age [s]; empty when the particles have no age
   std::vector<BodySnapshot> bodies;  ///< the non-static bodies, in creation (scene) order
   /// Number of particles.
   std::size_t size() const { return id.size(); }

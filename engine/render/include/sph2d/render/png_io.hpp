@@ -22,7 +22,7 @@ struct PngSettings {
   /// How the RGBA8 rows become the file's pixels: libpng drops A (png_set_filler), sph2d packs
   /// RGB rows itself, or the file keeps A (an RGBA PNG).
   enum class Input { Filler, PackedRgb, Rgba } input = Input::Filler;
-  bool wholeImage = false;        ///< every row in one png_write_image call (else png_write_row per row)
+  bool wholeImage = false;  ///< every row in one png_write_image call (else png_write_row per row)
 };
 
 /// The settings of PNG level `level` 0..9: 1 (the default, the fastest measured on the dam

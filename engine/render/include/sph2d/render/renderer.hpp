@@ -68,31 +68,33 @@ std::string colorFieldName(ColorField f);
 /// Render settings that the scene format does not carry (yet): they come from
 /// the command line. Unset optionals take the documented defaults.
 struct RenderOptions {
-  std::string mode;                          ///< "" = RenderDef::mode, else "liquid" or "particles"
-  ColorField colorBy = ColorField::Speed;    ///< particles mode: the field shown
-  std::optional<std::array<double, 2>> range;///< particles mode: fixed colour range (default: this frame's min..max)
-  bool overlay = false;                      ///< frame number, simulated time and particle count in the frame
-  double foamSpeed = 0;                      ///< liquid: speed [m/s] where foam starts (0 = 0.35·sqrt(g·view height)); full at 2×
-  double depthScale = 0;                     ///< liquid: metres of water above that darken by 1/e (0 = 1 m)
-  double ageFadeStart = 1.0;                 ///< a particle with an age fades from this age [s] ...
-  double ageFadeEnd = 3.0;                   ///< ... to nothing at this age [s]
-  std::optional<std::array<double, 3>> deepWater; ///< colour under deep water (default: water × 0.3)
-  std::optional<std::array<double, 3>> foam;      ///< foam colour (default: 0.9, 0.95, 1)
-  std::optional<std::array<double, 3>> text;      ///< overlay and colour-bar text (default: 0.92 grey)
-  bool profile = false;                      ///< glFinish after each stage so lastTimings() is per stage (slower)
+  std::string mode;                            ///< "" = RenderDef::mode, else "liquid" or "particles"
+  ColorField colorBy = ColorField::Speed;      ///< particles mode: the field shown
+  std::optional<std::array<double, 2>> range;  ///< particles mode: fixed colour range (default: this frame's min..max)
+  bool overlay = false;                        ///< frame number, simulated time and particle count in the frame
+  double foamSpeed = 0;       ///< liquid: speed [m/s] where foam starts (0 = 0.35·sqrt(g·view height)); full at 2×
+  double depthScale = 0;      ///< liquid: metres of water above that darken by 1/e (0 = 1 m)
+  double ageFadeStart = 1.0;  ///< a particle with an age fades from this age [s] ...
+  double ageFadeEnd = 3.0;    ///< ... to nothing at this age [s]
+  std::optional<std::array<double, 3>> deepWater;  ///< colour under deep water (default: water × 0.3)
+  std::optional<std::array<double, 3>> foam;       ///< foam colour (default: 0.9, 0.95, 1)
+  std::optional<std::array<double, 3>> text;       ///< overlay and colour-bar text (default: 0.92 grey)
+  bool profile = false;                            ///< glFinish after each stage so lastTimings() is per stage (slower)
 };
 
 /// What to draw. Particles are in the engine's local frame (add `origin` for world coordinates).
 struct RenderInput {
-  Particles particles;                             ///< what to draw: views whose arrays outlive the call (World::particles(), ParticleBuffer::view())
-  Vec2d origin{0, 0};                              ///< local frame offset [m]
-  double spacing = 0.02;                           ///< particle spacing dx [m]
-  const std::vector<Collider>* colliders = nullptr;///< solids in the local frame (may be null)
-  std::vector<Collider> moving;                    ///< moving bodies at their pose this frame (local frame), drawn every frame
-  const Real* age = nullptr;                       ///< optional: one age [s] per particle slot (null: particles.age when it has one per particle)
-  double gravity = 9.81;                           ///< |g| [m/s²], scales the default foam speed
-  std::uint64_t frame = 0;                         ///< for the overlay
-  double time = 0;                                 ///< simulated time [s], for the overlay
+  Particles
+      particles;  ///< what to draw: views whose arrays outlive the call (World::particles(), ParticleBuffer::view())
+  Vec2d origin{0, 0};                                ///< local frame offset [m]
+  double spacing = 0.02;                             ///< particle spacing dx [m]
+  const std::vector<Collider>* colliders = nullptr;  ///< solids in the local frame (may be null)
+  std::vector<Collider> moving;  ///< moving bodies at their pose this frame (local frame), drawn every frame
+  const Real* age =
+      nullptr;  ///< optional: one age [s] per particle slot (null: particles.age when it has one per particle)
+  double gravity = 9.81;    ///< |g| [m/s²], scales the default foam speed
+  std::uint64_t frame = 0;  ///< for the overlay
+  double time = 0;          ///< simulated time [s], for the overlay
 };
 
 /// Wall time of the stages of the last render() or draw() [ms]; per stage only with
@@ -175,7 +177,8 @@ class Renderer {
   void draw(const RenderInput& in, const GlTarget& target = {});
   /// True when this Renderer draws into the caller's context (made with CurrentGlContext).
   bool usesCurrentContext() const;
-  /// GL_RENDERER and GL_VERSION of the context, e.g. "llvmpipe (LLVM 15.0.6, 256 bits) / 4.5 (Core Profile) Mesa 22.3.6".
+  /// GL_RENDERER and GL_VERSION of the context, e.g. "llvmpipe (LLVM 15.0.6, 256 bits) / 4.5 (Core Profile)
+  /// Mesa 22.3.6".
   std::string rendererString() const;
   /// The world rectangle shown (after aspect correction), min x, min y, max x, max y.
   std::vector<double> cameraRect() const;
