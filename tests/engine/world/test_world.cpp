@@ -308,6 +308,10 @@ TEST_CASE(
   const std::uint64_t before = w.emittedCount(0);
   for (int f = 0; f < 10; ++f) w.stepFrame();
   CHECK(w.emittedCount(0) == before);
+  w.setEmitterEnabled(0, true);  // the same emitter, switched back on, emits (rate 200/s)
+  CHECK(w.emitterEnabled(0));
+  for (int f = 0; f < 10; ++f) w.stepFrame();
+  CHECK(w.emittedCount(0) > before + 20);
   for (const std::string& st : w.stages()) CHECK(st.find("viscosity") == std::string::npos);
 
   CHECK_THROWS_AS(w.emitterEnabled(1), std::out_of_range);
