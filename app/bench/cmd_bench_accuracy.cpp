@@ -157,7 +157,7 @@ Run runSurge(SceneDef s, const std::vector<std::vector<double>>& table, double t
   r.meanDensityError = densSum / frames;
   r.maxDensityError = densMax;
   r.wallPerSim = wall / w.time();
-  r.msPerStep = 1e3 * wall / double(std::max<std::uint64_t>(1, w.substeps()));
+  r.msPerStep = 1e3 * wall / double(std::max<std::uint64_t>(1, w.counters().substeps));
   return r;
 }
 
@@ -190,7 +190,7 @@ Run runHydrostatic(SceneDef s, int threads) {
   r.meanDensityError = densSum / std::max(1, frames - avgFrom);
   r.maxDensityError = densMax;
   r.wallPerSim = wall / w.time();
-  r.msPerStep = 1e3 * wall / double(std::max<std::uint64_t>(1, w.substeps()));
+  r.msPerStep = 1e3 * wall / double(std::max<std::uint64_t>(1, w.counters().substeps));
   return r;
 }
 

@@ -262,19 +262,19 @@ int cmdBenchEffects(const std::vector<std::string>& args) {
   double (*const now)() = clock == "cpu" ? &cpuSeconds : &wallSeconds;
   std::fflush(stdout);
   for (Row& r : rows)
-    for (int i = 0; i < warmup; ++i) r.world->stepSubstep();
+    for (int i = 0; i < warmup; ++i) sph2d::bench::stepSubstep(*r.world);
   for (int round = 0; round < rounds; ++round) {
     std::vector<double> msThisRound(rows.size());
     for (std::size_t k = 0; k < rows.size(); ++k) {
       const std::size_t idx = (k + std::size_t(round)) % rows.size();
       Row& r = rows[idx];
-      r.world->resetTimings();
+      r.world->resetProfile();
       const double t0 = now(), w0 = wallSeconds();
-      for (int i = 0; i < steps; ++i) r.world->stepSubstep();
+      for (int i = 0; i < steps; ++i) sph2d::bench::stepSubstep(*r.world);
       const double sec = now() - t0, wallSec = wallSeconds() - w0;
       msThisRound[idx] = 1e3 * sec / steps;
       r.stageSec.clear();
-      for (const StageTiming& t : r.world->timings()) r.stageSec[t.name] += t.seconds;
+      for (const StageTiming& t : r.world->profile().stages) r.stageSec[t.name] += t.seconds;
       r.wallSec = wallSec;
     }
     for (std::size_t k = 0; k < rows.size(); ++k) {

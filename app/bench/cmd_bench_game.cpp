@@ -152,7 +152,7 @@ Row runSph2d(const SceneDef& base, const std::string& preset, int threads, doubl
   std::vector<double> times = {0}, fronts = {front()};
   const int frames = int(std::lround(seconds * s.fps));
   double wall = 0, worstMean = 0, worstMax = 0, gain = 0, outside = 0;
-  const std::uint64_t it0 = w.solverIterations();
+  const std::uint64_t it0 = w.counters().solverIterations;
   for (int f = 0; f < frames; ++f) {
     const auto t0 = std::chrono::steady_clock::now();
     w.stepFrame();
@@ -171,8 +171,8 @@ Row runSph2d(const SceneDef& base, const std::string& preset, int threads, doubl
     fronts.push_back(front());
   }
   r.wallPerSim = wall / w.time();
-  r.substepsPerFrame = double(w.substeps()) / frames;
-  r.iterationsPerFrame = double(w.solverIterations() - it0) / frames;
+  r.substepsPerFrame = double(w.counters().substeps) / frames;
+  r.iterationsPerFrame = double(w.counters().solverIterations - it0) / frames;
   r.meanCompression = worstMean;
   r.maxCompression = worstMax;
   r.energyGain = gain;

@@ -81,16 +81,16 @@ int cmdBenchStep(const std::vector<std::string>& args) {
       w.takeWarnings();
       const std::size_t np = w.particleCount();
       const int k = steps > 0 ? steps : std::max(10, int(2e7 / double(np)));
-      for (int i = 0; i < warmup; ++i) w.stepSubstep();
-      w.resetTimings();
+      for (int i = 0; i < warmup; ++i) sph2d::bench::stepSubstep(w);
+      w.resetProfile();
       std::size_t pairs = 0;
       const auto t0 = std::chrono::steady_clock::now();
       for (int i = 0; i < k; ++i) {
-        w.stepSubstep();
-        pairs += w.neighbourPairs();
+        sph2d::bench::stepSubstep(w);
+        pairs += w.counters().neighbourPairs;
       }
       const double sec = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-      const auto timings = w.timings();
+      const auto timings = w.profile().stages;
       double stageTotal = 0;
       for (const auto& st : timings) stageTotal += st.seconds;
       if (!header) {
@@ -108,7 +108,7 @@ int cmdBenchStep(const std::vector<std::string>& args) {
       const double ms = 1e3 * sec / k;
       const double ps = double(np) * k / sec;
       const double pairsPerS = double(pairs) / sec;
-      const double bpp = double(w.memoryBytes()) / double(np);
+      const double bpp = double(w.counters().memoryBytes) / double(np);
       const double rss = double(peakRssBytes()) / double(np);
       if (csv) {
         std::printf("%zu,%d,%d,%.4f,%.0f,%.0f,%.1f,%.1f", np, w.threads(), k, ms, ps, pairsPerS, bpp, rss);

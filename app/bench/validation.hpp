@@ -112,7 +112,7 @@ inline TaylorGreenResult runTaylorGreen(const SceneDef& s, double seconds,
     r.maxDensityError = std::max(r.maxDensityError, d.meanError);
   }
   r.simSeconds = w.time();
-  r.substeps = w.substeps();
+  r.substeps = w.counters().substeps;
   // Least-squares slope of ln A(t).
   double st = 0, sy = 0, stt = 0, sty = 0, n = 0;
   for (std::size_t i = 0; i < r.t.size(); ++i) {
@@ -200,7 +200,7 @@ inline PoiseuilleResult runPoiseuille(const SceneDef& s, double y0, double heigh
   r.rmsError = r.points.empty() ? 0 : std::sqrt(sq / double(r.points.size()));
   if (!r.points.empty()) r.meanDensityError /= double(r.points.size());
   r.simSeconds = w.time();
-  r.substeps = w.substeps();
+  r.substeps = w.counters().substeps;
   return r;
 }
 

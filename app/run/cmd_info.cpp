@@ -120,7 +120,7 @@ int cmdInfo(const std::vector<std::string>& args) {
   std::printf(
       "engine       %.1f MB held by the World now (particle arrays %.1f MB; grid, neighbour lists, "
       "boundary samples)\n",
-      double(w.memoryBytes()) / 1e6, double(w.particleBytes()) / 1e6);
+      double(w.counters().memoryBytes) / 1e6, double(w.counters().particleBytes) / 1e6);
   std::printf("image        %dx%d, %s mode\n", s.render.width, s.render.height, s.render.mode.c_str());
   return 0;
 }

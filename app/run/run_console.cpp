@@ -111,9 +111,9 @@ void RunConsole::summary(const World& world, const RunReport& r) const {
 
 void printProfile(const World& w) {
   double total = 0;
-  for (const auto& t : w.timings()) total += t.seconds;
+  for (const auto& t : w.profile().stages) total += t.seconds;
   std::printf("%-16s %10s %10s %8s %7s\n", "stage", "calls", "seconds", "ms/call", "share");
-  for (const auto& t : w.timings())
+  for (const auto& t : w.profile().stages)
     std::printf("%-16s %10llu %10.3f %8.4f %6.1f%%\n", t.name.c_str(), (unsigned long long)t.calls, t.seconds,
                 t.calls ? 1e3 * t.seconds / double(t.calls) : 0.0, total > 0 ? 100.0 * t.seconds / total : 0.0);
 }

@@ -147,7 +147,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   if (particles > 2000 || worldCost(scene) > 20000 || scene.effects.emitters.size() > 4) return 0;
   try {
     sph2d::World world(scene, sph2d::WorldOptions{1});
-    world.stepSubstep();
+    sph2d::bench::stepSubstep(world);
   } catch (const sph2d::SimulationError&) {
     // The guard stopping a wild scene is a correct outcome.
   } catch (const sph2d::SceneError& e) {

@@ -217,7 +217,7 @@ void surfaceTensionBeyondLimit(const std::string& solver) {
   }
   World w(s, WorldOptions{2});
   for (int f = 0; f < 5; ++f) w.stepFrame();
-  CHECK(w.lastFrameSubsteps() == 30);  // the cap, not a longer substep
+  CHECK(w.counters().lastFrameSubsteps == 30);  // the cap, not a longer substep
   CHECK_FALSE(w.takeWarnings().empty());
   CHECK(test::allFiniteState(w));
   CHECK(outside(w, 1, 1) == 0);
@@ -299,9 +299,9 @@ TEST_CASE("stability: a frame time of 1 s holds the substep cap, stays stable an
     World w(s, WorldOptions{2});
     const double y0 = sumY(w);
     w.stepFrame();
-    CHECK(w.lastFrameSubsteps() <= 300);
+    CHECK(w.counters().lastFrameSubsteps <= 300);
     const auto warnings = w.takeWarnings();
-    if (w.lastFrameSubsteps() ==
+    if (w.counters().lastFrameSubsteps ==
         300) {  // the explicit solvers hit the cap and say so (pbf needs 60 substeps of 1/60 s)
       REQUIRE(warnings.size() == 1);
       CHECK(warnings[0].find("frame 0") != std::string::npos);
@@ -328,7 +328,7 @@ TEST_CASE(
     const std::size_t n0 = w.particleCount();
     for (int f = 0; f < 150 && w.particleCount() > 0; ++f) w.stepFrame();
     CHECK(w.particleCount() == 0);
-    CHECK(w.removedCount() == n0);
+    CHECK(w.counters().removed == n0);
     for (int f = 0; f < 5; ++f) w.stepFrame();  // stepping an empty world is fine
     CHECK(w.densityStats().meanDensity == 0);
     SceneDef empty = tank(solver, 1, 1, 0.04);
@@ -370,12 +370,12 @@ void longRest(const std::string& solver, int substeps) {
   s.blocks.push_back(blk);
   World w(s, WorldOptions{2});
   const int settle = substeps / 10;
-  for (int i = 0; i < settle; ++i) w.stepSubstep();
+  for (int i = 0; i < settle; ++i) sph2d::bench::stepSubstep(w);
   const Vec2d c1 = test::centroid(w);
   const double ke1 = w.kineticEnergy(), t1 = w.time();
   double keMax = 0, errMax = 0;
   for (int i = settle; i < substeps; ++i) {
-    w.stepSubstep();
+    sph2d::bench::stepSubstep(w);
     if (i % 500 == 0) {
       keMax = std::max(keMax, w.kineticEnergy());
       errMax = std::max(errMax, w.densityStats().meanError);
@@ -390,7 +390,7 @@ void longRest(const std::string& solver, int substeps) {
                  << (c2 - c1).norm() << " m; mean compression at most " << 100 * errMax << " %, final "
                  << 100 * w.densityStats().meanError << " % (band " << 100 * restBand(s, 0.45) << " %), max "
                  << 100 * w.densityStats().maxError << " %");
-  REQUIRE(w.substeps() == std::uint64_t(substeps));
+  REQUIRE(w.counters().substeps == std::uint64_t(substeps));
   CHECK(test::allFiniteState(w));
   CHECK(outside(w, 0.6, 0.8) == 0);
   // It decays — or it already sits below the energy of a 1 cm/s mean speed,

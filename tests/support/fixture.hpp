@@ -277,7 +277,7 @@ struct MomentumRun {
 inline MomentumRun momentumOver(const SceneDef& scene, int substeps) {
   World w(scene, WorldOptions{2});
   const Vec2d m0 = momentum(w);
-  for (int i = 0; i < substeps; ++i) w.stepSubstep();
+  for (int i = 0; i < substeps; ++i) sph2d::bench::stepSubstep(w);
   MomentumRun r;
   r.change = (momentum(w) - m0).norm();
   r.scale = double(w.particleCount()) * double(w.particleMass()) * 0.36;

@@ -48,7 +48,7 @@ class SimulationError : public std::runtime_error {
 /// The World was asked to stop (its stop flag, WorldOptions::stop or World::setStopFlag, was
 /// set) and stopped its work: `stage` names where (a stage of the substep, "construction: ..."
 /// or the call that was adding particles). Thrown by the constructor (nothing is built), by
-/// step()/stepFrame()/stepSubstep() (the step is abandoned: see World::interrupted()) and by
+/// step()/stepFrame()/bench::stepSubstep() (the step is abandoned: see World::interrupted()) and by
 /// the calls that add particles (nothing is added: the World is as before the call).
 class Interrupted : public std::runtime_error {
  public:
@@ -155,6 +155,38 @@ struct WallImpulse {
   Vec2d total() const { return samples + grid + collision; }
 };
 
+/// What a World has done, counted (World::counters()), as Box2D's b2Counters are for a b2World.
+struct WorldCounters {
+  std::uint64_t frames = 0;            ///< frames stepped (stepFrame, step)
+  std::uint64_t substeps = 0;          ///< substeps taken
+  int lastFrameSubsteps = 0;           ///< substeps of the last frame
+  std::uint64_t solverIterations = 0;  ///< pressure and divergence solve iterations summed over every substep
+  SolverStats lastSolve;               ///< the last substep's solve (explicit solvers: all zero)
+  std::size_t particles = 0;           ///< particles now
+  std::size_t neighbourPairs = 0;      ///< fluid pairs of the last substep, each counted from both sides
+  std::uint64_t removed = 0;           ///< particles removed by lifetimes, sinks and the budget policy
+  std::size_t memoryBytes = 0;         ///< bytes for the particles, grid, neighbour lists and boundary samples
+  std::size_t particleBytes = 0;       ///< bytes the particle arrays hold (the solver's working fields included)
+};
+
+/// Where a World's time went (World::profile()), as Box2D's b2Profile is for a b2World.
+struct WorldProfile {
+  std::vector<StageTiming> stages;  ///< wall time and calls per stage, in list order
+  /// The seconds of every stage together.
+  double totalSeconds() const {
+    double t = 0;
+    for (const StageTiming& s : stages) t += s.seconds;
+    return t;
+  }
+};
+
+class World;
+namespace bench {
+/// Advances one CFL-limited substep: a hook for benchmarks and tests that time or inspect a
+/// single substep, not part of a game's loop (which steps frames). Throws as World::step.
+void stepSubstep(World& world);
+}  // namespace bench
+
 /// The fluid simulation.
 class World {
  public:
@@ -180,8 +212,6 @@ class World {
   /// the stop flag is set: before the step starts (nothing changed), or within it (the step
   /// is abandoned: interrupted()).
   void step(double dt);
-  /// Advances one CFL-limited substep (for benchmarks and tests). Throws SimulationError.
-  void stepSubstep();
 
   /// Replaces the stop flag (WorldOptions::stop; null: none). While the flag is set, a step
   /// and the calls that add particles throw sph2d::Interrupted within milliseconds (between
@@ -190,7 +220,7 @@ class World {
   /// True after a step was interrupted by the stop flag: that step stopped inside a stage,
   /// so the particles are as that stage left them (readable, every array of one length, but
   /// not a state the solver produced) and the World will not step again: step(),
-  /// stepFrame() and stepSubstep() throw sph2d::Interrupted naming the stage. load() of a
+  /// stepFrame() and bench::stepSubstep() throw sph2d::Interrupted naming the stage. load() of a
   /// saved state clears it (the World is then that state). A game that may stop a World
   /// midway and go on saves a state to go back to, or builds a new World.
   bool interrupted() const;
@@ -221,12 +251,8 @@ class World {
   double time() const;
   /// Frames stepped.
   std::uint64_t frame() const;
-  /// Substeps taken.
-  std::uint64_t substeps() const;
   /// The substep length [s] the limits (CFL, force, effects) allow in the current state.
   double stableTimeStep() const;
-  /// Substeps of the last frame.
-  int lastFrameSubsteps() const;
   /// Particle mass [kg] (all particles share it).
   Real particleMass() const;
   /// Kernel support R [m].
@@ -242,8 +268,6 @@ class World {
   DensityStats densityStats() const;
   /// Kinetic energy ½ Σ m |v|² [J per metre of depth].
   double kineticEnergy() const;
-  /// Iterations and residuals of the pressure solver in the last substep (explicit solvers: all zero).
-  SolverStats solverStats() const;
   /// The impulse the static solids gave the fluid over every substep since construction, the
   /// last load() or the last resetWallImpulse() (whichever came last) [N·s per metre of depth].
   /// With the gravity impulse Σm·g·t it closes the fluid's momentum balance (docs/EMBEDDING.md)
@@ -253,18 +277,13 @@ class World {
   WallImpulse wallImpulse() const;
   /// Zeroes wallImpulse() (say, at the start of the interval a game wants to measure).
   void resetWallImpulse();
-  /// Pressure and divergence solve iterations summed over every substep so far.
-  std::uint64_t solverIterations() const;
-  /// Per-stage wall time and calls since construction (or the last resetTimings()), by stage name in list order.
-  std::vector<StageTiming> timings() const;
-  /// Zeroes the stage timings.
-  void resetTimings();
-  /// Neighbour pairs (each counted from both sides) of the last substep.
-  std::size_t neighbourPairs() const;
-  /// Bytes the world holds for its particles, grid, neighbour lists and boundary samples.
-  std::size_t memoryBytes() const;
-  /// Bytes the particle arrays hold (every field, the solver's working fields included).
-  std::size_t particleBytes() const;
+  /// The World's counts: frames, substeps, solver iterations, particles, neighbour pairs,
+  /// removals and memory (WorldCounters).
+  WorldCounters counters() const;
+  /// Per-stage wall time and calls since construction or the last resetProfile().
+  WorldProfile profile() const;
+  /// Zeroes the stage timings of profile().
+  void resetProfile();
   /// Messages the world wants the user to see (substep cap hits, dropped particles); cleared on read.
   std::vector<std::string> takeWarnings();
 
@@ -390,7 +409,7 @@ class World {
 
   /// Slots of the particles inside `shape` placed by `xf` (world coordinates; b2Shape::TestPoint:
   /// polygons and circles hold points, edges and chains none), in slot order.
-  std::vector<std::size_t> particlesInShape(const b2Shape& shape, const b2Transform& xf) const;
+  std::vector<std::size_t> slotsInShape(const b2Shape& shape, const b2Transform& xf) const;
   /// Removes the particles inside `shape` placed by `xf`. Returns their ids, in increasing order.
   std::vector<std::uint32_t> removeParticlesInShape(const b2Shape& shape, const b2Transform& xf);
   /// Fills `shape` placed by `xf` (a b2PolygonShape or b2CircleShape) with fluid on the lattice
@@ -401,9 +420,9 @@ class World {
   // The searches below visit only the cells of a grid of the current particles, built on the
   // first search after a step or a change (O(n)), not every particle.
   /// Slots of the particles within `radius` of `center` (world coordinates), in slot order.
-  std::vector<std::size_t> particlesInRadius(const Vec2d& center, double radius) const;
+  std::vector<std::size_t> slotsInRadius(const Vec2d& center, double radius) const;
   /// Slots of the particles inside the box [lo, hi] (world coordinates), in slot order.
-  std::vector<std::size_t> particlesInBox(const Vec2d& lo, const Vec2d& hi) const;
+  std::vector<std::size_t> slotsInBox(const Vec2d& lo, const Vec2d& hi) const;
   /// Shepard-normalised SPH samples at a world point: density [kg/m³] and velocity [m/s]
   /// (Σ V_j A_j W / Σ V_j W over the fluid, Wendland C2 kernel of the world's support).
   /// Where no particle is within the support, density 0 and velocity 0.
@@ -421,13 +440,13 @@ class World {
   /// fixture for a solver that samples moving bodies: wcsph, muller2003). With contact
   /// tracking on (setContactTracking), also every particle still in the World that touched it
   /// at the end of a substep of the last step.
-  std::vector<std::uint32_t> particlesTouching(const b2Fixture& fixture) const;
+  std::vector<std::uint32_t> idsTouching(const b2Fixture& fixture) const;
   /// Calls f(fixture, ids) for every fixture of box2d() that particles touch now, with their
-  /// ids as particlesTouching() gives them; bodies and fixtures in Box2D's list order. The
+  /// ids as idsTouching() gives them; bodies and fixtures in Box2D's list order. The
   /// game's contact listener for the fluid (a button the water reaches, a fire it puts out).
   void forEachContact(const std::function<void(const b2Fixture&, const std::vector<std::uint32_t>&)>& f) const;
   /// Turns on (or off) the `contacts` stage: at the end of every substep it records which
-  /// particles touch which fixture, so that particlesTouching() and forEachContact() also
+  /// particles touch which fixture, so that idsTouching() and forEachContact() also
   /// report the particles that touched a fixture during the last step and left it before its
   /// end (a splash that hit a button and bounced off; a jet through a sensor), not only those
   /// touching it at the step's end. Off by default: the stage exists only while it is on.
@@ -477,8 +496,6 @@ class World {
   std::vector<std::string> effects() const;
   /// Particles emitted so far by emitter `index`.
   std::uint64_t emittedCount(std::size_t index) const;
-  /// Particles removed so far by lifetimes, sinks and the budget policy.
-  std::uint64_t removedCount() const;
   /// Names of the per-particle fields this world allocates (the fixed ones
   /// and the optional ones its solver and effects created).
   std::vector<std::string> particleFields() const;
@@ -513,9 +530,9 @@ class World {
   template <class B2, IfB2<B2> = 0>
   IdRange addParticles(const std::vector<B2>& points);
   template <class B2, IfB2<B2> = 0>
-  std::vector<std::size_t> particlesInRadius(const B2& center, double radius) const;
+  std::vector<std::size_t> slotsInRadius(const B2& center, double radius) const;
   template <class B2, IfB2<B2> = 0>
-  std::vector<std::size_t> particlesInBox(const B2& lo, const B2& hi) const;
+  std::vector<std::size_t> slotsInBox(const B2& lo, const B2& hi) const;
   template <class B2, IfB2<B2> = 0>
   FieldSample sampleAt(const B2& point) const;
   template <class B2, IfB2<B2> = 0>
@@ -532,9 +549,9 @@ class World {
   std::size_t getParticles(const std::vector<std::uint32_t>& ids, std::vector<B2>& positions,
                            std::vector<B2>& velocities) const;
 
-  struct Impl;
-
  private:
+  friend void bench::stepSubstep(World& world);
+  struct Impl;  ///< the World's state and its subsystems (engine/src/world/world_impl.hpp)
   template <class B2>
   static std::vector<Vec2d> toVec2d(const std::vector<B2>& in);
   void init();

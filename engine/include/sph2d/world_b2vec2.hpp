@@ -60,13 +60,13 @@ inline IdRange World::addParticles(const std::vector<B2>& points) {
 }
 
 template <class B2, World::IfB2<B2>>
-inline std::vector<std::size_t> World::particlesInRadius(const B2& center, double radius) const {
-  return particlesInRadius(Vec2d(center.x, center.y), radius);
+inline std::vector<std::size_t> World::slotsInRadius(const B2& center, double radius) const {
+  return slotsInRadius(Vec2d(center.x, center.y), radius);
 }
 
 template <class B2, World::IfB2<B2>>
-inline std::vector<std::size_t> World::particlesInBox(const B2& lo, const B2& hi) const {
-  return particlesInBox(Vec2d(lo.x, lo.y), Vec2d(hi.x, hi.y));
+inline std::vector<std::size_t> World::slotsInBox(const B2& lo, const B2& hi) const {
+  return slotsInBox(Vec2d(lo.x, lo.y), Vec2d(hi.x, hi.y));
 }
 
 template <class B2, World::IfB2<B2>>

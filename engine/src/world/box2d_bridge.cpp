@@ -80,22 +80,13 @@ std::unique_ptr<b2World> makeSceneWorld(const SceneDef& scene) {
   return world;
 }
 
-namespace {
-/// True when `body` is one of `sliding`'s.
-bool isSliding(const std::vector<World::Impl::SlidingStatic>& sliding, const b2Body* body) {
-  for (const auto& s : sliding)
-    if (s.body == body) return true;
-  return false;
-}
-}  // namespace
-
-std::uint64_t World::Impl::staticSignature() const {
+std::uint64_t StaticBridge::signature(const b2World& world) const {
   Xxh64 h;
-  for (b2Body* body = b2->GetBodyList(); body; body = body->GetNext()) {
-    if (body->GetType() != b2_staticBody || isSliding(sliding, body)) continue;
+  for (const b2Body* body = world.GetBodyList(); body; body = body->GetNext()) {
+    if (body->GetType() != b2_staticBody || slidingOf(body)) continue;
     const b2Transform& xf = body->GetTransform();
     h.update(&xf, sizeof xf);
-    for (b2Fixture* f = body->GetFixtureList(); f; f = f->GetNext()) {
+    for (const b2Fixture* f = body->GetFixtureList(); f; f = f->GetNext()) {
       const void* ptr = f;
       h.update(&ptr, sizeof ptr);
       const int type = int(f->GetType());
@@ -105,21 +96,22 @@ std::uint64_t World::Impl::staticSignature() const {
   return h.digest();
 }
 
-void World::Impl::rebuildBoundary() {
+void StaticBridge::read(BoundarySet& boundary, b2World& world, const Vec2d& origin, Real dx, Real R, ThreadPool& pool,
+                        const std::atomic<bool>* stop) {
   std::vector<const void*> skip;
-  for (const SlidingStatic& s : sliding) skip.push_back(s.body);
-  boundarySignature = 0;  // until the samples are complete: a stop midway leaves them to be read again
-  boundary.collect(*b2, origin, skip);
+  for (const Sliding& s : sliding_) skip.push_back(s.body);
+  signature_ = 0;  // until the samples are complete: a stop midway leaves them to be read again
+  boundary.collect(world, origin, skip);
   boundary.sample(dx, R, pool, stop);
   boundary.buildBins(Real(4) * R);
-  boundarySignature = staticSignature();
-  ++boundaryVersion;  // a count, not the signature: a rebuilt fixture may reuse a freed one's address
+  signature_ = signature(world);
+  ++version_;
 }
 
-void World::Impl::recordStaticPoses() {
-  staticPoses.clear();
-  for (b2Body* body = b2->GetBodyList(); body; body = body->GetNext())
-    if (body->GetType() == b2_staticBody) staticPoses.emplace_back(body, body->GetTransform());
+void StaticBridge::recordPoses(const b2World& world) {
+  poses_.clear();
+  for (const b2Body* body = world.GetBodyList(); body; body = body->GetNext())
+    if (body->GetType() == b2_staticBody) poses_.emplace_back(body, body->GetTransform());
 }
 
 namespace {
@@ -146,39 +138,45 @@ double reach(const b2Body& body) {
 }
 }  // namespace
 
-void World::Impl::readStatics(double dt) {
-  sliding.clear();
-  std::size_t next = 0;  // staticPoses is in the body list's order: a walk, unless the game edited the list
-  for (b2Body* body = b2->GetBodyList(); body; body = body->GetNext()) {
+void StaticBridge::findSliding(b2World& world, double dt, double t0) {
+  sliding_.clear();
+  std::size_t next = 0;  // poses_ is in the body list's order: a walk, unless the game edited the list
+  for (b2Body* body = world.GetBodyList(); body; body = body->GetNext()) {
     if (body->GetType() != b2_staticBody || !(dt > 0)) continue;
     const b2Transform now = body->GetTransform();
-    if (!(next < staticPoses.size() && staticPoses[next].first == body))
-      for (next = 0; next < staticPoses.size() && staticPoses[next].first != body;) ++next;
-    if (next == staticPoses.size()) continue;  // a new body
-    const b2Transform was = staticPoses[next++].second;
+    if (!(next < poses_.size() && poses_[next].first == body))
+      for (next = 0; next < poses_.size() && poses_[next].first != body;) ++next;
+    if (next == poses_.size()) continue;  // a new body
+    const b2Transform was = poses_[next++].second;
     if (was.p.x == now.p.x && was.p.y == now.p.y && was.q.s == now.q.s && was.q.c == now.q.c) continue;
     const double a0 = std::atan2(double(was.q.s), double(was.q.c));
     const double turn = std::remainder(std::atan2(double(now.q.s), double(now.q.c)) - a0, 2 * kPi<double>);
     const Vec2d move(double(now.p.x) - was.p.x, double(now.p.y) - was.p.y);
     // Faster than a game slides a door: a teleport (the static solids take it where it is).
     if ((move.norm() + std::abs(turn) * reach(*body)) / dt > double(kStaticPushSpeed)) continue;
-    sliding.push_back({body, Vec2d(was.p.x, was.p.y), a0, move / dt, turn / dt, time});
+    sliding_.push_back({body, Vec2d(was.p.x, was.p.y), a0, move / dt, turn / dt, t0});
   }
-  if (staticSignature() != boundarySignature) {
-    rebuildBoundary();
+}
+
+void World::Impl::readStatics(double dt) {
+  statics.findSliding(*b2, dt, time);
+  if (statics.changed(*b2)) {
+    readBoundary();
     dropBuried();
   }
-  recordStaticPoses();
+  statics.recordPoses(*b2);
 }
+
+void World::Impl::readBoundary() { statics.read(boundary, *b2, origin, dx, R, pool, stop); }
 
 void World::Impl::dropBuried() {
   // Particles a new solid buries (a body the game added, or teleported) are dropped: pushing
   // them out stacks them on its faces, and the solver then threw some at 50–100 m/s.
-  dead.assign(P.size(), 0);
+  sources.dead.assign(P.size(), 0);
   std::size_t n = 0;
   for (std::size_t i = 0; i < P.size(); ++i) {
-    dead[i] = boundary.insideDepth(P.x[i]) > 0;
-    n += dead[i];
+    sources.dead[i] = boundary.insideDepth(P.x[i]) > 0;
+    n += sources.dead[i];
   }
   if (n) {
     removeFlagged();
@@ -189,10 +187,10 @@ void World::Impl::dropBuried() {
 
 void World::refreshBoundaries() {
   Impl& w = *impl_;
-  w.sliding.clear();
-  w.rebuildBoundary();
+  w.statics.stopSliding();
+  w.readBoundary();
   w.dropBuried();
-  w.recordStaticPoses();
+  w.statics.recordPoses(*w.b2);
 }
 
 }  // namespace sph2d

@@ -3,30 +3,31 @@
 // every substep rather than only read at the step's end, so that a splash that hit a
 // fixture and left it within one step is still reported. A particle touches a fixture when
 // its centre lies within one spacing of the surface the fluid meets there, or inside it (as
-// World::particlesTouching measures now): a static collider, or a moving body's shape at
+// World::idsTouching measures now): a static collider, or a moving body's shape at
 // its pose at the substep's end. Each block lists its contacts in slot order and the
 // blocks are joined in block order: the same list for any thread count.
 #include <algorithm>
 #include <cmath>
 
 #include "core/constants.hpp"
+#include "world/contacts.hpp"
 #include "world/world_impl.hpp"
 
 namespace sph2d {
 
-void World::Impl::recordContacts(StepContext& c) {
+void ContactTracker::record(StepContext& c, const ParticleStore& P, const BoundarySet& boundary,
+                            const MovingSolids& moving, Real reach) {
   const std::size_t n = P.size(), blocks = (n + kBlock - 1) / kBlock;
-  contactBlocks.resize(blocks);
-  const Real reach = dx;
+  blocks_.resize(blocks);
   const double tau = c.time - moving.time0 + double(c.dt);  // the moving bodies at the substep's end
-  std::vector<ContactPose>& placed = contactPoses;          // kept: no allocation in the step
+  std::vector<Pose>& placed = poses_;                       // kept: no allocation in the step
   placed.resize(moving.bodies.size());
   for (std::size_t k = 0; k < placed.size(); ++k) {
     moving.bodies[k].pose(tau, placed[k].theta, placed[k].o);
     placed[k].centre = moving.bodies[k].centreAt(tau);
   }
   c.pool.parallelFor(n, kBlock, [&](std::size_t b, std::size_t e) {
-    auto& out = contactBlocks[b / kBlock];
+    auto& out = blocks_[b / kBlock];
     out.clear();
     for (std::size_t i = b; i < e; ++i) {
       const Vec2 x = P.x[i];
@@ -50,23 +51,19 @@ void World::Impl::recordContacts(StepContext& c) {
       }
     }
   });
-  for (std::size_t k = 0; k < blocks; ++k)
-    frameContacts.insert(frameContacts.end(), contactBlocks[k].begin(), contactBlocks[k].end());
+  for (std::size_t k = 0; k < blocks; ++k) record_.insert(record_.end(), blocks_[k].begin(), blocks_[k].end());
 }
 
-void World::Impl::finishContacts() {
-  std::sort(frameContacts.begin(), frameContacts.end());  // by fixture, then id: each fixture's ids together
-  frameContacts.erase(std::unique(frameContacts.begin(), frameContacts.end()), frameContacts.end());
+void ContactTracker::finishStep() {
+  if (!on_) return;
+  std::sort(record_.begin(), record_.end());  // by fixture, then id: each fixture's ids together
+  record_.erase(std::unique(record_.begin(), record_.end()), record_.end());
 }
 
 void World::setContactTracking(bool on) {
-  Impl& w = *impl_;
-  if (w.contactsOn == on) return;
-  w.contactsOn = on;
-  w.frameContacts.clear();
-  w.buildStages();
+  if (impl_->contacts.setOn(on)) impl_->buildStages();
 }
 
-bool World::contactTracking() const { return impl_->contactsOn; }
+bool World::contactTracking() const { return impl_->contacts.on(); }
 
 }  // namespace sph2d

@@ -247,9 +247,9 @@ void shapeMoments(MovingSolid& m, const std::vector<Collider>& shapes) {
 }  // namespace
 
 void World::Impl::captureBodies() {
-  const bool had = !moving.bodies.empty(), hadDynamic = moving.anyDynamic();
-  moving.bodies.clear();
-  moving.time0 = time;
+  const bool had = !moving.solids.bodies.empty(), hadDynamic = moving.solids.anyDynamic();
+  moving.solids.bodies.clear();
+  moving.solids.time0 = time;
   const b2Vec2 g = b2->GetGravity();
   // A solver that samples the moving bodies (Solver::movingSamples: wcsph, muller2003) meets
   // them at their fixtures, as its samples stand for them: their pressure keeps the water out
@@ -257,9 +257,7 @@ void World::Impl::captureBodies() {
   const bool skinned = !(solver && solver->movingSamples());
   for (b2Body* body = b2->GetBodyList(); body; body = body->GetNext()) {
     // A static body the game slid moves as a kinematic one through the step (box2d_bridge.cpp).
-    const SlidingStatic* slide = nullptr;
-    for (const SlidingStatic& s : sliding)
-      if (s.body == body) slide = &s;
+    const StaticBridge::Sliding* slide = statics.slidingOf(body);
     if (body->GetType() == b2_staticBody && !slide) continue;
     MovingSolid m;
     m.body = body;
@@ -329,15 +327,15 @@ void World::Impl::captureBodies() {
     // A dynamic body's jump (Box2D moved it by more than the fluid saw: a contact's impulse
     // acts on its pose too) is swept; a kinematic body moves as the fluid saw it, up to float
     // rounding. Farther than its reach it was teleported (or is a new body at a freed address).
-    for (const MovingSolids::LastPose& l : moving.last)
+    for (const MovingSolids::LastPose& l : moving.solids.last)
       if (m.dynamic() && l.body == body && (l.origin - m.sweptOrigin).norm() <= m.radius) {
         m.sweptTheta = l.theta;
         m.sweptOrigin = l.origin;
       }
-    moving.bodies.push_back(std::move(m));
+    moving.solids.bodies.push_back(std::move(m));
   }
   // The `bodies` stage exists only with moving bodies, `body_gravity` and `body_walls` only with a dynamic one.
-  if (had != !moving.bodies.empty() || hadDynamic != moving.anyDynamic()) buildStages();
+  if (had != !moving.solids.bodies.empty() || hadDynamic != moving.solids.anyDynamic()) buildStages();
 }
 
 // An impulse at most this in each component [N·s per metre of depth] is none: the fluid did not
@@ -345,36 +343,36 @@ void World::Impl::captureBodies() {
 constexpr double kNegligibleImpulse = 1e-12;
 
 void World::Impl::moveOwnBodies(double dt) {
-  moving.last.clear();
-  for (const MovingSolid& m : moving.bodies) moving.last.push_back({m.body, m.sweptTheta, m.sweptOrigin});
-  for (const MovingSolid& m : moving.bodies) {
+  moving.solids.last.clear();
+  for (const MovingSolid& m : moving.solids.bodies) moving.solids.last.push_back({m.body, m.sweptTheta, m.sweptOrigin});
+  for (const MovingSolid& m : moving.solids.bodies) {
     const bool noImpulse =
         std::abs(m.impulse.x()) <= kNegligibleImpulse && std::abs(m.impulse.y()) <= kNegligibleImpulse;
     if (!m.dynamic() || (noImpulse && m.angularImpulse == 0)) continue;
     m.body->ApplyLinearImpulse(b2Vec2(float(m.impulse.x()), float(m.impulse.y())), m.body->GetWorldCenter(), true);
     m.body->ApplyAngularImpulse(float(m.angularImpulse), true);
   }
-  if (!ownWorld || moving.bodies.empty() || !(dt > 0)) return;
+  if (!ownWorld || moving.solids.bodies.empty() || !(dt > 0)) return;
   ownWorld->Step(float(dt), 8, 3);
 }
 
 bool World::Impl::insideMoving(const Vec2& p) const {
-  return solidAt(moving, time - moving.time0, Vec2d(p.x(), p.y())) >= 0;
+  return solidAt(moving.solids, time - moving.solids.time0, Vec2d(p.x(), p.y())) >= 0;
 }
 
 void World::Impl::bodyGravity(StepContext& c) {
-  const double tau0 = c.time - moving.time0;
-  for (MovingSolid& m : moving.bodies)
+  const double tau0 = c.time - moving.solids.time0;
+  for (MovingSolid& m : moving.solids.bodies)
     if (m.dynamic()) m.changeVelocity(tau0, m.gravity * double(c.dt), 0);
 }
 
 std::vector<Collider> World::movingColliders() const {
   const Impl& w = *impl_;
   std::vector<Collider> out;
-  for (const MovingSolid& m : w.moving.bodies) {
+  for (const MovingSolid& m : w.moving.solids.bodies) {
     double theta;
     Vec2d o;
-    m.pose(w.time - w.moving.time0, theta, o);
+    m.pose(w.time - w.moving.solids.time0, theta, o);
     for (Collider c : m.shapes) {
       auto place = [&](const Vec2& p) {
         const Vec2d q = o + rot(theta, Vec2d(p.x(), p.y()));
@@ -403,8 +401,8 @@ std::vector<Collider> World::movingColliders() const {
 
 bool World::Impl::nearMovingSamples(const Vec2& p) const {
   if (!bodySamplesOn()) return false;
-  const double tau = time - moving.time0, limit = -0.4 * double(dx);
-  for (const MovingSolid& m : moving.bodies)
+  const double tau = time - moving.solids.time0, limit = -0.4 * double(dx);
+  for (const MovingSolid& m : moving.solids.bodies)
     if (m.depth(tau, Vec2d(p.x(), p.y())) > limit) return true;
   return false;
 }

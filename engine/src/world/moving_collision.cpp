@@ -109,8 +109,8 @@ void World::Impl::bodyWalls(StepContext& c) {
   // end is tested against the static fixtures with Box2D's own collide functions; where the
   // skins would overlap deeper than kRunInto, the part of its velocity into the fixture (its
   // centre of mass's, along the contact normal) is removed, as Box2D's inelastic contact would.
-  const double tau0 = c.time - moving.time0, tau1 = tau0 + double(c.dt);
-  for (MovingSolid& m : moving.bodies) {
+  const double tau0 = c.time - moving.solids.time0, tau1 = tau0 + double(c.dt);
+  for (MovingSolid& m : moving.solids.bodies) {
     if (!m.dynamic()) continue;
     double theta;
     Vec2d o;
@@ -147,12 +147,12 @@ void World::Impl::bodyWalls(StepContext& c) {
 }
 
 void World::Impl::collideMoving(StepContext& c, bool atStart) {
-  if (moving.bodies.empty()) return;
-  const double tau0 = c.time - moving.time0, tau1 = atStart ? tau0 : tau0 + double(c.dt),
+  if (moving.solids.bodies.empty()) return;
+  const double tau0 = c.time - moving.solids.time0, tau1 = atStart ? tau0 : tau0 + double(c.dt),
                clearance = double(c.clearance);
-  using Pose = BodyPose;
-  const std::vector<MovingSolid>& bodies = moving.bodies;
-  std::vector<Pose>& poses = bodyPoses;
+  using Pose = MovingBodies::Pose;
+  const std::vector<MovingSolid>& bodies = moving.solids.bodies;
+  std::vector<Pose>& poses = moving.poses;
   poses.resize(bodies.size());
   for (std::size_t k = 0; k < bodies.size(); ++k) {
     Pose& q = poses[k];
@@ -176,10 +176,10 @@ void World::Impl::collideMoving(StepContext& c, bool atStart) {
                std::fabs(poses[k].theta1 - poses[k].theta0) * bodies[k].radius > tol;
     if (!jumped) return;
   }
-  const bool anyDynamic = moving.anyDynamic();
+  const bool anyDynamic = moving.solids.anyDynamic();
   if (anyDynamic) {
-    hitBody.assign(c.P.size(), -1);
-    hitNormal.resize(c.P.size());
+    moving.hitBody.assign(c.P.size(), -1);
+    moving.hitNormal.resize(c.P.size());
   }
   // Body frame from the local frame: rotate by −θ about the body origin.
   auto toBody = [](double co, double si, const Vec2d& p) {
@@ -190,8 +190,8 @@ void World::Impl::collideMoving(StepContext& c, bool atStart) {
   auto settle = [&](std::size_t i, std::size_t k, const Vec2d& x, const Vec2d& n) {
     const MovingSolid& m = bodies[k];
     if (m.dynamic()) {
-      hitBody[i] = std::int32_t(k);
-      hitNormal[i] = n;
+      moving.hitBody[i] = std::int32_t(k);
+      moving.hitNormal[i] = n;
       return;
     }
     const Vec2d r = x - poses[k].com1, vb = m.v + m.omega * Vec2d(-r.y(), r.x());
@@ -346,38 +346,38 @@ void World::Impl::collideMoving(StepContext& c, bool atStart) {
     }
   });
   for (std::size_t k = 0; k < bodies.size(); ++k) {
-    moving.bodies[k].sweptTheta = poses[k].theta1;
-    moving.bodies[k].sweptOrigin = poses[k].o1;
+    moving.solids.bodies[k].sweptTheta = poses[k].theta1;
+    moving.solids.bodies[k].sweptOrigin = poses[k].o1;
   }
   if (!anyDynamic) return;
   // The dynamic bodies' contacts, in slot order: count each body's approaching contacts,
   // then solve each as inelastic with the body's mass split among them.
-  std::vector<int>& count = contactCount;
+  std::vector<int>& count = moving.contactCount;
   count.assign(bodies.size(), 0);
   auto approach = [&](std::size_t i, Vec2d& r, double& vn) {
-    const MovingSolid& m = bodies[std::size_t(hitBody[i])];
+    const MovingSolid& m = bodies[std::size_t(moving.hitBody[i])];
     const Vec2d x(c.P.x[i].x(), c.P.x[i].y());
     r = x - m.centreAt(tau1);
-    vn = (Vec2d(c.P.v[i].x(), c.P.v[i].y()) - m.velocityAt(tau1, x)).dot(hitNormal[i]);
+    vn = (Vec2d(c.P.v[i].x(), c.P.v[i].y()) - m.velocityAt(tau1, x)).dot(moving.hitNormal[i]);
     return vn < 0;
   };
   for (std::size_t i = 0; i < c.P.size(); ++i) {
     Vec2d r;
     double vn;
-    if (hitBody[i] >= 0 && approach(i, r, vn)) ++count[std::size_t(hitBody[i])];
+    if (moving.hitBody[i] >= 0 && approach(i, r, vn)) ++count[std::size_t(moving.hitBody[i])];
   }
-  std::vector<Vec2d>& J = contactImpulse;
-  std::vector<double>& L = contactTorque;
+  std::vector<Vec2d>& J = moving.contactImpulse;
+  std::vector<double>& L = moving.contactTorque;
   J.assign(bodies.size(), Vec2d(0, 0));
   L.assign(bodies.size(), 0.0);
   const double m0 = double(c.mass);
   for (std::size_t i = 0; i < c.P.size(); ++i) {
     Vec2d r;
     double vn;
-    if (hitBody[i] < 0 || !approach(i, r, vn)) continue;
-    const std::size_t k = std::size_t(hitBody[i]);
+    if (moving.hitBody[i] < 0 || !approach(i, r, vn)) continue;
+    const std::size_t k = std::size_t(moving.hitBody[i]);
     const MovingSolid& m = bodies[k];
-    const Vec2d& n = hitNormal[i];
+    const Vec2d& n = moving.hitNormal[i];
     const double rn = r.x() * n.y() - r.y() * n.x();
     const double invMeff = m.invMass + rn * rn * m.invInertia;
     const double j = -vn / (1.0 / m0 + double(count[k]) * invMeff);  // > 0, along n for the particle
@@ -386,6 +386,6 @@ void World::Impl::collideMoving(StepContext& c, bool atStart) {
     L[k] -= j * rn;
   }
   for (std::size_t k = 0; k < bodies.size(); ++k)
-    if (count[k] > 0) moving.bodies[k].push(tau1, J[k], L[k]);
+    if (count[k] > 0) moving.solids.bodies[k].push(tau1, J[k], L[k]);
 }
 }  // namespace sph2d

@@ -45,19 +45,6 @@ std::uint32_t getU32(const World& w, const ParticleStore& P, const char* field, 
   return i == World::npos ? 0u : (*f)[i];
 }
 
-/// Rebuilds the id index of `P`.
-void rebuild(std::vector<std::pair<std::uint32_t, std::uint32_t>>& index, const ParticleStore& P) {
-  index.resize(P.size());
-  for (std::size_t i = 0; i < P.size(); ++i) index[i] = {P.id[i], std::uint32_t(i)};
-  std::sort(index.begin(), index.end());
-}
-
-/// The slot `id` has in `index` (sorted by id), or World::npos.
-std::size_t find(const std::vector<std::pair<std::uint32_t, std::uint32_t>>& index, std::uint32_t id) {
-  const auto it = std::lower_bound(index.begin(), index.end(), std::make_pair(id, std::uint32_t(0)));
-  return it != index.end() && it->first == id ? std::size_t(it->second) : World::npos;
-}
-
 /// The bulk calls' argument check: as many values as ids.
 template <class T>
 void checkLengths(const char* call, const std::vector<std::uint32_t>& ids, const std::vector<T>& values,
@@ -73,20 +60,6 @@ void checkFinite(const char* call, const std::vector<Vec2d>& values, const char*
     if (!finite(v)) throw std::invalid_argument(std::string(call) + ": every " + what + " must be finite");
 }
 
-/// Calls f(k, slot) for each ids[k] a particle has, the id index rebuilt once first (absent ids
-/// then cost a search each, not a rebuild); returns how many calls returned true.
-template <class F>
-std::size_t forEachId(std::vector<std::pair<std::uint32_t, std::uint32_t>>& index, const ParticleStore& P,
-                      const std::vector<std::uint32_t>& ids, F&& f) {
-  rebuild(index, P);
-  std::size_t n = 0;
-  for (std::size_t k = 0; k < ids.size(); ++k) {
-    const std::size_t i = find(index, ids[k]);
-    if (i != World::npos && f(k, i)) ++n;
-  }
-  return n;
-}
-
 }  // namespace
 
 bool World::Impl::teleport(std::size_t i, const Vec2d& position) {
@@ -97,15 +70,7 @@ bool World::Impl::teleport(std::size_t i, const Vec2d& position) {
   return true;
 }
 
-std::size_t World::slotOf(std::uint32_t id) const {
-  const Impl& w = *impl_;
-  std::size_t slot = find(w.idIndex, id);
-  if (slot < w.P.size() && w.P.id[slot] == id) return slot;
-  // Stale (the slot moved, or the id is absent, perhaps because it is newer than the
-  // index): rebuild, then the answer is exact.
-  rebuild(w.idIndex, w.P);
-  return find(w.idIndex, id);
-}
+std::size_t World::slotOf(std::uint32_t id) const { return impl_->index.slotOf(impl_->P, id); }
 
 bool World::getParticle(std::uint32_t id, Vec2d& position, Vec2d& velocity) const {
   const std::size_t i = slotOf(id);
@@ -122,7 +87,7 @@ bool World::setParticle(std::uint32_t id, const Vec2d& position, const Vec2d& ve
   const std::size_t i = slotOf(id);
   if (i == npos || !w.teleport(i, position)) return false;
   w.P.v[i] = Vec2(Real(velocity.x()), Real(velocity.y()));
-  ++w.edits;  // the query grid is stale
+  w.index.noteEdit();  // the query grid is stale
   w.refreshView();
   return true;
 }
@@ -139,7 +104,7 @@ std::size_t World::setVelocities(const std::vector<std::uint32_t>& ids, const st
   checkLengths("setVelocities", ids, velocities, "velocities");
   checkFinite("setVelocities", velocities, "velocity");
   Impl& w = *impl_;
-  return forEachId(w.idIndex, w.P, ids, [&](std::size_t k, std::size_t i) {
+  return w.index.forEachId(w.P, ids, [&](std::size_t k, std::size_t i) {
     w.P.v[i] = Vec2(Real(velocities[k].x()), Real(velocities[k].y()));
     return true;
   });
@@ -151,7 +116,7 @@ std::size_t World::getParticles(const std::vector<std::uint32_t>& ids, std::vect
   const double nan = std::numeric_limits<double>::quiet_NaN();
   positions.assign(ids.size(), Vec2d(nan, nan));
   velocities.assign(ids.size(), Vec2d(nan, nan));
-  return forEachId(w.idIndex, w.P, ids, [&](std::size_t k, std::size_t i) {
+  return w.index.forEachId(w.P, ids, [&](std::size_t k, std::size_t i) {
     positions[k] = worldPosition(i);
     velocities[k] = Vec2d(w.P.v[i].x(), w.P.v[i].y());
     return true;
@@ -163,9 +128,9 @@ std::size_t World::setPositions(const std::vector<std::uint32_t>& ids, const std
   checkFinite("setPositions", positions, "position");
   Impl& w = *impl_;
   const std::size_t moved =
-      forEachId(w.idIndex, w.P, ids, [&](std::size_t k, std::size_t i) { return w.teleport(i, positions[k]); });
+      w.index.forEachId(w.P, ids, [&](std::size_t k, std::size_t i) { return w.teleport(i, positions[k]); });
   if (moved) {
-    ++w.edits;  // the query grid is stale
+    w.index.noteEdit();  // the query grid is stale
     w.refreshView();
   }
   return moved;
@@ -182,7 +147,7 @@ std::size_t World::setParticleColors(const std::vector<std::uint32_t>& ids, cons
   Impl& w = *impl_;
   std::vector<std::uint32_t>& c = w.P.fieldU32(kColorField);
   w.refreshView();  // the field may be new
-  return forEachId(w.idIndex, w.P, ids, [&](std::size_t k, std::size_t i) {
+  return w.index.forEachId(w.P, ids, [&](std::size_t k, std::size_t i) {
     c[i] = colors[k];
     return true;
   });
@@ -231,7 +196,7 @@ IdRange World::addParticles(const std::vector<Vec2d>& points, const std::vector<
       ++inside;
       continue;
     }
-    if (w.P.size() >= w.budget) {
+    if (w.P.size() >= w.sources.budget) {
       refused = points.size() - k;
       break;
     }
@@ -239,13 +204,13 @@ IdRange World::addParticles(const std::vector<Vec2d>& points, const std::vector<
     ++ids.count;
     w.P.push(p, Vec2(Real(v.x()), Real(v.y())), w.nextId++, rho0);
   }
-  ++w.edits;  // the query grid is stale
+  w.index.noteEdit();  // the query grid is stale
   w.refreshView();
   if (inside) w.warnings.push_back("addParticles: skipped " + std::to_string(inside) + " points inside solids");
   if (refused) {
     std::ostringstream o;
-    o << "particle budget of " << w.budget << " (" << w.budgetKey() << ") reached: addParticles added " << ids.size()
-      << " and refused the last " << refused << " points (raise " << w.budgetKey() << " or add less)";
+    o << "particle budget of " << w.sources.budget << " (" << w.budgetKey() << ") reached: addParticles added "
+      << ids.size() << " and refused the last " << refused << " points (raise " << w.budgetKey() << " or add less)";
     w.warnings.push_back(o.str());
   }
   return ids;
@@ -255,11 +220,11 @@ std::vector<std::uint32_t> World::removeParticles(const std::vector<std::uint32_
   Impl& w = *impl_;
   std::vector<std::uint32_t> sorted(ids);
   std::sort(sorted.begin(), sorted.end());
-  w.dead.assign(w.P.size(), 0);
+  w.sources.dead.assign(w.P.size(), 0);
   std::size_t n = 0;
   for (std::size_t i = 0; i < w.P.size(); ++i) {
-    w.dead[i] = std::binary_search(sorted.begin(), sorted.end(), w.P.id[i]);
-    n += w.dead[i];
+    w.sources.dead[i] = std::binary_search(sorted.begin(), sorted.end(), w.P.id[i]);
+    n += w.sources.dead[i];
   }
   std::vector<std::uint32_t> removed;
   if (n) w.removeFlagged(&removed);
@@ -267,7 +232,7 @@ std::vector<std::uint32_t> World::removeParticles(const std::vector<std::uint32_
 }
 
 std::vector<std::uint32_t> World::removeParticlesInShape(const b2Shape& shape, const b2Transform& xf) {
-  const std::vector<std::size_t> in = particlesInShape(shape, xf);
+  const std::vector<std::size_t> in = slotsInShape(shape, xf);
   std::vector<std::uint32_t> ids;
   for (const std::size_t i : in) ids.push_back(impl_->P.id[i]);
   return removeParticles(ids);

@@ -100,7 +100,7 @@ IdRange World::Impl::fillBlock(const FluidBlockDef& b, bool hydrostaticStart) {
         ++dropped;
         continue;
       }
-      if (P.size() >= budget) {
+      if (P.size() >= sources.budget) {
         refused = true;
         break;
       }
@@ -118,12 +118,12 @@ IdRange World::Impl::fillBlock(const FluidBlockDef& b, bool hydrostaticStart) {
   if (refused) {
     const double lattice = disc ? 3.14159265358979323846 * b.radius * b.radius / (sd.spacing * sd.spacing) : nxd * nyd;
     std::ostringstream o;
-    o << "particle budget of " << budget << " (" << budgetKey() << ") reached: added " << added << " of the "
+    o << "particle budget of " << sources.budget << " (" << budgetKey() << ") reached: added " << added << " of the "
       << (disc ? "drop" : "block") << "'s about " << lattice << " and refused the rest (raise " << budgetKey()
       << " or add less)";
     warnings.push_back(o.str());
   }
-  ++edits;  // the query grid is stale
+  index.noteEdit();
   refreshView();
   ids.count = added;
   return ids;
@@ -143,11 +143,11 @@ void World::Impl::removeFlagged(std::vector<std::uint32_t>* ids) {
   if (ids) {
     ids->clear();
     for (std::size_t i = 0; i < P.size(); ++i)
-      if (dead[i]) ids->push_back(P.id[i]);
+      if (sources.dead[i]) ids->push_back(P.id[i]);
     std::sort(ids->begin(), ids->end());
   }
-  removed += P.compact(dead);
-  ++edits;  // the query grid is stale
+  sources.removed += P.compact(sources.dead);
+  index.noteEdit();
   refreshView();
 }
 
@@ -158,12 +158,12 @@ void World::Impl::removeOldest(std::size_t k) {
   std::vector<std::uint32_t> ids(P.id);
   std::nth_element(ids.begin(), ids.begin() + std::ptrdiff_t(k - 1), ids.end());  // ids are unique: no ties
   const std::uint32_t cut = ids[k - 1];
-  dead.assign(P.size(), 0);
-  for (std::size_t i = 0; i < P.size(); ++i) dead[i] = P.id[i] <= cut;
+  sources.dead.assign(P.size(), 0);
+  for (std::size_t i = 0; i < P.size(); ++i) sources.dead[i] = P.id[i] <= cut;
   removeFlagged();
 }
 
-std::string World::Impl::emitterProblem(const EmitterDef& d) {
+std::string ParticleSources::problem(const EmitterDef& d) {
   auto finite = [](const Vec2d& v) { return std::isfinite(v.x()) && std::isfinite(v.y()); };
   auto in = [](double v, double lo, double hi) { return v >= lo && v <= hi; };  // false for NaN
   std::ostringstream o;
@@ -198,8 +198,8 @@ void World::Impl::emit(Real dt) {
   // With emitter tracking on, each particle made here takes 1 + its emitter's index. (A field in
   // a deque: removeOldest below compacts it, and the pointer stays good.)
   std::vector<std::uint32_t>* tag = P.findU32(ParticleStore::kEmitter);
-  for (std::size_t e = 0; e < emitters.size(); ++e) {
-    EmitterState& s = emitters[e];
+  for (std::size_t e = 0; e < sources.emitters.size(); ++e) {
+    ParticleSources::Emitter& s = sources.emitters[e];
     const EmitterDef& d = s.def;
     if (!d.enabled || d.rate <= 0) continue;
     const double tEnd = std::min(time + double(dt), d.stop);
@@ -244,13 +244,13 @@ void World::Impl::emit(Real dt) {
         }
         pw = nozzle;
       }
-      if (P.size() >= budget) {
+      if (P.size() >= sources.budget) {
         if (scene.effects.budgetPolicy == BudgetPolicy::RecycleOldest) {
-          removeOldest(P.size() - budget + 1);
+          removeOldest(P.size() - sources.budget + 1);
         } else {
           if (!s.warnedBudget) {
             std::ostringstream o;
-            o << "particle budget " << budget << " reached at t = " << time << " s: emitter " << e
+            o << "particle budget " << sources.budget << " reached at t = " << time << " s: emitter " << e
               << " pauses until particles leave (policy stop_emitting)";
             warnings.push_back(o.str());
             s.warnedBudget = true;
@@ -269,23 +269,23 @@ void World::Impl::emit(Real dt) {
 void World::Impl::lifetimes(Real dt) {
   std::vector<Real>& age = P.field("age");
   const Real maxAge = Real(scene.effects.maxAge);
-  dead.assign(P.size(), 0);
+  sources.dead.assign(P.size(), 0);
   bool any = false;
   for (std::size_t i = 0; i < P.size(); ++i) {
     age[i] += dt;
-    dead[i] = age[i] > maxAge;
-    any = any || dead[i];
+    sources.dead[i] = age[i] > maxAge;
+    any = any || sources.dead[i];
   }
   if (any) removeFlagged();
 }
 
 void World::Impl::sinks() {
-  dead.assign(P.size(), 0);
+  sources.dead.assign(P.size(), 0);
   bool any = false;
   for (std::size_t i = 0; i < P.size(); ++i) {
     const Vec2d w = Vec2d(P.x[i].x(), P.x[i].y()) + origin;
-    for (const RegionDef& r : scene.effects.sinks) dead[i] = dead[i] || r.contains(w);
-    any = any || dead[i];
+    for (const RegionDef& r : scene.effects.sinks) sources.dead[i] = sources.dead[i] || r.contains(w);
+    any = any || sources.dead[i];
   }
   if (any) removeFlagged();
 }

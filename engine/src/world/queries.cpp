@@ -13,72 +13,18 @@
 
 namespace sph2d {
 
-const World::Impl::QueryGrid& World::Impl::currentQueryGrid() const {
-  QueryGrid& g = queryGrid;
-  if (g.steps == steps && g.edits == edits && g.count == P.size()) return g;
-  g.steps = steps;
-  g.edits = edits;
-  g.count = P.size();
-  g.nx = g.ny = 0;
-  g.start.clear();
-  g.items.clear();
-  if (P.size() == 0) return g;
-  double x0 = P.x[0].x(), y0 = P.x[0].y(), x1 = x0, y1 = y0;
-  for (const Vec2& x : P.x) {
-    x0 = std::min(x0, double(x.x()));
-    x1 = std::max(x1, double(x.x()));
-    y0 = std::min(y0, double(x.y()));
-    y1 = std::max(y1, double(x.y()));
-  }
-  // Cells of the support radius, grown when spray makes the bounds huge (at most 4 cells a particle).
-  g.h = double(R);
-  const double most = 4.0 * double(P.size()) + 64;
-  while (((x1 - x0) / g.h + 1) * ((y1 - y0) / g.h + 1) > most) g.h *= 2;
-  g.x0 = x0;
-  g.y0 = y0;
-  g.nx = long((x1 - x0) / g.h) + 1;
-  g.ny = long((y1 - y0) / g.h) + 1;
-  const std::size_t cells = std::size_t(g.nx * g.ny);
-  std::vector<std::uint32_t> cellOf(P.size());
-  g.start.assign(cells + 1, 0);
-  for (std::size_t i = 0; i < P.size(); ++i) {
-    const long ci = std::min(g.nx - 1, long((double(P.x[i].x()) - x0) / g.h));
-    const long cj = std::min(g.ny - 1, long((double(P.x[i].y()) - y0) / g.h));
-    cellOf[i] = std::uint32_t(cj * g.nx + ci);
-    ++g.start[cellOf[i] + 1];
-  }
-  for (std::size_t k = 0; k < cells; ++k) g.start[k + 1] += g.start[k];
-  g.items.resize(P.size());
-  std::vector<std::uint32_t> fill(g.start.begin(), g.start.end() - 1);
-  for (std::size_t i = 0; i < P.size(); ++i) g.items[fill[cellOf[i]]++] = std::uint32_t(i);  // slot order within a cell
-  return g;
-}
-
-namespace {
-/// The slots `f` accepts among the candidates of [lo, hi], in slot order.
-template <class Accept>
-std::vector<std::size_t> collect(const World::Impl& w, const Vec2d& lo, const Vec2d& hi, Accept&& accept) {
-  std::vector<std::size_t> out;
-  w.forCandidates(lo, hi, [&](std::size_t i) {
-    if (accept(i)) out.push_back(i);
-  });
-  std::sort(out.begin(), out.end());
-  return out;
-}
-}  // namespace
-
-std::vector<std::size_t> World::particlesInRadius(const Vec2d& c, double radius) const {
+std::vector<std::size_t> World::slotsInRadius(const Vec2d& c, double radius) const {
   const Vec2d r(radius, radius);
-  return collect(*impl_, c - r, c + r,
-                 [&](std::size_t i) { return (worldPosition(i) - c).squaredNorm() <= radius * radius; });
+  return impl_->slotsWhere(c - r, c + r,
+                           [&](std::size_t i) { return (worldPosition(i) - c).squaredNorm() <= radius * radius; });
 }
 
-std::vector<std::size_t> World::particlesInBox(const Vec2d& lo, const Vec2d& hi) const {
+std::vector<std::size_t> World::slotsInBox(const Vec2d& lo, const Vec2d& hi) const {
   const RegionDef r{lo, hi};
-  return collect(*impl_, lo, hi, [&](std::size_t i) { return r.contains(worldPosition(i)); });
+  return impl_->slotsWhere(lo, hi, [&](std::size_t i) { return r.contains(worldPosition(i)); });
 }
 
-std::vector<std::size_t> World::particlesInShape(const b2Shape& shape, const b2Transform& xf) const {
+std::vector<std::size_t> World::slotsInShape(const b2Shape& shape, const b2Transform& xf) const {
   b2AABB box;
   box.lowerBound = box.upperBound = b2Vec2(0, 0);
   for (int c = 0; c < shape.GetChildCount(); ++c) {
@@ -90,13 +36,13 @@ std::vector<std::size_t> World::particlesInShape(const b2Shape& shape, const b2T
       box.Combine(a);
   }
   const Vec2d lo(box.lowerBound.x, box.lowerBound.y), hi(box.upperBound.x, box.upperBound.y);
-  return collect(*impl_, lo, hi, [&](std::size_t i) {
+  return impl_->slotsWhere(lo, hi, [&](std::size_t i) {
     const Vec2d p = worldPosition(i);
     return shape.TestPoint(xf, b2Vec2(float(p.x()), float(p.y())));
   });
 }
 
-std::vector<std::uint32_t> World::particlesTouching(const b2Fixture& fixture) const {
+std::vector<std::uint32_t> World::idsTouching(const b2Fixture& fixture) const {
   const Impl& w = *impl_;
   const double reach = double(w.dx);  // the first layer of resting water sits 0.25–0.5 dx off a wall
   const b2Shape& shape = *fixture.GetShape();
@@ -116,7 +62,7 @@ std::vector<std::uint32_t> World::particlesTouching(const b2Fixture& fixture) co
     const bool skinned = shape.GetType() == b2Shape::e_polygon && fixture.GetBody()->GetType() != b2_staticBody &&
                          !w.solver->movingSamples();
     const double radius = shape.GetType() == b2Shape::e_circle || skinned ? double(shape.m_radius) : 0.0;
-    const std::vector<std::size_t> near = collect(w, lo, hi, [&](std::size_t i) {
+    const std::vector<std::size_t> near = w.slotsWhere(lo, hi, [&](std::size_t i) {
       const Vec2d p = worldPosition(i);
       const b2Vec2 q(float(p.x()), float(p.y()));
       b2DistanceProxy point;
@@ -139,16 +85,9 @@ std::vector<std::uint32_t> World::particlesTouching(const b2Fixture& fixture) co
   }
   // With contact tracking, also those that touched it at the end of a substep of the last
   // step (and are still there: not removed since).
-  bool merged = false;
-  if (w.contactsOn) {
-    const auto key = std::uintptr_t(static_cast<const void*>(&fixture));
-    const std::pair<std::uintptr_t, std::uint32_t> lo{key, 0}, hi{key, 0xffffffffu};
-    const auto b = std::lower_bound(w.frameContacts.begin(), w.frameContacts.end(), lo);
-    const auto e = std::upper_bound(b, w.frameContacts.end(), hi);
-    for (auto it = b; it != e; ++it)
-      if (slotOf(it->second) != npos) ids.push_back(it->second);
-    merged = b != e;
-  }
+  const bool merged = w.contacts.forFixture(&fixture, [&](std::uint32_t id) {
+    if (slotOf(id) != npos) ids.push_back(id);
+  });
   if (shape.GetChildCount() > 1 ||
       merged) {  // a particle found twice (two links, or now and before) once, in slot order
     std::vector<std::pair<std::size_t, std::uint32_t>> bySlot;
@@ -165,7 +104,7 @@ void World::forEachContact(const std::function<void(const b2Fixture&, const std:
   const b2World& b2 = box2d();
   for (const b2Body* body = b2.GetBodyList(); body; body = body->GetNext())
     for (const b2Fixture* fx = body->GetFixtureList(); fx; fx = fx->GetNext()) {
-      const std::vector<std::uint32_t> ids = particlesTouching(*fx);
+      const std::vector<std::uint32_t> ids = idsTouching(*fx);
       if (!ids.empty()) f(*fx, ids);
     }
 }
@@ -178,7 +117,7 @@ World::FieldSample World::sampleAt(const Vec2d& point) const {
   Vec2d vel(0, 0);
   // The particles within R, summed in slot order (the same sum as a scan of every particle).
   const Vec2d reach(W.R, W.R);
-  for (const std::size_t i : collect(w, point - reach, point + reach, [](std::size_t) { return true; })) {
+  for (const std::size_t i : w.slotsWhere(point - reach, point + reach, [](std::size_t) { return true; })) {
     const double r = (worldPosition(i) - point).norm();
     if (r >= W.R) continue;
     const double wv = W.value(r) * double(w.mass) / double(w.P.rho[i]);  // V_j W
@@ -234,8 +173,6 @@ double World::kineticEnergy() const {
   return e;
 }
 
-std::size_t World::neighbourPairs() const { return impl_->nbr.pairs(); }
-
 std::vector<std::string> World::particleFields() const {
   std::vector<std::string> f;
   impl_->P.forEachField([&](const char* name, const auto&) { f.push_back(name); });
@@ -254,22 +191,32 @@ std::vector<std::string> World::stages() const {
   return s;
 }
 
-std::vector<StageTiming> World::timings() const { return impl_->stages.timings(); }
+WorldProfile World::profile() const { return WorldProfile{impl_->stages.timings()}; }
 
-void World::resetTimings() { impl_->stages.resetTimings(); }
+void World::resetProfile() { impl_->stages.resetTimings(); }
 
-SolverStats World::solverStats() const { return impl_->solver->stats(); }
-
-std::uint64_t World::solverIterations() const { return impl_->iterations; }
+WorldCounters World::counters() const {
+  const Impl& w = *impl_;
+  WorldCounters c;
+  c.frames = w.frames;
+  c.substeps = w.steps;
+  c.lastFrameSubsteps = w.lastSubsteps;
+  c.solverIterations = w.iterations;
+  c.lastSolve = w.solver->stats();
+  c.particles = w.P.size();
+  c.neighbourPairs = w.nbr.pairs();
+  c.removed = w.sources.removed;
+  c.memoryBytes = w.memoryBytes();
+  c.particleBytes = w.P.bytes();
+  return c;
+}
 
 WallImpulse World::wallImpulse() const { return impl_->wall.sum; }
 
 void World::resetWallImpulse() { impl_->wall.sum = WallImpulse{}; }
 
-std::size_t World::particleBytes() const { return impl_->P.bytes(); }
-
-std::size_t World::memoryBytes() const {
-  const Impl& w = *impl_;
+std::size_t World::Impl::memoryBytes() const {
+  const Impl& w = *this;
   auto cap = [](const auto& v) { return v.capacity() * sizeof(v[0]); };
   std::size_t b = w.P.bytes();
   b += cap(w.grid.cellStart) + cap(w.grid.sorted) + cap(w.grid.cellOf);
@@ -278,8 +225,7 @@ std::size_t World::memoryBytes() const {
   for (const auto& v : w.nbr.boundaryPerBlock) b += cap(v);
   b += cap(w.scratch.v) + cap(w.scratch.r) + cap(w.scratch.u);
   b += cap(w.boundary.samples) + cap(w.boundary.volume) + cap(w.boundary.sideNormal) + cap(w.boundary.sideOffset);
-  b += cap(w.idIndex);                                   // only once a game looked a particle up by id
-  b += cap(w.queryGrid.start) + cap(w.queryGrid.items);  // only once a game searched
+  b += w.index.bytes();  // only once a game looked a particle up or searched
   return b;
 }
 

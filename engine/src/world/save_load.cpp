@@ -38,7 +38,7 @@ namespace sph2d {
 namespace {
 
 constexpr char kMagic[8] = {'S', 'P', 'H', '2', 'D', 'S', 'A', 'V'};
-constexpr std::uint64_t kMaxEmitters = World::Impl::kMaxEmitters;  // a save holding more is not one of ours
+constexpr std::uint64_t kMaxEmitters = ParticleSources::kMaxEmitters;  // a save holding more is not one of ours
 // 2: every emitter's whole definition (emitters added at run time); 3: bodies' swept poses;
 // 4: the swept poses of a game's b2World's bodies too; 5: the scene's own b2World's warm-starting
 // and sleeping switches and each of its moving bodies' awake state. Version 4 loads as well
@@ -49,19 +49,19 @@ constexpr std::size_t kMaxFields = 64, kMaxName = 128;
 constexpr const char* kUserForce = "user_force";  ///< the effect setUserForces adds
 
 /// What a save must match: the solver and its spacing, the emitters, the effects.
-std::uint64_t fingerprint(const World::Impl& w) {
+std::uint64_t fingerprint(const SceneDef& scene, const Solver& solver, const EffectList& effects) {
   Xxh64 h;
   auto str = [&](const std::string& s) {
     const std::uint64_t n = s.size();
     h.update(&n, sizeof n);
     h.update(s.data(), s.size());
   };
-  str(w.solver->name());
-  const double keys[] = {w.scene.solver.spacing, w.scene.solver.supportRatio, w.scene.solver.restDensity};
+  str(solver.name());
+  const double keys[] = {scene.solver.spacing, scene.solver.supportRatio, scene.solver.restDensity};
   h.update(keys, sizeof keys);
-  const std::uint64_t emitters = w.scene.effects.emitters.size();  // the scene's: a game adds and removes others
+  const std::uint64_t emitters = scene.effects.emitters.size();  // the scene's: a game adds and removes others
   h.update(&emitters, sizeof emitters);
-  for (const auto& e : w.effects)
+  for (const auto& e : effects)
     if (std::string(e->name()) != kUserForce) str(e->name());  // a game adds it at run time
   return h.digest();
 }
@@ -126,7 +126,7 @@ SaveReport World::save(std::ostream& out) const {
   StateOut o;
   for (const char c : kMagic) o.put(c);
   o.put(kVersion);
-  o.put(fingerprint(w));
+  o.put(fingerprint(w.scene, *w.solver, w.effects));
   o.put(w.time);
   o.put(w.frames);
   o.put(w.steps);
@@ -135,10 +135,10 @@ SaveReport World::save(std::ostream& out) const {
   o.put(w.lastDt);
   o.put(w.nextId);
   o.put(w.iterations);
-  o.put(w.removed);
+  o.put(w.sources.removed);
   putVec(o, w.scene.gravity);
-  o.put(std::uint64_t(w.emitters.size()));
-  for (const Impl::EmitterState& e : w.emitters) {
+  o.put(std::uint64_t(w.sources.emitters.size()));
+  for (const ParticleSources::Emitter& e : w.sources.emitters) {
     o.put(e.rng);
     o.put(e.emitted);
     o.put(std::uint8_t(e.warnedBudget));
@@ -198,7 +198,7 @@ SaveReport World::save(std::ostream& out) const {
       }
       // The pose the particles last saw a dynamic body at (moving_solid.hpp), if any.
       const MovingSolids::LastPose* last = nullptr;
-      for (const MovingSolids::LastPose& l : w.moving.last)
+      for (const MovingSolids::LastPose& l : w.moving.solids.last)
         if (l.body == b) last = &l;
       o.put(std::uint8_t(last != nullptr));
       o.put(last ? last->theta : 0.0);
@@ -226,7 +226,7 @@ void World::load(std::istream& input) {
   if (version < kOldestVersion || version > kVersion)
     throw SaveError("the saved state has version " + std::to_string(version) + "; this sph2d reads versions " +
                     std::to_string(kOldestVersion) + " to " + std::to_string(kVersion));
-  if (in.get<std::uint64_t>("the header") != fingerprint(w))
+  if (in.get<std::uint64_t>("the header") != fingerprint(w.scene, *w.solver, w.effects))
     throw SaveError("the saved state belongs to another scene (its solver, spacing, emitters or effects differ)");
   const double time = in.get<double>("the clock");
   const std::uint64_t frames = in.get<std::uint64_t>("the clock"), steps = in.get<std::uint64_t>("the clock");
@@ -243,8 +243,8 @@ void World::load(std::istream& input) {
   if (emitterCount > kMaxEmitters)
     throw SaveError("the saved state is malformed: " + std::to_string(emitterCount) + " emitters (at most " +
                     std::to_string(kMaxEmitters) + ")");
-  std::vector<Impl::EmitterState> emitters(static_cast<std::size_t>(emitterCount));
-  for (Impl::EmitterState& e : emitters) {
+  std::vector<ParticleSources::Emitter> emitters(static_cast<std::size_t>(emitterCount));
+  for (ParticleSources::Emitter& e : emitters) {
     e.rng = in.get<std::uint64_t>("an emitter");
     e.emitted = in.get<std::uint64_t>("an emitter");
     e.warnedBudget = in.get<std::uint8_t>("an emitter") != 0;
@@ -255,7 +255,7 @@ void World::load(std::istream& input) {
                        &e.def.jitter, &e.def.start, &e.def.stop};
     for (double* v : shape) *v = in.get<double>("an emitter");
     e.def.seed = in.get<std::uint64_t>("an emitter");
-    const std::string problem = Impl::emitterProblem(e.def);
+    const std::string problem = ParticleSources::problem(e.def);
     if (!problem.empty() || !(std::abs(e.def.direction.norm() - 1) < 1e-6))
       throw SaveError("the saved state is malformed: an emitter's " +
                       (problem.empty() ? std::string("direction") : problem));
@@ -282,9 +282,9 @@ void World::load(std::istream& input) {
     enabled.push_back(in.get<std::uint8_t>("an effect") != 0);
   }
   const std::uint64_t n = in.get<std::uint64_t>("the particle count");
-  if (n > w.budget)
+  if (n > w.sources.budget)
     throw SaveError("the saved state holds " + std::to_string(n) + " particles, beyond the scene's budget of " +
-                    std::to_string(w.budget) + " (" + w.budgetKey() + ")");
+                    std::to_string(w.sources.budget) + " (" + w.budgetKey() + ")");
   const std::uint64_t fieldCount = in.get<std::uint64_t>("the field count");
   if (fieldCount > kMaxFields)
     throw SaveError("the saved state is malformed: " + std::to_string(fieldCount) + " particle fields");
@@ -415,10 +415,11 @@ void World::load(std::istream& input) {
     movable[k]->SetAngularVelocity(bodyStates[k].omega);
     if (version >= 5) movable[k]->SetAwake(bodyStates[k].awake != 0);  // asleep: at rest, as Box2D put it to sleep
   }
-  w.moving.last.clear();  // the loaded state's, not those of the World's own last step
+  w.moving.solids.last.clear();  // the loaded state's, not those of the World's own last step
   for (std::size_t k = 0; k < movable.size(); ++k)
     if (bodyStates[k].hasLast)
-      w.moving.last.push_back({movable[k], bodyStates[k].lastTheta, Vec2d(bodyStates[k].lastX, bodyStates[k].lastY)});
+      w.moving.solids.last.push_back(
+          {movable[k], bodyStates[k].lastTheta, Vec2d(bodyStates[k].lastX, bodyStates[k].lastY)});
   w.time = time;
   w.frames = frames;
   w.steps = steps;
@@ -428,10 +429,10 @@ void World::load(std::istream& input) {
   w.nextId = nextId;
   w.iterations = iterations;
   w.wall = WallAccount{};  // World::wallImpulse() counts from the load on
-  w.removed = removed;
+  w.sources.removed = removed;
   w.scene.gravity = gravity;
   if (w.ownWorld) w.ownWorld->SetGravity(b2Vec2(float(gravity.x()), float(gravity.y())));
-  w.emitters = std::move(emitters);
+  w.sources.emitters = std::move(emitters);
   // The user-force effect exactly when the saved World had it (setUserForces adds it on the
   // first non-empty list); then the scene's effects as they were switched.
   if (userForceEffect && !w.userForceEffect) {
@@ -448,9 +449,8 @@ void World::load(std::istream& input) {
     for (auto& e : w.effects)
       if (effectNames[k] == e->name()) e->enabled = enabled[k];
   w.buildStages();
-  ++w.edits;
+  w.index.clear();
   w.refreshView();
-  w.idIndex.clear();
   w.abandonedIn.clear();  // an interrupted World is this state now, and steps again
 }
 

@@ -49,16 +49,16 @@ StepContext World::Impl::context(Real dt) {
   c.time = time;
   c.origin = origin;
   c.periodic = periodic;
-  c.boundaryVersion = boundaryVersion;
-  c.solids = moving.bodies.empty() ? nullptr : &moving;
-  if (bodySamplesOn()) c.bodySamples = &bodySamples;
+  c.boundaryVersion = statics.version();
+  c.solids = moving.solids.bodies.empty() ? nullptr : &moving.solids;
+  if (bodySamplesOn()) c.bodySamples = &moving.samples;
   return c;
 }
 
 void World::Impl::buildStages() {
   stages.clear();
-  if (!emitters.empty()) stages.add(plainStage("emit", [this](StepContext& c) { emit(c.dt); }));
-  if (moving.anyDynamic()) {
+  if (!sources.emitters.empty()) stages.add(plainStage("emit", [this](StepContext& c) { emit(c.dt); }));
+  if (moving.solids.anyDynamic()) {
     stages.add(plainStage("body_gravity", [this](StepContext& c) { bodyGravity(c); }));
     stages.add(plainStage("body_walls", [this](StepContext& c) { bodyWalls(c); }));
   }
@@ -66,8 +66,9 @@ void World::Impl::buildStages() {
     // A particle a body's Box2D step moved onto would read as a compression the solve must
     // remove within one substep (kicks of 50 m/s and more under a crate): put back first.
     stages.add(plainStage("body_jump", [this](StepContext& c) { collideMoving(c, true); }));
-    stages.add(plainStage(
-        "body_samples", [this](StepContext& c) { bodySamples.place(c.time, c.dx, c.R, c.P.size(), c.pool, moving); }));
+    stages.add(plainStage("body_samples", [this](StepContext& c) {
+      moving.samples.place(c.time, c.dx, c.R, c.P.size(), c.pool, moving.solids);
+    }));
   }
   bool anyEffect = false;
   Effect* first = nullptr;  // the first enabled effect: the solver may fold it into its pressure force
@@ -96,22 +97,24 @@ void World::Impl::buildStages() {
                                      : maxAccelOf(c.P, c.pool);  // the explicit solvers' force_limit measured it
   }));
   if (bodySamplesOn())
-    stages.add(plainStage("body_forces", [this](StepContext& c) { bodySamples.react(c.time, double(c.dt), moving); }));
+    stages.add(plainStage("body_forces",
+                          [this](StepContext& c) { moving.samples.react(c.time, double(c.dt), moving.solids); }));
   addParticleSystemStages(stages);
 
   drift.clear();
-  if (!emitters.empty()) drift.add(plainStage("emit", [this](StepContext& c) { emit(c.dt); }));
+  if (!sources.emitters.empty()) drift.add(plainStage("emit", [this](StepContext& c) { emit(c.dt); }));
   drift.add(Stage{"drift", [](StepContext& c) { return stageDrift(c); }});
   addParticleSystemStages(drift);
 }
 
 void World::Impl::addParticleSystemStages(StageList& list) {
   list.add(plainStage("collide", [](StepContext& c) { stageCollide(c); }));
-  if (!moving.bodies.empty()) list.add(plainStage("bodies", [this](StepContext& c) { collideMoving(c); }));
+  if (!moving.solids.bodies.empty()) list.add(plainStage("bodies", [this](StepContext& c) { collideMoving(c); }));
   if (periodic.any()) list.add(plainStage("wrap", [](StepContext& c) { stageWrap(c); }));
   if (scene.effects.lifetime) list.add(plainStage("lifetimes", [this](StepContext& c) { lifetimes(c.dt); }));
   if (!scene.effects.sinks.empty()) list.add(plainStage("sinks", [this](StepContext&) { sinks(); }));
-  if (contactsOn) list.add(plainStage("contacts", [this](StepContext& c) { recordContacts(c); }));
+  if (contacts.on())
+    list.add(plainStage("contacts", [this](StepContext& c) { contacts.record(c, P, boundary, moving.solids, dx); }));
 }
 
 Real World::Impl::sourceSpeed() const {
@@ -122,7 +125,7 @@ Real World::Impl::sourceSpeed() const {
   // was nearer).
   double v = 0;
   const double horizon = time + 1.0 / double(scene.fps);
-  for (const EmitterState& s : emitters) {
+  for (const ParticleSources::Emitter& s : sources.emitters) {
     const EmitterDef& d = s.def;
     if (d.enabled && d.rate > 0 && time < d.stop && d.start <= horizon) v = std::max(v, d.speed * (1.0 + d.jitter));
   }

@@ -147,7 +147,7 @@ void World::init() {
   Impl& w = *impl_;
   // The stop flag is read through the set-up too (sampling long solids, filling the blocks,
   // the first density pass): an interrupted constructor throws, and nothing is built.
-  Impl::StopScope scope(w.pool, w.stop);
+  World::Impl::StopScope scope(w.pool, w.stop);
   std::string phase = "solver";
   try {
     initPhases(phase);
@@ -171,12 +171,12 @@ void World::initPhases(std::string& phase) {
   w.solver = makeSolver(sd);
   w.effects = makeEffects(scene);
   for (const EmitterDef& e : scene.effects.emitters) {
-    Impl::EmitterState st;
+    ParticleSources::Emitter st;
     st.def = e;
     st.rng = e.seed;
-    w.emitters.push_back(st);
+    w.sources.emitters.push_back(st);
   }
-  w.budget = scene.effects.budget > 0 ? scene.effects.budget : scene.maxParticles;
+  w.sources.budget = scene.effects.budget > 0 ? scene.effects.budget : scene.maxParticles;
   if (scene.effects.lifetime) w.P.field("age");
   w.warnLowSoundSpeed();
   w.warnInviscidMuller();
@@ -226,8 +226,8 @@ void World::initPhases(std::string& phase) {
     w.periodic.ly = pd.y ? Real(pd.max.y() - pd.min.y()) : Real(0);
   }
   phase = "boundary samples";
-  w.rebuildBoundary();
-  w.recordStaticPoses();
+  w.readBoundary();
+  w.statics.recordPoses(*w.b2);
   w.captureBodies();
   // Fluid blocks on a square lattice; particles inside solids (moving ones too) are dropped.
   for (std::size_t k = 0; k < scene.blocks.size(); ++k) {
@@ -286,18 +286,18 @@ void World::Impl::abandon(const Interrupted& e) {
 void World::step(double dt) {
   Impl& w = *impl_;
   w.beforeStep("step");
-  Impl::StopScope scope(w.pool, w.stop);
+  World::Impl::StopScope scope(w.pool, w.stop);
   try {
     // A game may edit its level between frames: a static body it slid moves through this step
     // as a kinematic one; other changes are re-read (the particles a new solid covers dropped).
     w.readStatics(dt);
-    w.frameContacts.clear();  // the contacts stage's record is this step's
-    w.captureBodies();        // the moving bodies' pose and velocity for this step
+    w.contacts.beginStep();  // the contacts stage's record is this step's
+    w.captureBodies();       // the moving bodies' pose and velocity for this step
     const double t0 = w.time;
     const bool everySubstep = w.bodiesEverySubstep();  // then advance() stepped the bodies
     w.advance(dt);
     if (!everySubstep) w.moveOwnBodies(w.time - t0);
-    if (w.contactsOn) w.finishContacts();
+    w.contacts.finishStep();
     ++w.frames;
     w.refreshView();
   } catch (const Interrupted& e) {
@@ -332,54 +332,54 @@ IdRange World::addDrop(const Vec2d& center, double radius, const Vec2d& velocity
 }
 
 void World::moveEmitter(std::size_t index, const Vec2d& position, const Vec2d& direction) {
-  EmitterDef& d = impl_->emitters.at(index).def;
+  EmitterDef& d = impl_->sources.emitters.at(index).def;
   if (!(direction.norm() > 0)) throw std::invalid_argument("moveEmitter: the direction must not be zero");
   d.position = position;
   d.direction = direction.normalized();
 }
 
-const EmitterDef& World::emitter(std::size_t index) const { return impl_->emitters.at(index).def; }
+const EmitterDef& World::emitter(std::size_t index) const { return impl_->sources.emitters.at(index).def; }
 
 std::size_t World::addEmitter(const EmitterDef& def) {
   Impl& w = *impl_;
-  const std::string problem = Impl::emitterProblem(def);
+  const std::string problem = ParticleSources::problem(def);
   if (!problem.empty()) throw std::invalid_argument("addEmitter: " + problem);
-  if (w.emitters.size() >= Impl::kMaxEmitters)
-    throw std::invalid_argument("addEmitter: the world has " + std::to_string(Impl::kMaxEmitters) +
+  if (w.sources.emitters.size() >= ParticleSources::kMaxEmitters)
+    throw std::invalid_argument("addEmitter: the world has " + std::to_string(ParticleSources::kMaxEmitters) +
                                 " emitters, the most it holds");
-  Impl::EmitterState st;
+  ParticleSources::Emitter st;
   st.def = def;
   st.def.direction = def.direction.normalized();
   st.def.start = std::max(def.start, w.time);  // nothing is owed for the time before
   st.def.stop = std::max(st.def.stop, st.def.start);
   st.rng = def.seed;
-  w.emitters.push_back(st);
-  if (w.emitters.size() == 1) w.buildStages();  // the `emit` stage exists only with emitters
-  return w.emitters.size() - 1;
+  w.sources.emitters.push_back(st);
+  if (w.sources.emitters.size() == 1) w.buildStages();  // the `emit` stage exists only with emitters
+  return w.sources.emitters.size() - 1;
 }
 
 void World::removeEmitter(std::size_t index) {
   Impl& w = *impl_;
-  if (index >= w.emitters.size())
+  if (index >= w.sources.emitters.size())
     throw std::out_of_range("removeEmitter: no emitter " + std::to_string(index) + " (the world has " +
-                            std::to_string(w.emitters.size()) + ")");
-  w.emitters.erase(w.emitters.begin() + std::ptrdiff_t(index));
+                            std::to_string(w.sources.emitters.size()) + ")");
+  w.sources.emitters.erase(w.sources.emitters.begin() + std::ptrdiff_t(index));
   // Emitter tags follow the indices: the removed one's particles have none now, later ones move down.
   if (std::vector<std::uint32_t>* tag = w.P.findU32(ParticleStore::kEmitter)) {
     const std::uint32_t removed = std::uint32_t(index) + 1;
     for (std::uint32_t& t : *tag) t = t == removed ? 0u : t > removed ? t - 1 : t;
   }
-  if (w.emitters.empty()) w.buildStages();
+  if (w.sources.emitters.empty()) w.buildStages();
 }
 
 std::vector<std::uint32_t> World::removeParticlesInBox(const Vec2d& lo, const Vec2d& hi) {
   Impl& w = *impl_;
   const RegionDef r{lo, hi};
-  w.dead.assign(w.P.size(), 0);
+  w.sources.dead.assign(w.P.size(), 0);
   std::size_t n = 0;
   for (std::size_t i = 0; i < w.P.size(); ++i) {
-    w.dead[i] = r.contains(worldPosition(i));
-    n += w.dead[i];
+    w.sources.dead[i] = r.contains(worldPosition(i));
+    n += w.sources.dead[i];
   }
   std::vector<std::uint32_t> ids;
   if (n) w.removeFlagged(&ids);
@@ -435,8 +435,6 @@ const b2World& World::box2d() const { return *impl_->b2; }
 const SceneDef& World::scene() const { return impl_->scene; }
 double World::time() const { return impl_->time; }
 std::uint64_t World::frame() const { return impl_->frames; }
-std::uint64_t World::substeps() const { return impl_->steps; }
-int World::lastFrameSubsteps() const { return impl_->lastSubsteps; }
 double World::stableTimeStep() const { return double(impl_->stableDt()); }
 Real World::particleMass() const { return impl_->mass; }
 Real World::support() const { return impl_->R; }
@@ -452,7 +450,9 @@ void World::setUserForces(const std::vector<UserForce>& forces) {
   }
 }
 
-void World::setEmitterEnabled(std::size_t index, bool enabled) { impl_->emitters.at(index).def.enabled = enabled; }
+void World::setEmitterEnabled(std::size_t index, bool enabled) {
+  impl_->sources.emitters.at(index).def.enabled = enabled;
+}
 
 namespace {
 
@@ -483,24 +483,22 @@ Vec2d World::gravity() const { return impl_->scene.gravity; }
 
 const std::vector<UserForce>& World::userForces() const { return impl_->userForces; }
 
-bool World::emitterEnabled(std::size_t index) const { return impl_->emitters.at(index).def.enabled; }
+bool World::emitterEnabled(std::size_t index) const { return impl_->sources.emitters.at(index).def.enabled; }
 
-std::size_t World::emitterCount() const { return impl_->emitters.size(); }
+std::size_t World::emitterCount() const { return impl_->sources.emitters.size(); }
 
-std::uint64_t World::emittedCount(std::size_t index) const { return impl_->emitters.at(index).emitted; }
+std::uint64_t World::emittedCount(std::size_t index) const { return impl_->sources.emitters.at(index).emitted; }
 
-std::uint64_t World::removedCount() const { return impl_->removed; }
-
-void World::stepSubstep() {
-  Impl& w = *impl_;
+void bench::stepSubstep(World& world) {
+  World::Impl& w = *world.impl_;
   w.beforeStep("stepSubstep");
-  Impl::StopScope scope(w.pool, w.stop);
+  World::Impl::StopScope scope(w.pool, w.stop);
   try {
     w.readStatics(0);  // the level's edits (a moved static body is re-read where it is: no step to slide it over)
-    w.frameContacts.clear();
+    w.contacts.beginStep();
     w.captureBodies();
     w.moveOwnBodies(double(w.substep(w.stableDt())));
-    if (w.contactsOn) w.finishContacts();
+    w.contacts.finishStep();
     w.refreshView();
   } catch (const Interrupted& e) {
     w.abandon(e);

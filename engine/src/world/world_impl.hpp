@@ -1,10 +1,20 @@
-// world_impl.hpp (internal) — the World's state, shared by the files that
-// implement it, one job each:
+// world_impl.hpp (internal) — the World: its core (the scene, the particles, the neighbour
+// grid, the static solids, the solver and effects, the stage list, the clock) and the
+// subsystems it owns, each with its own data and header:
+//   ParticleSources   particle_sources.hpp  emitters, the budget, removals
+//   MovingBodies      moving_bodies.hpp     the kinematic and dynamic bodies, their samples
+//   StaticBridge      box2d_bridge.hpp      the static bodies read from the b2World
+//   ContactTracker    contacts.hpp          which particles touched which fixture
+//   ParticleIndex     particle_index.hpp    lookups by id and by region
+// The files that implement it, one job each:
 //   world.cpp            construction and the public API
 //   stepper.cpp          the stage list, the time-step policy, the guard
 //   particle_sources.cpp  fluid blocks and drops, emitters, lifetimes, sinks, the budget
 //   box2d_bridge.cpp     the scene's b2World and the colliders read from a b2World
+//   moving_bodies.cpp, moving_collision.cpp  the moving bodies' stages
+//   contacts.cpp         the contacts stage
 //   queries.cpp          what readers ask of the state (hash, statistics, searches)
+//   particle_index.cpp   the id index and the search grid
 //   particle_access.cpp  particles by id: read, write, add at points, remove
 //   save_load.cpp        the changing state to and from a byte stream
 #pragma once
@@ -20,13 +30,16 @@
 #include <utility>
 #include <vector>
 
-#include "bodies/body_samples.hpp"
-#include "bodies/moving_solid.hpp"
 #include "effects/effect.hpp"
 #include "solvers/solver.hpp"
 #include "sph2d/world.hpp"
 #include "step/stage_list.hpp"
 #include "step/stages.hpp"
+#include "world/box2d_bridge.hpp"
+#include "world/contacts.hpp"
+#include "world/moving_bodies.hpp"
+#include "world/particle_index.hpp"
+#include "world/particle_sources.hpp"
 
 namespace sph2d {
 
@@ -63,9 +76,14 @@ struct World::Impl {
   std::uint64_t iterations = 0;  ///< solver iterations summed over the substeps
   WallAccount wall;              ///< World::wallImpulse(): the stages of each substep add to it (substep())
   std::vector<std::string> warnings;
-  bool warnedSave = false;              ///< save() has warned of the b2World's state it cannot hold (once per World)
-  std::uint64_t boundarySignature = 0;  ///< staticSignature() when the colliders were last read
-  std::uint64_t boundaryVersion = 0;    ///< how many times the colliders were read (StepContext::boundaryVersion)
+  bool warnedSave = false;  ///< save() has warned of the b2World's state it cannot hold (once per World)
+
+  // The subsystems.
+  ParticleSources sources;  ///< emitters, the budget, removals
+  MovingBodies moving;      ///< the kinematic and dynamic bodies
+  StaticBridge statics;     ///< the static bodies read from the b2World
+  ContactTracker contacts;  ///< contact tracking (off until a game turns it on)
+  ParticleIndex index;      ///< lookups by id and by region
 
   // Stopping on request (World::setStopFlag, WorldOptions::stop).
   const std::atomic<bool>* stop = nullptr;  ///< the caller's stop flag (null: none)
@@ -91,34 +109,14 @@ struct World::Impl {
     StopScope& operator=(const StopScope&) = delete;
   };
 
-  // The particle system (particle_sources.cpp): emitters, lifetimes, sinks, budget.
-  struct EmitterState {
-    EmitterDef def;
-    std::uint64_t rng = 0;  ///< SplitMix64 state, seeded per emitter
-    std::uint64_t emitted = 0;
-    bool warnedBudget = false;
-  };
-  std::vector<EmitterState> emitters;
-  /// What is wrong with an emitter built in code or read from a save, naming the field and
-  /// its range (the scene format's), or "" when nothing is (particle_sources.cpp).
-  static std::string emitterProblem(const EmitterDef& d);
-  static constexpr std::size_t kMaxEmitters = 4096;  ///< addEmitter's and a save's limit
-  std::size_t budget = 0;
-  std::uint64_t removed = 0;
+  // Inputs a game sets between steps.
   std::vector<UserForce> userForces;
   bool userForceEffect = false;
-  std::vector<unsigned char> dead;  ///< scratch: removal flags
-  /// (id, slot) of every particle sorted by id: World::slotOf's index, rebuilt when a lookup
-  /// finds it stale (particle_access.cpp). Mutable: a lookup on a const World refreshes it.
-  mutable std::vector<std::pair<std::uint32_t, std::uint32_t>> idIndex;
   /// Moves particle slot i to `position` (world coordinates) as a teleport (xPrev too);
   /// false, changing nothing, when the position is inside a solid (setParticle, setPositions).
   bool teleport(std::size_t i, const Vec2d& position);
-  // Moving bodies (moving_bodies.cpp, moving_solid.hpp): the kinematic and dynamic bodies
-  // of the b2World, captured at the start of each step with their pose and velocity; the
-  // `bodies` stage pushes the fluid out of them and, for a dynamic body, takes the
-  // contacts' impulse; the grid projection of the game solver sees them as moving solids.
-  MovingSolids moving;
+
+  // The moving bodies' stages (moving_bodies.cpp, moving_collision.cpp).
   /// Reads the non-static bodies of the b2World (rebuilding the stage list when their
   /// presence or kind changed) at the current time.
   void captureBodies();
@@ -140,23 +138,8 @@ struct World::Impl {
   /// over (Box2D's step moves a dynamic body off the path the fluid's substeps assumed);
   /// nothing when no body jumped.
   void collideMoving(StepContext& c, bool atStart = false);
-  std::vector<std::int32_t> hitBody;  ///< the bodies stage's scratch: the dynamic body particle i met (−1: none)
-  std::vector<Vec2d> hitNormal;       ///< … and the body's outward normal there
-  /// The bodies stage's scratch per body: its pose at the substep's start and end.
-  struct BodyPose {
-    double theta0, theta1, c0, s0, c1, s1;  ///< the rotations at the substep's start and end
-    Vec2d o0, o1, com1;
-    double reach2;  ///< beyond this from com1, a particle's whole path misses the body (squared)
-  };
-  std::vector<BodyPose> bodyPoses;
-  std::vector<int> contactCount;      ///< … its approaching contacts
-  std::vector<Vec2d> contactImpulse;  ///< … the contacts' impulse on it
-  std::vector<double> contactTorque;  ///< … and their angular impulse
-
-  /// The moving bodies' boundary samples (body_samples.hpp), when the solver takes them.
-  BodySamples bodySamples;
   /// True when the substep places moving bodies' samples: some moving body, and a solver that takes them.
-  bool bodySamplesOn() const { return !moving.bodies.empty() && solver && solver->movingSamples(); }
+  bool bodySamplesOn() const { return !moving.solids.bodies.empty() && solver && solver->movingSamples(); }
   /// With moving bodies' samples (bodySamplesOn), true when local point p lies within 0.4
   /// spacing outside a moving body at the current pose: a particle there would overlap the
   /// samples' first layer (dx/2 deep), so a fluid block leaves it out (body_samples.cpp).
@@ -167,43 +150,16 @@ struct World::Impl {
   /// 1.6 ρ0 and threw a particle at 11 m/s; particle_sources.cpp).
   bool onStaticSurface(const Vec2& p) const;
 
-  /// Changes of the particles made between steps (the API's adds, removals and moves):
-  /// with `steps` and the count, what the query grid is valid for.
-  std::uint64_t edits = 0;
-  /// A uniform grid of the current particles for World's queries (queries.cpp): cells of
-  /// side `h` from (x0, y0) over the particles' bounds, slots counting-sorted by cell.
-  /// Built on the first query after a change, then each query visits only its cells.
-  struct QueryGrid {
-    std::uint64_t steps = ~std::uint64_t(0), edits = 0;
-    std::size_t count = 0;
-    double x0 = 0, y0 = 0, h = 1;
-    long nx = 0, ny = 0;
-    std::vector<std::uint32_t> start, items;  ///< cell k holds items[start[k] .. start[k + 1])
-  };
-  mutable QueryGrid queryGrid;
-  /// The query grid of the current particles (rebuilt when stale).
-  const QueryGrid& currentQueryGrid() const;
-  /// Calls f(slot) for every particle whose world position may lie in [lo, hi] (the
-  /// cells the box touches), in no particular order.
-  template <class F>
-  void forCandidates(const Vec2d& lo, const Vec2d& hi, F&& f) const {
-    const QueryGrid& g = currentQueryGrid();
-    if (g.nx == 0) return;
-    // Local = world − origin, up to rounding: the box grows by a micrometre so that a particle
-    // on a cell's edge is never missed (callers test each candidate exactly).
-    const double ox = origin.x(), oy = origin.y();
-    const Vec2d lo2 = lo - Vec2d(1e-6, 1e-6), hi2 = hi + Vec2d(1e-6, 1e-6);
-    auto cell = [&](double v, double v0, long n) { return std::clamp(long(std::floor((v - v0) / g.h)), 0L, n - 1); };
-    if (!(hi2.x() - ox >= g.x0 && hi2.y() - oy >= g.y0 && lo2.x() - ox <= g.x0 + double(g.nx) * g.h &&
-          lo2.y() - oy <= g.y0 + double(g.ny) * g.h))
-      return;  // outside the particles' bounds (or NaN)
-    const long i0 = cell(lo2.x() - ox, g.x0, g.nx), i1 = cell(hi2.x() - ox, g.x0, g.nx);
-    const long j0 = cell(lo2.y() - oy, g.y0, g.ny), j1 = cell(hi2.y() - oy, g.y0, g.ny);
-    for (long j = j0; j <= j1; ++j)
-      for (long i = i0; i <= i1; ++i) {
-        const std::size_t k = std::size_t(j * g.nx + i);
-        for (std::uint32_t q = g.start[k]; q < g.start[k + 1]; ++q) f(std::size_t(g.items[q]));
-      }
+  /// The slots `accept` takes among the particles that may lie in the world box [lo, hi]
+  /// (the search grid's candidates), in slot order.
+  template <class Accept>
+  std::vector<std::size_t> slotsWhere(const Vec2d& lo, const Vec2d& hi, Accept&& accept) const {
+    std::vector<std::size_t> out;
+    index.forCandidates(P, steps, double(R), origin, lo, hi, [&](std::size_t i) {
+      if (accept(i)) out.push_back(i);
+    });
+    std::sort(out.begin(), out.end());
+    return out;
   }
 
   /// The state of the particles and the scene's constants for a substep of length dt.
@@ -228,10 +184,12 @@ struct World::Impl {
   /// it has a dynamic body and the solver samples the moving bodies (those solvers take
   /// many substeps a frame, and a body–body contact resolved once a frame moved a crate by
   /// up to 5 cm off the path the fluid's substeps had assumed).
-  bool bodiesEverySubstep() const { return ownWorld && moving.anyDynamic() && bodySamplesOn(); }
+  bool bodiesEverySubstep() const { return ownWorld && moving.solids.anyDynamic() && bodySamplesOn(); }
   /// After a substep of `taken` seconds: with bodiesEverySubstep(), steps the scene's b2World by
   /// it and reads the bodies again.
   void bodiesFollow(Real taken);
+  /// Bytes held for the particles, grid, neighbour lists, boundary samples and indexes.
+  std::size_t memoryBytes() const;
   /// Throws the SimulationError naming the stage, the particle and its values.
   [[noreturn]] void fail(const std::string& stage, std::size_t slot);
 
@@ -256,60 +214,20 @@ struct World::Impl {
   void lifetimes(Real dt);
   /// The sinks stage: removes particles inside sink regions.
   void sinks();
-  /// Removes the particles flagged in `dead` (stable order), counting them; `ids`, when
+  /// Removes the particles flagged in `sources.dead` (stable order), counting them; `ids`, when
   /// given, receives their ids in increasing order.
   void removeFlagged(std::vector<std::uint32_t>* ids = nullptr);
   /// Removes the k oldest particles (smallest ids).
   void removeOldest(std::size_t k);
 
   // box2d_bridge.cpp
-  /// A static body the game moved (SetTransform) since the last step, no faster than
-  /// kStaticPushSpeed: through this step it moves as a kinematic body from its old pose to
-  /// its new one (the water sees a moving wall), and it rejoins the static solids when it stops.
-  struct SlidingStatic {
-    b2Body* body = nullptr;
-    Vec2d p0{0, 0};     ///< its origin at time t0 (world)
-    double angle0 = 0;  ///< its angle at t0 [rad]
-    Vec2d v{0, 0};      ///< its velocity over the step [m/s]
-    double omega = 0;   ///< its angular velocity over the step [rad/s]
-    double t0 = 0;      ///< the step's start
-  };
-  std::vector<SlidingStatic> sliding;
-  /// The static bodies' poses at the last step's start (or the last re-read), by body.
-  std::vector<std::pair<const void*, b2Transform>> staticPoses;
-  /// XXH64 of the static fixtures' identities and transforms, the sliding ones left out:
-  /// changes when the game edits its level.
-  std::uint64_t staticSignature() const;
-  /// Reads the colliders and boundary samples from the b2World's static bodies again, the
-  /// sliding ones left out.
-  void rebuildBoundary();
+  /// Reads the static solids from the b2World into `boundary` (StaticBridge::read).
+  void readBoundary();
   /// At a step of `dt`: finds the sliding static bodies, then re-reads the static solids when
   /// they changed (dropBuried), and records the static poses.
   void readStatics(double dt);
-  /// After rebuildBoundary: drops the particles now inside a static solid, with a warning.
+  /// After readBoundary: drops the particles now inside a static solid, with a warning.
   void dropBuried();
-  /// Records every static body's pose (staticPoses).
-  void recordStaticPoses();
-
-  // contacts.cpp (World::setContactTracking)
-  bool contactsOn = false;  ///< the `contacts` stage runs
-  /// (fixture, particle id) of every contact at the end of a substep of the current (or last)
-  /// step, sorted by fixture then id after the step (finishContacts).
-  std::vector<std::pair<std::uintptr_t, std::uint32_t>> frameContacts;               ///< the fixture by its address
-  std::vector<std::vector<std::pair<std::uintptr_t, std::uint32_t>>> contactBlocks;  ///< the stage's per-block scratch
-  /// A moving body as the contacts stage sees it: its pose and centre at the substep's end.
-  struct ContactPose {
-    double theta = 0;
-    Vec2d o{0, 0}, centre{0, 0};
-  };
-  std::vector<ContactPose> contactPoses;  ///< the stage's scratch, one per moving body
-  /// The `contacts` stage: the particles within one spacing of each fixture now, into frameContacts.
-  void recordContacts(StepContext& c);
-  /// Sorts frameContacts and removes repeats (after a step).
-  void finishContacts();
 };
-
-/// A b2World with the scene's gravity and static bodies (box2d_bridge.cpp).
-std::unique_ptr<b2World> makeSceneWorld(const SceneDef& scene);
 
 }  // namespace sph2d

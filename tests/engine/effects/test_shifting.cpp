@@ -59,7 +59,7 @@ TEST_CASE(
     const std::vector<std::string> fx = w.effects();
     REQUIRE(std::find(fx.begin(), fx.end(), "shifting") != fx.end());
     dx = double(w.spacing());
-    for (int k = 0; k < 10; ++k) w.stepSubstep();
+    for (int k = 0; k < 10; ++k) sph2d::bench::stepSubstep(w);
     for (std::size_t i = 0; i < w.particleCount(); ++i) {
       const Vec2d x = w.worldPosition(i);
       const double ex = std::fabs(x.x() - 1.0) - 0.2, ey = std::fabs(x.y() - 0.3) - 0.06;

@@ -105,12 +105,12 @@ TEST_CASE("dfsph: both implicit solves reach their tolerances within the iterati
   World w(s, WorldOptions{1});
   const double tol = s.solver.param("tolerance"), divTol = s.solver.param("divergence_tolerance");
   const int cap = int(s.solver.param("max_iterations"));
-  for (int k = 0; k < 200; ++k) w.stepSubstep();  // about 1.4 s: past the start-up transient
+  for (int k = 0; k < 200; ++k) sph2d::bench::stepSubstep(w);  // about 1.4 s: past the start-up transient
   int worstP = 0, worstD = 0;
   double worstErr = 0, worstDivErr = 0;
   for (int k = 0; k < 100; ++k) {
-    w.stepSubstep();
-    const SolverStats st = w.solverStats();
+    sph2d::bench::stepSubstep(w);
+    const SolverStats st = w.counters().lastSolve;
     worstP = std::max(worstP, st.pressureIterations);
     worstD = std::max(worstD, st.divergenceIterations);
     worstErr = std::max(worstErr, st.densityError);

@@ -39,8 +39,9 @@ TEST_CASE(
   // At rest the depth limit 0.35 R/sqrt(g D) sets the substep (D < H: the deepest column).
   const double R = s.solver.spacing * s.solver.supportRatio;
   const int perFrame = int(std::ceil((1.0 / 60) / (0.35 * R / std::sqrt(g * H))));
-  MESSAGE(w.substeps() << " substeps in 120 frames; the depth limit at D = H allows " << perFrame << " a frame");
-  CHECK(w.substeps() <= 120 * perFrame);
+  MESSAGE(w.counters().substeps << " substeps in 120 frames; the depth limit at D = H allows " << perFrame
+                                << " a frame");
+  CHECK(w.counters().substeps <= 120 * perFrame);
   REQUIRE(test::allFiniteState(w));
   const DensityStats d = w.densityStats();
   MESSAGE("mean compression " << d.meanError << ", max " << d.maxError << ", mean density " << d.meanDensity);
@@ -79,7 +80,7 @@ TEST_CASE("pbf: a 1 m deep tank at 12,800 particles holds at rest whatever max_m
       }
     }
     MESSAGE("max_move " << maxMove << ": fastest particle over frames 10-45 " << worst << " m/s (frame " << worstFrame
-                        << "), " << w.substeps() << " substeps");
+                        << "), " << w.counters().substeps << " substeps");
     CHECK(worst < 1.0);
     CHECK(outside(w, 0, 0, 2, 1.2) == 0);
   }
@@ -93,8 +94,8 @@ TEST_CASE("pbf: the small dam break runs 1 s at frame-sized steps: no NaN, nothi
   const std::size_t n0 = w.particleCount();
   for (int f = 0; f < 60; ++f) w.stepFrame();
   CHECK(w.time() == doctest::Approx(1.0).epsilon(1e-6));
-  MESSAGE(w.substeps() << " substeps for 60 frames");
-  CHECK(w.substeps() <= 3 * 60);  // frame-sized while slow, max_move·R/v_max when fast
+  MESSAGE(w.counters().substeps << " substeps for 60 frames");
+  CHECK(w.counters().substeps <= 3 * 60);  // frame-sized while slow, max_move·R/v_max when fast
   REQUIRE(test::allFiniteState(w));
   CHECK(w.particleCount() == n0);
   CHECK(outside(w, 0, 0, 4, 3) == 0);

@@ -79,7 +79,7 @@ TEST_CASE("lifetimes remove exactly the particles older than max_age, and only t
   // At steady state the particles alive are those emitted in the last max_age seconds.
   const double alive = double(w.particleCount());
   CHECK(std::fabs(alive - 200 * 0.25) <= 2.0);
-  CHECK(w.removedCount() + w.particleCount() == w.emittedCount(0));
+  CHECK(w.counters().removed + w.particleCount() == w.emittedCount(0));
   SceneDef none = box();
   World w2(none, WorldOptions{1});
   CHECK_FALSE(has(w2.particleFields(), "age"));
@@ -108,8 +108,8 @@ TEST_CASE("a sink removes what enters it and nothing else") {
   }
   MESSAGE("sink removed " << removedSeen << " of " << n0);
   CHECK(removedSeen > 0);
-  CHECK(removedSeen == w.removedCount());
-  CHECK(w.particleCount() + w.removedCount() == n0);
+  CHECK(removedSeen == w.counters().removed);
+  CHECK(w.particleCount() + w.counters().removed == n0);
   CHECK(has(w.stages(), "sinks"));
 }
 
@@ -137,7 +137,7 @@ TEST_CASE("the particle budget: stop_emitting caps the count and warns once, rec
     CHECK(w.particleCount() == 100);
     const std::uint32_t minId = *std::min_element(w.particles().id.begin(), w.particles().id.end());
     CHECK(minId == w.emittedCount(0) - 100);  // exactly the 100 newest remain
-    CHECK(w.removedCount() == w.emittedCount(0) - 100);
+    CHECK(w.counters().removed == w.emittedCount(0) - 100);
   }
 }
 

@@ -28,7 +28,7 @@ SceneDef periodicBlock(const std::string& solver, const Vec2d& u, double spacing
 
 }  // namespace
 
-TEST_CASE("particlesInRadius and particlesInBox return exactly the slots a brute-force scan finds, in slot order") {
+TEST_CASE("slotsInRadius and slotsInBox return exactly the slots a brute-force scan finds, in slot order") {
   SceneDef s = test::scene("tests/small_dam_break.json");
   World w(s, WorldOptions{2});
   for (int f = 0; f < 20; ++f) w.stepFrame();  // a collapsing column: an irregular set
@@ -38,7 +38,7 @@ TEST_CASE("particlesInRadius and particlesInBox return exactly the slots a brute
       std::vector<std::size_t> brute;
       for (std::size_t i = 0; i < w.particleCount(); ++i)
         if ((w.worldPosition(i) - c).squaredNorm() <= r * r) brute.push_back(i);
-      CHECK(w.particlesInRadius(c, r) == brute);
+      CHECK(w.slotsInRadius(c, r) == brute);
       nonEmpty += !brute.empty();
       const Vec2d lo = c - Vec2d(r, 0.5 * r), hi = c + Vec2d(0.5 * r, r);
       std::vector<std::size_t> inBox;
@@ -46,7 +46,7 @@ TEST_CASE("particlesInRadius and particlesInBox return exactly the slots a brute
         const Vec2d p = w.worldPosition(i);
         if (p.x() >= lo.x() && p.y() >= lo.y() && p.x() <= hi.x() && p.y() <= hi.y()) inBox.push_back(i);
       }
-      CHECK(w.particlesInBox(lo, hi) == inBox);
+      CHECK(w.slotsInBox(lo, hi) == inBox);
     }
   }
   CHECK(nonEmpty >= 6);  // the searches found particles, not only empty sets
@@ -57,23 +57,23 @@ TEST_CASE("searches see every change made between steps: a moved, an added and a
   // a grid kept across a change would miss these.
   World w(test::scene("tests/small_dam_break.json"), WorldOptions{1});
   for (int f = 0; f < 5; ++f) w.stepFrame();
-  const Vec2d spot(3.5, 2.5);                        // empty air, far from the water
-  REQUIRE(w.particlesInRadius(spot, 0.05).empty());  // builds the grid
+  const Vec2d spot(3.5, 2.5);                    // empty air, far from the water
+  REQUIRE(w.slotsInRadius(spot, 0.05).empty());  // builds the grid
   const std::uint32_t id = w.particles().id[0];
   REQUIRE(w.setParticle(id, spot, Vec2d(0, 0)));
-  std::vector<std::size_t> found = w.particlesInRadius(spot, 0.05);
+  std::vector<std::size_t> found = w.slotsInRadius(spot, 0.05);
   REQUIRE(found.size() == 1);
   CHECK(w.particles().id[found[0]] == id);
   const IdRange added = w.addParticles({spot + Vec2d(0.2, 0)});
   REQUIRE(added.size() == 1);
-  CHECK(w.particlesInBox(spot + Vec2d(0.1, -0.1), spot + Vec2d(0.3, 0.1)).size() == 1);
+  CHECK(w.slotsInBox(spot + Vec2d(0.1, -0.1), spot + Vec2d(0.3, 0.1)).size() == 1);
   CHECK(w.removeParticles({id}) == std::vector<std::uint32_t>{id});
-  CHECK(w.particlesInRadius(spot, 0.05).empty());
-  CHECK(w.particlesInRadius(spot, 0.25).size() == 1);  // the added one
+  CHECK(w.slotsInRadius(spot, 0.05).empty());
+  CHECK(w.slotsInRadius(spot, 0.25).size() == 1);  // the added one
 }
 
 TEST_CASE(
-    "shapes: particlesInShape matches b2Shape::TestPoint over every particle, and addShape and removeParticlesInShape fill and empty a rotated box") {
+    "shapes: slotsInShape matches b2Shape::TestPoint over every particle, and addShape and removeParticlesInShape fill and empty a rotated box") {
   SceneDef s = test::tank("wcsph", 2, 2, 0.02);
   s.gravity = Vec2d(0, 0);
   World w(s, WorldOptions{2});
@@ -100,18 +100,18 @@ TEST_CASE(
       if (shape->TestPoint(xf, b2Vec2(float(p.x()), float(p.y())))) brute.push_back(i);
     }
     CHECK(!brute.empty());
-    CHECK(w.particlesInShape(*shape, xf) == brute);
+    CHECK(w.slotsInShape(*shape, xf) == brute);
   }
   std::vector<std::uint32_t> inDisc;
-  for (const std::size_t i : w.particlesInShape(disc, xf)) inDisc.push_back(w.particles().id[i]);
+  for (const std::size_t i : w.slotsInShape(disc, xf)) inDisc.push_back(w.particles().id[i]);
   std::sort(inDisc.begin(), inDisc.end());
   CHECK(w.removeParticlesInShape(disc, xf) == inDisc);  // exactly those ids, in increasing order
-  CHECK(w.particlesInShape(disc, xf).empty());
+  CHECK(w.slotsInShape(disc, xf).empty());
   CHECK(w.particleCount() == n - inDisc.size());
   b2EdgeShape edge;
   edge.SetTwoSided(b2Vec2(0, 0), b2Vec2(1, 0));
   CHECK_THROWS_AS(w.addShape(edge, xf), std::invalid_argument);
-  CHECK(w.particlesInShape(edge, xf).empty());
+  CHECK(w.slotsInShape(edge, xf).empty());
 }
 
 TEST_CASE(
@@ -153,7 +153,7 @@ TEST_CASE(
   // A second block on the lower half of the box, every new particle on top of an old one:
   // 2 ρ0 there, ρ0 above, a row or two between.
   const std::size_t added = w.addBlock(test::block({0, 0}, {1, 0.5})).count;
-  w.stepSubstep();  // the densities of the new state
+  sph2d::bench::stepSubstep(w);  // the densities of the new state
   const DensityStats d = w.densityStats();
   const double doubled = 2.0 * double(added) / double(w.particleCount());  // the share of particles in the overlap
   MESSAGE(added << " added; mean compression " << d.meanError << ", largest " << d.maxError << ", mean density "
@@ -167,17 +167,17 @@ TEST_CASE("neighbourPairs counts each particle's 20 lattice neighbours within 2.
   // On a full square lattice the points within R = 2.5 dx of a particle are the 20
   // with i² + j² ≤ 5 (i² + j² = 6.25 has no integer solution; √8 = 2.83 dx is out).
   World w(periodicBlock("wcsph", Vec2d(0, 0)), WorldOptions{2});
-  w.stepSubstep();
-  CHECK(w.neighbourPairs() == 20 * w.particleCount());
+  sph2d::bench::stepSubstep(w);
+  CHECK(w.counters().neighbourPairs == 20 * w.particleCount());
 }
 
 TEST_CASE("the state hash is the same for the same state and changes with any particle's motion or removal") {
   const SceneDef s = test::scene("tests/small_dam_break.json");
   World a(s, WorldOptions{1}), b(s, WorldOptions{3});
   CHECK(a.stateHash() == b.stateHash());
-  a.stepSubstep();
+  sph2d::bench::stepSubstep(a);
   CHECK(a.stateHash() != b.stateHash());  // one substep moved the particles
-  b.stepSubstep();
+  sph2d::bench::stepSubstep(b);
   CHECK(a.stateHash() == b.stateHash());
   // Removing one particle changes it, and removing the same one in the other world agrees again.
   const Vec2d p = a.worldPosition(0);
@@ -188,7 +188,7 @@ TEST_CASE("the state hash is the same for the same state and changes with any pa
 }
 
 TEST_CASE(
-    "queries: particlesTouching finds the particles within one spacing of a fixture, and forEachContact visits the fixtures the water touches") {
+    "queries: idsTouching finds the particles within one spacing of a fixture, and forEachContact visits the fixtures the water touches") {
   SceneDef s = test::tank("game", 1.0, 1.0, 0.02);
   s.blocks.push_back(test::block({0, 0}, {1, 0.4}));
   BodyDef pole;  // a submerged circle, r = 0.06 m, at (0.5, 0.2)
@@ -223,9 +223,9 @@ TEST_CASE(
       if (dist(w.worldPosition(i)) <= dx) ids.push_back(w.particles().id[i]);
     return ids;
   };
-  const std::vector<std::uint32_t> onFloor = w.particlesTouching(*floor);
+  const std::vector<std::uint32_t> onFloor = w.idsTouching(*floor);
   const std::vector<std::uint32_t> floorScan = scan([](const Vec2d& p) { return std::max(0.0, p.y()); });
-  const std::vector<std::uint32_t> onPole = w.particlesTouching(*circle);
+  const std::vector<std::uint32_t> onPole = w.idsTouching(*circle);
   const std::vector<std::uint32_t> poleScan =
       scan([](const Vec2d& p) { return std::max(0.0, (p - Vec2d(0.5, 0.2)).norm() - 0.06); });
   MESSAGE(onFloor.size() << " particles on the floor, " << onPole.size() << " around the pole");
@@ -233,7 +233,7 @@ TEST_CASE(
   CHECK(onPole == poleScan);
   CHECK(onFloor.size() >= std::size_t(0.9 / dx));                // the whole bottom layer
   CHECK(onPole.size() >= std::size_t(2 * 3.14159 * 0.06 / dx));  // a ring around it
-  CHECK(w.particlesTouching(*ceiling).empty());
+  CHECK(w.idsTouching(*ceiling).empty());
   // forEachContact: the floor, the side walls and the pole, never the ceiling; the same lists.
   int visited = 0;
   bool sawCeiling = false, sawPole = false;
@@ -288,15 +288,15 @@ TEST_CASE(
       REQUIRE(ids.size() == 1);
       id = ids[0];
       w.stepFrame();
-      REQUIRE(w.substeps() > 5);
+      REQUIRE(w.counters().substeps > 5);
       endGap = (w.worldPosition(0) - Vec2d(0.5, 0.3)).norm() - 0.05;
-      touching = w.particlesTouching(*circle);
+      touching = w.idsTouching(*circle);
       visits = 0;
       w.forEachContact([&](const b2Fixture& fx, const std::vector<std::uint32_t>& l) {
         if (&fx == circle) visits += l == touching;
       });
       w.stepFrame();  // on, far from the circle: this step's record is empty
-      after = w.particlesTouching(*circle);
+      after = w.idsTouching(*circle);
     };
     std::vector<std::uint32_t> offNow, offAfter, onNow, onAfter;
     double gapOff = 0, gapOn = 0;
@@ -319,7 +319,7 @@ TEST_CASE(
 }
 
 TEST_CASE(
-    "queries: particlesTouching a kinematic box measures from where the fluid meets it: the skin for the game solver, the fixture for wcsph") {
+    "queries: idsTouching a kinematic box measures from where the fluid meets it: the skin for the game solver, the fixture for wcsph") {
   // A 0.3 m × 0.1 m kinematic box at rest in the water. The game solver meets a moving polygon
   // at Box2D's skin (1 cm out), wcsph at the fixture itself (its moving samples stand for it):
   // the particles touching it are those within one spacing of that surface.
@@ -347,7 +347,7 @@ TEST_CASE(
                    oy = std::max(0.0, std::fabs(p.y() - 0.25) - 0.05);
       if (std::sqrt(ox * ox + oy * oy) - skin <= dx) scan.push_back(w.particles().id[i]);
     }
-    const std::vector<std::uint32_t> touching = w.particlesTouching(*fixture);
+    const std::vector<std::uint32_t> touching = w.idsTouching(*fixture);
     MESSAGE(solver << ": " << touching.size() << " particles touch the box");
     CHECK(touching.size() >= std::size_t(0.6 / dx));  // a layer around it
     CHECK(touching == scan);

@@ -14,7 +14,7 @@ using namespace sph2d;
 namespace {
 
 std::uint64_t callsOf(const World& w, const std::string& stage) {
-  for (const StageTiming& t : w.timings())
+  for (const StageTiming& t : w.profile().stages)
     if (t.name == stage) return t.calls;
   return 0;
 }
@@ -33,7 +33,7 @@ TEST_CASE("the stage list exists from construction: the solver's stages, the eff
   CHECK(w.stages() == expected);
   w.stepFrame();
   CHECK(w.stages() == expected);  // running it does not change it
-  for (const std::string& name : expected) CHECK(callsOf(w, name) == w.substeps());
+  for (const std::string& name : expected) CHECK(callsOf(w, name) == w.counters().substeps);
 }
 
 TEST_CASE("switching an effect or adding a user force rebuilds the list, and a switched-off effect runs no stage") {
@@ -92,7 +92,7 @@ void sliverOnlyDrifts(const std::string& solver) {
   World w(s, WorldOptions{1});
   for (int f = 0; f < 30; ++f) w.stepFrame();
   const double v0 = maxSpeed(w), t0 = w.time();
-  const std::vector<StageTiming> before = w.timings();
+  const std::vector<StageTiming> before = w.profile().stages;
   // A caller stepping "up to time t" asks for a remainder of a microsecond, many times.
   for (int k = 0; k < 50; ++k) w.step(1e-6);
   CHECK(w.time() == doctest::Approx(t0 + 50e-6).epsilon(1e-9));

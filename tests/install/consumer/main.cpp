@@ -131,7 +131,7 @@ int main(int argc, char** argv) {
   // 0.21 m/s on average within 0.2 m of its axis after 1 s, where the crate's waves alone (the
   // paddle held still) leave 0.09 m/s.
   double stirred = 0;
-  const std::vector<std::size_t> around = reloaded.particlesInRadius(b2Vec2(0.45f, 0.25f), 0.2);
+  const std::vector<std::size_t> around = reloaded.slotsInRadius(b2Vec2(0.45f, 0.25f), 0.2);
   for (const std::size_t i : around) stirred += double(reloaded.particles().v[i].norm());
   stirred = around.empty() ? 0 : stirred / double(around.size());
   const bool pushed = around.size() > 50 && stirred > 0.15;

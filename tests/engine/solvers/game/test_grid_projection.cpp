@@ -159,7 +159,7 @@ TEST_CASE("grid projection: the compression shift moves a compressed block apart
       }
     REQUIRE(w.addParticles(pts, vel).size() == pts.size());
     w.stepFrame();
-    REQUIRE(w.substeps() == 1);
+    REQUIRE(w.counters().substeps == 1);
     v.clear();
     double x0 = 1e9, x1 = -1e9;
     for (std::size_t i = 0; i < w.particleCount(); ++i) {
@@ -275,7 +275,7 @@ TEST_CASE("game: the local iterations go on while any particle is above toleranc
     w.stepFrame();
     worst = std::max(worst, w.densityStats().maxError);
   }
-  MESSAGE(w.particleCount() << " particles, " << w.substeps()
+  MESSAGE(w.particleCount() << " particles, " << w.counters().substeps
                             << " substeps in 90 frames; largest single-particle compression " << 100 * worst
                             << " % (tolerance_max " << 100 * limit << " %)");
   CHECK(worst <= limit + 1e-6);
