@@ -10,10 +10,12 @@
 # serves tests/glvnd: the renderer's own OSMesa context with libOpenGL first in the link.
 # parallel (GNU parallel): the bench tests run `sph2d bench accuracy --list` and `bench game --list`
 # through it and compare the merged report with a one-process run (tests/app/test_bench_sweep.cpp).
+# gnuplot-nox: `sph2d bench accuracy` draws its charts with it; tests/app/test_bench_accuracy_charts.cpp
+# checks the SVG and PNG it draws (the bench itself runs without it: it writes the scripts).
 # What the demo needs (the engine, the renderer and the `sph2d` app, serve included):
 SPH2D_DEMO_PACKAGES="g++ cmake make pkg-config libbox2d-dev libosmesa6-dev libpng-dev libeigen3-dev nlohmann-json3-dev libboost-dev libturbojpeg0-dev"
 # What the tests add:
-SPH2D_TEST_PACKAGES="doctest-dev clang-14 libclang-rt-14-dev chromium libegl-dev libopengl-dev libegl-mesa0 parallel"
+SPH2D_TEST_PACKAGES="doctest-dev clang-14 libclang-rt-14-dev chromium libegl-dev libopengl-dev libegl-mesa0 parallel gnuplot-nox"
 SPH2D_PACKAGES="$SPH2D_DEMO_PACKAGES $SPH2D_TEST_PACKAGES"
 
 # sph2d_install [PACKAGES]: installs those of PACKAGES (default: all) that are missing.

@@ -3,19 +3,17 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdint>
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <iterator>
-#include <map>
 #include <sstream>
 
+#include "bench/accuracy_charts.hpp"
 #include "bench/sweep.hpp"
 #include "cli.hpp"
 #include "sph2d/hash.hpp"
-#include "sph2d/render/image.hpp"
 #include "sph2d/render/particle_export.hpp"
-#include "sph2d/render/png_io.hpp"
 
 namespace fs = std::filesystem;
 
@@ -119,8 +117,7 @@ std::vector<Run> readRuns(const std::string& path) {
   return runs;
 }
 
-/// The CFL index of a run id ("…-cfl2-…" → 2; 0 when it has none).
-static int cflIndexOf(const std::string& id) {
+int cflIndexOf(const std::string& id) {
   const auto at = id.find("-cfl");
   return at == std::string::npos ? 0 : std::atoi(id.c_str() + at + 4);
 }
@@ -148,95 +145,37 @@ void writeNoted(OutputJournal& journal, const std::string& out, const std::strin
   writeFileAtomic(path, bytes);
 }
 
-/// The files `sph2d bench accuracy` writes into its --out folder.
-const char* const kOutputs[] = {"accuracy.csv",     "accuracy.md",    "dam_break.png", "hydrostatic.png",
-                                "taylor_green.png", "poiseuille.png", "surge_long.png"};
-
 FolderSpec accuracyFolderSpec() {
   FolderSpec spec;
   spec.command = "bench accuracy";
   spec.writes = [](const std::string& name) {
-    return std::find(std::begin(kOutputs), std::end(kOutputs), name) != std::end(kOutputs);
+    return name == "accuracy.csv" || name == "accuracy.md" || isChartFile(name);
   };
   return spec;
 }
 
-/// Log-log chart of error against wall seconds per simulated second, one colour per solver, Pareto front.
-void chart(const std::vector<Run>& runs, const std::string& caseName, OutputJournal& journal, const std::string& out) {
-  const std::string path = out + "/" + caseName + ".png";
-  Frame img;
-  img.width = 720;
-  img.height = 480;
-  img.rgba.assign(std::size_t(img.width) * img.height * 4, 255);
-  std::vector<const Run*> rs;
-  for (const Run& r : runs)
-    if (r.caseName == caseName && r.error > 0 && r.wallPerSim > 0) rs.push_back(&r);
-  if (rs.empty()) return;
-  double x0 = 1e30, x1 = -1e30, y0 = 1e30, y1 = -1e30;
-  for (const Run* r : rs) {
-    x0 = std::min(x0, std::log10(r->wallPerSim));
-    x1 = std::max(x1, std::log10(r->wallPerSim));
-    y0 = std::min(y0, std::log10(r->error));
-    y1 = std::max(y1, std::log10(r->error));
+std::string reportMarkdown(const std::vector<Run>& runs, const std::string& header) {
+  std::ostringstream md;
+  md << "<!-- " << header.substr(0, header.size() - 1) << " -->\n\n";
+  md << "| run | case | solver | floor | particles | cfl | error | value | error 2 | value | mean density error | max density error | wall s / sim s | ms / step |\n"
+        "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+  char line[1024];
+  for (const Run& r : runs) {
+    if (r.status != "ok") {
+      std::snprintf(line, sizeof line, "| %s | %s | %s | %s | %zu | %.3f | %s | %s | | | | | | |\n", r.id.c_str(),
+                    r.caseName.c_str(), r.solver.c_str(), r.floor.c_str(), r.particles, r.cfl, r.errorName.c_str(),
+                    r.status.c_str());
+    } else {
+      std::snprintf(line, sizeof line,
+                    "| %s | %s | %s | %s | %zu | %.3f | %s | %.4f | %s | %s | %.3f %% | %.3f %% | %.3f | %.3f |\n",
+                    r.id.c_str(), r.caseName.c_str(), r.solver.c_str(), r.floor.c_str(), r.particles, r.cfl,
+                    r.errorName.c_str(), r.error, r.error2Name.c_str(),
+                    std::isnan(r.error2) ? "" : num(std::round(r.error2 * 1e4) / 1e4).c_str(), 100 * r.meanDensityError,
+                    100 * r.maxDensityError, r.wallPerSim, r.msPerStep);
+    }
+    md << line;
   }
-  x0 = std::floor(x0 - 0.1);
-  x1 = std::ceil(x1 + 0.1);
-  y0 = std::floor(y0 - 0.1);
-  y1 = std::ceil(y1 + 0.1);
-  const int L = 90, R = 700, T = 40, B = 420;
-  auto px = [&](double lx) { return L + int((lx - x0) / (x1 - x0) * (R - L)); };
-  auto py = [&](double ly) { return B - int((ly - y0) / (y1 - y0) * (B - T)); };
-  const Rgba8 axis{40, 40, 40, 255}, grid{220, 220, 220, 255};
-  for (double d = x0; d <= x1 + 1e-9; d += 1) {
-    fillRect(img, px(d), T, px(d) + 1, B, grid);
-    drawText(img, px(d) - 12, B + 8, formatLabel(std::pow(10.0, d)), 2, axis);
-  }
-  for (double d = y0; d <= y1 + 1e-9; d += 1) {
-    fillRect(img, L, py(d), R, py(d) + 1, grid);
-    drawText(img, 4, py(d) - 7, formatLabel(std::pow(10.0, d)), 2, axis);
-  }
-  fillRect(img, L, B, R, B + 2, axis);
-  fillRect(img, L - 2, T, L, B, axis);
-  drawText(img, L, 8, caseName + ": " + rs[0]->errorName + " vs wall s per sim s", 2, axis);
-  std::map<std::string, Rgba8> colour;
-  const Rgba8 palette[] = {
-      {200, 40, 40, 255}, {40, 120, 200, 255}, {40, 160, 60, 255}, {200, 140, 0, 255}, {140, 60, 180, 255}};
-  for (const Run* r : rs)
-    if (!colour.count(r->solver)) colour[r->solver] = palette[colour.size() % 5];
-  // Pareto front: runs no other run beats in both error and cost.
-  std::vector<const Run*> front;
-  for (const Run* a : rs) {
-    bool dominated = false;
-    for (const Run* b : rs)
-      dominated = dominated || (b != a && b->error <= a->error && b->wallPerSim <= a->wallPerSim &&
-                                (b->error < a->error || b->wallPerSim < a->wallPerSim));
-    if (!dominated) front.push_back(a);
-  }
-  std::sort(front.begin(), front.end(), [](const Run* a, const Run* b) { return a->wallPerSim < b->wallPerSim; });
-  for (std::size_t k = 1; k < front.size(); ++k) {
-    const int ax = px(std::log10(front[k - 1]->wallPerSim)), ay = py(std::log10(front[k - 1]->error));
-    const int bx = px(std::log10(front[k]->wallPerSim)), by = py(std::log10(front[k]->error));
-    const int steps = std::max(std::abs(bx - ax), std::abs(by - ay)) + 1;
-    for (int s = 0; s <= steps; ++s)
-      fillRect(img, ax + (bx - ax) * s / steps, ay + (by - ay) * s / steps, ax + (bx - ax) * s / steps + 2,
-               ay + (by - ay) * s / steps + 2, Rgba8{120, 120, 120, 255});
-  }
-  for (const Run* r : rs) {
-    const int x = px(std::log10(r->wallPerSim)), y = py(std::log10(r->error));
-    const int size = 3 + int(std::log10(double(std::max<std::size_t>(r->particles, 10))));
-    fillRect(img, x - size, y - size, x + size + 1, y + size + 1, colour[r->solver]);
-  }
-  int ly = T + 10;
-  for (const auto& c : colour) {
-    fillRect(img, R - 150, ly, R - 138, ly + 12, c.second);
-    drawText(img, R - 132, ly, c.first, 2, axis);
-    ly += 20;
-  }
-  drawText(img, R - 150, ly, "LINE: PARETO FRONT", 1, axis);
-  std::vector<std::uint8_t> bytes;
-  encodePng(img.width, img.height, img.rgba.data(), pngSettings(6), bytes);
-  journal.note(caseName + ".png", fs::path(tempPathFor(path)).filename().string(), xxh64(bytes.data(), bytes.size()));
-  writeEncodedPngAtomic(path, bytes);
+  return md.str();
 }
 
 }  // namespace sph2d::cli::accuracy

@@ -1,8 +1,8 @@
 // app/bench/accuracy_report.hpp — the rows of `sph2d bench accuracy` and what is done with
 // them apart from running: the cases and solvers in the sweep's order, each solver's CFL-type
 // number, accuracy.csv written and read back (also the format before run ids), the rows in
-// the sweep's order whatever order the runs finished in, the files the bench writes, and the
-// charts (error against wall seconds per simulated second, Pareto front).
+// the sweep's order whatever order the runs finished in, the table, and the files the bench
+// writes (the charts: accuracy_charts.hpp).
 #pragma once
 
 #include <cstddef>
@@ -50,6 +50,9 @@ std::string csvLine(const Run& r);
 /// settings "unknown"). Throws UsageError naming the file, the column and the cell.
 std::vector<Run> readRuns(const std::string& path);
 
+/// The CFL index of a run id ("…-cfl2-…" → 2; 0 when it has none).
+int cflIndexOf(const std::string& id);
+
 /// Rows in the sweep's order: solver (the default order, others by name), CFL index, case,
 /// particles, floor.
 void sortRuns(std::vector<Run>& runs);
@@ -60,8 +63,7 @@ void writeNoted(OutputJournal& journal, const std::string& out, const std::strin
 /// The files `sph2d bench accuracy` writes into its --out folder.
 FolderSpec accuracyFolderSpec();
 
-/// Writes `out`/CASE.png: log-log chart of error against wall seconds per simulated second, one
-/// colour per solver, the Pareto front drawn (nothing when the case has no measured run).
-void chart(const std::vector<Run>& runs, const std::string& caseName, OutputJournal& journal, const std::string& out);
+/// accuracy.md: `header` (the builds and settings, one per line) as a comment, then one table row per run.
+std::string reportMarkdown(const std::vector<Run>& runs, const std::string& header);
 
 }  // namespace sph2d::cli::accuracy

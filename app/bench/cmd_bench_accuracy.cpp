@@ -2,9 +2,10 @@
 // solver over the validation cases at several resolutions and CFL numbers,
 // measures each run's error against experiment or theory and its cost, and
 // writes accuracy.csv, accuracy.md and one chart per case (error against wall
-// seconds per simulated second, log-log, one colour per solver, the Pareto
-// front drawn). A benchmark, not a test: timings depend on the machine and its
-// load; compare them as ratios within one run.
+// seconds per simulated second, log-log, one series per solver, the Pareto
+// front drawn, by gnuplot: app/bench/accuracy_charts.hpp). A benchmark, not a
+// test: timings depend on the machine and its load; compare them as ratios
+// within one run.
 //
 // Cases (scenes in assets/scenes/validation/):
 //   hydrostatic  2 m × 1 m tank at rest: worst error of the time-averaged
@@ -30,15 +31,13 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <iterator>
 #include <map>
 #include <optional>
-#include <set>
-#include <sstream>
 #include <string>
 #include <vector>
 
+#include "bench/accuracy_charts.hpp"
 #include "bench/accuracy_report.hpp"
 #include "bench/sweep.hpp"
 #include "bench/validation.hpp"
@@ -46,9 +45,6 @@
 #include "commands.hpp"
 #include "output/output_dir.hpp"
 #include "sph2d/hash.hpp"
-#include "sph2d/render/image.hpp"
-#include "sph2d/render/particle_export.hpp"
-#include "sph2d/render/png_io.hpp"
 #include "sph2d/scene.hpp"
 #include "sph2d/world.hpp"
 
@@ -63,12 +59,17 @@ const char* kHelp =
     "Usage: sph2d bench accuracy [--out DIR] [--quick] [--levels K] [--solvers A,B] [--cases A,B] [--threads T]\n"
     "                            [--assets DIR] [--list | --list-ids | --only ID[,ID...]]\n"
     "       sph2d bench accuracy --merge DIR | --from-csv A.csv[,B.csv...] [--allow-mixed] [--out DIR]\n"
+    "       sph2d bench accuracy --charts-only A.csv[,B.csv...] [--allow-mixed] [--out DIR]\n"
     "\n"
     "Runs every solver over the validation cases (hydrostatic tank, dam break against\n"
     "Martin & Moyce 1952, Taylor-Green vortex, start-up Poiseuille flow) at three\n"
     "resolutions (dam break about 5k, 20k and 80k particles)\n"
-    "and two CFL numbers, and writes DIR/accuracy.csv, DIR/accuracy.md and\n"
-    "DIR/<case>.png (default DIR: out/accuracy). --quick runs one small resolution and one\n"
+    "and two CFL numbers, and writes DIR/accuracy.csv, DIR/accuracy.md and per case a chart\n"
+    "(default DIR: out/accuracy): DIR/<case>.gp, a gnuplot script, and DIR/<case>.dat, its data,\n"
+    "always; DIR/<case>.svg and DIR/<case>.png drawn from them when gnuplot is on PATH (else\n"
+    "`gnuplot DIR/<case>.gp` draws them later). Each chart: error against wall seconds per simulated\n"
+    "second, log-log, one series per solver, each point labelled with its particle count, the\n"
+    "Pareto front drawn. --quick runs one small resolution and one\n"
     "CFL number per solver (a smoke test of a minute or two). --assets: the assets folder\n"
     "(default: ./assets). --levels K runs only the K coarsest resolutions (1..3).\n"
     "--cases hydrostatic,dam_break,taylor_green,poiseuille,surge_long (or all) runs only those\n"
@@ -89,6 +90,9 @@ const char* kHelp =
     "  build's commit and the settings (quick, levels, threads, the assets' hash): rows of\n"
     "  different builds or settings are refused (exit 2, naming two files) unless\n"
     "  --allow-mixed, and a run id twice is refused.\n"
+    "--charts-only A.csv[,B.csv...] reads those files as --from-csv does and writes the charts\n"
+    "  alone into --out (default: the first file's folder), its accuracy.csv left as it is\n"
+    "  (benchmarks/plot_accuracy.sh runs it).\n"
     "\n"
     "Those files replace only the ones an earlier bench accuracy wrote in DIR (its\n"
     "DIR/.sph2d.journal lists them with their hashes): a file of those names that sph2d\n"
@@ -355,11 +359,20 @@ Run execute(const Spec& p, const Inputs& in, int threads) {
   return r;
 }
 
+/// --charts-only writes the charts alone: the report's names in its folder are not in its way.
+void dropReport(FolderScan& scan) {
+  auto& f = scan.foreign;
+  f.erase(std::remove_if(f.begin(), f.end(),
+                         [](const ForeignFile& x) { return x.name == "accuracy.csv" || x.name == "accuracy.md"; }),
+          f.end());
+}
+
 }  // namespace
 
 int cmdBenchAccuracy(const std::vector<std::string>& args) {
   std::string out = "out/accuracy", assets = "assets";
-  bool quick = false, list = false, listIds = false, allowMixed = false, filtered = false;
+  bool quick = false, list = false, listIds = false, allowMixed = false, filtered = false, chartsOnly = false,
+       outGiven = false;
   int threads = 0, levels = 3;
   std::vector<std::string> solvers, fromCsv, only, mergeDirs,
       cases(std::begin(kCases), std::begin(kCases) + kDefaultCases);
@@ -372,9 +385,10 @@ int cmdBenchAccuracy(const std::vector<std::string>& args) {
     if (a == "--help" || a == "-h") {
       std::fputs(kHelp, stdout);
       return 0;
-    } else if (a == "--out")
+    } else if (a == "--out") {
       out = value();
-    else if (a == "--assets")
+      outGiven = true;
+    } else if (a == "--assets")
       assets = value();
     else if (a == "--quick")
       quick = true;
@@ -384,6 +398,9 @@ int cmdBenchAccuracy(const std::vector<std::string>& args) {
       levels = parseInt(a, value(), 1, 3);
     else if (a == "--from-csv") {
       for (const std::string& f : splitList(value())) fromCsv.push_back(f);
+    } else if (a == "--charts-only") {
+      for (const std::string& f : splitList(value())) fromCsv.push_back(f);
+      chartsOnly = true;
     } else if (a == "--merge")
       mergeDirs.push_back(value());
     else if (a == "--allow-mixed")
@@ -411,17 +428,22 @@ int cmdBenchAccuracy(const std::vector<std::string>& args) {
   }
   const bool merging = !fromCsv.empty() || !mergeDirs.empty();
   if (int(list) + int(listIds) + int(!only.empty()) + int(merging) > 1)
-    throw UsageError("--list, --list-ids, --only and --merge/--from-csv are one each: give one of them");
+    throw UsageError("--list, --list-ids, --only and --merge/--from-csv/--charts-only are one each: give one of them");
   if (!only.empty() && filtered)
     throw UsageError("--only names its runs: not with --solvers or --cases (they select what --list prints)");
-  if (allowMixed && !merging) throw UsageError("--allow-mixed is for --merge and --from-csv");
+  if (allowMixed && !merging) throw UsageError("--allow-mixed is for --merge, --from-csv and --charts-only");
+  if (chartsOnly && fromCsv.empty()) throw UsageError("--charts-only needs an accuracy.csv");
+  if (chartsOnly && !outGiven) out = fs::path(fromCsv.front()).parent_path().string();
+  if (out.empty()) out = ".";
 
   // The folder, before any run: held by this bench alone, and refused when it holds a file of
   // the names it writes that an earlier bench accuracy did not write (its journal lists those).
   const FolderSpec spec = accuracyFolderSpec();
   auto holdFolder = [&](std::optional<OutputLock>& lock) {
     if (holdsLockFile(out)) lock.emplace(out);
-    refuseForeignFiles(out, scanOutputFolder(out, spec), spec);
+    FolderScan scan = scanOutputFolder(out, spec);
+    if (chartsOnly) dropReport(scan);
+    refuseForeignFiles(out, scan, spec);
     makeOutputDir(out);
     if (!lock) lock.emplace(out);
   };
@@ -525,47 +547,41 @@ int cmdBenchAccuracy(const std::vector<std::string>& args) {
   sortRuns(runs);
 
   // The files replace only an earlier bench accuracy's (scanned again: proven now), each whole.
-  const FolderScan scan = scanOutputFolder(out, spec);
+  // An earlier run's charts go first: this run draws its own, or none (no stale chart stays).
+  FolderScan scan = scanOutputFolder(out, spec);
+  if (chartsOnly) dropReport(scan);
   refuseForeignFiles(out, scan, spec);
-  OutputJournal journal(out, spec.command, scan.own);
-  {
+  removeOwnFiles(out, scan, isChartFile);
+  std::vector<OwnedFile> kept;
+  for (const OwnedFile& f : scan.own)
+    if (!isChartFile(f.name)) kept.push_back(f);
+  OutputJournal journal(out, spec.command, kept);
+  std::string wrote;
+  if (!chartsOnly) {
     std::string csv = std::string(kCsvHeader) + "\n";
     for (const Run& r : runs) csv += csvLine(r);
     writeNoted(journal, out, "accuracy.csv", csv);
+    writeNoted(journal, out, "accuracy.md", reportMarkdown(runs, header));
+    wrote = "accuracy.csv, accuracy.md";
   }
-  {
-    std::ostringstream md;
-    md << "<!-- " << header.substr(0, header.size() - 1) << " -->\n\n";
-    md << "| run | case | solver | floor | particles | cfl | error | value | error 2 | value | mean density error | max density error | wall s / sim s | ms / step |\n"
-          "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
-    char line[1024];
-    for (const Run& r : runs) {
-      if (r.status != "ok") {
-        std::snprintf(line, sizeof line, "| %s | %s | %s | %s | %zu | %.3f | %s | %s | | | | | | |\n", r.id.c_str(),
-                      r.caseName.c_str(), r.solver.c_str(), r.floor.c_str(), r.particles, r.cfl, r.errorName.c_str(),
-                      r.status.c_str());
-      } else {
-        std::snprintf(line, sizeof line,
-                      "| %s | %s | %s | %s | %zu | %.3f | %s | %.4f | %s | %s | %.3f %% | %.3f %% | %.3f | %.3f |\n",
-                      r.id.c_str(), r.caseName.c_str(), r.solver.c_str(), r.floor.c_str(), r.particles, r.cfl,
-                      r.errorName.c_str(), r.error, r.error2Name.c_str(),
-                      std::isnan(r.error2) ? "" : num(std::round(r.error2 * 1e4) / 1e4).c_str(),
-                      100 * r.meanDensityError, 100 * r.maxDensityError, r.wallPerSim, r.msPerStep);
-      }
-      md << line;
-    }
-    writeNoted(journal, out, "accuracy.md", md.str());
-  }
-  std::string wrote = "accuracy.csv, accuracy.md";
-  if (only.empty()) {
-    // The charts: for the sweep and for merges, not for single runs.
-    for (const char* c : kCases) {
-      if (std::none_of(runs.begin(), runs.end(), [&](const Run& r) { return r.caseName == c; })) continue;
-      chart(runs, c, journal, out);
-      wrote += std::string(", ") + c + ".png";
+  // The charts: for the sweep and for merges, not for single runs.
+  const ChartsDone charts = only.empty() ? writeCharts(runs, journal, out) : ChartsDone{};
+  for (const std::string& f : charts.written) wrote += (wrote.empty() ? "" : ", ") + f;
+  std::printf("bench accuracy: %zu runs; wrote %s into %s\n", runs.size(), wrote.empty() ? "nothing" : wrote.c_str(),
+              out.c_str());
+  if (!charts.problem.empty()) {
+    // One line: why, and how to draw them (the scripts and their data are written either way).
+    const std::string script = "`gnuplot " + out + "/" + charts.scripts.front() + "`";
+    if (charts.problem == kNoGnuplot)
+      std::printf(
+          "bench accuracy: charts not drawn (gnuplot is not on PATH); once it is installed (Debian: apt-get "
+          "install gnuplot-nox) draw them with `benchmarks/plot_accuracy.sh %s` or, one script per case, %s\n",
+          out.c_str(), script.c_str());
+    else {
+      std::printf("bench accuracy: charts not drawn (%s; gnuplot's message above)\n", charts.problem.c_str());
+      return 1;
     }
   }
-  std::printf("bench accuracy: %zu runs; wrote %s into %s\n", runs.size(), wrote.c_str(), out.c_str());
   return runs.empty() ? 1 : 0;
 }
 

@@ -1,0 +1,59 @@
+# dam_break.gp: the chart of sph2d bench accuracy's dam break case, what accuracy costs in
+# time: error against wall seconds per simulated second, log-log, one series per solver (filled
+# marks: the solver's default CFL-type number, open: twice it), each point labelled with its
+# particle count, the Pareto front drawn. Its data: dam_break.dat beside it.
+#   gnuplot dam_break.gp                 draws dam_break.svg and dam_break.png beside this file
+#   gnuplot -c dam_break.gp A.svg B.png   draws A.svg and B.png
+me = "dam_break.gp"
+n = strlen(ARG0) - strlen(me)
+dir = (n > 0 && ARG0[n+1:] eq me) ? ARG0[1:n] : ""
+data = dir . "dam_break.dat"
+svg = ARGC >= 1 ? ARG1 : dir . "dam_break.svg"
+png = ARGC >= 2 ? ARG2 : dir . "dam_break.png"
+
+set encoding utf8
+set logscale xy
+set xrange [0.050353:619.537]
+set yrange [0.124103:0.42244]
+set xtics ("0.1" 0.1, "1" 1, "10" 10, "100" 100)
+set ytics ("0.15" 0.15, "0.2" 0.2, "0.3" 0.3, "0.4" 0.4)
+set lmargin at screen 0.115; set rmargin at screen 0.8
+set bmargin at screen 0.095; set tmargin at screen 0.88
+set xlabel "cost: wall seconds per simulated second  (s/s)"
+set ylabel "error: RMS of the surge front Z = x/a against\nMartin and Moyce 1952  (column widths a)"
+set title "dam break: error against cost\n{/*0.8 lower left is better; the grey line joins the Pareto front: the runs no other run beats in both}"
+set grid xtics ytics lc rgb "#dddddd" lw 1
+set key outside right top vertical Left reverse noenhanced spacing 1.15 font ",10"
+
+set terminal svg size 960,600 fixed enhanced font "DejaVu Sans,12" background rgb "white"
+set output svg
+plot \
+  data index 5 using 1:2 with lines lw 8 lc rgb "#a0909090" title "Pareto front", \
+  data index 5 using 1:2 with points pt 6 ps 2.6 lw 1.5 lc rgb "#606060" notitle, \
+  data index 0 using 1:($4 == 1 ? $2 : NaN) with points pt 7 ps 1.4 lc rgb "#E69F00" title "muller2003", \
+  data index 0 using 1:($4 != 1 ? $2 : NaN) with points pt 6 ps 1.4 lw 2 lc rgb "#E69F00" notitle, \
+  data index 0 using 6:7:3 with labels left font ",9" tc rgb "#E69F00" notitle, \
+  data index 1 using 1:($4 == 1 ? $2 : NaN) with points pt 5 ps 1.4 lc rgb "#0072B2" title "wcsph", \
+  data index 1 using 1:($4 != 1 ? $2 : NaN) with points pt 4 ps 1.4 lw 2 lc rgb "#0072B2" notitle, \
+  data index 1 using 6:7:3 with labels left font ",9" tc rgb "#0072B2" notitle, \
+  data index 2 using 1:($4 == 1 ? $2 : NaN) with points pt 9 ps 1.4 lc rgb "#009E73" title "dfsph", \
+  data index 2 using 1:($4 != 1 ? $2 : NaN) with points pt 8 ps 1.4 lw 2 lc rgb "#009E73" notitle, \
+  data index 2 using 6:7:3 with labels left font ",9" tc rgb "#009E73" notitle, \
+  data index 3 using 1:($4 == 1 ? $2 : NaN) with points pt 13 ps 1.4 lc rgb "#CC79A7" title "pbf", \
+  data index 3 using 1:($4 != 1 ? $2 : NaN) with points pt 12 ps 1.4 lw 2 lc rgb "#CC79A7" notitle, \
+  data index 3 using 6:7:3 with labels left font ",9" tc rgb "#CC79A7" notitle, \
+  data index 4 using 1:($4 == 1 ? $2 : NaN) with points pt 15 ps 1.4 lc rgb "#D55E00" title "game", \
+  data index 4 using 1:($4 != 1 ? $2 : NaN) with points pt 14 ps 1.4 lw 2 lc rgb "#D55E00" notitle, \
+  data index 4 using 6:7:3 with labels left font ",9" tc rgb "#D55E00" notitle, \
+  keyentry with points pt 7 ps 1.4 lc rgb "#404040" title "CFL ×1", \
+  keyentry with points pt 6 ps 1.4 lw 2 lc rgb "#404040" title "CFL ×2"
+unset output
+
+if (strstrt(" " . GPVAL_TERMINALS . " ", " pngcairo ") > 0) {
+  set terminal pngcairo size 960,600 enhanced font "DejaVu Sans,11" background rgb "white"
+} else {
+  set terminal png size 960,600 enhanced font "DejaVuSans,10" background rgb "white"
+}
+set output png
+replot
+unset output
