@@ -13,6 +13,7 @@
 #include "sph2d/render/renderer.hpp"
 #include "sph2d/scene.hpp"
 #include "sph2d/world.hpp"
+#include "support/frame_pixels.hpp"
 
 using namespace sph2d;
 
@@ -51,23 +52,6 @@ double waterShare(const Frame& f) {
 }
 
 std::uint64_t hashOf(const Frame& f) { return xxh64(f.rgba.data(), f.rgba.size()); }
-
-/// Pixels of `def`'s solid colour in the 5 × 7 box around world point (wx, wy) of frame f,
-/// seen through camera rectangle `cam` (Renderer::cameraRect: aspect-fitted).
-int solidAround(const Frame& f, const RenderDef& def, const std::vector<double>& cam, double wx, double wy) {
-  const std::array<std::uint8_t, 3> solid{std::uint8_t(std::lround(def.solid[0] * 255)),
-                                          std::uint8_t(std::lround(def.solid[1] * 255)),
-                                          std::uint8_t(std::lround(def.solid[2] * 255))};
-  const int cx = int((wx - cam[0]) / (cam[2] - cam[0]) * f.width),
-            cy = int((cam[3] - wy) / (cam[3] - cam[1]) * f.height);
-  int n = 0;
-  for (int y = cy - 3; y <= cy + 3; ++y)
-    for (int x = cx - 2; x <= cx + 2; ++x) {
-      const std::uint8_t* p = &f.rgba[(std::size_t(y) * std::size_t(f.width) + std::size_t(x)) * 4];
-      n += p[0] == solid[0] && p[1] == solid[1] && p[2] == solid[2];
-    }
-  return n;
-}
 
 RenderInput inputOf(const World& w, const Particles& P) {
   RenderInput in;
@@ -186,7 +170,7 @@ TEST_CASE("moving bodies are drawn where they are in each frame, with no trace w
   const Frame& a = seq.render(world);
   const std::uint64_t sequential = hashOf(a);
   auto solidAround = [&](const Frame& f, double wx, double wy) {
-    return ::solidAround(f, s.render, seq.cameraRect(), wx, wy);
+    return test::solidAround(f, s.render, seq.cameraRect(), wx, wy);
   };
   CHECK(solidAround(a, 0.9, 0.7) == 35);  // the paddle now (it moved 0.5 m)
   CHECK(solidAround(a, 0.4, 0.7) == 0);   // nothing left where it started

@@ -14,29 +14,13 @@
 #include "sph2d/render/renderer.hpp"
 #include "sph2d/scene.hpp"
 #include "sph2d/world.hpp"
+#include "support/frame_pixels.hpp"
 
 using namespace sph2d;
 
 namespace {
 
 std::uint64_t hashOf(const Frame& f) { return xxh64(f.rgba.data(), f.rgba.size()); }
-
-/// Pixels of `def`'s solid colour in the 5 × 7 box around world point (wx, wy) of frame f,
-/// seen through camera rectangle `cam` (Renderer::cameraRect: aspect-fitted).
-int solidAround(const Frame& f, const RenderDef& def, const std::vector<double>& cam, double wx, double wy) {
-  const std::array<std::uint8_t, 3> solid{std::uint8_t(std::lround(def.solid[0] * 255)),
-                                          std::uint8_t(std::lround(def.solid[1] * 255)),
-                                          std::uint8_t(std::lround(def.solid[2] * 255))};
-  const int cx = int((wx - cam[0]) / (cam[2] - cam[0]) * f.width),
-            cy = int((cam[3] - wy) / (cam[3] - cam[1]) * f.height);
-  int n = 0;
-  for (int y = cy - 3; y <= cy + 3; ++y)
-    for (int x = cx - 2; x <= cx + 2; ++x) {
-      const std::uint8_t* p = &f.rgba[(std::size_t(y) * std::size_t(f.width) + std::size_t(x)) * 4];
-      n += p[0] == solid[0] && p[1] == solid[1] && p[2] == solid[2];
-    }
-  return n;
-}
 
 /// A pool 0.6 m deep from a wall at x = 0 to beyond the view's right edge, with a block 0.3 m
 /// high and 0.2 m wide standing on its surface at x = 0.8 .. 1.0 (a bump), as a square lattice
@@ -198,7 +182,7 @@ TEST_CASE("static solids a game moves are drawn where they are: a teleported wal
     World world(s, level, WorldOptions{1});
     Renderer seq(s.render);
     auto solidAround = [&](const Frame& f, double wx, double wy) {
-      return ::solidAround(f, s.render, seq.cameraRect(), wx, wy);
+      return test::solidAround(f, s.render, seq.cameraRect(), wx, wy);
     };
     auto sameAsFresh = [&](const Frame& f) {
       Renderer fresh(s.render);

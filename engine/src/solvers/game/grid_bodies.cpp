@@ -143,8 +143,8 @@ void GridProjection::assembleCoupling() {
   coupling_.clear();
   if (bodies_.empty()) return;
   const double h = double(h_);
-  forUnknowns([&](std::size_t a, int i, int j) {
-    const int k = cells_[a];
+  pcg_.forUnknowns([&](std::size_t a, int i, int j) {
+    const int k = pcg_.cells()[a];
     const int nb[4] = {k - 1, k + 1, k - nx_, k + nx_};
     const Vec2d normals[4] = {Vec2d(-1, 0), Vec2d(1, 0), Vec2d(0, -1), Vec2d(0, 1)};
     const Vec2d faces[4] = {Vec2d(double(I0_ + i) * h, (double(J0_ + j) + 0.5) * h),
@@ -159,7 +159,10 @@ void GridProjection::assembleCoupling() {
       if (!(st.invMass > 0)) continue;  // kinematic: a moving wall only
       std::size_t e = first;
       while (e < coupling_.size() && coupling_[e].body != body) ++e;
-      if (e == coupling_.size()) coupling_.push_back(Coupling{std::int32_t(a), body, {0, 0, 0}});
+      if (e == coupling_.size()) {
+        coupling_.push_back(Coupling{std::int32_t(a), body, {0, 0, 0}});
+        pcg_.vent(a);  // the body can move: the region is not sealed
+      }
       double g[3];
       st.coupling(normals[q], faces[q], g);
       for (int r = 0; r < 3; ++r) coupling_[e].g[r] += g[r];

@@ -1,7 +1,7 @@
 // The coarse-grid pressure projection (grid_projection.hpp): the grid's layout, the cells'
 // classification and the particles splatted to cells and faces; the projection's order
 // (project) and its saved state. Body coupling: grid_bodies.cpp; the pressure system and its
-// solve: grid_pcg.cpp; the velocity change back to the particles: grid_transfer.cpp.
+// solve: grid_solve.cpp and grid_pcg.cpp; the velocity change back to the particles: grid_transfer.cpp.
 #include "solvers/game/grid_projection.hpp"
 #include "bodies/moving_solid.hpp"
 #include "core/state_io.hpp"
@@ -67,7 +67,6 @@ void GridProjection::resetCells() {
   w_.assign(cells, 0);
   comp_.assign(cells, 0);
   if (surface_) top_.assign(cells, -std::numeric_limits<Real>::infinity());
-  index_.assign(cells, -1);
   uOpen_.assign(std::size_t(nx_ + 1) * std::size_t(ny_), 0);
   fluidU_.assign(uOpen_.size(), 0);
   vOpen_.assign(std::size_t(nx_) * std::size_t(ny_ + 1), 0);

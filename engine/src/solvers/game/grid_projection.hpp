@@ -42,6 +42,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "solvers/game/grid_pcg.hpp"
 #include "step/step_context.hpp"
 
 namespace sph2d {
@@ -94,7 +95,8 @@ class GridProjection {
   const GridProjectionStats& stats() const { return stats_; }
 
  private:
-  enum : std::uint8_t { kAir = 0, kFluid = 1, kSolid = 2, kBody = 3 };  ///< kBody: inside a moving body (bodyOf_)
+  /// The cells' kinds (GridPcg's, and kBody: inside a moving body, bodyOf_; solid to the system).
+  enum : std::uint8_t { kAir = GridPcg::kAir, kFluid = GridPcg::kFluid, kSolid = GridPcg::kSolid, kBody = 3 };
   /// The grid over the particles' box (cells of cellRatio_·dx, larger for spray).
   void layout(const StepContext& c);
   /// Sizes and clears the cell fields and the face flags (the first task of a projection).
@@ -106,30 +108,18 @@ class GridProjection {
   void splatCells(const StepContext& c);
   /// The particles' velocities to the u (axis 0) or v (axis 1) faces, in slot order.
   void splatFaces(const StepContext& c, int axis);
+  /// The pressure system of the classified cells (pcg_: grid_pcg.hpp), the ghost surface's θ
+  /// and the dynamic bodies' coupling rows with it.
   void assemble();
-  /// out = A·in; `coupled`: plus the dynamic bodies' response ρ0 h² G M⁻¹ Gᵀ·in.
-  void apply(const std::vector<Real>& in, std::vector<Real>& out, bool coupled) const;
-  /// apply(in, out, false), returning in·out (summed in cell order, in double).
-  double applyDot(const std::vector<Real>& in, std::vector<Real>& out) const;
-  /// a·b over the unknowns, summed in cell order in double.
-  double dot(const std::vector<Real>& a, const std::vector<Real>& b) const;
-  void precondition(const std::vector<Real>& r, std::vector<Real>& z, std::vector<Real>& y) const;
-  /// The vectors of one conjugate-gradient solve (two solves may run at once).
-  struct CgWork {
-    std::vector<Real> r, z, d, q, y;
-  };
-  int pcg(std::vector<Real>& x, const std::vector<Real>& b, Real tol, Real& res, CgWork& w, bool coupled) const;
+  /// out += the dynamic bodies' response ρ0 h² G M⁻¹ Gᵀ·in (the coupled pressure solve's extra term).
+  void addCoupled(const std::vector<Real>& in, std::vector<Real>& out) const;
   /// Marks the cells whose centre lies at least half a cell inside a moving body (kBody),
   /// static solids excepted; makes a cell its centre covers less deeply fluid when it holds
   /// any particle weight; computes each body's face correction T (bodies_).
   void markBodies(const StepContext& c);
-  /// The coupling rows G: one per (fluid cell, dynamic body) pair whose faces touch.
+  /// The coupling rows G: one per (fluid cell, dynamic body) pair whose faces touch (their
+  /// regions vented: a sealed pocket has no dynamic body).
   void assembleCoupling();
-  /// Finds the sealed pockets (fluid regions with no open face to air and no dynamic body)
-  /// and grounds each one's last cell (pocketOf_, pocketCells_, pocketLast_; diag_).
-  void groundPockets();
-  /// Takes each sealed pocket's mean out of a right-hand side (summed in cell order).
-  void balance(std::vector<Real>& rhs) const;
   /// The velocity along +x (axis 0, u face) or +y (axis 1, v face) that a moving body's
   /// cell imposes on face (i, j): g·(v, ω) with the face's corrected coupling g.
   Real bodyFaceVelocity(int body, int axis, int i, int j) const;
@@ -140,13 +130,6 @@ class GridProjection {
   /// The compression shift's right-hand side (rhsS_), its unknowns cleared (xs_).
   void shiftSystem(const StepContext& c);
   void solve(const StepContext& c);
-  /// Calls f(a, i, j) for every unknown a (cell (i, j)), in cell order, row by row.
-  template <class F>
-  void forUnknowns(F f) const {
-    for (int j = 0; j < ny_; ++j)
-      for (std::int32_t a = rowStart_[std::size_t(j)]; a < rowStart_[std::size_t(j) + 1]; ++a)
-        f(std::size_t(a), cells_[std::size_t(a)] - j * nx_, j);
-  }
   /// The bilinear weights of a point on the u and v faces, and the lower left face of each.
   struct FaceWeights {
     std::size_t ku, kv;
@@ -192,21 +175,13 @@ class GridProjection {
   std::vector<Real> u_, uw_, v_, vw_;          ///< face velocities and weights
   std::vector<Real> du_, dv_;                  ///< face velocity changes
   std::vector<Real> uNew_, vNew_;              ///< projected face velocities (for the PIC share)
-  std::vector<Real> kappa_, rhs_, x_, diag_;
-  CgWork cgMain_, cgShift_;
+  std::vector<Real> kappa_, rhs_, x_;  ///< per cell: κ; per unknown: the pressure solve's right-hand side and unknowns
+  GridPcg pcg_;                        ///< the matrix of the fluid cells (both solves)
+  GridPcg::Work cgMain_, cgShift_;
   GridShift shiftDef_;
   std::vector<Real> kappaS_, rhsS_, xs_, su_,
-      sv_;                            ///< the shift's potential (per cell; right-hand side and unknowns) and face moves
-  std::vector<Vec2> shift_;           ///< per particle
-  std::vector<std::int32_t> index_;   ///< cell → unknown (−1: none)
-  std::vector<std::int32_t> cells_;   ///< unknown → cell
-  std::vector<std::int32_t> adj_;     ///< per unknown: left, right, down, up unknown (−1: none)
-  std::vector<std::int32_t> nbrPad_;  ///< adj_ with m for none (applyDot reads a 0 there)
-  std::vector<Real> precon_, precon2_;  ///< MIC(0) factor: 1/diag(L), and its square
-  std::vector<std::int32_t> rowStart_;  ///< per grid row: its first unknown (ny + 1 entries, the last m)
-  std::vector<std::uint8_t> vented_;    ///< per unknown: an open face to air (then per region root: the region has one)
-  std::vector<std::int32_t> pocketOf_;  ///< per unknown: its sealed pocket (−1: a vented region)
-  std::vector<std::int32_t> pocketCells_, pocketLast_;  ///< per pocket: its cell count, its grounded (last) unknown
+      sv_;                   ///< the shift's potential (per cell; right-hand side and unknowns) and face moves
+  std::vector<Vec2> shift_;  ///< per particle
   // Warm start: the last substep's κ by anchored cell.
   Real pH_ = 0;  ///< the cell size of prevKappa_
   long pI0_ = 0, pJ0_ = 0;
@@ -238,7 +213,7 @@ class GridProjection {
   };
   std::vector<Coupling> coupling_;       ///< in unknown order
   double couplingScale_ = 0;             ///< ρ0 h²
-  mutable std::vector<double> bodySum_;  ///< apply()'s scratch: Gᵀ·in per body (the main solve only)
+  mutable std::vector<double> bodySum_;  ///< addCoupled()'s scratch: Gᵀ·in per body (the main solve only)
   std::vector<std::uint8_t> bodyCells_;  ///< markBodies' scratch: one body's cells over its box
   std::vector<double> bodyImpulse_;      ///< solve()'s scratch: each body's impulse Gᵀκ
 };
