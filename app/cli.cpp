@@ -145,6 +145,54 @@ void checkMemory(const SceneDef& scene, bool images, double limit) {
   throw UsageError(o.str());
 }
 
+ArgReader::ArgReader(const std::vector<std::string>& args, std::string command)
+    : args_(args), command_(std::move(command)) {}
+
+bool ArgReader::next() {
+  ++i_;
+  if (i_ >= args_.size()) return false;
+  flag_ = args_[i_];
+  return true;
+}
+
+std::string ArgReader::value() {
+  if (i_ + 1 >= args_.size()) throw UsageError(flag_ + " needs a value");
+  return args_[++i_];
+}
+
+std::string ArgReader::valueOr(std::string otherwise) {
+  if (i_ + 1 < args_.size() && args_[i_ + 1].rfind("--", 0) != 0) return args_[++i_];
+  return otherwise;
+}
+
+int ArgReader::intValue(int lo, int hi) {
+  const std::string flag = flag_;
+  return parseInt(flag, value(), lo, hi);
+}
+
+double ArgReader::numberValue() {
+  const std::string flag = flag_;
+  return parseNumber(flag, value());
+}
+
+double ArgReader::bytesValue() {
+  const std::string flag = flag_;
+  return parseBytes(flag, value());
+}
+
+std::vector<int> ArgReader::intListValue(int lo, int hi) {
+  const std::string flag = flag_;
+  return parseIntList(flag, value(), lo, hi);
+}
+
+std::vector<std::string> ArgReader::listValue() { return splitList(value()); }
+
+void ArgReader::unknown() const {
+  throw UsageError("unknown option '" + arg() + "' (see sph2d " + command_ + " --help)");
+}
+
+void ArgReader::unexpected() const { throw UsageError("unexpected argument '" + arg() + "'"); }
+
 int parseInt(const std::string& flag, const std::string& v, int lo, int hi) {
   char* end = nullptr;
   errno = 0;
@@ -190,12 +238,9 @@ const char* kRenderFlagsHelp =
     "  --foam-speed V  liquid: foam starts at V m/s, full at 2V (default 0.35·sqrt(g·view height))\n"
     "  --depth-scale D liquid: D metres of water above darken the colour by 1/e (default 1)\n";
 
-bool parseRenderFlag(const std::vector<std::string>& a, std::size_t& i, RenderOptions& o) {
-  const std::string& s = a[i];
-  auto value = [&]() -> std::string {
-    if (i + 1 >= a.size()) throw UsageError(s + " needs a value");
-    return a[++i];
-  };
+bool parseRenderFlag(ArgReader& a, RenderOptions& o) {
+  const std::string s = a.arg();
+  auto value = [&]() { return a.value(); };
   if (s == "--mode") {
     o.mode = value();
     if (o.mode != "liquid" && o.mode != "particles")

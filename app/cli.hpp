@@ -18,6 +18,54 @@ struct UsageError : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+/// A command's arguments read one at a time: the loop every command shares, with its errors
+/// ("--x needs a value", "unknown option '--y' (see sph2d CMD --help)"):
+///
+///     for (ArgReader a(args, "bench step"); a.next();) {
+///       if (a.help()) return printHelp();
+///       else if (a.is("--steps")) steps = a.intValue(1, 1000000);
+///       else a.unknown();
+///     }
+class ArgReader {
+ public:
+  /// `command` names the command in the errors ("bench step").
+  ArgReader(const std::vector<std::string>& args, std::string command);
+  /// Moves to the next argument; false after the last.
+  bool next();
+  /// The current argument.
+  const std::string& arg() const { return args_[i_]; }
+  /// True when the current argument is `flag`.
+  bool is(const char* flag) const { return arg() == flag; }
+  /// True for --help or -h.
+  bool help() const { return is("--help") || is("-h"); }
+  /// True when the current argument starts with '-' (an option, not a file).
+  bool option() const { return !arg().empty() && arg()[0] == '-'; }
+  /// The value after the current flag (consumed), or UsageError "<flag> needs a value".
+  std::string value();
+  /// The value after the current flag when one follows (an argument not starting with "--"),
+  /// consumed; else `otherwise` (a flag whose value is optional).
+  std::string valueOr(std::string otherwise);
+  /// The value as an integer in [lo, hi] (parseInt).
+  int intValue(int lo, int hi);
+  /// The value as a finite number (parseNumber).
+  double numberValue();
+  /// The value as a size in bytes (parseBytes).
+  double bytesValue();
+  /// The value as a comma-separated list of integers in [lo, hi] (parseIntList).
+  std::vector<int> intListValue(int lo, int hi);
+  /// The value as a comma-separated list (splitList).
+  std::vector<std::string> listValue();
+  /// Throws UsageError for the current argument as an unknown option.
+  [[noreturn]] void unknown() const;
+  /// Throws UsageError for the current argument as one too many.
+  [[noreturn]] void unexpected() const;
+
+ private:
+  const std::vector<std::string>& args_;
+  std::string command_, flag_;
+  std::size_t i_ = std::size_t(-1);
+};
+
 /// Parses an integer flag value in [lo, hi] or throws UsageError naming the flag.
 int parseInt(const std::string& flag, const std::string& v, int lo, int hi);
 /// Parses a finite number or throws UsageError naming the flag.
@@ -65,9 +113,9 @@ void installStopHandler();
 /// half done, so it need not finish. main() calls it first.
 void installExitHandler();
 
-/// Parses the render flag at args[i] (--mode, --color-by, --range, --overlay, --foam-speed,
-/// --depth-scale), advancing i past its value; false when args[i] is not a render flag.
-bool parseRenderFlag(const std::vector<std::string>& args, std::size_t& i, RenderOptions& o);
+/// Parses the render flag at the reader's argument (--mode, --color-by, --range, --overlay,
+/// --foam-speed, --depth-scale), consuming its value; false when it is not a render flag.
+bool parseRenderFlag(ArgReader& a, RenderOptions& o);
 /// The help lines of the render flags.
 extern const char* kRenderFlagsHelp;
 

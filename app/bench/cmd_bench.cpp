@@ -68,34 +68,30 @@ int cmdBench(const std::vector<std::string>& args) {
   int particles = 20000, width = 960, height = 540, frames = 30, level = 1;
   std::string save;
   RenderOptions opt;
-  for (std::size_t i = 1; i < args.size(); ++i) {
-    const std::string& s = args[i];
-    auto value = [&]() -> std::string {
-      if (i + 1 >= args.size()) throw UsageError(s + " needs a value");
-      return args[++i];
-    };
-    if (s == "--help" || s == "-h") {
+  const std::vector<std::string> rest(args.begin() + 1, args.end());
+  for (ArgReader in(rest, "bench"); in.next();) {
+    if (in.help()) {
       std::fputs(kBenchHelp, stdout);
       std::fputs(kRenderFlagsHelp, stdout);
       return 0;
     }
-    if (parseRenderFlag(args, i, opt)) continue;
-    if (s == "--particles")
-      particles = parseInt(s, value(), 1, 4000000);
-    else if (s == "--frames")
-      frames = parseInt(s, value(), 1, 100000);
-    else if (s == "--png-level")
-      level = parseInt(s, value(), 0, 9);
-    else if (s == "--save")
-      save = value();
-    else if (s == "--size") {
-      const std::string v = value();
+    if (parseRenderFlag(in, opt)) continue;
+    if (in.is("--particles"))
+      particles = in.intValue(1, 4000000);
+    else if (in.is("--frames"))
+      frames = in.intValue(1, 100000);
+    else if (in.is("--png-level"))
+      level = in.intValue(0, 9);
+    else if (in.is("--save"))
+      save = in.value();
+    else if (in.is("--size")) {
+      const std::string v = in.value();
       const auto x = v.find('x');
       if (x == std::string::npos) throw UsageError("--size expects WxH, got '" + v + "'");
-      width = parseInt(s, v.substr(0, x), 16, 8192);
-      height = parseInt(s, v.substr(x + 1), 16, 8192);
+      width = parseInt("--size", v.substr(0, x), 16, 8192);
+      height = parseInt("--size", v.substr(x + 1), 16, 8192);
     } else
-      throw UsageError("unknown option '" + s + "' (see sph2d bench --help)");
+      in.unknown();
   }
 
   // The dam-break tank (4 m × 3 m) and, on a square lattice, about N particles under a

@@ -376,47 +376,43 @@ int cmdBenchAccuracy(const std::vector<std::string>& args) {
   int threads = 0, levels = 3;
   std::vector<std::string> solvers, fromCsv, only, mergeDirs,
       cases(std::begin(kCases), std::begin(kCases) + kDefaultCases);
-  for (std::size_t i = 0; i < args.size(); ++i) {
-    const std::string& a = args[i];
-    auto value = [&]() -> std::string {
-      if (i + 1 >= args.size()) throw UsageError(a + " needs a value");
-      return args[++i];
-    };
-    if (a == "--help" || a == "-h") {
+  for (ArgReader opt(args, "bench accuracy"); opt.next();) {
+    const std::string a = opt.arg();
+    if (opt.help()) {
       std::fputs(kHelp, stdout);
       return 0;
-    } else if (a == "--out") {
-      out = value();
+    } else if (opt.is("--out")) {
+      out = opt.value();
       outGiven = true;
-    } else if (a == "--assets")
-      assets = value();
-    else if (a == "--quick")
+    } else if (opt.is("--assets"))
+      assets = opt.value();
+    else if (opt.is("--quick"))
       quick = true;
-    else if (a == "--threads")
-      threads = parseInt(a, value(), 1, 256);
-    else if (a == "--levels")
-      levels = parseInt(a, value(), 1, 3);
-    else if (a == "--from-csv") {
-      for (const std::string& f : splitList(value())) fromCsv.push_back(f);
-    } else if (a == "--charts-only") {
-      for (const std::string& f : splitList(value())) fromCsv.push_back(f);
+    else if (opt.is("--threads"))
+      threads = opt.intValue(1, 256);
+    else if (opt.is("--levels"))
+      levels = opt.intValue(1, 3);
+    else if (opt.is("--from-csv")) {
+      for (const std::string& f : opt.listValue()) fromCsv.push_back(f);
+    } else if (opt.is("--charts-only")) {
+      for (const std::string& f : opt.listValue()) fromCsv.push_back(f);
       chartsOnly = true;
-    } else if (a == "--merge")
-      mergeDirs.push_back(value());
-    else if (a == "--allow-mixed")
+    } else if (opt.is("--merge"))
+      mergeDirs.push_back(opt.value());
+    else if (opt.is("--allow-mixed"))
       allowMixed = true;
-    else if (a == "--list")
+    else if (opt.is("--list"))
       list = true;
-    else if (a == "--list-ids")
+    else if (opt.is("--list-ids"))
       listIds = true;
-    else if (a == "--only") {
-      only = splitList(value());
+    else if (opt.is("--only")) {
+      only = opt.listValue();
       if (only.empty()) throw UsageError("--only needs a run id (sph2d bench accuracy --list-ids lists them)");
-    } else if (a == "--solvers") {
-      solvers = splitList(value());
+    } else if (opt.is("--solvers")) {
+      solvers = opt.listValue();
       filtered = true;
-    } else if (a == "--cases") {
-      cases = splitList(value());
+    } else if (opt.is("--cases")) {
+      cases = opt.listValue();
       filtered = true;
       if (cases.size() == 1 && cases[0] == "all") cases.assign(std::begin(kCases), std::end(kCases));
       if (cases.empty()) throw UsageError("--cases needs at least one case (" + caseList() + ", or all)");
@@ -424,7 +420,7 @@ int cmdBenchAccuracy(const std::vector<std::string>& args) {
         if (indexOf(kCases, k) < 0)
           throw UsageError("--cases: unknown case '" + k + "' (allowed: " + caseList() + ", or all)");
     } else
-      throw UsageError("unknown option '" + a + "' (see sph2d bench accuracy --help)");
+      opt.unknown();
   }
   const bool merging = !fromCsv.empty() || !mergeDirs.empty();
   if (int(list) + int(listIds) + int(!only.empty()) + int(merging) > 1)

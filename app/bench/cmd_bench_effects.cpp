@@ -120,38 +120,33 @@ int cmdBenchEffects(const std::vector<std::string>& args) {
   std::string scenePath = "assets/scenes/dam_break_muller2003.json", csvPath, solver, clock = "wall";
   int particles = 20000, threads = 1, steps = 50, warmup = 50, rounds = 5;
   std::vector<std::string> only;
-  for (std::size_t i = 0; i < args.size(); ++i) {
-    const std::string& a = args[i];
-    auto value = [&]() -> std::string {
-      if (i + 1 >= args.size()) throw UsageError(a + " needs a value");
-      return args[++i];
-    };
-    if (a == "--help" || a == "-h") {
+  for (ArgReader opt(args, "bench effects"); opt.next();) {
+    if (opt.help()) {
       std::fputs(kHelp, stdout);
       return 0;
-    } else if (a == "--scene")
-      scenePath = value();
-    else if (a == "--particles")
-      particles = parseInt(a, value(), 1, 50000000);
-    else if (a == "--threads")
-      threads = parseInt(a, value(), 1, 256);
-    else if (a == "--steps")
-      steps = parseInt(a, value(), 1, 100000000);
-    else if (a == "--warmup")
-      warmup = parseInt(a, value(), 0, 100000000);
-    else if (a == "--rounds")
-      rounds = parseInt(a, value(), 1, 100000);
-    else if (a == "--effects")
-      only = splitList(value());
-    else if (a == "--solver")
-      solver = value();
-    else if (a == "--csv")
-      csvPath = value();
-    else if (a == "--clock") {
-      clock = value();
+    } else if (opt.is("--scene"))
+      scenePath = opt.value();
+    else if (opt.is("--particles"))
+      particles = opt.intValue(1, 50000000);
+    else if (opt.is("--threads"))
+      threads = opt.intValue(1, 256);
+    else if (opt.is("--steps"))
+      steps = opt.intValue(1, 100000000);
+    else if (opt.is("--warmup"))
+      warmup = opt.intValue(0, 100000000);
+    else if (opt.is("--rounds"))
+      rounds = opt.intValue(1, 100000);
+    else if (opt.is("--effects"))
+      only = opt.listValue();
+    else if (opt.is("--solver"))
+      solver = opt.value();
+    else if (opt.is("--csv"))
+      csvPath = opt.value();
+    else if (opt.is("--clock")) {
+      clock = opt.value();
       if (clock != "wall" && clock != "cpu") throw UsageError("--clock expects wall or cpu, got '" + clock + "'");
     } else
-      throw UsageError("unknown option '" + a + "' (see sph2d bench effects --help)");
+      opt.unknown();
   }
 
   const std::vector<std::string> known = {"none",   "none_again", "viscosity", "xsph",       "force_field", "csf",

@@ -270,63 +270,59 @@ int cmdBenchGame(const std::vector<std::string>& args) {
                            mergeDirs;
   std::string peer, csvPath, out, assetsPath = "assets";
   bool list = false, listIds = false, allowMixed = false, shaped = false;
-  for (std::size_t i = 0; i < args.size(); ++i) {
-    const std::string& a = args[i];
-    auto value = [&]() -> std::string {
-      if (i + 1 >= args.size()) throw UsageError(a + " needs a value");
-      return args[++i];
-    };
-    if (a == "--help" || a == "-h") {
+  for (ArgReader opt(args, "bench game"); opt.next();) {
+    const std::string a = opt.arg();
+    if (opt.help()) {
       std::fputs(kHelp, stdout);
       return 0;
-    } else if (a == "--particles") {
-      particles = parseIntList(a, value(), 100, 50000000);
+    } else if (opt.is("--particles")) {
+      particles = opt.intListValue(100, 50000000);
       shaped = true;
-    } else if (a == "--threads") {
-      threads = parseIntList(a, value(), 1, 256);
+    } else if (opt.is("--threads")) {
+      threads = opt.intListValue(1, 256);
       shaped = true;
-    } else if (a == "--seconds") {
-      seconds = parseNumber(a, value());
+    } else if (opt.is("--seconds")) {
+      seconds = opt.numberValue();
       // At least one frame of 1/60 s, so that every figure measures something.
       if (!(seconds >= 1.0 / 60 && seconds <= 60)) throw UsageError("--seconds must be in [1/60, 60]");
-    } else if (a == "--presets") {
-      presets = splitList(value());
+    } else if (opt.is("--presets")) {
+      presets = opt.listValue();
       shaped = true;
       for (const std::string& p : presets)
         if (p != "game" && p != "balanced" && p != "accurate")
           throw UsageError("--presets: unknown preset '" + p + "'; presets: game, balanced, accurate");
       if (presets.empty()) throw UsageError("--presets needs at least one preset");
-    } else if (a == "--floors") {
+    } else if (opt.is("--floors")) {
       floors.clear();
       shaped = true;
-      for (const std::string& f : splitList(value())) floors.push_back(parseFloorVariant(a, f).name);
+      for (const std::string& f : opt.listValue()) floors.push_back(parseFloorVariant(a, f).name);
       if (floors.empty()) throw UsageError("--floors needs at least one floor (scene, free, muX, noslip)");
-    } else if (a == "--set")
-      sets.push_back(value());
-    else if (a == "--peer") {
+    } else if (opt.is("--set"))
+      sets.push_back(opt.value());
+    else if (opt.is("--peer")) {
       // `--peer` alone: the harness this build tree builds (-DSPH2D_PEER_LIQUIDFUN=ON); `--peer PATH`: that one.
-      peer = i + 1 < args.size() && args[i + 1].rfind("--", 0) != 0 ? args[++i] : std::string(SPH2D_PEER_EXE);
-    } else if (a == "--assets")
-      assetsPath = value();
-    else if (a == "--csv")
-      csvPath = value();
-    else if (a == "--out")
-      out = value();
-    else if (a == "--list")
+      peer = opt.valueOr(SPH2D_PEER_EXE);
+    } else if (opt.is("--assets"))
+      assetsPath = opt.value();
+    else if (opt.is("--csv"))
+      csvPath = opt.value();
+    else if (opt.is("--out"))
+      out = opt.value();
+    else if (opt.is("--list"))
       list = true;
-    else if (a == "--list-ids")
+    else if (opt.is("--list-ids"))
       listIds = true;
-    else if (a == "--only") {
-      only = splitList(value());
+    else if (opt.is("--only")) {
+      only = opt.listValue();
       if (only.empty()) throw UsageError("--only needs a run id (sph2d bench game --list-ids lists them)");
-    } else if (a == "--merge")
-      mergeDirs.push_back(value());
-    else if (a == "--from-csv") {
-      for (const std::string& f : splitList(value())) fromCsv.push_back(f);
-    } else if (a == "--allow-mixed")
+    } else if (opt.is("--merge"))
+      mergeDirs.push_back(opt.value());
+    else if (opt.is("--from-csv")) {
+      for (const std::string& f : opt.listValue()) fromCsv.push_back(f);
+    } else if (opt.is("--allow-mixed"))
       allowMixed = true;
     else
-      throw UsageError("unknown option '" + a + "' (see sph2d bench game --help)");
+      opt.unknown();
   }
   const bool merging = !fromCsv.empty() || !mergeDirs.empty();
   if (int(list) + int(listIds) + int(!only.empty()) + int(merging) > 1)

@@ -22,25 +22,21 @@ int cmdBenchServe(const std::vector<std::string>& a) {
   std::string host = "127.0.0.1", csv;
   int port = 8080, drops = 10;
   double seconds = 20, radius = 0.08;
-  for (std::size_t i = 0; i < a.size(); ++i) {
-    const std::string& s = a[i];
-    auto value = [&]() -> std::string {
-      if (i + 1 >= a.size()) throw UsageError(s + " needs a value");
-      return a[++i];
-    };
-    if (s == "--host")
-      host = value();
-    else if (s == "--port")
-      port = parseInt(s, value(), 1, 65535);
-    else if (s == "--seconds")
-      seconds = parseNumber(s, value());
-    else if (s == "--drops")
-      drops = parseInt(s, value(), 0, 10000);
-    else if (s == "--radius")
-      radius = parseNumber(s, value());
-    else if (s == "--csv")
-      csv = value();
-    else if (s == "--help" || s == "-h") {
+  for (ArgReader opt(a, "bench serve"); opt.next();) {
+    const std::string s = opt.arg();
+    if (opt.is("--host"))
+      host = opt.value();
+    else if (opt.is("--port"))
+      port = opt.intValue(1, 65535);
+    else if (opt.is("--seconds"))
+      seconds = opt.numberValue();
+    else if (opt.is("--drops"))
+      drops = opt.intValue(0, 10000);
+    else if (opt.is("--radius"))
+      radius = opt.numberValue();
+    else if (opt.is("--csv"))
+      csv = opt.value();
+    else if (opt.help()) {
       std::printf(
           "Usage: sph2d bench serve [--host H] [--port P] [--seconds S] [--drops N] [--radius R] [--csv FILE]\n"
           "Connects one WebSocket client to a running `sph2d serve` for S seconds (default 20) and prints\n"

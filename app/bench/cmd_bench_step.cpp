@@ -43,29 +43,24 @@ int cmdBenchStep(const std::vector<std::string>& args) {
   std::vector<int> threads = {1, 0};
   int steps = 0, warmup = 20;
   bool csv = false;
-  for (std::size_t i = 0; i < args.size(); ++i) {
-    const std::string& a = args[i];
-    auto value = [&]() -> std::string {
-      if (i + 1 >= args.size()) throw UsageError(a + " needs a value");
-      return args[++i];
-    };
-    if (a == "--help" || a == "-h") {
+  for (ArgReader opt(args, "bench step"); opt.next();) {
+    if (opt.help()) {
       std::fputs(kHelp, stdout);
       return 0;
-    } else if (a == "--scene")
-      scenePath = value();
-    else if (a == "--particles")
-      counts = parseIntList(a, value(), 1, 50000000);
-    else if (a == "--threads")
-      threads = parseIntList(a, value(), 1, 256);
-    else if (a == "--steps")
-      steps = parseInt(a, value(), 1, 100000000);
-    else if (a == "--warmup")
-      warmup = parseInt(a, value(), 0, 100000000);
-    else if (a == "--csv")
+    } else if (opt.is("--scene"))
+      scenePath = opt.value();
+    else if (opt.is("--particles"))
+      counts = opt.intListValue(1, 50000000);
+    else if (opt.is("--threads"))
+      threads = opt.intListValue(1, 256);
+    else if (opt.is("--steps"))
+      steps = opt.intValue(1, 100000000);
+    else if (opt.is("--warmup"))
+      warmup = opt.intValue(0, 100000000);
+    else if (opt.is("--csv"))
       csv = true;
     else
-      throw UsageError("unknown option '" + a + "' (see sph2d bench step --help)");
+      opt.unknown();
   }
   const SceneDef base = loadScene(scenePath);
   const std::size_t n0 = countBlockParticles(base);

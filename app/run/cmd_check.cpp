@@ -275,34 +275,30 @@ int cmdCheck(const std::vector<std::string>& args) {
   std::string scenePath, manifestPath, out;
   int threads = 0;
   bool quiet = false, adoptEnv = false, files = false;
-  for (std::size_t i = 0; i < args.size(); ++i) {
-    const std::string& s = args[i];
-    auto value = [&]() -> std::string {
-      if (i + 1 >= args.size()) throw UsageError(s + " needs a value");
-      return args[++i];
-    };
-    if (s == "--help" || s == "-h") {
+  for (ArgReader opt(args, "check"); opt.next();) {
+    const std::string s = opt.arg();
+    if (opt.help()) {
       std::fputs(kCheckHelp, stdout);
       return 0;
     }
-    if (s == "--against")
-      manifestPath = value();
-    else if (s == "--out")
-      out = value();
-    else if (s == "--threads")
-      threads = parseInt(s, value(), 1, 256);
-    else if (s == "--quiet")
+    if (opt.is("--against"))
+      manifestPath = opt.value();
+    else if (opt.is("--out"))
+      out = opt.value();
+    else if (opt.is("--threads"))
+      threads = opt.intValue(1, 256);
+    else if (opt.is("--quiet"))
       quiet = true;
-    else if (s == "--adopt-env")
+    else if (opt.is("--adopt-env"))
       adoptEnv = true;
-    else if (s == "--files")
+    else if (opt.is("--files"))
       files = true;
-    else if (!s.empty() && s[0] == '-')
-      throw UsageError("unknown option '" + s + "' (see sph2d check --help)");
+    else if (opt.option())
+      opt.unknown();
     else if (scenePath.empty())
       scenePath = s;
     else
-      throw UsageError("unexpected argument '" + s + "'");
+      opt.unexpected();
   }
   if (scenePath.empty()) throw UsageError("missing the scene file (see sph2d check --help)");
   if (manifestPath.empty()) throw UsageError("missing --against MANIFEST (see sph2d check --help)");

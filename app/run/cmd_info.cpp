@@ -31,24 +31,21 @@ int cmdInfo(const std::vector<std::string>& args) {
   std::string path;
   int threads = 0;
   double maxMemory = 0;
-  for (std::size_t i = 0; i < args.size(); ++i) {
-    if (args[i] == "--help" || args[i] == "-h") {
+  for (ArgReader opt(args, "info"); opt.next();) {
+    if (opt.help()) {
       std::fputs(kInfoHelp, stdout);
       return 0;
     }
-    if (args[i] == "--threads") {
-      if (i + 1 >= args.size()) throw UsageError("--threads needs a value");
-      threads = parseInt("--threads", args[++i], 1, 256);
-    } else if (args[i] == "--max-memory") {
-      if (i + 1 >= args.size()) throw UsageError("--max-memory needs a value");
-      maxMemory = parseBytes("--max-memory", args[++i]);
-    } else if (args[i][0] == '-') {
-      throw UsageError("unknown option '" + args[i] + "' (see sph2d info --help)");
-    } else if (path.empty()) {
-      path = args[i];
-    } else {
-      throw UsageError("unexpected argument '" + args[i] + "'");
-    }
+    if (opt.is("--threads"))
+      threads = opt.intValue(1, 256);
+    else if (opt.is("--max-memory"))
+      maxMemory = opt.bytesValue();
+    else if (opt.option())
+      opt.unknown();
+    else if (path.empty())
+      path = opt.arg();
+    else
+      opt.unexpected();
   }
   if (path.empty()) throw UsageError("missing the scene file (see sph2d info --help)");
   const SceneDef s = loadScene(path);

@@ -28,28 +28,24 @@ const char* kRenderHelp =
 int cmdRender(const std::vector<std::string>& args) {
   std::string scenePath, csv, out;
   RenderOptions opt;
-  for (std::size_t i = 0; i < args.size(); ++i) {
-    const std::string& s = args[i];
-    auto value = [&]() -> std::string {
-      if (i + 1 >= args.size()) throw UsageError(s + " needs a value");
-      return args[++i];
-    };
-    if (s == "--help" || s == "-h") {
+  for (ArgReader in(args, "render"); in.next();) {
+    const std::string s = in.arg();
+    if (in.help()) {
       std::fputs(kRenderHelp, stdout);
       std::fputs(kRenderFlagsHelp, stdout);
       return 0;
     }
-    if (parseRenderFlag(args, i, opt)) continue;
-    if (s == "--particles")
-      csv = value();
-    else if (s == "--out")
-      out = value();
-    else if (!s.empty() && s[0] == '-')
-      throw UsageError("unknown option '" + s + "' (see sph2d render --help)");
+    if (parseRenderFlag(in, opt)) continue;
+    if (in.is("--particles"))
+      csv = in.value();
+    else if (in.is("--out"))
+      out = in.value();
+    else if (in.option())
+      in.unknown();
     else if (scenePath.empty())
       scenePath = s;
     else
-      throw UsageError("unexpected argument '" + s + "'");
+      in.unexpected();
   }
   if (scenePath.empty() || csv.empty() || out.empty())
     throw UsageError("sph2d render needs SCENE.json, --particles FRAME.csv and --out IMAGE.png");

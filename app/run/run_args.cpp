@@ -82,58 +82,54 @@ void printRunHelp() { std::printf(kRunHelp, kRenderFlagsHelp); }
 
 RunArgs parseRunArgs(const std::vector<std::string>& a) {
   RunArgs r;
-  for (std::size_t i = 0; i < a.size(); ++i) {
-    const std::string& s = a[i];
-    auto value = [&]() -> std::string {
-      if (i + 1 >= a.size()) throw UsageError(s + " needs a value");
-      return a[++i];
-    };
-    if (parseRenderFlag(a, i, r.render)) continue;
-    if (s == "--out")
-      r.out = value();
-    else if (s == "--frames")
-      r.frames = parseInt(s, value(), 1, 10000000);
-    else if (s == "--every")
-      r.every = parseInt(s, value(), 1, 10000000);
-    else if (s == "--threads")
-      r.threads = parseInt(s, value(), 1, 256);
-    else if (s == "--png-level")
-      r.pngLevel = parseInt(s, value(), 0, 9);
-    else if (s == "--video")
-      r.video = value();
-    else if (s == "--export") {
+  for (ArgReader opt(a, "run"); opt.next();) {
+    const std::string s = opt.arg();
+    if (parseRenderFlag(opt, r.render)) continue;
+    if (opt.is("--out"))
+      r.out = opt.value();
+    else if (opt.is("--frames"))
+      r.frames = opt.intValue(1, 10000000);
+    else if (opt.is("--every"))
+      r.every = opt.intValue(1, 10000000);
+    else if (opt.is("--threads"))
+      r.threads = opt.intValue(1, 256);
+    else if (opt.is("--png-level"))
+      r.pngLevel = opt.intValue(0, 9);
+    else if (opt.is("--video"))
+      r.video = opt.value();
+    else if (opt.is("--export")) {
       ExportFormat f;
-      const std::string v = value();
+      const std::string v = opt.value();
       if (!parseExportFormat(v, f)) throw UsageError("--export expects csv, vtk or vtk-ascii, got '" + v + "'");
       r.exportFormat = f;
-    } else if (s == "--realtime")
+    } else if (opt.is("--realtime"))
       r.realtime = true;
-    else if (s == "--catch-up")
-      r.catchUp = parseInt(s, value(), 1, 1000);
-    else if (s == "--input") {
-      r.inputs.push_back(value());
+    else if (opt.is("--catch-up"))
+      r.catchUp = opt.intValue(1, 1000);
+    else if (opt.is("--input")) {
+      r.inputs.push_back(opt.value());
       if (r.inputs.back() == "-" && std::count(r.inputs.begin(), r.inputs.end(), "-") > 1)
         throw UsageError("--input - may be given once (there is one standard input)");
-    } else if (s == "--record")
-      r.record = value();
-    else if (s == "--max-memory")
-      r.maxMemory = parseBytes(s, value());
-    else if (s == "--max-event-particles")
-      r.maxEventParticles = std::size_t(parseInt(s, value(), 1, 100000000));
-    else if (s == "--max-particles-per-second")
-      r.maxParticlesPerSecond = std::size_t(parseInt(s, value(), 1, 100000000));
-    else if (s == "--max-particles")
-      r.maxParticles = std::size_t(parseInt(s, value(), 1, 100000000));
-    else if (s == "--no-images")
+    } else if (opt.is("--record"))
+      r.record = opt.value();
+    else if (opt.is("--max-memory"))
+      r.maxMemory = opt.bytesValue();
+    else if (opt.is("--max-event-particles"))
+      r.maxEventParticles = std::size_t(opt.intValue(1, 100000000));
+    else if (opt.is("--max-particles-per-second"))
+      r.maxParticlesPerSecond = std::size_t(opt.intValue(1, 100000000));
+    else if (opt.is("--max-particles"))
+      r.maxParticles = std::size_t(opt.intValue(1, 100000000));
+    else if (opt.is("--no-images"))
       r.images = false;
-    else if (s == "--state-hash")
+    else if (opt.is("--state-hash"))
       r.stateHash = true;
-    else if (s == "--profile")
+    else if (opt.is("--profile"))
       r.profile = true;
-    else if (s == "--quiet")
+    else if (opt.is("--quiet"))
       r.quiet = true;
-    else if (!s.empty() && s[0] == '-')
-      throw UsageError("unknown option '" + s + "' (see sph2d run --help)");
+    else if (opt.option())
+      opt.unknown();
     else if (r.scene.empty())
       r.scene = s;
     else

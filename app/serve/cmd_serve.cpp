@@ -106,45 +106,41 @@ struct ServeArgs {
 
 ServeArgs parseServeArgs(const std::vector<std::string>& a) {
   ServeArgs r;
-  for (std::size_t i = 0; i < a.size(); ++i) {
-    const std::string& s = a[i];
-    auto value = [&]() -> std::string {
-      if (i + 1 >= a.size()) throw UsageError(s + " needs a value");
-      return a[++i];
-    };
-    if (parseRenderFlag(a, i, r.render)) continue;
-    if (s == "--port")
-      r.server.port = parseInt(s, value(), 0, 65535);
-    else if (s == "--bind") {
-      r.server.bind = value();
+  for (ArgReader opt(a, "serve"); opt.next();) {
+    const std::string s = opt.arg();
+    if (parseRenderFlag(opt, r.render)) continue;
+    if (opt.is("--port"))
+      r.server.port = opt.intValue(0, 65535);
+    else if (opt.is("--bind")) {
+      r.server.bind = opt.value();
       if (r.server.bind.empty()) throw UsageError("--bind expects an IP address (127.0.0.1, 0.0.0.0, ::1), got ''");
-    } else if (s == "--record")
-      r.record = value();
-    else if (s == "--threads")
-      r.threads = parseInt(s, value(), 1, 256);
-    else if (s == "--max-clients")
-      r.server.maxClients = parseInt(s, value(), 1, 64);
-    else if (s == "--quality")
-      r.server.jpegQuality = parseInt(s, value(), 1, 100);
-    else if (s == "--catch-up")
-      r.catchUp = parseInt(s, value(), 1, 1000);
-    else if (s == "--max-event-particles")
-      r.maxEventParticles = std::size_t(parseInt(s, value(), 1, 100000000));
-    else if (s == "--max-particles-per-second")
-      r.maxParticlesPerSecond = std::size_t(parseInt(s, value(), 1, 100000000));
-    else if (s == "--max-particles")
-      r.maxParticles = std::size_t(parseInt(s, value(), 1, 100000000));
-    else if (s == "--format") {
-      const std::string v = value();
+    } else if (opt.is("--record"))
+      r.record = opt.value();
+    else if (opt.is("--threads"))
+      r.threads = opt.intValue(1, 256);
+    else if (opt.is("--max-clients"))
+      r.server.maxClients = opt.intValue(1, 64);
+    else if (opt.is("--quality"))
+      r.server.jpegQuality = opt.intValue(1, 100);
+    else if (opt.is("--catch-up"))
+      r.catchUp = opt.intValue(1, 1000);
+    else if (opt.is("--max-event-particles"))
+      r.maxEventParticles = std::size_t(opt.intValue(1, 100000000));
+    else if (opt.is("--max-particles-per-second"))
+      r.maxParticlesPerSecond = std::size_t(opt.intValue(1, 100000000));
+    else if (opt.is("--max-particles"))
+      r.maxParticles = std::size_t(opt.intValue(1, 100000000));
+    else if (opt.is("--format")) {
+      const std::string v = opt.value();
       if (v == "jpeg" || v == "jpg")
         r.server.format = ImageFormat::Jpeg;
       else if (v == "png")
         r.server.format = ImageFormat::Png;
       else
         throw UsageError("--format expects jpeg or png, got '" + v + "'");
-    } else if (s == "--quiet")
+    } else if (opt.is("--quiet"))
       r.quiet = true;
-    else if (!s.empty() && s[0] == '-')
+    else if (opt.option())
       throw UsageError(
           "unknown option '" + s +
           "' for serve; options: --port, --bind, --record, --threads, "
