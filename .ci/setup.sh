@@ -12,10 +12,11 @@
 # through it and compare the merged report with a one-process run (tests/app/test_bench_sweep.cpp).
 # gnuplot-nox: `sph2d bench accuracy` draws its charts with it; tests/app/test_bench_accuracy_charts.cpp
 # checks the SVG and PNG it draws (the bench itself runs without it: it writes the scripts).
-# What the demo needs (the engine, the renderer and the `sph2d` app, serve included):
-SPH2D_DEMO_PACKAGES="g++ cmake make pkg-config libbox2d-dev libosmesa6-dev libpng-dev libeigen3-dev nlohmann-json3-dev libboost-dev libturbojpeg0-dev"
-# What the tests add:
-SPH2D_TEST_PACKAGES="doctest-dev clang-14 libclang-rt-14-dev chromium libegl-dev libopengl-dev libegl-mesa0 parallel gnuplot-nox"
+# What the demo needs (the engine, the renderer and the `sph2d` app's run commands; serve and
+# bench come with the tests):
+SPH2D_DEMO_PACKAGES="g++ cmake make pkg-config libbox2d-dev libosmesa6-dev libpng-dev libeigen3-dev nlohmann-json3-dev"
+# What the tests add (libboost-dev and libturbojpeg0-dev for `sph2d serve`):
+SPH2D_TEST_PACKAGES="libboost-dev libturbojpeg0-dev doctest-dev clang-14 libclang-rt-14-dev chromium libegl-dev libopengl-dev libegl-mesa0 parallel gnuplot-nox"
 SPH2D_PACKAGES="$SPH2D_DEMO_PACKAGES $SPH2D_TEST_PACKAGES"
 
 # sph2d_install [PACKAGES]: installs those of PACKAGES (default: all) that are missing.
@@ -34,16 +35,19 @@ sph2d_install() {
 
 # Everything: the engine, renderer, app, examples and every test.
 sph2d_build() {
-  cmake -S . -B build -DCMAKE_BUILD_TYPE=Release -DSPH2D_BUILD_TESTS=ON -DSPH2D_BUILD_EXAMPLES=ON >/dev/null
+  cmake -S . -B build -DCMAKE_BUILD_TYPE=Release -DSPH2D_BUILD_TESTS=ON -DSPH2D_BUILD_EXAMPLES=ON \
+    -DSPH2D_APP_SERVE=ON -DSPH2D_APP_BENCH=ON >/dev/null
   cmake --build build -j"$(nproc)"
 }
 
 # The demo's executable alone (target sph2d). The same build tree as sph2d_build: a later
-# ./test.sh builds the rest and reuses what this built. A first configure leaves the tests and
-# examples out (their packages may be missing); a tree ./test.sh configured keeps them.
+# ./test.sh builds the rest and reuses what this built. A first configure leaves the tests, the
+# examples, `serve` and `bench` out (their packages may be missing); a tree ./test.sh configured
+# keeps them.
 sph2d_build_demo() {
   local first=()
-  [ -f build/CMakeCache.txt ] || first=(-DSPH2D_BUILD_TESTS=OFF -DSPH2D_BUILD_EXAMPLES=OFF)
+  [ -f build/CMakeCache.txt ] ||
+    first=(-DSPH2D_BUILD_TESTS=OFF -DSPH2D_BUILD_EXAMPLES=OFF -DSPH2D_APP_SERVE=OFF -DSPH2D_APP_BENCH=OFF)
   cmake -S . -B build -DCMAKE_BUILD_TYPE=Release "${first[@]}" >/dev/null
   cmake --build build -j"$(nproc)" --target sph2d
 }

@@ -39,6 +39,13 @@ const char* kMainHelp =
     "\n"
     "Exit codes: 0 ok, 1 runtime failure (check: frames differ), 2 bad input, 3 simulation stopped by the guard, 130 interrupted.\n";
 
+/// A command this build left out (./demo.sh builds the run commands alone): exit 2, saying how
+/// to build it.
+[[noreturn]] [[maybe_unused]] void leftOut(const char* command, const char* option) {
+  throw UsageError(std::string("this sph2d was built without `") + command + "` (./demo.sh builds `run`, `info`, " +
+                   "`check` and `render` only): ./test.sh builds it, or configure build/ with -D" + option + "=ON");
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -54,13 +61,22 @@ int main(int argc, char** argv) {
     if (cmd == "run") return cmdRun(args);
     if (cmd == "info") return cmdInfo(args);
     if (cmd == "check") return cmdCheck(args);
+#ifdef SPH2D_HAVE_SERVE
     if (cmd == "serve") return cmdServe(args);
+#else
+    if (cmd == "serve") leftOut("serve", "SPH2D_APP_SERVE");
+#endif
     if (cmd == "render") return cmdRender(args);
     if (cmd == "bench") {
+#ifdef SPH2D_HAVE_BENCH
       if (!args.empty() && args[0] == "step")
         return cmdBenchStep(std::vector<std::string>(args.begin() + 1, args.end()));
+#ifdef SPH2D_HAVE_SERVE
       if (!args.empty() && args[0] == "serve")
         return cmdBenchServe(std::vector<std::string>(args.begin() + 1, args.end()));
+#else
+      if (!args.empty() && args[0] == "serve") leftOut("bench serve", "SPH2D_APP_SERVE");
+#endif
       if (!args.empty() && args[0] == "game")
         return cmdBenchGame(std::vector<std::string>(args.begin() + 1, args.end()));
       if (!args.empty() && args[0] == "effects")
@@ -68,6 +84,9 @@ int main(int argc, char** argv) {
       if (!args.empty() && args[0] == "accuracy")
         return cmdBenchAccuracy(std::vector<std::string>(args.begin() + 1, args.end()));
       return cmdBench(args);
+#else
+      leftOut("bench", "SPH2D_APP_BENCH");
+#endif
     }
     throw UsageError("unknown command '" + cmd +
                      "'; commands: run, info, check, render, bench, serve (see sph2d --help)");
