@@ -41,6 +41,10 @@ const Pinned kPinned[] = {
     {"tests/every_stage.json", "game", 20, true, 0x67ed88475eaf3e55ULL},
     {"validation/poiseuille.json", "wcsph", 20, false, 0x377f8c008f15fca1ULL},
     {"validation/poiseuille.json", "dfsph", 20, false, 0x365aeeeb32a9c100ULL},
+    // Dynamic and kinematic bodies in the water: the game solver's bodies in its grid solve,
+    // wcsph's body samples with the scene's b2World stepped every substep.
+    {"tests/small_crates.json", "game", 30, false, 0xf1c7411aefb1f666ULL},
+    {"tests/small_crates.json", "wcsph", 30, false, 0x932c1455c3cf3a3dULL},
 };
 
 std::uint64_t run(const Pinned& p, int threads) {
