@@ -72,6 +72,8 @@ const char* kHelp =
     "lf_dam_break; benchmarks/peers/liquidfun) on the same dam break, with its default iterations\n"
     "and with --static, and prints the ratio of each sph2d run's time to the peer's; --peer PATH\n"
     "runs the harness at PATH instead.\n"
+    "A run measured at more than one N ends with its cost growth: the wall time's ratio, per particle\n"
+    "too, and the substeps and iterations per frame at the smallest and each larger N.\n"
     "--csv FILE writes one row per run (fractions, not percent); --out DIR writes DIR/game.csv\n"
     "(replacing only a game.csv an earlier bench game wrote there).\n"
     "\n"
@@ -388,6 +390,7 @@ int cmdBenchGame(const std::vector<std::string>& args) {
     std::printf("bench game: %zu rows from %zu files", rows.size(), fromCsv.size());
     for (const RowOrigin& k : kinds) std::printf("; build %s, settings %s", k.build.c_str(), k.settings.c_str());
     std::printf("\n");
+    std::fputs(costGrowth(rows).c_str(), stdout);
     holdFolder();
     writeOutputs(rows);
     return 0;
@@ -490,6 +493,7 @@ int cmdBenchGame(const std::vector<std::string>& args) {
   }
   if (!peer.empty() && !peerTime.empty())
     std::printf("vs peer: sph2d's wall time per simulated second over LiquidFun --static's, measured in this run\n");
+  std::fputs(costGrowth(rows).c_str(), stdout);
   writeOutputs(rows);
   return 0;
 }

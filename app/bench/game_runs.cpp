@@ -7,6 +7,7 @@
 #include <cstdlib>
 #include <map>
 #include <sstream>
+#include <tuple>
 
 #include "bench/sweep.hpp"
 #include "cli.hpp"
@@ -172,6 +173,32 @@ FolderSpec gameFolderSpec() {
   spec.command = "bench game";
   spec.writes = [](const std::string& name) { return name == "game.csv"; };
   return spec;
+}
+
+std::string costGrowth(const std::vector<Row>& rows) {
+  std::map<std::tuple<std::string, std::string, int>, std::vector<const Row*>> runs;
+  for (const Row& r : rows)
+    if (r.particles > 0 && r.wallPerSim > 0) runs[{r.name, r.floor, r.threads}].push_back(&r);
+  std::string out;
+  char line[400];
+  for (auto& [key, list] : runs) {
+    std::stable_sort(list.begin(), list.end(), [](const Row* a, const Row* b) { return a->particles < b->particles; });
+    const Row& a = *list.front();
+    for (std::size_t k = 1; k < list.size(); ++k) {
+      const Row& b = *list[k];
+      if (b.particles == a.particles) continue;
+      const double n = double(b.particles) / double(a.particles), t = b.wallPerSim / a.wallPerSim;
+      std::snprintf(line, sizeof line,
+                    "cost growth, %s%s%s t%d: %zu -> %zu particles (x%.2f): wall/sim x%.2f, per particle x%.2f; "
+                    "substeps/frame %s -> %s, iterations/frame %s -> %s\n",
+                    a.name.c_str(), a.floor == "scene" || a.floor.empty() ? "" : " ",
+                    a.floor == "scene" ? "" : a.floor.c_str(), a.threads, a.particles, b.particles, n, t, t / n,
+                    fmt(a.substepsPerFrame, "%.2f").c_str(), fmt(b.substepsPerFrame, "%.2f").c_str(),
+                    fmt(a.iterationsPerFrame, "%.1f").c_str(), fmt(b.iterationsPerFrame, "%.1f").c_str());
+      out += line;
+    }
+  }
+  return out;
 }
 
 }  // namespace sph2d::cli::game_bench

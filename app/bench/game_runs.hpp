@@ -39,6 +39,12 @@ std::string fmt(double v, const char* f);
 /// The id of a run: preset-particles-tthreads[-floor] or peer-particles.
 std::string specId(const Spec& p);
 
+/// How the cost grows with the particle count: for each run (name, floor, threads) measured at
+/// more than one count, a line per larger count against the smallest: the counts' ratio, the
+/// wall time's and the wall time per particle's, and the substeps and iterations per frame at
+/// both ends ("" when no run has two counts).
+std::string costGrowth(const std::vector<Row>& rows);
+
 /// Parses a run id back into its run; throws UsageError saying what an id is and how to list them.
 Spec parseId(const std::string& id, bool havePeer);
 

@@ -6,6 +6,7 @@
 #include <doctest/doctest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <sstream>
 #include <vector>
 
@@ -77,4 +78,32 @@ TEST_CASE("bench game refuses a peer that is not an executable, and less than on
   const Result s = run("bench game --particles 600 --seconds 0.001");
   CHECK(s.code == 2);
   CHECK(s.out.find("--seconds") != std::string::npos);
+}
+
+TEST_CASE("bench game at two particle counts ends with the cost growth, per particle too, from its own rows") {
+  const std::string dir = freshDir("bench_game_growth");
+  const std::string csvPath = dir + "/game.csv";
+  const Result r = run("bench game --particles 400,900 --seconds 0.05 --presets game --threads 1 --assets " +
+                       q(std::string(SPH2D_ASSETS)) + " --csv " + q(csvPath));
+  INFO(r.out);
+  REQUIRE(r.code == 0);
+  std::string header;
+  const auto rs = rows(readText(csvPath), header);
+  REQUIRE(rs.size() == 2);
+  const double n0 = std::stod(rs[0][3]), n1 = std::stod(rs[1][3]);
+  const double t0 = std::stod(rs[0][5]), t1 = std::stod(rs[1][5]);
+  REQUIRE(n1 > n0);
+  const std::size_t at = r.out.find("cost growth, sph2d_game t1: ");
+  REQUIRE(at != std::string::npos);
+  unsigned long a = 0, b = 0;
+  double ratio = 0, wall = 0, perParticle = 0;
+  REQUIRE(std::sscanf(r.out.c_str() + at,
+                      "cost growth, sph2d_game t1: %lu -> %lu particles (x%lf): wall/sim x%lf, per particle x%lf", &a,
+                      &b, &ratio, &wall, &perParticle) == 5);
+  CHECK(double(a) == n0);
+  CHECK(double(b) == n1);
+  CHECK(ratio == doctest::Approx(n1 / n0).epsilon(0.005));
+  CHECK(wall == doctest::Approx(t1 / t0).epsilon(0.01));
+  CHECK(perParticle == doctest::Approx(t1 / t0 / (n1 / n0)).epsilon(0.01));
+  CHECK(r.out.find("cost growth", at + 1) == std::string::npos);  // one run, one larger count: one line
 }
