@@ -30,6 +30,8 @@ class ArgReader {
  public:
   /// `command` names the command in the errors ("bench step").
   ArgReader(const std::vector<std::string>& args, std::string command);
+  /// Refused: the reader keeps a reference to the arguments, which must outlive it.
+  ArgReader(std::vector<std::string>&& args, std::string command) = delete;
   /// Moves to the next argument; false after the last.
   bool next();
   /// The current argument.

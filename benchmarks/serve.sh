@@ -21,6 +21,8 @@ threads=${3:-2}
 formats=${4:-jpeg png}
 scene=${5:-$root/assets/scenes/dam_break.json}
 sph2d=$root/build/app/sph2d
+# A tree a first ./demo.sh configured has no `serve` (it says how to build it): stop here.
+"$sph2d" serve --help > /dev/null 2>&1 || { "$sph2d" serve --help; exit 2; }
 tmp=$(mktemp -d)
 server=""
 cleanup() {

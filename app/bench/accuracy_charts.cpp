@@ -371,7 +371,10 @@ ChartsDone writeCharts(const std::vector<Run>& runs, OutputJournal& journal, con
       journal.note(name, fs::path(temp).filename().string(), std::nullopt);
       files.emplace_back(name, temp);
     }
-    std::string why = runGnuplot(exe, out + "/" + script, files[0].second, files[1].second);
+    // Absolute paths: gnuplot opens a name starting with '|' or '<' as a command and expands
+    // '~', so a folder name (--out) never reaches it as the start of a path.
+    std::string why = runGnuplot(exe, fs::absolute(out + "/" + script).string(), fs::absolute(files[0].second).string(),
+                                 fs::absolute(files[1].second).string());
     for (const auto& [name, temp] : files)
       if (why.empty() && (!fs::is_regular_file(temp) || fs::file_size(temp) == 0))
         why = "gnuplot " + script + " wrote no " + name;

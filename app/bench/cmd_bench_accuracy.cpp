@@ -377,7 +377,6 @@ int cmdBenchAccuracy(const std::vector<std::string>& args) {
   std::vector<std::string> solvers, fromCsv, only, mergeDirs,
       cases(std::begin(kCases), std::begin(kCases) + kDefaultCases);
   for (ArgReader opt(args, "bench accuracy"); opt.next();) {
-    const std::string a = opt.arg();
     if (opt.help()) {
       std::fputs(kHelp, stdout);
       return 0;

@@ -165,8 +165,8 @@ struct WorldCounters {
   std::size_t particles = 0;           ///< particles now
   std::size_t neighbourPairs = 0;      ///< fluid pairs of the last substep, each counted from both sides
   std::uint64_t removed = 0;           ///< particles removed by lifetimes, sinks and the budget policy
-  std::size_t memoryBytes = 0;         ///< bytes for the particles, grid, neighbour lists and boundary samples
-  std::size_t particleBytes = 0;       ///< bytes the particle arrays hold (the solver's working fields included)
+  std::size_t memoryBytes = 0;  ///< bytes for the particles, grid, neighbour lists, boundary samples and lookup indexes
+  std::size_t particleBytes = 0;  ///< bytes the particle arrays hold (the solver's working fields included)
 };
 
 /// Where a World's time went (World::profile()), as Box2D's b2Profile is for a b2World.

@@ -1,6 +1,6 @@
 // particle_index.hpp (internal) — the World's indexes of its particles for the API's lookups:
 // slots by id (World::slotOf and the bulk calls by id) and a uniform grid for the searches by
-// region (World::slotsInBox, slotsInRadius, slotsInShape, particlesTouching, sampleAt). Both
+// region (World::slotsInBox, slotsInRadius, slotsInShape, idsTouching, sampleAt). Both
 // are built on the first lookup after the particles changed (a step, or an edit between
 // steps), so a game that never asks pays nothing (particle_index.cpp).
 #pragma once

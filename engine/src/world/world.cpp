@@ -275,7 +275,9 @@ void World::Impl::beforeStep(const char* call) {
 
 void World::Impl::abandon(const Interrupted& e) {
   abandonedIn = e.stage.empty() ? std::string("step") : e.stage;
-  refreshView();  // the arrays may have moved; every field has one length
+  refreshView();         // the arrays may have moved; every field has one length
+  index.noteEdit();      // the particles moved without a step's count: the search grid is stale
+  contacts.beginStep();  // an unfinished record (unsorted) is no record
   std::ostringstream o;
   o.precision(9);
   o << "stopped by the stop flag in stage '" << abandonedIn << "' of substep " << steps << " (frame " << frames
