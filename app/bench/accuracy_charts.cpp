@@ -20,6 +20,7 @@
 
 #include "bench/sweep.hpp"
 #include "sph2d/render/particle_export.hpp"
+#include "sph2d/render/video.hpp"
 
 extern char** environ;
 
@@ -332,19 +333,7 @@ ChartText chartText(const std::vector<Run>& runs, const std::string& caseName) {
   return {s, d.str()};
 }
 
-std::string findGnuplot() {
-  const char* path = std::getenv("PATH");
-  if (!path) return "";
-  std::stringstream ss(path);
-  std::string dir;
-  while (std::getline(ss, dir, ':')) {
-    if (dir.empty()) dir = ".";
-    const std::string p = dir + "/gnuplot";
-    struct stat st {};
-    if (::stat(p.c_str(), &st) == 0 && S_ISREG(st.st_mode) && ::access(p.c_str(), X_OK) == 0) return p;
-  }
-  return "";
-}
+std::string findGnuplot() { return findProgram("gnuplot"); }
 
 ChartsDone writeCharts(const std::vector<Run>& runs, OutputJournal& journal, const std::string& out) {
   ChartsDone done;

@@ -16,14 +16,16 @@ extern char** environ;
 
 namespace sph2d {
 
-std::string findFfmpeg() {
+std::string findFfmpeg() { return findProgram("ffmpeg"); }
+
+std::string findProgram(const std::string& name) {
   const char* path = std::getenv("PATH");
   if (!path) return "";
   std::stringstream ss(path);
   std::string dir;
   while (std::getline(ss, dir, ':')) {
     if (dir.empty()) dir = ".";
-    const std::string p = dir + "/ffmpeg";
+    const std::string p = dir + "/" + name;
     struct stat st;
     if (::stat(p.c_str(), &st) == 0 && S_ISREG(st.st_mode) && ::access(p.c_str(), X_OK) == 0) return p;
   }

@@ -17,6 +17,8 @@
 
 namespace sph2d {
 
+/// The first executable regular file named `name` in PATH's folders, or "" when there is none.
+std::string findProgram(const std::string& name);
 /// The path of `ffmpeg` on PATH, or "" when it is not installed.
 std::string findFfmpeg();
 
