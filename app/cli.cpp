@@ -230,9 +230,9 @@ std::vector<int> parseIntList(const std::string& flag, const std::string& v, int
 
 const char* kRenderFlagsHelp =
     "  --mode M        liquid (default: the scene's) or particles\n"
-    "  --color-by F    particles mode: speed (default), pressure, density, age or color (the\n"
-    "                  particles' own colours: a program sets them, setParticleColor; a\n"
-    "                  scene run by sph2d has none and draws in the fluid's colour)\n"
+    "  --color-by F    particles mode: speed (default), pressure, density, age, material (each\n"
+    "                  particle in its material's colour) or color (the particles' own colours,\n"
+    "                  setParticleColor; without one, the material's or the fluid's colour)\n"
     "  --range LO,HI   particles mode: fixed colour range (default: each frame's min..max)\n"
     "  --overlay       draw frame number, simulated time and particle count\n"
     "  --foam-speed V  liquid: foam starts at V m/s, full at 2V (default 0.35·sqrt(g·view height))\n"
@@ -248,7 +248,7 @@ bool parseRenderFlag(ArgReader& a, RenderOptions& o) {
   } else if (s == "--color-by") {
     const std::string v = value();
     if (!parseColorField(v, o.colorBy))
-      throw UsageError("--color-by expects speed, pressure, density, age or color, got '" + v + "'");
+      throw UsageError("--color-by expects speed, pressure, density, age, material or color, got '" + v + "'");
   } else if (s == "--range") {
     const std::string v = value();
     const auto c = v.find(',');

@@ -85,7 +85,7 @@ RenderOptions renderOptions(const json& j) {
   if (o.mode != "" && o.mode != "liquid" && o.mode != "particles")
     throw Malformed{w + "mode", "\"\", \"liquid\" or \"particles\""};
   if (!parseColorField(stringAt(j, "color_by", w), o.colorBy))
-    throw Malformed{w + "color_by", "\"speed\", \"pressure\", \"density\", \"age\" or \"color\""};
+    throw Malformed{w + "color_by", "\"speed\", \"pressure\", \"density\", \"age\", \"color\" or \"material\""};
   const json& range = member(j, "range", w, "null or two finite numbers");
   if (!range.is_null()) {
     if (!range.is_array() || range.size() != 2 || !range[0].is_number() || !range[1].is_number() ||

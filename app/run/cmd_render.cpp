@@ -65,6 +65,9 @@ int cmdRender(const std::vector<std::string>& args) {
            snap.rho[k]);
     B.p.back() = snap.p[k];
   }
+  if (!snap.material.empty())
+    B.material = snap.material;  // the scene's materials colour them (an index
+                                 // it has not is drawn in the fluid's colour)
   const Particles P = B.view();
   if (opt.colorBy == ColorField::Age && snap.age.empty() &&
       (opt.mode == "particles" || (opt.mode.empty() && scene.render.mode == "particles")))
@@ -75,6 +78,7 @@ int cmdRender(const std::vector<std::string>& args) {
   in.spacing = world.spacing();
   in.colliders = &world.colliders();
   in.age = snap.age.empty() ? nullptr : snap.age.data();
+  in.materialColors = materialColors(world);
   in.gravity = scene.gravity.norm();
   in.frame = snap.frame;
   in.time = snap.time;

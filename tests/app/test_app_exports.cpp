@@ -135,6 +135,32 @@ TEST_CASE("--export csv and vtk write each kept frame's particles in id order, w
   CHECK(x0 == s0.x[0]);
 }
 
+TEST_CASE("--export csv and vtk write each particle's material when the scene has more than one") {
+  const std::string scene = asset("scenes/tests/two_materials.json");
+  const std::string dir = freshDir("export_materials_csv"), vdir = freshDir("export_materials_vtk");
+  REQUIRE(run("run " + q(scene) + " --frames 20 --every 19 --quiet --export csv --out " + q(dir)).code == 0);
+  CHECK(readText(dir + "/frame_00019.csv").find("id,x,y,vx,vy,density,pressure,material\n") != std::string::npos);
+  const ParticleSnapshot s = readParticlesCsv(dir + "/frame_00019.csv");
+  REQUIRE(s.material.size() == s.size());
+  // The blocks: ids 0-624 water (0) below y = 1, 625-1249 dye (1) above; then the emitter's and
+  // the timeline drop's particles, all dye.
+  std::size_t dye = 0;
+  for (std::size_t k = 0; k < s.size(); ++k) {
+    CHECK(s.material[k] == (s.id[k] < 625 ? 0u : 1u));
+    dye += s.material[k] == 1;
+  }
+  CHECK(s.size() > 1250 + 50);
+  CHECK(dye == s.size() - 625);
+  REQUIRE(run("run " + q(scene) + " --frames 1 --quiet --export vtk-ascii --out " + q(vdir)).code == 0);
+  const std::string vtk = readText(vdir + "/frame_00000.vtk");
+  const std::size_t at = vtk.find("SCALARS material int 1\nLOOKUP_TABLE default\n0\n");
+  CHECK(at != std::string::npos);
+  // A scene of one fluid writes no material column.
+  const std::string one = freshDir("export_one_material");
+  REQUIRE(run("run " + q(kSmall) + " --frames 1 --quiet --export csv --out " + q(one)).code == 0);
+  CHECK(readText(one + "/frame_00000.csv").find("material") == std::string::npos);
+}
+
 TEST_CASE("--video: exit 2 with a message without ffmpeg, and frames reach ffmpeg's input when present") {
   const std::string dir = freshDir("video");
   Result r = run("run " + q(kSmall) + " --frames 3 --quiet --video " + q(dir + "/out.mp4") + " --out " + q(dir),

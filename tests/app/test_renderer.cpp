@@ -368,6 +368,46 @@ TEST_CASE(
   CHECK(magenta > 1000);
 }
 
+TEST_CASE("particles mode: color_by material draws each particle in its material's colour, own colours first") {
+  const SceneDef s = loadScene(std::string(SPH2D_ASSETS) + "/scenes/tests/two_materials.json");  // water below y = 1
+  World world(s, WorldOptions{1});
+  RenderOptions po;
+  po.mode = "particles";
+  po.colorBy = ColorField::Material;
+  // Water (0.10, 0.45, 0.85) and dye (0.85, 0.20, 0.25): the rows where each is the most.
+  auto rows = [](const Frame& f, bool dye) {
+    double sum = 0, n = 0;
+    for (std::size_t k = 0; k + 3 < f.rgba.size(); k += 4) {
+      const std::uint8_t* p = &f.rgba[k];
+      const bool isDye = p[0] > 150 && p[1] < 90 && p[2]<110, isWater = p[2]> 150 && p[0] < 90 && p[1] < 160;
+      if (dye ? isDye : isWater) sum += double(k / 4 / std::size_t(f.width)), n += 1;
+    }
+    return std::make_pair(n, n > 0 ? sum / n : 0.0);
+  };
+  Renderer r(s.render, po);
+  const Frame& f = r.render(world);
+  const auto [nDye, yDye] = rows(f, true);
+  const auto [nWater, yWater] = rows(f, false);
+  MESSAGE("dye " << nDye << " px about row " << yDye << ", water " << nWater << " px about row " << yWater);
+  CHECK(nDye > 300);
+  CHECK(double(nDye) / double(nWater) == doctest::Approx(1.0).epsilon(0.15));  // 625 particles each
+  CHECK(yDye < yWater);  // the dye above (image rows run top-down)
+  // color_by color: a particle's own colour wins, the others keep their material's.
+  for (std::size_t i = 0; i < world.particleCount(); ++i)
+    if (world.worldPosition(i).y() > 1.5) world.setParticleColor(world.particles().id[i], 0x00FF00u);
+  po.colorBy = ColorField::Color;
+  Renderer rc(s.render, po);
+  const Frame& fc = rc.render(world);
+  std::size_t green = 0;
+  for (std::size_t k = 0; k + 3 < fc.rgba.size(); k += 4)
+    green += fc.rgba[k + 1] > 150 && fc.rgba[k] < 60 && fc.rgba[k + 2] < 60;
+  const auto [nDye2, yDye2] = rows(fc, true);
+  const auto [nWater2, yWater2] = rows(fc, false);
+  CHECK(double(green) / double(nDye2) == doctest::Approx(1.0).epsilon(0.2));  // the dye's upper half green
+  CHECK(double(nWater2) / double(nWater) == doctest::Approx(1.0).epsilon(0.05));
+  CHECK(yDye2 > yDye);  // what is left of the dye is its lower half
+}
+
 TEST_CASE("the overlay changes only the pixels of its box in the top-left corner") {
   const SceneDef s = blockScene(320, 240, Vec2d(-0.1, -0.1), Vec2d(0.3, 0.3));
   World world(s, WorldOptions{1});

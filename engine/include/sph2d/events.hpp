@@ -43,6 +43,7 @@ struct EventDef {
   double radius = 0.5;        ///< Force: reach; Drop: disc radius [m]
   double strength = 0;        ///< Force: acceleration at the centre [m/s²] (> 0 pulls, < 0 pushes)
   Vec2d velocity{0, 0};       ///< Drop: initial velocity [m/s]
+  std::string material;       ///< Block, Drop: the material's name ("": the first)
   FluidBlockDef block;        ///< Block: the rectangle
   std::size_t index = 0;      ///< Emitter: scene order
   bool hasEnabled = false;    ///< Emitter: whether `enabled` was given

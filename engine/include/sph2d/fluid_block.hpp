@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdint>
 #include <utility>
 #include <vector>
 
@@ -61,6 +62,7 @@ struct FluidBlockDef {
   Vec2d center{0, 0};           ///< circle centre [m]
   double radius = 0;            ///< circle radius [m]
   std::vector<Vec2d> vertices;  ///< polygon corners [m], either orientation; filled by the even-odd rule
+  std::uint32_t material = 0;   ///< what it is made of: an index in the World's materials (scene: by name)
 
   /// The x where the polygon's edges cross the horizontal line at `y`, ascending (empty
   /// for a box or circle). A point (x, y) is inside the polygon when an odd number of

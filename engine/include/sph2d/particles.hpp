@@ -71,6 +71,9 @@ struct Particles {
   /// optional: 1 + the index of the emitter that made the particle, 0 for one no emitter made
   /// (World::setEmitterTracking; World::particleEmitter gives the index itself)
   ArrayView<std::uint32_t> emitter;
+  /// optional: each particle's material, an index in World::materials() (a World of one
+  /// material has none: every particle is of material 0)
+  ArrayView<std::uint32_t> material;
 
   /// Number of particles.
   std::size_t size() const { return x.size(); }
@@ -88,6 +91,7 @@ struct ParticleBuffer {
   std::vector<std::uint32_t> color;     ///< optional (empty or one per particle)
   std::vector<std::uint32_t> userData;  ///< optional (empty or one per particle)
   std::vector<std::uint32_t> emitter;   ///< optional (empty or one per particle)
+  std::vector<std::uint32_t> material;  ///< optional (empty or one per particle)
 
   /// Number of particles.
   std::size_t size() const { return x.size(); }
@@ -102,6 +106,7 @@ struct ParticleBuffer {
     if (!color.empty()) color.push_back(0);
     if (!userData.empty()) userData.push_back(0);
     if (!emitter.empty()) emitter.push_back(0);
+    if (!material.empty()) material.push_back(0);
   }
   /// Replaces the contents with copies of every array of `view` (capacity is kept, so a
   /// buffer reused frame after frame stops allocating).
@@ -115,6 +120,7 @@ struct ParticleBuffer {
     copy(view.color, color);
     copy(view.userData, userData);
     copy(view.emitter, emitter);
+    copy(view.material, material);
   }
   /// The buffer as Particles (valid until the buffer changes).
   Particles view() const& {
@@ -128,6 +134,7 @@ struct ParticleBuffer {
     P.color = color;
     P.userData = userData;
     P.emitter = emitter;
+    P.material = material;
     return P;
   }
   /// Not of a temporary buffer: the views would outlive their values.

@@ -18,6 +18,8 @@
 
 namespace sph2d {
 
+struct SceneDef;
+
 /// A bad scene file: says which file, where, which key and what is allowed.
 class SceneError : public std::runtime_error {
  public:
@@ -127,6 +129,40 @@ struct RenderDef {
   CameraDef camera;
 };
 
+/// A material: what a fluid region, an emitter, a drop or a game's particles are made of
+/// (docs/SCENES.md, "materials"). A scene without a `materials` table has one, named
+/// "fluid", with the solver's rest density and viscosity and the render's water colour.
+/// Each particle of a World holding more than one material carries its material's index
+/// (World::materialOf); a World of one material holds no such field.
+struct MaterialDef {
+  std::string name = "fluid";
+  double density = 1000;                          ///< rest density ρ0 [kg/m³]
+  double viscosity = -1;                          ///< kinematic ν [m²/s]; < 0: the solver's (solver.viscosity)
+  std::array<double, 3> color{0.10, 0.45, 0.85};  ///< drawn colour, linear RGB in 0..1
+  std::vector<std::string> miscibleWith;          ///< the materials it mixes with, by name
+  // The ranges a scene's `materials[]` and World::addMaterial accept.
+  static constexpr double kMinDensity = 1, kMaxDensity = 1e5, kMaxViscosity = 1e3;
+  static constexpr std::size_t kMaxMaterials = 256, kMaxName = 64;
+};
+
+/// True when solver `type` takes materials of different rest density in one pressure solve.
+bool takesDensityContrast(const std::string& type);
+
+/// Why `scene`'s effects cannot run beside materials of different density ("" when they can):
+/// the effects that weigh neighbours by one particle mass.
+std::string densityContrastProblem(const SceneDef& scene);
+
+/// The materials of `scene`: its `materials` table, or when it has none the one material
+/// made from its solver (rest density, viscosity) and its render's water colour.
+std::vector<MaterialDef> sceneMaterials(const SceneDef& scene);
+
+/// Why `m` cannot join `materials` in a World of `solver` ("" when it can): a name that is
+/// empty, too long or already taken, a density or viscosity out of range, a miscible_with
+/// naming no material, or a density or viscosity the solver cannot take beside the first
+/// material's (only wcsph takes a density contrast, no solver a viscosity per material:
+/// docs/SCENES.md).
+std::string materialProblem(const std::vector<MaterialDef>& materials, const MaterialDef& m, const SolverDef& solver);
+
 /// An axis-aligned box region.
 struct RegionDef {
   Vec2d min{0, 0};
@@ -158,16 +194,17 @@ struct SurfaceTensionDef {
 /// of `width`, shooting along `direction`.
 struct EmitterDef {
   Vec2d position{0, 0};
-  Vec2d direction{0, -1};  ///< normalised by the loader
-  double width = 0;        ///< nozzle width across the direction [m] (0: a point)
-  double rate = 100;       ///< particles per second
-  double speed = 2;        ///< m/s along the direction
-  double spread = 0;       ///< full cone angle of random directions [rad]
-  double jitter = 0;       ///< random speed variation, fraction of speed
-  double start = 0;        ///< s
-  double stop = 1e30;      ///< s
-  std::uint64_t seed = 1;  ///< per-emitter random seed: same seed, same particles
-  bool enabled = true;     ///< input events may switch it
+  Vec2d direction{0, -1};      ///< normalised by the loader
+  double width = 0;            ///< nozzle width across the direction [m] (0: a point)
+  double rate = 100;           ///< particles per second
+  double speed = 2;            ///< m/s along the direction
+  double spread = 0;           ///< full cone angle of random directions [rad]
+  double jitter = 0;           ///< random speed variation, fraction of speed
+  double start = 0;            ///< s
+  double stop = 1e30;          ///< s
+  std::uint64_t seed = 1;      ///< per-emitter random seed: same seed, same particles
+  bool enabled = true;         ///< input events may switch it
+  std::uint32_t material = 0;  ///< what it emits: an index in the World's materials (scene: by name)
   // The ranges a scene's `effects.emitters[]` and World::addEmitter accept (0 up to these).
   static constexpr double kMaxWidth = 1e4, kMaxRate = 1e8, kMaxSpeed = 1e4, kMaxSpread = 6.2832, kMaxJitter = 1;
   static constexpr double kMaxStart = 1e9, kMaxStop = 1e30;
@@ -200,6 +237,8 @@ struct EffectsDef {
 /// A whole scene: the solids, the fluid, the solver, the clock and the camera.
 struct SceneDef {
   std::string name = "scene";
+  /// The materials (`materials`); empty: one, made from the solver (sceneMaterials()).
+  std::vector<MaterialDef> materials;
   std::string path;  ///< file it came from ("" when built in code)
   Vec2d gravity{0, -9.81};
   /// Real time unless the program names another: the game preset (qualityPreset("game")). To

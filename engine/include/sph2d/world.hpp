@@ -302,8 +302,8 @@ class World {
   /// Adds a drop of fluid: the lattice points of a block around `center` that lie
   /// within `radius` (world coordinates), moving at `velocity`; points inside
   /// solids are skipped; the particle budget holds as for addBlock. Returns the ids
-  /// of the particles added. Throws Interrupted, adding nothing, when the stop flag is set.
-  IdRange addDrop(const Vec2d& center, double radius, const Vec2d& velocity = Vec2d(0, 0));
+  /// of the particles added, of `material`. Throws Interrupted, adding nothing, when the stop flag is set.
+  IdRange addDrop(const Vec2d& center, double radius, const Vec2d& velocity = Vec2d(0, 0), std::uint32_t material = 0);
   /// Removes the particles inside the box [lo, hi] (world coordinates). Returns their ids,
   /// in increasing order.
   std::vector<std::uint32_t> removeParticlesInBox(const Vec2d& lo, const Vec2d& hi);
@@ -368,9 +368,10 @@ class World {
   /// empty: at rest). Points inside solids are skipped, and the particle budget holds as
   /// for addBlock (one warning for the refused rest). Returns the ids of the particles
   /// added, in the order of their points (a skipped point takes none). Throws
-  /// std::invalid_argument when the lengths differ or a value is not finite (then nothing
-  /// is added).
-  IdRange addParticles(const std::vector<Vec2d>& points, const std::vector<Vec2d>& velocities = {});
+  /// std::invalid_argument when the lengths differ, a value is not finite or `material` does
+  /// not exist (then nothing is added).
+  IdRange addParticles(const std::vector<Vec2d>& points, const std::vector<Vec2d>& velocities = {},
+                       std::uint32_t material = 0);
   /// Removes the particles with these ids (ids no particle has, and repeats, are ignored).
   /// Returns the ids removed, in increasing order.
   std::vector<std::uint32_t> removeParticles(const std::vector<std::uint32_t>& ids);
@@ -416,7 +417,8 @@ class World {
   /// of the scene's spacing, moving at `velocity`, as addBlock does (solids skipped, the budget
   /// held). Returns the ids added. Throws std::invalid_argument for an edge or chain, and
   /// Interrupted (nothing added) when the stop flag is set.
-  IdRange addShape(const b2Shape& shape, const b2Transform& xf, const Vec2d& velocity = Vec2d(0, 0));
+  IdRange addShape(const b2Shape& shape, const b2Transform& xf, const Vec2d& velocity = Vec2d(0, 0),
+                   std::uint32_t material = 0);
   // The searches below visit only the cells of a grid of the current particles, built on the
   // first search after a step or a change (O(n)), not every particle.
   /// Slots of the particles within `radius` of `center` (world coordinates), in slot order.
@@ -482,6 +484,16 @@ class World {
   /// std::invalid_argument naming the field when a value is outside the scene format's range
   /// (docs/SCENES.md, `effects.emitters`) or the direction is zero.
   std::size_t addEmitter(const EmitterDef& def);
+  // Materials (docs/SCENES.md, "materials"): the scene's, then those added here, by index; a
+  // block, drop, shape, emitter or addParticles names one (default 0, the solver's fluid).
+  /// Adds material `m`; returns its index. Throws std::invalid_argument naming the problem
+  /// (materialProblem(): a name taken, a value out of range, a contrast the solver cannot take).
+  std::uint32_t addMaterial(const MaterialDef& m);
+  const std::vector<MaterialDef>& materials() const;           ///< every material, by index
+  static constexpr std::uint32_t kNoMaterial = 0xFFFFFFFFu;    ///< materialIndex/materialOf: none
+  std::uint32_t materialIndex(const std::string& name) const;  ///< the index of `name`, or kNoMaterial
+  /// The material of particle `id` (kNoMaterial when no particle has it); bulk: particles().material.
+  std::uint32_t materialOf(std::uint32_t id) const;
   /// Removes emitter `index` (its particles stay); the emitters after it move down one index.
   /// Throws std::out_of_range.
   void removeEmitter(std::size_t index);
@@ -514,7 +526,7 @@ class World {
   template <class B2, IfB2<B2> = 0>
   void setGravity(const B2& g);
   template <class B2, IfB2<B2> = 0>
-  IdRange addDrop(const B2& center, double radius, const B2& velocity);
+  IdRange addDrop(const B2& center, double radius, const B2& velocity, std::uint32_t material = 0);
   template <class B2, IfB2<B2> = 0>
   IdRange addDrop(const B2& center, double radius);
   template <class B2, IfB2<B2> = 0>
@@ -526,7 +538,7 @@ class World {
   template <class B2, IfB2<B2> = 0>
   bool setParticleVelocity(std::uint32_t id, const B2& velocity);
   template <class B2, IfB2<B2> = 0>
-  IdRange addParticles(const std::vector<B2>& points, const std::vector<B2>& velocities);
+  IdRange addParticles(const std::vector<B2>& points, const std::vector<B2>& velocities, std::uint32_t material = 0);
   template <class B2, IfB2<B2> = 0>
   IdRange addParticles(const std::vector<B2>& points);
   template <class B2, IfB2<B2> = 0>
@@ -540,7 +552,7 @@ class World {
   template <class B2, IfB2<B2> = 0>
   std::vector<std::uint32_t> removeParticlesInBox(const B2& lo, const B2& hi);
   template <class B2, IfB2<B2> = 0>
-  IdRange addShape(const b2Shape& shape, const b2Transform& xf, const B2& velocity);
+  IdRange addShape(const b2Shape& shape, const b2Transform& xf, const B2& velocity, std::uint32_t material = 0);
   template <class B2, IfB2<B2> = 0>
   std::size_t setVelocities(const std::vector<std::uint32_t>& ids, const std::vector<B2>& velocities);
   template <class B2, IfB2<B2> = 0>

@@ -15,8 +15,8 @@ inline void World::setGravity(const B2& g) {
 }
 
 template <class B2, World::IfB2<B2>>
-inline IdRange World::addDrop(const B2& center, double radius, const B2& velocity) {
-  return addDrop(Vec2d(center.x, center.y), radius, Vec2d(velocity.x, velocity.y));
+inline IdRange World::addDrop(const B2& center, double radius, const B2& velocity, std::uint32_t material) {
+  return addDrop(Vec2d(center.x, center.y), radius, Vec2d(velocity.x, velocity.y), material);
 }
 
 template <class B2, World::IfB2<B2>>
@@ -50,8 +50,9 @@ inline bool World::setParticleVelocity(std::uint32_t id, const B2& velocity) {
 }
 
 template <class B2, World::IfB2<B2>>
-inline IdRange World::addParticles(const std::vector<B2>& points, const std::vector<B2>& velocities) {
-  return addParticles(toVec2d(points), toVec2d(velocities));
+inline IdRange World::addParticles(const std::vector<B2>& points, const std::vector<B2>& velocities,
+                                   std::uint32_t material) {
+  return addParticles(toVec2d(points), toVec2d(velocities), material);
 }
 
 template <class B2, World::IfB2<B2>>
@@ -85,8 +86,9 @@ inline std::vector<std::uint32_t> World::removeParticlesInBox(const B2& lo, cons
 }
 
 template <class B2, World::IfB2<B2>>
-inline IdRange World::addShape(const b2Shape& shape, const b2Transform& xf, const B2& velocity) {
-  return addShape(shape, xf, Vec2d(velocity.x, velocity.y));
+inline IdRange World::addShape(const b2Shape& shape, const b2Transform& xf, const B2& velocity,
+                               std::uint32_t material) {
+  return addShape(shape, xf, Vec2d(velocity.x, velocity.y), material);
 }
 
 template <class B2, World::IfB2<B2>>

@@ -59,6 +59,7 @@ ParticleSnapshot snapshotOf(const World& world, const Real* age) {
   s.rho.resize(n);
   s.p.resize(n);
   if (age) s.age.resize(n);
+  if (!P.material.empty()) s.material.resize(n);
   const Vec2d o = world.origin();
   for (std::size_t k = 0; k < n; ++k) {
     const std::size_t i = order[k];
@@ -70,6 +71,7 @@ ParticleSnapshot snapshotOf(const World& world, const Real* age) {
     s.rho[k] = P.rho[i];
     s.p[k] = P.p[i];
     if (age) s.age[k] = float(age[i]);
+    if (!P.material.empty()) s.material[k] = P.material[i];
   }
   // Box2D lists the newest body first: walk the list, then number in creation order.
   std::vector<const b2Body*> bodies;
@@ -145,17 +147,20 @@ void writeParticlesAtomic(const std::string& path, const ParticleSnapshot& s, Ex
 
 std::string encodeParticles(const ParticleSnapshot& s, ExportFormat f) {
   const std::size_t n = s.size();
-  const bool hasAge = !s.age.empty();
+  const bool hasAge = !s.age.empty(), hasMaterial = !s.material.empty();
   std::string out;
   if (f == ExportFormat::Csv) {
     out.reserve(n * 100 + 128);
     appendf(out, "# sph2d particles: frame %llu, time %.9g s, %zu particles, world coordinates\n",
             static_cast<unsigned long long>(s.frame), s.time, n);
-    out += hasAge ? "id,x,y,vx,vy,density,pressure,age\n" : "id,x,y,vx,vy,density,pressure\n";
+    out += "id,x,y,vx,vy,density,pressure";
+    out += hasAge ? ",age" : "";
+    out += hasMaterial ? ",material\n" : "\n";
     for (std::size_t k = 0; k < n; ++k) {
       appendf(out, "%u,%.17g,%.17g,%.9g,%.9g,%.9g,%.9g", s.id[k], s.x[k], s.y[k], double(s.vx[k]), double(s.vy[k]),
               double(s.rho[k]), double(s.p[k]));
       if (hasAge) appendf(out, ",%.9g", double(s.age[k]));
+      if (hasMaterial) appendf(out, ",%u", s.material[k]);
       out += '\n';
     }
   } else {
@@ -215,6 +220,7 @@ std::string encodeParticles(const ParticleSnapshot& s, ExportFormat f) {
     scalars("density", "float", [&](std::size_t k) { return s.rho[k]; });
     scalars("pressure", "float", [&](std::size_t k) { return s.p[k]; });
     if (hasAge) scalars("age", "float", [&](std::size_t k) { return s.age[k]; });
+    if (hasMaterial) scalars("material", "int", [&](std::size_t k) { return std::int32_t(s.material[k]); });
   }
   return out;
 }
@@ -225,7 +231,7 @@ ParticleSnapshot readParticlesCsv(const std::string& path) {
   ParticleSnapshot s;
   std::string line;
   int lineNo = 0;
-  bool header = false, hasAge = false;
+  bool header = false, hasAge = false, hasMaterial = false;
   while (std::getline(in, line)) {
     ++lineNo;
     if (line.empty()) continue;
@@ -242,8 +248,17 @@ ParticleSnapshot readParticlesCsv(const std::string& path) {
       if (line.rfind("id,x,y,vx,vy,density,pressure", 0) != 0)
         throw std::runtime_error(path + ":" + std::to_string(lineNo) + ": not an sph2d particle CSV header");
       hasAge = line.find(",age") != std::string::npos;
+      hasMaterial = line.find(",material") != std::string::npos;
       header = true;
       continue;
+    }
+    unsigned material = 0;
+    if (hasMaterial) {  // the last column: a material index
+      const std::size_t comma = line.rfind(',');
+      char end = 0;
+      if (comma == std::string::npos || std::sscanf(line.c_str() + comma + 1, "%u%c", &material, &end) != 1)
+        throw std::runtime_error(path + ":" + std::to_string(lineNo) + ": column material is not a material index");
+      line.resize(comma);
     }
     unsigned id = 0;
     double x = 0, y = 0, vx = 0, vy = 0, rho = 0, p = 0, age = 0;
@@ -270,6 +285,7 @@ ParticleSnapshot readParticlesCsv(const std::string& path) {
     s.rho.push_back(float(rho));
     s.p.push_back(float(p));
     if (hasAge) s.age.push_back(float(age));
+    if (hasMaterial) s.material.push_back(material);
   }
   if (!header) throw std::runtime_error(path + ": empty");
   return s;

@@ -36,13 +36,19 @@ class ParticlesPass final : public RenderPass {
     const std::size_t n = f.order.size();
     if (agesOf(in) == nullptr && n > 0 && opt_.colorBy == ColorField::Age)
       throw std::runtime_error("colour by age needs particle ages, and none were given");
-    if (opt_.colorBy == ColorField::Color) {
-      // Each particle's own 0xRRGGBB (an integer below 2^24: exact in a float); none: the fluid's.
-      const std::uint32_t* own = P.color.size() == P.size() ? P.color.data() : nullptr;
+    if (ownColors()) {
+      // Each particle's own 0xRRGGBB (an integer below 2^24: exact in a float); none: its
+      // material's (by index, when the input names that material), else the fluid's.
+      const std::uint32_t* own =
+          opt_.colorBy == ColorField::Color && P.color.size() == P.size() ? P.color.data() : nullptr;
+      const std::uint32_t* mat = P.material.size() == P.size() ? P.material.data() : nullptr;
+      const std::vector<std::uint32_t>& matColor = in.materialColors;
       packed_.resize(n * 4);
       for (std::size_t k = 0; k < n; ++k) {
         const std::size_t i = f.order[k];
-        const std::uint32_t c = own && own[i] != 0 ? own[i] & 0xFFFFFFu : kFluidColor;
+        const std::uint32_t c = own && own[i] != 0                ? own[i] & 0xFFFFFFu
+                                : mat && mat[i] < matColor.size() ? matColor[mat[i]] & 0xFFFFFFu
+                                                                  : kFluidColor;
         packed_[4 * k] = P.x[i].x();
         packed_[4 * k + 1] = P.x[i].y();
         packed_[4 * k + 2] = float(c);
@@ -86,19 +92,21 @@ class ParticlesPass final : public RenderPass {
     glEnable(GL_BLEND);
     glBlendFuncSeparate(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA, GL_ZERO, GL_ONE);
     sprites_.setUniforms(discProg_, f.scale, f.offset, diameter, f.geo.EW, f.geo.EH, quads_);
-    glUniform1i(glGetUniformLocation(discProg_, "uOwnColor"), opt_.colorBy == ColorField::Color ? 1 : 0);
+    glUniform1i(glGetUniformLocation(discProg_, "uOwnColor"), ownColors() ? 1 : 0);
     sprites_.draw(GLsizei(f.order.size()), quads_);
     glDisable(GL_BLEND);
     timer.end(timings.splat);
   }
 
   void annotate(Frame& frame, int textScale) const override {
-    if (opt_.colorBy == ColorField::Color) return;  // own colours: no scale to show
+    if (ownColors()) return;  // own colours: no scale to show
     static const char* titles[] = {"SPEED M/S", "PRESSURE PA", "DENSITY KG/M3", "AGE S"};
     drawColorBar(frame, range_[0], range_[1], titles[int(opt_.colorBy)], textScale);
   }
 
  private:
+  /// True when each particle is drawn in a colour of its own or of its material (no scale).
+  bool ownColors() const { return opt_.colorBy == ColorField::Color || opt_.colorBy == ColorField::Material; }
   double valueOf(const RenderInput& in, std::size_t i) const {
     const Particles& P = in.particles;
     switch (opt_.colorBy) {
@@ -111,6 +119,7 @@ class ParticlesPass final : public RenderPass {
       case ColorField::Age:
         return agesOf(in) ? double(agesOf(in)[i]) : 0.0;
       case ColorField::Color:
+      case ColorField::Material:
         return 0.0;
     }
     return 0.0;

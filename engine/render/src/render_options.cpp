@@ -18,6 +18,8 @@ bool parseColorField(const std::string& s, ColorField& out) {
     out = ColorField::Age;
   else if (s == "color")
     out = ColorField::Color;
+  else if (s == "material")
+    out = ColorField::Material;
   else
     return false;
   return true;
@@ -35,6 +37,8 @@ std::string colorFieldName(ColorField f) {
       return "age";
     case ColorField::Color:
       return "color";
+    case ColorField::Material:
+      return "material";
   }
   return "?";
 }

@@ -17,6 +17,7 @@
 #include "sph2d/render/renderer.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <optional>
 #include <stdexcept>
@@ -45,6 +46,7 @@ RenderInput inputOf(const World& world, const Real* age) {
   in.moving = world.movingColliders();
   // Ages come from the caller, or from the engine's "age" field when the scene has lifetimes.
   in.age = age;  // null: the World's own ages when its scene has lifetimes (agesOf)
+  in.materialColors = materialColors(world);
   in.gravity = world.scene().gravity.norm();
   in.frame = world.frame();
   in.time = world.time();
@@ -52,6 +54,17 @@ RenderInput inputOf(const World& world, const Real* age) {
 }
 
 }  // namespace
+
+std::vector<std::uint32_t> materialColors(const World& world) {
+  std::vector<std::uint32_t> out;
+  if (world.materials().size() < 2) return out;
+  for (const MaterialDef& m : world.materials()) {
+    std::uint32_t c = 0;
+    for (const double v : m.color) c = (c << 8) | std::uint32_t(std::lround(std::clamp(v, 0.0, 1.0) * 255));
+    out.push_back(c);
+  }
+  return out;
+}
 
 std::vector<double> resolveCamera(const RenderDef& def, const World& world) {
   return resolveCamera(def, inputOf(world, nullptr));
@@ -170,6 +183,7 @@ struct Renderer::Impl {
     need("id", P.id.size(), false);
     need("age", P.age.size(), true);
     need("color", P.color.size(), true);
+    need("material", P.material.size(), true);
   }
 
   float fade(const RenderInput& in, std::size_t slot) const {

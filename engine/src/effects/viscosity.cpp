@@ -71,6 +71,11 @@ class LaplacianViscosity final : public Effect {
     const Vec2* X = P.x.data();
     const Vec2* V = P.v.data();
     const Real* IR = P.invRho.data();
+    // Materials of different rest density (wcsph's number density): 1/ρ̃ = r/ρ for the volumes,
+    // and the pair's dynamic viscosity the mean of the two, over the particle's mass r_i m
+    // (momentum-conserving: m_i a_i is symmetric in the pair). Null: every r is 1.
+    const std::vector<Real>* ratioField = P.find(ParticleStore::kRestRatio);
+    const Real* ratio = ratioField ? ratioField->data() : nullptr;
     const BoundarySet& B = c.boundary;
     const bool walls = t.walls;
     BodySamples* moving = t.noSlip && c.bodySamples && c.bodySamples->active() ? c.bodySamples : nullptr;
@@ -84,8 +89,10 @@ class LaplacianViscosity final : public Effect {
       for (std::size_t i = b; i < e; ++i) {
         const Real xix = X[i].x(), xiy = X[i].y(), vix = V[i].x(), viy = V[i].y();
         Real fx = 0, fy = 0;
-        const Real capI = t.pairCap / IR[i];  // ViscosityTerm::pairCap · ρ_i
-        const Real capWall = capI * c.rho0;   // … · ρ0, for a wall sample's ∇²W
+        const Real ri = ratio ? ratio[i] : Real(1);
+        const Real irN = IR[i] * ri;         // 1/ρ̃_i
+        const Real capI = t.pairCap / irN;   // ViscosityTerm::pairCap · ρ̃_i
+        const Real capWall = capI * c.rho0;  // … · ρ0, for a wall sample's ∇²W
         const std::uint32_t* nb = c.nbr.of(i);
         const std::uint32_t cnt = c.nbr.count[i];
         for (std::uint32_t k = 0; k < cnt; ++k) {
@@ -93,11 +100,13 @@ class LaplacianViscosity final : public Effect {
           Real dx = xix - X[j].x(), dy = xiy - X[j].y();
           c.periodic.nearest(dx, dy);
           const Real r2 = dx * dx + dy * dy;
-          const Real w = std::min(W.laplacianR2(r2) * IR[j], capI);
+          Real w = W.laplacianR2(r2) * IR[j];
+          if (ratio) w *= ratio[j] * (ri + ratio[j]) * Real(0.5) / ri;
+          w = std::min(w, capI);
           fx += (V[j].x() - vix) * w;
           fy += (V[j].y() - viy) * w;
         }
-        Vec2 acc = Vec2(fx, fy) * (muMass * IR[i]);
+        Vec2 acc = Vec2(fx, fy) * (muMass * irN);
         if (walls) {
           const Vec2 xi = X[i];
           Real sum = 0;  // Σ_b Ψ_b ∇²W_ib
@@ -106,9 +115,9 @@ class LaplacianViscosity final : public Effect {
             const std::uint32_t s = bl[k];
             sum += B.volume[s] * std::min(W.laplacianR2((xi - B.samples[s]).squaredNorm()), capWall);
           }
-          const Vec2 aWall = Vec2(vix, viy) * (t.wallFactor * IR[i] * sum);
+          const Vec2 aWall = Vec2(vix, viy) * (t.wallFactor * irN * sum);
           acc -= aWall;
-          wallAcc -= aWall.cast<double>();
+          wallAcc -= aWall.cast<double>() * double(ri);  // m_i/m
         }
         if (moving && c.nbr.movingCount[i] > 0) {
           // The moving bodies' samples, body by body: the wall term with the sample's
@@ -117,7 +126,7 @@ class LaplacianViscosity final : public Effect {
           const Vec2 xi = X[i];
           const std::uint32_t* ml = c.nbr.movingOf(i);
           const std::uint32_t mc = c.nbr.movingCount[i];
-          const Real vK = t.wallFactor * IR[i];
+          const Real vK = t.wallFactor * irN;
           moving->forEachBody(ml, mc, [&](std::uint32_t body, const std::uint32_t* run, const std::uint32_t* runEnd) {
             Vec2 lv = Vec2::Zero();
             Real tv = 0;  // Σ arm × the pair's term
@@ -132,8 +141,8 @@ class LaplacianViscosity final : public Effect {
             const Vec2 aBody = -lv * vK;
             acc += aBody;
             if (moving->placed[body].dynamic)
-              moving->addReaction(b / kBlock, body, aBody.cast<double>() * double(c.mass),
-                                  -double(tv) * double(vK) * double(c.mass));
+              moving->addReaction(b / kBlock, body, aBody.cast<double>() * (double(c.mass) * double(ri)),
+                                  -double(tv) * double(vK) * (double(c.mass) * double(ri)));
           });
         }
         P.a[i] += acc;

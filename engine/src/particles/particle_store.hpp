@@ -66,7 +66,12 @@ struct ParticleStore {
   static constexpr const char* kUserData = "user_data";
   /// 1 + the index of the emitter that made the particle; 0: none (World::setEmitterTracking).
   static constexpr const char* kEmitter = "emitter";
-  /// True for the name of an optional integer field.
+  /// The particle's material (an index in World::materials()); only while the World has more than one.
+  static constexpr const char* kMaterial = "material";
+  /// ρ0 of the particle's material over the first material's (a Real field): only while two
+  /// materials of the World differ in rest density (a solver that takes the contrast reads it).
+  static constexpr const char* kRestRatio = "rest_ratio";
+  /// True for the name of an optional integer field a game sets (absent from a save: zeros on load).
   static bool integerField(const std::string& name) { return name == kColor || name == kUserData || name == kEmitter; }
   /// Removes the optional integer field `name` (nothing when it does not exist).
   void dropU32(const std::string& name) {

@@ -56,10 +56,10 @@ EventDef readEvent(const Reader& r, const nlohmann::json& j, const std::string& 
       keys.insert(keys.end(), {"id"});
       break;
     case T::Block:
-      keys.insert(keys.end(), {"min", "max", "velocity"});
+      keys.insert(keys.end(), {"min", "max", "velocity", "material"});
       break;
     case T::Drop:
-      keys.insert(keys.end(), {"center", "radius", "velocity"});
+      keys.insert(keys.end(), {"center", "radius", "velocity", "material"});
       break;
     case T::Emitter:
       keys.insert(keys.end(), {"index", "enabled", "position", "direction"});
@@ -106,12 +106,14 @@ EventDef readEvent(const Reader& r, const nlohmann::json& j, const std::string& 
       e.block.max = r.requiredVec2(j, path, "max");
       e.block.velocity = r.vec2(j, path, "velocity", e.block.velocity);
       checkMaxAboveMin(r, e.block.min, e.block.max, path);
+      if (j.contains("material")) e.material = sceneMaterials(scene)[readMaterialName(r, j, path, scene)].name;
       break;
     case T::Drop:
       e.point = r.requiredVec2(j, path, "center");
       required("radius", "a number > 0 (metres)");
       e.radius = r.number(j, path, "radius", 0, 0, 1e4, true);
       e.velocity = r.vec2(j, path, "velocity", e.velocity);
+      if (j.contains("material")) e.material = sceneMaterials(scene)[readMaterialName(r, j, path, scene)].name;
       break;
     case T::Emitter: {
       const std::size_t n = scene.effects.emitters.size();
@@ -258,11 +260,13 @@ std::string eventToJson(const EventDef& e) {
       j["min"] = vec(e.block.min);
       j["max"] = vec(e.block.max);
       j["velocity"] = vec(e.block.velocity);
+      if (!e.material.empty()) j["material"] = e.material;
       break;
     case T::Drop:
       j["center"] = vec(e.point);
       j["radius"] = e.radius;
       j["velocity"] = vec(e.velocity);
+      if (!e.material.empty()) j["material"] = e.material;
       break;
     case T::Emitter:
       j["index"] = e.index;

@@ -35,18 +35,25 @@ SceneDef parseScene(const std::string& text, const std::string& file) {
   r.requireObject(root, "");
   r.checkKeys(root, "",
               {"name", "gravity", "fps", "duration", "max_particles", "solver", "boundaries", "fluid", "periodic",
-               "effects", "render", "events"});
+               "effects", "render", "events", "materials"});
   SceneDef s;
   s.path = file;
   // In this order: each section may check what it reads against those before it.
   readTopLevel(r, root, s);
   readSolver(r, root, s);
+  readRender(r, root, s);     // before the materials: the render's water colours the first
+  readMaterials(r, root, s);  // against the solver; before everything that names a material
   readBoundaries(r, root, s);
   readFluid(r, root, s);     // blocks against the spacing and the solids
   readPeriodic(r, root, s);  // periods against the support radius
   readEffects(r, root, s);
-  readRender(r, root, s);
   readEvents(r, root, s);  // the timeline last: against the emitters, effects and gravity
+  for (const MaterialDef& m : s.materials)
+    if (m.density != s.materials.front().density) {
+      const std::string problem = densityContrastProblem(s);
+      if (!problem.empty()) r.fail(problem.substr(0, problem.find(' ')), problem);
+      break;
+    }
   checkParticleBudget(r, s);
   return s;
 }

@@ -144,22 +144,23 @@ FluidBlockDef readBlock(const Reader& r, const json& j, const std::string& p, co
   const double dx = s.solver.spacing;
   if (shape == "circle") {
     // The lattice of a drop (World::addDrop): a square of whole spacings around the centre.
-    r.checkKeys(j, p, {"shape", "center", "radius", "velocity", "velocity_field"});
+    r.checkKeys(j, p, {"shape", "center", "radius", "velocity", "velocity_field", "material"});
     const Vec2d center = r.requiredVec2(j, p, "center");
     if (!j.contains("radius")) r.fail(Reader::sub(p, "radius"), "missing; expected a number > 0 [m]");
     blk = circleRegion(center, r.number(j, p, "radius", 0, 0, 1e6, true), dx);
   } else if (shape == "polygon") {
-    r.checkKeys(j, p, {"shape", "vertices", "velocity", "velocity_field"});
+    r.checkKeys(j, p, {"shape", "vertices", "velocity", "velocity_field", "material"});
     std::vector<Vec2d> vertices = r.points(j, p, "vertices");
     checkFluidPolygon(r, vertices, Reader::sub(p, "vertices"));
     blk = polygonRegion(std::move(vertices));
   } else {
-    r.checkKeys(j, p, {"shape", "min", "max", "velocity", "velocity_field"});
+    r.checkKeys(j, p, {"shape", "min", "max", "velocity", "velocity_field", "material"});
     blk.min = r.requiredVec2(j, p, "min");
     blk.max = r.requiredVec2(j, p, "max");
     checkMaxAboveMin(r, blk.min, blk.max, p);
   }
   blk.velocity = r.vec2(j, p, "velocity", blk.velocity);
+  blk.material = readMaterialName(r, j, p, s);
   if (j.contains("velocity_field"))
     blk.field = readVelocityField(r, j.at("velocity_field"), Reader::sub(p, "velocity_field"));
   checkBlock(r, s, blk, p);
@@ -250,11 +251,11 @@ void readSinks(const Reader& r, const json& j, EffectsDef& e) {
   }
 }
 
-EmitterDef readEmitter(const Reader& r, const json& j, const std::string& q) {
+EmitterDef readEmitter(const Reader& r, const json& j, const std::string& q, const SceneDef& s) {
   r.requireObject(j, q);
-  r.checkKeys(
-      j, q,
-      {"position", "direction", "width", "rate", "speed", "spread", "jitter", "start", "stop", "seed", "enabled"});
+  r.checkKeys(j, q,
+              {"position", "direction", "width", "rate", "speed", "spread", "jitter", "start", "stop", "seed",
+               "enabled", "material"});
   EmitterDef m;
   m.position = r.requiredVec2(j, q, "position");
   m.direction = r.vec2(j, q, "direction", m.direction);
@@ -271,15 +272,16 @@ EmitterDef readEmitter(const Reader& r, const json& j, const std::string& q) {
   m.seed = static_cast<std::uint64_t>(
       r.integer64(j, q, "seed", static_cast<long long>(m.seed), 0, static_cast<long long>(EmitterDef::kMaxSeed)));
   m.enabled = r.boolean(j, q, "enabled", m.enabled);
+  m.material = readMaterialName(r, j, q, s);
   return m;
 }
 
-void readEmitters(const Reader& r, const json& j, EffectsDef& e) {
+void readEmitters(const Reader& r, const json& j, EffectsDef& e, const SceneDef& s) {
   if (!j.contains("emitters")) return;
   const auto& a = j.at("emitters");
   if (!a.is_array()) r.fail("effects.emitters", "expected an array of emitters, got " + describe(a));
   for (std::size_t k = 0; k < a.size(); ++k)
-    e.emitters.push_back(readEmitter(r, a[k], "effects.emitters[" + std::to_string(k) + "]"));
+    e.emitters.push_back(readEmitter(r, a[k], "effects.emitters[" + std::to_string(k) + "]", s));
 }
 
 void readBudget(const Reader& r, const json& j, EffectsDef& e) {
@@ -405,7 +407,7 @@ void readEffects(const Reader& r, const json& root, SceneDef& s) {
   readSurfaceTension(r, j, e);
   readLifetime(r, j, e);
   readSinks(r, j, e);
-  readEmitters(r, j, e);
+  readEmitters(r, j, e, s);
   readBudget(r, j, e);
 }
 

@@ -22,6 +22,13 @@ void readTopLevel(const Reader& r, const nlohmann::json& root, SceneDef& s);
 /// parameter the solver declares (solverParams), with its default when absent.
 void readSolver(const Reader& r, const nlohmann::json& root, SceneDef& s);
 
+/// `materials`: the scene's materials (materialProblem's rule for each); the first is the
+/// solver's fluid, whose density and viscosity become the solver's rest density and viscosity.
+void readMaterials(const Reader& r, const nlohmann::json& root, SceneDef& s);
+
+/// `j`'s "material" key as an index in sceneMaterials(s) (0 when absent); fails naming them.
+std::uint32_t readMaterialName(const Reader& r, const nlohmann::json& j, const std::string& path, const SceneDef& s);
+
 /// `boundaries`: static bodies and their fixtures (box, polygon, circle, edge, chain).
 void readBoundaries(const Reader& r, const nlohmann::json& root, SceneDef& s);
 

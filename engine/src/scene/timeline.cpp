@@ -55,11 +55,14 @@ std::string EventApplier::apply(World& w, const EventDef& e) {
         else
           forces_.erase(e.id);
         break;
-      case T::Block:
-        w.addBlock(e.block);
+      case T::Block: {
+        FluidBlockDef b = e.block;
+        b.material = e.material.empty() ? 0 : w.materialIndex(e.material);
+        w.addBlock(b);
         break;
+      }
       case T::Drop:
-        w.addDrop(e.point, e.radius, e.velocity);
+        w.addDrop(e.point, e.radius, e.velocity, e.material.empty() ? 0 : w.materialIndex(e.material));
         break;
       case T::Emitter:
         if (e.hasPoint || e.hasDirection) {

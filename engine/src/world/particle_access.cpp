@@ -179,7 +179,9 @@ std::size_t World::particleEmitter(std::uint32_t id) const {
   return tag == 0 ? npos : std::size_t(tag) - 1;
 }
 
-IdRange World::addParticles(const std::vector<Vec2d>& points, const std::vector<Vec2d>& velocities) {
+IdRange World::addParticles(const std::vector<Vec2d>& points, const std::vector<Vec2d>& velocities,
+                            std::uint32_t material) {
+  impl_->checkMaterial(material, "addParticles");
   if (!velocities.empty() && velocities.size() != points.size())
     throw std::invalid_argument("addParticles: " + std::to_string(points.size()) + " points but " +
                                 std::to_string(velocities.size()) + " velocities");
@@ -204,6 +206,7 @@ IdRange World::addParticles(const std::vector<Vec2d>& points, const std::vector<
     ++ids.count;
     w.P.push(p, Vec2(Real(v.x()), Real(v.y())), w.nextId++, rho0);
   }
+  w.setMaterial(w.P.size() - ids.count, material);
   w.index.noteEdit();  // the query grid is stale
   w.refreshView();
   if (inside) w.warnings.push_back("addParticles: skipped " + std::to_string(inside) + " points inside solids");
@@ -238,7 +241,7 @@ std::vector<std::uint32_t> World::removeParticlesInShape(const b2Shape& shape, c
   return removeParticles(ids);
 }
 
-IdRange World::addShape(const b2Shape& shape, const b2Transform& xf, const Vec2d& velocity) {
+IdRange World::addShape(const b2Shape& shape, const b2Transform& xf, const Vec2d& velocity, std::uint32_t material) {
   FluidBlockDef b;
   if (shape.GetType() == b2Shape::e_circle) {
     const auto& c = static_cast<const b2CircleShape&>(shape);
@@ -256,6 +259,7 @@ IdRange World::addShape(const b2Shape& shape, const b2Transform& xf, const Vec2d
     throw std::invalid_argument("addShape: only a polygon or a circle holds fluid (an edge or chain has no inside)");
   }
   b.velocity = velocity;
+  b.material = material;
   return addBlock(b);
 }
 

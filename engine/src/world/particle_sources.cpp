@@ -37,6 +37,7 @@ double uniform(std::uint64_t& state) { return double(splitmix(state) >> 11) * (1
 /// 4096 lattice points: when it is set the particles this call added are taken back (the
 /// World is as before it) and Interrupted is thrown (empty stage: the caller names it).
 IdRange World::Impl::fillBlock(const FluidBlockDef& b, bool hydrostaticStart) {
+  checkMaterial(b.material, hydrostaticStart ? "fluid[].material" : "addBlock");
   IdRange ids;
   ids.first = nextId;  // every particle below takes the next id: the ones added are consecutive
   const std::size_t before = P.size();
@@ -123,6 +124,7 @@ IdRange World::Impl::fillBlock(const FluidBlockDef& b, bool hydrostaticStart) {
       << " or add less)";
     warnings.push_back(o.str());
   }
+  setMaterial(before, b.material);
   index.noteEdit();
   refreshView();
   ids.count = added;
@@ -198,6 +200,8 @@ void World::Impl::emit(Real dt) {
   // With emitter tracking on, each particle made here takes 1 + its emitter's index. (A field in
   // a deque: removeOldest below compacts it, and the pointer stays good.)
   std::vector<std::uint32_t>* tag = P.findU32(ParticleStore::kEmitter);
+  std::vector<std::uint32_t>* material = P.findU32(ParticleStore::kMaterial);  // with more than one
+  std::vector<Real>* ratio = P.find(ParticleStore::kRestRatio);                // with a density contrast
   for (std::size_t e = 0; e < sources.emitters.size(); ++e) {
     ParticleSources::Emitter& s = sources.emitters[e];
     const EmitterDef& d = s.def;
@@ -262,6 +266,8 @@ void World::Impl::emit(Real dt) {
       P.push(Vec2(Real(pw.x() - origin.x()), Real(pw.y() - origin.y())), Vec2(Real(vel.x()), Real(vel.y())), nextId++,
              rho0);
       if (tag) tag->back() = std::uint32_t(e + 1);
+      if (material) material->back() = d.material;
+      if (ratio) ratio->back() = Real(materials[d.material].density / materials.front().density);
     }
   }
 }

@@ -136,6 +136,8 @@ std::uint64_t World::stateHash() const {
   const ParticleStore& P = impl_->P;
   std::vector<std::uint32_t> slotOf(impl_->nextId, 0xffffffffu);
   for (std::size_t i = 0; i < P.size(); ++i) slotOf[P.id[i]] = std::uint32_t(i);
+  // With more than one material, each particle's too (a World of one hashes as before materials).
+  const std::vector<std::uint32_t>* material = P.findU32(ParticleStore::kMaterial);
   Xxh64 h;
   h.update(impl_->origin.data(), sizeof(double) * 2);
   for (std::uint32_t id = 0; id < impl_->nextId; ++id) {
@@ -144,6 +146,7 @@ std::uint64_t World::stateHash() const {
     h.update(&id, sizeof id);
     h.update(P.x[s].data(), sizeof(Real) * 2);
     h.update(P.v[s].data(), sizeof(Real) * 2);
+    if (material) h.update(&(*material)[s], sizeof(std::uint32_t));
   }
   return h.digest();
 }
@@ -153,9 +156,11 @@ DensityStats World::densityStats() const {
   DensityStats s;
   if (P.size() == 0) return s;
   const double rho0 = impl_->scene.solver.restDensity;
+  const std::vector<Real>* ratio = P.find(ParticleStore::kRestRatio);  // each material's own ρ0
   double sumErr = 0, sumRho = 0, maxErr = 0;
   for (std::size_t i = 0; i < P.size(); ++i) {
-    const double e = std::max(0.0, (double(P.rho[i]) - rho0) / rho0);
+    const double rho0i = ratio ? rho0 * double((*ratio)[i]) : rho0;
+    const double e = std::max(0.0, (double(P.rho[i]) - rho0i) / rho0i);
     sumErr += e;
     sumRho += P.rho[i];
     maxErr = std::max(maxErr, e);
@@ -168,8 +173,10 @@ DensityStats World::densityStats() const {
 
 double World::kineticEnergy() const {
   const ParticleStore& P = impl_->P;
+  const std::vector<Real>* ratio = P.find(ParticleStore::kRestRatio);  // m_i = r_i m
   double e = 0;
-  for (std::size_t i = 0; i < P.size(); ++i) e += 0.5 * double(impl_->mass) * double(P.v[i].squaredNorm());
+  for (std::size_t i = 0; i < P.size(); ++i)
+    e += 0.5 * double(impl_->mass) * (ratio ? double((*ratio)[i]) : 1.0) * double(P.v[i].squaredNorm());
   return e;
 }
 

@@ -41,15 +41,19 @@ constexpr char kMagic[8] = {'S', 'P', 'H', '2', 'D', 'S', 'A', 'V'};
 constexpr std::uint64_t kMaxEmitters = ParticleSources::kMaxEmitters;  // a save holding more is not one of ours
 // 2: every emitter's whole definition (emitters added at run time); 3: bodies' swept poses;
 // 4: the swept poses of a game's b2World's bodies too; 5: the scene's own b2World's warm-starting
-// and sleeping switches and each of its moving bodies' awake state. Version 4 loads as well
-// (those as the loading World has them).
-constexpr std::uint32_t kVersion = 5;
+// and sleeping switches and each of its moving bodies' awake state; 6: each emitter's material.
+// Versions 4 and 5 load as well (what they lack as the loading World has it; emitters of the
+// first material).
+constexpr std::uint32_t kVersion = 6;
 constexpr std::uint32_t kOldestVersion = 4;
 constexpr std::size_t kMaxFields = 64, kMaxName = 128;
 constexpr const char* kUserForce = "user_force";  ///< the effect setUserForces adds
 
-/// What a save must match: the solver and its spacing, the emitters, the effects.
-std::uint64_t fingerprint(const SceneDef& scene, const Solver& solver, const EffectList& effects) {
+/// What a save must match: the solver and its spacing, the emitters, the effects, and the
+/// materials when there is more than one (a World of one fluid has the fingerprint it had
+/// before materials existed).
+std::uint64_t fingerprint(const SceneDef& scene, const Solver& solver, const EffectList& effects,
+                          const std::vector<MaterialDef>& materials) {
   Xxh64 h;
   auto str = [&](const std::string& s) {
     const std::uint64_t n = s.size();
@@ -63,6 +67,11 @@ std::uint64_t fingerprint(const SceneDef& scene, const Solver& solver, const Eff
   h.update(&emitters, sizeof emitters);
   for (const auto& e : effects)
     if (std::string(e->name()) != kUserForce) str(e->name());  // a game adds it at run time
+  if (materials.size() > 1)
+    for (const MaterialDef& m : materials) {
+      str(m.name);
+      h.update(&m.density, sizeof m.density);
+    }
   return h.digest();
 }
 
@@ -126,7 +135,7 @@ SaveReport World::save(std::ostream& out) const {
   StateOut o;
   for (const char c : kMagic) o.put(c);
   o.put(kVersion);
-  o.put(fingerprint(w.scene, *w.solver, w.effects));
+  o.put(fingerprint(w.scene, *w.solver, w.effects, w.materials));
   o.put(w.time);
   o.put(w.frames);
   o.put(w.steps);
@@ -148,6 +157,7 @@ SaveReport World::save(std::ostream& out) const {
     const double shape[] = {e.def.width, e.def.rate, e.def.speed, e.def.spread, e.def.jitter, e.def.start, e.def.stop};
     for (const double v : shape) o.put(v);
     o.put(e.def.seed);
+    o.put(e.def.material);
   }
   o.put(std::uint8_t(w.userForceEffect));
   o.put(std::uint64_t(w.userForces.size()));
@@ -226,8 +236,9 @@ void World::load(std::istream& input) {
   if (version < kOldestVersion || version > kVersion)
     throw SaveError("the saved state has version " + std::to_string(version) + "; this sph2d reads versions " +
                     std::to_string(kOldestVersion) + " to " + std::to_string(kVersion));
-  if (in.get<std::uint64_t>("the header") != fingerprint(w.scene, *w.solver, w.effects))
-    throw SaveError("the saved state belongs to another scene (its solver, spacing, emitters or effects differ)");
+  if (in.get<std::uint64_t>("the header") != fingerprint(w.scene, *w.solver, w.effects, w.materials))
+    throw SaveError(
+        "the saved state belongs to another scene (its solver, spacing, materials, emitters or effects differ)");
   const double time = in.get<double>("the clock");
   const std::uint64_t frames = in.get<std::uint64_t>("the clock"), steps = in.get<std::uint64_t>("the clock");
   const std::int32_t lastSubsteps = in.get<std::int32_t>("the clock");
@@ -255,6 +266,10 @@ void World::load(std::istream& input) {
                        &e.def.jitter, &e.def.start, &e.def.stop};
     for (double* v : shape) *v = in.get<double>("an emitter");
     e.def.seed = in.get<std::uint64_t>("an emitter");
+    if (version >= 6) e.def.material = in.get<std::uint32_t>("an emitter");
+    if (e.def.material >= w.materials.size())
+      throw SaveError("the saved state is malformed: an emitter's material " + std::to_string(e.def.material) +
+                      " (the World has " + std::to_string(w.materials.size()) + ")");
     const std::string problem = ParticleSources::problem(e.def);
     if (!problem.empty() || !(std::abs(e.def.direction.norm() - 1) < 1e-6))
       throw SaveError("the saved state is malformed: an emitter's " +
@@ -327,6 +342,16 @@ void World::load(std::istream& input) {
   std::sort(ids.begin(), ids.end());
   if (std::adjacent_find(ids.begin(), ids.end()) != ids.end() || (!ids.empty() && ids.back() >= nextId))
     throw SaveError("the saved state is malformed: particle ids repeat or reach the next id");
+  if (const Field* mf = find(ParticleStore::kMaterial)) {
+    if (w.materials.size() < 2)
+      throw SaveError("the saved state is malformed: it holds each particle's material, and the World has one");
+    std::vector<std::uint32_t> mat(static_cast<std::size_t>(n));
+    if (n) std::memcpy(mat.data(), mf->data.data(), mat.size() * sizeof(std::uint32_t));
+    for (const std::uint32_t m : mat)
+      if (m >= w.materials.size())
+        throw SaveError("the saved state is malformed: a particle of material " + std::to_string(m) +
+                        " (the World has " + std::to_string(w.materials.size()) + ")");
+  }
   std::vector<b2Body*> movable;
   if (w.b2)
     for (b2Body* b = w.b2->GetBodyList(); b; b = b->GetNext())

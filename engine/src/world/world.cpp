@@ -169,8 +169,10 @@ void World::initPhases(std::string& phase) {
   if (!problem.first.empty())
     throw SceneError(scene.path.empty() ? "scene" : scene.path, 0, 0, problem.first, problem.second);
   w.solver = makeSolver(sd);
+  w.initMaterials();
   w.effects = makeEffects(scene);
   for (const EmitterDef& e : scene.effects.emitters) {
+    w.checkMaterial(e.material, "effects.emitters[].material");
     ParticleSources::Emitter st;
     st.def = e;
     st.rng = e.seed;
@@ -327,9 +329,10 @@ IdRange World::Impl::fillNamed(const FluidBlockDef& b, const char* call) {
 
 IdRange World::addBlock(const FluidBlockDef& block) { return impl_->fillNamed(block, "addBlock"); }
 
-IdRange World::addDrop(const Vec2d& center, double radius, const Vec2d& velocity) {
+IdRange World::addDrop(const Vec2d& center, double radius, const Vec2d& velocity, std::uint32_t material) {
   FluidBlockDef b = circleRegion(center, radius, impl_->scene.solver.spacing);
   b.velocity = velocity;
+  b.material = material;
   return impl_->fillNamed(b, "addDrop");
 }
 
@@ -346,6 +349,7 @@ std::size_t World::addEmitter(const EmitterDef& def) {
   Impl& w = *impl_;
   const std::string problem = ParticleSources::problem(def);
   if (!problem.empty()) throw std::invalid_argument("addEmitter: " + problem);
+  w.checkMaterial(def.material, "addEmitter");
   if (w.sources.emitters.size() >= ParticleSources::kMaxEmitters)
     throw std::invalid_argument("addEmitter: the world has " + std::to_string(ParticleSources::kMaxEmitters) +
                                 " emitters, the most it holds");
@@ -406,6 +410,7 @@ Particles viewOf(const ParticleStore& S) {
   V.color = opt(S.findU32(ParticleStore::kColor));
   V.userData = opt(S.findU32(ParticleStore::kUserData));
   V.emitter = opt(S.findU32(ParticleStore::kEmitter));
+  V.material = opt(S.findU32(ParticleStore::kMaterial));
   return V;
 }
 
@@ -416,7 +421,7 @@ bool World::Impl::viewCurrent() const {
   auto same = [](const auto& a, const auto& b) { return a.data() == b.data() && a.size() == b.size(); };
   return same(view.x, now.x) && same(view.v, now.v) && same(view.rho, now.rho) && same(view.p, now.p) &&
          same(view.id, now.id) && same(view.age, now.age) && same(view.color, now.color) &&
-         same(view.userData, now.userData) && same(view.emitter, now.emitter);
+         same(view.userData, now.userData) && same(view.emitter, now.emitter) && same(view.material, now.material);
 }
 
 void World::Impl::refreshView() const { view = viewOf(P); }

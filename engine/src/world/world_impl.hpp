@@ -76,7 +76,20 @@ struct World::Impl {
   std::uint64_t iterations = 0;  ///< solver iterations summed over the substeps
   WallAccount wall;              ///< World::wallImpulse(): the stages of each substep add to it (substep())
   std::vector<std::string> warnings;
-  bool warnedSave = false;  ///< save() has warned of the b2World's state it cannot hold (once per World)
+  bool warnedSave = false;             ///< save() has warned of the b2World's state it cannot hold (once per World)
+  std::vector<MaterialDef> materials;  ///< World::materials(): index 0 is the solver's fluid (materials.cpp)
+  /// Fills `materials` from the scene (its table, checked as addMaterial checks, or the solver's
+  /// one fluid); with more than one, creates the per-particle field. Throws SceneError by key.
+  void initMaterials();
+  /// Throws std::invalid_argument naming `call` and the materials unless material `m` exists.
+  void checkMaterial(std::uint32_t m, const char* call) const;
+  /// Gives the particles in slots [from, P.size()) material `m` (nothing to do with one material).
+  void setMaterial(std::size_t from, std::uint32_t m);
+  /// True when two materials differ in rest density (then P holds ParticleStore::kRestRatio).
+  bool densityContrast() const;
+  /// Writes each particle's ρ0 over the first material's into the rest-ratio field, from slot
+  /// `from` on (nothing without the field).
+  void fillRestRatio(std::size_t from);
 
   // The subsystems.
   ParticleSources sources;  ///< emitters, the budget, removals

@@ -45,6 +45,11 @@ const Pinned kPinned[] = {
     // wcsph's body samples with the scene's b2World stepped every substep.
     {"tests/small_crates.json", "game", 30, false, 0xf1c7411aefb1f666ULL},
     {"tests/small_crates.json", "wcsph", 30, false, 0x932c1455c3cf3a3dULL},
+    // Two materials (of one density): each particle's material in the hash, an emitter of the second.
+    {"tests/two_materials.json", "muller2003", 30, false, 0x5442f256eb2acb21ULL},
+    {"tests/two_materials.json", "game", 30, false, 0x2135cb6372b35f34ULL},
+    // Oil on water: wcsph's number density (the materials' own masses and pressures).
+    {"tests/oil_on_water.json", "wcsph", 30, false, 0x2c04a061e24f7234ULL},
 };
 
 std::uint64_t run(const Pinned& p, int threads) {

@@ -28,6 +28,16 @@
 // artificial viscosity, so that a collision at impact speeds is damped near critically
 // instead of bouncing off the compression it stores.
 //
+// Materials of different rest density (docs/SCENES.md, materials) in one pressure solve: the
+// number-density formulation of Solenthaler & Pajarola 2008 ("Density contrast SPH
+// interfaces", SCA). Every particle has the lattice's volume and the mass of its material,
+// m_i = r_i m (r_i = ρ0_i/ρ0, the field "rest_ratio"); the density is the particle's mass
+// times the number density, ρ_i = m_i Σ_j W_ij (walls as rest-density neighbours), so a
+// particle beside a lighter one is not counted lighter (standard summation Σ m_j W_ij smears
+// the interface and pushes it apart); p_i = r_i B((ρ_i/ρ0_i)^γ − 1); the pressure acceleration
+// a_i = −(1/m_i) Σ_j (p_i/δ_i² + p_j/δ_j²) ∇W_ij, δ = ρ/m the number density. With one
+// density (no field) every r_i is 1 and these are the formulas above, bit for bit.
+//
 // Parameters (solver.*): gamma, alpha, expected_speed, impact_alpha, impact_speed.
 #include <algorithm>
 #include <cmath>
@@ -73,7 +83,8 @@ class Wcsph final : public Solver {
         P.size(), 4096, c.rho0,
         [&](std::size_t b, std::size_t e) {
           Real m = c.rho0;
-          for (std::size_t i = b; i < e; ++i) m = std::max(m, P.rho[i]);
+          const Real* rr = restRatio(P);  // the compression ρ_i/ρ0_i counts, not the density
+          for (std::size_t i = b; i < e; ++i) m = std::max(m, rr ? P.rho[i] / rr[i] : P.rho[i]);
           return m;
         },
         [](Real a, Real b2) { return std::max(a, b2); });
@@ -93,6 +104,7 @@ class Wcsph final : public Solver {
  private:
   std::size_t density(StepContext& c, const WendlandC2<Real>& W) const {
     ParticleStore& P = c.P;
+    const Real* ratio = restRatio(P);  // null with one rest density
     const Vec2* X = P.x.data();
     const Real self = W.value(0);
     const bool walls = !c.boundary.samples.empty();
@@ -124,6 +136,7 @@ class Wcsph final : public Solver {
             s += moving->volume[ml[k]] * W.value(std::sqrt((xi - moving->x[ml[k]]).squaredNorm()));
           rho += c.rho0 * s;
         }
+        if (ratio) rho *= ratio[i];  // m_i δ_i
         P.rho[i] = rho;
         if (!std::isfinite(rho) && bad == kNone) bad = i;
       }
@@ -143,17 +156,21 @@ class Wcsph final : public Solver {
     const Real kneeRatio = Real(1.1);
     const Real kneeP = B * (std::pow(kneeRatio, gamma_) - Real(1));
     const Real kneeSlope = B * gamma_ * std::pow(kneeRatio, gamma_ - Real(1)) / c.rho0;
+    const Real* rr = restRatio(P);
     c.pool.parallelFor(P.size(), 4096, [&](std::size_t b, std::size_t e) {
       for (std::size_t i = b; i < e; ++i) {
-        const Real ratio = P.rho[i] / c.rho0;
+        // ρ̃ = m δ: the density the particle would have as the first material (ρ_i/r_i).
+        const Real rhoN = rr ? P.rho[i] / rr[i] : P.rho[i];
+        const Real ratio = rhoN / c.rho0;
         Real p = ratio <= kneeRatio ? B * (std::pow(ratio, gamma_) - Real(1))
-                                    : kneeP + kneeSlope * (P.rho[i] - kneeRatio * c.rho0);
+                                    : kneeP + kneeSlope * (rhoN - kneeRatio * c.rho0);
         if (clamp && p < 0) p = 0;
+        if (rr) p *= rr[i];  // B_i = r_i B
         P.p[i] = p;
         P.invRho[i] = Real(1) / P.rho[i];
-        const Real pr = p * P.invRho[i];
-        P.pOverRho[i] = pr;
-        pOverRho2_[i] = pr * P.invRho[i];  // p/ρ² for the symmetric pressure form
+        P.pOverRho[i] = p * P.invRho[i];
+        const Real invN = Real(1) / rhoN;
+        pOverRho2_[i] = p * invN * invN;  // p/ρ̃² = p/(m δ)² for the symmetric pressure form
       }
     });
   }
@@ -178,6 +195,7 @@ class Wcsph final : public Solver {
     const Vec2* V = P.v.data();
     const Real* IR = P.invRho.data();
     const Real* POR2 = pOverRho2_.data();
+    const Real* rr = restRatio(P);  // m_i = r_i m (null: every r_i is 1)
     const std::size_t blocks = (P.size() + kBlock - 1) / kBlock;
     wallBlock_.assign(blocks, Vec2d(0, 0));
     const std::size_t first = firstBad(c.pool, P.size(), [&](std::size_t b, std::size_t e) {
@@ -186,6 +204,7 @@ class Wcsph final : public Solver {
       for (std::size_t i = b; i < e; ++i) {
         const Real vix = V[i].x(), viy = V[i].y();
         const Real pri = POR2[i], iri = IR[i];
+        const Real invRi = rr ? Real(1) / rr[i] : Real(1);  // m / m_i
         Real ax = 0, ay = 0;
         const std::uint32_t* nb = c.nbr.of(i);
         const std::uint32_t cnt = c.nbr.count[i];
@@ -199,15 +218,16 @@ class Wcsph final : public Solver {
           // ∇W = g·d; closer than R/4 it keeps its peak magnitude along d, so a stacked or
           // coincident pair pushes apart (constants.hpp, kFlatGradientQ).
           const Real g = q < kFlatGradientQ ? gradFlat / r : gradK * a * a * a;
-          // Pressure: −m (p_i/ρ_i² + p_j/ρ_j²) ∇W.
-          Real coef = -c.mass * pScale * (pri + POR2[j]);
-          // Artificial viscosity for approaching pairs.
+          // Pressure: −(m²/m_i) (p_i/ρ̃_i² + p_j/ρ̃_j²) ∇W (one density: −m (p_i/ρ_i² + p_j/ρ_j²) ∇W).
+          Real coef = -c.mass * invRi * pScale * (pri + POR2[j]);
+          // Artificial viscosity for approaching pairs (−m_j Π_ij ∇W).
           const Real vdotx = (vix - V[j].x()) * dx + (viy - V[j].y()) * dy;
           if (vdotx < 0) {
+            const Real mj = rr ? c.mass * rr[j] : c.mass;
             const Real mu = h * vdotx / (r2 + eta2);
-            coef += c.mass * avK * mu * Real(2) / (Real(1) / iri + Real(1) / IR[j]);
+            coef += mj * avK * mu * Real(2) / (Real(1) / iri + Real(1) / IR[j]);
             const Real ai = imp.alpha(vdotx, r);
-            if (ai > 0) coef += c.mass * (c0_ * ai) * mu * Real(2) / (Real(1) / iri + Real(1) / IR[j]);
+            if (ai > 0) coef += mj * (c0_ * ai) * mu * Real(2) / (Real(1) / iri + Real(1) / IR[j]);
           }
           ax += coef * g * dx;
           ay += coef * g * dy;
@@ -239,17 +259,18 @@ class Wcsph final : public Solver {
           }
           Vec2 aViscous = gv * (c.rho0 * avK * Real(2) / (rhoi + c.rho0));
           if (impactWall) aViscous += gi * (c.rho0 * c0_ * Real(2) / (rhoi + c.rho0));
-          const Vec2 aPressure = gb * (c.rho0 * pScale);
+          const Vec2 aPressure = gb * (c.rho0 * pScale * invRi);
           acc -= aPressure;
           acc += aViscous;
-          wallAcc += aViscous.cast<double>() - aPressure.cast<double>();  // this particle's wall acceleration
+          // This particle's wall force over m (the mass the sum is multiplied by below).
+          wallAcc += (aViscous.cast<double>() - aPressure.cast<double>()) / double(invRi);
         }
         if (moving && c.nbr.movingCount[i] > 0) {
           // The moving bodies' samples: the same terms, the viscosity with the sample's
           // velocity; body by body (the list holds each body's samples together), each body's
           // share of the acceleration is also its reaction (body_samples.hpp).
           const Real pi = P.p[i], rhoi = P.rho[i];
-          const Real pressK = c.rho0 * pScale, viscK = c.rho0 * avK * Real(2) / (rhoi + c.rho0);
+          const Real pressK = c.rho0 * pScale * invRi, viscK = c.rho0 * avK * Real(2) / (rhoi + c.rho0);
           const Real impactK = c.rho0 * c0_ * Real(2) / (rhoi + c.rho0);
           const std::uint32_t* ml = c.nbr.movingOf(i);
           const std::uint32_t mc = c.nbr.movingCount[i];
@@ -290,7 +311,8 @@ class Wcsph final : public Solver {
             }
             acc += aBody;
             if (moving->placed[body].dynamic)
-              moving->addReaction(b / kBlock, body, aBody.cast<double>() * double(c.mass), torque * double(c.mass));
+              moving->addReaction(b / kBlock, body, aBody.cast<double>() * (double(c.mass) / double(invRi)),
+                                  torque * (double(c.mass) / double(invRi)));
           });
         }
         acc += c.gravity;
@@ -304,6 +326,12 @@ class Wcsph final : public Solver {
     // substep integrate takes (force_limit may still shorten it).
     if (c.wall) c.wall->force += sumInOrder(wallBlock_, blocks) * double(c.mass);
     return first;
+  }
+
+  /// r_i = ρ0_i/ρ0 per particle, or null when every material has the first's rest density.
+  static const Real* restRatio(const ParticleStore& P) {
+    const std::vector<Real>* f = P.find(ParticleStore::kRestRatio);
+    return f ? f->data() : nullptr;
   }
 
   Real gamma_, alpha_, c0_;

@@ -6,9 +6,9 @@
 // FrameWriter's thread. Files are written whole or not at all (temporary name,
 // then rename). VTK is the legacy "vtk DataFile Version 3.0" POLYDATA format
 // that ParaView and VisIt open: POINTS (double, world coordinates), one VERTEX
-// cell per particle, and POINT_DATA arrays id, velocity, density, pressure and
-// age; binary files are big-endian, as the format requires. readParticlesCsv()
-// reads our own CSV back, so frames can be re-rendered without re-simulating.
+// cell per particle, and POINT_DATA arrays id, velocity, density, pressure,
+// age and material (each of the last two only when the World has it); binary files are big-endian, as the format
+// requires. readParticlesCsv() reads our own CSV back, so frames can be re-rendered without re-simulating.
 #pragma once
 
 #include <cstdint>
@@ -30,14 +30,15 @@ struct BodySnapshot {
 };
 
 struct ParticleSnapshot {
-  std::uint64_t frame = 0;           ///< frames stepped
-  double time = 0;                   ///< simulated time [s]
-  std::vector<std::uint32_t> id;     ///< stable ids, ascending
-  std::vector<double> x, y;          ///< world position [m]
-  std::vector<float> vx, vy;         ///< velocity [m/s]
-  std::vector<float> rho, p;         ///< density [kg/m³], pressure [Pa]
-  std::vector<float> age;            ///< age [s]; empty when the particles have no age
-  std::vector<BodySnapshot> bodies;  ///< the non-static bodies, in creation (scene) order
+  std::uint64_t frame = 0;              ///< frames stepped
+  double time = 0;                      ///< simulated time [s]
+  std::vector<std::uint32_t> id;        ///< stable ids, ascending
+  std::vector<double> x, y;             ///< world position [m]
+  std::vector<float> vx, vy;            ///< velocity [m/s]
+  std::vector<float> rho, p;            ///< density [kg/m³], pressure [Pa]
+  std::vector<float> age;               ///< age [s]; empty when the particles have no age
+  std::vector<std::uint32_t> material;  ///< material index (World::materials()); empty with one material
+  std::vector<BodySnapshot> bodies;     ///< the non-static bodies, in creation (scene) order
   /// Number of particles.
   std::size_t size() const { return id.size(); }
 };

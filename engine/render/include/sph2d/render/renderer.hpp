@@ -58,11 +58,11 @@ class World;
 /// The particle quantity the particles mode colours by.
 /// What the particles mode colours by: a field on the ramp, or each particle's own colour
 /// (World::setParticleColor; particles without one in the fluid's colour).
-enum class ColorField { Speed, Pressure, Density, Age, Color };
+enum class ColorField { Speed, Pressure, Density, Age, Color, Material };
 
-/// Parses "speed", "pressure", "density", "age" or "color"; returns false for anything else.
+/// Parses "speed", "pressure", "density", "age", "color" or "material"; returns false for anything else.
 bool parseColorField(const std::string& s, ColorField& out);
-/// "speed", "pressure", "density", "age" or "color".
+/// "speed", "pressure", "density", "age", "color" or "material".
 std::string colorFieldName(ColorField f);
 
 /// Render settings that the scene format does not carry (yet): they come from
@@ -92,6 +92,9 @@ struct RenderInput {
   std::vector<Collider> moving;  ///< moving bodies at their pose this frame (local frame), drawn every frame
   const Real* age =
       nullptr;  ///< optional: one age [s] per particle slot (null: particles.age when it has one per particle)
+  /// 0xRRGGBB per material (materialColors(World)): particles mode, `color_by` material draws
+  /// each particle in its material's colour, and `color` those without one of their own.
+  std::vector<std::uint32_t> materialColors;
   double gravity = 9.81;    ///< |g| [m/s²], scales the default foam speed
   std::uint64_t frame = 0;  ///< for the overlay
   double time = 0;          ///< simulated time [s], for the overlay
@@ -209,6 +212,9 @@ inline const Real* agesOf(const RenderInput& in) {
   const Particles& P = in.particles;
   return P.age.size() == P.size() && P.size() > 0 ? P.age.data() : nullptr;
 }
+/// The colours of `world`'s materials as 0xRRGGBB, by index; empty for a World of one material.
+std::vector<std::uint32_t> materialColors(const World& world);
+
 /// The camera of `def` for a RenderInput (same rules as above).
 std::vector<double> resolveCamera(const RenderDef& def, const RenderInput& in);
 

@@ -1,0 +1,151 @@
+// materials.cpp — a scene's `materials` table and the one rule every way of adding a
+// material follows (materialProblem): the scene loader, World's constructor and
+// World::addMaterial all ask it, so a table refused in a file is refused in code too.
+#include <cmath>
+#include <sstream>
+
+#include "scene/scene_sections.hpp"
+
+namespace sph2d {
+namespace {
+
+/// The viscosity material `m` has in a World of `solver`.
+double viscosityOf(const MaterialDef& m, const SolverDef& solver) {
+  return m.viscosity < 0 ? solver.viscosity : m.viscosity;
+}
+
+std::string names(const std::vector<MaterialDef>& materials) {
+  std::string out;
+  for (const MaterialDef& m : materials) out += (out.empty() ? "" : ", ") + m.name;
+  return out;
+}
+
+}  // namespace
+
+bool takesDensityContrast(const std::string& solver) { return solver == "wcsph"; }
+
+std::string densityContrastProblem(const SceneDef& scene) {
+  const EffectsDef& e = scene.effects;
+  const char* effect = e.xsph ? "xsph" : e.shifting ? "shifting" : e.surfaceTension ? "surface_tension" : nullptr;
+  if (!effect) return "";
+  return std::string("effects.") + effect +
+         " does not take materials of different density yet (it weighs neighbours by one particle mass)";
+}
+
+std::vector<MaterialDef> sceneMaterials(const SceneDef& scene) {
+  if (!scene.materials.empty()) return scene.materials;
+  MaterialDef m;
+  m.density = scene.solver.restDensity;
+  m.viscosity = scene.solver.viscosity;
+  m.color = scene.render.water;
+  return {m};
+}
+
+std::string materialProblem(const std::vector<MaterialDef>& materials, const MaterialDef& m, const SolverDef& solver) {
+  std::ostringstream o;
+  o.precision(9);
+  if (m.name.empty() || m.name.size() > MaterialDef::kMaxName)
+    o << "a material's name must be 1 to " << MaterialDef::kMaxName << " characters";
+  else if (materials.size() >= MaterialDef::kMaxMaterials)
+    o << "a World holds at most " << MaterialDef::kMaxMaterials << " materials";
+  else if (!(m.density >= MaterialDef::kMinDensity && m.density <= MaterialDef::kMaxDensity))
+    o << "density must be in " << MaterialDef::kMinDensity << ".." << MaterialDef::kMaxDensity << " kg/m³, got "
+      << m.density;
+  else if (!(m.viscosity <= MaterialDef::kMaxViscosity) || (m.viscosity < 0 && m.viscosity != -1))
+    o << "viscosity must be in 0.." << MaterialDef::kMaxViscosity << " m²/s (or absent: the solver's), got "
+      << m.viscosity;
+  for (double c : m.color)
+    if (o.tellp() == 0 && !(c >= 0 && c <= 1)) o << "color components must be in 0..1, got " << c;
+  if (o.tellp() != 0) return o.str();
+  for (const MaterialDef& other : materials)
+    if (other.name == m.name) return "the name \"" + m.name + "\" is taken (materials: " + names(materials) + ")";
+  for (const std::string& n : m.miscibleWith) {
+    bool known = n == m.name;
+    for (const MaterialDef& other : materials) known = known || other.name == n;
+    if (!known)
+      return "miscible_with names \"" + n + "\", which is no material before it (materials: " +
+             (materials.empty() ? std::string("none") : names(materials)) + ")";
+  }
+  if (materials.empty()) return "";
+  // wcsph takes a density contrast (number density), the others one rest density for all
+  // particles; every solver one viscosity.
+  const MaterialDef& first = materials.front();
+  if (m.density != first.density && !takesDensityContrast(solver.type))
+    o << "density " << m.density << " kg/m³ differs from the first material's (" << first.name << ", " << first.density
+      << "): solver '" << solver.type << "' takes materials of one density (wcsph takes a density contrast)";
+  else if (viscosityOf(m, solver) != viscosityOf(first, solver))
+    o << "viscosity " << viscosityOf(m, solver) << " m²/s differs from the first material's (" << first.name << ", "
+      << viscosityOf(first, solver) << "): solver '" << solver.type
+      << "' takes materials of one viscosity (no solver takes a viscosity per material yet)";
+  return o.str();
+}
+
+void readMaterials(const Reader& r, const nlohmann::json& root, SceneDef& s) {
+  if (!root.contains("materials")) return;
+  const nlohmann::json& arr = root.at("materials");
+  if (!arr.is_array() || arr.empty())
+    r.fail("materials", "expected an array of one or more materials, got " + describe(arr));
+  const nlohmann::json* solver = root.contains("solver") ? &root.at("solver") : nullptr;
+  for (std::size_t k = 0; k < arr.size(); ++k) {
+    const std::string p = "materials[" + std::to_string(k) + "]";
+    const nlohmann::json& j = arr[k];
+    r.requireObject(j, p);
+    r.checkKeys(j, p, {"name", "density", "viscosity", "color", "miscible_with"});
+    MaterialDef m;
+    if (!j.contains("name")) r.fail(Reader::sub(p, "name"), "missing; expected the material's name");
+    m.name = r.string(j, p, "name", "", {});
+    // The first material is the solver's fluid: its density and viscosity default to the
+    // solver's, and may not contradict them.
+    const bool first = k == 0;
+    m.density = r.number(j, p, "density", first ? s.solver.restDensity : 1000, MaterialDef::kMinDensity,
+                         MaterialDef::kMaxDensity);
+    if (j.contains("viscosity")) m.viscosity = r.number(j, p, "viscosity", 0, 0, MaterialDef::kMaxViscosity);
+    m.color = r.color(j, p, "color", s.render.water);
+    if (j.contains("miscible_with")) {
+      const nlohmann::json& mw = j.at("miscible_with");
+      const std::string q = Reader::sub(p, "miscible_with");
+      if (!mw.is_array()) r.fail(q, "expected an array of material names, got " + describe(mw));
+      for (std::size_t i = 0; i < mw.size(); ++i) {
+        if (!mw[i].is_string()) r.fail(q + "[" + std::to_string(i) + "]", "expected a material's name");
+        m.miscibleWith.push_back(mw[i].get<std::string>());
+      }
+    }
+    if (first) {
+      for (const char* key : {"rest_density", "viscosity"}) {
+        const bool density = std::string(key) == "rest_density";
+        const double mine = density ? m.density : m.viscosity;
+        const double theirs = density ? s.solver.restDensity : s.solver.viscosity;
+        if (solver && solver->is_object() && solver->contains(key) && j.contains(density ? "density" : "viscosity") &&
+            mine != theirs)
+          r.fail(Reader::sub(p, density ? "density" : "viscosity"), "the first material is the solver's fluid: its " +
+                                                                        std::string(density ? "density" : "viscosity") +
+                                                                        " must be solver." + key + "'s or absent");
+      }
+      s.solver.restDensity = m.density;
+      if (m.viscosity >= 0) s.solver.viscosity = m.viscosity;
+    }
+    const std::string problem = materialProblem(s.materials, m, s.solver);
+    if (!problem.empty()) {
+      const char* key = problem.rfind("density", 0) == 0     ? "density"
+                        : problem.rfind("viscosity", 0) == 0 ? "viscosity"
+                        : problem.rfind("color", 0) == 0     ? "color"
+                        : problem.rfind("miscible", 0) == 0  ? "miscible_with"
+                                                             : "name";
+      r.fail(Reader::sub(p, key), problem);
+    }
+    s.materials.push_back(m);
+  }
+}
+
+std::uint32_t readMaterialName(const Reader& r, const nlohmann::json& j, const std::string& path, const SceneDef& s) {
+  if (!j.contains("material")) return 0;
+  const std::vector<MaterialDef> all = sceneMaterials(s);
+  std::vector<std::string> allowed;
+  for (const MaterialDef& m : all) allowed.push_back(m.name);
+  const std::string name = r.string(j, path, "material", "", allowed);
+  for (std::size_t k = 0; k < all.size(); ++k)
+    if (all[k].name == name) return std::uint32_t(k);
+  return 0;
+}
+
+}  // namespace sph2d

@@ -1,0 +1,108 @@
+// materials.cpp — the World's materials (docs/SCENES.md, "materials"): the scene's table
+// or the solver's one fluid, those a game adds, and each particle's material. The
+// per-particle field ("material", ParticleStore::kMaterial) exists only while the World
+// holds more than one material: a World of one fluid allocates nothing for materials.
+#include <sstream>
+#include <stdexcept>
+
+#include "world/world_impl.hpp"
+
+namespace sph2d {
+
+void World::Impl::initMaterials() {
+  const SolverDef& sd = scene.solver;
+  const std::string file = scene.path.empty() ? "scene" : scene.path;
+  if (!scene.materials.empty()) {
+    const MaterialDef& first = scene.materials.front();
+    if (first.density != sd.restDensity || (first.viscosity >= 0 && first.viscosity != sd.viscosity)) {
+      std::ostringstream o;
+      o.precision(9);
+      o << "the first material is the solver's fluid: its density (" << first.density << ") and viscosity ("
+        << first.viscosity << ") must be solver.rest_density's (" << sd.restDensity << ") and solver.viscosity's ("
+        << sd.viscosity << "), or the viscosity absent (< 0)";
+      throw SceneError(file, 0, 0, "materials[0]", o.str());
+    }
+  }
+  materials.clear();
+  const std::vector<MaterialDef> all = sceneMaterials(scene);
+  for (std::size_t k = 0; k < all.size(); ++k) {
+    const std::string problem = materialProblem(materials, all[k], sd);
+    if (!problem.empty()) throw SceneError(file, 0, 0, "materials[" + std::to_string(k) + "]", problem);
+    materials.push_back(all[k]);
+  }
+  if (materials.size() > 1) P.fieldU32(ParticleStore::kMaterial);
+  if (densityContrast()) {
+    const std::string problem = densityContrastProblem(scene);
+    if (!problem.empty()) throw SceneError(file, 0, 0, "effects", problem);
+    P.field(ParticleStore::kRestRatio, 1);
+  }
+}
+
+bool World::Impl::densityContrast() const {
+  for (const MaterialDef& m : materials)
+    if (m.density != materials.front().density) return true;
+  return false;
+}
+
+void World::Impl::fillRestRatio(std::size_t from) {
+  std::vector<Real>* ratio = P.find(ParticleStore::kRestRatio);
+  const std::vector<std::uint32_t>* material = P.findU32(ParticleStore::kMaterial);
+  if (!ratio || !material) return;
+  const double rho0 = materials.front().density;
+  for (std::size_t i = from; i < ratio->size(); ++i) (*ratio)[i] = Real(materials[(*material)[i]].density / rho0);
+}
+
+void World::Impl::checkMaterial(std::uint32_t m, const char* call) const {
+  if (m < materials.size()) return;
+  std::ostringstream o;
+  o << call << ": material " << m << " does not exist (the world has " << materials.size() << ":";
+  for (std::size_t k = 0; k < materials.size(); ++k) o << (k ? ", " : " ") << k << " " << materials[k].name;
+  o << "; World::addMaterial adds one)";
+  throw std::invalid_argument(o.str());
+}
+
+void World::Impl::setMaterial(std::size_t from, std::uint32_t m) {
+  std::vector<std::uint32_t>* f = P.findU32(ParticleStore::kMaterial);
+  if (!f) return;
+  if (m != 0)  // the field starts at 0, the first material
+    for (std::size_t i = from; i < f->size(); ++i) (*f)[i] = m;
+  fillRestRatio(from);  // a new particle's ratio starts at 0
+}
+
+std::uint32_t World::addMaterial(const MaterialDef& m) {
+  Impl& w = *impl_;
+  const std::string problem = materialProblem(w.materials, m, w.scene.solver);
+  if (!problem.empty()) throw std::invalid_argument("addMaterial: " + problem);
+  if (m.density != w.materials.front().density) {
+    const std::string effects = densityContrastProblem(w.scene);
+    if (!effects.empty()) throw std::invalid_argument("addMaterial: " + effects);
+  }
+  w.materials.push_back(m);
+  if (w.materials.size() == 2) {  // from now on each particle says which (every one there now: the first)
+    w.P.fieldU32(ParticleStore::kMaterial);
+    w.refreshView();
+  }
+  if (w.densityContrast() && !w.P.find(ParticleStore::kRestRatio)) {
+    w.P.field(ParticleStore::kRestRatio, 1);  // every particle there now: its material's
+    w.fillRestRatio(0);
+  }
+  return std::uint32_t(w.materials.size() - 1);
+}
+
+const std::vector<MaterialDef>& World::materials() const { return impl_->materials; }
+
+std::uint32_t World::materialIndex(const std::string& name) const {
+  const std::vector<MaterialDef>& all = impl_->materials;
+  for (std::size_t k = 0; k < all.size(); ++k)
+    if (all[k].name == name) return std::uint32_t(k);
+  return kNoMaterial;
+}
+
+std::uint32_t World::materialOf(std::uint32_t id) const {
+  const std::size_t i = slotOf(id);
+  if (i == npos) return kNoMaterial;
+  const std::vector<std::uint32_t>* f = impl_->P.findU32(ParticleStore::kMaterial);
+  return f ? (*f)[i] : 0u;
+}
+
+}  // namespace sph2d
