@@ -7,7 +7,9 @@
 //    towards the deep colour;
 //  - surface: shading from the field's gradient (light from above), a bright
 //    meniscus just inside the edge and a specular highlight;
-//  - foam: towards white where the kernel-weighted speed is high.
+//  - foam: towards white where the kernel-weighted speed is high;
+//  - with TINT defined (more than one material): the surface colour is the materials' colours
+//    weighted by the splat (uTint), the deep colour 0.3 of it.
 // Rows of this target run top-down in the world (the camera flips y). It is
 // drawn only over the tiles that fluid can reach (solid.vert: quads in NDC);
 // the rest of the frame keeps the background.
@@ -24,6 +26,9 @@ uniform vec3 uFoam;
 uniform float uInvDepth;     // 1 / metres of water that darken by 1/e
 uniform vec2 uFoamSpeed;     // foam starts, foam full [m/s]
 uniform float uSpacingPx;    // particle spacing [px]
+#ifdef TINT
+uniform sampler2D uTint;     // RGBA: sum w*colour, sum w (the field's resolution, bilinear)
+#endif
 void main() {
   vec2 vUv = gl_FragCoord.xy * uTexel;
   vec2 c = texture(uField, vUv).rg;
@@ -42,9 +47,18 @@ void main() {
     outColor = vec4(bg, 1.0);
     return;
   }
+#ifdef TINT
+  vec4 tint = texture(uTint, vUv);
+  vec3 surfaceColor = tint.rgb / max(tint.a, 1e-6);
+#define SURFACE surfaceColor
+#define DEEP (surfaceColor * 0.3)
+#else
+#define SURFACE uWater
+#define DEEP uDeep
+#endif
   // Body: Beer-Lambert-like absorption of the light coming from above.
   float absorb = exp(-aux.r * uInvDepth);
-  vec3 water = mix(uDeep, uWater, absorb);
+  vec3 water = mix(DEEP, SURFACE, absorb);
   // Surface normal from the field: it points out of the fluid (-grad), tilted by the slope.
   float inside = smoothstep(threshold, threshold + 0.45, f);
   vec3 n = vec3(-grad * (6.0 * (1.0 - 0.7 * inside)), 1.0);
@@ -56,7 +70,7 @@ void main() {
   h = h / sqrt(dot(h, h));
   float spec = pow(max(dot(n, h), 0.0), 30.0) * 0.55 * (1.0 - inside);
   float rim = (1.0 - inside) * 0.3;
-  water = water * lambert + vec3(spec) + uWater * rim;
+  water = water * lambert + vec3(spec) + SURFACE * rim;
   // Foam: fast water, strongest at the surface and in spray.
   float speed = c.g / max(c.r, 1e-6);
   float foam = smoothstep(uFoamSpeed.x, uFoamSpeed.y, speed);

@@ -408,6 +408,41 @@ TEST_CASE("particles mode: color_by material draws each particle in its material
   CHECK(yDye2 > yDye);  // what is left of the dye is its lower half
 }
 
+TEST_CASE("liquid mode: each material in its own colour, and without materials none of the dye's") {
+  const SceneDef s = loadScene(std::string(SPH2D_ASSETS) + "/scenes/tests/two_materials.json");  // dye above water
+  World world(s, WorldOptions{1});
+  RenderOptions lo;
+  lo.mode = "liquid";
+  Renderer r(s.render, lo);
+  const Frame& f = r.render(world);
+  // Pixels whose hue is the dye's (red) or the water's (blue), and their mean image row.
+  auto hue = [](const Frame& fr, bool red) {
+    double n = 0, rows = 0;
+    for (std::size_t k = 0; k + 3 < fr.rgba.size(); k += 4) {
+      const int R = fr.rgba[k], G = fr.rgba[k + 1], B = fr.rgba[k + 2];
+      if (red ? (R > G + 40 && R > B + 40) : (B > R + 40 && B > G + 20))
+        n += 1, rows += double(k / 4 / std::size_t(fr.width));
+    }
+    return std::make_pair(n, n > 0 ? rows / n : 0.0);
+  };
+  const auto [nRed, rowRed] = hue(f, true);
+  const auto [nBlue, rowBlue] = hue(f, false);
+  MESSAGE("dye " << nRed << " px about row " << rowRed << ", water " << nBlue << " px about row " << rowBlue);
+  CHECK(nRed > 500);
+  CHECK(double(nRed) / double(nBlue) == doctest::Approx(1.0).epsilon(0.25));  // 625 particles each
+  CHECK(rowRed < rowBlue);                                                    // the dye above
+  // The same particles as one material: every pixel of the fluid the render's water colour, as
+  // a World without materials draws it.
+  SceneDef one = s;
+  one.materials.clear();
+  for (FluidBlockDef& b : one.blocks) b.material = 0;
+  for (EmitterDef& e : one.effects.emitters) e.material = 0;
+  World plain(one, WorldOptions{1});
+  Renderer rp(one.render, lo);
+  const Frame& fp = rp.render(plain);
+  CHECK(hue(fp, true).first == 0);
+}
+
 TEST_CASE("the overlay changes only the pixels of its box in the top-left corner") {
   const SceneDef s = blockScene(320, 240, Vec2d(-0.1, -0.1), Vec2d(0.3, 0.3));
   World world(s, WorldOptions{1});

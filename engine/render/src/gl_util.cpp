@@ -14,8 +14,10 @@ const std::map<std::string, std::string>& embeddedShaders();
 namespace gl {
 namespace {
 
-GLuint compile(GLenum type, const std::string& name) {
-  const std::string src = shaderSource(name);
+/// Compiles shaders/`name`, with `defines` ("#define X\n" lines) after its #version line.
+GLuint compile(GLenum type, const std::string& name, const std::string& defines = "") {
+  std::string src = shaderSource(name);
+  if (!defines.empty()) src.insert(src.find('\n') + 1, defines);
   GLuint s = glCreateShader(type);
   const char* p = src.c_str();
   glShaderSource(s, 1, &p, nullptr);
@@ -47,9 +49,9 @@ std::string shaderSource(const std::string& name) {
   return it->second;
 }
 
-GLuint program(const std::string& vs, const std::string& fs) {
+GLuint program(const std::string& vs, const std::string& fs, const std::string& fsDefines) {
   GLuint p = glCreateProgram();
-  GLuint a = compile(GL_VERTEX_SHADER, vs), b = compile(GL_FRAGMENT_SHADER, fs);
+  GLuint a = compile(GL_VERTEX_SHADER, vs), b = compile(GL_FRAGMENT_SHADER, fs, fsDefines);
   glAttachShader(p, a);
   glAttachShader(p, b);
   glLinkProgram(p);

@@ -15,8 +15,9 @@ namespace sph2d::gl {
 
 /// Shader text: $SPH2D_SHADER_DIR/name when that is set (for shader work), else the embedded copy.
 std::string shaderSource(const std::string& name);
-/// Compiles and links shaders/`vs` + shaders/`fs` into a program. Throws with the compiler's log.
-GLuint program(const std::string& vs, const std::string& fs);
+/// Compiles and links shaders/`vs` + shaders/`fs` into a program, `fsDefines` ("#define X\n"
+/// lines) inserted after the fragment shader's #version line. Throws with the compiler's log.
+GLuint program(const std::string& vs, const std::string& fs, const std::string& fsDefines = "");
 /// (Re)allocates `tex` (created when 0) as a w × h 2D texture, clamped at the edges, with `filter`.
 void makeTexture(GLuint& tex, GLenum internal, GLenum format, GLenum type, int w, int h, GLint filter);
 /// A framebuffer rendering into `tex` (made as by makeTexture, nearest filtering). Throws when incomplete.

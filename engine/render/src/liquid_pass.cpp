@@ -11,6 +11,11 @@
 //  3. composite: over those tiles only, the field becomes water (shaders/composite.frag:
 //     thresholded edge, depth colour, shading from the field's gradient, foam); elsewhere the
 //     frame keeps its background.
+// With more than one material (RenderInput::materialColors and a material per particle), the
+// particles are splatted once more into an RGBA32F tint target (shaders/tint.frag: Σ w·colour,
+// Σ w) and the composite (compiled with TINT) takes the surface colour from it: each material
+// in its own colour, blended over a kernel's width where two meet. One material: neither the
+// pass nor its target exists, and the frame is the one it was.
 #include <algorithm>
 #include <cmath>
 
@@ -42,6 +47,7 @@ class LiquidPass final : public RenderPass {
 
   void targetsChanged() override {
     fieldW_ = fieldH_ = 0;  // recreated at the next splat
+    tintW_ = tintH_ = 0;
     grid_.solidsChanged();
     drawnRows_ = {0, 1 << 30};  // a new colour target: the whole background at the next frame
   }
@@ -52,14 +58,17 @@ class LiquidPass final : public RenderPass {
   }
 
   void release() override {
-    for (GLuint p : {splatProg_, compositeProg_})
+    for (GLuint p : {splatProg_, compositeProg_, tintProg_, compositeTintProg_})
       if (p) glDeleteProgram(p);
-    const GLuint textures[2] = {fieldTex_, auxTex_};
-    glDeleteTextures(2, textures);
-    glDeleteFramebuffers(1, &fieldFbo_);
+    const GLuint textures[3] = {fieldTex_, auxTex_, tintTex_};
+    glDeleteTextures(3, textures);
+    const GLuint fbos[2] = {fieldFbo_, tintFbo_};
+    glDeleteFramebuffers(2, fbos);
     glDeleteVertexArrays(1, &tileVao_);
     glDeleteBuffers(1, &tileVbo_);
     splatProg_ = compositeProg_ = fieldTex_ = auxTex_ = fieldFbo_ = tileVao_ = tileVbo_ = 0;
+    tintProg_ = compositeTintProg_ = tintTex_ = tintFbo_ = 0;
+    tintW_ = tintH_ = 0;
   }
 
   void prepare(const PassFrame& f) override {
@@ -74,6 +83,20 @@ class LiquidPass final : public RenderPass {
       packed_[4 * k + 3] = f.weight[k];
     }
     sprites_.upload(packed_);
+    // More than one material: each particle's material colour too (uploaded by splat()).
+    const std::vector<std::uint32_t>& colors = f.in.materialColors;
+    tinted_ = !colors.empty() && P.material.size() == P.size();
+    if (tinted_) {
+      packedTint_.resize(n * 4);
+      for (std::size_t k = 0; k < n; ++k) {
+        const std::size_t i = f.order[k];
+        const std::uint32_t m = P.material[i];
+        packedTint_[4 * k] = P.x[i].x();
+        packedTint_[4 * k + 1] = P.x[i].y();
+        packedTint_[4 * k + 2] = float(m < colors.size() ? colors[m] & 0xFFFFFFu : 0u);
+        packedTint_[4 * k + 3] = f.weight[k];
+      }
+    }
     const int EW = f.geo.EW, EH = f.geo.EH;
     if (grid_.resize(EW, EH, f.spacingPx))
       gl::makeTexture(auxTex_, GL_RG32F, GL_RG, GL_FLOAT, grid_.width(), grid_.height(), GL_LINEAR);
@@ -131,6 +154,23 @@ class LiquidPass final : public RenderPass {
     glBlendFunc(GL_ONE, GL_ONE);
     sprites_.setUniforms(splatProg_, f.scale, f.offset, fieldDiameter, fw, fh, quads_);
     sprites_.draw(GLsizei(f.order.size()), quads_);
+    if (tinted_) {  // the materials' colours, splatted alike into the tint target
+      if (!tintProg_) tintProg_ = gl::program("splat.vert", "tint.frag");
+      if (fw != tintW_ || fh != tintH_) {
+        if (tintFbo_) glDeleteFramebuffers(1, &tintFbo_);
+        tintFbo_ = gl::target(GL_RGBA32F, GL_RGBA, GL_FLOAT, fw, fh, tintTex_);
+        const GLint filter = shrink > 1 ? GL_LINEAR : GL_NEAREST;
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, filter);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, filter);
+        tintW_ = fw;
+        tintH_ = fh;
+      }
+      glBindFramebuffer(GL_FRAMEBUFFER, tintFbo_);
+      glClear(GL_COLOR_BUFFER_BIT);
+      sprites_.upload(packedTint_);
+      sprites_.setUniforms(tintProg_, f.scale, f.offset, fieldDiameter, fw, fh, quads_);
+      sprites_.draw(GLsizei(f.order.size()), quads_);
+    }
     glDisable(GL_BLEND);
     glViewport(0, 0, EW, EH);
   }
@@ -138,7 +178,9 @@ class LiquidPass final : public RenderPass {
   /// The field becomes water over the tiles the fluid can reach (shaders/composite.frag).
   void composite(const PassFrame& f) {
     const int EW = f.geo.EW, EH = f.geo.EH;
-    const GLuint cp = compositeProg_;
+    if (tinted_ && !compositeTintProg_)
+      compositeTintProg_ = gl::program("solid.vert", "composite.frag", "#define TINT\n");
+    const GLuint cp = tinted_ ? compositeTintProg_ : compositeProg_;
     // The colour target still holds the last frame: background and solids, and water over the
     // rows its tiles covered. Only those rows go back to the background; the tiles of this
     // frame write every pixel they cover.
@@ -157,6 +199,11 @@ class LiquidPass final : public RenderPass {
     glBindTexture(GL_TEXTURE_2D, auxTex_);
     glActiveTexture(GL_TEXTURE2);
     glBindTexture(GL_TEXTURE_2D, f.color.background);
+    if (tinted_) {
+      glActiveTexture(GL_TEXTURE3);
+      glBindTexture(GL_TEXTURE_2D, tintTex_);
+      glUniform1i(gl::uniform(cp, "uTint"), 3);
+    }
     glActiveTexture(GL_TEXTURE0);
     glUniform1i(gl::uniform(cp, "uField"), 0);
     glUniform1i(gl::uniform(cp, "uAux"), 1);
@@ -191,6 +238,11 @@ class LiquidPass final : public RenderPass {
   RenderOptions opt_;
   SpriteBatch& sprites_;
   GLuint splatProg_ = 0, compositeProg_ = 0;
+  // More than one material (made on the first such frame): the tint pass and its target.
+  GLuint tintProg_ = 0, compositeTintProg_ = 0, tintTex_ = 0, tintFbo_ = 0;
+  int tintW_ = 0, tintH_ = 0;
+  bool tinted_ = false;            // this frame draws each material in its colour
+  std::vector<float> packedTint_;  // particles (x, y, material colour, weight) in id order
   GLuint fieldTex_ = 0, fieldFbo_ = 0, auxTex_ = 0, tileVao_ = 0, tileVbo_ = 0;
   int fieldW_ = 0, fieldH_ = 0;  // the splat target: full resolution, or half when sprites are wide
   GLsizei tileVertices_ = 0;
