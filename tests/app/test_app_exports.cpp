@@ -151,6 +151,17 @@ TEST_CASE("--export csv and vtk write each particle's material when the scene ha
   }
   CHECK(s.size() > 1250 + 50);
   CHECK(dye == s.size() - 625);
+  // `sph2d render` reads the column back: the dye drawn in its colour (0.85, 0.20, 0.25).
+  const std::string png = dir + "/redrawn.png";
+  REQUIRE(run("render " + q(scene) + " --particles " + q(dir + "/frame_00019.csv") + " --out " + q(png) +
+              " --mode particles --color-by material")
+              .code == 0);
+  int w = 0, h = 0;
+  std::vector<std::uint8_t> rgba;
+  readPng(png, w, h, rgba);
+  std::size_t red = 0;
+  for (std::size_t k = 0; k + 3 < rgba.size(); k += 4) red += rgba[k] > 150 && rgba[k + 1] < 90 && rgba[k + 2] < 110;
+  CHECK(red > 100);
   REQUIRE(run("run " + q(scene) + " --frames 1 --quiet --export vtk-ascii --out " + q(vdir)).code == 0);
   const std::string vtk = readText(vdir + "/frame_00000.vtk");
   const std::size_t at = vtk.find("SCALARS material int 1\nLOOKUP_TABLE default\n0\n");

@@ -253,7 +253,7 @@ class World {
   std::uint64_t frame() const;
   /// The substep length [s] the limits (CFL, force, effects) allow in the current state.
   double stableTimeStep() const;
-  /// Particle mass [kg] (all particles share it).
+  /// Particle mass [kg] of the first material (a particle of material k: × its density over the first's).
   Real particleMass() const;
   /// Kernel support R [m].
   Real support() const;
@@ -262,7 +262,7 @@ class World {
   /// Threads of the job system.
   int threads() const;
 
-  /// XXH64 of (id, position, velocity) in id order, plus the origin.
+  /// XXH64 of (id, position, velocity, and material with more than one) in id order, plus the origin.
   std::uint64_t stateHash() const;
   /// Density error statistics of the current state.
   DensityStats densityStats() const;

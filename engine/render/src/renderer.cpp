@@ -57,7 +57,6 @@ RenderInput inputOf(const World& world, const Real* age) {
 
 std::vector<std::uint32_t> materialColors(const World& world) {
   std::vector<std::uint32_t> out;
-  if (world.materials().size() < 2) return out;
   for (const MaterialDef& m : world.materials()) {
     std::uint32_t c = 0;
     for (const double v : m.color) c = (c << 8) | std::uint32_t(std::lround(std::clamp(v, 0.0, 1.0) * 255));

@@ -117,9 +117,10 @@ void readMaterials(const Reader& r, const nlohmann::json& root, SceneDef& s) {
         const double theirs = density ? s.solver.restDensity : s.solver.viscosity;
         if (solver && solver->is_object() && solver->contains(key) && j.contains(density ? "density" : "viscosity") &&
             mine != theirs)
-          r.fail(Reader::sub(p, density ? "density" : "viscosity"), "the first material is the solver's fluid: its " +
-                                                                        std::string(density ? "density" : "viscosity") +
-                                                                        " must be solver." + key + "'s or absent");
+          r.fail(Reader::sub(p, density ? "density" : "viscosity"),
+                 "the first material is the solver's fluid: its " + std::string(density ? "density" : "viscosity") +
+                     " (" + j.at(density ? "density" : "viscosity").dump() + ") must be solver." + key + "'s (" +
+                     solver->at(key).dump() + ") or absent");
       }
       s.solver.restDensity = m.density;
       if (m.viscosity >= 0) s.solver.viscosity = m.viscosity;
@@ -131,7 +132,7 @@ void readMaterials(const Reader& r, const nlohmann::json& root, SceneDef& s) {
                         : problem.rfind("color", 0) == 0     ? "color"
                         : problem.rfind("miscible", 0) == 0  ? "miscible_with"
                                                              : "name";
-      r.fail(Reader::sub(p, key), problem);
+      r.fail(problem.rfind("a World", 0) == 0 ? p : Reader::sub(p, key), problem);
     }
     s.materials.push_back(m);
   }

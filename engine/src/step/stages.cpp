@@ -467,6 +467,8 @@ void stageCollide(StepContext& c) {
   if (c.boundary.colliders.empty()) return;
   // The velocity response is the static solids' impulse on the fluid: m·Δv of each contact,
   // summed per block and the blocks in order (WallImpulse::collision). Δv of two floats in double is exact.
+  const std::vector<Real>* ratioField = P.find(ParticleStore::kRestRatio);  // m_i = r_i m with a density contrast
+  const Real* ratio = ratioField ? ratioField->data() : nullptr;
   const Vec2d dv = c.pool.reduce(
       P.size(), kBlock, Vec2d(0, 0),
       [&](std::size_t b, std::size_t e) {
@@ -475,8 +477,10 @@ void stageCollide(StepContext& c) {
           // Most particles are far from every solid: resolve would find no candidate there.
           if (c.boundary.clearOf(P.x[i], P.xPrev[i], c.clearance)) continue;
           const Vec2 v0 = P.v[i];
-          if (c.boundary.resolve(P.x[i], P.v[i], P.xPrev[i], c.clearance))
-            s += P.v[i].cast<double>() - v0.cast<double>();
+          if (c.boundary.resolve(P.x[i], P.v[i], P.xPrev[i], c.clearance)) {
+            const Vec2d d = P.v[i].cast<double>() - v0.cast<double>();
+            s += ratio ? Vec2d(d * double(ratio[i])) : d;
+          }
         }
         return s;
       },

@@ -61,6 +61,16 @@ void World::Impl::checkMaterial(std::uint32_t m, const char* call) const {
   throw std::invalid_argument(o.str());
 }
 
+void World::Impl::checkSceneMaterial(std::uint32_t m, const std::string& key) const {
+  try {
+    checkMaterial(m, "the scene");
+  } catch (const std::invalid_argument& e) {
+    std::string why = e.what();
+    why.erase(0, std::string("the scene: ").size());
+    throw SceneError(scene.path.empty() ? "scene" : scene.path, 0, 0, key, why);
+  }
+}
+
 void World::Impl::setMaterial(std::size_t from, std::uint32_t m) {
   std::vector<std::uint32_t>* f = P.findU32(ParticleStore::kMaterial);
   if (!f) return;

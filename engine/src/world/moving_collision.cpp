@@ -370,11 +370,12 @@ void World::Impl::collideMoving(StepContext& c, bool atStart) {
   std::vector<double>& L = moving.contactTorque;
   J.assign(bodies.size(), Vec2d(0, 0));
   L.assign(bodies.size(), 0.0);
-  const double m0 = double(c.mass);
+  const std::vector<Real>* ratio = c.P.find(ParticleStore::kRestRatio);  // m_i = r_i m with a density contrast
   for (std::size_t i = 0; i < c.P.size(); ++i) {
     Vec2d r;
     double vn;
     if (moving.hitBody[i] < 0 || !approach(i, r, vn)) continue;
+    const double m0 = ratio ? double(c.mass) * double((*ratio)[i]) : double(c.mass);
     const std::size_t k = std::size_t(moving.hitBody[i]);
     const MovingSolid& m = bodies[k];
     const Vec2d& n = moving.hitNormal[i];

@@ -36,8 +36,8 @@ double uniform(std::uint64_t& state) { return double(splitmix(state) >> 11) * (1
 /// filled, a drop's rows only over its chord). The stop flag is read at every row and every
 /// 4096 lattice points: when it is set the particles this call added are taken back (the
 /// World is as before it) and Interrupted is thrown (empty stage: the caller names it).
-IdRange World::Impl::fillBlock(const FluidBlockDef& b, bool hydrostaticStart) {
-  checkMaterial(b.material, hydrostaticStart ? "fluid[].material" : "addBlock");
+IdRange World::Impl::fillBlock(const FluidBlockDef& b, bool hydrostaticStart, const char* call) {
+  checkMaterial(b.material, call);
   IdRange ids;
   ids.first = nextId;  // every particle below takes the next id: the ones added are consecutive
   const std::size_t before = P.size();

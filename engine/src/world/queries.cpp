@@ -117,10 +117,12 @@ World::FieldSample World::sampleAt(const Vec2d& point) const {
   Vec2d vel(0, 0);
   // The particles within R, summed in slot order (the same sum as a scan of every particle).
   const Vec2d reach(W.R, W.R);
+  const std::vector<Real>* ratio = w.P.find(ParticleStore::kRestRatio);  // m_j = r_j m with a density contrast
   for (const std::size_t i : w.slotsWhere(point - reach, point + reach, [](std::size_t) { return true; })) {
     const double r = (worldPosition(i) - point).norm();
     if (r >= W.R) continue;
-    const double wv = W.value(r) * double(w.mass) / double(w.P.rho[i]);  // V_j W
+    const double mj = ratio ? double(w.mass) * double((*ratio)[i]) : double(w.mass);
+    const double wv = W.value(r) * mj / double(w.P.rho[i]);  // V_j W
     s.weight += wv;
     rho += wv * double(w.P.rho[i]);
     vel += wv * Vec2d(w.P.v[i].x(), w.P.v[i].y());

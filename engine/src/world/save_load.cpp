@@ -430,6 +430,7 @@ void World::load(std::istream& input) {
   }
   for (auto& e : w.P.extraU32)  // integer fields the save lacks: none set at the time of the save
     if (!find(e.first)) e.second.assign(static_cast<std::size_t>(n), 0u);
+  w.fillRestRatio(0);  // from the materials (checked above), not from the file: the same values
   if (savedOwn) {
     w.ownWorld->SetWarmStarting(warmStarting);
     w.ownWorld->SetAllowSleeping(allowSleeping);  // (false wakes every body: before the bodies' own state)

@@ -171,8 +171,11 @@ void World::initPhases(std::string& phase) {
   w.solver = makeSolver(sd);
   w.initMaterials();
   w.effects = makeEffects(scene);
+  for (std::size_t k = 0; k < scene.effects.emitters.size(); ++k)
+    w.checkSceneMaterial(scene.effects.emitters[k].material, "effects.emitters[" + std::to_string(k) + "].material");
+  for (std::size_t k = 0; k < scene.blocks.size(); ++k)
+    w.checkSceneMaterial(scene.blocks[k].material, "fluid[" + std::to_string(k) + "].material");
   for (const EmitterDef& e : scene.effects.emitters) {
-    w.checkMaterial(e.material, "effects.emitters[].material");
     ParticleSources::Emitter st;
     st.def = e;
     st.rng = e.seed;
@@ -321,7 +324,7 @@ void World::setGravity(const Vec2d& g) {
 
 IdRange World::Impl::fillNamed(const FluidBlockDef& b, const char* call) {
   try {
-    return fillBlock(b, false);
+    return fillBlock(b, false, call);
   } catch (const Interrupted&) {
     throw Interrupted(std::string(call) + ": stopped by the stop flag; nothing was added", call);
   }

@@ -83,6 +83,8 @@ struct World::Impl {
   void initMaterials();
   /// Throws std::invalid_argument naming `call` and the materials unless material `m` exists.
   void checkMaterial(std::uint32_t m, const char* call) const;
+  /// The same for a scene built in code: SceneError at `key`.
+  void checkSceneMaterial(std::uint32_t m, const std::string& key) const;
   /// Gives the particles in slots [from, P.size()) material `m` (nothing to do with one material).
   void setMaterial(std::size_t from, std::uint32_t m);
   /// True when two materials differ in rest density (then P holds ParticleStore::kRestRatio).
@@ -211,7 +213,7 @@ struct World::Impl {
   /// depth, at the density the solver holds at rest), keeping the points of its circle
   /// (a drop, addDrop) or polygon. Stops at the particle budget (one warning for the rest).
   /// Returns the ids added (consecutive: each particle takes the next id).
-  IdRange fillBlock(const FluidBlockDef& b, bool hydrostaticStart);
+  IdRange fillBlock(const FluidBlockDef& b, bool hydrostaticStart, const char* call = "addBlock");
   /// Warns once when a weakly compressible solver's sound speed is below 10 × the fastest
   /// speed the scene sets (blocks, emitters, timeline events).
   void warnLowSoundSpeed();

@@ -4,6 +4,7 @@
 // one fluid holding no field for it.
 #include <doctest/doctest.h>
 
+#include <cstring>
 #include <map>
 #include <sstream>
 #include <stdexcept>
@@ -231,6 +232,52 @@ TEST_CASE("materials: a save holds each particle's material and loads only into 
   buf.clear();
   buf.seekg(0);
   CHECK_THROWS_AS(c.load(buf), SaveError);
+}
+
+TEST_CASE("materials: a save whose particle names a material the World lacks is refused, and nothing changes") {
+  const SceneDef s = test::scene("tests/two_materials.json");
+  World a(s);
+  a.stepFrame();
+  std::stringstream buf;
+  a.save(buf);
+  std::string bytes = buf.str();
+  // The field "material": its name (u64 length, bytes), element size (u32), byte count (u64),
+  // then the values: the first particle's material becomes 7 (the World has 2).
+  const std::string name = std::string("\x08\0\0\0\0\0\0\0", 8) + "material";
+  const std::size_t at = bytes.find(name);
+  REQUIRE(at != std::string::npos);
+  const std::size_t value = at + name.size() + 4 + 8;
+  REQUIRE(value + 4 <= bytes.size());
+  const std::uint32_t seven = 7;
+  std::memcpy(&bytes[value], &seven, 4);
+  World b(s);
+  const std::uint64_t before = b.stateHash();
+  std::istringstream in(bytes);
+  CHECK_THROWS_WITH_AS(b.load(in), doctest::Contains("material 7"), SaveError);
+  CHECK(b.stateHash() == before);
+}
+
+TEST_CASE("materials: a material added at run time gives the particles what the scene's table gives them") {
+  // wcsph with oil (800): the rest ratio a particle carries, whether the table named oil or a
+  // game added it before adding the oil, is the same, and so is every bit of 20 frames.
+  SceneDef base = test::tank("wcsph", 1.0, 1.0, 0.04);
+  base.blocks.push_back(test::block({0, 0}, {1.0, 0.4}));
+  MaterialDef water;
+  water.name = "water";
+  water.density = base.solver.restDensity;
+  MaterialDef oil = water;
+  oil.name = "oil";
+  oil.density = 800;
+  SceneDef table = base;
+  table.materials = {water, oil};
+  World a(table), b(base);
+  CHECK(b.addMaterial(oil) == 1);
+  const IdRange da = a.addDrop(Vec2d(0.5, 0.7), 0.1, Vec2d(0, 0), 1),
+                db = b.addDrop(Vec2d(0.5, 0.7), 0.1, Vec2d(0, 0), 1);
+  REQUIRE(da.size() == db.size());
+  for (int f = 0; f < 20; ++f) a.stepFrame(), b.stepFrame();
+  CHECK(a.stateHash() == b.stateHash());
+  CHECK(a.kineticEnergy() == b.kineticEnergy());
 }
 
 TEST_CASE("materials: the state hash counts each particle's material, and only with more than one") {

@@ -212,7 +212,7 @@ inline const Real* agesOf(const RenderInput& in) {
   const Particles& P = in.particles;
   return P.age.size() == P.size() && P.size() > 0 ? P.age.data() : nullptr;
 }
-/// The colours of `world`'s materials as 0xRRGGBB, by index; empty for a World of one material.
+/// The colours of `world`'s materials as 0xRRGGBB, by index (one for a World of one material).
 std::vector<std::uint32_t> materialColors(const World& world);
 
 /// The camera of `def` for a RenderInput (same rules as above).
