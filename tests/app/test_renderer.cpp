@@ -443,6 +443,56 @@ TEST_CASE("liquid mode: each material in its own colour, and without materials n
   CHECK(hue(fp, true).first == 0);
 }
 
+TEST_CASE("both modes draw mixed particles in their mixed colour") {
+  // blockScene's block in zero gravity: its left half red, its right half blue, miscible at a
+  // diffusion fast enough to mix it through in a second.
+  SceneDef s = blockScene(160, 120, Vec2d(-0.1, -0.1), Vec2d(0.3, 0.3));
+  s.gravity = Vec2d(0, 0);
+  MaterialDef red;
+  red.name = "red";
+  red.density = s.solver.restDensity;
+  red.color = {1, 0, 0};
+  red.diffusion = 0.05;
+  MaterialDef blue = red;
+  blue.name = "blue";
+  blue.color = {0, 0, 1};
+  blue.miscibleWith = {"red"};
+  s.materials = {red, blue};
+  FluidBlockDef right = s.blocks[0];
+  s.blocks[0].max.x() = 0.1;
+  right.min.x() = 0.1;
+  right.material = 1;
+  s.blocks.push_back(right);
+  auto count = [](const Frame& f) {  // pure red, pure blue, purple pixels
+    std::array<std::size_t, 3> n{0, 0, 0};
+    for (std::size_t k = 0; k + 3 < f.rgba.size(); k += 4) {
+      const int R = f.rgba[k], G = f.rgba[k + 1], B = f.rgba[k + 2];
+      if (G > 60) continue;
+      n[0] += R > 100 && B < 40;
+      n[1] += B > 100 && R < 40;
+      n[2] += R > 50 && B > 50;
+    }
+    return n;
+  };
+  for (const char* mode : {"particles", "liquid"}) {
+    RenderOptions o;
+    o.mode = mode;
+    o.colorBy = ColorField::Material;
+    Renderer r(s.render, o);
+    World w(s, WorldOptions{1});
+    const std::array<std::size_t, 3> before = count(r.render(w));
+    for (int f = 0; f < 60; ++f) w.stepFrame();
+    const std::array<std::size_t, 3> after = count(r.render(w));
+    MESSAGE(std::string(mode) << ": red, blue, purple pixels " << before[0] << ", " << before[1] << ", " << before[2]
+                              << " -> " << after[0] << ", " << after[1] << ", " << after[2]);
+    CHECK(before[0] > 200);
+    CHECK(before[1] > 200);
+    CHECK(after[0] < before[0] / 10);
+    CHECK(after[1] < before[1] / 10);
+    CHECK(after[2] > before[0]);
+  }
+}
+
 TEST_CASE("the overlay changes only the pixels of its box in the top-left corner") {
   const SceneDef s = blockScene(320, 240, Vec2d(-0.1, -0.1), Vec2d(0.3, 0.3));
   World world(s, WorldOptions{1});

@@ -74,6 +74,9 @@ struct Particles {
   /// optional: each particle's material, an index in World::materials() (a World of one
   /// material has none: every particle is of material 0)
   ArrayView<std::uint32_t> material;
+  /// optional: with miscible materials, each particle's colour from its concentrations
+  /// (0xRRGGBB, the materials' colours weighted), what the renderer draws it in
+  ArrayView<std::uint32_t> mixedColor;
 
   /// Number of particles.
   std::size_t size() const { return x.size(); }
@@ -82,16 +85,17 @@ struct Particles {
 /// Particles a program owns: copies of a World's arrays taken between frames (to draw on
 /// another thread), or particles read from a file. view() shows them as Particles.
 struct ParticleBuffer {
-  std::vector<Vec2> x;                  ///< position, in the local frame of the World they came from [m]
-  std::vector<Vec2> v;                  ///< velocity [m/s]
-  std::vector<Real> rho;                ///< density [kg/m³]
-  std::vector<Real> p;                  ///< pressure [Pa]
-  std::vector<std::uint32_t> id;        ///< stable identifier
-  std::vector<Real> age;                ///< optional (empty or one per particle)
-  std::vector<std::uint32_t> color;     ///< optional (empty or one per particle)
-  std::vector<std::uint32_t> userData;  ///< optional (empty or one per particle)
-  std::vector<std::uint32_t> emitter;   ///< optional (empty or one per particle)
-  std::vector<std::uint32_t> material;  ///< optional (empty or one per particle)
+  std::vector<Vec2> x;                    ///< position, in the local frame of the World they came from [m]
+  std::vector<Vec2> v;                    ///< velocity [m/s]
+  std::vector<Real> rho;                  ///< density [kg/m³]
+  std::vector<Real> p;                    ///< pressure [Pa]
+  std::vector<std::uint32_t> id;          ///< stable identifier
+  std::vector<Real> age;                  ///< optional (empty or one per particle)
+  std::vector<std::uint32_t> color;       ///< optional (empty or one per particle)
+  std::vector<std::uint32_t> userData;    ///< optional (empty or one per particle)
+  std::vector<std::uint32_t> emitter;     ///< optional (empty or one per particle)
+  std::vector<std::uint32_t> material;    ///< optional (empty or one per particle)
+  std::vector<std::uint32_t> mixedColor;  ///< optional (empty or one per particle)
 
   /// Number of particles.
   std::size_t size() const { return x.size(); }
@@ -107,6 +111,7 @@ struct ParticleBuffer {
     if (!userData.empty()) userData.push_back(0);
     if (!emitter.empty()) emitter.push_back(0);
     if (!material.empty()) material.push_back(0);
+    if (!mixedColor.empty()) mixedColor.push_back(0);
   }
   /// Replaces the contents with copies of every array of `view` (capacity is kept, so a
   /// buffer reused frame after frame stops allocating).
@@ -121,6 +126,7 @@ struct ParticleBuffer {
     copy(view.userData, userData);
     copy(view.emitter, emitter);
     copy(view.material, material);
+    copy(view.mixedColor, mixedColor);
   }
   /// The buffer as Particles (valid until the buffer changes).
   Particles view() const& {
@@ -135,6 +141,7 @@ struct ParticleBuffer {
     P.userData = userData;
     P.emitter = emitter;
     P.material = material;
+    P.mixedColor = mixedColor;
     return P;
   }
   /// Not of a temporary buffer: the views would outlive their values.

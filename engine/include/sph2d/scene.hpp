@@ -140,8 +140,9 @@ struct MaterialDef {
   double viscosity = -1;                          ///< kinematic ν [m²/s]; < 0: the solver's (solver.viscosity)
   std::array<double, 3> color{0.10, 0.45, 0.85};  ///< drawn colour, linear RGB in 0..1
   std::vector<std::string> miscibleWith;          ///< the materials it mixes with, by name
+  double diffusion = 1e-3;  ///< D [m²/s] of dc/dt = D∇²c with a material it mixes with (the pair's mean)
   // The ranges a scene's `materials[]` and World::addMaterial accept.
-  static constexpr double kMinDensity = 1, kMaxDensity = 1e5, kMaxViscosity = 1e3;
+  static constexpr double kMinDensity = 1, kMaxDensity = 1e5, kMaxViscosity = 1e3, kMaxDiffusion = 1;
   static constexpr std::size_t kMaxMaterials = 256, kMaxName = 64;
 };
 

@@ -494,6 +494,11 @@ class World {
   std::uint32_t materialIndex(const std::string& name) const;  ///< the index of `name`, or kNoMaterial
   /// The material of particle `id` (kNoMaterial when no particle has it); bulk: particles().material.
   std::uint32_t materialOf(std::uint32_t id) const;
+  /// Particle `id`'s concentration of `material` (with mixing; else 1 for its own, 0 for others;
+  /// NaN when no particle has the id). Its colour from them: particles().mixedColor.
+  double concentrationOf(std::uint32_t id, std::uint32_t material) const;
+  /// Σ over the particles of their concentration of `material` (in double, in slot order).
+  double totalConcentration(std::uint32_t material) const;
   /// Removes emitter `index` (its particles stay); the emitters after it move down one index.
   /// Throws std::out_of_range.
   void removeEmitter(std::size_t index);

@@ -87,13 +87,14 @@ class LiquidPass final : public RenderPass {
     const std::vector<std::uint32_t>& colors = f.in.materialColors;
     tinted_ = !colors.empty() && P.material.size() == P.size();
     if (tinted_) {
+      const std::uint32_t* mixed = P.mixedColor.size() == P.size() ? P.mixedColor.data() : nullptr;  // mixing
       packedTint_.resize(n * 4);
       for (std::size_t k = 0; k < n; ++k) {
         const std::size_t i = f.order[k];
         const std::uint32_t m = P.material[i];
         packedTint_[4 * k] = P.x[i].x();
         packedTint_[4 * k + 1] = P.x[i].y();
-        packedTint_[4 * k + 2] = float(m < colors.size() ? colors[m] & 0xFFFFFFu : 0u);
+        packedTint_[4 * k + 2] = float(mixed ? mixed[i] & 0xFFFFFFu : m < colors.size() ? colors[m] & 0xFFFFFFu : 0u);
         packedTint_[4 * k + 3] = f.weight[k];
       }
     }

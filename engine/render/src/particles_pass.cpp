@@ -43,6 +43,8 @@ class ParticlesPass final : public RenderPass {
           opt_.colorBy == ColorField::Color && P.color.size() == P.size() ? P.color.data() : nullptr;
       const std::uint32_t* mat = P.material.size() == P.size() ? P.material.data() : nullptr;
       const std::vector<std::uint32_t>& matColor = in.materialColors;
+      // With mixing, each particle's colour from its concentrations.
+      const std::uint32_t* mixed = P.mixedColor.size() == P.size() ? P.mixedColor.data() : nullptr;
       // Colour by material without a material per particle (one material): that material's colour.
       const std::uint32_t none =
           opt_.colorBy == ColorField::Material && !mat && !matColor.empty() ? matColor[0] & 0xFFFFFFu : kFluidColor;
@@ -50,6 +52,7 @@ class ParticlesPass final : public RenderPass {
       for (std::size_t k = 0; k < n; ++k) {
         const std::size_t i = f.order[k];
         const std::uint32_t c = own && own[i] != 0                ? own[i] & 0xFFFFFFu
+                                : mixed                           ? mixed[i] & 0xFFFFFFu
                                 : mat && mat[i] < matColor.size() ? matColor[mat[i]] & 0xFFFFFFu
                                                                   : none;
         packed_[4 * k] = P.x[i].x();

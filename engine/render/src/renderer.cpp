@@ -183,6 +183,7 @@ struct Renderer::Impl {
     need("age", P.age.size(), true);
     need("color", P.color.size(), true);
     need("material", P.material.size(), true);
+    need("mixedColor", P.mixedColor.size(), true);
   }
 
   float fade(const RenderInput& in, std::size_t slot) const {

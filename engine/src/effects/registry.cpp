@@ -2,6 +2,7 @@
 #include <stdexcept>
 
 #include "effects/effect.hpp"
+#include "particles/material_fields.hpp"
 
 namespace sph2d {
 
@@ -24,6 +25,7 @@ EffectList makeEffects(const SceneDef& scene) {
   if (!e.forceFields.empty()) noModules("effects.force_fields");
   if (e.surfaceTension) noModules("effects.surface_tension");
   if (e.shifting) noModules("effects.shifting");
+  if (anyMiscible(sceneMaterials(scene))) noModules("mixing (materials[].miscible_with)");
   return {};
 }
 

@@ -54,6 +54,8 @@ std::string materialProblem(const std::vector<MaterialDef>& materials, const Mat
   else if (!(m.viscosity <= MaterialDef::kMaxViscosity) || (m.viscosity < 0 && m.viscosity != -1))
     o << "viscosity must be in 0.." << MaterialDef::kMaxViscosity << " m²/s (or absent: the solver's), got "
       << m.viscosity;
+  if (o.tellp() == 0 && !(m.diffusion >= 0 && m.diffusion <= MaterialDef::kMaxDiffusion))
+    o << "diffusion must be in 0.." << MaterialDef::kMaxDiffusion << " m²/s, got " << m.diffusion;
   for (double c : m.color)
     if (o.tellp() == 0 && !(c >= 0 && c <= 1)) o << "color components must be in 0..1, got " << c;
   if (o.tellp() != 0) return o.str();
@@ -90,7 +92,7 @@ void readMaterials(const Reader& r, const nlohmann::json& root, SceneDef& s) {
     const std::string p = "materials[" + std::to_string(k) + "]";
     const nlohmann::json& j = arr[k];
     r.requireObject(j, p);
-    r.checkKeys(j, p, {"name", "density", "viscosity", "color", "miscible_with"});
+    r.checkKeys(j, p, {"name", "density", "viscosity", "color", "miscible_with", "diffusion"});
     MaterialDef m;
     if (!j.contains("name")) r.fail(Reader::sub(p, "name"), "missing; expected the material's name");
     m.name = r.string(j, p, "name", "", {});
@@ -101,6 +103,7 @@ void readMaterials(const Reader& r, const nlohmann::json& root, SceneDef& s) {
                          MaterialDef::kMaxDensity);
     if (j.contains("viscosity")) m.viscosity = r.number(j, p, "viscosity", 0, 0, MaterialDef::kMaxViscosity);
     m.color = r.color(j, p, "color", s.render.water);
+    m.diffusion = r.number(j, p, "diffusion", m.diffusion, 0, MaterialDef::kMaxDiffusion);
     if (j.contains("miscible_with")) {
       const nlohmann::json& mw = j.at("miscible_with");
       const std::string q = Reader::sub(p, "miscible_with");
@@ -130,6 +133,7 @@ void readMaterials(const Reader& r, const nlohmann::json& root, SceneDef& s) {
       const char* key = problem.rfind("density", 0) == 0     ? "density"
                         : problem.rfind("viscosity", 0) == 0 ? "viscosity"
                         : problem.rfind("color", 0) == 0     ? "color"
+                        : problem.rfind("diffusion", 0) == 0 ? "diffusion"
                         : problem.rfind("miscible", 0) == 0  ? "miscible_with"
                                                              : "name";
       r.fail(problem.rfind("a World", 0) == 0 ? p : Reader::sub(p, key), problem);

@@ -221,6 +221,7 @@ void permuteField(std::vector<T>& field, const std::vector<std::uint32_t>& order
 std::vector<Vec2>& scratchFor(Scratch& s, const std::vector<Vec2>&) { return s.v; }
 std::vector<Real>& scratchFor(Scratch& s, const std::vector<Real>&) { return s.r; }
 std::vector<std::uint32_t>& scratchFor(Scratch& s, const std::vector<std::uint32_t>&) { return s.u; }
+std::vector<double>& scratchFor(Scratch& s, const std::vector<double>&) { return s.d; }
 
 }  // namespace
 

@@ -67,6 +67,7 @@ struct Scratch {
   std::vector<Vec2> v;
   std::vector<Real> r;
   std::vector<std::uint32_t> u;
+  std::vector<double> d;  ///< the double fields' (ParticleStore::extraD: the mixing's concentrations)
 };
 
 /// World::wallImpulse()'s accumulator. Stages that change particle velocities because of the

@@ -2,9 +2,11 @@
 // or the solver's one fluid, those a game adds, and each particle's material. The
 // per-particle field ("material", ParticleStore::kMaterial) exists only while the World
 // holds more than one material: a World of one fluid allocates nothing for materials.
+#include <limits>
 #include <sstream>
 #include <stdexcept>
 
+#include "particles/material_fields.hpp"
 #include "world/world_impl.hpp"
 
 namespace sph2d {
@@ -31,6 +33,10 @@ void World::Impl::initMaterials() {
     materials.push_back(all[k]);
   }
   if (materials.size() > 1) P.fieldU32(ParticleStore::kMaterial);
+  if (anyMiscible(materials)) {  // the mixing effect's fields: every particle's concentrations and colour
+    for (std::size_t k = 0; k < materials.size(); ++k) P.fieldD(ParticleStore::concentration(k));
+    P.fieldU32(ParticleStore::kMixedColor);
+  }
   if (densityContrast()) {
     const std::string problem = densityContrastProblem(scene);
     if (!problem.empty()) throw SceneError(file, 0, 0, "effects", problem);
@@ -76,13 +82,28 @@ void World::Impl::setMaterial(std::size_t from, std::uint32_t m) {
   if (!f) return;
   if (m != 0)  // the field starts at 0, the first material
     for (std::size_t i = from; i < f->size(); ++i) (*f)[i] = m;
+  initMaterialFields(from);
+}
+
+void World::Impl::initMaterialFields(std::size_t from) {
   fillRestRatio(from);  // a new particle's ratio starts at 0
+  const std::vector<std::uint32_t>* material = P.findU32(ParticleStore::kMaterial);
+  if (!material || !P.findD(ParticleStore::concentration(0))) return;
+  for (std::size_t k = 0; k < materials.size(); ++k) {  // all of its own material
+    std::vector<double>& c = *P.findD(ParticleStore::concentration(k));
+    for (std::size_t i = from; i < c.size(); ++i) c[i] = (*material)[i] == k ? 1.0 : 0.0;
+  }
+  deriveFromConcentrations(P, materials, from);
 }
 
 std::uint32_t World::addMaterial(const MaterialDef& m) {
   Impl& w = *impl_;
   const std::string problem = materialProblem(w.materials, m, w.scene.solver);
   if (!problem.empty()) throw std::invalid_argument("addMaterial: " + problem);
+  if (w.P.findD(ParticleStore::concentration(0)) || !m.miscibleWith.empty())
+    throw std::invalid_argument(
+        "addMaterial: mixing (miscible_with) is set up from the scene's materials table when the World is built: a "
+        "World that mixes takes no more materials, and one added at run time mixes with none");
   if (m.density != w.materials.front().density) {
     const std::string effects = densityContrastProblem(w.scene);
     if (!effects.empty()) throw std::invalid_argument("addMaterial: " + effects);
@@ -113,6 +134,25 @@ std::uint32_t World::materialOf(std::uint32_t id) const {
   if (i == npos) return kNoMaterial;
   const std::vector<std::uint32_t>* f = impl_->P.findU32(ParticleStore::kMaterial);
   return f ? (*f)[i] : 0u;
+}
+
+double World::concentrationOf(std::uint32_t id, std::uint32_t material) const {
+  const std::size_t i = slotOf(id);
+  if (i == npos) return std::numeric_limits<double>::quiet_NaN();
+  if (const std::vector<double>* c = impl_->P.findD(ParticleStore::concentration(material))) return (*c)[i];
+  return materialOf(id) == material ? 1.0 : 0.0;
+}
+
+double World::totalConcentration(std::uint32_t material) const {
+  const ParticleStore& P = impl_->P;
+  double sum = 0;
+  if (const std::vector<double>* c = P.findD(ParticleStore::concentration(material))) {
+    for (const double v : *c) sum += v;
+    return sum;
+  }
+  const std::vector<std::uint32_t>* m = P.findU32(ParticleStore::kMaterial);
+  for (std::size_t i = 0; i < P.size(); ++i) sum += (m ? (*m)[i] : 0u) == material ? 1.0 : 0.0;
+  return sum;
 }
 
 }  // namespace sph2d

@@ -201,7 +201,6 @@ void World::Impl::emit(Real dt) {
   // a deque: removeOldest below compacts it, and the pointer stays good.)
   std::vector<std::uint32_t>* tag = P.findU32(ParticleStore::kEmitter);
   std::vector<std::uint32_t>* material = P.findU32(ParticleStore::kMaterial);  // with more than one
-  std::vector<Real>* ratio = P.find(ParticleStore::kRestRatio);                // with a density contrast
   for (std::size_t e = 0; e < sources.emitters.size(); ++e) {
     ParticleSources::Emitter& s = sources.emitters[e];
     const EmitterDef& d = s.def;
@@ -266,8 +265,10 @@ void World::Impl::emit(Real dt) {
       P.push(Vec2(Real(pw.x() - origin.x()), Real(pw.y() - origin.y())), Vec2(Real(vel.x()), Real(vel.y())), nextId++,
              rho0);
       if (tag) tag->back() = std::uint32_t(e + 1);
-      if (material) material->back() = d.material;
-      if (ratio) ratio->back() = Real(materials[d.material].density / materials.front().density);
+      if (material) {
+        material->back() = d.material;
+        initMaterialFields(P.size() - 1);
+      }
     }
   }
 }

@@ -140,6 +140,9 @@ std::uint64_t World::stateHash() const {
   for (std::size_t i = 0; i < P.size(); ++i) slotOf[P.id[i]] = std::uint32_t(i);
   // With more than one material, each particle's too (a World of one hashes as before materials).
   const std::vector<std::uint32_t>* material = P.findU32(ParticleStore::kMaterial);
+  std::vector<const std::vector<double>*> conc;  // with mixing, the concentrations too
+  for (std::size_t k = 0; P.findD(ParticleStore::concentration(k)); ++k)
+    conc.push_back(P.findD(ParticleStore::concentration(k)));
   Xxh64 h;
   h.update(impl_->origin.data(), sizeof(double) * 2);
   for (std::uint32_t id = 0; id < impl_->nextId; ++id) {
@@ -149,6 +152,7 @@ std::uint64_t World::stateHash() const {
     h.update(P.x[s].data(), sizeof(Real) * 2);
     h.update(P.v[s].data(), sizeof(Real) * 2);
     if (material) h.update(&(*material)[s], sizeof(std::uint32_t));
+    for (const std::vector<double>* c : conc) h.update(&(*c)[s], sizeof(double));
   }
   return h.digest();
 }

@@ -31,6 +31,7 @@
 #include <box2d/box2d.h>
 
 #include "core/state_io.hpp"
+#include "particles/material_fields.hpp"
 #include "sph2d/hash.hpp"
 #include "world/world_impl.hpp"
 
@@ -342,6 +343,15 @@ void World::load(std::istream& input) {
   std::sort(ids.begin(), ids.end());
   if (std::adjacent_find(ids.begin(), ids.end()) != ids.end() || (!ids.empty() && ids.back() >= nextId))
     throw SaveError("the saved state is malformed: particle ids repeat or reach the next id");
+  for (std::size_t k = 0; k < w.materials.size(); ++k)  // with mixing: concentrations, each in 0..1
+    if (const Field* cf = find(ParticleStore::concentration(k))) {
+      std::vector<double> c(static_cast<std::size_t>(n));
+      if (n && cf->element == sizeof(double)) std::memcpy(c.data(), cf->data.data(), c.size() * sizeof(double));
+      for (const double v : c)
+        if (!(v >= -1e-3 && v <= 1.001))
+          throw SaveError("the saved state is malformed: a concentration of " + std::to_string(v) + " (field " +
+                          ParticleStore::concentration(k) + ")");
+    }
   if (const Field* mf = find(ParticleStore::kMaterial)) {
     if (w.materials.size() < 2)
       throw SaveError("the saved state is malformed: it holds each particle's material, and the World has one");
@@ -430,7 +440,8 @@ void World::load(std::istream& input) {
   }
   for (auto& e : w.P.extraU32)  // integer fields the save lacks: none set at the time of the save
     if (!find(e.first)) e.second.assign(static_cast<std::size_t>(n), 0u);
-  w.fillRestRatio(0);  // from the materials (checked above), not from the file: the same values
+  w.fillRestRatio(0);                             // from the materials (checked above), not the file
+  deriveFromConcentrations(w.P, w.materials, 0);  // with mixing: from the concentrations (checked above)
   if (savedOwn) {
     w.ownWorld->SetWarmStarting(warmStarting);
     w.ownWorld->SetAllowSleeping(allowSleeping);  // (false wakes every body: before the bodies' own state)

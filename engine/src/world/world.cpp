@@ -414,6 +414,7 @@ Particles viewOf(const ParticleStore& S) {
   V.userData = opt(S.findU32(ParticleStore::kUserData));
   V.emitter = opt(S.findU32(ParticleStore::kEmitter));
   V.material = opt(S.findU32(ParticleStore::kMaterial));
+  V.mixedColor = opt(S.findU32(ParticleStore::kMixedColor));
   return V;
 }
 
@@ -424,7 +425,8 @@ bool World::Impl::viewCurrent() const {
   auto same = [](const auto& a, const auto& b) { return a.data() == b.data() && a.size() == b.size(); };
   return same(view.x, now.x) && same(view.v, now.v) && same(view.rho, now.rho) && same(view.p, now.p) &&
          same(view.id, now.id) && same(view.age, now.age) && same(view.color, now.color) &&
-         same(view.userData, now.userData) && same(view.emitter, now.emitter) && same(view.material, now.material);
+         same(view.userData, now.userData) && same(view.emitter, now.emitter) && same(view.material, now.material) &&
+         same(view.mixedColor, now.mixedColor);
 }
 
 void World::Impl::refreshView() const { view = viewOf(P); }

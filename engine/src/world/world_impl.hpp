@@ -92,6 +92,9 @@ struct World::Impl {
   /// Writes each particle's ρ0 over the first material's into the rest-ratio field, from slot
   /// `from` on (nothing without the field).
   void fillRestRatio(std::size_t from);
+  /// A new particle's fields that follow its material (slots ≥ `from`): the rest ratio, and with
+  /// mixing all of its own material and that material's colour.
+  void initMaterialFields(std::size_t from);
 
   // The subsystems.
   ParticleSources sources;  ///< emitters, the budget, removals

@@ -154,7 +154,9 @@ TEST_CASE("materials: addMaterial follows the scene's rule, and the field appear
   oil.viscosity = -1;
   oil.miscibleWith = {"honey"};
   CHECK_THROWS_WITH_AS(w.addMaterial(oil), doctest::Contains("\"honey\""), std::invalid_argument);
-  oil.miscibleWith = {"dye"};
+  oil.miscibleWith = {"dye"};  // mixing is set up from the scene's table
+  CHECK_THROWS_WITH_AS(w.addMaterial(oil), doctest::Contains("mixes with none"), std::invalid_argument);
+  oil.miscibleWith.clear();
   CHECK(w.addMaterial(oil) == 2);
 }
 
