@@ -12,7 +12,8 @@
 // particle's colour ("mixed_color", drawn by the renderer) is Σ_k c_k colour_k, and with a
 // density contrast its rest ratio Σ_k c_k ρ0_k / ρ0: density follows concentration. Colour
 // mixing (LiquidFun's colorMixing) is the case of materials of one density.
-// Time-step limit: 0.03 R²/D (explicit diffusion, as the viscosity's).
+// Time-step limit: 0.03 R²/D (explicit diffusion, as the viscosity's), and each pair's share
+// capped at 1/8 a substep (symmetric: the totals still hold).
 #include <algorithm>
 #include <cmath>
 
@@ -57,6 +58,10 @@ class Mixing final : public Effect {
     next_.resize(K * n);
     const ViscosityKernel<Real> W(c.R);
     const Real k0 = c.dt * scale_ * c.mass / c.rho0;  // dt V / m₂
+    // Each pair moves at most an eighth of its difference per substep (the viscosity's
+    // kViscousPairShare, for the same reason: ∇²W grows as 1/r³, and a pair pressed together
+    // would overshoot). Lattice pairs at the time-step limit take at most 0.061: not reached.
+    const double cap = kViscousPairShare / double(k0);
     const Vec2* X = P.x.data();
     const std::uint32_t* M = mat->data();
     const std::size_t bad = firstBad(c.pool, n, [&](std::size_t b, std::size_t e) {
@@ -72,7 +77,7 @@ class Mixing final : public Effect {
           if (D <= 0) continue;  // immiscible (or no diffusion)
           Real dx = X[i].x() - X[j].x(), dy = X[i].y() - X[j].y();
           c.periodic.nearest(dx, dy);
-          const double w = double(D * W.laplacianR2(dx * dx + dy * dy));
+          const double w = std::min(double(D * W.laplacianR2(dx * dx + dy * dy)), cap);
           for (std::size_t k = 0; k < K; ++k) sum[k] += w * (conc[k][j] - conc[k][i]);
         }
         for (std::size_t k = 0; k < K; ++k) {
