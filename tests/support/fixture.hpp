@@ -9,7 +9,7 @@
 // momentum, velocityVariance, layerVelocityDifference, centroid,
 // minPairDistance(Periodic), inertiaAspect, cornerRatio, surfaceHeight,
 // PressureProbe (fitLine). Flows:
-// wallScene, periodicShearLayer, freeMovingBlock (momentumOver). Floating bodies:
+// wallScene, periodicShearLayer (shearLayerDecay), freeMovingBlock (momentumOver). Floating bodies:
 // crateScene, dynamicBody, crateSurface, bottomOf, insideMovingCount.
 #pragma once
 
@@ -232,6 +232,15 @@ inline double velocityVariance(const World& w) {
   for (std::size_t i = 0; i < w.particleCount(); ++i)
     s += (Vec2d(w.particles().v[i].x(), w.particles().v[i].y()) - mean).squaredNorm();
   return s / double(w.particleCount());
+}
+
+/// Δ(t)/Δ(0) for a shear layer ±U in a periodic box of side L = 2π/k (periodicShearLayer): u(y, 0)
+/// is a square wave, u = (4U/π) Σ_{n odd} sin(nky)/n, each mode decays as e^{−ν n²k² t}, and the
+/// halves' mean velocities differ by (16U/π²) Σ_{n odd} e^{−ν n²k² t}/n².
+inline double shearLayerDecay(double nu, double k, double t) {
+  double s = 0;
+  for (int n = 1; n < 400; n += 2) s += std::exp(-nu * n * n * k * k * t) / (n * n);
+  return 8 / (kPi * kPi) * s;
 }
 
 /// Mean x velocity of the particles with id ≥ firstId minus that of those below it

@@ -146,6 +146,9 @@ struct MaterialDef {
   static constexpr std::size_t kMaxMaterials = 256, kMaxName = 64;
 };
 
+/// The kinematic viscosity material `m` has in a World of `solver` (its own, or solver.viscosity).
+double viscosityOf(const MaterialDef& m, const SolverDef& solver);
+
 /// True when solver `type` takes materials of different rest density in one pressure solve.
 bool takesDensityContrast(const std::string& type);
 
@@ -159,9 +162,8 @@ std::vector<MaterialDef> sceneMaterials(const SceneDef& scene);
 
 /// Why `m` cannot join `materials` in a World of `solver` ("" when it can): a name that is
 /// empty, too long or already taken, a density or viscosity out of range, a miscible_with
-/// naming no material, or a density or viscosity the solver cannot take beside the first
-/// material's (only wcsph takes a density contrast, no solver a viscosity per material:
-/// docs/SCENES.md).
+/// naming no material, or a density the solver cannot take beside the first material's (only
+/// wcsph takes a density contrast: docs/SCENES.md).
 std::string materialProblem(const std::vector<MaterialDef>& materials, const MaterialDef& m, const SolverDef& solver);
 
 /// An axis-aligned box region.

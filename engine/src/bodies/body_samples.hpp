@@ -95,6 +95,12 @@ struct BodySamples {
     }
   }
 
+  /// The velocity of sample s's body at x (the body turning at ω): v_s + ω × (x − x_s).
+  Vec2d velocityAt(std::uint32_t s, double omega, const Vec2& at) const {
+    const Vec2 d = at - x[s];
+    return v[s].cast<double>() + Vec2d(-double(d.y()), double(d.x())) * omega;
+  }
+
   /// The torque arm × f about a body's centre of mass (2D cross product).
   static Real torque(const Vec2& arm, const Vec2& f) { return arm.x() * f.y() - arm.y() * f.x(); }
 

@@ -55,6 +55,8 @@ class Effect {
   /// True for the Laplacian viscosity, which an explicit solver may fold into its
   /// pressure-force pair loop (stepper.cpp; the effect then runs no stage of its own).
   virtual bool foldable() const { return false; }
+  /// True while the solver computes this effect in its own pair loop (set by the World).
+  bool folded = false;
   /// The constants of a foldable effect for this substep (others: never called).
   virtual ViscosityTerm viscosityTerm(const StepContext& c) {
     (void)c;

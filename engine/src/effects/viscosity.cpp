@@ -25,24 +25,53 @@
 // body takes minus the force they exert (its viscous drag, Akinci et al. 2012).
 // Without no_slip (the default) walls are free-slip and only the collision stage's
 // Coulomb friction acts on the fluid at the wall.
+//
+// Materials (docs/SCENES.md, "materials"): each has its own ν (absent: solver.viscosity). With
+// materials of different viscosity a pair takes the mean of the two dynamic viscosities
+// (μ_k = ν_k ρ0_k; the wall terms the particle's own), and ν above is the largest.
+//
+// Explicit or implicit, substep by substep: the effect does not limit the substep. A substep
+// no longer than the explicit limit 0.03 R²/ν runs the explicit step above; a longer one (honey,
+// ν of 0.01 m²/s and more, at the solver's own step) runs backward Euler on the same Laplacian
+// (viscosity_implicit.hpp), so a stiff material never shortens the substep. The one exception:
+// muller2003 computes a single viscosity inside its pressure loop (Solver::foldViscosity), and
+// then the explicit limit holds.
 #include <algorithm>
 #include <cmath>
 
 #include "bodies/body_samples.hpp"
 #include "effects/effect.hpp"
+#include "effects/viscosity_implicit.hpp"
 
 namespace sph2d {
 namespace {
 
 class LaplacianViscosity final : public Effect {
  public:
-  LaplacianViscosity(double nu, bool noSlip) : nu_(Real(nu)), noSlip_(noSlip) {}
+  LaplacianViscosity(const std::vector<MaterialDef>& materials, const SolverDef& solver)
+      : nu_(Real(viscosityOf(materials.front(), solver))), noSlip_(solver.noSlip) {
+    for (const MaterialDef& m : materials) {
+      nu_ = std::max(nu_, Real(viscosityOf(m, solver)));
+      uniform_ = uniform_ && viscosityOf(m, solver) == viscosityOf(materials.front(), solver);
+    }
+  }
   const char* name() const override { return "viscosity"; }
   const char* limitKey() const override { return "solver.viscosity"; }
 
-  Real maxTimeStep(const StepContext& c) const override { return Real(0.03) * c.R * c.R / nu_; }
+  /// Explicit step limit, at the largest viscosity (a material added at run time may exceed
+  /// the scene's); the effect holds the substep to it only when folded (see the top).
+  Real explicitLimit(const StepContext& c) const {
+    Real nu = nu_;
+    if (c.materials)
+      for (const MaterialDef& m : *c.materials) nu = std::max(nu, Real(viscosityOf(m, c.def)));
+    return Real(0.03) * c.R * c.R / nu;
+  }
+  Real maxTimeStep(const StepContext& c) const override {
+    return folded ? explicitLimit(c) : std::numeric_limits<Real>::infinity();
+  }
 
-  bool foldable() const override { return true; }
+  /// One viscosity for every particle: a solver may compute it in its own pair loop.
+  bool foldable() const override { return uniform_; }
 
   ViscosityTerm viscosityTerm(const StepContext& c) override {
     if (c.R != momentR_ || c.dx != momentDx_) {
@@ -66,24 +95,66 @@ class LaplacianViscosity final : public Effect {
   std::size_t apply(StepContext& c) override {
     ParticleStore& P = c.P;
     const ViscosityTerm t = viscosityTerm(c);
+    const ViscosityWeights wt = weights(c);
+    const bool count = t.walls && c.wall;
+    const std::size_t blocks = (P.size() + kBlock - 1) / kBlock;
+    if (count) wallBlock_.assign(blocks, Vec2d(0, 0));
+    std::size_t first;
+    if (c.dt > explicitLimit(c))
+      first = implicit_.apply(c, t, wt, count, wallBlock_);
+    else
+      first = explicitStep(c, t, wt, count);
+    if (count) c.wall->force += sumInOrder(wallBlock_, blocks) * double(c.mass);
+    return first;
+  }
+
+ private:
+  /// The pairs' weights this substep. Materials of different rest density (wcsph's number
+  /// density): 1/ρ̃ = r/ρ for the volumes, and the pair's dynamic viscosity the mean of the two,
+  /// over the particle's mass r_i m (momentum-conserving: m_i a_i is symmetric in the pair).
+  /// Materials of different viscosity: each particle's dynamic viscosity r_i ν_i/ν.
+  ViscosityWeights weights(const StepContext& c) {
+    ViscosityWeights w;
+    const ParticleStore& P = c.P;
+    const std::vector<Real>* ratioField = P.find(ParticleStore::kRestRatio);
+    w.ratio = ratioField ? ratioField->data() : nullptr;
+    w.rel = w.ratio;
+    const std::vector<std::uint32_t>* mat = P.findU32(ParticleStore::kMaterial);
+    if (!c.materials || !mat) return w;
+    std::vector<Real>& perMaterial = perMaterial_;
+    perMaterial.clear();
+    bool same = true;
+    for (const MaterialDef& m : *c.materials) {
+      perMaterial.push_back(Real(viscosityOf(m, c.def)) / nu_);
+      same = same && perMaterial.back() == perMaterial.front();
+    }
+    if (same && perMaterial.front() == Real(1)) return w;
+    rel_.resize(P.size());
+    nuRel_.resize(P.size());
+    for (std::size_t i = 0; i < P.size(); ++i) {
+      nuRel_[i] = perMaterial[(*mat)[i]];
+      rel_[i] = (w.ratio ? w.ratio[i] : Real(1)) * nuRel_[i];
+    }
+    w.rel = rel_.data();
+    w.nuRel = nuRel_.data();
+    return w;
+  }
+
+  std::size_t explicitStep(StepContext& c, const ViscosityTerm& t, const ViscosityWeights& wt, bool count) {
+    ParticleStore& P = c.P;
     const ViscosityKernel<Real>& W = t.W;
     const Real muMass = t.muMass;
     const Vec2* X = P.x.data();
     const Vec2* V = P.v.data();
     const Real* IR = P.invRho.data();
-    // Materials of different rest density (wcsph's number density): 1/ρ̃ = r/ρ for the volumes,
-    // and the pair's dynamic viscosity the mean of the two, over the particle's mass r_i m
-    // (momentum-conserving: m_i a_i is symmetric in the pair). Null: every r is 1.
-    const std::vector<Real>* ratioField = P.find(ParticleStore::kRestRatio);
-    const Real* ratio = ratioField ? ratioField->data() : nullptr;
+    const Real* ratio = wt.ratio;
+    const Real* rel = wt.rel;
+    const Real* nuRel = wt.nuRel;
     const BoundarySet& B = c.boundary;
     const bool walls = t.walls;
     BodySamples* moving = t.noSlip && c.bodySamples && c.bodySamples->active() ? c.bodySamples : nullptr;
     // With the walls: their force on the fluid (World::wallImpulse), Σ m a_wall per block, the blocks in order.
-    const bool count = walls && c.wall;
-    const std::size_t blocks = (P.size() + kBlock - 1) / kBlock;
-    if (count) wallBlock_.assign(blocks, Vec2d(0, 0));
-    const std::size_t first = firstBad(c.pool, P.size(), [&](std::size_t b, std::size_t e) {
+    return firstBad(c.pool, P.size(), [&](std::size_t b, std::size_t e) {
       std::size_t bad = kNone;
       Vec2d wallAcc(0, 0);
       for (std::size_t i = b; i < e; ++i) {
@@ -101,7 +172,7 @@ class LaplacianViscosity final : public Effect {
           c.periodic.nearest(dx, dy);
           const Real r2 = dx * dx + dy * dy;
           Real w = W.laplacianR2(r2) * IR[j];
-          if (ratio) w *= ratio[j] * (ri + ratio[j]) * Real(0.5) / ri;
+          if (rel) w *= (ratio ? ratio[j] : Real(1)) * (rel[i] + rel[j]) * Real(0.5) / ri;
           w = std::min(w, capI);
           fx += (V[j].x() - vix) * w;
           fy += (V[j].y() - viy) * w;
@@ -115,7 +186,8 @@ class LaplacianViscosity final : public Effect {
             const std::uint32_t s = bl[k];
             sum += B.volume[s] * std::min(W.laplacianR2((xi - B.samples[s]).squaredNorm()), capWall);
           }
-          const Vec2 aWall = Vec2(vix, viy) * (t.wallFactor * irN * sum);
+          Vec2 aWall = Vec2(vix, viy) * (t.wallFactor * irN * sum);
+          if (nuRel) aWall *= nuRel[i];
           acc -= aWall;
           wallAcc -= aWall.cast<double>() * double(ri);  // m_i/m
         }
@@ -126,18 +198,20 @@ class LaplacianViscosity final : public Effect {
           const Vec2 xi = X[i];
           const std::uint32_t* ml = c.nbr.movingOf(i);
           const std::uint32_t mc = c.nbr.movingCount[i];
-          const Real vK = t.wallFactor * irN;
+          const Real vK = t.wallFactor * irN * (nuRel ? nuRel[i] : Real(1));
           moving->forEachBody(ml, mc, [&](std::uint32_t body, const std::uint32_t* run, const std::uint32_t* runEnd) {
-            Vec2 lv = Vec2::Zero();
-            Real tv = 0;  // Σ arm × the pair's term
-            for (const std::uint32_t* p = run; p != runEnd; ++p) {
-              const std::uint32_t s = *p;
-              const Real rr = (xi - moving->x[s]).squaredNorm();
-              const Vec2 u =
-                  (Vec2(vix, viy) - moving->v[s]) * (moving->volume[s] * std::min(W.laplacianR2(rr), capWall));
-              lv += u;
-              tv += BodySamples::torque(moving->arm[s], u);
-            }
+            // Against the body's velocity at the particle (BodySamples::velocityAt), not at the
+            // sample: a body turning with the water feels no torque from it (at the samples' own
+            // velocities the Laplacian's pairs, one-sided across the surface, spun a disc in a
+            // turning pool past the water, to 1.5 times its rate at ν = 0.5 m²/s).
+            const double omega = c.solids ? c.solids->bodies[body].omega : 0.0;
+            const Vec2 vBody = moving->velocityAt(*run, omega, xi).cast<Real>();
+            const Vec2 arm = moving->arm[*run] + (xi - moving->x[*run]);  // x_i − the centre of mass
+            Real sum = 0;
+            for (const std::uint32_t* p = run; p != runEnd; ++p)
+              sum += moving->volume[*p] * std::min(W.laplacianR2((xi - moving->x[*p]).squaredNorm()), capWall);
+            const Vec2 lv = (Vec2(vix, viy) - vBody) * sum;
+            const Real tv = BodySamples::torque(arm, lv);
             const Vec2 aBody = -lv * vK;
             acc += aBody;
             if (moving->placed[body].dynamic)
@@ -151,23 +225,28 @@ class LaplacianViscosity final : public Effect {
       if (count) wallBlock_[b / kBlock] = wallAcc;
       return bad;
     });
-    if (count) c.wall->force += sumInOrder(wallBlock_, blocks) * double(c.mass);
-    return first;
   }
 
- private:
-  Real nu_;
+  Real nu_;  ///< the largest material's ν
   bool noSlip_;
+  bool uniform_ = true;            ///< every material has ν
+  std::vector<Real> rel_, nuRel_;  ///< weights(): per particle, with materials of different viscosity
+  std::vector<Real> perMaterial_;  ///< weights(): ν_k/ν per material
+  ImplicitViscosity implicit_;
   Real scale_ = 1, momentR_ = -1, momentDx_ = -1;  ///< 1 / lattice moment, for (R, dx)
   std::vector<Vec2d> wallBlock_;  ///< with the walls: per block of kBlock particles, Σ of their acceleration
 };
 
 }  // namespace
 
-/// The viscosity effect when solver.viscosity > 0 (with the walls when solver.no_slip).
+/// The viscosity effect when a material's viscosity (or solver.viscosity) is above 0 (with the
+/// walls when solver.no_slip).
 std::unique_ptr<Effect> viscosityEffect(const SceneDef& scene) {
-  if (!(scene.solver.viscosity > 0)) return nullptr;
-  return std::make_unique<LaplacianViscosity>(scene.solver.viscosity, scene.solver.noSlip);
+  const std::vector<MaterialDef> materials = sceneMaterials(scene);
+  double most = 0;
+  for (const MaterialDef& m : materials) most = std::max(most, viscosityOf(m, scene.solver));
+  if (!(most > 0)) return nullptr;
+  return std::make_unique<LaplacianViscosity>(materials, scene.solver);
 }
 
 }  // namespace sph2d

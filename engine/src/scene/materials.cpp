@@ -9,11 +9,6 @@
 namespace sph2d {
 namespace {
 
-/// The viscosity material `m` has in a World of `solver`.
-double viscosityOf(const MaterialDef& m, const SolverDef& solver) {
-  return m.viscosity < 0 ? solver.viscosity : m.viscosity;
-}
-
 std::string names(const std::vector<MaterialDef>& materials) {
   std::string out;
   for (const MaterialDef& m : materials) out += (out.empty() ? "" : ", ") + m.name;
@@ -21,6 +16,10 @@ std::string names(const std::vector<MaterialDef>& materials) {
 }
 
 }  // namespace
+
+double viscosityOf(const MaterialDef& m, const SolverDef& solver) {
+  return m.viscosity < 0 ? solver.viscosity : m.viscosity;
+}
 
 bool takesDensityContrast(const std::string& solver) { return solver == "wcsph"; }
 
@@ -70,15 +69,11 @@ std::string materialProblem(const std::vector<MaterialDef>& materials, const Mat
   }
   if (materials.empty()) return "";
   // wcsph takes a density contrast (number density), the others one rest density for all
-  // particles; every solver one viscosity.
+  // particles; every solver a viscosity per material.
   const MaterialDef& first = materials.front();
   if (m.density != first.density && !takesDensityContrast(solver.type))
     o << "density " << m.density << " kg/m³ differs from the first material's (" << first.name << ", " << first.density
       << "): solver '" << solver.type << "' takes materials of one density (wcsph takes a density contrast)";
-  else if (viscosityOf(m, solver) != viscosityOf(first, solver))
-    o << "viscosity " << viscosityOf(m, solver) << " m²/s differs from the first material's (" << first.name << ", "
-      << viscosityOf(first, solver) << "): solver '" << solver.type
-      << "' takes materials of one viscosity (no solver takes a viscosity per material yet)";
   return o.str();
 }
 

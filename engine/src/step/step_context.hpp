@@ -122,6 +122,8 @@ struct StepContext {
   /// (Solver::movingSamples) in a scene with moving bodies; else null. The neighbour lists
   /// hold them only while bodySamples->active().
   BodySamples* bodySamples = nullptr;
+  /// The World's materials while it holds more than one (World::materials()); else null.
+  const std::vector<MaterialDef>* materials = nullptr;
 };
 
 /// Lowest slot reported by the blocks (the blocks are in slot order).

@@ -104,6 +104,23 @@ std::uint32_t World::addMaterial(const MaterialDef& m) {
     throw std::invalid_argument(
         "addMaterial: mixing (miscible_with) is set up from the scene's materials table when the World is built: a "
         "World that mixes takes no more materials, and one added at run time mixes with none");
+  const double nu = viscosityOf(m, w.scene.solver);
+  if (nu != viscosityOf(w.materials.front(), w.scene.solver)) {
+    const Effect* viscosity = nullptr;
+    for (const auto& e : w.effects)
+      if (std::string(e->name()) == "viscosity") viscosity = e.get();
+    std::ostringstream o;
+    o.precision(9);
+    if (!viscosity && nu > 0)
+      o << "addMaterial: viscosity " << nu
+        << " m²/s in a World built without viscosity (every material's 0): give the material in the scene's "
+           "materials table, so that the World is built with the viscosity effect";
+    else if (viscosity && viscosity->folded)
+      o << "addMaterial: viscosity " << nu << " m²/s differs from the first material's, and solver '"
+        << w.scene.solver.type
+        << "' computes one viscosity inside its pressure loop: give the material in the scene's materials table";
+    if (o.tellp() != 0) throw std::invalid_argument(o.str());
+  }
   if (m.density != w.materials.front().density) {
     const std::string effects = densityContrastProblem(w.scene);
     if (!effects.empty()) throw std::invalid_argument("addMaterial: " + effects);

@@ -52,6 +52,7 @@ StepContext World::Impl::context(Real dt) {
   c.boundaryVersion = statics.version();
   c.solids = moving.solids.bodies.empty() ? nullptr : &moving.solids;
   if (bodySamplesOn()) c.bodySamples = &moving.samples;
+  if (materials.size() > 1) c.materials = &materials;
   return c;
 }
 
@@ -78,6 +79,7 @@ void World::Impl::buildStages() {
   }
   Effect* folded = first && first->foldable() && solver->foldViscosity(first) ? first : nullptr;
   if (!folded) solver->foldViscosity(nullptr);
+  for (const auto& e : effects) e->folded = e.get() == folded;
   bool marker = false;
   for (Stage& s : solver->stages(anyEffect)) {
     if (!s.effectsMarker) {

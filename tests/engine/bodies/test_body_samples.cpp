@@ -136,10 +136,11 @@ TEST_CASE("body samples: a neutrally buoyant wcsph crate stays within 5 cm of wh
 TEST_CASE("body samples: a neutrally buoyant muller2003 crate stays within 3 cm of where it was put") {
   staysPut("muller2003", 3);
 }
-// dfsph: 0.28 cm (0.48 cm with the signed body row; 7.6 cm with the Box2D skin alone; the crate sank away when the
-// solves counted its samples without giving it their reaction).
-TEST_CASE("body samples: a neutrally buoyant dfsph crate stays within 1 cm of where it was put") {
-  staysPut("dfsph", 1);
+// dfsph: 1.4 cm at its own substep, where the viscosity (ν = 0.01 m²/s) takes its implicit step (2.1 cm with
+// no viscosity; 0.28 cm when the explicit viscosity held the substep to 0.03 R²/ν = 1.9 ms; 7.6 cm with the
+// Box2D skin alone; the crate sank away when the solves counted its samples without giving it their reaction).
+TEST_CASE("body samples: a neutrally buoyant dfsph crate stays within 2 cm of where it was put") {
+  staysPut("dfsph", 2);
 }
 
 TEST_CASE(
