@@ -63,6 +63,9 @@ const char* kHelp =
     "the initial (a fraction of it), the most particles outside the tank in any frame, the RMS\n"
     "of the surge front Z = x/a against Martin & Moyce 1952, and the compression and surface\n"
     "height at the end measured from positions alone (as for the peer).\n"
+    "A preset with _oil (balanced_oil: wcsph takes a density contrast) or _dye (game_dye, ...)\n"
+    "runs the column in two materials, water below and oil of 800 kg/m3 or a dye of the water's\n"
+    "density above: the second material's cost, against the preset alone in the same run.\n"
     "--floors: the tank's walls: scene (as the scene says, the default), free (friction 0),\n"
     "muX (Coulomb friction X at contact, e.g. mu0.5), noslip (friction 0, solver.no_slip with\n"
     "the viscosity at least 7.3e-5 m2/s, Martin & Moyce's Reynolds number at a = 1 m).\n"
@@ -128,6 +131,28 @@ void endMeasures(const std::vector<Vec2d>& pos, double dx, double& compression, 
   surface = 0;
   for (const auto& kv : top) surface += kv.second;
   surface = top.empty() ? 0 : surface / double(top.size());
+}
+
+/// The dam break's column in two materials: water below, `second` (oil of 800 kg/m³, or dye of
+/// the water's density) above, split at the lattice row nearest half the column's height (the
+/// particles where the one block would put them).
+void addSecondMaterial(SceneDef& s, const std::string& second) {
+  MaterialDef water, other;
+  water.name = "water";
+  other.name = second;
+  other.density = second == "oil" ? 800 : s.solver.restDensity;
+  other.color = {0.95, 0.70, 0.15};
+  s.materials = {water, other};
+  std::vector<FluidBlockDef> blocks;
+  for (const FluidBlockDef& b : s.blocks) {
+    FluidBlockDef lower = b, upper = b;
+    const double dx = s.solver.spacing;
+    lower.max.y() = upper.min.y() = b.min.y() + dx * std::round(0.5 * (b.max.y() - b.min.y()) / dx);
+    upper.material = 1;
+    blocks.push_back(lower);
+    blocks.push_back(upper);
+  }
+  s.blocks = blocks;
 }
 
 Row runSph2d(const SceneDef& base, const std::string& preset, int threads, double seconds,
@@ -291,8 +316,7 @@ int cmdBenchGame(const std::vector<std::string>& args) {
       presets = opt.listValue();
       shaped = true;
       for (const std::string& p : presets)
-        if (p != "game" && p != "balanced" && p != "accurate")
-          throw UsageError("--presets: unknown preset '" + p + "'; presets: game, balanced, accurate");
+        if (const std::string why = game_bench::presetProblem(p); !why.empty()) throw UsageError("--presets: " + why);
       if (presets.empty()) throw UsageError("--presets needs at least one preset");
     } else if (opt.is("--floors")) {
       floors.clear();
@@ -477,8 +501,11 @@ int cmdBenchGame(const std::vector<std::string>& args) {
       r.floor = "";
     } else {
       SceneDef s = scene;
-      s.solver = qualityPreset(p.preset);
+      std::string base, second;
+      game_bench::splitPreset(p.preset, base, second);
+      s.solver = qualityPreset(base);
       s.solver.spacing = spacing;
+      if (!second.empty()) addSecondMaterial(s, second);
       for (const std::string& kv : sets) applySet(s.solver, kv);
       s.maxParticles = std::size_t(p.particles) * 2 + 1000;
       applyFloorVariant(s, parseFloorVariant("--floors", p.floor));

@@ -11,6 +11,7 @@
 
 #include "bench/sweep.hpp"
 #include "cli.hpp"
+#include "sph2d/scene.hpp"
 
 namespace sph2d::cli::game_bench {
 
@@ -25,6 +26,26 @@ const char* const kCsvHeader =
     "run_id,name,floor,particles,threads,wall_s_per_sim_s,ratio_to_peer,substeps_per_frame,iterations_per_frame,"
     "mean_compression,max_compression,energy_gain,surge_rms,outside,end_compression,end_surface_m,build,settings";
 
+bool splitPreset(const std::string& preset, std::string& base, std::string& second) {
+  const auto cut = preset.find('_');
+  base = preset.substr(0, cut);
+  second = cut == std::string::npos ? "" : preset.substr(cut + 1);
+  return indexOf(kPresets, base) >= 0 && (second.empty() || indexOf(kSecondMaterials, second) >= 0);
+}
+
+std::string presetProblem(const std::string& preset) {
+  std::string base, second;
+  if (!splitPreset(preset, base, second))
+    return "unknown preset '" + preset +
+           "'; presets: game, balanced, accurate, each alone or with _oil (oil of 800 kg/m³ over the water: "
+           "balanced) or _dye (a second material of the water's density), e.g. balanced_oil, game_dye";
+  if (second == "oil" && !takesDensityContrast(qualityPreset(base).type))
+    return "'" + preset + "': the " + base + " preset's solver (" + qualityPreset(base).type +
+           ") takes materials of one density; oil over water runs on balanced (wcsph), and " + base +
+           "_dye measures a second material of one density";
+  return "";
+}
+
 std::string specId(const Spec& p) {
   if (!p.peer.empty()) return p.peer + "-" + std::to_string(p.particles);
   return p.preset + "-" + std::to_string(p.particles) + "-t" + std::to_string(p.threads) +
@@ -34,7 +55,8 @@ std::string specId(const Spec& p) {
 /// Parses a run id back into its run; throws UsageError saying what an id is.
 Spec parseId(const std::string& id, bool havePeer) {
   const std::string form =
-      "; ids are PRESET-PARTICLES-tTHREADS[-FLOOR] (presets game, balanced, accurate; particles 100..50000000; threads "
+      "; ids are PRESET-PARTICLES-tTHREADS[-FLOOR] (presets game, balanced, accurate, with _dye or (balanced) "
+      "_oil for a second material; particles 100..50000000; threads "
       "1..256; floors free, muX, noslip), e.g. game-20000-t2 or balanced-5000-t1-mu0.5, and with --peer "
       "liquidfun-PARTICLES or liquidfun_static-PARTICLES; `sph2d bench game --list-ids` lists the default sweep";
   std::vector<std::string> parts;
@@ -60,7 +82,7 @@ Spec parseId(const std::string& id, bool havePeer) {
     if (!havePeer) throw UsageError("--only " + id + ": a peer run needs --peer PATH (the LiquidFun harness)");
     p.peer = parts[0];
     p.particles = integer(parts[1], 100, 50000000);
-  } else if ((parts.size() == 3 || parts.size() == 4) && indexOf(kPresets, parts[0]) >= 0 && parts[2].size() > 1 &&
+  } else if ((parts.size() == 3 || parts.size() == 4) && presetProblem(parts[0]).empty() && parts[2].size() > 1 &&
              parts[2][0] == 't') {
     p.preset = parts[0];
     p.particles = integer(parts[1], 100, 50000000);
@@ -87,7 +109,9 @@ void sortRows(std::vector<Row>& rows) {
   auto rank = [](const Row& r) {
     const int peer = indexOf(kPeers, r.name);
     if (peer >= 0) return peer;
-    const int preset = indexOf(kPresets, r.name.substr(r.name.rfind('_') + 1));
+    std::string base, second;
+    splitPreset(r.name.substr(std::string("sph2d_").size()), base, second);
+    const int preset = r.name.rfind("sph2d_", 0) == 0 ? indexOf(kPresets, base) : -1;
     return 10 + (preset < 0 ? 9 : preset);
   };
   std::stable_sort(rows.begin(), rows.end(), [&](const Row& a, const Row& b) {

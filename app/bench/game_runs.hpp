@@ -1,5 +1,5 @@
 // app/bench/game_runs.hpp — the runs and rows of `sph2d bench game` apart from running them:
-// run ids (preset-particles-tthreads[-floor], liquidfun[_static]-particles) made and parsed back,
+// run ids (preset[_second]-particles-tthreads[-floor], liquidfun[_static]-particles) made and parsed back,
 // game.csv written (the peer ratio from the liquidfun_static row of the same particle count)
 // and read back, the rows in the sweep's order, and the file the bench writes.
 #pragma once
@@ -15,6 +15,17 @@ namespace sph2d::cli::game_bench {
 
 inline const char* const kPresets[] = {"game", "balanced", "accurate"};
 inline const char* const kPeers[] = {"liquidfun", "liquidfun_static"};
+/// A run's second material: none, oil (800 kg/m³ over the water: presets whose solver takes a
+/// density contrast) or dye (a second material of the water's density).
+inline const char* const kSecondMaterials[] = {"oil", "dye"};
+
+/// A run's preset: BASE or BASE_SECOND (kPresets, kSecondMaterials), e.g. balanced_oil. Sets
+/// `base` and `second` ("" for none); false when it is no such name.
+bool splitPreset(const std::string& preset, std::string& base, std::string& second);
+
+/// Why `preset` cannot run ("" when it can): an unknown name, or oil on a preset whose solver
+/// takes materials of one density.
+std::string presetProblem(const std::string& preset);
 
 /// One row of game.csv: a run's figures (NaN: not measured).
 struct Row {

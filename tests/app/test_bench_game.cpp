@@ -7,6 +7,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <map>
 #include <sstream>
 #include <vector>
 
@@ -108,4 +109,35 @@ TEST_CASE("bench game at two particle counts ends with the cost growth, per part
   CHECK(wall == doctest::Approx(t1 / t0).epsilon(0.01));
   CHECK(perParticle == doctest::Approx(t1 / t0 / (n1 / n0)).epsilon(0.01));
   CHECK(r.out.find("cost growth", at + 1) == std::string::npos);  // one run, one larger count: one line
+}
+
+TEST_CASE("bench game runs the column in two materials: a dye changes no physics, oil only where the solver takes it") {
+  const std::string dir = freshDir("bench_game_materials");
+  const std::string csvPath = dir + "/game.csv";
+  const Result r =
+      run("bench game --particles 600 --seconds 0.25 --presets game,game_dye,balanced_oil --threads 1 "
+          "--assets " +
+          q(std::string(SPH2D_ASSETS)) + " --csv " + q(csvPath));
+  INFO(r.out);
+  REQUIRE(r.code == 0);
+  std::string header;
+  const auto rs = rows(readText(csvPath), header);
+  REQUIRE(rs.size() == 3);
+  std::map<std::string, std::vector<std::string>> by;
+  for (const auto& f : rs) by[f[1]] = f;
+  REQUIRE(by.count("sph2d_game_dye"));
+  REQUIRE(by.count("sph2d_balanced_oil"));
+  CHECK(by["sph2d_game_dye"][0] == "game_dye-600-t1");
+  CHECK(by["sph2d_balanced_oil"][0] == "balanced_oil-600-t1");
+  // Water below and dye of its density above move as water alone: the same particles,
+  // substeps, compression, surge and surface.
+  for (std::size_t c : {3u, 7u, 8u, 9u, 10u, 12u, 14u, 15u}) CHECK(by["sph2d_game_dye"][c] == by["sph2d_game"][c]);
+  CHECK(std::stod(by["sph2d_balanced_oil"][13]) == 0);  // nothing outside the tank
+  CHECK(std::stod(by["sph2d_balanced_oil"][9]) < 0.05);
+  // Oil needs a solver that takes a density contrast: the game preset's refuses, naming what runs.
+  const Result refused = run("bench game --particles 600 --seconds 0.25 --presets game_oil");
+  CHECK(refused.code == 2);
+  CHECK(refused.out.find("balanced (wcsph)") != std::string::npos);
+  const Result unknown = run("bench game --only game_syrup-600-t1");
+  CHECK(unknown.code == 2);
 }
