@@ -139,6 +139,7 @@ void endMeasures(const std::vector<Vec2d>& pos, double dx, double& compression, 
 void addSecondMaterial(SceneDef& s, const std::string& second) {
   MaterialDef water, other;
   water.name = "water";
+  water.density = s.solver.restDensity;
   other.name = second;
   other.density = second == "oil" ? 800 : s.solver.restDensity;
   other.color = {0.95, 0.70, 0.15};
@@ -505,8 +506,8 @@ int cmdBenchGame(const std::vector<std::string>& args) {
       game_bench::splitPreset(p.preset, base, second);
       s.solver = qualityPreset(base);
       s.solver.spacing = spacing;
-      if (!second.empty()) addSecondMaterial(s, second);
       for (const std::string& kv : sets) applySet(s.solver, kv);
+      if (!second.empty()) addSecondMaterial(s, second);  // after --set: the water is the solver's fluid
       s.maxParticles = std::size_t(p.particles) * 2 + 1000;
       applyFloorVariant(s, parseFloorVariant("--floors", p.floor));
       r = runSph2d(s, p.preset, p.threads, seconds, surge);

@@ -96,6 +96,9 @@ Spec parseId(const std::string& id, bool havePeer) {
       }
     }
   } else {
+    std::string base, second;
+    if (splitPreset(parts[0], base, second) && !presetProblem(parts[0]).empty())  // a name it cannot run (game_oil)
+      throw UsageError("--only " + id + ": " + presetProblem(parts[0]));
     throw UsageError("--only: '" + id + "' is not a run of bench game" + form);
   }
   if (specId(p) != id)
@@ -110,8 +113,9 @@ void sortRows(std::vector<Row>& rows) {
     const int peer = indexOf(kPeers, r.name);
     if (peer >= 0) return peer;
     std::string base, second;
-    splitPreset(r.name.substr(std::string("sph2d_").size()), base, second);
-    const int preset = r.name.rfind("sph2d_", 0) == 0 ? indexOf(kPresets, base) : -1;
+    const bool ours = r.name.rfind("sph2d_", 0) == 0;
+    if (ours) splitPreset(r.name.substr(std::string("sph2d_").size()), base, second);
+    const int preset = ours ? indexOf(kPresets, base) : -1;
     return 10 + (preset < 0 ? 9 : preset);
   };
   std::stable_sort(rows.begin(), rows.end(), [&](const Row& a, const Row& b) {

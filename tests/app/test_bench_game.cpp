@@ -140,4 +140,7 @@ TEST_CASE("bench game runs the column in two materials: a dye changes no physics
   CHECK(refused.out.find("balanced (wcsph)") != std::string::npos);
   const Result unknown = run("bench game --only game_syrup-600-t1");
   CHECK(unknown.code == 2);
+  const Result oilId = run("bench game --only game_oil-600-t1");
+  CHECK(oilId.code == 2);
+  CHECK(oilId.out.find("balanced (wcsph)") != std::string::npos);
 }

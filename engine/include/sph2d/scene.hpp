@@ -10,6 +10,7 @@
 #include <map>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "sph2d/events.hpp"
@@ -141,8 +142,11 @@ struct MaterialDef {
   std::array<double, 3> color{0.10, 0.45, 0.85};  ///< drawn colour, linear RGB in 0..1
   std::vector<std::string> miscibleWith;          ///< the materials it mixes with, by name
   double diffusion = 1e-3;  ///< D [m²/s] of dc/dt = D∇²c with a material it mixes with (the pair's mean)
+  /// Interface tension σ [N/m] with materials before it, by name (a pair that does not mix).
+  std::vector<std::pair<std::string, double>> tensionWith;
   // The ranges a scene's `materials[]` and World::addMaterial accept.
   static constexpr double kMinDensity = 1, kMaxDensity = 1e5, kMaxViscosity = 1e3, kMaxDiffusion = 1;
+  static constexpr double kMaxTension = 1e3;
   static constexpr std::size_t kMaxMaterials = 256, kMaxName = 64;
 };
 

@@ -505,8 +505,8 @@ class World {
   /// Number of emitters: the scene's and those added since, less those removed.
   std::size_t emitterCount() const;
   /// Switches an effect the scene enables ("viscosity", "xsph", "force_fields",
-  /// "surface_tension", "user_force") on or off. Throws std::invalid_argument
-  /// naming the scene's effects when it has no such effect.
+  /// "surface_tension", "interface_tension", "shifting", "mixing", "user_force") on or off. Throws
+  /// std::invalid_argument naming the scene's effects when it has no such effect.
   void setEffectEnabled(const std::string& name, bool enabled);
   bool effectEnabled(const std::string& name) const;  ///< the effect runs (refused as setEffectEnabled)
   /// Names of the effects this world can run (enabled or not), in stage order.

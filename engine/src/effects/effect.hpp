@@ -57,6 +57,11 @@ class Effect {
   virtual bool foldable() const { return false; }
   /// True while the solver computes this effect in its own pair loop (set by the World).
   bool folded = false;
+  /// The World's materials changed (World::addMaterial); the World then rebuilds the stages.
+  virtual void materialsChanged(const std::vector<MaterialDef>& materials, const SolverDef& solver) {
+    (void)materials;
+    (void)solver;
+  }
   /// The constants of a foldable effect for this substep (others: never called).
   virtual ViscosityTerm viscosityTerm(const StepContext& c) {
     (void)c;

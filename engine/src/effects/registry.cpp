@@ -20,12 +20,17 @@ namespace {
 /// No effects; a scene that enables one is refused (std::invalid_argument).
 EffectList makeEffects(const SceneDef& scene) {
   const EffectsDef& e = scene.effects;
-  if (scene.solver.viscosity > 0) noModules("the viscosity effect (solver.viscosity > 0)");
+  const std::vector<MaterialDef> materials = sceneMaterials(scene);
+  for (const MaterialDef& m : materials)
+    if (viscosityOf(m, scene.solver) > 0) noModules("the viscosity effect (solver.viscosity or a material's > 0)");
   if (e.xsph) noModules("effects.xsph");
   if (!e.forceFields.empty()) noModules("effects.force_fields");
   if (e.surfaceTension) noModules("effects.surface_tension");
   if (e.shifting) noModules("effects.shifting");
-  if (anyMiscible(sceneMaterials(scene))) noModules("mixing (materials[].miscible_with)");
+  if (anyMiscible(materials)) noModules("mixing (materials[].miscible_with)");
+  for (std::size_t a = 0; a < materials.size(); ++a)
+    for (std::size_t b = 0; b < a; ++b)
+      if (tensionBetween(materials, a, b) > 0) noModules("interface tension (materials[].tension_with)");
   return {};
 }
 

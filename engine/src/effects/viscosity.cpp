@@ -48,8 +48,13 @@ namespace {
 
 class LaplacianViscosity final : public Effect {
  public:
-  LaplacianViscosity(const std::vector<MaterialDef>& materials, const SolverDef& solver)
-      : nu_(Real(viscosityOf(materials.front(), solver))), noSlip_(solver.noSlip) {
+  LaplacianViscosity(const std::vector<MaterialDef>& materials, const SolverDef& solver) : noSlip_(solver.noSlip) {
+    materialsChanged(materials, solver);
+  }
+  /// ν (the largest) and whether every material has it, from the World's materials.
+  void materialsChanged(const std::vector<MaterialDef>& materials, const SolverDef& solver) override {
+    nu_ = Real(viscosityOf(materials.front(), solver));
+    uniform_ = true;
     for (const MaterialDef& m : materials) {
       nu_ = std::max(nu_, Real(viscosityOf(m, solver)));
       uniform_ = uniform_ && viscosityOf(m, solver) == viscosityOf(materials.front(), solver);
@@ -58,14 +63,9 @@ class LaplacianViscosity final : public Effect {
   const char* name() const override { return "viscosity"; }
   const char* limitKey() const override { return "solver.viscosity"; }
 
-  /// Explicit step limit, at the largest viscosity (a material added at run time may exceed
-  /// the scene's); the effect holds the substep to it only when folded (see the top).
-  Real explicitLimit(const StepContext& c) const {
-    Real nu = nu_;
-    if (c.materials)
-      for (const MaterialDef& m : *c.materials) nu = std::max(nu, Real(viscosityOf(m, c.def)));
-    return Real(0.03) * c.R * c.R / nu;
-  }
+  /// Explicit step limit, at the largest viscosity; the effect holds the substep to it only
+  /// when folded (see the top).
+  Real explicitLimit(const StepContext& c) const { return Real(0.03) * c.R * c.R / nu_; }
   Real maxTimeStep(const StepContext& c) const override {
     return folded ? explicitLimit(c) : std::numeric_limits<Real>::infinity();
   }
@@ -201,9 +201,10 @@ class LaplacianViscosity final : public Effect {
           const Real vK = t.wallFactor * irN * (nuRel ? nuRel[i] : Real(1));
           moving->forEachBody(ml, mc, [&](std::uint32_t body, const std::uint32_t* run, const std::uint32_t* runEnd) {
             // Against the body's velocity at the particle (BodySamples::velocityAt), not at the
-            // sample: a body turning with the water feels no torque from it (at the samples' own
-            // velocities the Laplacian's pairs, one-sided across the surface, spun a disc in a
-            // turning pool past the water, to 1.5 times its rate at ν = 0.5 m²/s).
+            // sample's: a body turning with the water then feels no torque from its own surface
+            // (at the samples' velocities a disc in a turning pool at ν = 0.5 m²/s was spun to 1.5
+            // times the water's rate; at the particle's 1.4, the rest the Laplacian form's own,
+            // docs/SCENES.md).
             const double omega = c.solids ? c.solids->bodies[body].omega : 0.0;
             const Vec2 vBody = moving->velocityAt(*run, omega, xi).cast<Real>();
             const Vec2 arm = moving->arm[*run] + (xi - moving->x[*run]);  // x_i − the centre of mass
@@ -227,7 +228,7 @@ class LaplacianViscosity final : public Effect {
     });
   }
 
-  Real nu_;  ///< the largest material's ν
+  Real nu_ = 0;  ///< the largest material's ν
   bool noSlip_;
   bool uniform_ = true;            ///< every material has ν
   std::vector<Real> rel_, nuRel_;  ///< weights(): per particle, with materials of different viscosity

@@ -14,6 +14,15 @@ bool mixes(const std::vector<MaterialDef>& m, std::size_t a, std::size_t b) {
   return lists(a, b) || lists(b, a);
 }
 
+double tensionBetween(const std::vector<MaterialDef>& m, std::size_t a, std::size_t b) {
+  if (a == b) return 0;
+  for (const auto& [name, sigma] : m[a].tensionWith)
+    if (name == m[b].name) return sigma;
+  for (const auto& [name, sigma] : m[b].tensionWith)
+    if (name == m[a].name) return sigma;
+  return 0;
+}
+
 bool anyMiscible(const std::vector<MaterialDef>& m) {
   for (std::size_t a = 0; a < m.size(); ++a)
     for (std::size_t b = a + 1; b < m.size(); ++b)

@@ -18,6 +18,9 @@ namespace sph2d {
 bool mixes(const std::vector<MaterialDef>& m, std::size_t a, std::size_t b);
 /// True when two materials of `m` mix: the mixing effect and its particle fields exist.
 bool anyMiscible(const std::vector<MaterialDef>& m);
+/// The interface tension σ [N/m] between materials a and b of `m` (either's tension_with naming
+/// the other; 0 for none, and for a material with itself).
+double tensionBetween(const std::vector<MaterialDef>& m, std::size_t a, std::size_t b);
 /// From each particle's concentrations (slots ≥ `from`): its mixed colour and, with a density
 /// contrast, its rest ratio Σ_k c_k ρ0_k/ρ0 (nothing without the mixing fields).
 void deriveFromConcentrations(ParticleStore& P, const std::vector<MaterialDef>& materials, std::size_t from);

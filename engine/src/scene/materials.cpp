@@ -1,6 +1,7 @@
 // materials.cpp — a scene's `materials` table and the one rule every way of adding a
 // material follows (materialProblem): the scene loader, World's constructor and
 // World::addMaterial all ask it, so a table refused in a file is refused in code too.
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 
@@ -67,6 +68,24 @@ std::string materialProblem(const std::vector<MaterialDef>& materials, const Mat
       return "miscible_with names \"" + n + "\", which is no material before it (materials: " +
              (materials.empty() ? std::string("none") : names(materials)) + ")";
   }
+  for (const auto& [n, sigma] : m.tensionWith) {
+    const MaterialDef* other = nullptr;
+    for (const MaterialDef& candidate : materials)
+      if (candidate.name == n) other = &candidate;
+    if (!other)
+      return "tension_with names \"" + n + "\", which is no material before it (materials: " +
+             (materials.empty() ? std::string("none") : names(materials)) + ")";
+    if (!(sigma >= 0 && sigma <= MaterialDef::kMaxTension)) {
+      o << "tension_with." << n << " must be in 0.." << MaterialDef::kMaxTension << " N/m, got " << sigma;
+      return o.str();
+    }
+    const bool listed =
+        std::find(m.miscibleWith.begin(), m.miscibleWith.end(), n) != m.miscibleWith.end() ||
+        std::find(other->miscibleWith.begin(), other->miscibleWith.end(), m.name) != other->miscibleWith.end();
+    if (listed && sigma > 0)
+      return "tension_with names \"" + n +
+             "\", which it mixes with (miscible_with): a pair that mixes has no interface";
+  }
   if (materials.empty()) return "";
   // wcsph takes a density contrast (number density), the others one rest density for all
   // particles; every solver a viscosity per material.
@@ -87,7 +106,7 @@ void readMaterials(const Reader& r, const nlohmann::json& root, SceneDef& s) {
     const std::string p = "materials[" + std::to_string(k) + "]";
     const nlohmann::json& j = arr[k];
     r.requireObject(j, p);
-    r.checkKeys(j, p, {"name", "density", "viscosity", "color", "miscible_with", "diffusion"});
+    r.checkKeys(j, p, {"name", "density", "viscosity", "color", "miscible_with", "diffusion", "tension_with"});
     MaterialDef m;
     if (!j.contains("name")) r.fail(Reader::sub(p, "name"), "missing; expected the material's name");
     m.name = r.string(j, p, "name", "", {});
@@ -107,6 +126,15 @@ void readMaterials(const Reader& r, const nlohmann::json& root, SceneDef& s) {
         if (!mw[i].is_string()) r.fail(q + "[" + std::to_string(i) + "]", "expected a material's name");
         m.miscibleWith.push_back(mw[i].get<std::string>());
       }
+    }
+    if (j.contains("tension_with")) {
+      const nlohmann::json& tw = j.at("tension_with");
+      const std::string q = Reader::sub(p, "tension_with");
+      if (!tw.is_object())
+        r.fail(q,
+               "expected an object of material names and tensions in N/m, e.g. {\"water\": 0.03}, got " + describe(tw));
+      for (auto it = tw.begin(); it != tw.end(); ++it)
+        m.tensionWith.emplace_back(it.key(), r.number(tw, q, it.key(), 0, 0, MaterialDef::kMaxTension));
     }
     if (first) {
       for (const char* key : {"rest_density", "viscosity"}) {
@@ -130,6 +158,7 @@ void readMaterials(const Reader& r, const nlohmann::json& root, SceneDef& s) {
                         : problem.rfind("color", 0) == 0     ? "color"
                         : problem.rfind("diffusion", 0) == 0 ? "diffusion"
                         : problem.rfind("miscible", 0) == 0  ? "miscible_with"
+                        : problem.rfind("tension", 0) == 0   ? "tension_with"
                                                              : "name";
       r.fail(problem.rfind("a World", 0) == 0 ? p : Reader::sub(p, key), problem);
     }

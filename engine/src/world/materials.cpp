@@ -100,32 +100,37 @@ std::uint32_t World::addMaterial(const MaterialDef& m) {
   Impl& w = *impl_;
   const std::string problem = materialProblem(w.materials, m, w.scene.solver);
   if (!problem.empty()) throw std::invalid_argument("addMaterial: " + problem);
+  if (!m.tensionWith.empty())
+    throw std::invalid_argument(
+        "addMaterial: an interface tension (tension_with) is set up from the scene's materials table when the World "
+        "is built: a material added at run time has none");
   if (w.P.findD(ParticleStore::concentration(0)) || !m.miscibleWith.empty())
     throw std::invalid_argument(
         "addMaterial: mixing (miscible_with) is set up from the scene's materials table when the World is built: a "
         "World that mixes takes no more materials, and one added at run time mixes with none");
   const double nu = viscosityOf(m, w.scene.solver);
-  if (nu != viscosityOf(w.materials.front(), w.scene.solver)) {
-    const Effect* viscosity = nullptr;
-    for (const auto& e : w.effects)
-      if (std::string(e->name()) == "viscosity") viscosity = e.get();
+  Effect* viscosity = nullptr;
+  for (const auto& e : w.effects)
+    if (std::string(e->name()) == "viscosity") viscosity = e.get();
+  if (!viscosity && nu > 0) {
     std::ostringstream o;
     o.precision(9);
-    if (!viscosity && nu > 0)
-      o << "addMaterial: viscosity " << nu
-        << " m²/s in a World built without viscosity (every material's 0): give the material in the scene's "
-           "materials table, so that the World is built with the viscosity effect";
-    else if (viscosity && viscosity->folded)
-      o << "addMaterial: viscosity " << nu << " m²/s differs from the first material's, and solver '"
-        << w.scene.solver.type
-        << "' computes one viscosity inside its pressure loop: give the material in the scene's materials table";
-    if (o.tellp() != 0) throw std::invalid_argument(o.str());
+    o << "addMaterial: viscosity " << nu
+      << " m²/s in a World built without viscosity (every material's 0): give the material in the scene's "
+         "materials table, so that the World is built with the viscosity effect";
+    throw std::invalid_argument(o.str());
   }
   if (m.density != w.materials.front().density) {
     const std::string effects = densityContrastProblem(w.scene);
     if (!effects.empty()) throw std::invalid_argument("addMaterial: " + effects);
   }
   w.materials.push_back(m);
+  if (viscosity && nu != viscosityOf(w.materials.front(), w.scene.solver)) {
+    // A viscosity of its own: the effect's largest ν, and muller2003 no longer folds one
+    // viscosity into its pressure loop.
+    viscosity->materialsChanged(w.materials, w.scene.solver);
+    w.buildStages();
+  }
   if (w.materials.size() == 2) {  // from now on each particle says which (every one there now: the first)
     w.P.fieldU32(ParticleStore::kMaterial);
     w.refreshView();

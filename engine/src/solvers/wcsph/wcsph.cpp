@@ -195,7 +195,7 @@ class Wcsph final : public Solver {
     const Vec2* V = P.v.data();
     const Real* IR = P.invRho.data();
     const Real* POR2 = pOverRho2_.data();
-    const Real* rr = restRatio(P);  // m_i = r_i m (null: every r_i is 1)
+    const Real* ratio = restRatio(P);  // m_i = r_i m (null: every r_i is 1)
     const std::size_t blocks = (P.size() + kBlock - 1) / kBlock;
     wallBlock_.assign(blocks, Vec2d(0, 0));
     const std::size_t first = firstBad(c.pool, P.size(), [&](std::size_t b, std::size_t e) {
@@ -204,7 +204,7 @@ class Wcsph final : public Solver {
       for (std::size_t i = b; i < e; ++i) {
         const Real vix = V[i].x(), viy = V[i].y();
         const Real pri = POR2[i], iri = IR[i];
-        const Real invRi = rr ? Real(1) / rr[i] : Real(1);  // m / m_i
+        const Real invRi = ratio ? Real(1) / ratio[i] : Real(1);  // m / m_i
         Real ax = 0, ay = 0;
         const std::uint32_t* nb = c.nbr.of(i);
         const std::uint32_t cnt = c.nbr.count[i];
@@ -223,7 +223,7 @@ class Wcsph final : public Solver {
           // Artificial viscosity for approaching pairs (−m_j Π_ij ∇W).
           const Real vdotx = (vix - V[j].x()) * dx + (viy - V[j].y()) * dy;
           if (vdotx < 0) {
-            const Real mj = rr ? c.mass * rr[j] : c.mass;
+            const Real mj = ratio ? c.mass * ratio[j] : c.mass;
             const Real mu = h * vdotx / (r2 + eta2);
             coef += mj * avK * mu * Real(2) / (Real(1) / iri + Real(1) / IR[j]);
             const Real ai = imp.alpha(vdotx, r);
