@@ -61,12 +61,14 @@ class InterfaceTension final : public Effect {
     c.pool.parallelFor(n, kBlock, [&](std::size_t lo, std::size_t hi) {
       std::vector<Vec2> g(K_, Vec2::Zero());
       for (std::size_t i = lo; i < hi; ++i) {
+        stress_[i] = Stress{};
+        if (M[i] >= K_) continue;  // a material added at run time has no tension
         const Real* sig = sigma_.data() + std::size_t(M[i]) * K_;
         const std::uint32_t* nb = c.nbr.of(i);
         bool any = false;
         for (std::uint32_t q = 0; q < c.nbr.count[i]; ++q) {
           const std::uint32_t j = nb[q];
-          if (!(sig[M[j]] > 0)) continue;
+          if (M[j] >= K_ || !(sig[M[j]] > 0)) continue;
           Real dx, dy, r2;
           pairDelta(c, i, j, dx, dy, r2);
           g[M[j]] += W.gradient(Vec2(dx, dy), std::sqrt(r2)) * V;

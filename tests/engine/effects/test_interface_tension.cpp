@@ -149,10 +149,16 @@ TEST_CASE(
   refused("{\"name\": \"oil\", \"tension_with\": [\"water\"]}", "materials[1].tension_with", "expected an object");
   refused("{\"name\": \"oil\", \"miscible_with\": [\"water\"], \"tension_with\": {\"water\": 0.05}}",
           "materials[1].tension_with", "a pair that mixes has no interface");
-  // Run time: a material added by the game has none.
-  World w(parseScene(scene("{\"name\": \"oil\"}"), "t.json"));
+  // Run time: a material added by the game has none, beside the table's pair that has one.
+  World w(parseScene(scene("{\"name\": \"oil\", \"tension_with\": {\"water\": 0.05}}"), "t.json"));
   MaterialDef syrup;
   syrup.name = "syrup";
   syrup.tensionWith = {{"water", 0.1}};
   CHECK_THROWS_WITH_AS(w.addMaterial(syrup), doctest::Contains("tension_with"), std::invalid_argument);
+  syrup.tensionWith.clear();
+  const std::uint32_t k = w.addMaterial(syrup);
+  REQUIRE(w.addDrop(Vec2d(0.25, 0.6), 0.1, Vec2d(0, 0), k).size() > 0);
+  REQUIRE(w.addDrop(Vec2d(0.25, 0.9), 0.1, Vec2d(0, 0), 1).size() > 0);
+  for (int f = 0; f < 30; ++f) w.stepFrame();
+  CHECK(test::allFiniteState(w));
 }
