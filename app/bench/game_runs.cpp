@@ -38,10 +38,10 @@ std::string presetProblem(const std::string& preset) {
   if (!splitPreset(preset, base, second))
     return "unknown preset '" + preset +
            "'; presets: game, balanced, accurate, each alone or with _oil (oil of 800 kg/m³ over the water: "
-           "balanced) or _dye (a second material of the water's density), e.g. balanced_oil, game_dye";
+           "game and balanced) or _dye (a second material of the water's density), e.g. balanced_oil, game_dye";
   if (second == "oil" && !takesDensityContrast(qualityPreset(base).type))
     return "'" + preset + "': the " + base + " preset's solver (" + qualityPreset(base).type +
-           ") takes materials of one density; oil over water runs on balanced (wcsph), and " + base +
+           ") takes materials of one density; oil over water runs on game and balanced, and " + base +
            "_dye measures a second material of one density";
   return "";
 }

@@ -115,14 +115,14 @@ TEST_CASE("bench game runs the column in two materials: a dye changes no physics
   const std::string dir = freshDir("bench_game_materials");
   const std::string csvPath = dir + "/game.csv";
   const Result r =
-      run("bench game --particles 600 --seconds 0.25 --presets game,game_dye,balanced_oil --threads 1 "
+      run("bench game --particles 600 --seconds 0.25 --presets game,game_dye,game_oil,balanced_oil --threads 1 "
           "--assets " +
           q(std::string(SPH2D_ASSETS)) + " --csv " + q(csvPath));
   INFO(r.out);
   REQUIRE(r.code == 0);
   std::string header;
   const auto rs = rows(readText(csvPath), header);
-  REQUIRE(rs.size() == 3);
+  REQUIRE(rs.size() == 4);
   std::map<std::string, std::vector<std::string>> by;
   for (const auto& f : rs) by[f[1]] = f;
   REQUIRE(by.count("sph2d_game_dye"));
@@ -132,15 +132,19 @@ TEST_CASE("bench game runs the column in two materials: a dye changes no physics
   // Water below and dye of its density above move as water alone: the same particles,
   // substeps, compression, surge and surface.
   for (std::size_t c : {3u, 7u, 8u, 9u, 10u, 12u, 14u, 15u}) CHECK(by["sph2d_game_dye"][c] == by["sph2d_game"][c]);
-  CHECK(std::stod(by["sph2d_balanced_oil"][13]) == 0);  // nothing outside the tank
-  CHECK(std::stod(by["sph2d_balanced_oil"][9]) < 0.05);
-  // Oil needs a solver that takes a density contrast: the game preset's refuses, naming what runs.
-  const Result refused = run("bench game --particles 600 --seconds 0.25 --presets game_oil");
+  for (const char* oil : {"sph2d_balanced_oil", "sph2d_game_oil"}) {
+    REQUIRE(by.count(oil));
+    CHECK(std::stod(by[oil][13]) == 0);  // nothing outside the tank
+    CHECK(std::stod(by[oil][9]) < 0.05);
+  }
+  // Oil needs a solver that takes a density contrast: the accurate preset's (dfsph) refuses,
+  // naming what runs.
+  const Result refused = run("bench game --particles 600 --seconds 0.25 --presets accurate_oil");
   CHECK(refused.code == 2);
-  CHECK(refused.out.find("balanced (wcsph)") != std::string::npos);
+  CHECK(refused.out.find("runs on game and balanced") != std::string::npos);
   const Result unknown = run("bench game --only game_syrup-600-t1");
   CHECK(unknown.code == 2);
-  const Result oilId = run("bench game --only game_oil-600-t1");
+  const Result oilId = run("bench game --only accurate_oil-600-t1");
   CHECK(oilId.code == 2);
-  CHECK(oilId.out.find("balanced (wcsph)") != std::string::npos);
+  CHECK(oilId.out.find("runs on game and balanced") != std::string::npos);
 }

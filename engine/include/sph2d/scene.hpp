@@ -166,8 +166,8 @@ std::vector<MaterialDef> sceneMaterials(const SceneDef& scene);
 
 /// Why `m` cannot join `materials` in a World of `solver` ("" when it can): a name that is
 /// empty, too long or already taken, a density or viscosity out of range, a miscible_with
-/// naming no material, or a density the solver cannot take beside the first material's (only
-/// wcsph takes a density contrast: docs/SCENES.md).
+/// naming no material, or a density the solver cannot take beside the first material's
+/// (wcsph, pbf and game take a density contrast: docs/SCENES.md).
 std::string materialProblem(const std::vector<MaterialDef>& materials, const MaterialDef& m, const SolverDef& solver);
 
 /// An axis-aligned box region.

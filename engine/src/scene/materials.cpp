@@ -22,7 +22,9 @@ double viscosityOf(const MaterialDef& m, const SolverDef& solver) {
   return m.viscosity < 0 ? solver.viscosity : m.viscosity;
 }
 
-bool takesDensityContrast(const std::string& solver) { return solver == "wcsph"; }
+bool takesDensityContrast(const std::string& solver) {
+  return solver == "wcsph" || solver == "pbf" || solver == "game";
+}
 
 std::string densityContrastProblem(const SceneDef& scene) {
   const EffectsDef& e = scene.effects;
@@ -87,12 +89,13 @@ std::string materialProblem(const std::vector<MaterialDef>& materials, const Mat
              "\", which it mixes with (miscible_with): a pair that mixes has no interface";
   }
   if (materials.empty()) return "";
-  // wcsph takes a density contrast (number density), the others one rest density for all
-  // particles; every solver a viscosity per material.
+  // wcsph, pbf and game take a density contrast (number density), muller2003 and dfsph one
+  // rest density for all particles; every solver a viscosity per material.
   const MaterialDef& first = materials.front();
   if (m.density != first.density && !takesDensityContrast(solver.type))
     o << "density " << m.density << " kg/m³ differs from the first material's (" << first.name << ", " << first.density
-      << "): solver '" << solver.type << "' takes materials of one density (wcsph takes a density contrast)";
+      << "): solver '" << solver.type
+      << "' takes materials of one density (wcsph, pbf and game take a density contrast)";
   return o.str();
 }
 

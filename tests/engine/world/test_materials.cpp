@@ -4,6 +4,7 @@
 // one fluid holding no field for it.
 #include <doctest/doctest.h>
 
+#include <algorithm>
 #include <cstring>
 #include <map>
 #include <sstream>
@@ -147,7 +148,13 @@ TEST_CASE("materials: addMaterial follows the scene's rule, and the field appear
   MaterialDef oil = dye;
   oil.name = "oil";
   oil.density = 800;
-  CHECK_THROWS_WITH_AS(w.addMaterial(oil), doctest::Contains("takes materials of one density"), std::invalid_argument);
+  {  // dfsph takes materials of one density; game takes a contrast (below)
+    SceneDef d = test::tank("dfsph", 1.0, 1.0, 0.04);
+    d.blocks = s.blocks;
+    World wd(d);
+    CHECK_THROWS_WITH_AS(wd.addMaterial(oil), doctest::Contains("takes materials of one density"),
+                         std::invalid_argument);
+  }
   oil.density = s.solver.restDensity;
   oil.viscosity = s.solver.viscosity + 0.01;
   CHECK_THROWS_WITH_AS(w.addMaterial(oil), doctest::Contains("built without viscosity"), std::invalid_argument);
@@ -158,6 +165,13 @@ TEST_CASE("materials: addMaterial follows the scene's rule, and the field appear
   CHECK_THROWS_WITH_AS(w.addMaterial(oil), doctest::Contains("mixes with none"), std::invalid_argument);
   oil.miscibleWith.clear();
   CHECK(w.addMaterial(oil) == 2);
+  for (const std::string& f : w.particleFields()) CHECK(f != "rest_ratio");
+  MaterialDef slurry = dye;
+  slurry.name = "slurry";
+  slurry.density = 3000;
+  CHECK(w.addMaterial(slurry) == 3);  // a density contrast: the rest ratio field appears
+  const std::vector<std::string> fields = w.particleFields();
+  CHECK(std::find(fields.begin(), fields.end(), "rest_ratio") != fields.end());
 }
 
 TEST_CASE("materials: a viscosity of its own is taken at run time where the World has the viscosity effect") {

@@ -11,7 +11,8 @@
 namespace sph2d {
 
 void GridPcg::assemble(int nx, int ny, const std::vector<std::uint8_t>& type, const std::vector<std::uint8_t>& uOpen,
-                       const std::vector<std::uint8_t>& vOpen, const std::vector<Real>* thetaUp) {
+                       const std::vector<std::uint8_t>& vOpen, const std::vector<Real>* thetaUp,
+                       const std::vector<Real>* uBeta, const std::vector<Real>* vBeta) {
   nx_ = nx;
   ny_ = ny;
   const int nu = nx_ + 1;
@@ -34,22 +35,30 @@ void GridPcg::assemble(int nx, int ny, const std::vector<std::uint8_t>& type, co
   diag_.assign(m, 0);
   adj_.assign(4 * m, -1);
   vented_.assign(m, 0);
+  const bool weighted = uBeta && vBeta;
+  if (weighted)
+    beta_.assign(4 * m, 0);
+  else
+    beta_.clear();
   forUnknowns([&](std::size_t a, int i, int j) {
     const int k = cells_[a];
-    const bool open[4] = {uOpen[std::size_t(j) * nu + i] != 0, uOpen[std::size_t(j) * nu + i + 1] != 0,
-                          vOpen[std::size_t(j) * nx_ + i] != 0, vOpen[std::size_t(j + 1) * nx_ + i] != 0};
+    const std::size_t faces[4] = {std::size_t(j) * nu + i, std::size_t(j) * nu + i + 1, std::size_t(j) * nx_ + i,
+                                  std::size_t(j + 1) * nx_ + i};
+    const bool open[4] = {uOpen[faces[0]] != 0, uOpen[faces[1]] != 0, vOpen[faces[2]] != 0, vOpen[faces[3]] != 0};
     const int nb[4] = {k - 1, k + 1, k - nx_, k + nx_};
     Real dg = 0;
     for (int q = 0; q < 4; ++q) {
       const std::uint8_t t = type[std::size_t(nb[q])];
+      const Real b = weighted ? (q < 2 ? *uBeta : *vBeta)[faces[q]] : Real(1);
       if (q == 3 && open[q] && t == kAir && thetaUp) {
-        dg += Real(1) / (*thetaUp)[std::size_t(k)];  // the ghost-fluid surface θ of the way up
+        dg += b / (*thetaUp)[std::size_t(k)];  // the ghost-fluid surface θ of the way up
         vented_[a] = 1;
       } else if (open[q] && (t == kFluid || t == kAir)) {
-        dg += 1;
+        dg += b;
         if (t == kAir) vented_[a] = 1;
       }
       adj_[4 * a + q] = open[q] ? index_[std::size_t(nb[q])] : -1;  // −1: air, solid or closed
+      if (weighted && adj_[4 * a + q] >= 0) beta_[4 * a + q] = b;
     }
     diag_[a] = dg;
   });
@@ -60,29 +69,48 @@ void GridPcg::factor() {
   groundPockets();
   nbrPad_.resize(adj_.size());
   for (std::size_t e = 0; e < adj_.size(); ++e) nbrPad_[e] = adj_[e] >= 0 ? adj_[e] : std::int32_t(m);
+  if (beta_.empty())
+    factorRows<false>();
+  else
+    factorRows<true>();
+  precon2_.resize(m);
+  for (std::size_t a = 0; a < m; ++a) precon2_[a] = precon_[a] * precon_[a];
+}
+
+template <bool Weighted>
+void GridPcg::factorRows() {
   // MIC(0) (Bridson, "Fluid Simulation for Computer Graphics", 2nd ed., fig. 5.7):
-  // the incomplete Cholesky factor of the 5-point Laplacian, in cell order.
+  // the incomplete Cholesky factor of the 5-point Laplacian, in cell order. The entry of
+  // face q of unknown a is −β (−1 unweighted).
+  const std::size_t m = cells_.size();
+  auto beta = [&](std::size_t a, int q) { return Weighted ? beta_[4 * a + std::size_t(q)] : Real(1); };
   const Real tau = Real(0.97), sigma = Real(0.25);
   precon_.assign(m, 0);
   for (std::size_t a = 0; a < m; ++a) {
     if (!(diag_[a] > 0)) continue;
     Real e = diag_[a];
     const std::int32_t l = adj_[4 * a + 0], d = adj_[4 * a + 2];
-    if (l >= 0) {  // A(left, a) = −1; the left cell's "plus j" entry: its up neighbour
+    if (l >= 0) {  // A(left, a) = −β; the left cell's "plus j" entry: its up neighbour
       const Real pl = precon_[std::size_t(l)];
-      const Real aUpL = adj_[4 * std::size_t(l) + 3] >= 0 ? Real(-1) : Real(0);
-      e -= pl * pl + tau * (-1) * aUpL * pl * pl;
+      const Real aL = -beta(a, 0);
+      const Real aUpL = adj_[4 * std::size_t(l) + 3] >= 0 ? -beta(std::size_t(l), 3) : Real(0);
+      if (Weighted)
+        e -= (aL * pl) * (aL * pl) + tau * aL * aUpL * pl * pl;
+      else
+        e -= pl * pl + tau * (-1) * aUpL * pl * pl;
     }
     if (d >= 0) {
       const Real pd = precon_[std::size_t(d)];
-      const Real aRightD = adj_[4 * std::size_t(d) + 1] >= 0 ? Real(-1) : Real(0);
-      e -= pd * pd + tau * (-1) * aRightD * pd * pd;
+      const Real aD = -beta(a, 2);
+      const Real aRightD = adj_[4 * std::size_t(d) + 1] >= 0 ? -beta(std::size_t(d), 1) : Real(0);
+      if (Weighted)
+        e -= (aD * pd) * (aD * pd) + tau * aD * aRightD * pd * pd;
+      else
+        e -= pd * pd + tau * (-1) * aRightD * pd * pd;
     }
     if (e < sigma * diag_[a]) e = diag_[a];
     precon_[a] = Real(1) / std::sqrt(e);
   }
-  precon2_.resize(m);
-  for (std::size_t a = 0; a < m; ++a) precon2_[a] = precon_[a] * precon_[a];
 }
 
 void GridPcg::groundPockets() {
@@ -153,6 +181,7 @@ void GridPcg::balance(std::vector<Real>& rhs) const {
     }
 }
 
+template <bool Weighted>
 void GridPcg::precondition(const std::vector<Real>& r, std::vector<Real>& z, std::vector<Real>& y) const {
   // z = (L Lᵀ)⁻¹ r with L = MIC(0)'s factor (p = precon_ = 1/diag(L), p2 = p²). Each
   // substitution is a chain from one cell to the next along a row (a left neighbour is
@@ -161,21 +190,23 @@ void GridPcg::precondition(const std::vector<Real>& r, std::vector<Real>& z, std
   // free: two rows run side by side, the second a cell or more behind the first, so two
   // chains are in flight (the chain is one multiply and one add per cell, and with one
   // row at a time the core waits on it). Each cursor carries its row's last value in a
-  // register. The same bits as one cell after the other.
+  // register. The same bits as one cell after the other. Weighted, each neighbour's share
+  // is taken times its face's β.
   const std::size_t m = cells_.size();
   const Real* p = precon_.data();
   const Real* p2 = precon2_.data();
   const std::int32_t* A = adj_.data();
   const std::int32_t* rows = rowStart_.data();
   const Real* R = r.data();
+  const Real* Bt = beta_.data();
   y.resize(m);
   Real* Y = y.data();
   Real* Z = z.data();
   // Forward: q = L⁻¹ r, kept as z (= q) and y = q·p (what the right and up cells read).
   auto forward = [&](std::int32_t a, Real& yPrev) {
     const std::int32_t l = A[4 * a + 0], d = A[4 * a + 2];
-    const Real t = R[a] + (d >= 0 ? Y[d] : Real(0));
-    const Real yl = l < 0 ? Real(0) : yPrev;
+    const Real t = R[a] + (d >= 0 ? (Weighted ? Bt[4 * a + 2] * Y[d] : Y[d]) : Real(0));
+    const Real yl = l < 0 ? Real(0) : Weighted ? Bt[4 * a + 0] * yPrev : yPrev;
     Z[a] = (t + yl) * p[a];
     yPrev = Y[a] = t * p2[a] + yl * p2[a];
   };
@@ -193,8 +224,8 @@ void GridPcg::precondition(const std::vector<Real>& r, std::vector<Real>& z, std
   // Backward: z = L⁻ᵀ q, from the top row down.
   auto backward = [&](std::int32_t a, Real& zNext) {
     const std::int32_t rt = A[4 * a + 1], u = A[4 * a + 3];
-    const Real s = Z[a] * p[a] + (u >= 0 ? Z[u] : Real(0)) * p2[a];
-    const Real zr = rt < 0 ? Real(0) : zNext;
+    const Real s = Z[a] * p[a] + (u >= 0 ? (Weighted ? Bt[4 * a + 3] * Z[u] : Z[u]) : Real(0)) * p2[a];
+    const Real zr = rt < 0 ? Real(0) : Weighted ? Bt[4 * a + 1] * zNext : zNext;
     zNext = Z[a] = s + zr * p2[a];
   };
   for (int j = ny_ - 1; j >= 0; j -= 2) {
@@ -217,6 +248,7 @@ double GridPcg::dot(const std::vector<Real>& a, const std::vector<Real>& b) cons
   return s;
 }
 
+template <bool Weighted>
 double GridPcg::applyDot(const std::vector<Real>& in, std::vector<Real>& out) const {
   // apply(in, out, false), and in·out summed in cell order as it goes. `in` holds m + 1
   // values, the last 0: a missing neighbour (nbrPad_ = m) subtracts that 0, as exact as
@@ -227,12 +259,20 @@ double GridPcg::applyDot(const std::vector<Real>& in, std::vector<Real>& out) co
   const Real* D = diag_.data();
   Real* O = out.data();
   double dsum = 0;
+  const Real* Bt = beta_.data();
   for (std::size_t a = 0; a < m; ++a) {
     Real s = D[a] * I[a];
-    s -= I[A[4 * a + 0]];
-    s -= I[A[4 * a + 1]];
-    s -= I[A[4 * a + 2]];
-    s -= I[A[4 * a + 3]];
+    if (Weighted) {
+      s -= Bt[4 * a + 0] * I[A[4 * a + 0]];
+      s -= Bt[4 * a + 1] * I[A[4 * a + 1]];
+      s -= Bt[4 * a + 2] * I[A[4 * a + 2]];
+      s -= Bt[4 * a + 3] * I[A[4 * a + 3]];
+    } else {
+      s -= I[A[4 * a + 0]];
+      s -= I[A[4 * a + 1]];
+      s -= I[A[4 * a + 2]];
+      s -= I[A[4 * a + 3]];
+    }
     O[a] = s;
     dsum += double(I[a]) * double(s);
   }
@@ -245,7 +285,8 @@ void GridPcg::apply(const std::vector<Real>& in, std::vector<Real>& out) const {
   for (std::size_t a = 0; a < m; ++a) {
     Real s = diag_[a] * in[a];
     for (int q = 0; q < 4; ++q)
-      if (A[4 * a + q] >= 0) s -= in[std::size_t(A[4 * a + q])];
+      if (A[4 * a + q] >= 0)
+        s -= (beta_.empty() ? Real(1) : beta_[4 * a + std::size_t(q)]) * in[std::size_t(A[4 * a + q])];
     out[a] = s;
   }
 }
@@ -268,7 +309,14 @@ int GridPcg::solve(std::vector<Real>& x, const std::vector<Real>& b, Real tol, i
     return mx;
   };
   double rz = 0;
-  precondition(r_, z_, w.y);
+  const bool weighted = !beta_.empty();
+  auto precondition = [&] {
+    if (weighted)
+      this->precondition<true>(r_, z_, w.y);
+    else
+      this->precondition<false>(r_, z_, w.y);
+  };
+  precondition();
   for (std::size_t a = 0; a < m; ++a) {
     d_[a] = z_[a];
     rz += double(r_[a]) * double(z_[a]);
@@ -278,7 +326,9 @@ int GridPcg::solve(std::vector<Real>& x, const std::vector<Real>& b, Real tol, i
   while (it < maxIterations && res > tol && rz > 0) {
     // q = A d and d·q (in one pass when no extra term adds to q afterwards), the update of r
     // with the largest |r| in one pass: the same sums in the same order.
-    const double dq = extra ? (apply(d_, q_), (*extra)(d_, q_), dot(d_, q_)) : applyDot(d_, q_);
+    const double dq = extra      ? (apply(d_, q_), (*extra)(d_, q_), dot(d_, q_))
+                      : weighted ? applyDot<true>(d_, q_)
+                                 : applyDot<false>(d_, q_);
     if (!(dq > 0)) break;
     const Real alpha = Real(rz / dq);
     Real mx = 0;
@@ -286,7 +336,7 @@ int GridPcg::solve(std::vector<Real>& x, const std::vector<Real>& b, Real tol, i
       r_[a] -= alpha * q_[a];
       mx = std::max(mx, std::fabs(r_[a]));
     }
-    precondition(r_, z_, w.y);
+    precondition();
     // r·z in cell order, and x's update beside it (d is still this iteration's: the same
     // x; the sum is a chain of additions, and the update fills the core's idle slots).
     double rzNew = 0;

@@ -8,7 +8,11 @@
 // or air cells; an air cell holds x = 0 at its centre (Dirichlet), a solid cell or a closed
 // face adds nothing (Neumann, no flow). With the ghost-fluid surface the face up to air
 // counts 1/θ instead of 1 (the surface a fraction θ of the way to the air cell's centre:
-// Gibou, Fedkiw, Cheng & Kang 2002, JCP).
+// Gibou, Fedkiw, Cheng & Kang 2002, JCP). With a coefficient per face (materials of
+// different density: β = ρ0/ρ_face) each face counts β instead of 1, on the diagonal and
+// off it: the matrix of −h²∇·(β∇x), still symmetric (one β per face), the MIC(0) factor
+// and both substitutions weighted alike. Without one, the loops run as before (β = 1 is no
+// multiplication: the same bits).
 //
 // A sealed pocket (fluid cells joined by open faces with no open face to air, and none the
 // caller vents: a body that can move) is a pure Neumann block: singular, its solution
@@ -48,10 +52,13 @@ class GridPcg {
   /// Numbers the fluid cells of `type` (nx·ny, row by row) and builds their rows. `uOpen`
   /// ((nx + 1)·ny) and `vOpen` (nx·(ny + 1)) say which faces flow may cross (a fluid cell's
   /// faces are read); `thetaUp` (per cell, or null: 1) where the surface lies above a fluid
-  /// cell whose face up is open to air. Fluid cells must not touch the grid's border (the
-  /// projection leaves its border cells air). Then vent() and factor() follow.
+  /// cell whose face up is open to air; `uBeta` and `vBeta` (laid out as uOpen and vOpen,
+  /// both or neither) each face's coefficient β > 0 (null: 1). Fluid cells must not touch
+  /// the grid's border (the projection leaves its border cells air). Then vent() and
+  /// factor() follow.
   void assemble(int nx, int ny, const std::vector<std::uint8_t>& type, const std::vector<std::uint8_t>& uOpen,
-                const std::vector<std::uint8_t>& vOpen, const std::vector<Real>* thetaUp);
+                const std::vector<std::uint8_t>& vOpen, const std::vector<Real>* thetaUp,
+                const std::vector<Real>* uBeta = nullptr, const std::vector<Real>* vBeta = nullptr);
   /// Unknown a's region is not sealed (a dynamic body it pushes can give way).
   void vent(std::size_t a) { vented_[a] = 1; }
   /// Grounds the sealed pockets and computes the MIC(0) factor (after assemble() and vent()).
@@ -83,8 +90,12 @@ class GridPcg {
 
  private:
   void groundPockets();
+  template <bool Weighted>
+  void factorRows();
+  template <bool Weighted>
   void precondition(const std::vector<Real>& r, std::vector<Real>& z, std::vector<Real>& y) const;
   /// apply(in, out), returning in·out (summed in cell order, in double); `in` holds m + 1 values, the last 0.
+  template <bool Weighted>
   double applyDot(const std::vector<Real>& in, std::vector<Real>& out) const;
   /// a·b over the unknowns, summed in cell order in double.
   double dot(const std::vector<Real>& a, const std::vector<Real>& b) const;
@@ -96,6 +107,7 @@ class GridPcg {
   std::vector<Real> diag_;              ///< per unknown
   std::vector<std::int32_t> adj_;       ///< per unknown: left, right, down, up unknown (−1: none)
   std::vector<std::int32_t> nbrPad_;    ///< adj_ with m for none (applyDot reads a 0 there)
+  std::vector<Real> beta_;              ///< per unknown, its four faces' β as adj_ (empty: every β is 1)
   std::vector<Real> precon_, precon2_;  ///< MIC(0) factor: 1/diag(L), and its square
   std::vector<std::uint8_t> vented_;    ///< per unknown: an open face to air (then per region root: the region has one)
   std::vector<std::int32_t> pocketOf_;  ///< per unknown: its sealed pocket (−1: a vented region)

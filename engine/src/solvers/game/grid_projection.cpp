@@ -11,6 +11,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <type_traits>
 
 namespace sph2d {
 
@@ -60,11 +61,20 @@ void GridProjection::layout(const StepContext& c) {
   }
 }
 
-void GridProjection::resetCells() {
+void GridProjection::resetCells(bool contrast) {
   // The cells' fields and the faces' flags (classify and assemble write them).
   const std::size_t cells = std::size_t(nx_) * std::size_t(ny_);
   type_.assign(cells, kAir);
   w_.assign(cells, 0);
+  if (contrast) {
+    wr_.assign(cells, 0);
+    uBeta_.assign(std::size_t(nx_ + 1) * std::size_t(ny_), Real(1));
+    vBeta_.assign(std::size_t(nx_) * std::size_t(ny_ + 1), Real(1));
+  } else {
+    wr_.clear();
+    uBeta_.clear();
+    vBeta_.clear();
+  }
   comp_.assign(cells, 0);
   if (surface_) top_.assign(cells, -std::numeric_limits<Real>::infinity());
   uOpen_.assign(std::size_t(nx_ + 1) * std::size_t(ny_), 0);
@@ -178,16 +188,42 @@ void GridProjection::splatCells(const StepContext& c) {
   // Serial in slot order (the same bits for any thread count).
   const ParticleStore& P = c.P;
   const Real rho0 = c.rho0;
-  // The cells' SPH compression is read only by the compression source.
+  // The cells' SPH compression is read only by the compression source; with a density
+  // contrast it counts particles (ρ_i/(r_i ρ0)), and the cells' rest ratios are splatted too.
   Real* comp = rate_ > 0 ? comp_.data() : nullptr;
-  for (std::size_t p = 0; p < P.size(); ++p) {
-    const Real px = P.x[p].x() * invH_ - Real(I0_), py = P.x[p].y() * invH_ - Real(J0_);
-    splat(comp, w_, nx_, px - Real(0.5), py - Real(0.5), P.rho[p] / rho0 - Real(1));  // cell centres
-    if (surface_) {  // the highest particle of each cell (the ghost surface's height)
-      const std::size_t k = std::size_t(int(py)) * std::size_t(nx_) + std::size_t(int(px));
-      top_[k] = std::max(top_[k], P.x[p].y());
+  const std::vector<Real>* ratioField = wr_.empty() ? nullptr : P.find(ParticleStore::kRestRatio);
+  const Real* ratio = ratioField ? ratioField->data() : nullptr;
+  // The loop, compiled once with a density contrast and once without.
+  auto loop = [&](auto contrastTag) {
+    constexpr bool kContrast = decltype(contrastTag)::value;
+    for (std::size_t p = 0; p < P.size(); ++p) {
+      const Real px = P.x[p].x() * invH_ - Real(I0_), py = P.x[p].y() * invH_ - Real(J0_);
+      Real compression;
+      if constexpr (kContrast)
+        compression = P.rho[p] / (rho0 * ratio[p]) - Real(1);
+      else
+        compression = P.rho[p] / rho0 - Real(1);
+      splat(comp, w_, nx_, px - Real(0.5), py - Real(0.5), compression);  // cell centres
+      if constexpr (kContrast) {                                          // Σ w r with splat()'s weights
+        const Real fx = px - Real(0.5), fy = py - Real(0.5);
+        const int i0 = int(fx), j0 = int(fy);
+        const Real tx = fx - Real(i0), ty = fy - Real(j0);
+        const std::size_t k = std::size_t(j0) * std::size_t(nx_) + std::size_t(i0);
+        wr_[k] += (1 - tx) * (1 - ty) * ratio[p];
+        wr_[k + 1] += tx * (1 - ty) * ratio[p];
+        wr_[k + std::size_t(nx_)] += (1 - tx) * ty * ratio[p];
+        wr_[k + std::size_t(nx_) + 1] += tx * ty * ratio[p];
+      }
+      if (surface_) {  // the highest particle of each cell (the ghost surface's height)
+        const std::size_t k = std::size_t(int(py)) * std::size_t(nx_) + std::size_t(int(px));
+        top_[k] = std::max(top_[k], P.x[p].y());
+      }
     }
-  }
+  };
+  if (ratio)
+    loop(std::true_type{});
+  else
+    loop(std::false_type{});
 }
 
 void GridProjection::splatFaces(const StepContext& c, int axis) {
@@ -216,7 +252,7 @@ std::size_t GridProjection::project(StepContext& c) {
   c.pool.parallelFor(3, 1, [&](std::size_t b, std::size_t e) {
     for (std::size_t task = b; task < e; ++task) {
       if (task == 0) {
-        resetCells();
+        resetCells(c.P.find(ParticleStore::kRestRatio) != nullptr);
         splatCells(c);
         classify(c);
         assemble();

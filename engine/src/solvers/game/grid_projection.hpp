@@ -31,6 +31,13 @@
 // the deficit of interior cells (Kugelstadt et al. correct both signs): air that
 // the projection would keep in a cell rises out of the water.
 //
+// Materials of different rest density (the field "rest_ratio", r = ρ0_i/ρ0): the cells'
+// compression counts particles (number density: ρ_i/(r_i ρ0)), and each face takes
+// β = 1/r_face, r_face the mean of its two cells' mass-weighted ratios: the system is
+// −h²∇·(β∇κ) with κ = p/ρ0 continuous across an interface, and a face's velocity changes by
+// −dt β ∇κ (the variable-density projection: Bridson's book, ch. 5.2 and ch. 12, as used for
+// multiphase FLIP by Boyd & Bridson 2012, "MultiFLIP for energetic two-phase fluid simulation").
+//
 // Deterministic: particles go to the grid in slot order (each field on one
 // thread), the conjugate-gradient sums are taken in cell order. On two threads
 // a projection is four steps of a few tasks each (project()): the cells'
@@ -100,7 +107,11 @@ class GridProjection {
   /// The grid over the particles' box (cells of cellRatio_·dx, larger for spray).
   void layout(const StepContext& c);
   /// Sizes and clears the cell fields and the face flags (the first task of a projection).
-  void resetCells();
+  void resetCells(bool contrast);
+  /// Each face's β = 1/r_face from the cells' rest ratios (a density contrast).
+  void faceCoefficients();
+  /// β of u face f (axis 0) or v face f (axis 1): 1 without a density contrast.
+  Real beta(int axis, std::size_t f) const { return uBeta_.empty() ? Real(1) : axis == 0 ? uBeta_[f] : vBeta_[f]; }
   /// Sizes and clears one axis's face fields (0: u, 1: v; that axis's splat task).
   void resetFaces(int axis);
   void classify(const StepContext& c);
@@ -169,6 +180,8 @@ class GridProjection {
   std::vector<std::uint8_t> uOpen_, vOpen_;    ///< per face: flow may cross it
   std::vector<std::uint8_t> fluidU_, fluidV_;  ///< per face: next to a fluid cell (its change is known)
   std::vector<Real> w_, comp_;                 ///< per cell: particle weight, weighted compression
+  std::vector<Real> wr_;                       ///< per cell: weighted rest ratio (a density contrast only)
+  std::vector<Real> uBeta_, vBeta_;            ///< per face: 1/r_face (a density contrast only; else empty)
   std::vector<Real> top_;                      ///< per cell: its highest particle's y (the ghost surface only)
   std::vector<Real> thetaUp_;                  ///< per cell: where the ghost surface lies above it, in cells (1: none)
   Real dx_ = 0;                                ///< the particle spacing

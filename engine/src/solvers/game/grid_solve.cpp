@@ -35,9 +35,34 @@ void GridProjection::assemble() {
             std::clamp(Real((double(ytop) + 0.5 * double(dx_) - ya) * double(invH_)), kMinSurfaceFraction, Real(1));
       }
   }
-  pcg_.assemble(nx_, ny_, type_, uOpen_, vOpen_, surface_ ? &thetaUp_ : nullptr);
+  const bool contrast = !uBeta_.empty();
+  if (contrast) faceCoefficients();
+  pcg_.assemble(nx_, ny_, type_, uOpen_, vOpen_, surface_ ? &thetaUp_ : nullptr, contrast ? &uBeta_ : nullptr,
+                contrast ? &vBeta_ : nullptr);
   assembleCoupling();  // vents the regions a dynamic body touches
   pcg_.factor();
+}
+
+void GridProjection::faceCoefficients() {
+  // r_face: the mean of the two cells' mass-weighted rest ratios (Σ w r / Σ w), or the one
+  // cell's that holds particles; β = 1/r_face (1 where neither does).
+  auto cellRatio = [&](std::size_t k) { return w_[k] > 0 ? wr_[k] / w_[k] : Real(0); };
+  auto coefficient = [&](std::size_t k1, std::size_t k2) {
+    const Real r1 = cellRatio(k1), r2 = cellRatio(k2);
+    const Real r = r1 > 0 && r2 > 0 ? Real(0.5) * (r1 + r2) : std::max(r1, r2);
+    return r > 0 ? Real(1) / r : Real(1);
+  };
+  const int nu = nx_ + 1;
+  for (int j = 0; j < ny_; ++j)
+    for (int i = 1; i < nx_; ++i) {
+      const std::size_t k = std::size_t(j) * nx_ + std::size_t(i);
+      uBeta_[std::size_t(j) * nu + i] = coefficient(k - 1, k);
+    }
+  for (int j = 1; j < ny_; ++j)
+    for (int i = 0; i < nx_; ++i) {
+      const std::size_t k = std::size_t(j) * nx_ + std::size_t(i);
+      vBeta_[k] = coefficient(k - std::size_t(nx_), k);
+    }
 }
 
 void GridProjection::addCoupled(const std::vector<Real>& in, std::vector<Real>& out) const {

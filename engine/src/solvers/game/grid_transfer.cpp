@@ -83,7 +83,7 @@ void GridProjection::shiftMoves(const StepContext& c) {
       if (!fluidU_[f]) continue;
       const std::size_t kl = std::size_t(j) * nx_ + i - 1, kr = kl + 1;
       const bool solidSide = type_[kl] == kSolid || type_[kr] == kSolid;
-      if (uOpen_[f] && !solidSide && bodyAcross(kl, kr) < 0) su_[f] = k2 * (phi(i, j) - phi(i - 1, j));
+      if (uOpen_[f] && !solidSide && bodyAcross(kl, kr) < 0) su_[f] = k2 * (phi(i, j) - phi(i - 1, j)) * beta(0, f);
     }
   extrapolate(su_, nu, ny_, fluidU_);
   for (int j = 1; j < ny_; ++j)
@@ -94,7 +94,8 @@ void GridProjection::shiftMoves(const StepContext& c) {
       const bool solidSide = type_[kd] == kSolid || type_[ku] == kSolid;
       // Under the ghost surface the gradient spans θ of a cell (the matrix's 1/θ).
       const Real span = surface_ && type_[ku] == kAir ? thetaUp_[kd] : Real(1);
-      if (vOpen_[f] && !solidSide && bodyAcross(kd, ku) < 0) sv_[f] = k2 * (phi(i, j) - phi(i, j - 1)) / span;
+      if (vOpen_[f] && !solidSide && bodyAcross(kd, ku) < 0)
+        sv_[f] = k2 * (phi(i, j) - phi(i, j - 1)) / span * beta(1, f);
     }
   extrapolate(sv_, nx_, ny_ + 1, fluidV_);
 }
@@ -131,11 +132,11 @@ std::size_t GridProjection::transferToParticles(StepContext& c) {
             const bool solidSide = type_[kl] == kSolid || type_[kr] == kSolid;
             const int body = solidSide ? -1 : bodyAcross(kl, kr);
             du_[f] = body >= 0                 ? bodyFaceVelocity(body, 0, i, j) - u_[f]  // a moving body's face
-                     : uOpen_[f] && !solidSide ? -dt * (kap(i, j) - kap(i - 1, j)) * invH_
+                     : uOpen_[f] && !solidSide ? -dt * (kap(i, j) - kap(i - 1, j)) * invH_ * beta(0, f)
                                                : -u_[f];
             if (countWall && body < 0 && !(uOpen_[f] && !solidSide))
-              wallAxis[0] +=
-                  wallP * (double(kap(i, j)) - double(kap(i - 1, j))) + wallM * double(uw_[f]) * double(du_[f]);
+              wallAxis[0] += wallP * (double(kap(i, j)) - double(kap(i - 1, j))) +
+                             wallM * double(uw_[f]) * double(du_[f]) / double(beta(0, f));
           }
         extrapolate(du_, nu, ny_, fluidU_);
         if (pic_ > 0)  // the projected face velocities (closed faces: 0)
@@ -151,11 +152,11 @@ std::size_t GridProjection::transferToParticles(StepContext& c) {
             // Under the ghost surface the gradient spans θ of a cell (the matrix's 1/θ).
             const Real span = surface_ && type_[ku] == kAir ? thetaUp_[kd] : Real(1);
             dv_[f] = body >= 0                 ? bodyFaceVelocity(body, 1, i, j) - v_[f]
-                     : vOpen_[f] && !solidSide ? -dt * (kap(i, j) - kap(i, j - 1)) * invH_ / span
+                     : vOpen_[f] && !solidSide ? -dt * (kap(i, j) - kap(i, j - 1)) * invH_ / span * beta(1, f)
                                                : -v_[f];
             if (countWall && body < 0 && !(vOpen_[f] && !solidSide))
-              wallAxis[1] +=
-                  wallP * (double(kap(i, j)) - double(kap(i, j - 1))) + wallM * double(vw_[f]) * double(dv_[f]);
+              wallAxis[1] += wallP * (double(kap(i, j)) - double(kap(i, j - 1))) +
+                             wallM * double(vw_[f]) * double(dv_[f]) / double(beta(1, f));
           }
         extrapolate(dv_, nx_, ny_ + 1, fluidV_);
         if (pic_ > 0)

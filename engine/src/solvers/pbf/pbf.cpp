@@ -5,10 +5,11 @@
 // prediction, the final density and pressure, and the velocity with XSPH
 // (Monaghan 1989). The method and its design choices: pbf.hpp; the
 // constraint and correction passes: pbf_constraint.cpp; the parameters and
-// the registrations of pbf and game: pbf_params.cpp.
+// the registrations of pbf and game, and the calibration of D0: pbf_params.cpp.
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <type_traits>
 
 #include "core/state_io.hpp"
 #include "solvers/pbf/pbf.hpp"
@@ -157,6 +158,15 @@ std::size_t Pbf::solve(StepContext& c) {
   if (n == 0) return kNone;
   if (!(d0_ > 0)) calibrate(c);
   std::vector<Real>& lambda = c.P.field("pbf.lambda");
+  // A density contrast: each particle's inverse mass ratio 1/r_i (pbf.hpp).
+  if (const std::vector<Real>* ratio = c.P.find(ParticleStore::kRestRatio)) {
+    invRatio_.resize(n);
+    c.pool.parallelFor(n, kStreamBlock, [&](std::size_t b, std::size_t e) {
+      for (std::size_t i = b; i < e; ++i) invRatio_[i] = Real(1) / (*ratio)[i];
+    });
+  } else {
+    invRatio_.clear();
+  }
   dLambda_.resize(n);
   lOld_.resize(n);
   wallGrad_.resize(n);
@@ -315,25 +325,6 @@ void Pbf::neighbourhood(const StepContext& c, const std::vector<std::uint32_t>& 
   }
 }
 
-void Pbf::calibrate(const StepContext& c) {
-  const double R = double(c.R), dx = double(c.dx);
-  const double V = double(c.mass) / double(c.rho0);
-  const Spiky<double> W(R);
-  const int n = int(std::ceil(R / dx)) + 1;
-  double s = 0;
-  for (int j = -n; j <= n; ++j)
-    for (int i = -n; i <= n; ++i) {
-      if (i == 0 && j == 0) continue;
-      const double g = W.derivative(std::sqrt(double(i * i + j * j)) * dx);
-      s += g * g;
-    }
-  d0_ = Real(V * V * s);
-  eps_ = relaxation_ * d0_;
-  // s_corr = −k (W(r)/W(Δq))^n, in multipliers: 1/D0 corrects a density error of 1.
-  invWdq_ = Real(1.0 / W.value(double(tensileDq_) * R));
-  sCorrScale_ = Real(-double(tensileK_) / double(d0_));
-}
-
 std::size_t Pbf::predict(StepContext& c, std::vector<Real>& lambda) {
   ParticleStore& P = c.P;
   const Real dt = c.dt, vmax2 = c.maxSpeed * c.maxSpeed, moveMax2 = vmax2 * dt * dt;
@@ -350,6 +341,8 @@ std::size_t Pbf::predict(StepContext& c, std::vector<Real>& lambda) {
   // may remove as velocity in this substep.
   std::vector<Real>* carried = pushoutSpeed_ > 0 && toVelocity_ > 0 ? P.find("pbf.carried") : nullptr;
   const Real pushout = Real(2) * pushoutSpeed_ * dt / c.dx;
+  const std::vector<Real>* ratioField = P.find(ParticleStore::kRestRatio);  // m_i = r_i m with a density contrast
+  const Real* ratio = ratioField ? ratioField->data() : nullptr;
   const std::size_t first = firstBad(c.pool, P.size(), [&](std::size_t b, std::size_t e) {
     std::size_t bad = kNone;
     Vec2d push(0, 0);
@@ -366,12 +359,14 @@ std::size_t Pbf::predict(StepContext& c, std::vector<Real>& lambda) {
       const Vec2 xFree = x;
       // clearOf: resolve would find no collider near the move (most particles; exact).
       if (!c.boundary.clearOf(x, x0, c.clearance) && c.boundary.resolve(x, vd, x0, c.clearance) && countWall)
-        push += x.cast<double>() - xFree.cast<double>();
+        push += (x.cast<double>() - xFree.cast<double>()) * (ratio ? double(ratio[i]) : 1.0);
       P.xPrev[i] = x0;
       P.v[i] = v;
       P.x[i] = x;
       lambda[i] = 0;
-      if (carried) (*carried)[i] = std::max(Real(0), P.rho[i] / c.rho0 - Real(1) - pushout);
+      if (carried)
+        (*carried)[i] =
+            std::max(Real(0), (ratio ? P.rho[i] / (c.rho0 * ratio[i]) : P.rho[i] / c.rho0) - Real(1) - pushout);
       // A move longer than the speed limit allows over the substep is a runaway too (the
       // shift and the sweep move positions without a velocity the speed check would see).
       if (bad == kNone &&
@@ -412,6 +407,9 @@ Real Pbf::pressure(const StepContext& c, const std::vector<Real>* lam, Real pK, 
 
 std::size_t Pbf::finalDensity(StepContext& c, Real dt) {
   ParticleStore& P = c.P;
+  // A density contrast: the density is r_i times the number density the solve sums (pbf.hpp).
+  const std::vector<Real>* ratioField = P.find(ParticleStore::kRestRatio);
+  const Real* ratio = ratioField ? ratioField->data() : nullptr;
   if (rhoCurrent_) {  // the last constraint pass already summed ρ (and cached W) at these positions
     const std::vector<Real>* lam = P.find("pbf.lambda");
     const Real pK = dt > 0 ? -c.rho0 / (dt * dt) : Real(0);
@@ -419,6 +417,7 @@ std::size_t Pbf::finalDensity(StepContext& c, Real dt) {
     // and five blocks of 20k would leave one thread a block behind the other.
     c.pool.parallelFor(P.size(), kBlock, [&](std::size_t b, std::size_t e) {
       for (std::size_t i = b; i < e; ++i) {
+        if (ratio) P.rho[i] *= ratio[i];
         const Real p = pressure(c, lam, pK, i);
         P.invRho[i] = Real(1) / P.rho[i];
         P.p[i] = p;
@@ -464,6 +463,7 @@ std::size_t Pbf::finalDensity(StepContext& c, Real dt) {
         }
         rho += c.rho0 * wK * bw;
       }
+      if (ratio) rho *= ratio[i];
       const Real p = pressure(c, lam, pK, i);
       P.rho[i] = rho;
       P.invRho[i] = Real(1) / rho;
@@ -486,6 +486,23 @@ std::size_t Pbf::velocity(StepContext& c) {
   const Real* IR = P.invRho.data();
   const Spiky<Real> S(c.R);
   const Real cm = xsph_ * c.mass * S.c * c.R * c.R * c.R;
+  // A density contrast: XSPH weighs neighbour j by its volume m_j/ρ_j times sqrt(r_j/r_i), so
+  // that Σ m_i Δv_i = 0 with m_i = r_i m (m_i sqrt(r_j/r_i) is symmetric): per particle
+  // sqrt(r_j) m_j/ρ_j for its neighbours and 1/sqrt(r_i) for its own sum, no division per pair.
+  const std::vector<Real>* ratioField = cm > 0 ? P.find(ParticleStore::kRestRatio) : nullptr;
+  const Real* ratio = ratioField ? ratioField->data() : nullptr;
+  if (ratio) {
+    xsphNeighbour_.resize(P.size());
+    xsphOwn_.resize(P.size());
+    c.pool.parallelFor(P.size(), kStreamBlock, [&](std::size_t b, std::size_t e) {
+      for (std::size_t i = b; i < e; ++i) {
+        const Real root = std::sqrt(ratio[i]);
+        xsphNeighbour_[i] = IR[i] * ratio[i] * root;
+        xsphOwn_[i] = Real(1) / root;
+      }
+    });
+  }
+  const Real* XN = ratio ? xsphNeighbour_.data() : nullptr;
   vNew_.resize(P.size());
   const Real kc = toVelocity_;
   const Vec2* V0 = P.v.data();
@@ -496,7 +513,9 @@ std::size_t Pbf::velocity(StepContext& c) {
     const Vec2 moved = (X[j] - X0[j]) * invDt;
     return kc == Real(1) ? moved : Vec2(V0[j] + (moved - V0[j]) * kc);
   };
-  const std::size_t first = firstBad(c.pool, P.size(), [&](std::size_t b, std::size_t e) {
+  // The block's loop, compiled once with a density contrast and once without.
+  auto block = [&](auto contrastTag, std::size_t b, std::size_t e) {
+    constexpr bool kContrast = decltype(contrastTag)::value;
     const Real* cache = cm > 0 ? gCache_[b / kBlock].data() : nullptr;
     std::size_t bad = kNone;
     for (std::size_t i = b; i < e; ++i) {
@@ -525,7 +544,7 @@ std::size_t Pbf::velocity(StepContext& c) {
         Real sx = 0, sy = 0;
         for (std::uint32_t k = 0; k < cnt; ++k) {
           const std::uint32_t j = nb[k];
-          const Real f = wc[k] * IR[j];
+          const Real f = wc[k] * (kContrast ? XN[j] : IR[j]);
           if (kc == Real(1)) {
             sx += f * ((X[j].x() - X0[j].x()) * invDt - vi.x());
             sy += f * ((X[j].y() - X0[j].y()) * invDt - vi.y());
@@ -535,12 +554,19 @@ std::size_t Pbf::velocity(StepContext& c) {
             sy += f * (vj.y() - vi.y());
           }
         }
+        if constexpr (kContrast) {
+          sx *= xsphOwn_[i];
+          sy *= xsphOwn_[i];
+        }
         v += Vec2(sx, sy) * cm;
       }
       vNew_[i] = v;
       if (bad == kNone && (!allFinite(v) || v.squaredNorm() > vmax2)) bad = i;
     }
     return bad;
+  };
+  const std::size_t first = firstBad(c.pool, P.size(), [&](std::size_t b, std::size_t e) {
+    return ratio ? block(std::true_type{}, b, e) : block(std::false_type{}, b, e);
   });
   P.v.swap(vNew_);
   // The walls' share of the move becomes velocity as the move does: kc·D/dt (XSPH then mixes

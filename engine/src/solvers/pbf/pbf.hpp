@@ -70,6 +70,14 @@
 //   dynamics"), but not in a substep that starts beyond chebyshev_plain_above
 //   (an impact): Jacobi corrects the long (hydrostatic) modes by about N/layers²
 //   per N iterations, Chebyshev by N²/layers².
+// - Materials of different rest density (the field "rest_ratio", r_i = ρ0_i/ρ0): the
+//   constraint counts particles (C_i = δ_i/δ0 − 1, the number density of Solenthaler &
+//   Pajarola 2008), and the projection weighs each particle by its inverse mass as
+//   position-based dynamics does (Müller et al. 2007): Δx_i = (1/r_i)·(the step above) and
+//   D_i = |∇_i C_i|²/r_i + Σ_j |∇_j C_i|²/r_j. λ stays a pressure (continuous across an
+//   interface); a heavy particle is moved less by it, so gravity sorts the layers. XSPH
+//   weighs neighbour j by sqrt(r_j/r_i) (momentum-conserving). P.rho
+//   is the density r_i ρ0 δ_i/δ0 after the substep, the number density during the solve.
 // - No warm start from the previous substep's multipliers.
 // - Convergence needs the mean compression and the largest below their tolerances.
 // - Time step: min(max_dt, max_move · R / v_max, 0.35 R/sqrt(|g| D) without the
@@ -241,6 +249,10 @@ class Pbf final : public Solver {
   SolverStats stats_;
   Real dtLimit_ = std::numeric_limits<Real>::infinity();  ///< shortened while the iterations do not converge
   std::vector<Real> dLambda_, lOld_;
+  /// 1/r_i with a density contrast (solve() fills it; else empty).
+  std::vector<Real> invRatio_;
+  /// XSPH with a density contrast (velocity()): per particle sqrt(r_j) m_j/ρ_j and 1/sqrt(r_i).
+  std::vector<Real> xsphNeighbour_, xsphOwn_;
   std::vector<Vec2> wallGrad_;         ///< the boundary part of ∇_i C_i
   std::vector<double> blockErr_;       ///< compression per block (fixed-order sum)
   std::vector<Real> blockMax_;         ///< largest compression per block

@@ -1,8 +1,11 @@
 // pbf_params.cpp — the scene keys of the Position Based Fluids solver (Macklin &
 // Müller 2013) and its two registrations in solvers.def: "pbf", the classic
 // defaults, and "game", the same code with real-time defaults and the coarse-grid
-// pressure projection on (Hybrid SPH, Raveendran, Wojtan & Turk 2011). What each
-// key does: pbf.hpp and docs/SCENES.md.
+// pressure projection on (Hybrid SPH, Raveendran, Wojtan & Turk 2011); the
+// calibration of the constraint's scale D0 from the spacing. What each key does:
+// pbf.hpp and docs/SCENES.md.
+#include <cmath>
+
 #include "solvers/pbf/pbf.hpp"
 
 namespace sph2d {
@@ -97,6 +100,25 @@ SolverInfo gameSolver() {
             d.supportRatio = 2;  // 8 neighbours at rest: measured as accurate as 2.5 here, at half the pairs
           },
           pbfCheck};
+}
+
+void Pbf::calibrate(const StepContext& c) {
+  const double R = double(c.R), dx = double(c.dx);
+  const double V = double(c.mass) / double(c.rho0);
+  const Spiky<double> W(R);
+  const int n = int(std::ceil(R / dx)) + 1;
+  double s = 0;
+  for (int j = -n; j <= n; ++j)
+    for (int i = -n; i <= n; ++i) {
+      if (i == 0 && j == 0) continue;
+      const double g = W.derivative(std::sqrt(double(i * i + j * j)) * dx);
+      s += g * g;
+    }
+  d0_ = Real(V * V * s);
+  eps_ = relaxation_ * d0_;
+  // s_corr = −k (W(r)/W(Δq))^n, in multipliers: 1/D0 corrects a density error of 1.
+  invWdq_ = Real(1.0 / W.value(double(tensileDq_) * R));
+  sCorrScale_ = Real(-double(tensileK_) / double(d0_));
 }
 
 }  // namespace sph2d
