@@ -22,8 +22,10 @@
 
 #include "sph2d/boundary.hpp"
 #include "sph2d/id_range.hpp"
+#include "sph2d/particle_events.hpp"
 #include "sph2d/particles.hpp"
 #include "sph2d/scene.hpp"
+#include "sph2d/world_stats.hpp"
 
 class b2World;
 class b2Shape;
@@ -70,13 +72,6 @@ struct WorldOptions {
   const std::atomic<bool>* stop = nullptr;
 };
 
-/// Time and call count of one stage.
-struct StageTiming {
-  std::string name;
-  double seconds = 0;
-  std::uint64_t calls = 0;
-};
-
 /// A push/pull at a point, set at run time (the mouse of a game).
 struct UserForce {
   Vec2d point{0, 0};    ///< world coordinates [m]
@@ -112,72 +107,6 @@ struct SaveReport {
   std::string warning;
   /// True when none of the above is live: with the same bodies rebuilt, a load steps on bit for bit.
   bool complete() const { return warmStartedContacts == 0 && warmStartedJoints == 0 && sleepTimers == 0; }
-};
-
-/// What an iterative pressure solver did in its last substep (all zero for explicit solvers).
-struct SolverStats {
-  int pressureIterations = 0;    ///< constant-density (pressure) solve iterations
-  int divergenceIterations = 0;  ///< divergence-free solve iterations (0 when disabled)
-  double densityError = 0;     ///< mean predicted density error /ρ0 after the pressure solve (solver-defined residual)
-  double divergenceError = 0;  ///< mean |Dρ/Dt|·dt/ρ0 after the divergence solve (solver-defined residual)
-};
-
-/// Density error of the fluid, relative to ρ0.
-struct DensityStats {
-  double meanError = 0;  ///< mean of max(ρ − ρ0, 0)/ρ0 over particles (compression)
-  double maxError = 0;   ///< max of max(ρ − ρ0, 0)/ρ0 over particles (the most compressed particle)
-  double meanDensity = 0;
-};
-
-/// The impulse the static solids gave the fluid [N·s per metre of depth, i.e. kg·m/s in 2D],
-/// split by the stage that applied it. A static solid is a fixture of a static body of the
-/// b2World (World::colliders() and its boundary samples); kinematic and dynamic bodies are
-/// not: what they exchange with the fluid stays inside fluid plus bodies and is not counted.
-/// Each part is the m·Δv the solver gives the particles because of the solids, taken where it
-/// applies it (not inferred from the fluid's momentum). docs/EMBEDDING.md: what each solver
-/// counts, and how closely Δ(momentum) = gravity's impulse + this closes.
-struct WallImpulse {
-  /// The solver's boundary-sample terms: wcsph's wall pressure and wall viscosity (m·a·dt of the
-  /// substep taken), dfsph's wall terms of both velocity solves, pbf's wall share of the density
-  /// solve when its moves become velocity (correction_to_velocity > 0), muller2003's wall pressure,
-  /// and with solver.no_slip the viscosity's wall term (every solver). 0 for the game solver
-  /// unless no_slip.
-  Vec2d samples{0, 0};
-  /// The game solver's grid projection (pbf with grid_cell > 0): the pressure of the fluid cells
-  /// on their faces closed by a static solid (ρ0 κ h dt), and the normal velocity those faces
-  /// remove (the faces' particle mass times their change). Grid-level figures: the transfer to
-  /// the particles does not conserve momentum exactly.
-  Vec2d grid{0, 0};
-  /// The swept collision with the static colliders (the collide stage, and pbf's own sweeps
-  /// when its moves become velocity): m·Δv of the velocity response.
-  Vec2d collision{0, 0};
-  /// samples + grid + collision.
-  Vec2d total() const { return samples + grid + collision; }
-};
-
-/// What a World has done, counted (World::counters()), as Box2D's b2Counters are for a b2World.
-struct WorldCounters {
-  std::uint64_t frames = 0;            ///< frames stepped (stepFrame, step)
-  std::uint64_t substeps = 0;          ///< substeps taken
-  int lastFrameSubsteps = 0;           ///< substeps of the last frame
-  std::uint64_t solverIterations = 0;  ///< pressure and divergence solve iterations summed over every substep
-  SolverStats lastSolve;               ///< the last substep's solve (explicit solvers: all zero)
-  std::size_t particles = 0;           ///< particles now
-  std::size_t neighbourPairs = 0;      ///< fluid pairs of the last substep, each counted from both sides
-  std::uint64_t removed = 0;           ///< particles removed by lifetimes, sinks and the budget policy
-  std::size_t memoryBytes = 0;  ///< bytes for the particles, grid, neighbour lists, boundary samples and lookup indexes
-  std::size_t particleBytes = 0;  ///< bytes the particle arrays hold (the solver's working fields included)
-};
-
-/// Where a World's time went (World::profile()), as Box2D's b2Profile is for a b2World.
-struct WorldProfile {
-  std::vector<StageTiming> stages;  ///< wall time and calls per stage, in list order
-  /// The seconds of every stage together.
-  double totalSeconds() const {
-    double t = 0;
-    for (const StageTiming& s : stages) t += s.seconds;
-    return t;
-  }
 };
 
 class World;
@@ -375,6 +304,22 @@ class World {
   /// Removes the particles with these ids (ids no particle has, and repeats, are ignored).
   /// Returns the ids removed, in increasing order.
   std::vector<std::uint32_t> removeParticles(const std::vector<std::uint32_t>& ids);
+  /// Sets the destruction listener (particle_events.hpp; empty: none, the default). Only
+  /// while one is set are the removed ids collected.
+  void setDestructionListener(DestructionListener listener);
+  /// Each particle of `ids` leaves the World `seconds` from now (within the substep that
+  /// passes that time; 0: in the next substep; infinity: never, the default). Returns how
+  /// many of the ids a particle has. The field and its stage exist from the first call on
+  /// (kept through save/load). Throws std::invalid_argument for a negative or NaN `seconds`.
+  std::size_t setLifetimes(const std::vector<std::uint32_t>& ids, double seconds);
+  /// The seconds particle `id` has left (infinity: no lifetime of its own, or no such particle).
+  double lifetimeLeft(std::uint32_t id) const;
+  /// Calls f for each particle whose disc (radius half the spacing) the segment p1 → p2
+  /// enters, nearest first (ties by id), until f returns false; a disc p1 lies in is not
+  /// hit. Visits only the neighbour grid's cells along the segment.
+  void rayCast(const Vec2d& p1, const Vec2d& p2, const std::function<bool(const RayHit&)>& f) const;
+  /// The nearest hit of rayCast(p1, p2); false (and `hit` untouched) when there is none.
+  bool rayCastFirst(const Vec2d& p1, const Vec2d& p2, RayHit& hit) const;
 
   // Per-particle colour and user data: each field is allocated on the first set (every
   // other particle, and every particle added later, holds 0), kept through reordering,

@@ -69,6 +69,8 @@ struct ParticleStore {
   /// The names of the optional integer fields (a save that holds one makes it one).
   static constexpr const char* kColor = "color";
   static constexpr const char* kUserData = "user_data";
+  /// Each particle's own lifetime left [s] (0: none; World::setLifetimes).
+  static constexpr const char* kLife = "life";
   /// 1 + the index of the emitter that made the particle; 0: none (World::setEmitterTracking).
   static constexpr const char* kEmitter = "emitter";
   /// The particle's material (an index in World::materials()); only while the World has more than one.

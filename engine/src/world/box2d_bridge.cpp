@@ -179,7 +179,7 @@ void World::Impl::dropBuried() {
     n += sources.dead[i];
   }
   if (n) {
-    removeFlagged();
+    removeFlagged(RemovalReason::solid);
     warnings.push_back("dropped " + std::to_string(n) + " particles now inside solids (the level changed at frame " +
                        std::to_string(frames) + ")");
   }
@@ -191,6 +191,7 @@ void World::refreshBoundaries() {
   w.readBoundary();
   w.dropBuried();
   w.statics.recordPoses(*w.b2);
+  w.deliverRemovals();
 }
 
 }  // namespace sph2d

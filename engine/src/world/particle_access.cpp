@@ -230,7 +230,8 @@ std::vector<std::uint32_t> World::removeParticles(const std::vector<std::uint32_
     n += w.sources.dead[i];
   }
   std::vector<std::uint32_t> removed;
-  if (n) w.removeFlagged(&removed);
+  if (n) w.removeFlagged(RemovalReason::game, &removed);
+  w.deliverRemovals();
   return removed;
 }
 

@@ -141,7 +141,14 @@ const char* World::Impl::budgetKey() const {
   return scene.effects.budget > 0 ? "effects.budget.max_particles" : "max_particles";
 }
 
-void World::Impl::removeFlagged(std::vector<std::uint32_t>* ids) {
+void World::Impl::removeFlagged(RemovalReason reason, std::vector<std::uint32_t>* ids) {
+  if (destructionListener) {  // slot order, then the removal's ids increasing
+    const std::size_t first = removals.size();
+    for (std::size_t i = 0; i < P.size(); ++i)
+      if (sources.dead[i]) removals.push_back(Removal{P.id[i], reason});
+    std::sort(removals.begin() + std::ptrdiff_t(first), removals.end(),
+              [](const Removal& a, const Removal& b) { return a.id < b.id; });
+  }
   if (ids) {
     ids->clear();
     for (std::size_t i = 0; i < P.size(); ++i)
@@ -162,7 +169,7 @@ void World::Impl::removeOldest(std::size_t k) {
   const std::uint32_t cut = ids[k - 1];
   sources.dead.assign(P.size(), 0);
   for (std::size_t i = 0; i < P.size(); ++i) sources.dead[i] = P.id[i] <= cut;
-  removeFlagged();
+  removeFlagged(RemovalReason::budget);
 }
 
 std::string ParticleSources::problem(const EmitterDef& d) {
@@ -283,7 +290,7 @@ void World::Impl::lifetimes(Real dt) {
     sources.dead[i] = age[i] > maxAge;
     any = any || sources.dead[i];
   }
-  if (any) removeFlagged();
+  if (any) removeFlagged(RemovalReason::lifetime);
 }
 
 void World::Impl::sinks() {
@@ -294,7 +301,27 @@ void World::Impl::sinks() {
     for (const RegionDef& r : scene.effects.sinks) sources.dead[i] = sources.dead[i] || r.contains(w);
     any = any || sources.dead[i];
   }
-  if (any) removeFlagged();
+  if (any) removeFlagged(RemovalReason::sink);
+}
+
+void World::Impl::particleLifetimes(Real dt) {
+  std::vector<Real>& life = P.field(ParticleStore::kLife);
+  sources.dead.assign(P.size(), 0);
+  bool any = false;
+  for (std::size_t i = 0; i < P.size(); ++i) {
+    if (!(life[i] > 0)) continue;  // none of its own
+    life[i] -= dt;
+    sources.dead[i] = !(life[i] > 0);
+    any = any || sources.dead[i];
+  }
+  if (any) removeFlagged(RemovalReason::lifetime);
+}
+
+void World::Impl::deliverRemovals() {
+  if (removals.empty() || !destructionListener) return;
+  std::vector<Removal> batch;
+  batch.swap(removals);
+  destructionListener(batch);
 }
 
 }  // namespace sph2d

@@ -308,8 +308,13 @@ void World::step(double dt) {
     ++w.frames;
     w.refreshView();
   } catch (const Interrupted& e) {
+    w.deliverRemovals();  // what left the World before it stopped has left
     w.abandon(e);
+  } catch (...) {
+    w.deliverRemovals();
+    throw;
   }
+  w.deliverRemovals();
 }
 
 void World::setStopFlag(const std::atomic<bool>* stop) { impl_->stop = stop; }
@@ -391,7 +396,8 @@ std::vector<std::uint32_t> World::removeParticlesInBox(const Vec2d& lo, const Ve
     n += w.sources.dead[i];
   }
   std::vector<std::uint32_t> ids;
-  if (n) w.removeFlagged(&ids);
+  if (n) w.removeFlagged(RemovalReason::game, &ids);
+  w.deliverRemovals();
   return ids;
 }
 

@@ -97,11 +97,13 @@ struct World::Impl {
   void initMaterialFields(std::size_t from);
 
   // The subsystems.
-  ParticleSources sources;  ///< emitters, the budget, removals
-  MovingBodies moving;      ///< the kinematic and dynamic bodies
-  StaticBridge statics;     ///< the static bodies read from the b2World
-  ContactTracker contacts;  ///< contact tracking (off until a game turns it on)
-  ParticleIndex index;      ///< lookups by id and by region
+  ParticleSources sources;                  ///< emitters, the budget, removals
+  MovingBodies moving;                      ///< the kinematic and dynamic bodies
+  StaticBridge statics;                     ///< the static bodies read from the b2World
+  ContactTracker contacts;                  ///< contact tracking (off until a game turns it on)
+  ParticleIndex index;                      ///< lookups by id and by region
+  DestructionListener destructionListener;  ///< the game's (empty: none; then nothing is collected)
+  std::vector<Removal> removals;            ///< removed since the last delivery (with a listener)
 
   // Stopping on request (World::setStopFlag, WorldOptions::stop).
   const std::atomic<bool>* stop = nullptr;  ///< the caller's stop flag (null: none)
@@ -232,9 +234,15 @@ struct World::Impl {
   void lifetimes(Real dt);
   /// The sinks stage: removes particles inside sink regions.
   void sinks();
+  /// The particle_lifetimes stage: counts down each particle's own lifetime (the field
+  /// ParticleStore::kLife, World::setLifetimes) and removes those whose time ran out.
+  void particleLifetimes(Real dt);
   /// Removes the particles flagged in `sources.dead` (stable order), counting them; `ids`, when
-  /// given, receives their ids in increasing order.
-  void removeFlagged(std::vector<std::uint32_t>* ids = nullptr);
+  /// given, receives their ids in increasing order. With a destruction listener, their ids and
+  /// `reason` join the removals to deliver.
+  void removeFlagged(RemovalReason reason, std::vector<std::uint32_t>* ids = nullptr);
+  /// Hands the removals collected since the last delivery to the destruction listener.
+  void deliverRemovals();
   /// Removes the k oldest particles (smallest ids).
   void removeOldest(std::size_t k);
 
