@@ -21,6 +21,7 @@
 #include <vector>
 
 #include "sph2d/boundary.hpp"
+#include "sph2d/groups.hpp"
 #include "sph2d/id_range.hpp"
 #include "sph2d/particle_events.hpp"
 #include "sph2d/particles.hpp"
@@ -320,6 +321,17 @@ class World {
   void rayCast(const Vec2d& p1, const Vec2d& p2, const std::function<bool(const RayHit&)>& f) const;
   /// The nearest hit of rayCast(p1, p2); false (and `hit` untouched) when there is none.
   bool rayCastFirst(const Vec2d& p1, const Vec2d& p2, RayHit& hit) const;
+  /// Makes a group (groups.hpp) of new particles filling def.region; `ids` (when given) gets
+  /// them. Returns the group's index. The fields and the `groups` stage exist from the first
+  /// group on. Throws std::invalid_argument for a stiffness outside (0, 1] or a region that
+  /// makes no particle (nothing added).
+  std::uint32_t createGroup(const GroupDef& def, IdRange* ids = nullptr);
+  /// The state of group `group` now; false when no particle is in it.
+  bool groupState(std::uint32_t group, GroupState& state) const;
+  /// Gives group `group` a linear impulse (N·s per metre of depth) at its centre and an
+  /// angular one (N·m·s per metre): each particle's velocity changes as the rigid body's.
+  /// False when no particle is in it.
+  bool applyGroupImpulse(std::uint32_t group, const Vec2d& linear, double angular);
 
   // Per-particle colour and user data: each field is allocated on the first set (every
   // other particle, and every particle added later, holds 0), kept through reordering,

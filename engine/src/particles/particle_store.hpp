@@ -71,6 +71,12 @@ struct ParticleStore {
   static constexpr const char* kUserData = "user_data";
   /// Each particle's own lifetime left [s] (0: none; World::setLifetimes).
   static constexpr const char* kLife = "life";
+  /// Groups (World::createGroup): 1 + the particle's group (0: none), its place in the
+  /// group's rest shape, and the group's stiffness.
+  static constexpr const char* kGroup = "group";
+  static constexpr const char* kGroupQx = "group_qx";
+  static constexpr const char* kGroupQy = "group_qy";
+  static constexpr const char* kGroupStiffness = "group_stiffness";
   /// 1 + the index of the emitter that made the particle; 0: none (World::setEmitterTracking).
   static constexpr const char* kEmitter = "emitter";
   /// The particle's material (an index in World::materials()); only while the World has more than one.
@@ -83,7 +89,9 @@ struct ParticleStore {
   static constexpr const char* kMixedColor = "mixed_color";
   static std::string concentration(std::size_t k) { return "concentration." + std::to_string(k); }
   /// True for the name of an optional integer field a game sets (absent from a save: zeros on load).
-  static bool integerField(const std::string& name) { return name == kColor || name == kUserData || name == kEmitter; }
+  static bool integerField(const std::string& name) {
+    return name == kColor || name == kUserData || name == kEmitter || name == kGroup;
+  }
   /// Removes the optional integer field `name` (nothing when it does not exist).
   void dropU32(const std::string& name) {
     for (auto it = extraU32.begin(); it != extraU32.end(); ++it)

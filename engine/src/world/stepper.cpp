@@ -112,6 +112,7 @@ void World::Impl::buildStages() {
 void World::Impl::addParticleSystemStages(StageList& list) {
   list.add(plainStage("collide", [](StepContext& c) { stageCollide(c); }));
   if (!moving.solids.bodies.empty()) list.add(plainStage("bodies", [this](StepContext& c) { collideMoving(c); }));
+  if (P.findU32(ParticleStore::kGroup)) list.add(plainStage("groups", [this](StepContext& c) { matchGroups(c); }));
   if (periodic.any()) list.add(plainStage("wrap", [](StepContext& c) { stageWrap(c); }));
   if (scene.effects.lifetime) list.add(plainStage("lifetimes", [this](StepContext& c) { lifetimes(c.dt); }));
   if (!scene.effects.sinks.empty()) list.add(plainStage("sinks", [this](StepContext&) { sinks(); }));

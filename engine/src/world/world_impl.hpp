@@ -243,6 +243,20 @@ struct World::Impl {
   void removeFlagged(RemovalReason reason, std::vector<std::uint32_t>* ids = nullptr);
   /// Hands the removals collected since the last delivery to the destruction listener.
   void deliverRemovals();
+  // groups.cpp
+  /// The groups stage: each group's particles towards the best-fit rigid placement of its
+  /// rest shape (all the way when rigid), their velocities with them; then out of the static
+  /// solids (a rigid group as one).
+  void matchGroups(StepContext& c);
+  /// Each group's figures now (index g: group g), in slot order, in double.
+  struct GroupSums {
+    double m = 0, mx = 0, my = 0, mvx = 0, mvy = 0, mqx = 0, mqy = 0;  // Σ m, Σ m x, Σ m v, Σ m q
+    double a00 = 0, a01 = 0, a10 = 0, a11 = 0, L = 0, I = 0;           // Σ m r q̃ᵀ, Σ m r × ṽ, Σ m |r|²
+    std::size_t n = 0;
+  };
+  void groupSums(std::vector<GroupSums>& sums) const;
+  std::vector<GroupSums> groupScratch;  ///< matchGroups' sums
+  std::vector<double> groupPush;        ///< matchGroups' pushes out of the solids, per group
   /// Removes the k oldest particles (smallest ids).
   void removeOldest(std::size_t k);
 

@@ -1,0 +1,35 @@
+// sph2d/groups.hpp — particle groups: a set of particles made together that moves as one
+// rigid body (stiffness 1) or springs back towards its shape (a jelly: stiffness below 1),
+// by shape matching (Müller, Heidelberger, Teschner & Gross 2005, "Meshless deformations
+// based on shape matching"). World::createGroup, World::groupState, World::applyGroupImpulse.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+
+#include "sph2d/fluid_block.hpp"
+#include "sph2d/math.hpp"
+
+namespace sph2d {
+
+/// A group to make: its particles fill `region` (on the lattice of the spacing, as addBlock
+/// does; its material and velocity too).
+struct GroupDef {
+  FluidBlockDef region;
+  /// The share of the way to the best-fit rigid placement of its rest shape each particle
+  /// goes per substep: 1 a rigid body, below 1 an elastic one (0 < stiffness ≤ 1).
+  double stiffness = 1;
+};
+
+/// A group as it is now: its centre of mass, the rotation of its shape from when it was made,
+/// and the velocity and spin of its particles' momentum.
+struct GroupState {
+  Vec2d centre{0, 0};
+  double angle = 0;  ///< rad, counter-clockwise
+  Vec2d velocity{0, 0};
+  double angularVelocity = 0;  ///< rad/s
+  double mass = 0;             ///< kg per metre of depth
+  std::size_t particles = 0;
+};
+
+}  // namespace sph2d
