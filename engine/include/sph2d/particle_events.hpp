@@ -28,7 +28,9 @@ struct Removal {
 
 /// Receives the particles removed since the last call: once after each step (stepFrame,
 /// step) that removed any, and once after each game call that removed any; in the order of
-/// their removals, each removal's ids increasing. It may read the World, not change it.
+/// their removals, each removal's ids increasing. It may read the World and replace or clear
+/// itself, not change the World otherwise. In a step that fails (SimulationError,
+/// Interrupted) it hears what left before, and an exception it throws there is dropped.
 using DestructionListener = std::function<void(const std::vector<Removal>&)>;
 
 /// Where a ray p1 → p2 enters a particle's disc (radius half the spacing).

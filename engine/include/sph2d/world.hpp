@@ -322,9 +322,10 @@ class World {
   /// The nearest hit of rayCast(p1, p2); false (and `hit` untouched) when there is none.
   bool rayCastFirst(const Vec2d& p1, const Vec2d& p2, RayHit& hit) const;
   /// Makes a group (groups.hpp) of new particles filling def.region; `ids` (when given) gets
-  /// them. Returns the group's index. The fields and the `groups` stage exist from the first
-  /// group on. Throws std::invalid_argument for a stiffness outside (0, 1] or a region that
-  /// makes no particle (nothing added).
+  /// them. Returns the group's index: one past the highest a particle holds now (the index of
+  /// a group whose particles are all gone may be given again). The fields and the `groups`
+  /// stage exist from the first group on. Throws std::invalid_argument for a stiffness
+  /// outside (0, 1] or a region that makes no particle (nothing added).
   std::uint32_t createGroup(const GroupDef& def, IdRange* ids = nullptr);
   /// The state of group `group` now; false when no particle is in it.
   bool groupState(std::uint32_t group, GroupState& state) const;

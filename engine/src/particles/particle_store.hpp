@@ -69,8 +69,9 @@ struct ParticleStore {
   /// The names of the optional integer fields (a save that holds one makes it one).
   static constexpr const char* kColor = "color";
   static constexpr const char* kUserData = "user_data";
-  /// Each particle's own lifetime left [s] (0: none; World::setLifetimes).
-  static constexpr const char* kLife = "life";
+  /// The World time at which each particle leaves [s] (a double field; 0: never;
+  /// World::setLifetimes).
+  static constexpr const char* kLifeEnd = "life_end";
   /// Groups (World::createGroup): 1 + the particle's group (0: none), its place in the
   /// group's rest shape, and the group's stiffness.
   static constexpr const char* kGroup = "group";
@@ -91,6 +92,11 @@ struct ParticleStore {
   /// True for the name of an optional integer field a game sets (absent from a save: zeros on load).
   static bool integerField(const std::string& name) {
     return name == kColor || name == kUserData || name == kEmitter || name == kGroup;
+  }
+  /// True for the name of an optional float field a game's calls make (groups; absent from a
+  /// save: zeros on load, which hold "none").
+  static bool gameRealField(const std::string& name) {
+    return name == kGroupQx || name == kGroupQy || name == kGroupStiffness;
   }
   /// Removes the optional integer field `name` (nothing when it does not exist).
   void dropU32(const std::string& name) {

@@ -88,12 +88,23 @@ void World::Impl::setMaterial(std::size_t from, std::uint32_t m) {
 void World::Impl::initMaterialFields(std::size_t from) {
   fillRestRatio(from);  // a new particle's ratio starts at 0
   const std::vector<std::uint32_t>* material = P.findU32(ParticleStore::kMaterial);
-  if (!material || !P.findD(ParticleStore::concentration(0))) return;
-  for (std::size_t k = 0; k < materials.size(); ++k) {  // all of its own material
-    std::vector<double>& c = *P.findD(ParticleStore::concentration(k));
-    for (std::size_t i = from; i < c.size(); ++i) c[i] = (*material)[i] == k ? 1.0 : 0.0;
+  if (material && P.findD(ParticleStore::concentration(0))) {
+    for (std::size_t k = 0; k < materials.size(); ++k) {  // all of its own material
+      std::vector<double>& c = *P.findD(ParticleStore::concentration(k));
+      for (std::size_t i = from; i < c.size(); ++i) c[i] = (*material)[i] == k ? 1.0 : 0.0;
+    }
+    deriveFromConcentrations(P, materials, from);
   }
-  deriveFromConcentrations(P, materials, from);
+  // With a density contrast a new particle starts at its own rest density (ParticleStore::push
+  // gives ρ0): the solvers that read the last density as a compression (pbf's pushout, the
+  // game solver's grid) then see none.
+  if (const std::vector<Real>* ratio = P.find(ParticleStore::kRestRatio)) {
+    const Real rho0 = Real(materials.front().density);
+    for (std::size_t i = from; i < P.size(); ++i) {
+      P.rho[i] = (*ratio)[i] * rho0;
+      P.invRho[i] = Real(1) / P.rho[i];
+    }
+  }
 }
 
 std::uint32_t World::addMaterial(const MaterialDef& m) {

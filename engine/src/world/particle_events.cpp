@@ -12,7 +12,7 @@ namespace sph2d {
 
 void World::setDestructionListener(DestructionListener listener) {
   impl_->destructionListener = std::move(listener);
-  if (!impl_->destructionListener) impl_->removals.clear();
+  if (!impl_->destructionListener) impl_->removals.clear();  // a later listener hears nothing of before
 }
 
 std::size_t World::setLifetimes(const std::vector<std::uint32_t>& ids, double seconds) {
@@ -20,12 +20,13 @@ std::size_t World::setLifetimes(const std::vector<std::uint32_t>& ids, double se
     throw std::invalid_argument("setLifetimes: seconds must be 0 or more (infinity: no lifetime), got " +
                                 std::to_string(seconds));
   Impl& w = *impl_;
-  const bool had = w.P.find(ParticleStore::kLife) != nullptr;
-  std::vector<Real>& life = w.P.field(ParticleStore::kLife);
-  // 0 holds "none": a lifetime of 0 becomes the smallest positive value (gone next substep).
-  const Real value = std::isinf(seconds) ? Real(0) : std::max(Real(seconds), std::numeric_limits<Real>::min());
+  const bool had = w.P.findD(ParticleStore::kLifeEnd) != nullptr;
+  std::vector<double>& end = w.P.fieldD(ParticleStore::kLifeEnd);
+  // The World time it leaves at, in double (no drift over long lives); 0 holds "never", so
+  // an end at time 0 becomes the smallest positive double (gone in the next substep).
+  const double value = std::isinf(seconds) ? 0.0 : std::max(w.time + seconds, std::numeric_limits<double>::min());
   const std::size_t n = w.index.forEachId(w.P, ids, [&](std::size_t, std::size_t i) {
-    life[i] = value;
+    end[i] = value;
     return true;
   });
   if (!had) {
@@ -37,10 +38,10 @@ std::size_t World::setLifetimes(const std::vector<std::uint32_t>& ids, double se
 
 double World::lifetimeLeft(std::uint32_t id) const {
   const Impl& w = *impl_;
-  const std::vector<Real>* life = w.P.find(ParticleStore::kLife);
-  const std::size_t i = life ? w.index.slotOf(w.P, id) : ParticleIndex::npos;
-  if (i == ParticleIndex::npos || !((*life)[i] > 0)) return std::numeric_limits<double>::infinity();
-  return double((*life)[i]);
+  const std::vector<double>* end = w.P.findD(ParticleStore::kLifeEnd);
+  const std::size_t i = end ? w.index.slotOf(w.P, id) : ParticleIndex::npos;
+  if (i == ParticleIndex::npos || !((*end)[i] > 0)) return std::numeric_limits<double>::infinity();
+  return std::max(0.0, (*end)[i] - w.time);
 }
 
 namespace {
@@ -65,29 +66,51 @@ void World::rayCast(const Vec2d& p1, const Vec2d& p2, const std::function<bool(c
     throw std::invalid_argument("rayCast: the points must be finite");
   const double radius = 0.5 * w.scene.solver.spacing;
   const Vec2d d = p2 - p1;
-  // The search grid's cells (side R ≥ a spacing) along the segment: boxes of at most R along
-  // it, each grown by the disc radius; the candidates deduplicated by slot.
-  const double len = d.norm(), cell = double(w.R);
+  const double cell = double(w.R);
+  // The part of the segment within the search grid's box grown by the disc radius (Liang &
+  // Barsky's clipping): a ray of any length visits the cells it crosses there, no more.
+  Vec2d lo, hi;
+  if (!w.index.bounds(w.P, w.steps, cell, w.origin, lo, hi)) return;
+  double t0 = 0, t1 = 1;
+  for (int axis = 0; axis < 2; ++axis) {
+    const double o = axis == 0 ? p1.x() : p1.y(), v = axis == 0 ? d.x() : d.y();
+    const double a = (axis == 0 ? lo.x() : lo.y()) - radius, b = (axis == 0 ? hi.x() : hi.y()) + radius;
+    if (v == 0) {
+      if (o < a || o > b) return;
+      continue;
+    }
+    const double ta = (a - o) / v, tb = (b - o) / v;
+    t0 = std::max(t0, std::min(ta, tb));
+    t1 = std::min(t1, std::max(ta, tb));
+  }
+  if (!(t0 <= t1)) return;
+  // The grid's cells (side R ≥ a spacing) along that part: boxes of at most R along it, each
+  // grown by the disc radius; the candidates deduplicated by slot.
+  const double len = d.norm() * (t1 - t0);
   const int pieces = std::max(1, int(std::ceil(len / cell)));
   std::vector<std::size_t> slots;
   const Vec2d grow(radius, radius);
   for (int k = 0; k < pieces; ++k) {
-    const Vec2d a = p1 + d * (double(k) / pieces), b = p1 + d * (double(k + 1) / pieces);
-    const Vec2d lo(std::min(a.x(), b.x()), std::min(a.y(), b.y())), hi(std::max(a.x(), b.x()), std::max(a.y(), b.y()));
-    w.index.forCandidates(w.P, w.steps, cell, w.origin, lo - grow, hi + grow,
+    const Vec2d a = p1 + d * (t0 + (t1 - t0) * double(k) / pieces),
+                b = p1 + d * (t0 + (t1 - t0) * double(k + 1) / pieces);
+    const Vec2d boxLo(std::min(a.x(), b.x()), std::min(a.y(), b.y()));
+    const Vec2d boxHi(std::max(a.x(), b.x()), std::max(a.y(), b.y()));
+    w.index.forCandidates(w.P, w.steps, cell, w.origin, boxLo - grow, boxHi + grow,
                           [&](std::size_t i) { slots.push_back(i); });
   }
   std::sort(slots.begin(), slots.end());
   slots.erase(std::unique(slots.begin(), slots.end()), slots.end());
+  // Entries from the clipped part's start (no cancellation for a ray from far away).
+  const Vec2d q1 = p1 + d * t0, e = d * (t1 - t0);
   std::vector<RayHit> hits;
   for (const std::size_t i : slots) {
     const Vec2d c = worldPosition(i);
     double t = 0;
-    if (!enters(p1, d, c, radius, t)) continue;
+    if (!enters(q1, e, c, radius, t)) continue;
     RayHit h;
     h.id = w.P.id[i];
-    h.fraction = t;
-    h.point = p1 + d * t;
+    h.fraction = t0 + (t1 - t0) * t;
+    h.point = q1 + e * t;
     h.normal = (h.point - c) / radius;
     h.normal /= h.normal.norm();
     hits.push_back(h);

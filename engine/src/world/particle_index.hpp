@@ -71,6 +71,17 @@ class ParticleIndex {
       }
   }
 
+  /// The world box the search grid covers (every particle is in it); false when it has no
+  /// cell (no particle).
+  bool bounds(const ParticleStore& P, std::uint64_t steps, double cell, const Vec2d& origin, Vec2d& lo,
+              Vec2d& hi) const {
+    const Grid& g = grid(P, steps, cell);
+    if (g.nx == 0) return false;
+    lo = Vec2d(g.x0, g.y0) + origin;
+    hi = Vec2d(g.x0 + double(g.nx) * g.h, g.y0 + double(g.ny) * g.h) + origin;
+    return true;
+  }
+
   /// Bytes the indexes hold (nothing until a game looks a particle up or searches).
   std::size_t bytes() const {
     return ids_.capacity() * sizeof(ids_[0]) +

@@ -304,14 +304,12 @@ void World::Impl::sinks() {
   if (any) removeFlagged(RemovalReason::sink);
 }
 
-void World::Impl::particleLifetimes(Real dt) {
-  std::vector<Real>& life = P.field(ParticleStore::kLife);
+void World::Impl::particleLifetimes(double t1) {
+  const std::vector<double>& end = *P.findD(ParticleStore::kLifeEnd);
   sources.dead.assign(P.size(), 0);
   bool any = false;
   for (std::size_t i = 0; i < P.size(); ++i) {
-    if (!(life[i] > 0)) continue;  // none of its own
-    life[i] -= dt;
-    sources.dead[i] = !(life[i] > 0);
+    sources.dead[i] = end[i] > 0 && end[i] <= t1;  // 0: none of its own
     any = any || sources.dead[i];
   }
   if (any) removeFlagged(RemovalReason::lifetime);
@@ -321,7 +319,9 @@ void World::Impl::deliverRemovals() {
   if (removals.empty() || !destructionListener) return;
   std::vector<Removal> batch;
   batch.swap(removals);
-  destructionListener(batch);
+  // A copy: the listener may replace or clear itself while it runs.
+  const DestructionListener listener = destructionListener;
+  listener(batch);
 }
 
 }  // namespace sph2d

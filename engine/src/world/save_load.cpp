@@ -328,14 +328,18 @@ void World::load(std::istream& input) {
   std::string missing;
   w.P.forEachField([&](const char* name, const auto& vec) {
     const Field* f = find(name);
-    if (!f && ParticleStore::integerField(name)) return;  // a colour or tag set after the save: zeros on load
+    // A colour, tag, group or lifetime set after the save: zeros ("none") on load.
+    if (!f && (ParticleStore::integerField(name) || ParticleStore::gameRealField(name) ||
+               std::string(name) == ParticleStore::kLifeEnd))
+      return;
     if (!f || f->element != sizeof(vec[0])) missing += (missing.empty() ? "" : ", ") + std::string(name);
   });
   if (!missing.empty()) throw SaveError("the saved state is malformed: it lacks the particle fields " + missing);
   for (const Field& f : saved) {
     bool fixed = false;
     w.P.forEachField([&](const char* name, const auto&) { fixed = fixed || f.name == name; });
-    if (!fixed && f.element != sizeof(Real))
+    const std::size_t element = f.name == ParticleStore::kLifeEnd ? sizeof(double) : sizeof(Real);
+    if (!fixed && f.element != element)
       throw SaveError("the saved state is malformed: field " + f.name + "'s element size");
   }
   std::vector<std::uint32_t> ids(static_cast<std::size_t>(n));
@@ -432,6 +436,10 @@ void World::load(std::istream& input) {
       std::vector<std::uint32_t>& vec = w.P.fieldU32(f.name);
       vec.resize(static_cast<std::size_t>(n));
       if (n) std::memcpy(vec.data(), f.data.data(), f.data.size());
+    } else if (!fixed && f.name == ParticleStore::kLifeEnd) {  // lifetimes the save holds and this World lacks
+      std::vector<double>& vec = w.P.fieldD(f.name);
+      vec.resize(static_cast<std::size_t>(n));
+      if (n) std::memcpy(vec.data(), f.data.data(), f.data.size());
     } else if (!fixed) {
       std::vector<Real>& vec = w.P.field(f.name);
       vec.resize(static_cast<std::size_t>(n));
@@ -440,6 +448,10 @@ void World::load(std::istream& input) {
   }
   for (auto& e : w.P.extraU32)  // integer fields the save lacks: none set at the time of the save
     if (!find(e.first)) e.second.assign(static_cast<std::size_t>(n), 0u);
+  for (auto& e : w.P.extra)  // the groups' fields the save lacks: no group at the time of the save
+    if (ParticleStore::gameRealField(e.first) && !find(e.first)) e.second.assign(static_cast<std::size_t>(n), Real(0));
+  if (std::vector<double>* end = w.P.findD(ParticleStore::kLifeEnd))  // no lifetime at the time of the save
+    if (!find(ParticleStore::kLifeEnd)) end->assign(static_cast<std::size_t>(n), 0.0);
   w.fillRestRatio(0);                             // from the materials (checked above), not the file
   deriveFromConcentrations(w.P, w.materials, 0);  // with mixing: from the concentrations (checked above)
   if (savedOwn) {

@@ -116,8 +116,9 @@ void World::Impl::addParticleSystemStages(StageList& list) {
   if (periodic.any()) list.add(plainStage("wrap", [](StepContext& c) { stageWrap(c); }));
   if (scene.effects.lifetime) list.add(plainStage("lifetimes", [this](StepContext& c) { lifetimes(c.dt); }));
   if (!scene.effects.sinks.empty()) list.add(plainStage("sinks", [this](StepContext&) { sinks(); }));
-  if (P.find(ParticleStore::kLife))
-    list.add(plainStage("particle_lifetimes", [this](StepContext& c) { particleLifetimes(c.dt); }));
+  if (P.findD(ParticleStore::kLifeEnd))
+    list.add(
+        plainStage("particle_lifetimes", [this](StepContext& c) { particleLifetimes(double(c.time) + double(c.dt)); }));
   if (contacts.on())
     list.add(plainStage("contacts", [this](StepContext& c) { contacts.record(c, P, boundary, moving.solids, dx); }));
 }

@@ -308,10 +308,14 @@ void World::step(double dt) {
     ++w.frames;
     w.refreshView();
   } catch (const Interrupted& e) {
-    w.deliverRemovals();  // what left the World before it stopped has left
-    w.abandon(e);
+    try {
+      w.abandon(e);  // marks the World abandoned and throws what to report
+    } catch (const Interrupted&) {
+      w.deliverRemovalsAfterFailure();  // what left the World before it stopped has left
+      throw;
+    }
   } catch (...) {
-    w.deliverRemovals();
+    w.deliverRemovalsAfterFailure();
     throw;
   }
   w.deliverRemovals();

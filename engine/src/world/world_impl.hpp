@@ -234,15 +234,23 @@ struct World::Impl {
   void lifetimes(Real dt);
   /// The sinks stage: removes particles inside sink regions.
   void sinks();
-  /// The particle_lifetimes stage: counts down each particle's own lifetime (the field
-  /// ParticleStore::kLife, World::setLifetimes) and removes those whose time ran out.
-  void particleLifetimes(Real dt);
+  /// The particle_lifetimes stage: removes the particles whose own end (the double field
+  /// ParticleStore::kLifeEnd, World::setLifetimes) is at or before `t1`, the substep's end.
+  void particleLifetimes(double t1);
   /// Removes the particles flagged in `sources.dead` (stable order), counting them; `ids`, when
   /// given, receives their ids in increasing order. With a destruction listener, their ids and
   /// `reason` join the removals to deliver.
   void removeFlagged(RemovalReason reason, std::vector<std::uint32_t>* ids = nullptr);
   /// Hands the removals collected since the last delivery to the destruction listener.
   void deliverRemovals();
+  /// deliverRemovals() in a step that is failing: an exception from the listener is dropped
+  /// (the step's own error is the one to report).
+  void deliverRemovalsAfterFailure() noexcept {
+    try {
+      deliverRemovals();
+    } catch (...) {
+    }
+  }
   // groups.cpp
   /// The groups stage: each group's particles towards the best-fit rigid placement of its
   /// rest shape (all the way when rigid), their velocities with them; then out of the static

@@ -5,7 +5,7 @@
 // wavelength of the periodic problem. The heavy layer has a free surface on top.
 //
 // The game solver: its grid projection carries the pressure (its β = 1/r_face weighs the two
-// fluids), and it grows within 5 % of σ (0.95–1.00 at λ/dx from 50 to 100, layers 0.25 to 1 m
+// fluids), and it grows within 5 % of σ as measured (the bound is 15 %) (0.95–1.00 at λ/dx from 50 to 100, layers 0.25 to 1 m
 // deep, A from 1/3 to 0.6; 0.81 at λ/dx = 25). wcsph on the same set-up grows at 0.3–0.9 of σ,
 // erratically (docs/notes/rayleigh-taylor.md): not tested here. With every β held at 1 (the
 // grid blind to the contrast) the interface does not grow at all.

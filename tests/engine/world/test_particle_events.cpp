@@ -108,11 +108,22 @@ TEST_CASE("particle events: the destruction listener hears exactly the ids that 
   w.refreshBoundaries();
   REQUIRE_FALSE(heard.empty());
   for (const Removal& r : heard) CHECK(r.reason == RemovalReason::solid);
-  // No listener: nothing is collected.
+  // No listener: nothing is collected, so a listener set later hears nothing of before.
   w.setDestructionListener(nullptr);
   heard.clear();
   w.removeParticles({w.particles().id[0]});
-  CHECK(heard.empty());
+  w.setDestructionListener([&](const std::vector<Removal>& r) { heard.insert(heard.end(), r.begin(), r.end()); });
+  const std::uint32_t next = w.particles().id[1];
+  w.removeParticles({next});
+  REQUIRE(heard.size() == 1);
+  CHECK(heard[0].id == next);
+  // A listener may replace itself while it runs.
+  int replaced = 0;
+  w.setDestructionListener(
+      [&](const std::vector<Removal>&) { w.setDestructionListener([&](const std::vector<Removal>&) { ++replaced; }); });
+  w.removeParticles({w.particles().id[0]});
+  w.removeParticles({w.particles().id[0]});
+  CHECK(replaced == 1);
 }
 
 TEST_CASE("particle events: an emitter at a recycling budget removes the oldest, heard as budget") {
@@ -203,6 +214,7 @@ TEST_CASE("particle events: a ray cast finds the particles a brute-force scan fi
       REQUIRE(got.size() == want.size());
       for (std::size_t k = 0; k < got.size(); ++k) {
         CHECK(got[k].fraction == doctest::Approx(want[k].first).epsilon(1e-9));
+        if (k + 1 < got.size() && want[k + 1].first - want[k].first > 1e-9) CHECK(got[k].id == want[k].second);
         CHECK(std::fabs((got[k].point - (p1 + d * got[k].fraction)).norm()) < 1e-9);
         CHECK(got[k].normal.norm() == doctest::Approx(1));
       }
@@ -214,6 +226,22 @@ TEST_CASE("particle events: a ray cast finds the particles a brute-force scan fi
         CHECK(first.id == want.front().second);
       }
     }
+    // A horizontal ray from far beyond the tank to far beyond it the other way: every disc
+    // the line y = 0.7 crosses, nearest first.
+    std::vector<std::pair<double, std::uint32_t>> line;
+    for (std::size_t i = 0; i < w.particleCount(); ++i) {
+      const Vec2d c = w.worldPosition(i);
+      if (std::fabs(c.y() - 0.7) < r) line.push_back({c.x(), w.particles().id[i]});
+    }
+    std::sort(line.begin(), line.end());
+    std::vector<std::uint32_t> far;
+    w.rayCast(Vec2d(-1e7, 0.7), Vec2d(1e7, 0.7), [&](const RayHit& h) {
+      far.push_back(h.id);
+      return true;
+    });
+    REQUIRE(far.size() == line.size());
+    for (std::size_t k = 0; k + 1 < line.size(); ++k)
+      if (line[k + 1].first - line[k].first > 1e-6) CHECK(far[k] == line[k].second);
   }
 }
 
@@ -235,4 +263,24 @@ TEST_CASE("particle events: lifetimes are kept by save and load, and a loaded Wo
   for (int f = 0; f < 12; ++f) fresh.stepFrame();
   CHECK_FALSE(idSet(fresh).count(id));
   CHECK(fresh.particleCount() == w.particleCount() - 1);
+}
+
+TEST_CASE("particle events: a save taken before any lifetime or group loads into a World that has them") {
+  SceneDef s = test::tank("game", 1.0, 1.0, 0.02);
+  s.blocks = {test::block({0.1, 0.1}, {0.3, 0.2})};
+  World w(s);
+  std::stringstream before;
+  w.save(before);
+  const std::uint32_t id = w.particles().id[2];
+  w.setLifetimes({id}, 0.5);
+  GroupDef g;
+  g.region = test::block({0.6, 0.6}, {0.7, 0.7});
+  const std::uint32_t group = w.createGroup(g);
+  w.stepFrame();
+  CHECK_NOTHROW(w.load(before));  // the checkpoint of before: no lifetime, no group
+  CHECK(w.lifetimeLeft(id) == std::numeric_limits<double>::infinity());
+  GroupState st;
+  CHECK_FALSE(w.groupState(group, st));
+  for (int f = 0; f < 40; ++f) w.stepFrame();
+  CHECK(idSet(w).count(id));
 }

@@ -487,7 +487,8 @@ std::size_t Pbf::velocity(StepContext& c) {
   const Spiky<Real> S(c.R);
   const Real cm = xsph_ * c.mass * S.c * c.R * c.R * c.R;
   // A density contrast: XSPH weighs neighbour j by its volume m_j/ρ_j times sqrt(r_j/r_i), so
-  // that Σ m_i Δv_i = 0 with m_i = r_i m (m_i sqrt(r_j/r_i) is symmetric): per particle
+  // that m_i times the pair's weight is symmetric in the masses (m_i = r_i m; what is left is
+  // the volumes' asymmetry of XSPH with one material): per particle
   // sqrt(r_j) m_j/ρ_j for its neighbours and 1/sqrt(r_i) for its own sum, no division per pair.
   const std::vector<Real>* ratioField = cm > 0 ? P.find(ParticleStore::kRestRatio) : nullptr;
   const Real* ratio = ratioField ? ratioField->data() : nullptr;

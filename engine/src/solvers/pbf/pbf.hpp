@@ -76,7 +76,7 @@
 //   position-based dynamics does (Müller et al. 2007): Δx_i = (1/r_i)·(the step above) and
 //   D_i = |∇_i C_i|²/r_i + Σ_j |∇_j C_i|²/r_j. λ stays a pressure (continuous across an
 //   interface); a heavy particle is moved less by it, so gravity sorts the layers. XSPH
-//   weighs neighbour j by sqrt(r_j/r_i) (momentum-conserving). P.rho
+//   weighs neighbour j by sqrt(r_j/r_i) (symmetric in the masses). P.rho
 //   is the density r_i ρ0 δ_i/δ0 after the substep, the number density during the solve.
 // - No warm start from the previous substep's multipliers.
 // - Convergence needs the mean compression and the largest below their tolerances.
