@@ -94,19 +94,13 @@ void GridPcg::factorRows() {
       const Real pl = precon_[std::size_t(l)];
       const Real aL = -beta(a, 0);
       const Real aUpL = adj_[4 * std::size_t(l) + 3] >= 0 ? -beta(std::size_t(l), 3) : Real(0);
-      if (Weighted)
-        e -= (aL * pl) * (aL * pl) + tau * aL * aUpL * pl * pl;
-      else
-        e -= pl * pl + tau * (-1) * aUpL * pl * pl;
+      e -= (aL * pl) * (aL * pl) + tau * aL * aUpL * pl * pl;  // unweighted: aL = −1, the same bits
     }
     if (d >= 0) {
       const Real pd = precon_[std::size_t(d)];
       const Real aD = -beta(a, 2);
       const Real aRightD = adj_[4 * std::size_t(d) + 1] >= 0 ? -beta(std::size_t(d), 1) : Real(0);
-      if (Weighted)
-        e -= (aD * pd) * (aD * pd) + tau * aD * aRightD * pd * pd;
-      else
-        e -= pd * pd + tau * (-1) * aRightD * pd * pd;
+      e -= (aD * pd) * (aD * pd) + tau * aD * aRightD * pd * pd;
     }
     if (e < sigma * diag_[a]) e = diag_[a];
     precon_[a] = Real(1) / std::sqrt(e);
