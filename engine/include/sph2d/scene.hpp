@@ -15,6 +15,7 @@
 
 #include "sph2d/events.hpp"
 #include "sph2d/fluid_block.hpp"
+#include "sph2d/groups.hpp"
 #include "sph2d/math.hpp"
 
 namespace sph2d {
@@ -144,9 +145,17 @@ struct MaterialDef {
   double diffusion = 1e-3;  ///< D [m²/s] of dc/dt = D∇²c with a material it mixes with (the pair's mean)
   /// Interface tension σ [N/m] with materials before it, by name (a pair that does not mix).
   std::vector<std::pair<std::string, double>> tensionWith;
+  /// A liquid, or a granular material (sand, powder): a liquid whose shear stress is bounded by
+  /// Coulomb friction, cohesion + tan(frictionAngle)·pressure (the granular effect; game solver).
+  enum class Kind { fluid, granular };
+  Kind kind = Kind::fluid;
+  double frictionAngle = 30;  ///< granular: the angle of repose [degrees]; 0 flows as a liquid
+  double cohesion = 0;        ///< granular: the shear stress it bears at no pressure [Pa]
+  bool granular() const { return kind == Kind::granular; }
   // The ranges a scene's `materials[]` and World::addMaterial accept.
   static constexpr double kMinDensity = 1, kMaxDensity = 1e5, kMaxViscosity = 1e3, kMaxDiffusion = 1;
   static constexpr double kMaxTension = 1e3;
+  static constexpr double kMaxFrictionAngle = 60, kMaxCohesion = 1e5;
   static constexpr std::size_t kMaxMaterials = 256, kMaxName = 64;
 };
 
@@ -255,6 +264,7 @@ struct SceneDef {
   SolverDef solver = qualityPreset("game");
   std::vector<BodyDef> bodies;
   std::vector<FluidBlockDef> blocks;
+  std::vector<GroupDef> groups;        ///< particle groups made with the World (`groups`), after the blocks
   PeriodicDef periodic;                ///< periodic axes (none by default)
   double fps = 60;                     ///< frames per simulated second
   double duration = 4;                 ///< simulated seconds the app renders
@@ -270,7 +280,7 @@ SceneDef loadScene(const std::string& path);
 /// Parses scene JSON text; `file` names it in errors. Throws SceneError.
 SceneDef parseScene(const std::string& text, const std::string& file);
 
-/// Number of particles the blocks of `scene` will create.
+/// Number of particles the blocks and groups of `scene` will create.
 std::size_t countBlockParticles(const SceneDef& scene);
 
 /// An upper estimate of the boundary samples the World will lay in the solids of `scene`

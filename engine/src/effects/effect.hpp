@@ -57,6 +57,9 @@ class Effect {
   virtual bool foldable() const { return false; }
   /// True while the solver computes this effect in its own pair loop (set by the World).
   bool folded = false;
+  /// True for an effect that runs where the solver's velocities are final, after the pressure
+  /// and before the move (Stage::velocities()); false: at the effects marker, with the forces.
+  virtual bool afterPressure() const { return false; }
   /// The World's materials changed (World::addMaterial); the World then rebuilds the stages.
   virtual void materialsChanged(const std::vector<MaterialDef>& materials, const SolverDef& solver) {
     (void)materials;

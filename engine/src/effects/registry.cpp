@@ -28,6 +28,8 @@ EffectList makeEffects(const SceneDef& scene) {
   if (e.surfaceTension) noModules("effects.surface_tension");
   if (e.shifting) noModules("effects.shifting");
   if (anyMiscible(materials)) noModules("mixing (materials[].miscible_with)");
+  for (const MaterialDef& m : materials)
+    if (m.granular()) noModules("a granular material (materials[].kind)");
   for (std::size_t a = 0; a < materials.size(); ++a)
     for (std::size_t b = 0; b < a; ++b)
       if (tensionBetween(materials, a, b) > 0) noModules("interface tension (materials[].tension_with)");

@@ -126,6 +126,7 @@ std::size_t ImplicitViscosity::apply(StepContext& c, const ViscosityTerm& t, con
         Real g = t.muMass * t.W.laplacianR2(dx * dx + dy * dy) * (IR[i] * IR[j]);
         if (w.ratio) g *= si * w.ratio[j];
         if (w.rel) g *= (reli + w.rel[j]) * Real(0.5);
+        if (w.member && !(w.member[i] && w.member[j])) g = 0;
         Si[k] = dt * g;
         rowSum += double(Si[k]);
       }

@@ -14,6 +14,9 @@ struct ViscosityWeights {
   const Real* ratio = nullptr;  ///< rest ratio r_i = ρ0_i/ρ0 (density contrast: the particle's mass is r_i m)
   const Real* rel = nullptr;    ///< r_i·ν_i/ν: the particle's dynamic viscosity over ν ρ0 (a pair takes the mean)
   const Real* nuRel = nullptr;  ///< ν_i/ν (the wall terms), present with materials of different viscosity
+  /// Non-null: a pair takes part only when both its particles do (1): the granular friction
+  /// acts between grains, not between a grain and the water around it.
+  const std::uint8_t* member = nullptr;
 };
 
 /// Backward Euler for the Laplacian viscosity over one substep (Weiler et al. 2018, "A

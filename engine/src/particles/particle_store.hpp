@@ -78,6 +78,13 @@ struct ParticleStore {
   static constexpr const char* kGroupQx = "group_qx";
   static constexpr const char* kGroupQy = "group_qy";
   static constexpr const char* kGroupStiffness = "group_stiffness";
+  /// Elastic groups that yield or break (GroupDef::yieldStrain, breakStrain): the strains.
+  static constexpr const char* kGroupYield = "group_yield";
+  static constexpr const char* kGroupBreak = "group_break";
+  /// Granular materials (effects/granular.cpp): each grain's viscosity over its density, and
+  /// its wall's, for the next substep (0: not measured yet).
+  static constexpr const char* kGranularNu = "granular.nu";
+  static constexpr const char* kGranularWallNu = "granular.wall_nu";
   /// 1 + the index of the emitter that made the particle; 0: none (World::setEmitterTracking).
   static constexpr const char* kEmitter = "emitter";
   /// The particle's material (an index in World::materials()); only while the World has more than one.
@@ -93,10 +100,11 @@ struct ParticleStore {
   static bool integerField(const std::string& name) {
     return name == kColor || name == kUserData || name == kEmitter || name == kGroup;
   }
-  /// True for the name of an optional float field a game's calls make (groups; absent from a
-  /// save: zeros on load, which hold "none").
+  /// True for the name of an optional float field a game's calls or a stage make (groups,
+  /// granular; absent from a save: zeros on load, which hold "none" or "not measured yet").
   static bool gameRealField(const std::string& name) {
-    return name == kGroupQx || name == kGroupQy || name == kGroupStiffness;
+    return name == kGroupQx || name == kGroupQy || name == kGroupStiffness || name == kGroupYield ||
+           name == kGroupBreak || name == kGranularNu || name == kGranularWallNu;
   }
   /// Removes the optional integer field `name` (nothing when it does not exist).
   void dropU32(const std::string& name) {

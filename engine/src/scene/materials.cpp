@@ -58,6 +58,14 @@ std::string materialProblem(const std::vector<MaterialDef>& materials, const Mat
       << m.viscosity;
   if (o.tellp() == 0 && !(m.diffusion >= 0 && m.diffusion <= MaterialDef::kMaxDiffusion))
     o << "diffusion must be in 0.." << MaterialDef::kMaxDiffusion << " m²/s, got " << m.diffusion;
+  if (o.tellp() == 0 && !(m.frictionAngle >= 0 && m.frictionAngle <= MaterialDef::kMaxFrictionAngle))
+    o << "friction_angle must be in 0.." << MaterialDef::kMaxFrictionAngle << " degrees, got " << m.frictionAngle;
+  if (o.tellp() == 0 && !(m.cohesion >= 0 && m.cohesion <= MaterialDef::kMaxCohesion))
+    o << "cohesion must be in 0.." << MaterialDef::kMaxCohesion << " Pa, got " << m.cohesion;
+  if (o.tellp() == 0 && m.granular() && solver.type != "game")
+    o << "kind \"granular\" needs solver.type \"game\" (its friction acts between the pressure projection "
+         "and the move), got \""
+      << solver.type << "\"";
   for (double c : m.color)
     if (o.tellp() == 0 && !(c >= 0 && c <= 1)) o << "color components must be in 0..1, got " << c;
   if (o.tellp() != 0) return o.str();
@@ -109,7 +117,9 @@ void readMaterials(const Reader& r, const nlohmann::json& root, SceneDef& s) {
     const std::string p = "materials[" + std::to_string(k) + "]";
     const nlohmann::json& j = arr[k];
     r.requireObject(j, p);
-    r.checkKeys(j, p, {"name", "density", "viscosity", "color", "miscible_with", "diffusion", "tension_with"});
+    r.checkKeys(j, p,
+                {"name", "density", "viscosity", "color", "miscible_with", "diffusion", "tension_with", "kind",
+                 "friction_angle", "cohesion"});
     MaterialDef m;
     if (!j.contains("name")) r.fail(Reader::sub(p, "name"), "missing; expected the material's name");
     m.name = r.string(j, p, "name", "", {});
@@ -121,6 +131,12 @@ void readMaterials(const Reader& r, const nlohmann::json& root, SceneDef& s) {
     if (j.contains("viscosity")) m.viscosity = r.number(j, p, "viscosity", 0, 0, MaterialDef::kMaxViscosity);
     m.color = r.color(j, p, "color", s.render.water);
     m.diffusion = r.number(j, p, "diffusion", m.diffusion, 0, MaterialDef::kMaxDiffusion);
+    if (r.string(j, p, "kind", "fluid", {"fluid", "granular"}) == "granular") m.kind = MaterialDef::Kind::granular;
+    for (const char* key : {"friction_angle", "cohesion"})
+      if (j.contains(key) && !m.granular())
+        r.fail(Reader::sub(p, key), std::string(key) + " is a granular material's: give \"kind\": \"granular\"");
+    m.frictionAngle = r.number(j, p, "friction_angle", m.frictionAngle, 0, MaterialDef::kMaxFrictionAngle);
+    m.cohesion = r.number(j, p, "cohesion", m.cohesion, 0, MaterialDef::kMaxCohesion);
     if (j.contains("miscible_with")) {
       const nlohmann::json& mw = j.at("miscible_with");
       const std::string q = Reader::sub(p, "miscible_with");
@@ -162,6 +178,9 @@ void readMaterials(const Reader& r, const nlohmann::json& root, SceneDef& s) {
                         : problem.rfind("diffusion", 0) == 0 ? "diffusion"
                         : problem.rfind("miscible", 0) == 0  ? "miscible_with"
                         : problem.rfind("tension", 0) == 0   ? "tension_with"
+                        : problem.rfind("friction", 0) == 0  ? "friction_angle"
+                        : problem.rfind("cohesion", 0) == 0  ? "cohesion"
+                        : problem.rfind("kind", 0) == 0      ? "kind"
                                                              : "name";
       r.fail(problem.rfind("a World", 0) == 0 ? p : Reader::sub(p, key), problem);
     }

@@ -12,7 +12,8 @@ void StageList::clear() {
 }
 
 void StageList::add(Stage s) {
-  if (s.effectsMarker || !s.run) throw std::logic_error("StageList::add: stage '" + s.name + "' has no work");
+  if (s.effectsMarker || s.velocityMarker || !s.run)
+    throw std::logic_error("StageList::add: stage '" + s.name + "' has no work");
   std::size_t k = 0;
   while (k < timing_.size() && timing_[k].name != s.name) ++k;
   if (k == timing_.size()) timing_.push_back(StageTiming{s.name, 0, 0});

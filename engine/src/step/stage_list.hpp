@@ -27,8 +27,14 @@ struct Stage {
   std::string name;            ///< shown by --profile, World::stages() and the guard's errors
   Fn run;                      ///< the work (empty for the effects marker)
   bool effectsMarker = false;  ///< true: not a stage, the place in a solver's list where effects run
+  /// True: not a stage, the place where the velocities are final and the positions have not
+  /// moved yet (after the pressure): the effects that bound the flow run there (granular).
+  bool velocityMarker = false;
   /// The marker a solver puts where the scene's effects run.
   static Stage effects() { return Stage{"", nullptr, true}; }
+  /// The marker a solver puts where its velocities are final, before the move; `pressure`
+  /// (a stage named "pressure_now" when effects run there) brings P.p up to this substep.
+  static Stage velocities(Fn pressure) { return Stage{"pressure_now", std::move(pressure), false, true}; }
 };
 
 /// Builds a stage that cannot find a bad particle.

@@ -131,6 +131,13 @@ std::uint32_t World::addMaterial(const MaterialDef& m) {
          "materials table, so that the World is built with the viscosity effect";
     throw std::invalid_argument(o.str());
   }
+  Effect* granular = nullptr;
+  for (const auto& e : w.effects)
+    if (std::string(e->name()) == "granular") granular = e.get();
+  if (m.granular() && !granular)
+    throw std::invalid_argument(
+        "addMaterial: a granular material in a World built without one: give it in the scene's materials table, so "
+        "that the World is built with the granular effect");
   if (m.density != w.materials.front().density) {
     const std::string effects = densityContrastProblem(w.scene);
     if (!effects.empty()) throw std::invalid_argument("addMaterial: " + effects);
@@ -142,6 +149,7 @@ std::uint32_t World::addMaterial(const MaterialDef& m) {
     viscosity->materialsChanged(w.materials, w.scene.solver);
     w.buildStages();
   }
+  if (granular) granular->materialsChanged(w.materials, w.scene.solver);
   if (w.materials.size() == 2) {  // from now on each particle says which (every one there now: the first)
     w.P.fieldU32(ParticleStore::kMaterial);
     w.refreshView();

@@ -80,20 +80,25 @@ void World::Impl::buildStages() {
   Effect* folded = first && first->foldable() && solver->foldViscosity(first) ? first : nullptr;
   if (!folded) solver->foldViscosity(nullptr);
   for (const auto& e : effects) e->folded = e.get() == folded;
-  bool marker = false;
+  bool marker = false, late = false, lateMarker = false;
+  for (const auto& e : effects) late = late || (e->enabled && e->afterPressure());
   for (Stage& s : solver->stages(anyEffect)) {
-    if (!s.effectsMarker) {
+    if (!s.effectsMarker && !s.velocityMarker) {
       stages.add(std::move(s));
       continue;
     }
-    marker = true;
+    marker = marker || s.effectsMarker;
+    lateMarker = lateMarker || s.velocityMarker;
+    if (s.velocityMarker && late && s.run) stages.add(Stage{s.name, s.run});
     for (const auto& e : effects) {
-      if (!e->enabled || e.get() == folded) continue;
+      if (!e->enabled || e.get() == folded || e->afterPressure() != s.velocityMarker) continue;
       Effect* fx = e.get();
       stages.add(Stage{fx->name(), [fx](StepContext& c) { return fx->apply(c); }});
     }
   }
   if (!marker) throw std::logic_error(std::string("solver ") + solver->name() + " has no effects marker in its stages");
+  if (late && !lateMarker)
+    throw std::logic_error(std::string("solver ") + solver->name() + " has no velocity marker for its effects");
   stages.add(plainStage("max_acceleration", [this](StepContext& c) {
     lastAccel = c.accelMeasured >= 0 ? c.accelMeasured
                                      : maxAccelOf(c.P, c.pool);  // the explicit solvers' force_limit measured it

@@ -143,6 +143,7 @@ std::vector<Stage> Pbf::stages(bool effects) {
       });
     }));
     s.push_back(Stage{"grid_projection", [this](StepContext& c) { return projection_->project(c); }});
+    s.push_back(Stage::velocities([this](StepContext& c) { return pressureNow(c); }));
   }
   s.push_back(Stage{"predict", [this](StepContext& c) { return predict(c, c.P.field("pbf.lambda")); }});
   s.push_back(plainStage("predicted_grid", [](StepContext& c) { stageGrid(c, reorderThisStep(c)); }));
@@ -397,12 +398,6 @@ void Pbf::addWallMoves(std::size_t blocks, Real omega, bool rotate) {
     if (rotate) wallMovePrev_[q] = wallMove_[q];
     wallMove_[q] = next;
   }
-}
-
-Real Pbf::pressure(const StepContext& c, const std::vector<Real>* lam, Real pK, std::size_t i) const {
-  Real p = lam ? std::max(Real(0), pK * (*lam)[i]) : Real(0);
-  if (projection_) p += c.rho0 * std::max(Real(0), projection_->kappaAt(c.P.x[i]));
-  return p;
 }
 
 std::size_t Pbf::finalDensity(StepContext& c, Real dt) {

@@ -187,6 +187,9 @@ class Pbf final : public Solver {
   /// The pressure reported for particle i: −ρ0 λ_i/dt² of the constraint, plus ρ0 κ of the
   /// grid projection when there is one (it carries the hydrostatic part).
   Real pressure(const StepContext& c, const std::vector<Real>* lam, Real pK, std::size_t i) const;
+  /// The velocity marker's stage (game): p of this substep's projection (κ) and the last
+  /// density solve (λ), for the effects that run there (the granular friction's bound).
+  std::size_t pressureNow(StepContext& c);
 
   /// ρ of the final positions (what the World reports), 1/ρ, p (pressure()). Caches W_ij/wK for XSPH.
   std::size_t finalDensity(StepContext& c, Real dt);

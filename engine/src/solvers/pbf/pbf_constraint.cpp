@@ -439,4 +439,19 @@ std::size_t Pbf::correct(StepContext& c, std::vector<Real>& lambda, Real omega,
   return first;
 }
 
+Real Pbf::pressure(const StepContext& c, const std::vector<Real>* lam, Real pK, std::size_t i) const {
+  Real p = lam ? std::max(Real(0), pK * (*lam)[i]) : Real(0);
+  if (projection_) p += c.rho0 * std::max(Real(0), projection_->kappaAt(c.P.x[i]));
+  return p;
+}
+
+std::size_t Pbf::pressureNow(StepContext& c) {
+  const std::vector<Real>* lam = c.P.find("pbf.lambda");
+  const Real pK = -c.rho0 / (c.dt * c.dt);
+  c.pool.parallelFor(c.P.size(), kBlock, [&](std::size_t b, std::size_t e) {
+    for (std::size_t i = b; i < e; ++i) c.P.p[i] = pressure(c, lam, pK, i);
+  });
+  return kNone;
+}
+
 }  // namespace sph2d
