@@ -19,6 +19,17 @@ struct GroupDef {
   /// The share of the way to the best-fit rigid placement of its rest shape each particle
   /// goes per substep: 1 a rigid body, below 1 an elastic one (0 < stiffness ≤ 1).
   double stiffness = 1;
+  /// Elastic only: the strain beyond which it yields (plastic): a particle farther from its
+  /// place than this times its rest distance from the centre (at least a spacing) moves its
+  /// place in the rest shape by the excess. 0: it always springs back.
+  double yieldStrain = 0;
+  /// Elastic only: the strain at which it breaks: after the substep, pairs of neighbours (in
+  /// the rest shape, at most 1.5 spacings apart) stretched or squeezed by more than this
+  /// part, and what stays connected becomes a group of its own (at least 3 particles; fewer
+  /// go free as fluid). 0: it never breaks.
+  double breakStrain = 0;
+  /// A scene's elastic group without a stiffness of its own.
+  static constexpr double kElasticStiffness = 0.25;
 };
 
 /// A group as it is now: its centre of mass, the rotation of its shape from when it was made,

@@ -333,6 +333,18 @@ class World {
   /// angular one (N·m·s per metre): each particle's velocity changes as the rigid body's.
   /// False when no particle is in it.
   bool applyGroupImpulse(std::uint32_t group, const Vec2d& linear, double angular);
+  /// Ends group `group`: its particles go free as fluid, or with `withParticles` are removed
+  /// (to the destruction listener as a game call). False when no particle is in it.
+  bool destroyGroup(std::uint32_t group, bool withParticles = false);
+  /// Joins group `from` into `into`: one group, of `into`'s stiffness and strains, whose rest
+  /// shape is the two as they are now. False when either has no particle or they are one.
+  bool joinGroups(std::uint32_t into, std::uint32_t from);
+  /// Splits group `group` into the parts of it connected now (neighbours at most 1.5
+  /// spacings apart): the largest keeps the index, each other part of 3 or more particles
+  /// gets a new one (returned, by its lowest slot), smaller parts go free as fluid.
+  std::vector<std::uint32_t> splitGroup(std::uint32_t group);
+  /// One past the highest group index a particle holds (0: no group).
+  std::uint32_t groupCount() const;
 
   // Per-particle colour and user data: each field is allocated on the first set (every
   // other particle, and every particle added later, holds 0), kept through reordering,

@@ -35,7 +35,7 @@ SceneDef parseScene(const std::string& text, const std::string& file) {
   r.requireObject(root, "");
   r.checkKeys(root, "",
               {"name", "gravity", "fps", "duration", "max_particles", "solver", "boundaries", "fluid", "periodic",
-               "effects", "render", "events", "materials"});
+               "effects", "render", "events", "materials", "groups"});
   SceneDef s;
   s.path = file;
   // In this order: each section may check what it reads against those before it.
@@ -45,6 +45,7 @@ SceneDef parseScene(const std::string& text, const std::string& file) {
   readMaterials(r, root, s);  // against the solver; before everything that names a material
   readBoundaries(r, root, s);
   readFluid(r, root, s);     // blocks against the spacing and the solids
+  readGroups(r, root, s);    // the groups' regions, likewise
   readPeriodic(r, root, s);  // periods against the support radius
   readEffects(r, root, s);
   readEvents(r, root, s);  // the timeline last: against the emitters, effects and gravity

@@ -443,6 +443,7 @@ double estimateWorldBytes(const SceneDef& scene) {
 std::size_t countBlockParticles(const SceneDef& scene) {
   double n = 0;
   for (const auto& b : scene.blocks) n += regionLatticeCount(b, scene.solver.spacing);
+  for (const auto& g : scene.groups) n += regionLatticeCount(g.region, scene.solver.spacing);
   const double most = double(std::numeric_limits<std::size_t>::max() / 2);
   return !(n < most) ? std::numeric_limits<std::size_t>::max() / 2 : static_cast<std::size_t>(n);
 }

@@ -375,6 +375,33 @@ void readFluid(const Reader& r, const json& root, SceneDef& s) {
     s.blocks.push_back(readBlock(r, arr[b], "fluid[" + std::to_string(b) + "]", s));
 }
 
+void readGroups(const Reader& r, const json& root, SceneDef& s) {
+  if (!root.contains("groups")) return;
+  const json& arr = root.at("groups");
+  if (!arr.is_array()) r.fail("groups", "expected an array of groups, got " + describe(arr));
+  for (std::size_t k = 0; k < arr.size(); ++k) {
+    const std::string p = "groups[" + std::to_string(k) + "]";
+    r.requireObject(arr[k], p);
+    GroupDef g;
+    const bool elastic = r.string(arr[k], p, "kind", "rigid", {"rigid", "elastic"}) == "elastic";
+    if (!elastic && arr[k].contains("stiffness"))
+      r.fail(Reader::sub(p, "stiffness"), "a rigid group has stiffness 1: give \"kind\": \"elastic\" for less");
+    // An elastic group's share of the way back to its shape per substep: below 1.
+    g.stiffness = elastic ? r.number(arr[k], p, "stiffness", GroupDef::kElasticStiffness, 0, 1, true) : 1.0;
+    if (elastic && !(g.stiffness < 1))
+      r.fail(Reader::sub(p, "stiffness"), "an elastic group's stiffness must be below 1 (1 is rigid), got 1");
+    for (const char* key : {"yield_strain", "break_strain"}) {
+      if (!arr[k].contains(key)) continue;
+      if (!elastic) r.fail(Reader::sub(p, key), "a rigid group neither yields nor breaks: give \"kind\": \"elastic\"");
+      (std::string(key) == "yield_strain" ? g.yieldStrain : g.breakStrain) = r.number(arr[k], p, key, 0, 0, 10);
+    }
+    json region = arr[k];  // the region's keys are a fluid block's (errors name this path's lines)
+    for (const char* key : {"kind", "stiffness", "yield_strain", "break_strain"}) region.erase(key);
+    g.region = readBlock(r, region, p, s);
+    s.groups.push_back(g);
+  }
+}
+
 void readPeriodic(const Reader& r, const json& root, SceneDef& s) {
   if (!root.contains("periodic")) return;
   const json& j = root.at("periodic");

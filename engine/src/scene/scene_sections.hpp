@@ -35,6 +35,8 @@ void readBoundaries(const Reader& r, const nlohmann::json& root, SceneDef& s);
 /// `fluid`: blocks of fluid with their velocities and velocity fields; each must
 /// hold a particle at the solver's spacing outside the solids read before.
 void readFluid(const Reader& r, const nlohmann::json& root, SceneDef& s);
+/// `groups`: regions (as `fluid` blocks) made into rigid or elastic particle groups.
+void readGroups(const Reader& r, const nlohmann::json& root, SceneDef& s);
 
 /// `periodic`: the wrapping axes and their ranges (at least 3 support radii long).
 void readPeriodic(const Reader& r, const nlohmann::json& root, SceneDef& s);

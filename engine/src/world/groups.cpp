@@ -14,6 +14,22 @@
 #include "world/world_impl.hpp"
 
 namespace sph2d {
+namespace {
+
+/// An elastic group's internal damping [1/s]: the rate at which its particles' velocity
+/// relative to the group's rigid motion decays (a jelly's own viscosity).
+constexpr double kElasticDamping = 4;
+
+/// The largest yield or break strain a group takes.
+constexpr double kMaxStrain = 10;
+
+/// Union–find over slots: the root of a, halving the path.
+std::size_t findRoot(std::vector<std::size_t>& parent, std::size_t a) {
+  while (parent[a] != a) a = parent[a] = parent[parent[a]];
+  return a;
+}
+
+}  // namespace
 
 void World::Impl::groupSums(std::vector<GroupSums>& sums) const {
   const std::vector<std::uint32_t>& group = *P.findU32(ParticleStore::kGroup);
@@ -61,6 +77,10 @@ void World::Impl::matchGroups(StepContext& c) {
   const std::vector<Real>& qx = *P.find(ParticleStore::kGroupQx);
   const std::vector<Real>& qy = *P.find(ParticleStore::kGroupQy);
   const std::vector<Real>& stiffness = *P.find(ParticleStore::kGroupStiffness);
+  const std::vector<Real>* yield = P.find(ParticleStore::kGroupYield);
+  const Real damp = Real(std::exp(-kElasticDamping * double(dt)));
+  std::vector<Real>* qxw = P.find(ParticleStore::kGroupQx);  // the rest shape, which plasticity moves
+  std::vector<Real>* qyw = P.find(ParticleStore::kGroupQy);
   for (std::size_t i = 0; i < P.size(); ++i) {
     if (!group[i]) continue;
     const GroupSums& s = sums[group[i] - 1];
@@ -74,11 +94,32 @@ void World::Impl::matchGroups(StepContext& c) {
       P.x[i] = Vec2(Real(gx), Real(gy));
       P.v[i] = Vec2(Real(s.mvx / s.m - omega * (gy - cy)), Real(s.mvy / s.m + omega * (gx - cx)));
     } else {  // elastic: a share of the way, the velocity with it
+      if (yield && (*yield)[i] > 0) {
+        // Plastic: beyond the yield strain its place in the rest shape takes the excess (rotated
+        // back into the rest frame), so the shape it springs back to is the deformed one.
+        const double ex = double(P.x[i].x()) - gx, ey = double(P.x[i].y()) - gy, e = std::sqrt(ex * ex + ey * ey);
+        const double limit = double((*yield)[i]) * std::max(std::sqrt(ux * ux + uy * uy), double(dx));
+        if (e > limit) {
+          const double f = 1 - limit / e, rx = f * (cs * ex + sn * ey), ry = f * (-sn * ex + cs * ey);
+          (*qxw)[i] += Real(rx);
+          (*qyw)[i] += Real(ry);
+        }
+      }
       const Vec2 d(Real(k * (gx - double(P.x[i].x()))), Real(k * (gy - double(P.x[i].y()))));
       P.x[i] += d;
-      P.v[i] += d / dt;
+      // The velocity of the substep's move (as position-based dynamics takes it): the solver's
+      // corrections of the positions, which a liquid's velocity leaves out, are part of a
+      // jelly's motion; left out, a jelly at rest kept the corrections' −dt·g as velocity.
+      P.v[i] = (P.x[i] - P.xPrev[i]) / dt;
+      // Internal friction: the velocity relative to the group's rigid motion decays at
+      // kElasticDamping per second (the rigid motion itself, momentum and spin, is kept).
+      const double omega = s.I > 0 ? s.L / s.I : 0;
+      const double rx = double(P.x[i].x()) - cx, ry = double(P.x[i].y()) - cy;
+      const Vec2 rigid(Real(s.mvx / s.m - omega * ry), Real(s.mvy / s.m + omega * rx));
+      P.v[i] = rigid + (P.v[i] - rigid) * damp;
     }
   }
+  if (P.find(ParticleStore::kGroupBreak)) breakGroups(c);
   if (c.boundary.colliders.empty()) return;
   // The static solids: an elastic group's particles leave them one by one (as the collide
   // stage moves fluid); a rigid group as one, by the largest push each way along each axis,
@@ -118,6 +159,13 @@ std::uint32_t World::createGroup(const GroupDef& def, IdRange* ids) {
   if (!(def.stiffness > 0 && def.stiffness <= 1))
     throw std::invalid_argument("createGroup: stiffness must be in (0, 1] (1: rigid), got " +
                                 std::to_string(def.stiffness));
+  if (!(def.yieldStrain >= 0 && def.yieldStrain <= kMaxStrain) ||
+      !(def.breakStrain >= 0 && def.breakStrain <= kMaxStrain))
+    throw std::invalid_argument("createGroup: yieldStrain and breakStrain must be in 0.." + std::to_string(kMaxStrain) +
+                                " (0: none), got " + std::to_string(def.yieldStrain) + " and " +
+                                std::to_string(def.breakStrain));
+  if (def.stiffness >= 1 && (def.yieldStrain > 0 || def.breakStrain > 0))
+    throw std::invalid_argument("createGroup: a rigid group (stiffness 1) neither yields nor breaks");
   Impl& w = *impl_;
   const IdRange added = w.fillNamed(def.region, "createGroup");
   if (added.size() == 0)
@@ -147,6 +195,13 @@ std::uint32_t World::createGroup(const GroupDef& def, IdRange* ids) {
     qx[i] = Real(double(w.P.x[i].x()) - cx);
     qy[i] = Real(double(w.P.x[i].y()) - cy);
     k[i] = Real(def.stiffness);
+  }
+  // Yield and break strains: fields only once a group has one (0 in the others: none).
+  for (const auto& [name, value] : {std::pair<const char*, double>{ParticleStore::kGroupYield, def.yieldStrain},
+                                    {ParticleStore::kGroupBreak, def.breakStrain}}) {
+    if (value <= 0 && !w.P.find(name)) continue;
+    std::vector<Real>& f = w.P.field(name);
+    for (const std::size_t i : slots) f[i] = Real(value);
   }
   w.refreshView();
   if (!had) w.buildStages();
@@ -185,6 +240,169 @@ bool World::applyGroupImpulse(std::uint32_t g, const Vec2d& linear, double angul
     w.P.v[i] += Vec2(Real(linear.x() / s.m - dw * ry), Real(linear.y() / s.m + dw * rx));
   }
   return true;
+}
+
+void World::Impl::splitParts(std::uint32_t g, const std::vector<std::size_t>& slots,
+                             const std::function<bool(std::size_t, std::size_t)>& linked,
+                             std::vector<std::uint32_t>* made) {
+  std::vector<std::uint32_t>& group = *P.findU32(ParticleStore::kGroup);
+  std::vector<std::size_t> parent(slots.size());
+  for (std::size_t a = 0; a < slots.size(); ++a) parent[a] = a;
+  for (std::size_t a = 0; a < slots.size(); ++a)
+    for (std::size_t b = a + 1; b < slots.size(); ++b)
+      if (linked(slots[a], slots[b])) {
+        const std::size_t ra = findRoot(parent, a), rb = findRoot(parent, b);
+        if (ra != rb) parent[std::max(ra, rb)] = std::min(ra, rb);
+      }
+  // The parts in order of their lowest slot; the largest (the first of equals) keeps g.
+  std::vector<std::size_t> size(slots.size(), 0), roots;
+  for (std::size_t a = 0; a < slots.size(); ++a) {
+    const std::size_t r = findRoot(parent, a);
+    if (size[r]++ == 0) roots.push_back(r);
+  }
+  if (roots.size() < 2) return;
+  std::size_t keep = roots.front();
+  for (const std::size_t r : roots)
+    if (size[r] > size[keep]) keep = r;
+  std::uint32_t next = 0;
+  for (const std::uint32_t v : group) next = std::max(next, v);
+  std::vector<std::uint32_t> partIndex(slots.size(), g + 1);
+  for (const std::size_t r : roots) {
+    if (r == keep) continue;
+    if (size[r] < kMinGroup) {
+      partIndex[r] = 0;  // too few to hold a shape: free fluid
+      continue;
+    }
+    partIndex[r] = ++next;
+    if (made) made->push_back(next - 1);
+  }
+  for (std::size_t a = 0; a < slots.size(); ++a) group[slots[a]] = partIndex[findRoot(parent, a)];
+  if (size[keep] < kMinGroup)
+    for (std::size_t a = 0; a < slots.size(); ++a)
+      if (findRoot(parent, a) == keep) group[slots[a]] = 0;
+}
+
+void World::Impl::breakGroups(const StepContext& c) {
+  const std::vector<std::uint32_t>& group = *P.findU32(ParticleStore::kGroup);
+  const std::vector<Real>& qx = *P.find(ParticleStore::kGroupQx);
+  const std::vector<Real>& qy = *P.find(ParticleStore::kGroupQy);
+  const std::vector<Real>& strain = *P.find(ParticleStore::kGroupBreak);
+  if (c.nbr.count.size() != P.size()) return;  // no neighbour lists of these particles (a drift)
+  const double adjacent2 = 1.5 * 1.5 * double(dx) * double(dx);
+  auto restDist2 = [&](std::size_t i, std::size_t j) {
+    const double ax = double(qx[i]) - double(qx[j]), ay = double(qy[i]) - double(qy[j]);
+    return ax * ax + ay * ay;
+  };
+  auto stretched = [&](std::size_t i, std::size_t j) {  // current / rest − 1 beyond the strain
+    double d2x = double(P.x[i].x()) - double(P.x[j].x()), d2y = double(P.x[i].y()) - double(P.x[j].y());
+    const double ratio = std::sqrt((d2x * d2x + d2y * d2y) / restDist2(i, j));
+    return ratio - 1 > double(strain[i]);
+  };
+  // The breakable groups with a broken pair (neighbours in the rest shape, now stretched or
+  // squeezed beyond the strain, or apart beyond the search radius).
+  std::vector<std::uint32_t> broken;
+  for (std::size_t i = 0; i < P.size(); ++i) {
+    if (!group[i] || !(strain[i] > 0)) continue;
+    if (std::find(broken.begin(), broken.end(), group[i]) != broken.end()) continue;
+    const std::uint32_t* nb = c.nbr.of(i);
+    std::size_t adjacent = 0;
+    bool cut = false;
+    for (std::uint32_t k = 0; k < c.nbr.count[i] && !cut; ++k) {
+      const std::uint32_t j = nb[k];
+      if (group[j] != group[i] || restDist2(i, j) > adjacent2) continue;
+      ++adjacent;
+      cut = stretched(i, j);
+    }
+    if (cut) broken.push_back(group[i]);
+  }
+  std::sort(broken.begin(), broken.end());
+  for (const std::uint32_t g : broken) {
+    std::vector<std::size_t> slots;
+    for (std::size_t i = 0; i < P.size(); ++i)
+      if (group[i] == g) slots.push_back(i);
+    splitParts(g - 1, slots,
+               [&](std::size_t i, std::size_t j) { return restDist2(i, j) <= adjacent2 && !stretched(i, j); });
+  }
+}
+
+bool World::destroyGroup(std::uint32_t g, bool withParticles) {
+  Impl& w = *impl_;
+  std::vector<std::uint32_t>* group = w.P.findU32(ParticleStore::kGroup);
+  if (!group) return false;
+  std::size_t n = 0;
+  if (withParticles) w.sources.dead.assign(w.P.size(), 0);
+  for (std::size_t i = 0; i < w.P.size(); ++i) {
+    if ((*group)[i] != g + 1) continue;
+    ++n;
+    if (withParticles)
+      w.sources.dead[i] = 1;
+    else
+      (*group)[i] = 0;
+  }
+  if (n == 0) return false;
+  if (withParticles) {
+    w.removeFlagged(RemovalReason::game);
+    w.deliverRemovals();
+  }
+  return true;
+}
+
+bool World::joinGroups(std::uint32_t into, std::uint32_t from) {
+  Impl& w = *impl_;
+  std::vector<std::uint32_t>* group = w.P.findU32(ParticleStore::kGroup);
+  if (!group || into == from) return false;
+  std::vector<std::size_t> slots;
+  std::size_t inInto = 0;
+  for (std::size_t i = 0; i < w.P.size(); ++i)
+    if ((*group)[i] == into + 1 || (*group)[i] == from + 1) {
+      slots.push_back(i);
+      inInto += (*group)[i] == into + 1;
+    }
+  if (inInto == 0 || inInto == slots.size()) return false;
+  // One group of `into`'s kind whose rest shape is the two as they are now.
+  std::size_t first = slots.front();
+  for (const std::size_t i : slots)
+    if ((*group)[i] == into + 1) {
+      first = i;
+      break;
+    }
+  std::vector<Real>& qx = w.P.field(ParticleStore::kGroupQx);
+  std::vector<Real>& qy = w.P.field(ParticleStore::kGroupQy);
+  std::vector<Real>& k = w.P.field(ParticleStore::kGroupStiffness);
+  std::vector<Real>* yield = w.P.find(ParticleStore::kGroupYield);
+  std::vector<Real>* brk = w.P.find(ParticleStore::kGroupBreak);
+  for (const std::size_t i : slots) {
+    (*group)[i] = into + 1;
+    qx[i] = w.P.x[i].x();
+    qy[i] = w.P.x[i].y();
+    k[i] = k[first];
+    if (yield) (*yield)[i] = (*yield)[first];
+    if (brk) (*brk)[i] = (*brk)[first];
+  }
+  return true;
+}
+
+std::vector<std::uint32_t> World::splitGroup(std::uint32_t g) {
+  Impl& w = *impl_;
+  std::vector<std::uint32_t> made;
+  if (!w.P.findU32(ParticleStore::kGroup)) return made;
+  const std::vector<std::uint32_t>& group = *w.P.findU32(ParticleStore::kGroup);
+  std::vector<std::size_t> slots;
+  for (std::size_t i = 0; i < w.P.size(); ++i)
+    if (group[i] == g + 1) slots.push_back(i);
+  const double near2 = 1.5 * 1.5 * double(w.dx) * double(w.dx);
+  w.splitParts(
+      g, slots,
+      [&](std::size_t i, std::size_t j) { return (w.P.x[i] - w.P.x[j]).cast<double>().squaredNorm() <= near2; }, &made);
+  return made;
+}
+
+std::uint32_t World::groupCount() const {
+  const std::vector<std::uint32_t>* group = impl_->P.findU32(ParticleStore::kGroup);
+  std::uint32_t n = 0;
+  if (group)
+    for (const std::uint32_t g : *group) n = std::max(n, g);
+  return n;
 }
 
 }  // namespace sph2d

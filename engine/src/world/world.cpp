@@ -200,6 +200,10 @@ void World::initPhases(std::string& phase) {
     grow(b.min);
     grow(b.max);
   }
+  for (const auto& g : scene.groups) {
+    grow(g.region.min);
+    grow(g.region.max);
+  }
   for (const auto& b : scene.bodies) grow(b.position);
   if (!w.ownWorld)
     for (b2Body* body = w.b2->GetBodyList(); body; body = body->GetNext())
@@ -263,6 +267,16 @@ void World::initPhases(std::string& phase) {
   w.solver->prepare(c);
   w.buildStages();
   w.refreshView();
+  for (std::size_t k = 0; k < scene.groups.size(); ++k) {
+    w.checkSceneMaterial(scene.groups[k].region.material, "groups[" + std::to_string(k) + "].material");
+    try {
+      createGroup(scene.groups[k]);
+    } catch (const std::invalid_argument& e) {
+      std::string why = e.what();
+      why.erase(0, std::string("createGroup: ").size());
+      throw SceneError(scene.path.empty() ? "scene" : scene.path, 0, 0, "groups[" + std::to_string(k) + "]", why);
+    }
+  }
 }
 
 World::~World() = default;

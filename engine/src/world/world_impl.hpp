@@ -263,6 +263,17 @@ struct World::Impl {
     std::size_t n = 0;
   };
   void groupSums(std::vector<GroupSums>& sums) const;
+  /// After matching: splits each breakable group with a pair of rest neighbours stretched or
+  /// squeezed beyond its break strain into the parts still connected (splitParts).
+  void breakGroups(const StepContext& c);
+  /// Splits group g (its particles `slots`, in slot order) into the parts `linked` pairs
+  /// connect: the largest keeps g, each other part of at least kMinGroup particles a new
+  /// index (appended to `made`), smaller parts go free (group 0).
+  void splitParts(std::uint32_t g, const std::vector<std::size_t>& slots,
+                  const std::function<bool(std::size_t, std::size_t)>& linked,
+                  std::vector<std::uint32_t>* made = nullptr);
+  /// The fewest particles a group keeps (fewer hold no shape).
+  static constexpr std::size_t kMinGroup = 3;
   std::vector<GroupSums> groupScratch;  ///< matchGroups' sums
   std::vector<double> groupPush;        ///< matchGroups' pushes out of the solids, per group
   /// Removes the k oldest particles (smallest ids).

@@ -1,0 +1,222 @@
+// Elastic groups (jelly: shape matching with a stiffness below 1, engine/src/world/groups.cpp):
+// a dropped block bounces, comes to rest and springs back to its shape; a plastic one stays
+// deformed; a breakable one hit by a fast body breaks apart; and a game joins, splits and
+// destroys groups, in code and from a scene's `groups`.
+#include <doctest/doctest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include "support/fixture.hpp"
+#include "test_util.hpp"
+
+using namespace sph2d;
+
+namespace {
+
+/// RMS distance of `x` from the best-fit rigid placement of `rest` (least squares: the
+/// centroids matched, the rotation of Σ r q̃ᵀ), over `size`.
+double shapeError(const std::vector<Vec2d>& rest, const std::vector<Vec2d>& x, double size) {
+  Vec2d c0(0, 0), c(0, 0);
+  for (std::size_t i = 0; i < x.size(); ++i) c0 += rest[i] / double(x.size()), c += x[i] / double(x.size());
+  double a00 = 0, a01 = 0, a10 = 0, a11 = 0;
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    const Vec2d r = x[i] - c, q = rest[i] - c0;
+    a00 += r.x() * q.x(), a01 += r.x() * q.y(), a10 += r.y() * q.x(), a11 += r.y() * q.y();
+  }
+  const double th = std::atan2(a10 - a01, a00 + a11), cs = std::cos(th), sn = std::sin(th);
+  double e = 0;
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    const Vec2d q = rest[i] - c0, g = c + Vec2d(cs * q.x() - sn * q.y(), sn * q.x() + cs * q.y());
+    e += (x[i] - g).squaredNorm();
+  }
+  return std::sqrt(e / double(x.size())) / size;
+}
+
+std::vector<Vec2d> positions(const World& w, const std::vector<std::uint32_t>& ids) {
+  std::vector<Vec2d> xs, vs;
+  w.getParticles(ids, xs, vs);
+  return xs;
+}
+
+struct Drop {
+  double firstImpact = -1;  ///< s: when the centre first moved up
+  double rebound = 0;       ///< m/s: its fastest rise after that
+  double restError = 0;     ///< shapeError at the end
+  double endSpeed = 0;      ///< m/s: the centre's speed at the end
+};
+
+/// A 0.2 m jelly block dropped from `height` (0: placed on the floor) in an empty tank, 4 s.
+Drop dropJelly(double stiffness, double yield, double height = 0.5) {
+  const double dx = 0.01;
+  SceneDef s = test::tank("game", 1.0, 1.2, dx);
+  World w(s, WorldOptions{2});
+  GroupDef g;
+  g.region = test::block({0.4, height + dx / 2}, {0.6, height + 0.2 + dx / 2});
+  g.stiffness = stiffness;
+  g.yieldStrain = yield;
+  IdRange range;
+  const std::uint32_t index = w.createGroup(g, &range);
+  const std::vector<std::uint32_t> ids = range.ids();
+  const std::vector<Vec2d> rest = positions(w, ids);
+  Drop d;
+  for (int f = 0; f < 240; ++f) {
+    w.stepFrame();
+    GroupState st;
+    REQUIRE(w.groupState(index, st));
+    if (st.velocity.y() > 0.05 && d.firstImpact < 0 && f > 5) d.firstImpact = f / 60.0;
+    if (d.firstImpact >= 0) d.rebound = std::max(d.rebound, st.velocity.y());
+    d.endSpeed = st.velocity.norm();
+  }
+  REQUIRE(test::allFiniteState(w));
+  d.restError = shapeError(rest, positions(w, ids), 0.2);
+  return d;
+}
+
+}  // namespace
+
+TEST_CASE("jelly: a block dropped 0.5 m bounces, comes to rest and returns to its rest shape within 2 %") {
+  // Its shape at rest is the one it has placed on the floor (a jelly sags under its weight: the
+  // softer, the more): the drop leaves nothing of its own.
+  for (const double k : {0.25, 0.6}) {
+    const Drop d = dropJelly(k, 0), placed = dropJelly(k, 0, 0);
+    MESSAGE("stiffness " << k << ": first rise at " << d.firstImpact << " s, rebound " << d.rebound
+                         << " m/s, shape error " << 100 * d.restError << " % (placed on the floor: "
+                         << 100 * placed.restError << " %), end speed " << d.endSpeed << " m/s");
+    CHECK(d.firstImpact > 0.25);  // it fell 0.5 m first (free fall: 0.32 s)
+    CHECK(d.firstImpact < 0.5);
+    CHECK(d.rebound > 0.2);  // it bounced
+    CHECK(d.endSpeed < 0.02);
+    CHECK(std::fabs(d.restError - placed.restError) < 0.01);
+    if (k > 0.5) CHECK(d.restError < 0.02);
+  }
+}
+
+TEST_CASE("jelly: a plastic block stays deformed where an elastic one springs back") {
+  const Drop elastic = dropJelly(0.5, 0), plastic = dropJelly(0.5, 0.2), placed = dropJelly(0.5, 0.2, 0);
+  MESSAGE("shape error at rest: elastic " << 100 * elastic.restError << " %, plastic " << 100 * plastic.restError
+                                          << " % (placed on the floor: " << 100 * placed.restError << " %)");
+  CHECK(elastic.restError < 0.03);
+  CHECK(plastic.restError > 0.08);
+  CHECK(plastic.restError > 3 * placed.restError);
+  CHECK(plastic.endSpeed < 0.05);
+}
+
+TEST_CASE("jelly: a breakable column hit by a fast body breaks in two, an unbreakable one does not") {
+  for (const double strain : {0.0, 0.3}) {
+    const double dx = 0.01;
+    SceneDef s = test::tank("game", 2.0, 1.0, dx);
+    BodyDef ball;
+    ball.type = BodyDef::Type::Dynamic;
+    ball.position = Vec2d(0.3, 0.2);
+    ball.velocity = Vec2d(8, 0);
+    ShapeDef disc;
+    disc.type = ShapeDef::Type::Circle;
+    disc.radius = 0.08;
+    disc.density = 3000;
+    ball.fixtures.push_back(disc);
+    s.bodies.push_back(ball);
+    World w(s, WorldOptions{2});
+    GroupDef g;
+    g.region = test::block({0.9, 0}, {0.96, 0.4});  // 6 × 40 particles, struck at mid-height
+    g.stiffness = 0.5;
+    g.breakStrain = strain;
+    w.createGroup(g);
+    for (int f = 0; f < 120; ++f) w.stepFrame();
+    REQUIRE(test::allFiniteState(w));
+    std::vector<std::size_t> sizes;
+    for (std::uint32_t k = 0; k < w.groupCount(); ++k) {
+      GroupState st;
+      if (w.groupState(k, st)) sizes.push_back(st.particles);
+    }
+    std::sort(sizes.rbegin(), sizes.rend());
+    MESSAGE("break strain " << strain << ": " << sizes.size() << " groups, the largest "
+                            << (sizes.size() > 0 ? sizes[0] : 0) << " and " << (sizes.size() > 1 ? sizes[1] : 0)
+                            << " particles (of " << w.particleCount() << ")");
+    if (strain > 0) {
+      REQUIRE(sizes.size() >= 2);
+      CHECK(sizes[1] >= 20);  // two pieces, not a chip
+    } else {
+      REQUIRE(sizes.size() == 1);
+      CHECK(sizes[0] == w.particleCount());
+    }
+  }
+}
+
+TEST_CASE("jelly: a game joins, splits and destroys groups") {
+  const double dx = 0.02;
+  SceneDef s = test::tank("game", 2.0, 1.0, dx);
+  s.gravity = Vec2d(0, 0);
+  World w(s, WorldOptions{1});
+  GroupDef a;
+  a.region = test::block({0.2, 0.2}, {0.4, 0.4});
+  a.stiffness = 0.5;
+  GroupDef b = a;
+  b.region = test::block({0.4, 0.2}, {0.6, 0.4});  // a's neighbour: one spacing apart
+  GroupDef c = a;
+  c.region = test::block({1.2, 0.2}, {1.4, 0.4});
+  IdRange ra, rb, rc;
+  const std::uint32_t ga = w.createGroup(a, &ra), gb = w.createGroup(b, &rb), gc = w.createGroup(c, &rc);
+  CHECK(w.groupCount() == 3);
+  // Join: b's particles are a's now, a's stiffness; b is empty.
+  CHECK(w.joinGroups(ga, gb));
+  GroupState st;
+  CHECK_FALSE(w.groupState(gb, st));
+  REQUIRE(w.groupState(ga, st));
+  CHECK(st.particles == ra.size() + rb.size());
+  CHECK_FALSE(w.joinGroups(ga, gb));  // b has none left
+  // Join a far group, then split: the two parts come apart again (the larger keeps the index).
+  CHECK(w.joinGroups(ga, gc));
+  const std::vector<std::uint32_t> made = w.splitGroup(ga);
+  REQUIRE(made.size() == 1);
+  REQUIRE(w.groupState(ga, st));
+  CHECK(st.particles == ra.size() + rb.size());
+  REQUIRE(w.groupState(made[0], st));
+  CHECK(st.particles == rc.size());
+  // Destroy: without its particles the fluid keeps them, with them the listener hears of each.
+  const std::size_t before = w.particleCount();
+  CHECK(w.destroyGroup(made[0]));
+  CHECK(w.particleCount() == before);
+  CHECK_FALSE(w.groupState(made[0], st));
+  std::vector<Removal> heard;
+  w.setDestructionListener([&](const std::vector<Removal>& r) { heard.insert(heard.end(), r.begin(), r.end()); });
+  CHECK(w.destroyGroup(ga, true));
+  CHECK(w.particleCount() == before - ra.size() - rb.size());
+  CHECK(heard.size() == ra.size() + rb.size());
+  CHECK(std::all_of(heard.begin(), heard.end(), [](const Removal& r) { return r.reason == RemovalReason::game; }));
+  CHECK_FALSE(w.destroyGroup(ga, true));
+}
+
+TEST_CASE("jelly: a scene's groups make rigid and elastic groups, and bad keys are refused at their key") {
+  const auto scene = [](const std::string& groups) {
+    return "{\"solver\": {\"type\": \"game\", \"spacing\": 0.02},\n\"boundaries\": [{\"fixtures\": [{\"shape\": "
+           "\"box\", \"center\": [1, -0.1], \"half_size\": [1.2, 0.1]}]}],\n\"groups\": [\n" +
+           groups + "]}";
+  };
+  World w(parseScene(scene("{\"min\": [0.2, 0.2], \"max\": [0.4, 0.4]},\n{\"min\": [1, 0.2], \"max\": [1.2, 0.4], "
+                           "\"kind\": \"elastic\", \"stiffness\": 0.3, \"yield_strain\": 0.1, \"break_strain\": 0.5}"),
+                     "t.json"));
+  CHECK(w.groupCount() == 2);
+  GroupState st;
+  REQUIRE(w.groupState(0, st));
+  CHECK(st.particles == 100);
+  REQUIRE(w.groupState(1, st));
+  CHECK(st.particles == 100);
+  auto refused = [&](const std::string& groups, const std::string& key, const std::string& why) {
+    try {
+      parseScene(scene(groups), "t.json");
+      FAIL("accepted " << groups);
+    } catch (const SceneError& e) {
+      CHECK(e.key == key);
+      CHECK(e.line == 4);
+      CHECK(e.message.find(why) != std::string::npos);
+    }
+  };
+  refused("{\"min\": [0.2, 0.2], \"max\": [0.4, 0.4], \"stiffness\": 0.5}", "groups[0].stiffness", "elastic");
+  refused("{\"min\": [0.2, 0.2], \"max\": [0.4, 0.4], \"kind\": \"elastic\", \"stiffness\": 1}", "groups[0].stiffness",
+          "below 1");
+  refused("{\"min\": [0.2, 0.2], \"max\": [0.4, 0.4], \"kind\": \"soft\"}", "groups[0].kind", "elastic");
+  refused("{\"min\": [0.2, 0.2], \"max\": [0.4, 0.4], \"break_strain\": 0.2}", "groups[0].break_strain", "elastic");
+  refused("{\"min\": [0.2, 0.2], \"max\": [0.4, 0.4], \"colour\": 1}", "groups[0].colour", "");
+}
