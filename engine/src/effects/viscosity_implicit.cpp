@@ -52,9 +52,14 @@ double ImplicitViscosity::multiply(StepContext& c, const Vec& x, Vec& out) {
     std::size_t q = 0;
     double dot = 0;
     for (std::size_t i = lo; i < hi; ++i) {
+      Vec2d s = x.p[i] * diag_[i];
+      if (!coupled_[i]) {  // no pair and no body: its row is its diagonal alone
+        out.p[i] = s;
+        dot += x.p[i].dot(s);
+        continue;
+      }
       const std::uint32_t* nbr = c.nbr.of(i);
       const Real* Si = S + c.nbr.start[i];
-      Vec2d s = x.p[i] * diag_[i];
       for (std::uint32_t k = 0; k < c.nbr.count[i]; ++k) s -= x.p[nbr[k]] * double(Si[k]);
       for (; q < L.size() && L[q].particle == i; ++q) {
         const Link& l = L[q];
@@ -99,6 +104,7 @@ std::size_t ImplicitViscosity::apply(StepContext& c, const ViscosityTerm& t, con
   partial_.resize(blocks);
   for (std::vector<BodyVel>& part : partial_) part.resize(nb);
   diag_.resize(n);
+  coupled_.resize(n);
   for (Vec* v : {&b_, &x_, &r_, &z_, &d_, &q_}) {
     v->p.resize(n);
     v->b.assign(nb, BodyVel{});
@@ -170,6 +176,7 @@ std::size_t ImplicitViscosity::apply(StepContext& c, const ViscosityTerm& t, con
                               L.push_back(l);
                             });
       diag_[i] = double(si) * (1.0 + double(dt) * vK * gi) + rowSum;
+      coupled_[i] = rowSum != 0 || (!L.empty() && L.back().particle == i);
       const Vec2d vStar = (P.v[i] + P.a[i] * dt).cast<double>();
       b_.p[i] = vStar * double(si) + h * e;
       x_.p[i] = vStar;

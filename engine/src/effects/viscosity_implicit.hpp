@@ -72,6 +72,7 @@ class ImplicitViscosity {
 
   std::vector<std::vector<Real>> coef_;        ///< dt·S_ij per fluid neighbour entry, aligned with nbr.perBlock
   std::vector<double> diag_;                   ///< m_i(1 + dt g_i) + dt Σ_j S_ij, in units of m
+  std::vector<std::uint8_t> coupled_;          ///< per particle: a pair or a body link (else its row is diag_ alone)
   std::vector<std::vector<Link>> links_;       ///< per block: its particles' links to dynamic bodies
   std::vector<std::vector<BodyVel>> partial_;  ///< per block × body: Σ over its links (multiply)
   std::vector<double> mass_, inertia_;         ///< per body, in units of m (inertia 0: it cannot turn)
