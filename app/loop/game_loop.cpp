@@ -157,6 +157,7 @@ void GameLoop::capture(std::int64_t f) {
   q.input.colliders = &q.colliders;
   q.input.moving = world_.movingColliders();  // where the moving bodies are in this frame
   q.input.materialColors = materialColors(world_);
+  q.input.materialGranular = materialGranular(world_);
   q.input.gravity = world_.scene().gravity.norm();
   q.input.frame = world_.frame();
   q.input.time = world_.time();

@@ -79,6 +79,7 @@ int cmdRender(const std::vector<std::string>& args) {
   in.colliders = &world.colliders();
   in.age = snap.age.empty() ? nullptr : snap.age.data();
   in.materialColors = materialColors(world);
+  in.materialGranular = materialGranular(world);
   in.gravity = scene.gravity.norm();
   in.frame = snap.frame;
   in.time = snap.time;

@@ -556,3 +556,50 @@ TEST_CASE("100k particles render: a 2 m x 1 m lattice covers its share of a 960x
   MESSAGE("100k discs: lit share " << litShare << ", block " << block / 0.75);
   CHECK(litShare == doctest::Approx(block / 0.75).epsilon(0.05));
 }
+
+TEST_CASE("liquid mode: a granular material is drawn as grains, a liquid of the same colour as a surface") {
+  // blockScene's 0.2 m block at 0.02 m spacing, 400 px across (one spacing: 40 px), as sand and
+  // as a liquid of the sand's colour. Grains are discs one spacing wide: the background shows
+  // between them, and each grain has its own shade; the liquid covers the block.
+  SceneDef s = blockScene(320, 320, Vec2d(-0.04, -0.04), Vec2d(0.24, 0.24));
+  MaterialDef sand;
+  sand.name = "sand";
+  sand.density = s.solver.restDensity;
+  sand.color = {0.85, 0.70, 0.40};
+  s.render.water = sand.color;  // one material: the liquid is drawn in the render's water colour
+  std::array<double, 2> cover{0, 0};
+  std::array<std::size_t, 2> shades{0, 0};
+  for (const bool granular : {true, false}) {
+    sand.kind = granular ? MaterialDef::Kind::granular : MaterialDef::Kind::fluid;
+    s.materials = {sand};
+    World world(s, WorldOptions{1});
+    RenderOptions lo;
+    lo.mode = "liquid";
+    Renderer r(s.render, lo);
+    const Frame& f = r.render(world);
+    // Over the block's middle (the inner half of the image's block), the share of sand-hued
+    // pixels (red above green above blue, bright) and their distinct brightnesses.
+    const int W = f.width;
+    auto px = [&](double x) { return int((x + 0.04) / 0.28 * W); };
+    std::size_t n = 0, hued = 0;
+    std::vector<int> seen(256, 0);
+    for (int row = W - px(0.15); row < W - px(0.05); ++row)
+      for (int col = px(0.05); col < px(0.15); ++col) {
+        const std::uint8_t* p = &f.rgba[4 * (std::size_t(row) * std::size_t(W) + std::size_t(col))];
+        ++n;
+        if (p[0] > 120 && p[0] > p[1] && p[1] > p[2] + 20) {
+          ++hued;
+          seen[p[0]] = 1;
+        }
+      }
+    cover[granular ? 0 : 1] = double(hued) / double(n);
+    for (const int v : seen) shades[granular ? 0 : 1] += std::size_t(v);
+  }
+  MESSAGE("sand-hued share of the block's middle: grains " << cover[0] << ", liquid " << cover[1]
+                                                           << "; distinct reds: grains " << shades[0] << ", liquid "
+                                                           << shades[1]);
+  CHECK(cover[1] > 0.99);  // a surface covers it
+  CHECK(cover[0] < 0.97);  // gaps between the grains
+  CHECK(cover[0] > 0.6);   // but mostly grains
+  CHECK(shades[0] > 20);   // each grain its own shade
+}

@@ -16,6 +16,11 @@
 // Σ w) and the composite (compiled with TINT) takes the surface colour from it: each material
 // in its own colour, blended over a kernel's width where two meet. One material: neither the
 // pass nor its target exists, and the frame is the one it was.
+// A granular material (RenderInput::materialGranular) is no liquid: its particles add nothing
+// to the field and the tint, and after the composite each is drawn as a grain, an opaque disc
+// one spacing wide (shaders/particles.frag) in its material's colour, lighter or darker by up
+// to 15 % by a hash of its id (the same grain keeps its shade). They still count in the depth
+// grid's tiles, so the composite rewrites where they were each frame.
 #include <algorithm>
 #include <cmath>
 
@@ -58,7 +63,7 @@ class LiquidPass final : public RenderPass {
   }
 
   void release() override {
-    for (GLuint p : {splatProg_, compositeProg_, tintProg_, compositeTintProg_})
+    for (GLuint p : {splatProg_, compositeProg_, tintProg_, compositeTintProg_, grainProg_})
       if (p) glDeleteProgram(p);
     const GLuint textures[3] = {fieldTex_, auxTex_, tintTex_};
     glDeleteTextures(3, textures);
@@ -67,20 +72,42 @@ class LiquidPass final : public RenderPass {
     glDeleteVertexArrays(1, &tileVao_);
     glDeleteBuffers(1, &tileVbo_);
     splatProg_ = compositeProg_ = fieldTex_ = auxTex_ = fieldFbo_ = tileVao_ = tileVbo_ = 0;
-    tintProg_ = compositeTintProg_ = tintTex_ = tintFbo_ = 0;
+    tintProg_ = compositeTintProg_ = tintTex_ = tintFbo_ = grainProg_ = 0;
     tintW_ = tintH_ = 0;
+  }
+
+  /// True for the particle in slot i when its material is granular (drawn as a grain).
+  static bool grainAt(const RenderInput& in, std::size_t i) {
+    const std::vector<std::uint8_t>& g = in.materialGranular;
+    if (g.empty()) return false;
+    const Particles& P = in.particles;
+    const std::uint32_t m = P.material.size() == P.size() ? P.material[i] : 0u;
+    return m < g.size() && g[m];
   }
 
   void prepare(const PassFrame& f) override {
     const Particles& P = f.in.particles;
     const std::size_t n = f.order.size();
     packed_.resize(n * 4);
+    grains_.clear();
     for (std::size_t k = 0; k < n; ++k) {
       const std::size_t i = f.order[k];
+      const bool grain = grainAt(f.in, i);
       packed_[4 * k] = P.x[i].x();
       packed_[4 * k + 1] = P.x[i].y();
       packed_[4 * k + 2] = P.v[i].norm();
-      packed_[4 * k + 3] = f.weight[k];
+      packed_[4 * k + 3] = grain ? 0.0f : f.weight[k];
+      if (grain) {
+        const std::uint32_t m = P.material.size() == P.size() ? P.material[i] : 0u;
+        const std::uint32_t base = m < f.in.materialColors.size() ? f.in.materialColors[m] : 0xC8A870u;
+        std::uint32_t h = P.id.size() == P.size() ? P.id[i] * 2654435761u : std::uint32_t(i) * 2654435761u;
+        h ^= h >> 16;
+        const double shade = 0.85 + 0.3 * double(h & 1023u) / 1023.0;  // 0.85 .. 1.15
+        std::uint32_t c = 0;
+        for (int s = 16; s >= 0; s -= 8)
+          c = (c << 8) | std::uint32_t(std::min(255.0, std::round(double((base >> s) & 255u) * shade)));
+        grains_.insert(grains_.end(), {P.x[i].x(), P.x[i].y(), float(c), f.weight[k]});
+      }
     }
     sprites_.upload(packed_);
     // More than one material: each particle's material colour too (uploaded by splat()).
@@ -95,7 +122,7 @@ class LiquidPass final : public RenderPass {
         packedTint_[4 * k] = P.x[i].x();
         packedTint_[4 * k + 1] = P.x[i].y();
         packedTint_[4 * k + 2] = float(mixed ? mixed[i] & 0xFFFFFFu : m < colors.size() ? colors[m] & 0xFFFFFFu : 0u);
-        packedTint_[4 * k + 3] = f.weight[k];
+        packedTint_[4 * k + 3] = grainAt(f.in, i) ? 0.0f : f.weight[k];
       }
     }
     const int EW = f.geo.EW, EH = f.geo.EH;
@@ -125,6 +152,7 @@ class LiquidPass final : public RenderPass {
     splat(f);
     timer.end(timings.splat);
     composite(f);
+    if (!grains_.empty()) drawGrains(f);
     timer.end(timings.composite);
   }
 
@@ -174,6 +202,21 @@ class LiquidPass final : public RenderPass {
     }
     glDisable(GL_BLEND);
     glViewport(0, 0, EW, EH);
+  }
+
+  /// The granular particles, each a disc one spacing wide in its shade of its material's colour.
+  void drawGrains(const PassFrame& f) {
+    if (!grainProg_) grainProg_ = gl::program("splat.vert", "particles.frag");
+    const float diameter = float(std::max(3.0, f.spacingPx));
+    const bool quads = diameter > sprites_.maxPoint();
+    sprites_.upload(grains_);
+    glViewport(0, 0, f.geo.EW, f.geo.EH);
+    glEnable(GL_BLEND);
+    glBlendFuncSeparate(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA, GL_ZERO, GL_ONE);
+    sprites_.setUniforms(grainProg_, f.scale, f.offset, diameter, f.geo.EW, f.geo.EH, quads);
+    glUniform1i(glGetUniformLocation(grainProg_, "uOwnColor"), 1);
+    sprites_.draw(GLsizei(grains_.size() / 4), quads);
+    glDisable(GL_BLEND);
   }
 
   /// The field becomes water over the tiles the fluid can reach (shaders/composite.frag).
@@ -243,6 +286,8 @@ class LiquidPass final : public RenderPass {
   GLuint tintProg_ = 0, compositeTintProg_ = 0, tintTex_ = 0, tintFbo_ = 0;
   int tintW_ = 0, tintH_ = 0;
   bool tinted_ = false;            // this frame draws each material in its colour
+  GLuint grainProg_ = 0;           // the grains' discs (made on the first frame with grains)
+  std::vector<float> grains_;      // granular particles (x, y, shaded colour, weight) in id order
   std::vector<float> packedTint_;  // particles (x, y, material colour, weight) in id order
   GLuint fieldTex_ = 0, fieldFbo_ = 0, auxTex_ = 0, tileVao_ = 0, tileVbo_ = 0;
   int fieldW_ = 0, fieldH_ = 0;  // the splat target: full resolution, or half when sprites are wide

@@ -47,6 +47,7 @@ RenderInput inputOf(const World& world, const Real* age) {
   // Ages come from the caller, or from the engine's "age" field when the scene has lifetimes.
   in.age = age;  // null: the World's own ages when its scene has lifetimes (agesOf)
   in.materialColors = materialColors(world);
+  in.materialGranular = materialGranular(world);
   in.gravity = world.scene().gravity.norm();
   in.frame = world.frame();
   in.time = world.time();
@@ -62,6 +63,17 @@ std::vector<std::uint32_t> materialColors(const World& world) {
     for (const double v : m.color) c = (c << 8) | std::uint32_t(std::lround(std::clamp(v, 0.0, 1.0) * 255));
     out.push_back(c);
   }
+  return out;
+}
+
+std::vector<std::uint8_t> materialGranular(const World& world) {
+  std::vector<std::uint8_t> out;
+  bool any = false;
+  for (const MaterialDef& m : world.materials()) {
+    out.push_back(m.granular() ? 1 : 0);
+    any = any || m.granular();
+  }
+  if (!any) out.clear();
   return out;
 }
 

@@ -58,6 +58,9 @@ const Pinned kPinned[] = {
     {"tests/syrup_and_water.json", "game", 30, false, 0xbb68b4da62215c88ULL},
     {"tests/syrup_and_water.json", "wcsph", 30, false, 0x8a9954d4ead7eb01ULL},
     {"honey.json", "wcsph", 30, false, 0xe732445b0882ee0bULL},
+    // Sand poured (granular friction after the grid projection) beside water, a jelly (elastic
+    // group), a rigid blob of particles and a Box2D crate.
+    {"sandbox.json", "game", 90, false, 0x835d17ed7aff125fULL},
 };
 
 std::uint64_t run(const Pinned& p, int threads) {

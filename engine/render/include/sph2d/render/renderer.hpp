@@ -95,6 +95,9 @@ struct RenderInput {
   /// 0xRRGGBB per material (materialColors(World)): particles mode, `color_by` material draws
   /// each particle in its material's colour, and `color` those without one of their own.
   std::vector<std::uint32_t> materialColors;
+  /// 1 per granular material, by index (materialGranular(World)): the liquid mode draws their
+  /// particles as grains, each a disc in its material's colour, and no liquid surface for them.
+  std::vector<std::uint8_t> materialGranular;
   double gravity = 9.81;    ///< |g| [m/s²], scales the default foam speed
   std::uint64_t frame = 0;  ///< for the overlay
   double time = 0;          ///< simulated time [s], for the overlay
@@ -214,6 +217,8 @@ inline const Real* agesOf(const RenderInput& in) {
 }
 /// The colours of `world`'s materials as 0xRRGGBB, by index (one for a World of one material).
 std::vector<std::uint32_t> materialColors(const World& world);
+/// 1 for each granular material of `world`, by index (empty when it has none).
+std::vector<std::uint8_t> materialGranular(const World& world);
 
 /// The camera of `def` for a RenderInput (same rules as above).
 std::vector<double> resolveCamera(const RenderDef& def, const RenderInput& in);
