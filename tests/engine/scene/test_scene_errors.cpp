@@ -73,7 +73,7 @@ TEST_CASE("bad input: an unknown key lists the allowed keys and suggests the nea
   CHECK(e.key == "fsp");
   CHECK(e.message ==
         "unknown key 'fsp' (did you mean 'fps'?); allowed keys: name, gravity, fps, duration, max_particles, solver, "
-        "boundaries, fluid, periodic, effects, render, events, materials");
+        "boundaries, fluid, periodic, effects, render, events, materials, groups");
 
   e = errorOf(withFixture("{\"shape\": \"circle\", \"radius\": 1, \"centre\": [0, 0]}"));
   CHECK(e.key == "boundaries[0].fixtures[0].centre");
