@@ -6,6 +6,9 @@
 // holds a hose, an emitter that a scripted input sweeps along the top and switches on
 // and off; its water pours down the platforms to a drain on the floor (a sink), and the
 // game counts what is in the bucket and what touches the bumper (World::forEachContact).
+// Toys beside the water: a heap of sand on the top platform (a granular material), a jelly
+// block on the middle one (an elastic group) and a wooden ball of particles floating in the
+// bucket (a rigid group) that the player throws into the air every 2 s.
 // Frames are drawn with sph2d::render and written as PNG files.
 //
 // Usage: sph2d_example_game [OUT_DIR] [FRAMES]   (default out/example_game, 150)
@@ -97,6 +100,36 @@ int main(int argc, char** argv) {
   sph2d::SceneDef scene;
   scene.fps = 30;
   scene.solver.spacing = 0.03;
+  // Materials: the water first (the solver's fluid), then the toys'.
+  sph2d::MaterialDef water, sand, jelly, wood;
+  water.name = "water";
+  sand.name = "sand";
+  sand.kind = sph2d::MaterialDef::Kind::granular;  // piles at its friction angle
+  sand.density = 1600;
+  sand.frictionAngle = 30;
+  sand.color = {0.86, 0.72, 0.45};
+  jelly.name = "jelly";
+  jelly.density = 1050;
+  jelly.color = {0.35, 0.8, 0.3};
+  wood.name = "wood";
+  wood.density = 600;  // floats
+  wood.color = {0.6, 0.38, 0.2};
+  scene.materials = {water, sand, jelly, wood};
+  sph2d::FluidBlockDef heap;  // sand on the top platform, upstream of the hose's water
+  heap.min = {0.2, 2.47};
+  heap.max = {0.5, 2.6};
+  heap.material = 1;
+  scene.blocks.push_back(heap);
+  sph2d::GroupDef block;  // a jelly block on the middle platform
+  block.region.min = {3.0, 1.68};
+  block.region.max = {3.2, 1.86};
+  block.region.material = 2;
+  block.stiffness = 0.4;
+  scene.groups.push_back(block);
+  sph2d::GroupDef ball;  // a wooden ball of particles in the bucket (a rigid group: stiffness 1)
+  ball.region = sph2d::circleRegion({3.55, 0.36}, 0.08, 0.03);
+  ball.region.material = 3;
+  scene.groups.push_back(ball);
   sph2d::FluidBlockDef pool;
   pool.min = {3.05, 0.0};
   pool.max = {4.0, 0.25};
@@ -132,6 +165,11 @@ int main(int argc, char** argv) {
       fluid.setUserForces({sph2d::UserForce{{0.6, 2.4}, 0.5, gust ? -30.0 : 0.0}});
       // The paddle sweeps the bucket: 0.4 m/s, turning every second.
       paddle->SetLinearVelocity(b2Vec2(std::fmod(fluid.time(), 2.0) < 1.0 ? 0.4f : -0.4f, 0.0f));
+      // Every 2 s the player throws the ball (group 1) up and to the left: an impulse of 3 m/s
+      // times its mass, and a spin.
+      sph2d::GroupState thrown;
+      if (f % 60 == 45 && fluid.groupState(1, thrown))
+        fluid.applyGroupImpulse(1, sph2d::Vec2d(-1.0, 3.0) * thrown.mass, 0.02 * thrown.mass);
 
       // 5. Step one frame: the fluid (it pushes out of the paddle where the paddle is
       // going), then the game's own b2World, which moves the paddle; draw it.
@@ -151,11 +189,15 @@ int main(int argc, char** argv) {
         fluid.forEachContact([&](const b2Fixture& fx, const std::vector<std::uint32_t>& ids) {
           if (fx.GetShape()->GetType() == b2Shape::e_circle) onBumper = ids.size();
         });
+        sph2d::GroupState jellyState, ballState;
+        fluid.groupState(0, jellyState);
+        fluid.groupState(1, ballState);
         std::printf(
             "t = %.1f s: %zu particles, %zu in the bucket, density at its bottom %.0f kg/m3, %zu on the bumper, "
-            "crates at (%.2f, %.2f) m and (%.2f, %.2f) m\n",
+            "crates at (%.2f, %.2f) m and (%.2f, %.2f) m, jelly at (%.2f, %.2f) m, ball at (%.2f, %.2f) m\n",
             fluid.time(), fluid.particleCount(), inBucket, probe.density, onBumper, pine->GetPosition().x,
-            pine->GetPosition().y, oak->GetPosition().x, oak->GetPosition().y);
+            pine->GetPosition().y, oak->GetPosition().x, oak->GetPosition().y, jellyState.centre.x(),
+            jellyState.centre.y(), ballState.centre.x(), ballState.centre.y());
       }
     }
     writer.finish();

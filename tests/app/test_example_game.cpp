@@ -21,8 +21,9 @@ TEST_CASE("the example game runs, its crates float, and it writes non-blank fram
   const std::string out = readText(log);
   INFO(out);
   REQUIRE(status == 0);
-  // The bucket's pool (224 particles beside the paddle) and 1 s of the hose (258: 266 a second, 90 % on).
-  CHECK(out.find("t = 1.0 s: 482 particles") != std::string::npos);
+  // The bucket's pool (224 particles beside the paddle), 1 s of the hose (258: 266 a second, 90 %
+  // on) and the toys' 100 (the sand heap, the jelly and the wooden ball).
+  CHECK(out.find("t = 1.0 s: 582 particles") != std::string::npos);
   CHECK(out.find("150 frames in") != std::string::npos);
   CHECK(out.find(", 0 on the bumper, crates at ") != std::string::npos);  // no water reaches the bumper within 1 s
   // Both crates float in the bucket (x 3.05..4) from the first second to the last: resting on
@@ -38,6 +39,14 @@ TEST_CASE("the example game runs, its crates float, and it writes non-blank fram
       CHECK(y[k] > 0.13);
       CHECK(y[k] < 1.0);
     }
+    // The ball floats in the bucket between the player's throws.
+    double jx = 0, jy = 0, bx = 0, by = 0;
+    const std::size_t toys = out.find("jelly at ", at);
+    REQUIRE(toys != std::string::npos);
+    REQUIRE(std::sscanf(out.c_str() + toys, "jelly at (%lf, %lf) m, ball at (%lf, %lf) m", &jx, &jy, &bx, &by) == 4);
+    CHECK(bx > 3.05);
+    CHECK(bx < 4.0);
+    CHECK(by > 0.1);
     ++lines;
   }
   CHECK(lines == 5);

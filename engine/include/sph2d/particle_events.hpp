@@ -33,6 +33,27 @@ struct Removal {
 /// Interrupted) it hears what left before, and an exception it throws there is dropped.
 using DestructionListener = std::function<void(const std::vector<Removal>&)>;
 
+/// Two particles touching at the end of a step: their centres less than 1.5 spacings apart (a
+/// resting particle touches its nearest and diagonal neighbours on the lattice).
+struct ParticleContact {
+  std::uint32_t a = 0, b = 0;  ///< their ids, a < b
+  bool began = false;          ///< true when they did not touch at the end of the step before
+};
+
+/// Which pairs a particle contact listener hears of: a pair whose one particle is of side A and
+/// the other of side B. A side is a material (an index in World::materials()) and a group
+/// (kNoGroup: in none), each kAny for any.
+struct ParticleContactFilter {
+  static constexpr std::uint32_t kAny = 0xffffffffu;
+  static constexpr std::uint32_t kNoGroup = 0xfffffffeu;
+  std::uint32_t materialA = kAny, groupA = kAny;
+  std::uint32_t materialB = kAny, groupB = kAny;
+};
+
+/// Receives, once after each step, every pair the filter takes that touches then, in
+/// increasing (a, b) order (none: no call). It may read the World, not change it.
+using ParticleContactListener = std::function<void(const std::vector<ParticleContact>&)>;
+
 /// Where a ray p1 → p2 enters a particle's disc (radius half the spacing).
 struct RayHit {
   std::uint32_t id = 0;

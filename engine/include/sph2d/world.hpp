@@ -321,6 +321,10 @@ class World {
   void rayCast(const Vec2d& p1, const Vec2d& p2, const std::function<bool(const RayHit&)>& f) const;
   /// The nearest hit of rayCast(p1, p2); false (and `hit` untouched) when there is none.
   bool rayCastFirst(const Vec2d& p1, const Vec2d& p2, RayHit& hit) const;
+  /// Sets (or with an empty listener clears) the particle contact listener: after each step
+  /// the pairs of particles touching that `filter` takes (particle_events.hpp). While none is
+  /// set nothing is computed; with one, a search around each particle of either side.
+  void setParticleContactListener(const ParticleContactFilter& filter, ParticleContactListener listener);
   /// Makes a group (groups.hpp) of new particles filling def.region; `ids` (when given) gets
   /// them. Returns the group's index: one past the highest a particle holds now (the index of
   /// a group whose particles are all gone may be given again). The fields and the `groups`

@@ -1,6 +1,6 @@
 // particle_events.cpp — the game's calls about single particles (sph2d/particle_events.hpp):
-// the destruction listener, each particle's own lifetime, and ray casts through the search
-// grid of the current particles (particle_index.hpp).
+// the destruction listener, each particle's own lifetime, ray casts through the search
+// grid of the current particles (particle_index.hpp), and the particle contact listener.
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -130,6 +130,55 @@ bool World::rayCastFirst(const Vec2d& p1, const Vec2d& p2, RayHit& hit) const {
     return false;
   });
   return found;
+}
+
+void World::setParticleContactListener(const ParticleContactFilter& filter, ParticleContactListener listener) {
+  impl_->contactFilter = filter;
+  impl_->contactListener = std::move(listener);
+  impl_->lastContacts.clear();
+}
+
+namespace {
+/// How far apart two particles' centres touch, in spacings: a resting particle's nearest and
+/// diagonal neighbours on the lattice (1 and 1.41), not the next ring (2).
+constexpr double kTouch = 1.5;
+}  // namespace
+
+void World::Impl::deliverParticleContacts() {
+  const ParticleContactFilter& f = contactFilter;
+  const std::vector<std::uint32_t>* material = P.findU32(ParticleStore::kMaterial);
+  const std::vector<std::uint32_t>* group = P.findU32(ParticleStore::kGroup);
+  auto side = [&](std::size_t i, std::uint32_t m, std::uint32_t g) {
+    const std::uint32_t mi = material ? (*material)[i] : 0u, gi = group ? (*group)[i] : 0u;
+    const bool groupOk =
+        g == ParticleContactFilter::kAny || (g == ParticleContactFilter::kNoGroup ? gi == 0 : gi == g + 1);
+    return (m == ParticleContactFilter::kAny || mi == m) && groupOk;
+  };
+  const double reach = kTouch * double(dx), reach2 = reach * reach, cell = double(R);
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> pairs;
+  for (std::size_t i = 0; i < P.size(); ++i) {
+    const bool inA = side(i, f.materialA, f.groupA), inB = side(i, f.materialB, f.groupB);
+    if (!inA && !inB) continue;
+    const Vec2d xi = Vec2d(double(P.x[i].x()), double(P.x[i].y())) + origin;
+    index.forCandidates(P, steps, cell, origin, xi - Vec2d(reach, reach), xi + Vec2d(reach, reach), [&](std::size_t j) {
+      if (P.id[j] <= P.id[i]) return;  // each pair once, from its lower id
+      Real ddx = P.x[i].x() - P.x[j].x(), ddy = P.x[i].y() - P.x[j].y();
+      periodic.nearest(ddx, ddy);
+      if (double(ddx) * double(ddx) + double(ddy) * double(ddy) >= reach2) return;
+      if ((inA && side(j, f.materialB, f.groupB)) || (inB && side(j, f.materialA, f.groupA)))
+        pairs.emplace_back(P.id[i], P.id[j]);
+    });
+  }
+  std::sort(pairs.begin(), pairs.end());
+  std::vector<ParticleContact> out;
+  out.reserve(pairs.size());
+  for (const auto& [a, b] : pairs)
+    out.push_back(
+        ParticleContact{a, b, !std::binary_search(lastContacts.begin(), lastContacts.end(), std::make_pair(a, b))});
+  lastContacts = std::move(pairs);
+  if (out.empty()) return;
+  const ParticleContactListener listener = contactListener;  // it may replace or clear itself
+  listener(out);
 }
 
 }  // namespace sph2d

@@ -333,6 +333,7 @@ void World::step(double dt) {
     throw;
   }
   w.deliverRemovals();
+  if (w.contactListener) w.deliverParticleContacts();
 }
 
 void World::setStopFlag(const std::atomic<bool>* stop) { impl_->stop = stop; }

@@ -103,6 +103,11 @@ struct World::Impl {
   ContactTracker contacts;                  ///< contact tracking (off until a game turns it on)
   ParticleIndex index;                      ///< lookups by id and by region
   DestructionListener destructionListener;  ///< the game's (empty: none; then nothing is collected)
+  ParticleContactListener contactListener;  ///< the game's particle contact listener (empty: none)
+  ParticleContactFilter contactFilter;      ///< … and which pairs it hears of
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> lastContacts;  ///< the pairs it heard of last
+  /// After a step: the pairs touching that the filter takes, to the listener.
+  void deliverParticleContacts();
   std::vector<Removal> removals;            ///< removed since the last delivery (with a listener)
 
   // Stopping on request (World::setStopFlag, WorldOptions::stop).
