@@ -69,6 +69,16 @@ void World::Impl::groupSums(std::vector<GroupSums>& sums) const {
   }
 }
 
+void World::Impl::groupsBeforeCollide(const StepContext& c) {
+  const std::vector<std::uint32_t>& group = *P.findU32(ParticleStore::kGroup);
+  const std::vector<Real>& stiffness = *P.find(ParticleStore::kGroupStiffness);
+  groupBefore.resize(P.size());
+  c.pool.parallelFor(P.size(), kStreamBlock, [&](std::size_t b, std::size_t e) {
+    for (std::size_t i = b; i < e; ++i)
+      if (group[i] && stiffness[i] < 1) groupBefore[i] = {P.x[i], P.v[i]};
+  });
+}
+
 void World::Impl::matchGroups(StepContext& c) {
   const Real dt = c.dt;
   std::vector<GroupSums>& sums = groupScratch;
@@ -107,10 +117,12 @@ void World::Impl::matchGroups(StepContext& c) {
       }
       const Vec2 d(Real(k * (gx - double(P.x[i].x()))), Real(k * (gy - double(P.x[i].y()))));
       P.x[i] += d;
-      // The velocity of the substep's move (as position-based dynamics takes it): the solver's
-      // corrections of the positions, which a liquid's velocity leaves out, are part of a
-      // jelly's motion; left out, a jelly at rest kept the corrections' −dt·g as velocity.
-      P.v[i] = (P.x[i] - P.xPrev[i]) / dt;
+      // Its velocity takes the shape's pull, d/dt, and the solver's corrections of its position
+      // this substep, which a liquid's velocity leaves out (the game solver's density solve):
+      // left out, a jelly at rest kept −dt·g of velocity and never read as still. Not the
+      // collisions' pushes: they set the velocity themselves (with a body's reaction).
+      if (groupBefore.size() == P.size()) P.v[i] += (groupBefore[i].x - P.xPrev[i]) / dt - groupBefore[i].v;
+      P.v[i] += d / dt;
       // Internal friction: the velocity relative to the group's rigid motion decays at
       // kElasticDamping per second (the rigid motion itself, momentum and spin, is kept).
       const double omega = s.I > 0 ? s.L / s.I : 0;
@@ -172,7 +184,6 @@ std::uint32_t World::createGroup(const GroupDef& def, IdRange* ids) {
     throw std::invalid_argument(
         "createGroup: the region makes no particle (outside the fluid's space, "
         "inside solids or past the budget)");
-  const bool had = w.P.findU32(ParticleStore::kGroup) != nullptr;
   std::vector<std::uint32_t>& group = w.P.fieldU32(ParticleStore::kGroup);
   std::vector<Real>& qx = w.P.field(ParticleStore::kGroupQx);
   std::vector<Real>& qy = w.P.field(ParticleStore::kGroupQy);
@@ -204,7 +215,7 @@ std::uint32_t World::createGroup(const GroupDef& def, IdRange* ids) {
     for (const std::size_t i : slots) f[i] = Real(value);
   }
   w.refreshView();
-  if (!had) w.buildStages();
+  w.buildStages();  // the groups stage, and the elastic groups' record before the collisions
   if (ids) *ids = added;
   return index;
 }

@@ -115,6 +115,11 @@ void World::Impl::buildStages() {
 }
 
 void World::Impl::addParticleSystemStages(StageList& list) {
+  const std::vector<Real>* k = P.find(ParticleStore::kGroupStiffness);
+  if (k && std::any_of(k->begin(), k->end(), [](Real s) { return s > 0 && s < 1; }))
+    list.add(plainStage("groups_before_collide", [this](StepContext& c) { groupsBeforeCollide(c); }));
+  else
+    groupBefore.clear();
   list.add(plainStage("collide", [](StepContext& c) { stageCollide(c); }));
   if (!moving.solids.bodies.empty()) list.add(plainStage("bodies", [this](StepContext& c) { collideMoving(c); }));
   if (P.findU32(ParticleStore::kGroup)) list.add(plainStage("groups", [this](StepContext& c) { matchGroups(c); }));

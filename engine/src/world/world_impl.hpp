@@ -108,7 +108,7 @@ struct World::Impl {
   std::vector<std::pair<std::uint32_t, std::uint32_t>> lastContacts;  ///< the pairs it heard of last
   /// After a step: the pairs touching that the filter takes, to the listener.
   void deliverParticleContacts();
-  std::vector<Removal> removals;            ///< removed since the last delivery (with a listener)
+  std::vector<Removal> removals;  ///< removed since the last delivery (with a listener)
 
   // Stopping on request (World::setStopFlag, WorldOptions::stop).
   const std::atomic<bool>* stop = nullptr;  ///< the caller's stop flag (null: none)
@@ -261,6 +261,13 @@ struct World::Impl {
   /// rest shape (all the way when rigid), their velocities with them; then out of the static
   /// solids (a rigid group as one).
   void matchGroups(StepContext& c);
+  /// Before the collisions (with an elastic group): each elastic group particle's position and
+  /// velocity, so that matchGroups can tell the solver's corrections from the collisions'.
+  void groupsBeforeCollide(const StepContext& c);
+  struct PositionVelocity {
+    Vec2 x, v;
+  };
+  std::vector<PositionVelocity> groupBefore;  ///< groupsBeforeCollide's record (empty: none this substep)
   /// Each group's figures now (index g: group g), in slot order, in double.
   struct GroupSums {
     double m = 0, mx = 0, my = 0, mvx = 0, mvy = 0, mqx = 0, mqy = 0;  // Σ m, Σ m x, Σ m v, Σ m q
