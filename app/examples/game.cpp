@@ -183,7 +183,9 @@ int main(int argc, char** argv) {
 
       // 6. Game logic reads the fluid: water in the bucket, and a probe above it.
       if (f % 30 == 29 || f == frames - 1) {
-        const std::size_t inBucket = fluid.slotsInBox(bucketLo, bucketHi).size();
+        std::size_t inBucket = 0;  // the water in the bucket (material 0: not the ball's wood)
+        for (const std::size_t slot : fluid.slotsInBox(bucketLo, bucketHi))
+          inBucket += fluid.particles().material[slot] == 0;
         const sph2d::World::FieldSample probe = fluid.sampleAt({3.5, 0.05});
         std::size_t onBumper = 0;  // the bumper is the level's only circle: a "button" the water presses
         fluid.forEachContact([&](const b2Fixture& fx, const std::vector<std::uint32_t>& ids) {

@@ -24,9 +24,10 @@ struct GroupDef {
   /// place in the rest shape by the excess. 0: it always springs back.
   double yieldStrain = 0;
   /// Elastic only: the strain at which it breaks: after the substep, pairs of neighbours (in
-  /// the rest shape, at most 1.5 spacings apart) stretched or squeezed by more than this
-  /// part, and what stays connected becomes a group of its own (at least 3 particles; fewer
-  /// go free as fluid). 0: it never breaks.
+  /// the rest shape, at most 1.5 spacings apart) stretched by more than this part are cut, and
+  /// what stays connected becomes a group of its own (at least 3 particles; fewer go free as
+  /// fluid). At most the support over 1.5 spacings, less 1 (0.33 on the game solver, whose
+  /// support is 2 spacings). 0: it never breaks.
   double breakStrain = 0;
   /// A scene's elastic group without a stiffness of its own.
   static constexpr double kElasticStiffness = 0.25;

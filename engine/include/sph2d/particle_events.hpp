@@ -51,7 +51,8 @@ struct ParticleContactFilter {
 };
 
 /// Receives, once after each step, every pair the filter takes that touches then, in
-/// increasing (a, b) order (none: no call). It may read the World, not change it.
+/// increasing (a, b) order (none: no call). It may read the World, not change it. Pairs across
+/// a periodic seam are not reported.
 using ParticleContactListener = std::function<void(const std::vector<ParticleContact>&)>;
 
 /// Where a ray p1 → p2 enters a particle's disc (radius half the spacing).

@@ -66,6 +66,8 @@ std::string materialProblem(const std::vector<MaterialDef>& materials, const Mat
     o << "kind \"granular\" needs solver.type \"game\" (its friction acts between the pressure projection "
          "and the move), got \""
       << solver.type << "\"";
+  else if (o.tellp() == 0 && m.granular() && !(solver.param("grid_cell") > 0))
+    o << "kind \"granular\" needs the game solver's grid projection (solver.grid_cell above 0, its default 2)";
   for (double c : m.color)
     if (o.tellp() == 0 && !(c >= 0 && c <= 1)) o << "color components must be in 0..1, got " << c;
   if (o.tellp() != 0) return o.str();

@@ -9,6 +9,7 @@
 // same bits for any thread count.
 #include <algorithm>
 #include <cmath>
+#include <sstream>
 #include <stdexcept>
 
 #include "world/world_impl.hpp"
@@ -179,6 +180,16 @@ std::uint32_t World::createGroup(const GroupDef& def, IdRange* ids) {
   if (def.stiffness >= 1 && (def.yieldStrain > 0 || def.breakStrain > 0))
     throw std::invalid_argument("createGroup: a rigid group (stiffness 1) neither yields nor breaks");
   Impl& w = *impl_;
+  // A pair of rest neighbours (1.5 spacings apart at most) stretched by the break strain must
+  // still be within the support R, where the neighbour lists see it.
+  const double maxBreak = double(w.R) / (1.5 * double(w.dx)) - 1;
+  if (def.breakStrain > maxBreak) {
+    std::ostringstream o;
+    o.precision(3);
+    o << "createGroup: breakStrain must be at most " << maxBreak
+      << " for this solver (its support over 1.5 spacings, less 1), got " << def.breakStrain;
+    throw std::invalid_argument(o.str());
+  }
   const IdRange added = w.fillNamed(def.region, "createGroup");
   if (added.size() == 0)
     throw std::invalid_argument(
@@ -304,25 +315,31 @@ void World::Impl::breakGroups(const StepContext& c) {
     const double ax = double(qx[i]) - double(qx[j]), ay = double(qy[i]) - double(qy[j]);
     return ax * ax + ay * ay;
   };
+  // Rest neighbours: at most 1.5 spacings apart in the rest shape (not two particles a join
+  // left on one point).
+  const double tooClose2 = 0.25 * 0.25 * double(dx) * double(dx);
+  auto restAdjacent = [&](std::size_t i, std::size_t j) {
+    const double r2 = restDist2(i, j);
+    return r2 <= adjacent2 && r2 > tooClose2;
+  };
   auto stretched = [&](std::size_t i, std::size_t j) {  // current / rest − 1 beyond the strain
     double d2x = double(P.x[i].x()) - double(P.x[j].x()), d2y = double(P.x[i].y()) - double(P.x[j].y());
     const double ratio = std::sqrt((d2x * d2x + d2y * d2y) / restDist2(i, j));
     return ratio - 1 > double(strain[i]);
   };
-  // The breakable groups with a broken pair (neighbours in the rest shape, now stretched or
-  // squeezed beyond the strain, or apart beyond the search radius).
+  // The breakable groups with a broken pair: rest neighbours in each other's neighbour list
+  // (within R: createGroup holds the break strain below R / 1.5 spacings − 1, so a pair
+  // stretched that far is still in the list), now stretched beyond the strain. (A pair torn
+  // past R within one substep is not seen until another is stretched.)
   std::vector<std::uint32_t> broken;
   for (std::size_t i = 0; i < P.size(); ++i) {
     if (!group[i] || !(strain[i] > 0)) continue;
     if (std::find(broken.begin(), broken.end(), group[i]) != broken.end()) continue;
     const std::uint32_t* nb = c.nbr.of(i);
-    std::size_t adjacent = 0;
     bool cut = false;
     for (std::uint32_t k = 0; k < c.nbr.count[i] && !cut; ++k) {
       const std::uint32_t j = nb[k];
-      if (group[j] != group[i] || restDist2(i, j) > adjacent2) continue;
-      ++adjacent;
-      cut = stretched(i, j);
+      if (group[j] == group[i] && restAdjacent(i, j)) cut = stretched(i, j);
     }
     if (cut) broken.push_back(group[i]);
   }
@@ -331,8 +348,7 @@ void World::Impl::breakGroups(const StepContext& c) {
     std::vector<std::size_t> slots;
     for (std::size_t i = 0; i < P.size(); ++i)
       if (group[i] == g) slots.push_back(i);
-    splitParts(g - 1, slots,
-               [&](std::size_t i, std::size_t j) { return restDist2(i, j) <= adjacent2 && !stretched(i, j); });
+    splitParts(g - 1, slots, [&](std::size_t i, std::size_t j) { return restAdjacent(i, j) && !stretched(i, j); });
   }
 }
 

@@ -499,6 +499,7 @@ void World::load(std::istream& input) {
       if (effectNames[k] == e->name()) e->enabled = enabled[k];
   w.buildStages();
   w.index.clear();
+  w.lastContacts.clear();  // the particle contact listener's `began` is of the loaded state on
   w.contacts.beginStep();  // the contacts of the state before the load are not this state's
   w.refreshView();
   w.abandonedIn.clear();  // an interrupted World is this state now, and steps again

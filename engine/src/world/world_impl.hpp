@@ -275,8 +275,8 @@ struct World::Impl {
     std::size_t n = 0;
   };
   void groupSums(std::vector<GroupSums>& sums) const;
-  /// After matching: splits each breakable group with a pair of rest neighbours stretched or
-  /// squeezed beyond its break strain into the parts still connected (splitParts).
+  /// After matching: splits each breakable group with a pair of rest neighbours stretched
+  /// beyond its break strain into the parts still connected (splitParts).
   void breakGroups(const StepContext& c);
   /// Splits group g (its particles `slots`, in slot order) into the parts `linked` pairs
   /// connect: the largest keeps g, each other part of at least kMinGroup particles a new

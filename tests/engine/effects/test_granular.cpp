@@ -271,6 +271,13 @@ TEST_CASE(
   refused("game", "{\"name\": \"oil\", \"friction_angle\": 30}", "materials[1].friction_angle",
           "\"kind\": \"granular\"");
   refused("wcsph", "{\"name\": \"sand\", \"kind\": \"granular\"}", "materials[1].kind", "needs solver.type");
+  SolverDef noGrid = solverDefaults("game");  // the game solver without its grid projection
+  noGrid.params["grid_cell"] = 0;
+  MaterialDef grains;
+  grains.name = "grains";
+  grains.kind = MaterialDef::Kind::granular;
+  CHECK(materialProblem({}, grains, noGrid).find("grid projection") != std::string::npos);
+  CHECK(materialProblem({}, grains, solverDefaults("game")).empty());
   // Run time: a World built without grains takes none; one built with them takes more.
   World plain(parseScene(scene("game", "{\"name\": \"oil\"}"), "t.json"));
   MaterialDef sand;
