@@ -145,8 +145,6 @@ class Granular final : public Effect {
     ParticleStore& P = c.P;
     const Spiky<Real> S(c.R);
     const Real dt = c.dt;
-    da_.resize(P.size());
-    ds_.resize(P.size());
     c.pool.parallelFor(P.size(), kBlock, [&](std::size_t b, std::size_t e) {
       for (std::size_t i = b; i < e; ++i) {
         if (!member_i_[i]) continue;
@@ -174,25 +172,14 @@ class Granular final : public Effect {
         }
         const Real det = axx * ayy - axy * ayx;
         if (!(det > kMinDet)) {  // too few grains around to tell: rigid until they are
-          da_[i] = ds_[i] = std::numeric_limits<Real>::quiet_NaN();
+          nu[i] = nuMax;
           continue;
         }
         const Real ixx = ayy / det, ixy = -axy / det, iyx = -ayx / det, iyy = axx / det;  // A⁻¹
         const Real gxx = bxx * ixx + bxy * iyx, gxy = bxx * ixy + bxy * iyy;
         const Real gyx = byx * ixx + byy * iyx, gyy = byx * ixy + byy * iyy;
-        da_[i] = Real(0.5) * (gxx - gyy);  // D' = [[a, s], [s, −a]]
-        ds_[i] = Real(0.5) * (gxy + gyx);
-      }
-    });
-    c.pool.parallelFor(P.size(), kBlock, [&](std::size_t b, std::size_t e) {
-      for (std::size_t i = b; i < e; ++i) {
-        if (!member_i_[i]) continue;
-        if (std::isnan(da_[i])) {
-          nu[i] = nuMax;
-          continue;
-        }
-        const Real a = da_[i], s = ds_[i];
-        const Real rate = Real(2) * std::sqrt(a * a + s * s);  // |γ̇| = sqrt(2 D':D')
+        const Real a = Real(0.5) * (gxx - gyy), s = Real(0.5) * (gxy + gyx);  // D' = [[a, s], [s, −a]]
+        const Real rate = Real(2) * std::sqrt(a * a + s * s);                 // |γ̇| = sqrt(2 D':D')
         const std::uint32_t m = mat ? mat[i] : 0u;
         const Real bound = cohesion_[m] + mu_[m] * std::max(Real(0), P.p[i]);  // c + μs p
         const Real rho = P.rho[i] > 0 ? P.rho[i] : c.rho0;
@@ -218,7 +205,6 @@ class Granular final : public Effect {
   std::vector<std::uint8_t> member_;    ///< per material: granular
   std::vector<Real> mu_, cohesion_;     ///< per material: μs = tan(friction_angle), c [Pa]
   std::vector<std::uint8_t> member_i_;  ///< per particle: granular
-  std::vector<Real> da_, ds_;           ///< per particle: the deviatoric strain rate (NaN: not measured)
   std::vector<Real> rel_, nuRel_;       ///< per particle: r_i·η_i/(ρ η_max), η_i/(ρ η_max)
   ImplicitViscosity implicit_;
   std::vector<Vec2d> wallBlock_;
