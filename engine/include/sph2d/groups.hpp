@@ -29,6 +29,10 @@ struct GroupDef {
   /// fluid). At most the support over 1.5 spacings, less 1 (0.33 on the game solver, whose
   /// support is 2 spacings). 0: it never breaks.
   double breakStrain = 0;
+  /// The colour it is drawn in, 0xRRGGBB: its particles' own colour (World::setParticleColor),
+  /// which the renderer's liquid mode fills the group's blob with (a darker outline round it)
+  /// and the particles mode's `color` shows. 0: its material's colour (no colour field).
+  std::uint32_t color = 0;
   /// A scene's elastic group without a stiffness of its own.
   static constexpr double kElasticStiffness = 0.25;
 };

@@ -77,6 +77,9 @@ struct Particles {
   /// optional: with miscible materials, each particle's colour from its concentrations
   /// (0xRRGGBB, the materials' colours weighted), what the renderer draws it in
   ArrayView<std::uint32_t> mixedColor;
+  /// optional: 1 + the index of the particle's group (World::createGroup), 0 for one in no
+  /// group (a World that never had a group has none)
+  ArrayView<std::uint32_t> group;
 
   /// Number of particles.
   std::size_t size() const { return x.size(); }
@@ -96,6 +99,7 @@ struct ParticleBuffer {
   std::vector<std::uint32_t> emitter;     ///< optional (empty or one per particle)
   std::vector<std::uint32_t> material;    ///< optional (empty or one per particle)
   std::vector<std::uint32_t> mixedColor;  ///< optional (empty or one per particle)
+  std::vector<std::uint32_t> group;       ///< optional (empty or one per particle)
 
   /// Number of particles.
   std::size_t size() const { return x.size(); }
@@ -112,6 +116,7 @@ struct ParticleBuffer {
     if (!emitter.empty()) emitter.push_back(0);
     if (!material.empty()) material.push_back(0);
     if (!mixedColor.empty()) mixedColor.push_back(0);
+    if (!group.empty()) group.push_back(0);
   }
   /// Replaces the contents with copies of every array of `view` (capacity is kept, so a
   /// buffer reused frame after frame stops allocating).
@@ -127,6 +132,7 @@ struct ParticleBuffer {
     copy(view.emitter, emitter);
     copy(view.material, material);
     copy(view.mixedColor, mixedColor);
+    copy(view.group, group);
   }
   /// The buffer as Particles (valid until the buffer changes).
   Particles view() const& {
@@ -142,6 +148,7 @@ struct ParticleBuffer {
     P.emitter = emitter;
     P.material = material;
     P.mixedColor = mixedColor;
+    P.group = group;
     return P;
   }
   /// Not of a temporary buffer: the views would outlive their values.

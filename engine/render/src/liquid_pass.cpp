@@ -21,6 +21,11 @@
 // one spacing wide (shaders/particles.frag) in its material's colour, lighter or darker by up
 // to 15 % by a hash of its id (the same grain keeps its shade). They still count in the depth
 // grid's tiles, so the composite rewrites where they were each frame.
+// A particle group (Particles::group) is no liquid either: its particles add nothing to the
+// water's field and tint but are splatted into a target of their own (shaders/tint.frag: Σ w·
+// colour, Σ w; the colour is each particle's own, World::setParticleColor / GroupDef::color, else
+// its material's), which a second composite (shaders/blob.frag) draws over the water as solid
+// blobs with a darker outline. A frame without group particles has neither pass nor target.
 #include <algorithm>
 #include <cmath>
 
@@ -52,7 +57,7 @@ class LiquidPass final : public RenderPass {
 
   void targetsChanged() override {
     fieldW_ = fieldH_ = 0;  // recreated at the next splat
-    tintW_ = tintH_ = 0;
+    tintW_ = tintH_ = blobW_ = blobH_ = 0;
     grid_.solidsChanged();
     drawnRows_ = {0, 1 << 30};  // a new colour target: the whole background at the next frame
   }
@@ -63,17 +68,18 @@ class LiquidPass final : public RenderPass {
   }
 
   void release() override {
-    for (GLuint p : {splatProg_, compositeProg_, tintProg_, compositeTintProg_, grainProg_})
+    for (GLuint p : {splatProg_, compositeProg_, tintProg_, compositeTintProg_, grainProg_, blobProg_})
       if (p) glDeleteProgram(p);
-    const GLuint textures[3] = {fieldTex_, auxTex_, tintTex_};
-    glDeleteTextures(3, textures);
-    const GLuint fbos[2] = {fieldFbo_, tintFbo_};
-    glDeleteFramebuffers(2, fbos);
+    const GLuint textures[4] = {fieldTex_, auxTex_, tintTex_, blobTex_};
+    glDeleteTextures(4, textures);
+    const GLuint fbos[3] = {fieldFbo_, tintFbo_, blobFbo_};
+    glDeleteFramebuffers(3, fbos);
     glDeleteVertexArrays(1, &tileVao_);
     glDeleteBuffers(1, &tileVbo_);
     splatProg_ = compositeProg_ = fieldTex_ = auxTex_ = fieldFbo_ = tileVao_ = tileVbo_ = 0;
     tintProg_ = compositeTintProg_ = tintTex_ = tintFbo_ = grainProg_ = 0;
-    tintW_ = tintH_ = 0;
+    blobProg_ = blobTex_ = blobFbo_ = 0;
+    tintW_ = tintH_ = blobW_ = blobH_ = 0;
   }
 
   /// True for the particle in slot i when its material is granular (drawn as a grain).
@@ -85,18 +91,38 @@ class LiquidPass final : public RenderPass {
     return m < g.size() && g[m];
   }
 
+  /// True for the particle in slot i when it is in a particle group (drawn in a blob).
+  static bool blobAt(const RenderInput& in, std::size_t i) {
+    const Particles& P = in.particles;
+    return P.group.size() == P.size() && P.group[i] != 0;
+  }
+
+  /// The colour of a group's particle: its own, else its material's, else the water's.
+  std::uint32_t blobColor(const RenderInput& in, std::size_t i) const {
+    const Particles& P = in.particles;
+    if (P.color.size() == P.size() && P.color[i]) return P.color[i] & 0xFFFFFFu;
+    const std::uint32_t m = P.material.size() == P.size() ? P.material[i] : 0u;
+    if (m < in.materialColors.size()) return in.materialColors[m] & 0xFFFFFFu;
+    std::uint32_t c = 0;
+    for (const double v : def_.water) c = (c << 8) | std::uint32_t(std::lround(std::clamp(v, 0.0, 1.0) * 255));
+    return c;
+  }
+
   void prepare(const PassFrame& f) override {
     const Particles& P = f.in.particles;
     const std::size_t n = f.order.size();
     packed_.resize(n * 4);
     grains_.clear();
+    blobs_.clear();
     for (std::size_t k = 0; k < n; ++k) {
       const std::size_t i = f.order[k];
       const bool grain = grainAt(f.in, i);
+      const bool blob = !grain && blobAt(f.in, i);
       packed_[4 * k] = P.x[i].x();
       packed_[4 * k + 1] = P.x[i].y();
       packed_[4 * k + 2] = P.v[i].norm();
-      packed_[4 * k + 3] = grain ? 0.0f : f.weight[k];
+      packed_[4 * k + 3] = grain || blob ? 0.0f : f.weight[k];
+      if (blob) blobs_.insert(blobs_.end(), {P.x[i].x(), P.x[i].y(), float(blobColor(f.in, i)), f.weight[k]});
       if (grain) {
         const std::uint32_t m = P.material.size() == P.size() ? P.material[i] : 0u;
         const std::uint32_t base = m < f.in.materialColors.size() ? f.in.materialColors[m] : 0xC8A870u;
@@ -122,7 +148,7 @@ class LiquidPass final : public RenderPass {
         packedTint_[4 * k] = P.x[i].x();
         packedTint_[4 * k + 1] = P.x[i].y();
         packedTint_[4 * k + 2] = float(mixed ? mixed[i] & 0xFFFFFFu : m < colors.size() ? colors[m] & 0xFFFFFFu : 0u);
-        packedTint_[4 * k + 3] = grainAt(f.in, i) ? 0.0f : f.weight[k];
+        packedTint_[4 * k + 3] = grainAt(f.in, i) || blobAt(f.in, i) ? 0.0f : f.weight[k];
       }
     }
     const int EW = f.geo.EW, EH = f.geo.EH;
@@ -152,6 +178,7 @@ class LiquidPass final : public RenderPass {
     splat(f);
     timer.end(timings.splat);
     composite(f);
+    if (!blobs_.empty()) drawBlobs(f);
     if (!grains_.empty()) drawGrains(f);
     timer.end(timings.composite);
   }
@@ -200,8 +227,50 @@ class LiquidPass final : public RenderPass {
       sprites_.setUniforms(tintProg_, f.scale, f.offset, fieldDiameter, fw, fh, quads_);
       sprites_.draw(GLsizei(f.order.size()), quads_);
     }
+    if (!blobs_.empty()) {  // the groups' particles, in their colours, into the blob target
+      if (!tintProg_) tintProg_ = gl::program("splat.vert", "tint.frag");
+      if (fw != blobW_ || fh != blobH_) {
+        if (blobFbo_) glDeleteFramebuffers(1, &blobFbo_);
+        blobFbo_ = gl::target(GL_RGBA32F, GL_RGBA, GL_FLOAT, fw, fh, blobTex_);
+        const GLint filter = shrink > 1 ? GL_LINEAR : GL_NEAREST;
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, filter);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, filter);
+        blobW_ = fw;
+        blobH_ = fh;
+      }
+      glBindFramebuffer(GL_FRAMEBUFFER, blobFbo_);
+      glClear(GL_COLOR_BUFFER_BIT);
+      sprites_.upload(blobs_);
+      sprites_.setUniforms(tintProg_, f.scale, f.offset, fieldDiameter, fw, fh, quads_);
+      sprites_.draw(GLsizei(blobs_.size() / 4), quads_);
+    }
     glDisable(GL_BLEND);
     glViewport(0, 0, EW, EH);
+  }
+
+  /// The groups' blobs over the water (shaders/blob.frag), over the tiles the fluid can reach.
+  void drawBlobs(const PassFrame& f) {
+    if (!blobProg_) blobProg_ = gl::program("solid.vert", "blob.frag");
+    glViewport(0, 0, f.geo.EW, f.geo.EH);
+    glUseProgram(blobProg_);
+    glActiveTexture(GL_TEXTURE0);
+    glBindTexture(GL_TEXTURE_2D, blobTex_);
+    glUniform1i(gl::uniform(blobProg_, "uBlob"), 0);
+    glUniform2f(gl::uniform(blobProg_, "uTexel"), 1.0f / float(f.geo.EW), 1.0f / float(f.geo.EH));
+    glUniform1f(gl::uniform(blobProg_, "uInvBulk"), 1.0f / bulk(f));
+    glUniform1f(gl::uniform(blobProg_, "uOutlinePx"), float(std::clamp(0.35 * f.spacingPx, 1.5, 4.0)));
+    glEnable(GL_BLEND);
+    glBlendFuncSeparate(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA, GL_ZERO, GL_ONE);
+    glBindVertexArray(tileVao_);
+    if (tileVertices_) glDrawArrays(GL_TRIANGLES, 0, tileVertices_);
+    glDisable(GL_BLEND);
+  }
+
+  /// The field's value inside a bulk of particles: Σ (1 − q²)³ over a square lattice ≈ π s²/4,
+  /// s = the sprite's radius in spacings.
+  float bulk(const PassFrame& f) const {
+    const float rs = float(spriteDiameter(f.spacingPx) * 0.5 / f.spacingPx);
+    return std::max(1e-3f, 3.14159265f * rs * rs / 4.0f);
   }
 
   /// The granular particles, each a disc one spacing wide in its shade of its material's colour.
@@ -255,11 +324,7 @@ class LiquidPass final : public RenderPass {
     glUniform2f(gl::uniform(cp, "uAuxScale"), float(EW) / float(grid_.width() * grid_.cell()),
                 float(EH) / float(grid_.height() * grid_.cell()));
     glUniform2f(gl::uniform(cp, "uTexel"), 1.0f / float(EW), 1.0f / float(EH));
-    // Bulk value of the field: Σ (1 − q²)³ over a square lattice ≈ π s²/4, s = sprite radius in spacings.
-    const float diameter = spriteDiameter(f.spacingPx);
-    const float rs = float(diameter * 0.5 / f.spacingPx);
-    const float bulk = std::max(1e-3f, 3.14159265f * rs * rs / 4.0f);
-    glUniform1f(gl::uniform(cp, "uInvBulk"), 1.0f / bulk);
+    glUniform1f(gl::uniform(cp, "uInvBulk"), 1.0f / bulk(f));
     const auto water = color3(def_.water);
     const std::array<float, 3> deep = opt_.deepWater
                                           ? color3(*opt_.deepWater)
@@ -285,8 +350,12 @@ class LiquidPass final : public RenderPass {
   // More than one material (made on the first such frame): the tint pass and its target.
   GLuint tintProg_ = 0, compositeTintProg_ = 0, tintTex_ = 0, tintFbo_ = 0;
   int tintW_ = 0, tintH_ = 0;
-  bool tinted_ = false;            // this frame draws each material in its colour
-  GLuint grainProg_ = 0;           // the grains' discs (made on the first frame with grains)
+  bool tinted_ = false;   // this frame draws each material in its colour
+  GLuint grainProg_ = 0;  // the grains' discs (made on the first frame with grains)
+  // Particle groups (made on the first frame with one): their splat target and composite.
+  GLuint blobProg_ = 0, blobTex_ = 0, blobFbo_ = 0;
+  int blobW_ = 0, blobH_ = 0;
+  std::vector<float> blobs_;       // group particles (x, y, colour, weight) in id order
   std::vector<float> grains_;      // granular particles (x, y, shaded colour, weight) in id order
   std::vector<float> packedTint_;  // particles (x, y, material colour, weight) in id order
   GLuint fieldTex_ = 0, fieldFbo_ = 0, auxTex_ = 0, tileVao_ = 0, tileVbo_ = 0;

@@ -4,6 +4,9 @@
 // several mistakes always reports the same first one.
 #include "scene/scene_sections.hpp"
 
+#include <array>
+#include <cmath>
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -395,8 +398,13 @@ void readGroups(const Reader& r, const json& root, SceneDef& s) {
       if (!elastic) r.fail(Reader::sub(p, key), "a rigid group neither yields nor breaks: give \"kind\": \"elastic\"");
       (std::string(key) == "yield_strain" ? g.yieldStrain : g.breakStrain) = r.number(arr[k], p, key, 0, 0, 10);
     }
+    if (arr[k].contains("color")) {  // 0xRRGGBB; black is 0x010101 (0 means "the material's")
+      const std::array<double, 3> c = r.color(arr[k], p, "color", {});
+      for (const double v : c) g.color = (g.color << 8) | std::uint32_t(std::lround(v * 255));
+      if (!g.color) g.color = 0x010101u;
+    }
     json region = arr[k];  // the region's keys are a fluid block's (errors name this path's lines)
-    for (const char* key : {"kind", "stiffness", "yield_strain", "break_strain"}) region.erase(key);
+    for (const char* key : {"kind", "stiffness", "yield_strain", "break_strain", "color"}) region.erase(key);
     g.region = readBlock(r, region, p, s);
     s.groups.push_back(g);
   }

@@ -225,6 +225,10 @@ std::uint32_t World::createGroup(const GroupDef& def, IdRange* ids) {
     std::vector<Real>& f = w.P.field(name);
     for (const std::size_t i : slots) f[i] = Real(value);
   }
+  if (def.color) {  // drawn in its own colour: the particles' colour field (made now if new)
+    std::vector<std::uint32_t>& c = w.P.fieldU32(ParticleStore::kColor);
+    for (const std::size_t i : slots) c[i] = def.color & 0xFFFFFFu;
+  }
   w.refreshView();
   w.buildStages();  // the groups stage, and the elastic groups' record before the collisions
   if (ids) *ids = added;

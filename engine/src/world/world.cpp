@@ -440,6 +440,7 @@ Particles viewOf(const ParticleStore& S) {
   V.emitter = opt(S.findU32(ParticleStore::kEmitter));
   V.material = opt(S.findU32(ParticleStore::kMaterial));
   V.mixedColor = opt(S.findU32(ParticleStore::kMixedColor));
+  V.group = opt(S.findU32(ParticleStore::kGroup));
   return V;
 }
 
@@ -451,7 +452,7 @@ bool World::Impl::viewCurrent() const {
   return same(view.x, now.x) && same(view.v, now.v) && same(view.rho, now.rho) && same(view.p, now.p) &&
          same(view.id, now.id) && same(view.age, now.age) && same(view.color, now.color) &&
          same(view.userData, now.userData) && same(view.emitter, now.emitter) && same(view.material, now.material) &&
-         same(view.mixedColor, now.mixedColor);
+         same(view.mixedColor, now.mixedColor) && same(view.group, now.group);
 }
 
 void World::Impl::refreshView() const { view = viewOf(P); }

@@ -228,6 +228,21 @@ TEST_CASE("jelly: a scene's groups make rigid and elastic groups, and bad keys a
     CHECK(e.message.find("at most 0.333") != std::string::npos);
   }
   refused("{\"min\": [0.2, 0.2], \"max\": [0.4, 0.4], \"colour\": 1}", "groups[0].colour", "");
+  refused("{\"min\": [0.2, 0.2], \"max\": [0.4, 0.4], \"color\": [1, 0.5, 2]}", "groups[0].color", "0..1");
+  // A colour of its own: the group's particles carry it (the particles' colour field), the
+  // others none; a group's index is in particles().group.
+  World c(parseScene(scene("{\"min\": [0.2, 0.2], \"max\": [0.4, 0.4], \"color\": [1, 0.5, 0]}"), "t.json"));
+  const Particles& P = c.particles();
+  REQUIRE(P.color.size() == P.size());
+  REQUIRE(P.group.size() == P.size());
+  std::size_t red = 0, grouped = 0;
+  for (std::size_t i = 0; i < P.size(); ++i) {
+    red += P.color[i] == 0xFF8000u;
+    grouped += P.group[i] == 1;
+    CHECK((P.color[i] == 0xFF8000u) == (P.group[i] == 1));
+  }
+  CHECK(red == 100);
+  CHECK(grouped == 100);
 }
 
 TEST_CASE("groups: momentum of water, a rigid and an elastic group and a Box2D body holds in zero gravity") {

@@ -13,6 +13,9 @@
 //     composite  field → liquid: anti-aliased edge, shading from the field's
 //                gradient (light from above), colour from the depth of water
 //                above, foam where the weighted speed is high
+//     grains     a granular material's particles as discs in its colour
+//     blobs      particle groups as solid blobs in their colour with a darker outline
+//                (their own splat target, then shaders/blob.frag over the water)
 //   particles mode
 //     discs      one anti-aliased disc per particle coloured by a field (speed,
 //                pressure, density, age) on a ramp, plus a colour bar with its range
