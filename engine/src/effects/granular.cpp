@@ -21,8 +21,12 @@
 // of grains takes the mean, a pair of a grain and a liquid none (the liquid's viscosity is the
 // viscosity effect's). The static walls' samples take part with a wall viscosity of the
 // grain's own, bounded so that the wall's force on a sliding grain is at most the bound over
-// its share of the wall (Coulomb friction at the floor, the material's μs); a grain against a
-// moving body meets its pressure and the collide stage's Coulomb friction.
+// its share of the wall (Coulomb friction at the floor, the material's μs). A moving body's
+// face takes part alike (the game solver places no samples in bodies: ShapeContacts gives each
+// grain within a support of a body's shape the samples' sum of a flat face at its distance),
+// no-slip against the body's velocity there under the same Coulomb bound, and a dynamic body
+// is an unknown of the solve that takes the reaction: sand holds a body up by its friction,
+// not only by its pressure, and a body that pushes sand is pushed back.
 //
 // η is lagged, a Picard iteration across substeps: each substep solves with the η the last
 // one left (fields granular.nu and granular.wall_nu, η/ρ; 0 for a grain not measured yet,
@@ -35,12 +39,15 @@
 // the friction angle from 20° to 40°; the 2D column collapses run out as Lajeunesse et al.'s
 // law at 20 to 60 particles per column height, and further at finer spacings (a rate-independent
 // Coulomb material is ill-posed, Barker, Schaeffer, Bohórquez & Gray 2015, JFM 779: its shear
-// bands take the spacing's width; docs/notes/granular-resolution.md). Sand under water reads
+// bands take the spacing's width; docs/notes/granular-resolution.md); a box 2.5 times as dense
+// presses into a bed by less the larger φ and stops, where it sinks through φ = 0 to the floor
+// (test_granular_bodies.cpp). Sand under water reads
 // the total pressure, not the effective (no pore pressure): it stands steeper than in air.
 #include <algorithm>
 #include <cmath>
 #include <limits>
 
+#include "bodies/moving_solid.hpp"
 #include "effects/effect.hpp"
 #include "effects/viscosity_implicit.hpp"
 
@@ -119,12 +126,14 @@ class Granular final : public Effect {
     t.muMass = nuMax * scale_ * c.rho0 * c.mass;
     t.wallFactor = Real(2) * nuMax * scale_ * c.rho0;
     t.walls = !c.boundary.samples.empty();
-    t.noSlip = false;  // the moving bodies: pressure and the collide stage's Coulomb friction
+    t.noSlip = false;  // the game solver places no samples in the moving bodies: their shapes
+    contactBodies(c, t);
     ViscosityWeights w;
     w.ratio = ratio;
     w.rel = rel_.data();
     w.nuRel = nuRel_.data();
     w.member = member_i_.data();
+    w.shapes = shapes_.list.empty() ? nullptr : &shapes_;
     const bool count = t.walls && c.wall;
     if (count) wallBlock_.assign((n + kBlock - 1) / kBlock, Vec2d(0, 0));
     const std::size_t bad = implicit_.apply(c, t, w, count, wallBlock_);
@@ -145,6 +154,7 @@ class Granular final : public Effect {
     ParticleStore& P = c.P;
     const Spiky<Real> S(c.R);
     const Real dt = c.dt;
+    const double tau = c.solids ? double(c.time) - c.solids->time0 : 0.0;
     c.pool.parallelFor(P.size(), kBlock, [&](std::size_t b, std::size_t e) {
       for (std::size_t i = b; i < e; ++i) {
         if (!member_i_[i]) continue;
@@ -187,21 +197,79 @@ class Granular final : public Effect {
         // The walls: Coulomb friction on the grain's slip. The wall term's force on the grain
         // (viscosity_implicit.cpp), m s_i·(wallFactor IR_i s_i ν_w/ν_max)·Σ_b Ψ_b ∇²W_ib·|v_i|,
         // at most the bound over the grain's share of the wall, dx per unit depth.
+        // A moving body's face alike (ShapeContacts), the slip relative to the body there.
         wallNu[i] = nuMax;
         const std::uint32_t bc = t.walls ? c.nbr.boundaryCount[i] : 0u;
-        if (bc == 0) continue;
+        const bool touches = !shapes_.list.empty() && shapes_.start[i] < shapes_.start[i + 1];
+        if (bc == 0 && !touches) continue;
         const std::uint32_t* bl = c.nbr.boundaryOf(i);
         Real gi = 0;
         for (std::uint32_t k = 0; k < bc; ++k)
           gi += c.boundary.volume[bl[k]] * t.W.laplacianR2((P.x[i] - c.boundary.samples[bl[k]]).squaredNorm());
         const Real si = ratio ? ratio[i] : Real(1);
         const Real slip = (P.v[i] + P.a[i] * dt).norm();
-        const Real perNu = c.mass * si * si * t.wallFactor / nuMax * P.invRho[i] * gi * slip;  // force per unit ν_w
+        const Real per = c.mass * si * si * t.wallFactor / nuMax * P.invRho[i];
+        Real perNu = per * gi * slip;  // force per unit ν_w
+        if (touches) {
+          Real gb = 0;  // Σ over the bodies' faces of g |v_i − v_body|
+          for (std::uint32_t k = shapes_.start[i]; k < shapes_.start[i + 1]; ++k) {
+            const ShapeContacts::Contact& ct = shapes_.list[k];
+            const Vec2d vb = c.solids->bodies[ct.body].velocityAt(tau, P.x[i].cast<double>());
+            gb += Real(ct.g) * (vi - vb.cast<Real>()).norm();
+          }
+          perNu += per * gb;
+        }
         if (perNu * nuMax > bound * c.dx) wallNu[i] = std::max(bound * c.dx / perNu, kZero);
       }
     });
   }
 
+  /// The grains within a support of a moving body's shape: shapes_, with g of a flat face at
+  /// their distance from it (a table over [0, R], 64 steps, linear between).
+  void contactBodies(StepContext& c, const ViscosityTerm& t) {
+    shapes_.list.clear();
+    shapes_.start.clear();
+    if (!c.solids || c.solids->bodies.empty()) return;
+    if (face_.empty() || faceR_ != c.R || faceDx_ != c.dx) {
+      face_.resize(kFaceSteps + 1);
+      for (int k = 0; k <= kFaceSteps; ++k)
+        face_[std::size_t(k)] = flatFaceLaplacian(t.W, double(c.dx), double(c.R) * k / kFaceSteps);
+      faceR_ = c.R;
+      faceDx_ = c.dx;
+    }
+    const std::size_t n = c.P.size(), blocks = (n + kBlock - 1) / kBlock;
+    const double tau = double(c.time) - c.solids->time0, R = double(c.R);
+    shapes_.start.resize(n + 1);
+    blockLists_.resize(blocks);
+    c.pool.parallelFor(n, kBlock, [&](std::size_t lo, std::size_t hi) {
+      std::vector<ShapeContacts::Contact>& L = blockLists_[lo / kBlock];
+      L.clear();
+      for (std::size_t i = lo; i < hi; ++i) {
+        shapes_.start[i] = std::uint32_t(L.size());  // within the block; made global below
+        if (!member_i_[i]) continue;
+        for (std::size_t k = 0; k < c.solids->bodies.size(); ++k) {
+          const double d = -c.solids->bodies[k].depth(tau, c.P.x[i].cast<double>());  // distance outside
+          if (!(d < R)) continue;
+          const double u = std::max(0.0, d) / R * kFaceSteps;
+          const std::size_t j = std::min(std::size_t(u), std::size_t(kFaceSteps - 1));
+          const double g = face_[j] + (face_[j + 1] - face_[j]) * (u - double(j));
+          if (g > 0) L.push_back({std::uint32_t(k), g});
+        }
+      }
+    });
+    for (std::size_t b = 0; b < blocks; ++b) {  // the blocks' lists in order
+      const std::uint32_t base = std::uint32_t(shapes_.list.size());
+      for (std::size_t i = b * kBlock; i < std::min(n, (b + 1) * kBlock); ++i) shapes_.start[i] += base;
+      shapes_.list.insert(shapes_.list.end(), blockLists_[b].begin(), blockLists_[b].end());
+    }
+    shapes_.start[n] = std::uint32_t(shapes_.list.size());
+  }
+
+  static constexpr int kFaceSteps = 64;
+  ShapeContacts shapes_;                                         ///< this substep's grains near moving bodies
+  std::vector<std::vector<ShapeContacts::Contact>> blockLists_;  ///< per block, while they are found
+  std::vector<double> face_;                                     ///< flatFaceLaplacian over [0, R]
+  Real faceR_ = -1, faceDx_ = -1;
   std::vector<std::uint8_t> member_;    ///< per material: granular
   std::vector<Real> mu_, cohesion_;     ///< per material: μs = tan(friction_angle), c [Pa]
   std::vector<std::uint8_t> member_i_;  ///< per particle: granular

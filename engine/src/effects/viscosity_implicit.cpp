@@ -21,6 +21,22 @@ Vec2d perp(const Vec2& arm) { return Vec2d(-double(arm.y()), double(arm.x())); }
 
 }  // namespace
 
+double flatFaceLaplacian(const ViscosityKernel<Real>& W, double dx, double distance) {
+  const double R = double(W.R);
+  const int steps = 64;  // along the face: Simpson's rule over [−R, R]
+  double g = 0;
+  for (double y = std::max(0.0, distance) + 0.5 * dx; y < R; y += dx) {
+    const double half = std::sqrt(R * R - y * y), h = 2 * half / steps;
+    double layer = 0;
+    for (int k = 0; k <= steps; ++k) {
+      const double a = -half + k * h, f = double(W.laplacianR2(Real(a * a + y * y)));
+      layer += f * (k == 0 || k == steps ? 1 : k % 2 ? 4 : 2);
+    }
+    g += layer * h / 3 * dx;  // samples dx apart along the face, each of volume dx²
+  }
+  return g;
+}
+
 double ImplicitViscosity::dot(StepContext& c, const Vec& a, const Vec& b) {
   double s = sumParts(c.pool, a.p.size(), [&](std::size_t lo, std::size_t hi) {
     double d = 0;
@@ -95,9 +111,15 @@ std::size_t ImplicitViscosity::apply(StepContext& c, const ViscosityTerm& t, con
   const Real* IR = P.invRho.data();
   const BoundarySet& B = c.boundary;
   BodySamples* moving = t.noSlip && c.bodySamples && c.bodySamples->active() ? c.bodySamples : nullptr;
+  const ShapeContacts* shapes = !moving && c.solids && w.shapes && !w.shapes->list.empty() ? w.shapes : nullptr;
   // The dynamic bodies' unknowns: every placed body has a row (a kinematic one's stays at 0).
-  const std::size_t nb = moving && c.solids ? std::min(moving->placed.size(), c.solids->bodies.size()) : 0;
-  auto isDynamic = [&](std::uint32_t k) { return k < nb && moving->placed[k].dynamic; };
+  const std::size_t nb = moving && c.solids ? std::min(moving->placed.size(), c.solids->bodies.size())
+                         : shapes           ? c.solids->bodies.size()
+                                            : 0;
+  auto isDynamic = [&](std::uint32_t k) {
+    return k < nb && (moving ? moving->placed[k].dynamic : c.solids->bodies[k].dynamic());
+  };
+  const double tau = c.solids ? double(c.time) - c.solids->time0 : 0.0;
   const std::size_t blocks = (n + kBlock - 1) / kBlock;
   coef_.resize(blocks);
   links_.resize(blocks);
@@ -175,6 +197,25 @@ std::size_t ImplicitViscosity::apply(StepContext& c, const ViscosityTerm& t, con
                               }
                               L.push_back(l);
                             });
+      if (shapes)  // a body's face as its samples would be (ShapeContacts)
+        for (std::uint32_t k = shapes->start[i]; k < shapes->start[i + 1]; ++k) {
+          const ShapeContacts::Contact& ct = shapes->list[k];
+          const MovingSolid& m = c.solids->bodies[ct.body];
+          gi += ct.g;
+          const Vec2d xi = X[i].cast<double>(), arm = xi - m.centreAt(tau);
+          if (!isDynamic(ct.body)) {
+            h += m.velocityAt(tau, xi) * ct.g;
+            continue;
+          }
+          Link l{std::uint32_t(i), ct.body, e * ct.g, Vec2d(0, 0), 0};
+          if (m.invInertia > 0) {
+            l.P = Vec2d(-arm.y(), arm.x()) * l.E;
+            l.A = arm.squaredNorm() * l.E;
+          } else {
+            h += Vec2d(-arm.y(), arm.x()) * (m.omega * ct.g);
+          }
+          L.push_back(l);
+        }
       diag_[i] = double(si) * (1.0 + double(dt) * vK * gi) + rowSum;
       coupled_[i] = rowSum != 0 || (!L.empty() && L.back().particle == i);
       const Vec2d vStar = (P.v[i] + P.a[i] * dt).cast<double>();
@@ -254,9 +295,11 @@ std::size_t ImplicitViscosity::apply(StepContext& c, const ViscosityTerm& t, con
 
   // a_i += (v'_i − v*_i)/dt; the walls' force on the fluid and the moving bodies' reactions
   // from v' (a dynamic body's samples at its solved velocity and spin).
-  return firstBad(c.pool, n, [&](std::size_t lo, std::size_t hi) {
+  const std::size_t firstBadSlot = firstBad(c.pool, n, [&](std::size_t lo, std::size_t hi) {
     std::size_t bad = kNone;
     Vec2d wallAcc(0, 0);
+    std::vector<BodyVel>& react = partial_[lo / kBlock];  // the shapes' reactions, this block's
+    std::fill(react.begin(), react.end(), BodyVel{});
     for (std::size_t i = lo; i < hi; ++i) {
       const Real si = w.ratio ? w.ratio[i] : Real(1);
       const Vec2d vStar = (P.v[i] + P.a[i] * dt).cast<double>();
@@ -264,6 +307,19 @@ std::size_t ImplicitViscosity::apply(StepContext& c, const ViscosityTerm& t, con
       P.a[i] += acc;
       if (!allFinite(acc) && bad == kNone) bad = i;
       if (t.walls && count) wallAcc -= x_.p[i] * (wallG[i] * double(si));
+      if (shapes && shapes->start[i] < shapes->start[i + 1]) {
+        const double vK = double(t.wallFactor) * double(IR[i] * si) * (w.nuRel ? double(w.nuRel[i]) : 1.0);
+        const double mass = double(c.mass) * double(si);
+        for (std::uint32_t k = shapes->start[i]; k < shapes->start[i + 1]; ++k) {
+          const ShapeContacts::Contact& ct = shapes->list[k];
+          if (!isDynamic(ct.body)) continue;
+          const BodyVel& u = x_.b[ct.body];
+          const Vec2d arm = X[i].cast<double>() - c.solids->bodies[ct.body].centreAt(tau);
+          const Vec2d lv = (x_.p[i] - (u.v + Vec2d(-arm.y(), arm.x()) * u.w)) * ct.g;
+          react[ct.body].v += lv * (vK * mass);  // the particle's pull on the body
+          react[ct.body].w += (arm.x() * lv.y() - arm.y() * lv.x()) * vK * mass;
+        }
+      }
       if (!moving || c.nbr.movingCount[i] == 0) continue;
       const Vec2 xi = X[i];
       const Vec2 vi = x_.p[i].cast<Real>();
@@ -286,6 +342,17 @@ std::size_t ImplicitViscosity::apply(StepContext& c, const ViscosityTerm& t, con
     if (count) wallBlock[lo / kBlock] = wallAcc;
     return bad;
   });
+  if (shapes)  // the bodies take the reactions, block by block in order
+    for (std::size_t k = 0; k < nb; ++k) {
+      if (!isDynamic(std::uint32_t(k))) continue;
+      BodyVel J;
+      for (const std::vector<BodyVel>& part : partial_) {
+        J.v += part[k].v;
+        J.w += part[k].w;
+      }
+      c.solids->bodies[k].push(tau, J.v * double(dt), J.w * double(dt));  // the particles' pull over the substep
+    }
+  return firstBadSlot;
 }
 
 }  // namespace sph2d

@@ -9,6 +9,25 @@
 
 namespace sph2d {
 
+/// Particles' contacts with the moving bodies' shapes, for a solver that places no samples in
+/// the bodies (the game solver): per particle, each body within its support and g = Σ_s Ψ_s
+/// ∇²W_is of the samples a flat face of the body would hold at the particle's distance from
+/// it (flatFaceLaplacian), taking part as the samples do (no-slip, a dynamic body a row of
+/// the system, its reaction pushed onto it when the solve ends).
+struct ShapeContacts {
+  struct Contact {
+    std::uint32_t body;  ///< index in StepContext::solids
+    double g;            ///< Σ_s Ψ_s ∇²W_is of the body's face
+  };
+  std::vector<std::uint32_t> start;  ///< per particle its first contact, n + 1 entries (empty: no contact)
+  std::vector<Contact> list;
+};
+
+/// Σ_s Ψ_s ∇²W(|x − x_s|) over the samples of a flat face at `distance` from x (≥ 0): layers
+/// `dx` apart from dx/2 behind the face, each integrated along the face (a lattice of
+/// spacing dx, each sample's volume dx², averaged over its offset), as a static wall's.
+double flatFaceLaplacian(const ViscosityKernel<Real>& W, double dx, double distance);
+
 /// Per-particle weights of the viscosity's pairs (viscosity.cpp); a null pointer: all 1.
 struct ViscosityWeights {
   const Real* ratio = nullptr;  ///< rest ratio r_i = ρ0_i/ρ0 (density contrast: the particle's mass is r_i m)
@@ -17,6 +36,8 @@ struct ViscosityWeights {
   /// Non-null: a pair takes part only when both its particles do (1): the granular friction
   /// acts between grains, not between a grain and the water around it.
   const std::uint8_t* member = nullptr;
+  /// Non-null (and no moving samples placed): the particles' contacts with the moving bodies.
+  const ShapeContacts* shapes = nullptr;
 };
 
 /// Backward Euler for the Laplacian viscosity over one substep (Weiler et al. 2018, "A
