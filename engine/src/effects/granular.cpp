@@ -35,7 +35,7 @@
 // momentum balance, so the stress it leaves, η|γ̇|, is the stress that holds the grains; where
 // it exceeds the bound, η falls to the bound over |γ̇| and the grains yield.
 //
-// Measured (tests/engine/effects/test_granular.cpp): slowly poured piles stand within 1° of
+// Measured (tests/engine/effects/test_granular.cpp): slowly poured piles stand within 1.5° of
 // the friction angle from 20° to 40°; the 2D column collapses run out as Lajeunesse et al.'s
 // law at 20 to 60 particles per column height, and further at finer spacings (a rate-independent
 // Coulomb material is ill-posed, Barker, Schaeffer, Bohórquez & Gray 2015, JFM 779: its shear

@@ -186,6 +186,7 @@ class GridProjection {
   std::vector<Real> thetaUp_;                  ///< per cell: where the ghost surface lies above it, in cells (1: none)
   Real dx_ = 0;                                ///< the particle spacing
   std::vector<Real> u_, uw_, v_, vw_;          ///< face velocities and weights
+  std::vector<std::uint8_t> uKnown_, vKnown_;  ///< per face: a particle reaches it (splatFaces)
   std::vector<Real> du_, dv_;                  ///< face velocity changes
   std::vector<Real> uNew_, vNew_;              ///< projected face velocities (for the PIC share)
   std::vector<Real> kappa_, rhs_, x_;  ///< per cell: κ; per unknown: the pressure solve's right-hand side and unknowns
