@@ -21,7 +21,8 @@ struct GroupDef {
   double stiffness = 1;
   /// Elastic only: the strain beyond which it yields (plastic): a particle farther from its
   /// place than this times its rest distance from the centre (at least a spacing) moves its
-  /// place in the rest shape by the excess. 0: it always springs back.
+  /// place in the rest shape by the excess, at most half a spacing a substep (a flow: taken at
+  /// once, a hard landing crossed places and blew a stiff block up). 0: it always springs back.
   double yieldStrain = 0;
   /// Elastic only: the strain at which it breaks: after the substep, pairs of neighbours (in
   /// the rest shape, at most 1.5 spacings apart) stretched by more than this part are cut, and
