@@ -68,6 +68,8 @@ int cmdRender(const std::vector<std::string>& args) {
   if (!snap.material.empty())
     B.material = snap.material;  // the scene's materials colour them (an index
                                  // it has not is drawn in the fluid's colour)
+  B.color = snap.color;          // the particles' own colours, and their groups (drawn as blobs)
+  B.group = snap.group;
   const Particles P = B.view();
   if (opt.colorBy == ColorField::Age && snap.age.empty() &&
       (opt.mode == "particles" || (opt.mode.empty() && scene.render.mode == "particles")))

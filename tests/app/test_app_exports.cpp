@@ -226,6 +226,29 @@ TEST_CASE("sph2d render redraws an exported CSV frame bit-identically to the run
   CHECK(pngHash(dir + "/discs.png") != pngHash(dir + "/again.png"));
 }
 
+TEST_CASE("sph2d render redraws grains and particle groups from a CSV as the run drew them") {
+  // The sandbox with its jelly in a colour of its own: the CSV carries each particle's material,
+  // own colour and group, and the frame drawn from it has the run's pixels. (Without its crate:
+  // a redraw shows the scene's bodies where the scene puts them, not where they moved.)
+  const std::string dir = freshDir("rerender_groups");
+  json scene = json::parse(readText(asset("scenes/sandbox.json")));
+  scene["groups"][0]["color"] = {0.9, 0.3, 0.5};
+  json statics = json::array();
+  for (const json& b : scene["boundaries"])
+    if (b.value("type", "static") == "static") statics.push_back(b);
+  scene["boundaries"] = statics;
+  const std::string path = dir + "/sandbox_pink.json";
+  std::ofstream(path) << scene.dump(1);
+  REQUIRE(run("run " + q(path) + " --frames 61 --every 60 --quiet --export csv --out " + q(dir + "/out")).code == 0);
+  const std::string csv = readText(dir + "/out/frame_00060.csv");
+  CHECK(csv.find(",material,color,group\n") != std::string::npos);
+  const Result r =
+      run("render " + q(path) + " --particles " + q(dir + "/out/frame_00060.csv") + " --out " + q(dir + "/again.png"));
+  INFO(r.out);
+  REQUIRE(r.code == 0);
+  CHECK(pngHash(dir + "/again.png") == readManifest(dir + "/out")["frames"][1]["rgba_xxh64"].get<std::string>());
+}
+
 TEST_CASE("sph2d render refuses a CSV with a NaN or infinite value, naming the line and the column") {
   // Before (issue 18): NaN and infinite positions were accepted and a picture was written.
   const std::string dir = freshDir("rerender_nan");

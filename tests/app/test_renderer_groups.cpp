@@ -121,8 +121,7 @@ TEST_CASE("liquid mode: a particle group is a solid blob in its colour with a da
     greenPx += G > R + 40 && G > B + 40;
   }
   const double pxPerM = f.width / (cam[2] - cam[0]);
-  const double redArea = kPi<double> * std::pow(0.08 * pxPerM, 2),
-               greenArea = kPi<double> * std::pow(0.05 * pxPerM, 2);
+  const double redArea = kPi<double> * std::pow(0.08 * pxPerM, 2), greenArea = kPi<double> * std::pow(0.05 * pxPerM, 2);
   MESSAGE("areas: red " << redPx << " px (disc " << redArea << "), green " << greenPx << " px (disc " << greenArea
                         << ")");
   CHECK(double(redPx) == doctest::Approx(redArea).epsilon(0.10));
@@ -130,8 +129,16 @@ TEST_CASE("liquid mode: a particle group is a solid blob in its colour with a da
 }
 
 TEST_CASE("liquid mode: a group without a colour of its own is a blob in its material's colour") {
+  // The red disc without a colour, of the water; the green one of a material coloured (0.2, 0.4, 0.9).
   SceneDef s = groupsScene();
   for (GroupDef& g : s.groups) g.color = 0;
+  MaterialDef water, blue;
+  water.name = "water";
+  water.color = s.render.water;
+  blue.name = "blue";
+  blue.color = {0.2, 0.4, 0.9};
+  s.materials = {water, blue};
+  s.groups[1].region.material = 1;
   World world(s, WorldOptions{1});
   RenderOptions lo;
   lo.mode = "liquid";
@@ -141,6 +148,10 @@ TEST_CASE("liquid mode: a group without a colour of its own is a blob in its mat
   const int c = int((0.55 - cam[0]) / (cam[2] - cam[0]) * f.width),
             rr = int((cam[3] - 0.33) / (cam[3] - cam[1]) * f.height);
   const std::uint8_t* p = &f.rgba[4 * (std::size_t(rr) * std::size_t(f.width) + std::size_t(c))];
-  // The water's colour (one material: RenderDef::water) at the centre of the green disc's place.
-  for (int k = 0; k < 3; ++k) CHECK(std::abs(int(p[k]) - int(std::lround(s.render.water[k] * 255))) <= 3);
+  // The material's colour at the centre of the second disc, the water's at the first's.
+  for (int k = 0; k < 3; ++k) CHECK(std::abs(int(p[k]) - int(std::lround(s.materials[1].color[k] * 255))) <= 3);
+  const int c2 = int((0.385 - cam[0]) / (cam[2] - cam[0]) * f.width),
+            r2 = int((cam[3] - 0.1) / (cam[3] - cam[1]) * f.height);
+  const std::uint8_t* q = &f.rgba[4 * (std::size_t(r2) * std::size_t(f.width) + std::size_t(c2))];
+  for (int k = 0; k < 3; ++k) CHECK(std::abs(int(q[k]) - int(std::lround(s.render.water[k] * 255))) <= 3);
 }

@@ -60,6 +60,8 @@ ParticleSnapshot snapshotOf(const World& world, const Real* age) {
   s.p.resize(n);
   if (age) s.age.resize(n);
   if (!P.material.empty()) s.material.resize(n);
+  if (!P.color.empty()) s.color.resize(n);
+  if (!P.group.empty()) s.group.resize(n);
   const Vec2d o = world.origin();
   for (std::size_t k = 0; k < n; ++k) {
     const std::size_t i = order[k];
@@ -72,6 +74,8 @@ ParticleSnapshot snapshotOf(const World& world, const Real* age) {
     s.p[k] = P.p[i];
     if (age) s.age[k] = float(age[i]);
     if (!P.material.empty()) s.material[k] = P.material[i];
+    if (!P.color.empty()) s.color[k] = P.color[i];
+    if (!P.group.empty()) s.group[k] = P.group[i];
   }
   // Box2D lists the newest body first: walk the list, then number in creation order.
   std::vector<const b2Body*> bodies;
@@ -148,6 +152,7 @@ void writeParticlesAtomic(const std::string& path, const ParticleSnapshot& s, Ex
 std::string encodeParticles(const ParticleSnapshot& s, ExportFormat f) {
   const std::size_t n = s.size();
   const bool hasAge = !s.age.empty(), hasMaterial = !s.material.empty();
+  const bool hasColor = !s.color.empty(), hasGroup = !s.group.empty();
   std::string out;
   if (f == ExportFormat::Csv) {
     out.reserve(n * 100 + 128);
@@ -155,12 +160,16 @@ std::string encodeParticles(const ParticleSnapshot& s, ExportFormat f) {
             static_cast<unsigned long long>(s.frame), s.time, n);
     out += "id,x,y,vx,vy,density,pressure";
     out += hasAge ? ",age" : "";
-    out += hasMaterial ? ",material\n" : "\n";
+    out += hasMaterial ? ",material" : "";
+    out += hasColor ? ",color" : "";
+    out += hasGroup ? ",group\n" : "\n";
     for (std::size_t k = 0; k < n; ++k) {
       appendf(out, "%u,%.17g,%.17g,%.9g,%.9g,%.9g,%.9g", s.id[k], s.x[k], s.y[k], double(s.vx[k]), double(s.vy[k]),
               double(s.rho[k]), double(s.p[k]));
       if (hasAge) appendf(out, ",%.9g", double(s.age[k]));
       if (hasMaterial) appendf(out, ",%u", s.material[k]);
+      if (hasColor) appendf(out, ",%u", s.color[k]);
+      if (hasGroup) appendf(out, ",%u", s.group[k]);
       out += '\n';
     }
   } else {
@@ -221,6 +230,8 @@ std::string encodeParticles(const ParticleSnapshot& s, ExportFormat f) {
     scalars("pressure", "float", [&](std::size_t k) { return s.p[k]; });
     if (hasAge) scalars("age", "float", [&](std::size_t k) { return s.age[k]; });
     if (hasMaterial) scalars("material", "int", [&](std::size_t k) { return std::int32_t(s.material[k]); });
+    if (hasColor) scalars("color", "int", [&](std::size_t k) { return std::int32_t(s.color[k]); });
+    if (hasGroup) scalars("group", "int", [&](std::size_t k) { return std::int32_t(s.group[k]); });
   }
   return out;
 }
@@ -231,7 +242,7 @@ ParticleSnapshot readParticlesCsv(const std::string& path) {
   ParticleSnapshot s;
   std::string line;
   int lineNo = 0;
-  bool header = false, hasAge = false, hasMaterial = false;
+  bool header = false, hasAge = false, hasMaterial = false, hasColor = false, hasGroup = false;
   while (std::getline(in, line)) {
     ++lineNo;
     if (line.empty()) continue;
@@ -249,17 +260,24 @@ ParticleSnapshot readParticlesCsv(const std::string& path) {
         throw std::runtime_error(path + ":" + std::to_string(lineNo) + ": not an sph2d particle CSV header");
       hasAge = line.find(",age") != std::string::npos;
       hasMaterial = line.find(",material") != std::string::npos;
+      hasColor = line.find(",color") != std::string::npos;
+      hasGroup = line.find(",group") != std::string::npos;
       header = true;
       continue;
     }
-    unsigned material = 0;
-    if (hasMaterial) {  // the last column: a material index
+    // The optional whole-number columns at the end, last first: group, color, material.
+    auto trailing = [&](const char* name, const char* what) {
       const std::size_t comma = line.rfind(',');
+      unsigned value = 0;
       char end = 0;
-      if (comma == std::string::npos || std::sscanf(line.c_str() + comma + 1, "%u%c", &material, &end) != 1)
-        throw std::runtime_error(path + ":" + std::to_string(lineNo) + ": column material is not a material index");
+      if (comma == std::string::npos || std::sscanf(line.c_str() + comma + 1, "%u%c", &value, &end) != 1)
+        throw std::runtime_error(path + ":" + std::to_string(lineNo) + ": column " + name + " is not " + what);
       line.resize(comma);
-    }
+      return value;
+    };
+    const unsigned group = hasGroup ? trailing("group", "a group number") : 0u;
+    const unsigned color = hasColor ? trailing("color", "a colour 0xRRGGBB as a whole number") : 0u;
+    const unsigned material = hasMaterial ? trailing("material", "a material index") : 0u;
     unsigned id = 0;
     double x = 0, y = 0, vx = 0, vy = 0, rho = 0, p = 0, age = 0;
     const int want = hasAge ? 8 : 7;
@@ -286,6 +304,8 @@ ParticleSnapshot readParticlesCsv(const std::string& path) {
     s.p.push_back(float(p));
     if (hasAge) s.age.push_back(float(age));
     if (hasMaterial) s.material.push_back(material);
+    if (hasColor) s.color.push_back(color);
+    if (hasGroup) s.group.push_back(group);
   }
   if (!header) throw std::runtime_error(path + ": empty");
   return s;

@@ -196,6 +196,7 @@ struct Renderer::Impl {
     need("color", P.color.size(), true);
     need("material", P.material.size(), true);
     need("mixedColor", P.mixedColor.size(), true);
+    need("group", P.group.size(), true);
   }
 
   float fade(const RenderInput& in, std::size_t slot) const {

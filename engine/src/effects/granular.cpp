@@ -126,7 +126,7 @@ class Granular final : public Effect {
     t.muMass = nuMax * scale_ * c.rho0 * c.mass;
     t.wallFactor = Real(2) * nuMax * scale_ * c.rho0;
     t.walls = !c.boundary.samples.empty();
-    t.noSlip = false;  // the game solver places no samples in the moving bodies: their shapes
+    t.noSlip = false;  // no samples in the moving bodies (game solver): their shapes take part instead
     contactBodies(c, t);
     ViscosityWeights w;
     w.ratio = ratio;

@@ -23,7 +23,7 @@ Vec2d perp(const Vec2& arm) { return Vec2d(-double(arm.y()), double(arm.x())); }
 
 double flatFaceLaplacian(const ViscosityKernel<Real>& W, double dx, double distance) {
   const double R = double(W.R);
-  const int steps = 64;  // along the face: Simpson's rule over [−R, R]
+  const int steps = 64;  // along the face: Simpson's rule over the layer's chord of the support
   double g = 0;
   for (double y = std::max(0.0, distance) + 0.5 * dx; y < R; y += dx) {
     const double half = std::sqrt(R * R - y * y), h = 2 * half / steps;
@@ -223,11 +223,16 @@ std::size_t ImplicitViscosity::apply(StepContext& c, const ViscosityTerm& t, con
       x_.p[i] = vStar;
     }
   });
-  // The bodies' rows, from their links (blocks in order).
+  // The bodies' rows, from their links (blocks in order). Through ShapeContacts, a body no
+  // particle touches has the row of a given velocity (its m·v would loosen the stop norm).
   bodyDiag_.assign(nb, BodyVel{});
   bodyP_.assign(nb, Vec2d(0, 0));
+  linked_.assign(nb, shapes ? 0 : 1);
+  if (shapes)
+    for (const std::vector<Link>& L : links_)
+      for (const Link& l : L) linked_[l.body] = 1;
   for (std::size_t k = 0; k < nb; ++k) {
-    if (!isDynamic(std::uint32_t(k))) {
+    if (!isDynamic(std::uint32_t(k)) || !linked_[k]) {
       bodyDiag_[k].v = Vec2d(1, 1);
       bodyDiag_[k].w = 1;
       continue;
@@ -344,7 +349,7 @@ std::size_t ImplicitViscosity::apply(StepContext& c, const ViscosityTerm& t, con
   });
   if (shapes)  // the bodies take the reactions, block by block in order
     for (std::size_t k = 0; k < nb; ++k) {
-      if (!isDynamic(std::uint32_t(k))) continue;
+      if (!isDynamic(std::uint32_t(k)) || !linked_[k]) continue;
       BodyVel J;
       for (const std::vector<BodyVel>& part : partial_) {
         J.v += part[k].v;

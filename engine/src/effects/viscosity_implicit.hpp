@@ -3,6 +3,7 @@
 // Laplacian, solved by conjugate gradients.
 #pragma once
 
+#include <cstdint>
 #include <vector>
 
 #include "effects/effect.hpp"
@@ -56,7 +57,8 @@ struct ViscosityWeights {
 class ImplicitViscosity {
  public:
   /// Runs the step; adds the walls' force to `wallBlock` (per block, when `count`) and the
-  /// moving bodies' reactions as the explicit step does. Returns the first bad slot or kNone.
+  /// moving bodies' reactions as the explicit step does (samples), or pushed onto the bodies
+  /// when the solve ends (ShapeContacts). Returns the first bad slot or kNone.
   std::size_t apply(StepContext& c, const ViscosityTerm& t, const ViscosityWeights& w, bool count,
                     std::vector<Vec2d>& wallBlock);
   /// Conjugate-gradient iterations of the last apply().
@@ -99,6 +101,7 @@ class ImplicitViscosity {
   std::vector<double> mass_, inertia_;         ///< per body, in units of m (inertia 0: it cannot turn)
   std::vector<double> wallG_;                  ///< per particle, the static walls' coupling alone (their force)
   std::vector<BodyVel> bodyDiag_;              ///< the bodies' rows: diagonal (v.x = v.y, ω)
+  std::vector<std::uint8_t> linked_;           ///< per body: a particle links to it (its row is solved)
   std::vector<Vec2d> bodyP_;                   ///< Σ of its links' P: the v–ω coupling
   Vec b_, x_, r_, z_, d_, q_;
   int iterations_ = 0;

@@ -7,7 +7,8 @@
 // then rename). VTK is the legacy "vtk DataFile Version 3.0" POLYDATA format
 // that ParaView and VisIt open: POINTS (double, world coordinates), one VERTEX
 // cell per particle, and POINT_DATA arrays id, velocity, density, pressure,
-// age and material (each of the last two only when the World has it); binary files are big-endian, as the format
+// age, material, color and group (each of the last four only when the World has it: ages, more
+// than one material, particles' own colours, particle groups); binary files are big-endian, as the format
 // requires. readParticlesCsv() reads our own CSV back, so frames can be re-rendered without re-simulating.
 #pragma once
 
@@ -38,6 +39,8 @@ struct ParticleSnapshot {
   std::vector<float> rho, p;            ///< density [kg/m³], pressure [Pa]
   std::vector<float> age;               ///< age [s]; empty when the particles have no age
   std::vector<std::uint32_t> material;  ///< material index (World::materials()); empty with one material
+  std::vector<std::uint32_t> color;     ///< each particle's own colour 0xRRGGBB (0: none); empty when none has one
+  std::vector<std::uint32_t> group;     ///< 1 + its particle group's index (0: none); empty without groups
   std::vector<BodySnapshot> bodies;     ///< the non-static bodies, in creation (scene) order
   /// Number of particles.
   std::size_t size() const { return id.size(); }
