@@ -184,6 +184,21 @@ class LiquidPass final : public RenderPass {
   }
 
  private:
+  /// Makes the float target `fbo` (texture `tex`, now w × h) fw × fh when its size changed,
+  /// sampled bilinearly when the field is shrunk: the splat field (RG), the tint and the blobs
+  /// (RGBA).
+  static void sizeTarget(GLenum internal, GLenum format, int fw, int fh, int shrink, GLuint& fbo, GLuint& tex, int& w,
+                         int& h) {
+    if (fw == w && fh == h) return;
+    if (fbo) glDeleteFramebuffers(1, &fbo);
+    fbo = gl::target(internal, format, GL_FLOAT, fw, fh, tex);
+    const GLint filter = shrink > 1 ? GL_LINEAR : GL_NEAREST;
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, filter);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, filter);
+    w = fw;
+    h = fh;
+  }
+
   /// Σw and Σw·speed into the RG32F field (shaders/splat.*); at half resolution when sprites
   /// are at least 8 px wide (a quarter of the fragments; the composite samples it bilinearly).
   void splat(const PassFrame& f) {
@@ -191,15 +206,7 @@ class LiquidPass final : public RenderPass {
     const float diameter = spriteDiameter(f.spacingPx);
     const int shrink = spriteShrink(f.spacingPx);
     const int fw = (EW + shrink - 1) / shrink, fh = (EH + shrink - 1) / shrink;
-    if (fw != fieldW_ || fh != fieldH_) {
-      if (fieldFbo_) glDeleteFramebuffers(1, &fieldFbo_);
-      fieldFbo_ = gl::target(GL_RG32F, GL_RG, GL_FLOAT, fw, fh, fieldTex_);
-      const GLint filter = shrink > 1 ? GL_LINEAR : GL_NEAREST;
-      glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, filter);
-      glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, filter);
-      fieldW_ = fw;
-      fieldH_ = fh;
-    }
+    sizeTarget(GL_RG32F, GL_RG, fw, fh, shrink, fieldFbo_, fieldTex_, fieldW_, fieldH_);
     const float fieldDiameter = diameter * float(fw) / float(EW);
     quads_ = fieldDiameter > sprites_.maxPoint();
     glViewport(0, 0, fw, fh);
@@ -212,15 +219,7 @@ class LiquidPass final : public RenderPass {
     sprites_.draw(GLsizei(f.order.size()), quads_);
     if (tinted_) {  // the materials' colours, splatted alike into the tint target
       if (!tintProg_) tintProg_ = gl::program("splat.vert", "tint.frag");
-      if (fw != tintW_ || fh != tintH_) {
-        if (tintFbo_) glDeleteFramebuffers(1, &tintFbo_);
-        tintFbo_ = gl::target(GL_RGBA32F, GL_RGBA, GL_FLOAT, fw, fh, tintTex_);
-        const GLint filter = shrink > 1 ? GL_LINEAR : GL_NEAREST;
-        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, filter);
-        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, filter);
-        tintW_ = fw;
-        tintH_ = fh;
-      }
+      sizeTarget(GL_RGBA32F, GL_RGBA, fw, fh, shrink, tintFbo_, tintTex_, tintW_, tintH_);
       glBindFramebuffer(GL_FRAMEBUFFER, tintFbo_);
       glClear(GL_COLOR_BUFFER_BIT);
       sprites_.upload(packedTint_);
@@ -229,15 +228,7 @@ class LiquidPass final : public RenderPass {
     }
     if (!blobs_.empty()) {  // the groups' particles, in their colours, into the blob target
       if (!tintProg_) tintProg_ = gl::program("splat.vert", "tint.frag");
-      if (fw != blobW_ || fh != blobH_) {
-        if (blobFbo_) glDeleteFramebuffers(1, &blobFbo_);
-        blobFbo_ = gl::target(GL_RGBA32F, GL_RGBA, GL_FLOAT, fw, fh, blobTex_);
-        const GLint filter = shrink > 1 ? GL_LINEAR : GL_NEAREST;
-        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, filter);
-        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, filter);
-        blobW_ = fw;
-        blobH_ = fh;
-      }
+      sizeTarget(GL_RGBA32F, GL_RGBA, fw, fh, shrink, blobFbo_, blobTex_, blobW_, blobH_);
       glBindFramebuffer(GL_FRAMEBUFFER, blobFbo_);
       glClear(GL_COLOR_BUFFER_BIT);
       sprites_.upload(blobs_);
