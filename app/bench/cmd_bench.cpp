@@ -15,6 +15,7 @@
 #include "sph2d/render/png_io.hpp"
 #include "sph2d/render/renderer.hpp"
 #include "sph2d/scene.hpp"
+#include "sph2d/surface.hpp"
 #include "sph2d/world.hpp"
 
 namespace fs = std::filesystem;
@@ -28,7 +29,8 @@ const char* kBenchHelp =
     "Renders K frames (default 30) of N particles (default 20000: a collapsing water\n"
     "column in the dam-break tank) at WxH (default 960x540) and prints the mean and\n"
     "best milliseconds of each stage: upload (CPU packing, depth grid), splat,\n"
-    "composite, solids, readback, overlay, PNG encode (level L, default 1) and hash.\n"
+    "composite, solids, readback, overlay, PNG encode (level L, default 1) and hash,\n"
+    "and the fluid's outline as curves (World::surfaceCurves' work, one thread).\n"
     "Stages are timed with glFinish between them; the 'render, no sync' row is the\n"
     "same frame without those fences, as `sph2d run` renders it. The CPU rows are the\n"
     "process's CPU time (every thread: llvmpipe's too) per frame, which other processes\n"
@@ -182,6 +184,20 @@ int cmdBench(const std::vector<std::string>& args) {
     }
   }
   fs::remove_all(tmp);
+  // The fluid's outline as curves (sph2d/surface.hpp), on this thread alone: what a game pays
+  // for World::surfaceCurves without the renderer.
+  Stat surface;
+  std::size_t curves = 0;
+  {
+    std::vector<Vec2d> points;
+    points.reserve(P.size());
+    for (std::size_t i = 0; i < P.size(); ++i) points.push_back(o + P.x[i].cast<double>());
+    for (int k = 0; k < frames; ++k) {
+      const auto t0 = std::chrono::steady_clock::now();
+      curves = surfaceCurves(points, double(world.spacing())).size();
+      surface.v.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+    }
+  }
   std::printf("%-22s %9s %9s\n", "stage", "mean ms", "best ms");
   auto row = [](const char* name, const Stat& s) { std::printf("%-22s %9.2f %9.2f\n", name, s.mean(), s.best()); };
   row("upload (CPU, grid)", upload);
@@ -202,6 +218,8 @@ int cmdBench(const std::vector<std::string>& args) {
   row("CPU: render, no sync", cpuRender);
   row("CPU: PNG encode", cpuPng);
   row("CPU: render + PNG", cpuSum);
+  row("surface curves (CPU)", surface);
+  std::printf("surface: %zu curves\n", curves);
   std::printf("PNG size %.0f KB; sprites as %s\n", pngBytes.mean() / 1024.0,
               profiled.usedQuads() ? "instanced quads" : "points");
   return 0;

@@ -40,7 +40,9 @@ json renderOptionsJson(const RenderOptions& o) {
 RunManifest::RunManifest(const RunArgs& a, const SceneDef& scene, const Renderer& renderer, int frames, int threads) {
   std::string exportName = "none";
   if (a.exportFormat)
-    exportName = exportExtension(*a.exportFormat) + (*a.exportFormat == ExportFormat::VtkAscii ? "-ascii" : "");
+    exportName = *a.exportFormat == ExportFormat::Surface
+                     ? "surface"
+                     : exportExtension(*a.exportFormat) + (*a.exportFormat == ExportFormat::VtkAscii ? "-ascii" : "");
   j_["format"] = "sph2d-frames";
   j_["format_version"] = 1;
   j_["engine_version"] = SPH2D_VERSION;

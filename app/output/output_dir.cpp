@@ -216,7 +216,7 @@ OutputLock::~OutputLock() {
 }
 
 bool isRunFileName(const std::string& name) {
-  static const std::regex mine(R"(frame_\d{5,}\.(png|csv|vtk)|bodies_\d{5,}\.csv)");
+  static const std::regex mine(R"(frame_\d{5,}\.(png|csv|vtk|json|svg)|bodies_\d{5,}\.csv)");
   return std::regex_match(name, mine);
 }
 

@@ -65,7 +65,9 @@ class RunOutputs : public LoopObserver {
     snap_.reset();
     if (a_.exportFormat && rendered) {
       const auto s0 = std::chrono::steady_clock::now();
-      snap_ = std::make_shared<ParticleSnapshot>(snapshotOf(world));
+      auto snap = std::make_shared<ParticleSnapshot>(snapshotOf(world));
+      if (*a_.exportFormat == ExportFormat::Surface) snap->surface = world.surfaceCurves();
+      snap_ = std::move(snap);
       exportSeconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - s0).count();
     }
   }

@@ -54,7 +54,8 @@ const char* kRunHelp =
     "  --max-memory S  refuse (exit 2) a scene whose estimated peak memory exceeds S (512M,\n"
     "                  2G, ...; default: the memory available)\n"
     "  --png-level N   PNG compression 0..9 (default 1: fast)\n"
-    "  --export FMT    also write each kept frame's particles: csv, vtk (binary) or vtk-ascii\n"
+    "  --export FMT    also write each kept frame's particles: csv, vtk (binary) or vtk-ascii;\n"
+    "                  or surface: the fluid's outlines as frame_NNNNN.json and frame_NNNNN.svg\n"
     "  --video FILE    also encode the kept frames into FILE with ffmpeg (must be installed);\n"
     "                  an existing FILE is replaced under --record's rule\n"
     "%s"
@@ -100,7 +101,8 @@ RunArgs parseRunArgs(const std::vector<std::string>& a) {
     else if (opt.is("--export")) {
       ExportFormat f;
       const std::string v = opt.value();
-      if (!parseExportFormat(v, f)) throw UsageError("--export expects csv, vtk or vtk-ascii, got '" + v + "'");
+      if (!parseExportFormat(v, f))
+        throw UsageError("--export expects csv, vtk, vtk-ascii or surface, got '" + v + "'");
       r.exportFormat = f;
     } else if (opt.is("--realtime"))
       r.realtime = true;

@@ -98,7 +98,9 @@ void RunConsole::summary(const World& world, const RunReport& r) const {
         "(the simulation fell %.3f s behind the wall clock)\n",
         r.fps, (unsigned long long)r.loop.dropped, (unsigned long long)r.loop.late, r.loop.behindSeconds);
   if (r.exports)
-    std::printf("sph2d: %d particle files (%s) in %s\n", r.exports, r.exportExtension.c_str(), r.out.c_str());
+    std::printf("sph2d: %d %s (%s) in %s\n", r.exports,
+                r.exportExtension == "json" ? "surface outlines" : "particle files",
+                r.exportExtension == "json" ? "json and svg" : r.exportExtension.c_str(), r.out.c_str());
   if (r.videoFrames) std::printf("sph2d: %d frames encoded into %s\n", r.videoFrames, r.video.c_str());
   if (r.profile) printProfile(world);
   if (r.stateHash) {

@@ -8,6 +8,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstring>
@@ -294,4 +295,41 @@ TEST_CASE(
   CHECK(r.code == 1);
   CHECK(r.out.find("cannot write /dev/full: No space left on device") != std::string::npos);
   CHECK(fs::is_character_file("/dev/full"));
+}
+
+TEST_CASE("--export surface writes each kept frame's outlines as JSON and SVG, listed in the manifest") {
+  // The small dam break (1250 particles, spacing 0.04 m): at frame 0 a resting column, one
+  // curve of the water's area; at frame 30 the surge, whose curves hold the same area within
+  // a few percent (spray makes none).
+  const std::string dir = freshDir("export_surface");
+  const Result r = run("run " + q(kSmall) + " --frames 31 --every 30 --export surface --out " + q(dir));
+  REQUIRE(r.code == 0);
+  CHECK(r.out.find("2 surface outlines (json and svg)") != std::string::npos);
+  CHECK(filesEnding(dir, ".json") == std::vector<std::string>{"frame_00000.json", "frame_00030.json", "manifest.json"});
+  CHECK(filesEnding(dir, ".svg") == std::vector<std::string>{"frame_00000.svg", "frame_00030.svg"});
+  const double water = 1250 * 0.04 * 0.04;
+  for (const int frame : {0, 30}) {
+    CAPTURE(frame);
+    const std::string name = frame ? "frame_00030" : "frame_00000";
+    const json s = json::parse(readText(dir + "/" + name + ".json"));
+    CHECK(s.at("format") == "sph2d-surface");
+    CHECK(s.at("frame") == frame);
+    double area = 0;
+    for (const json& c : s.at("curves")) {
+      area += c.at("area").get<double>();
+      CHECK(c.at("hole").get<bool>() == (c.at("area").get<double>() < 0));
+      CHECK(c.at("points").size() >= 4);
+    }
+    if (frame == 0) CHECK(s.at("curves").size() == 1);
+    CHECK(std::fabs(area / water - 1) < 0.05);
+    const std::string svg = readText(dir + "/" + name + ".svg");
+    CHECK(svg.rfind("<svg ", 0) == 0);
+    CHECK(svg.find("fill-rule=\"evenodd\"") != std::string::npos);
+  }
+  const json m = readManifest(dir);
+  std::vector<std::string> listed;
+  for (const json& f : m.at("files")) listed.push_back(f.at("file").get<std::string>());
+  for (const char* f : {"frame_00000.json", "frame_00000.svg", "frame_00030.json", "frame_00030.svg"})
+    CHECK(std::find(listed.begin(), listed.end(), f) != listed.end());
+  CHECK(run("run " + q(kSmall) + " --frames 1 --export outline --out " + q(dir + "_bad")).code == 2);
 }

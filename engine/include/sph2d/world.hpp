@@ -26,6 +26,7 @@
 #include "sph2d/particle_events.hpp"
 #include "sph2d/particles.hpp"
 #include "sph2d/scene.hpp"
+#include "sph2d/surface.hpp"
 #include "sph2d/world_stats.hpp"
 
 class b2World;
@@ -321,6 +322,10 @@ class World {
   void rayCast(const Vec2d& p1, const Vec2d& p2, const std::function<bool(const RayHit&)>& f) const;
   /// The nearest hit of rayCast(p1, p2); false (and `hit` untouched) when there is none.
   bool rayCastFirst(const Vec2d& p1, const Vec2d& p2, RayHit& hit) const;
+  /// The fluid's outlines now (surface.hpp: closed curves in world coordinates, holes
+  /// clockwise), from the particles of options.material or of every material. Costs one pass
+  /// over the particles and one over the nodes around them; nothing is kept.
+  std::vector<SurfaceCurve> surfaceCurves(const SurfaceOptions& options = {}) const;
   /// Sets (or with an empty listener clears) the particle contact listener: after each step
   /// the pairs of particles touching that `filter` takes (particle_events.hpp). While none is
   /// set nothing is computed; with one, a search around each particle of either side.

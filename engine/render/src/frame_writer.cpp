@@ -90,6 +90,13 @@ void FrameWriter::loop() {
           announce(opt_.dir + name, text.data(), text.size());
           writeFileAtomic(opt_.dir + name, text);
         }
+        if (*opt_.exportFormat == ExportFormat::Surface) {  // the drawing beside the JSON
+          char name[32];
+          std::snprintf(name, sizeof name, "/frame_%05d.svg", job.index);
+          text = encodeSurfaceSvg(*job.particles);
+          announce(opt_.dir + name, text.data(), text.size());
+          writeFileAtomic(opt_.dir + name, text);
+        }
         std::lock_guard<std::mutex> lock(mutex_);
         ++counts_.exports;
       }

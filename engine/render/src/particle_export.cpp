@@ -113,12 +113,16 @@ bool parseExportFormat(const std::string& s, ExportFormat& out) {
     out = ExportFormat::VtkBinary;
   else if (s == "vtk-ascii")
     out = ExportFormat::VtkAscii;
+  else if (s == "surface")
+    out = ExportFormat::Surface;
   else
     return false;
   return true;
 }
 
-std::string exportExtension(ExportFormat f) { return f == ExportFormat::Csv ? "csv" : "vtk"; }
+std::string exportExtension(ExportFormat f) {
+  return f == ExportFormat::Csv ? "csv" : f == ExportFormat::Surface ? "json" : "vtk";
+}
 
 std::string tempPathFor(const std::string& path) { return path + ".tmp" + std::to_string(::getpid()); }
 
@@ -150,6 +154,7 @@ void writeParticlesAtomic(const std::string& path, const ParticleSnapshot& s, Ex
 }
 
 std::string encodeParticles(const ParticleSnapshot& s, ExportFormat f) {
+  if (f == ExportFormat::Surface) return encodeSurfaceJson(s);
   const std::size_t n = s.size();
   const bool hasAge = !s.age.empty(), hasMaterial = !s.material.empty();
   const bool hasColor = !s.color.empty(), hasGroup = !s.group.empty();

@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "sph2d/math.hpp"
+#include "sph2d/surface.hpp"
 
 namespace sph2d {
 
@@ -42,6 +43,8 @@ struct ParticleSnapshot {
   std::vector<std::uint32_t> color;     ///< each particle's own colour 0xRRGGBB (0: none); empty when none has one
   std::vector<std::uint32_t> group;     ///< 1 + its particle group's index (0: none); empty without groups
   std::vector<BodySnapshot> bodies;     ///< the non-static bodies, in creation (scene) order
+  /// The fluid's outlines (World::surfaceCurves), taken for an export in format Surface only.
+  std::vector<SurfaceCurve> surface;
   /// Number of particles.
   std::size_t size() const { return id.size(); }
 };
@@ -50,11 +53,12 @@ struct ParticleSnapshot {
 ParticleSnapshot snapshotOf(const World& world, const Real* age = nullptr);
 
 /// File formats of particle exports.
-enum class ExportFormat { Csv, VtkBinary, VtkAscii };
+/// Surface: the fluid's outlines of the frame, as JSON (encodeSurfaceJson) and SVG (encodeSurfaceSvg).
+enum class ExportFormat { Csv, VtkBinary, VtkAscii, Surface };
 
-/// Parses "csv", "vtk" (binary) or "vtk-ascii"; false for anything else.
+/// Parses "csv", "vtk" (binary), "vtk-ascii" or "surface"; false for anything else.
 bool parseExportFormat(const std::string& s, ExportFormat& out);
-/// File extension without the dot: "csv" or "vtk".
+/// File extension without the dot: "csv", "vtk" or (surface) "json".
 std::string exportExtension(ExportFormat f);
 
 /// Writes the bodies of `s` as CSV (`body,x,y,angle,vx,vy,omega`, one row per non-static body)
@@ -63,8 +67,15 @@ void writeBodiesCsvAtomic(const std::string& path, const ParticleSnapshot& s);
 
 /// Writes `s` to `path` in format `f`, atomically. Throws std::runtime_error naming the path.
 void writeParticlesAtomic(const std::string& path, const ParticleSnapshot& s, ExportFormat f);
-/// The bytes writeParticlesAtomic writes.
+/// The bytes writeParticlesAtomic writes (for Surface: encodeSurfaceJson).
 std::string encodeParticles(const ParticleSnapshot& s, ExportFormat f);
+/// The outlines of `s` as JSON: {"format": "sph2d-surface", "frame", "time", "curves": [{"area",
+/// "hole", "points": [[x, y], ...]}, ...]}, world coordinates in metres, each curve closed (its
+/// last point joins its first), the fluid on its left (holes clockwise, negative area).
+std::string encodeSurfaceJson(const ParticleSnapshot& s);
+/// The outlines of `s` as an SVG drawing (world coordinates, y up, one path, even-odd fill so
+/// that holes stay open), framed on the curves with a margin.
+std::string encodeSurfaceSvg(const ParticleSnapshot& s);
 /// The bytes writeBodiesCsvAtomic writes.
 std::string encodeBodiesCsv(const ParticleSnapshot& s);
 
