@@ -235,6 +235,7 @@ const char* kRenderFlagsHelp =
     "                  setParticleColor; without one, the material's or the fluid's colour)\n"
     "  --range LO,HI   particles mode: fixed colour range (default: each frame's min..max)\n"
     "  --overlay       draw frame number, simulated time and particle count\n"
+    "  --outline       draw the fluid's outline (World::surfaceCurves) over it\n"
     "  --foam-speed V  liquid: foam starts at V m/s, full at 2V (default 0.35·sqrt(g·view height))\n"
     "  --depth-scale D liquid: D metres of water above darken the colour by 1/e (default 1)\n";
 
@@ -258,6 +259,8 @@ bool parseRenderFlag(ArgReader& a, RenderOptions& o) {
     o.range = std::array<double, 2>{lo, hi};
   } else if (s == "--overlay") {
     o.overlay = true;
+  } else if (s == "--outline") {
+    o.outline = true;
   } else if (s == "--foam-speed") {
     o.foamSpeed = parseNumber(s, value());
     if (!(o.foamSpeed > 0)) throw UsageError("--foam-speed must be > 0");

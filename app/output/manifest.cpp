@@ -32,6 +32,7 @@ json renderOptionsJson(const RenderOptions& o) {
   j["color_by"] = colorFieldName(o.colorBy);
   j["range"] = o.range ? json::array({(*o.range)[0], (*o.range)[1]}) : json(nullptr);
   j["overlay"] = o.overlay;
+  j["outline"] = o.outline;
   j["foam_speed"] = o.foamSpeed;
   j["depth_scale"] = o.depthScale;
   return j;

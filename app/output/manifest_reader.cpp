@@ -95,6 +95,10 @@ RenderOptions renderOptions(const json& j) {
   }
   if (!member(j, "overlay", w, "true or false").is_boolean()) throw Malformed{w + "overlay", "true or false"};
   o.overlay = j["overlay"].get<bool>();
+  if (j.contains("outline")) {  // manifests written before the outline existed have none
+    if (!j["outline"].is_boolean()) throw Malformed{w + "outline", "true or false"};
+    o.outline = j["outline"].get<bool>();
+  }
   o.foamSpeed = finiteAt(j, "foam_speed", w, 0);
   o.depthScale = finiteAt(j, "depth_scale", w, 0);
   return o;

@@ -100,6 +100,7 @@ struct Renderer::Impl {
   gl::ContextInfo glInfo;
   SpriteBatch sprites;
   Scenery scenery;
+  std::vector<Vec2d> outlinePoints;  ///< drawOutline's scratch: the particles in world coordinates
   std::unique_ptr<RenderPass> pass;
   Presenter presenter;  // the caller's context only
   FrameGeometry geo;
@@ -276,9 +277,22 @@ struct Renderer::Impl {
     pass->restoreRows(movingRows);  // where moving bodies were last frame goes back to the background
     pass->draw(f, timer, timings);
     const auto rows = pass->changedRows();  // solids on top, where the pass may have drawn over them
+    if (opt.outline) drawOutline(in, rows);
     scenery.drawSolids(d, rows.first, rows.second);
     movingRows = scenery.drawMoving(d, geo, in);
     timer.end(timings.solids);
+  }
+
+  /// The fluid's outline (surfaceCurves of every particle, world coordinates) over the rows the
+  /// pass drew this frame, in the foam colour.
+  void drawOutline(const RenderInput& in, std::pair<int, int> rows) {
+    const Particles& P = in.particles;
+    outlinePoints.resize(P.size());
+    for (std::size_t k = 0; k < P.size(); ++k) outlinePoints[k] = in.origin + P.x[k].cast<double>();
+    const std::vector<SurfaceCurve> curves = surfaceCurves(outlinePoints, in.spacing);
+    const std::array<double, 3> c = opt.foam.value_or(std::array<double, 3>{0.9, 0.95, 1.0});
+    const float color[3] = {float(c[0]), float(c[1]), float(c[2])};
+    scenery.drawOutline(geo, curves, color, 1.5, rows.first, rows.second);
   }
 
   /// The image into `frame` (glReadPixels from the colour target, bound by drawFrame), then the

@@ -47,6 +47,23 @@ void Scenery::buildBackground(const RenderDef& def, const FrameGeometry& geo) {
   glDrawArrays(GL_TRIANGLES, 0, 3);
 }
 
+namespace {
+
+/// Appends the two triangles of segment a → b (NDC) drawn 2·halfPx pixels wide (pixels of
+/// pxX × pxY in NDC) to `tri`.
+void segmentQuad(const std::array<float, 2>& a, const std::array<float, 2>& b, double halfPx, double pxX, double pxY,
+                 std::vector<float>& tri) {
+  const double dxp = (b[0] - a[0]) / pxX, dyp = (b[1] - a[1]) / pxY;
+  const double len = std::sqrt(dxp * dxp + dyp * dyp);
+  if (len <= 0) return;
+  const float ox = float(-dyp / len * halfPx * pxX), oy = float(dxp / len * halfPx * pxY);
+  const float q[6][2] = {{a[0] + ox, a[1] + oy}, {a[0] - ox, a[1] - oy}, {b[0] + ox, b[1] + oy},
+                         {b[0] + ox, b[1] + oy}, {a[0] - ox, a[1] - oy}, {b[0] - ox, b[1] - oy}};
+  for (const auto& p : q) tri.insert(tri.end(), {p[0], p[1]});
+}
+
+}  // namespace
+
 std::vector<float> solidTriangles(const FrameGeometry& geo, const Vec2d& o, const std::vector<Collider>& colliders) {
   // Triangles in NDC.
   const std::vector<double>& ext = geo.ext;
@@ -75,22 +92,8 @@ std::vector<float> solidTriangles(const FrameGeometry& geo, const Vec2d& o, cons
         put(ndc(c.center + c.radius * Vec2(std::cos(a0), std::sin(a0))));
         put(ndc(c.center + c.radius * Vec2(std::cos(a1), std::sin(a1))));
       }
-    } else {
-      // A zero-thickness segment drawn 3 px wide.
-      const auto a = ndc(c.vertices[0]), b = ndc(c.vertices[1]);
-      const double dxp = (b[0] - a[0]) / pxX, dyp = (b[1] - a[1]) / pxY;
-      const double len = std::sqrt(dxp * dxp + dyp * dyp);
-      if (len <= 0) continue;
-      const double nxp = -dyp / len * 1.5, nyp = dxp / len * 1.5;
-      const float ox = float(nxp * pxX), oy = float(nyp * pxY);
-      const std::array<float, 2> p0{a[0] + ox, a[1] + oy}, p1{a[0] - ox, a[1] - oy}, p2{b[0] + ox, b[1] + oy},
-          p3{b[0] - ox, b[1] - oy};
-      put(p0);
-      put(p1);
-      put(p2);
-      put(p2);
-      put(p1);
-      put(p3);
+    } else {  // a zero-thickness segment drawn 3 px wide
+      segmentQuad(ndc(c.vertices[0]), ndc(c.vertices[1]), 1.5, pxX, pxY, tri);
     }
   }
   return tri;
@@ -142,6 +145,34 @@ std::pair<int, int> Scenery::drawMoving(const RenderDef& def, const FrameGeometr
   const int first = std::max(0, int(std::floor((double(lo) + 1) * 0.5 * geo.EH)) - 1);
   const int last = std::min(geo.EH, int(std::ceil((double(hi) + 1) * 0.5 * geo.EH)) + 1);
   return {first, last};
+}
+
+void Scenery::drawOutline(const FrameGeometry& geo, const std::vector<SurfaceCurve>& curves, const float color[3],
+                          double widthPx, int rowFirst, int rowLast) {
+  if (curves.empty() || rowLast <= rowFirst) return;
+  const std::vector<double>& ext = geo.ext;
+  const double sx = 2.0 / (ext[2] - ext[0]), sy = 2.0 / (ext[3] - ext[1]), pxX = 2.0 / geo.EW, pxY = 2.0 / geo.EH;
+  auto ndc = [&](const Vec2d& p) {
+    return std::array<float, 2>{float((p.x() - ext[0]) * sx - 1.0), float(1.0 - (p.y() - ext[1]) * sy)};
+  };
+  std::vector<float> tri;
+  for (const SurfaceCurve& c : curves)
+    for (std::size_t k = 0; k < c.points.size(); ++k)
+      segmentQuad(ndc(c.points[k]), ndc(c.points[(k + 1) % c.points.size()]), widthPx / 2, pxX, pxY, tri);
+  if (tri.empty()) return;
+  glUseProgram(solidProg_);
+  glUniform3f(gl::uniform(solidProg_, "uColor"), color[0], color[1], color[2]);
+  glBindVertexArray(movingVao_);
+  glBindBuffer(GL_ARRAY_BUFFER, movingVbo_);
+  glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(tri.size() * sizeof(float)), tri.data(), GL_STREAM_DRAW);
+  glEnableVertexAttribArray(0);
+  glVertexAttribPointer(0, 2, GL_FLOAT, GL_FALSE, 0, nullptr);
+  GLint vp[4] = {0, 0, 0, 0};
+  glGetIntegerv(GL_VIEWPORT, vp);
+  glEnable(GL_SCISSOR_TEST);
+  glScissor(0, rowFirst, vp[2], std::min(rowLast, vp[3]) - rowFirst);
+  glDrawArrays(GL_TRIANGLES, 0, GLsizei(tri.size() / 2));
+  glDisable(GL_SCISSOR_TEST);
 }
 
 }  // namespace sph2d

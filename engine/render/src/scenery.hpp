@@ -12,6 +12,7 @@
 #include "camera.hpp"
 #include "gl_util.hpp"
 #include "sph2d/render/renderer.hpp"
+#include "sph2d/surface.hpp"
 
 namespace sph2d {
 
@@ -36,6 +37,10 @@ class Scenery {
   /// Draws the moving bodies of `in` (their pose this frame) over the whole bound target;
   /// returns the target rows [first, last) they cover (empty when there are none).
   std::pair<int, int> drawMoving(const RenderDef& def, const FrameGeometry& geo, const RenderInput& in);
+  /// Draws `curves` (world coordinates) as lines `widthPx` wide in `color` into the bound
+  /// target, over the target rows [rowFirst, rowLast) only.
+  void drawOutline(const FrameGeometry& geo, const std::vector<SurfaceCurve>& curves, const float color[3],
+                   double widthPx, int rowFirst, int rowLast);
 
  private:
   void buildBackground(const RenderDef& def, const FrameGeometry& geo);
@@ -43,7 +48,7 @@ class Scenery {
 
   GLuint bgProg_ = 0, solidProg_ = 0, emptyVao_ = 0, solidVao_ = 0, solidVbo_ = 0, bgTex_ = 0, bgFbo_ = 0;
   GLsizei solidCount_ = 0;
-  GLuint movingVao_ = 0, movingVbo_ = 0;
+  GLuint movingVao_ = 0, movingVbo_ = 0;  // also the outline's (drawn after the moving bodies)
 };
 
 }  // namespace sph2d

@@ -75,6 +75,9 @@ struct RenderOptions {
   ColorField colorBy = ColorField::Speed;      ///< particles mode: the field shown
   std::optional<std::array<double, 2>> range;  ///< particles mode: fixed colour range (default: this frame's min..max)
   bool overlay = false;                        ///< frame number, simulated time and particle count in the frame
+  /// The fluid's outline (surfaceCurves of the particles, sph2d/surface.hpp) drawn over it,
+  /// 1.5 px wide in the foam colour, under the solids.
+  bool outline = false;
   double foamSpeed = 0;       ///< liquid: speed [m/s] where foam starts (0 = 0.35·sqrt(g·view height)); full at 2×
   double depthScale = 0;      ///< liquid: metres of water above that darken by 1/e (0 = 1 m)
   double ageFadeStart = 1.0;  ///< a particle with an age fades from this age [s] ...
