@@ -14,7 +14,7 @@
 // Deterministic: the particles are summed in their order and the filter runs row by row, so
 // World::surfaceCurves, which runs the rows on the World's threads, gives the same curves on
 // any thread count; the curves come in the order of their first edge on the grid (rows from
-// the bottom).
+// the bottom), region by region.
 #pragma once
 
 #include <cstdint>
@@ -26,8 +26,8 @@ namespace sph2d {
 
 /// How surfaceCurves() samples the fluid.
 struct SurfaceOptions {
-  double cell = 1;     ///< the node grid's cell, in particle spacings (0.25 to 4)
-  int smoothing = 1;   ///< passes of the (1 2 1)/4 filter along each axis (0 to 4)
+  double cell = 1;     ///< the node grid's cell, in particle spacings (1 to 4: finer cells see single particles)
+  int smoothing = 1;   ///< passes of the (1 2 1)/4 filter along each axis (1 to 4)
   double level = 0.5;  ///< the covered fraction the curves follow (strictly between 0 and 1)
   /// World::surfaceCurves only: the material (an index in World::materials()) whose particles
   /// count; kAllMaterials counts every particle.
@@ -37,16 +37,18 @@ struct SurfaceOptions {
 
 /// One closed outline.
 struct SurfaceCurve {
-  std::vector<Vec2d> points;  ///< in order, world coordinates [m]; the last joins the first
+  std::vector<Vec2d> points;  ///< in order, world coordinates [m]; the last joins the first (not repeated)
   double area = 0;            ///< enclosed area [m²]: > 0 fluid (counter-clockwise), < 0 a hole (clockwise)
   /// True for the outline of a hole in the fluid (a bubble, a pocket of air).
   bool hole() const { return area < 0; }
 };
 
 /// The outlines of the fluid made of particles at `points` (world coordinates) of spacing
-/// `spacing` [m]. The node grid grows its cell when the points' box would need more than
-/// max(64 n, 2^16) nodes (spray far from the bulk). Throws std::invalid_argument for a spacing
-/// that is not positive or options outside their ranges.
+/// `spacing` [m]. Particles far apart (spray across a level) are taken in regions, each with a
+/// grid of its own, so a stray particle costs its region only; one region larger than
+/// max(64 n, 2^16) nodes gets larger cells. Throws std::invalid_argument for a spacing that is
+/// not positive, options outside their ranges, a position that is not finite, or points that
+/// span more than 2^30 spacings.
 std::vector<SurfaceCurve> surfaceCurves(const std::vector<Vec2d>& points, double spacing,
                                         const SurfaceOptions& options = {});
 

@@ -320,7 +320,7 @@ class LiquidPass final : public RenderPass {
     const std::array<float, 3> deep = opt_.deepWater
                                           ? color3(*opt_.deepWater)
                                           : std::array<float, 3>{water[0] * 0.3f, water[1] * 0.3f, water[2] * 0.3f};
-    const auto foam = color3(opt_.foam.value_or(std::array<double, 3>{0.9, 0.95, 1.0}));
+    const auto foam = color3(foamColor(opt_));
     glUniform3fv(gl::uniform(cp, "uWater"), 1, water.data());
     glUniform3fv(gl::uniform(cp, "uDeep"), 1, deep.data());
     glUniform3fv(gl::uniform(cp, "uFoam"), 1, foam.data());

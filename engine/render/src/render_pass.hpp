@@ -23,6 +23,11 @@
 
 namespace sph2d {
 
+/// The foam's colour: RenderOptions::foam, or a white tinged blue (also the outline's).
+inline std::array<double, 3> foamColor(const RenderOptions& o) {
+  return o.foam.value_or(std::array<double, 3>{0.9, 0.95, 1.0});
+}
+
 /// Wall time per stage; with `profile`, glFinish first so the time is the stage's own.
 struct StageTimer {
   using Clock = std::chrono::steady_clock;

@@ -290,9 +290,9 @@ struct Renderer::Impl {
     outlinePoints.resize(P.size());
     for (std::size_t k = 0; k < P.size(); ++k) outlinePoints[k] = in.origin + P.x[k].cast<double>();
     const std::vector<SurfaceCurve> curves = surfaceCurves(outlinePoints, in.spacing);
-    const std::array<double, 3> c = opt.foam.value_or(std::array<double, 3>{0.9, 0.95, 1.0});
-    const float color[3] = {float(c[0]), float(c[1]), float(c[2])};
-    scenery.drawOutline(geo, curves, color, 1.5, rows.first, rows.second);
+    const std::array<double, 3> c = foamColor(opt);
+    const float rgb[3] = {float(c[0]), float(c[1]), float(c[2])};
+    scenery.drawOutline(geo, curves, rgb, 1.5, rows.first, rows.second);
   }
 
   /// The image into `frame` (glReadPixels from the colour target, bound by drawFrame), then the

@@ -48,7 +48,7 @@ class Scenery {
 
   GLuint bgProg_ = 0, solidProg_ = 0, emptyVao_ = 0, solidVao_ = 0, solidVbo_ = 0, bgTex_ = 0, bgFbo_ = 0;
   GLsizei solidCount_ = 0;
-  GLuint movingVao_ = 0, movingVbo_ = 0;  // also the outline's (drawn after the moving bodies)
+  GLuint movingVao_ = 0, movingVbo_ = 0;  // also the outline's: each uploads its triangles before drawing
 };
 
 }  // namespace sph2d

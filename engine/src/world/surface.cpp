@@ -39,13 +39,11 @@ NodeField sampleField(const std::vector<Vec2d>& points, double dx, const Surface
   if (points.empty()) return f;
   double lo[2] = {points[0].x(), points[0].y()}, hi[2] = {lo[0], lo[1]};
   for (const Vec2d& p : points) {
-    if (!std::isfinite(p.x()) || !std::isfinite(p.y()))
-      throw std::invalid_argument("surfaceCurves: a particle's position is not finite");
     lo[0] = std::min(lo[0], p.x()), lo[1] = std::min(lo[1], p.y());
     hi[0] = std::max(hi[0], p.x()), hi[1] = std::max(hi[1], p.y());
   }
   // A margin of the smoothing's reach and two cells: the border nodes read 0, so every curve
-  // closes. Spray far from the bulk must not make the grid huge: above the budget the cells grow.
+  // closes. A region too large for the budget (a long jet in one piece) gets larger cells.
   const double budget = std::max(64.0 * double(points.size()), 65536.0);
   f.h = o.cell * dx;
   for (;;) {
@@ -68,7 +66,7 @@ NodeField sampleField(const std::vector<Vec2d>& points, double dx, const Surface
   const double invH = 1 / f.h, share = dx * dx / (f.h * f.h);
   for (const Vec2d& p : points) {
     const double px = (p.x() - f.x0) * invH, py = (p.y() - f.y0) * invH;
-    const std::size_t i = std::size_t(px), j = std::size_t(py);
+    const std::size_t i = std::min(std::size_t(px), nx - 2), j = std::min(std::size_t(py), ny - 2);
     const double tx = px - double(i), ty = py - double(j);
     double* n = &f.phi[j * nx + i];
     n[0] += share * (1 - tx) * (1 - ty);
@@ -131,18 +129,11 @@ std::vector<std::int64_t> linkCrossings(const NodeField& f, double level, Thread
   return next;
 }
 
-/// surfaceCurves() with its rows on `pool`'s threads (nullptr: the caller's alone).
-std::vector<SurfaceCurve> extractCurves(const std::vector<Vec2d>& points, double spacing, const SurfaceOptions& o,
-                                        ThreadPool* pool) {
-  if (!(spacing > 0) || !std::isfinite(spacing))
-    throw std::invalid_argument("surfaceCurves: the spacing must be a positive length, got " + std::to_string(spacing));
-  if (!(o.cell >= 0.25 && o.cell <= 4)) throw std::invalid_argument("surfaceCurves: cell must be 0.25 to 4 spacings");
-  if (!(o.smoothing >= 0 && o.smoothing <= 4))
-    throw std::invalid_argument("surfaceCurves: smoothing must be 0 to 4 passes");
-  if (!(o.level > 0 && o.level < 1)) throw std::invalid_argument("surfaceCurves: level must lie strictly in (0, 1)");
-  std::vector<SurfaceCurve> curves;
+/// The curves of one region of points (coordinates relative to the caller's reference).
+void regionCurves(const std::vector<Vec2d>& points, double spacing, const SurfaceOptions& o, ThreadPool* pool,
+                  std::vector<SurfaceCurve>& curves) {
   const NodeField f = sampleField(points, spacing, o, pool);
-  if (f.phi.empty()) return curves;
+  if (f.phi.empty()) return;
   std::vector<std::int64_t> next = linkCrossings(f, o.level, pool);
   const std::size_t nx = std::size_t(f.nx);
   auto crossing = [&](std::int64_t e) {  // where φ crosses the level along edge e
@@ -156,12 +147,15 @@ std::vector<SurfaceCurve> extractCurves(const std::vector<Vec2d>& points, double
     if (next[start] < 0) continue;
     SurfaceCurve c;
     std::int64_t e = std::int64_t(start);
-    while (e >= 0) {  // every crossing has one successor; taking it marks it used
-      c.points.push_back(crossing(e));
+    do {  // every crossing has one successor; taking it marks it used
+      const Vec2d p = crossing(e);
+      // A node exactly at the level puts the same point on two edges: kept once.
+      if (c.points.empty() || !(p == c.points.back())) c.points.push_back(p);
       const std::int64_t n = next[std::size_t(e)];
       next[std::size_t(e)] = -1;
       e = n;
-    }
+    } while (e >= 0 && e != std::int64_t(start));
+    if (c.points.size() > 1 && c.points.front() == c.points.back()) c.points.pop_back();
     double a = 0;
     for (std::size_t k = 0; k < c.points.size(); ++k) {
       const Vec2d& p = c.points[k];
@@ -171,6 +165,83 @@ std::vector<SurfaceCurve> extractCurves(const std::vector<Vec2d>& points, double
     c.area = a / 2;
     curves.push_back(std::move(c));
   }
+}
+
+/// surfaceCurves() with its rows on `pool`'s threads (nullptr: the caller's alone).
+std::vector<SurfaceCurve> extractCurves(const std::vector<Vec2d>& points, double spacing, const SurfaceOptions& o,
+                                        ThreadPool* pool) {
+  if (!(spacing > 0) || !std::isfinite(spacing))
+    throw std::invalid_argument("surfaceCurves: the spacing must be a positive length, got " + std::to_string(spacing));
+  if (!(o.cell >= 1 && o.cell <= 4)) throw std::invalid_argument("surfaceCurves: cell must be 1 to 4 spacings");
+  if (!(o.smoothing >= 1 && o.smoothing <= 4))
+    throw std::invalid_argument("surfaceCurves: smoothing must be 1 to 4 passes");
+  if (!(o.level > 0 && o.level < 1)) throw std::invalid_argument("surfaceCurves: level must lie strictly in (0, 1)");
+  std::vector<SurfaceCurve> curves;
+  if (points.empty()) return curves;
+  // Coordinates relative to the node nearest below the first point (far from the origin a level
+  // keeps its precision; the nodes stay at whole cells of the world, so the curves do not move
+  // with whichever particle comes first), spanning at most 2^30 spacings (the node indices).
+  const double h = o.cell * spacing, limit = double(1 << 30) * spacing;
+  if (!std::isfinite(points[0].x()) || !std::isfinite(points[0].y()))
+    throw std::invalid_argument("surfaceCurves: particle 0's position is not finite");
+  const Vec2d ref(std::floor(points[0].x() / h) * h, std::floor(points[0].y() / h) * h);
+  std::vector<Vec2d> rel(points.size());
+  double lo[2] = {points[0].x() - ref.x(), points[0].y() - ref.y()}, hi[2] = {lo[0], lo[1]};
+  for (std::size_t k = 0; k < points.size(); ++k) {
+    const Vec2d& p = points[k];
+    if (!std::isfinite(p.x()) || !std::isfinite(p.y()))
+      throw std::invalid_argument("surfaceCurves: particle " + std::to_string(k) + "'s position is not finite");
+    rel[k] = p - ref;
+    lo[0] = std::min(lo[0], rel[k].x()), lo[1] = std::min(lo[1], rel[k].y());
+    hi[0] = std::max(hi[0], rel[k].x()), hi[1] = std::max(hi[1], rel[k].y());
+  }
+  if (!(hi[0] - lo[0] <= limit && hi[1] - lo[1] <= limit))
+    throw std::invalid_argument("surfaceCurves: the particles span more than 2^30 spacings");
+  const double nodes = ((hi[0] - lo[0]) / h + 2 * (o.smoothing + 4)) * ((hi[1] - lo[1]) / h + 2 * (o.smoothing + 4));
+  if (nodes <= std::max(64.0 * double(points.size()), 65536.0)) {
+    regionCurves(rel, spacing, o, pool, curves);
+  } else {
+    // Far-flung particles (spray across a level): each region of coarse cells (64 nodes wide,
+    // touching ones joined) gets a grid of its own, so that one stray particle neither makes
+    // the grid huge nor its cells coarse. Regions apart by a coarse cell cannot share a curve
+    // (the field reaches a few nodes). Regions in the order of their lowest, then leftmost cell.
+    const double C = 64 * h;
+    auto key = [&](const Vec2d& p) {
+      return std::pair<std::int64_t, std::int64_t>{std::int64_t(std::floor((p.y() - lo[1]) / C)),
+                                                   std::int64_t(std::floor((p.x() - lo[0]) / C))};
+    };
+    std::vector<std::pair<std::int64_t, std::int64_t>> cells(rel.size());
+    for (std::size_t k = 0; k < rel.size(); ++k) cells[k] = key(rel[k]);
+    std::vector<std::pair<std::int64_t, std::int64_t>> keys = cells;
+    std::sort(keys.begin(), keys.end());
+    keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
+    std::vector<std::size_t> parent(keys.size());
+    for (std::size_t k = 0; k < keys.size(); ++k) parent[k] = k;
+    auto root = [&](std::size_t k) {
+      while (parent[k] != k) k = parent[k] = parent[parent[k]];
+      return k;
+    };
+    for (std::size_t k = 0; k < keys.size(); ++k)
+      for (std::int64_t dy = 0; dy <= 1; ++dy)
+        for (std::int64_t dx = -1; dx <= 1; ++dx) {
+          if (dy == 0 && dx <= 0) continue;
+          const auto it = std::lower_bound(
+              keys.begin(), keys.end(), std::pair<std::int64_t, std::int64_t>{keys[k].first + dy, keys[k].second + dx});
+          if (it == keys.end() || *it != std::pair<std::int64_t, std::int64_t>{keys[k].first + dy, keys[k].second + dx})
+            continue;
+          const std::size_t a = root(k), b = root(std::size_t(it - keys.begin()));
+          if (a != b) parent[std::max(a, b)] = std::min(a, b);  // the root: the region's first cell
+        }
+    std::vector<std::vector<Vec2d>> regions(keys.size());
+    for (std::size_t k = 0; k < rel.size(); ++k) {
+      const std::size_t c = std::size_t(std::lower_bound(keys.begin(), keys.end(), cells[k]) - keys.begin());
+      regions[root(c)].push_back(rel[k]);
+    }
+    for (const std::vector<Vec2d>& r : regions)
+      if (!r.empty()) regionCurves(r, spacing, o, pool, curves);
+  }
+  for (SurfaceCurve& c : curves)
+    for (Vec2d& p : c.points) p += ref;
   return curves;
 }
 
@@ -184,6 +255,7 @@ std::vector<SurfaceCurve> World::surfaceCurves(const SurfaceOptions& options) co
   const ParticleStore& P = impl_->P;
   const std::vector<std::uint32_t>* material = P.findU32(ParticleStore::kMaterial);
   const bool all = options.material == SurfaceOptions::kAllMaterials;
+  if (!all) impl_->checkMaterial(options.material, "surfaceCurves");
   std::vector<Vec2d> points;
   points.reserve(P.size());
   const Vec2d o = origin();
