@@ -12,12 +12,24 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <cstdarg>
 #include <cstdio>
 #include <cstring>
 #include <stdexcept>
 #include <string>
 
 namespace sph2d {
+
+/// Appends printf-style text (at most 255 characters a call) to `out`: the exports' lines.
+inline void appendf(std::string& out, const char* fmt, ...) __attribute__((format(printf, 2, 3)));
+inline void appendf(std::string& out, const char* fmt, ...) {
+  char buf[256];
+  va_list ap;
+  va_start(ap, fmt);
+  const int n = std::vsnprintf(buf, sizeof buf, fmt, ap);
+  va_end(ap);
+  if (n > 0) out.append(buf, std::size_t(n < int(sizeof buf) ? n : int(sizeof buf) - 1));
+}
 
 /// True when `path` exists and is not a regular file (after symlinks).
 inline bool isSpecialFile(const std::string& path) {

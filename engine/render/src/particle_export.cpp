@@ -30,16 +30,6 @@ void putBigEndian(std::string& out, T v) {
   for (std::size_t k = 0; k < sizeof(T); ++k) out.push_back(char(b[sizeof(T) - 1 - k]));  // x86 is little-endian
 }
 
-void appendf(std::string& out, const char* fmt, ...) __attribute__((format(printf, 2, 3)));
-void appendf(std::string& out, const char* fmt, ...) {
-  char buf[256];
-  va_list ap;
-  va_start(ap, fmt);
-  const int n = std::vsnprintf(buf, sizeof buf, fmt, ap);
-  va_end(ap);
-  if (n > 0) out.append(buf, std::size_t(std::min(n, int(sizeof buf) - 1)));
-}
-
 }  // namespace
 
 ParticleSnapshot snapshotOf(const World& world, const Real* age) {
