@@ -14,7 +14,7 @@
 # checks the SVG and PNG it draws (the bench itself runs without it: it writes the scripts).
 # What the demo needs (the engine, the renderer and the `sph2d` app's run commands; serve and
 # bench come with the tests):
-SPH2D_DEMO_PACKAGES="g++ cmake make pkg-config libbox2d-dev libosmesa6-dev libpng-dev libeigen3-dev nlohmann-json3-dev"
+SPH2D_DEMO_PACKAGES="g++ cmake make pkg-config libbox2d-dev libosmesa6-dev libpng-dev libdeflate-dev libeigen3-dev nlohmann-json3-dev"
 # What the tests add (libboost-dev and libturbojpeg0-dev for `sph2d serve`):
 SPH2D_TEST_PACKAGES="libboost-dev libturbojpeg0-dev doctest-dev clang-14 libclang-rt-14-dev chromium libegl-dev libopengl-dev libegl-mesa0 parallel gnuplot-nox"
 SPH2D_PACKAGES="$SPH2D_DEMO_PACKAGES $SPH2D_TEST_PACKAGES"

@@ -146,6 +146,7 @@ int cmdBench(const std::vector<std::string>& args) {
   std::printf("bench render: %zu particles, %dx%d, %s mode, %d frames, PNG level %d\nrenderer: %s\n", P.size(), width,
               height, profiled.mode().c_str(), frames, level, profiled.rendererString().c_str());
   Stat upload, splat, composite, solids, readback, overlay, png, hash, total, nosync, pngBytes, cpuRender, cpuPng;
+  Stat encodeOwn, encodeZlib, bytesOwn, bytesZlib;  // level L's coder against zlib (libpng) with the same filter
   {
     const Frame& first = profiled.render(in);  // warm-up: shader compilation, first-use costs
     if (!save.empty()) writePngAtomic(save, first.width, first.height, first.rgba.data(), level);
@@ -171,6 +172,18 @@ int cmdBench(const std::vector<std::string>& args) {
     cpuPng.v.push_back(processCpuMs() - c0);
     png.v.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
     pngBytes.v.push_back(double(fs::file_size(path)));
+    // Encoding alone (no file), this level's coder and then zlib through libpng.
+    thread_local std::vector<std::uint8_t> encoded;
+    PngSettings settings = pngSettings(level);
+    t0 = std::chrono::steady_clock::now();
+    encodePng(fr.width, fr.height, fr.rgba.data(), settings, encoded);
+    encodeOwn.v.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+    bytesOwn.v.push_back(double(encoded.size()));
+    settings.deflater = PngSettings::Deflater::Zlib;
+    t0 = std::chrono::steady_clock::now();
+    encodePng(fr.width, fr.height, fr.rgba.data(), settings, encoded);
+    encodeZlib.v.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+    bytesZlib.v.push_back(double(encoded.size()));
   }
   opt.profile = false;
   {
@@ -210,6 +223,8 @@ int cmdBench(const std::vector<std::string>& args) {
   row("render, no sync", nosync);
   row("PNG encode", png);
   row("XXH64 of pixels", hash);
+  row("PNG, coder only", encodeOwn);
+  row("PNG, zlib (libpng)", encodeZlib);
   Stat sum;
   for (std::size_t k = 0; k < nosync.v.size(); ++k) sum.v.push_back(nosync.v[k] + png.v[k]);
   row("render + PNG", sum);
@@ -220,6 +235,10 @@ int cmdBench(const std::vector<std::string>& args) {
   row("CPU: render + PNG", cpuSum);
   row("surface curves (CPU)", surface);
   std::printf("surface: %zu curves\n", curves);
+  std::printf("PNG level %d: %s, %.0f KB; zlib through libpng with its settings %.0f KB, %.2fx the coder's time\n",
+              level, pngSettings(level).deflater == PngSettings::Deflater::Libdeflate ? "libdeflate" : "zlib",
+              bytesOwn.mean() / 1024.0, bytesZlib.mean() / 1024.0,
+              encodeZlib.mean() / std::max(encodeOwn.mean(), 1e-9));
   std::printf("PNG size %.0f KB; sprites as %s\n", pngBytes.mean() / 1024.0,
               profiled.usedQuads() ? "instanced quads" : "points");
   return 0;

@@ -5,10 +5,12 @@
 #include "file_io.hpp"
 #include "sph2d/render/particle_export.hpp"
 
+#include <libdeflate.h>
 #include <png.h>
 #include <unistd.h>
 #include <zlib.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cerrno>
 #include <csetjmp>
@@ -134,13 +136,84 @@ PngSettings pngSettings(int level) {
   } else {  // 1: the fastest measured on the dam break's frames (docs/RENDERING.md "PNG settings")
     s.strategy = Z_DEFAULT_STRATEGY;
     s.filters = PNG_FILTER_NONE;
+    s.deflater = PngSettings::Deflater::Libdeflate;
   }
   return s;
 }
 
+namespace {
+
+/// Appends a PNG chunk: length, type, data, CRC-32 of type and data.
+void putChunk(std::vector<std::uint8_t>& out, const char type[4], const std::uint8_t* data, std::size_t n) {
+  auto be32 = [&](std::uint32_t v) {
+    for (int s = 24; s >= 0; s -= 8) out.push_back(std::uint8_t(v >> s));
+  };
+  be32(std::uint32_t(n));
+  const std::size_t at = out.size();
+  out.insert(out.end(), type, type + 4);
+  if (n) out.insert(out.end(), data, data + n);
+  be32(libdeflate_crc32(0, out.data() + at, n + 4));
+}
+
+/// encodePng with libdeflate: filter NONE, RGB (or RGBA with Input::Rgba) rows behind their
+/// filter byte, one zlib stream in one IDAT chunk.
+void encodeLibdeflate(int width, int height, const std::uint8_t* rgba, const PngSettings& s,
+                      std::vector<std::uint8_t>& out) {
+  const bool keepAlpha = s.input == PngSettings::Input::Rgba;
+  const std::size_t w = std::size_t(width), h = std::size_t(height), bpp = keepAlpha ? 4 : 3, stride = 1 + w * bpp;
+  thread_local std::vector<std::uint8_t> raw, z;
+  raw.resize(stride * h + 1);  // a spare byte: each pixel copies four
+  for (std::size_t y = 0; y < h; ++y) {
+    std::uint8_t* row = &raw[y * stride];
+    row[0] = 0;  // filter NONE
+    const std::uint8_t* src = rgba + y * w * 4;
+    if (keepAlpha)
+      std::memcpy(row + 1, src, w * 4);
+    else
+      for (std::size_t x = 0; x < w; ++x) std::memcpy(row + 1 + 3 * x, src + 4 * x, 4);
+  }
+  // One compressor per thread and level (allocating one costs more than a frame).
+  struct Compressor {
+    int level = -1;
+    libdeflate_compressor* c = nullptr;
+    ~Compressor() { libdeflate_free_compressor(c); }
+  };
+  thread_local Compressor comp;
+  const int level = std::clamp(s.level, 0, 12);
+  if (comp.level != level) {
+    libdeflate_free_compressor(comp.c);
+    comp.c = libdeflate_alloc_compressor(level);
+    comp.level = comp.c ? level : -1;
+    if (!comp.c) throw std::runtime_error("libdeflate could not allocate a compressor");
+  }
+  const std::size_t n = stride * h;
+  z.resize(libdeflate_zlib_compress_bound(comp.c, n));
+  const std::size_t zn = libdeflate_zlib_compress(comp.c, raw.data(), n, z.data(), z.size());
+  if (zn == 0) throw std::runtime_error("libdeflate could not compress the image");
+  out.clear();
+  out.reserve(zn + 64);
+  static const std::uint8_t signature[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
+  out.insert(out.end(), signature, signature + 8);
+  std::uint8_t ihdr[13];
+  for (int k = 0; k < 4; ++k) {
+    ihdr[k] = std::uint8_t(std::uint32_t(width) >> (24 - 8 * k));
+    ihdr[4 + k] = std::uint8_t(std::uint32_t(height) >> (24 - 8 * k));
+  }
+  ihdr[8] = 8;                         // bit depth
+  ihdr[9] = keepAlpha ? 6 : 2;         // RGBA or RGB
+  ihdr[10] = ihdr[11] = ihdr[12] = 0;  // deflate, adaptive filtering, no interlace
+  putChunk(out, "IHDR", ihdr, sizeof ihdr);
+  putChunk(out, "IDAT", z.data(), zn);
+  putChunk(out, "IEND", nullptr, 0);
+}
+
+}  // namespace
+
 void encodePng(int width, int height, const std::uint8_t* rgba, const PngSettings& settings,
                std::vector<std::uint8_t>& out) {
   if (width <= 0 || height <= 0) throw std::runtime_error("encodePng: empty image");
+  if (settings.deflater == PngSettings::Deflater::Libdeflate)
+    return encodeLibdeflate(width, height, rgba, settings, out);
   const std::size_t w = std::size_t(width), h = std::size_t(height);
   thread_local std::vector<std::uint8_t> packed;
   thread_local std::vector<png_bytep> rows;

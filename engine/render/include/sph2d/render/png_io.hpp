@@ -23,6 +23,10 @@ struct PngSettings {
   /// RGB rows itself, or the file keeps A (an RGBA PNG).
   enum class Input { Filler, PackedRgb, Rgba } input = Input::Filler;
   bool wholeImage = false;  ///< every row in one png_write_image call (else png_write_row per row)
+  /// The deflate coder: zlib through libpng, or libdeflate (its level, filter NONE on every
+  /// row, the whole image in one IDAT chunk; strategy, memLevel, windowBits, bufferSize and
+  /// wholeImage do not apply).
+  enum class Deflater { Zlib, Libdeflate } deflater = Deflater::Zlib;
 };
 
 /// The settings of PNG level `level` 0..9: 1 (the default, the fastest measured on the dam
