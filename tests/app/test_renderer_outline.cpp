@@ -6,14 +6,17 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
+#include <fstream>
 #include <string>
 
+#include "app_util.hpp"
 #include "sph2d/render/png_io.hpp"
 #include "sph2d/render/renderer.hpp"
 #include "sph2d/scene.hpp"
 #include "sph2d/world.hpp"
 
 using namespace sph2d;
+using namespace sph2d::apptest;
 
 TEST_CASE("--outline draws the fluid's outline where its particles end, in both modes") {
   // Water 0.4 m × 0.2 m (dx 0.01) resting on a floor, 700 px per metre.
@@ -74,4 +77,18 @@ TEST_CASE("--outline draws the fluid's outline where its particles end, in both 
     CHECK(onTop > int(0.35 * pxPerM));  // most of the 0.4 m top (280 px)
     CHECK(stray == 0);
   }
+}
+
+TEST_CASE("--outline is recorded in the manifest: sph2d check redraws it, and without it the frames differ") {
+  const std::string dir = freshDir("outline_check");
+  const std::string scene = asset("scenes/tests/small_dam_break.json");
+  REQUIRE(run("run " + q(scene) + " --frames 11 --every 5 --outline --quiet --out " + q(dir)).code == 0);
+  const std::string manifest = readText(dir + "/manifest.json");
+  REQUIRE(manifest.find("\"outline\": true") != std::string::npos);
+  CHECK(run("check " + q(scene) + " --against " + q(dir + "/manifest.json") + " --out " + q(dir + "_check")).code == 0);
+  // The same manifest saying no outline: the rerun's first frame differs.
+  std::string plain = manifest;
+  plain.replace(plain.find("\"outline\": true"), std::string("\"outline\": true").size(), "\"outline\": false");
+  std::ofstream(dir + "/plain.json") << plain;
+  CHECK(run("check " + q(scene) + " --against " + q(dir + "/plain.json") + " --out " + q(dir + "_plain")).code != 0);
 }
