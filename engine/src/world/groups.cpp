@@ -278,16 +278,38 @@ bool World::applyGroupImpulse(std::uint32_t g, const Vec2d& linear, double angul
 }
 
 void World::Impl::splitParts(std::uint32_t g, const std::vector<std::size_t>& slots,
+                             const std::function<Vec2d(std::size_t)>& place, double reach,
                              const std::function<bool(std::size_t, std::size_t)>& linked,
                              std::vector<std::uint32_t>* made) {
   std::vector<std::uint32_t>& group = *P.findU32(ParticleStore::kGroup);
   std::vector<std::size_t> parent(slots.size());
   for (std::size_t a = 0; a < slots.size(); ++a) parent[a] = a;
+  // The candidates: the particles in cells of `reach` at `place`, sorted by cell; each asks the
+  // cells around its own for partners of a higher index (each pair once). The parts do not
+  // depend on the order of the unions (each root is its part's lowest index).
+  struct Entry {
+    std::int64_t cy, cx;
+    std::size_t a;
+    bool operator<(const Entry& o) const { return cy != o.cy ? cy < o.cy : cx != o.cx ? cx < o.cx : a < o.a; }
+  };
+  std::vector<Entry> cells(slots.size());
+  for (std::size_t a = 0; a < slots.size(); ++a) {
+    const Vec2d p = place(slots[a]);
+    cells[a] = Entry{std::int64_t(std::floor(p.y() / reach)), std::int64_t(std::floor(p.x() / reach)), a};
+  }
+  std::vector<Entry> sorted = cells;
+  std::sort(sorted.begin(), sorted.end());
   for (std::size_t a = 0; a < slots.size(); ++a)
-    for (std::size_t b = a + 1; b < slots.size(); ++b)
-      if (linked(slots[a], slots[b])) {
-        const std::size_t ra = findRoot(parent, a), rb = findRoot(parent, b);
-        if (ra != rb) parent[std::max(ra, rb)] = std::min(ra, rb);
+    for (std::int64_t dy = -1; dy <= 1; ++dy)
+      for (std::int64_t dxc = -1; dxc <= 1; ++dxc) {
+        const Entry lo{cells[a].cy + dy, cells[a].cx + dxc, a + 1};
+        for (auto it = std::lower_bound(sorted.begin(), sorted.end(), lo);
+             it != sorted.end() && it->cy == lo.cy && it->cx == lo.cx; ++it) {
+          const std::size_t b = it->a;
+          if (!linked(slots[a], slots[b])) continue;
+          const std::size_t ra = findRoot(parent, a), rb = findRoot(parent, b);
+          if (ra != rb) parent[std::max(ra, rb)] = std::min(ra, rb);
+        }
       }
   // The parts in order of their lowest slot; the largest (the first of equals) keeps g.
   std::vector<std::size_t> size(slots.size(), 0), roots;
@@ -361,7 +383,9 @@ void World::Impl::breakGroups(const StepContext& c) {
     std::vector<std::size_t> slots;
     for (std::size_t i = 0; i < P.size(); ++i)
       if (group[i] == g) slots.push_back(i);
-    splitParts(g - 1, slots, [&](std::size_t i, std::size_t j) { return restAdjacent(i, j) && !stretched(i, j); });
+    splitParts(
+        g - 1, slots, [&](std::size_t i) { return Vec2d(double(qx[i]), double(qy[i])); }, 1.5 * double(dx),
+        [&](std::size_t i, std::size_t j) { return restAdjacent(i, j) && !stretched(i, j); });
   }
 }
 
@@ -432,7 +456,7 @@ std::vector<std::uint32_t> World::splitGroup(std::uint32_t g) {
     if (group[i] == g + 1) slots.push_back(i);
   const double near2 = 1.5 * 1.5 * double(w.dx) * double(w.dx);
   w.splitParts(
-      g, slots,
+      g, slots, [&](std::size_t i) { return w.P.x[i].cast<double>(); }, 1.5 * double(w.dx),
       [&](std::size_t i, std::size_t j) { return (w.P.x[i] - w.P.x[j]).cast<double>().squaredNorm() <= near2; }, &made);
   return made;
 }

@@ -280,8 +280,10 @@ struct World::Impl {
   void breakGroups(const StepContext& c);
   /// Splits group g (its particles `slots`, in slot order) into the parts `linked` pairs
   /// connect: the largest keeps g, each other part of at least kMinGroup particles a new
-  /// index (appended to `made`), smaller parts go free (group 0).
+  /// index (appended to `made`), smaller parts go free (group 0). Only pairs within `reach` of
+  /// each other at `place` are asked (a linked pair must be): O(n log n) in the group's size.
   void splitParts(std::uint32_t g, const std::vector<std::size_t>& slots,
+                  const std::function<Vec2d(std::size_t)>& place, double reach,
                   const std::function<bool(std::size_t, std::size_t)>& linked,
                   std::vector<std::uint32_t>* made = nullptr);
   /// The fewest particles a group keeps (fewer hold no shape).

@@ -214,6 +214,45 @@ TEST_CASE("jelly: a game joins, splits and destroys groups") {
   CHECK_FALSE(w.destroyGroup(ga, true));
 }
 
+TEST_CASE("jelly: splitting a large group finds its parts, a ring's in one piece") {
+  // A group of about 25,000 particles: two blocks joined, then split (each pair within 1.5
+  // spacings is asked only through a grid of cells: the old all-pairs search asked 3e8), and a
+  // ring of 2,000, whose particles link all the way round, stays whole.
+  const double dx = 0.01;
+  SceneDef s = test::tank("game", 4.0, 2.0, dx);
+  s.gravity = Vec2d(0, 0);
+  World w(s, WorldOptions{2});
+  GroupDef a;
+  a.region = test::block({0.2, 0.2}, {1.2, 1.4});
+  a.stiffness = 0.5;
+  GroupDef b = a;
+  b.region = test::block({1.4, 0.2}, {2.4, 1.4});
+  IdRange ra, rb;
+  const std::uint32_t ga = w.createGroup(a, &ra), gb = w.createGroup(b, &rb);
+  REQUIRE(w.joinGroups(ga, gb));
+  const std::vector<std::uint32_t> made = w.splitGroup(ga);
+  REQUIRE(made.size() == 1);
+  GroupState st;
+  REQUIRE(w.groupState(ga, st));
+  CHECK(st.particles == std::max(ra.size(), rb.size()));
+  REQUIRE(w.groupState(made[0], st));
+  CHECK(st.particles == std::min(ra.size(), rb.size()));
+  CHECK(ra.size() + rb.size() > 20000);
+  GroupDef ring;
+  ring.region.shape = FluidBlockDef::Shape::Circle;
+  ring.region.center = Vec2d(3.2, 1.0);
+  ring.region.radius = 0.4;
+  ring.region.min = ring.region.center - Vec2d(0.4, 0.4);
+  ring.region.max = ring.region.center + Vec2d(0.4, 0.4);
+  const std::uint32_t gr = w.createGroup(ring);
+  std::vector<std::uint32_t> inner;  // the disc's middle taken out: a ring 0.1 m thick
+  for (std::size_t i = 0; i < w.particleCount(); ++i)
+    if (w.particles().group[i] == gr + 1 && (w.worldPosition(i) - ring.region.center).norm() < 0.3)
+      inner.push_back(w.particles().id[i]);
+  w.removeParticles(inner);
+  CHECK(w.splitGroup(gr).empty());
+}
+
 TEST_CASE("jelly: a scene's groups make rigid and elastic groups, and bad keys are refused at their key") {
   const auto scene = [](const std::string& groups) {
     return "{\"solver\": {\"type\": \"game\", \"spacing\": 0.02},\n\"boundaries\": [{\"fixtures\": [{\"shape\": "
