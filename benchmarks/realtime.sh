@@ -11,16 +11,26 @@
 # A benchmark, not a test: the machine is shared, and a busy machine drops frames that a quiet
 # one does not (the load average says which it was).
 #
-# Usage: benchmarks/realtime.sh [ROUNDS] [SCENE]   (defaults 3, assets/scenes/dam_break.json)
+# With BUSY=1 a busy loop holds the last core (taskset) for every round, as another program on a
+# player's machine would; the CSV's `busy` column says which.
+#
+# Usage: [BUSY=1] [OTHER=...] benchmarks/realtime.sh [ROUNDS] [SCENE]   (defaults 3, assets/scenes/dam_break.json)
 set -eu
 root=$(cd "$(dirname "$0")/.." && pwd)
 rounds=${1:-3}
 scene=${2:-$root/assets/scenes/dam_break.json}
 app=$root/build/app/sph2d
 work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
+busy_pid=""
+trap 'rm -rf "$work"; [ -n "$busy_pid" ] && kill "$busy_pid" 2>/dev/null' EXIT INT TERM
+busy=${BUSY:-0}
+if [ "$busy" = 1 ]; then
+  last=$(($(nproc) - 1))
+  taskset -c "$last" sh -c 'while :; do :; done' &
+  busy_pid=$!
+fi
 
-csv="binary,round,load1,dropped,late,wall_s,simulation_s,rendering_s"
+csv="binary,busy,round,load1,dropped,late,wall_s,simulation_s,rendering_s"
 i=0
 while [ "$i" -lt "$rounds" ]; do
   i=$((i + 1))
@@ -40,7 +50,7 @@ while [ "$i" -lt "$rounds" ]; do
            NR > 1 { for (k = prev + 1; k < $1; ++k) printf "%d ", k } { prev = $1 }')
     echo "$bin round $i: load $load, dropped ${dropped:-?}, late ${late:-?}, wall/simulation/rendering ${times:-?} s${which:+; dropped frames: $which}"
     csv="$csv
-$bin,$i,$load,$dropped,$late,$times"
+$bin,$busy,$i,$load,$dropped,$late,$times"
   done
 done
 echo "$csv"
