@@ -41,6 +41,25 @@ struct ViscosityTerm {
   Real pairCap = std::numeric_limits<Real>::infinity();
 };
 
+/// 1 / the viscosity kernel's Laplacian lattice moment (kernels.hpp) at the substep's R and dx,
+/// computed again only when they change: the scale that makes the Laplacian viscosity exact
+/// on a rest lattice (viscosity.cpp, and the granular effect's viscosity at its largest).
+class LaplacianMomentScale {
+ public:
+  Real operator()(const StepContext& c) {
+    if (c.R != R_ || c.dx != dx_) {
+      const ViscosityKernel<double> Wd(double(c.R));
+      scale_ = Real(1.0 / latticeLaplacianMoment([&](double r) { return Wd.laplacian(r); }, Wd.R, double(c.dx)));
+      R_ = c.R;
+      dx_ = c.dx;
+    }
+    return scale_;
+  }
+
+ private:
+  Real scale_ = 1, R_ = -1, dx_ = -1;
+};
+
 class Effect {
  public:
   virtual ~Effect() = default;

@@ -115,16 +115,11 @@ class Granular final : public Effect {
       }
     });
     // The Laplacian viscosity's constants at ν = η_max/ρ0 (viscosity.cpp), its lattice moment included.
-    if (c.R != momentR_ || c.dx != momentDx_) {
-      const ViscosityKernel<double> Wd(double(c.R));
-      scale_ = Real(1.0 / latticeLaplacianMoment([&](double r) { return Wd.laplacian(r); }, Wd.R, double(c.dx)));
-      momentR_ = c.R;
-      momentDx_ = c.dx;
-    }
+    const Real scale = momentScale_(c);
     ViscosityTerm t;
     t.W = ViscosityKernel<Real>(c.R);
-    t.muMass = nuMax * scale_ * c.rho0 * c.mass;
-    t.wallFactor = Real(2) * nuMax * scale_ * c.rho0;
+    t.muMass = nuMax * scale * c.rho0 * c.mass;
+    t.wallFactor = Real(2) * nuMax * scale * c.rho0;
     t.walls = !c.boundary.samples.empty();
     t.noSlip = false;  // no samples in the moving bodies (game solver): their shapes take part instead
     contactBodies(c, t);
@@ -276,7 +271,7 @@ class Granular final : public Effect {
   std::vector<Real> rel_, nuRel_;       ///< per particle: r_i·η_i/(ρ η_max), η_i/(ρ η_max)
   ImplicitViscosity implicit_;
   std::vector<Vec2d> wallBlock_;
-  Real scale_ = 1, momentR_ = -1, momentDx_ = -1;
+  LaplacianMomentScale momentScale_;
 };
 
 }  // namespace

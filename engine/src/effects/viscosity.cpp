@@ -74,14 +74,7 @@ class LaplacianViscosity final : public Effect {
   bool foldable() const override { return uniform_; }
 
   ViscosityTerm viscosityTerm(const StepContext& c) override {
-    if (c.R != momentR_ || c.dx != momentDx_) {
-      const ViscosityKernel<double> Wd(double(c.R));
-      const double m = latticeLaplacianMoment([&](double r) { return Wd.laplacian(r); }, Wd.R, double(c.dx));
-      scale_ = Real(1.0 / m);
-      momentR_ = c.R;
-      momentDx_ = c.dx;
-    }
-    const Real nuS = nu_ * scale_;
+    const Real nuS = nu_ * momentScale_(c);
     ViscosityTerm t;
     t.W = ViscosityKernel<Real>(c.R);
     t.muMass = nuS * c.rho0 * c.mass;
@@ -234,7 +227,7 @@ class LaplacianViscosity final : public Effect {
   std::vector<Real> rel_, nuRel_;  ///< weights(): per particle, with materials of different viscosity
   std::vector<Real> perMaterial_;  ///< weights(): ν_k/ν per material
   ImplicitViscosity implicit_;
-  Real scale_ = 1, momentR_ = -1, momentDx_ = -1;  ///< 1 / lattice moment, for (R, dx)
+  LaplacianMomentScale momentScale_;
   std::vector<Vec2d> wallBlock_;  ///< with the walls: per block of kBlock particles, Σ of their acceleration
 };
 
