@@ -5,6 +5,15 @@
 //  - body: light from above absorbed by the water above the pixel (depth from
 //    the CPU grid, scattered sideways on its way down), from the surface colour
 //    towards the deep colour;
+//  - behind (with SEE_THROUGH: a transmission above 0): what is behind the water
+//    (uBg: the background with the solids) seen
+//    through it, absorbed per colour channel by the water's thickness
+//    (Beer-Lambert: a full layer lets uTransmission through, a thinner one
+//    uTransmission^fill) and shifted where that thickness changes (its front face
+//    tilts: a thin prism deviates the ray towards the thicker water). The light the
+//    water scatters itself is the one that makes a full layer over the plain
+//    background (uBgColor) the water's colour: where nothing else is behind, the
+//    water looks as its colour says;
 //  - surface: shading from the field's gradient (light from above), a bright
 //    meniscus just inside the edge and a specular highlight;
 //  - foam: towards white where the kernel-weighted speed is high;
@@ -14,7 +23,8 @@
 // drawn only over the tiles that fluid can reach (solid.vert: quads in NDC);
 // the rest of the frame keeps the background.
 out vec4 outColor;
-uniform sampler2D uBg;       // the background (RGBA8, same size)
+uniform sampler2D uBg;       // the backdrop: background and solids (RGBA8, same size, bilinear)
+uniform sampler2D uPlain;    // the background alone: where uBg differs, a solid is behind
 uniform sampler2D uField;    // RG: sum w, sum w*speed (full or half resolution, bilinear)
 uniform sampler2D uAux;      // RG: depth of water above [m], local fill 0..1 (bilinear)
 uniform vec2 uAuxScale;      // vUv -> aux texture coordinates
@@ -26,6 +36,9 @@ uniform vec3 uFoam;
 uniform float uInvDepth;     // 1 / metres of water that darken by 1/e
 uniform vec2 uFoamSpeed;     // foam starts, foam full [m/s]
 uniform float uSpacingPx;    // particle spacing [px]
+uniform vec3 uLogTransmission;  // ln of the share of each channel a full layer lets through
+uniform float uRefractPx;    // shift [px] of what is behind per unit of the fill's slope [1/px]
+uniform vec3 uBgColor;       // the background's colour (render.background)
 #ifdef TINT
 uniform sampler2D uTint;     // RGBA: sum w*colour, sum w (the field's resolution, bilinear)
 #endif
@@ -42,7 +55,11 @@ void main() {
   vec2 aux = texture(uAux, vUv * uAuxScale).rg;
   vec3 bg = texelFetch(uBg, ivec2(gl_FragCoord.xy), 0).rgb;
   float threshold = mix(0.24, 0.5, smoothstep(0.15, 0.55, aux.g));
-  float cover = clamp((f - threshold) / max(g, 1e-3) + 0.5, 0.0, 1.0);
+  // Over a solid the water shows only where the fluid covers it (a body the water flows in
+  // front of): the fringe of the field along a body's faces, where the fluid only meets it,
+  // leaves the body's edge as it is drawn.
+  bool solid = bg != texelFetch(uPlain, ivec2(gl_FragCoord.xy), 0).rgb;
+  float cover = clamp((f - (solid ? max(threshold, 0.85) : threshold)) / max(g, 1e-3) + 0.5, 0.0, 1.0);
   if (cover <= 0.0) {
     outColor = vec4(bg, 1.0);
     return;
@@ -70,7 +87,17 @@ void main() {
   h = h / sqrt(dot(h, h));
   float spec = pow(max(dot(n, h), 0.0), 30.0) * 0.55 * (1.0 - inside);
   float rim = (1.0 - inside) * 0.3;
-  water = water * lambert + vec3(spec) + SURFACE * rim;
+#ifdef SEE_THROUGH
+  // Behind: the ray bends towards the thicker water (+grad in the world; rows run top-down).
+  vec2 seenAt = gl_FragCoord.xy + vec2(grad.x, -grad.y) * uRefractPx;
+  vec3 behind = texture(uBg, seenAt * uTexel).rgb;
+  vec3 full = exp(uLogTransmission);
+  vec3 through = exp(uLogTransmission * clamp(f, 0.0, 1.0));
+  vec3 scatter = max((water * lambert - full * uBgColor) / max(vec3(1.0) - full, vec3(1e-3)), vec3(0.0));
+  water = mix(scatter, behind, through) + vec3(spec) + SURFACE * rim;
+#else
+  water = water * lambert + vec3(spec) + SURFACE * rim;  // opaque: the colour alone
+#endif
   // Foam: fast water, strongest at the surface and in spray.
   float speed = c.g / max(c.r, 1e-6);
   float foam = smoothstep(uFoamSpeed.x, uFoamSpeed.y, speed);

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <optional>
 
 #include "cli.hpp"
 #include "commands.hpp"
@@ -32,7 +33,9 @@ const char* kBenchHelp =
     "composite, solids, readback, overlay, PNG encode (level L, default 1) and hash,\n"
     "and the fluid's outline as curves (World::surfaceCurves' work, one thread).\n"
     "Stages are timed with glFinish between them; the 'render, no sync' row is the\n"
-    "same frame without those fences, as `sph2d run` renders it. The CPU rows are the\n"
+    "same frame without those fences, as `sph2d run` renders it. In liquid mode the\n"
+    "'opaque water' rows render the same frames, alternately, with render.transmission\n"
+    "0 (nothing seen through the water): what the see-through costs. The CPU rows are the\n"
     "process's CPU time (every thread: llvmpipe's too) per frame, which other processes\n"
     "on a shared machine disturb less than wall time. --save writes the frame.\n"
     "\n"
@@ -143,6 +146,15 @@ int cmdBench(const std::vector<std::string>& args) {
   fs::create_directories(tmp);
   opt.profile = true;
   Renderer profiled(scene.render, opt);
+  // The liquid's water without what is behind it (opaque: no backdrop sampled or mixed in), the
+  // same frames in the same run: what seeing through the water costs.
+  RenderDef opaqueDef = scene.render;
+  opaqueDef.transmission = {0, 0, 0};
+  opaqueDef.refraction = 0;
+  const bool liquid = profiled.mode() == "liquid";
+  std::optional<Renderer> opaqueProfiled;
+  if (liquid) opaqueProfiled.emplace(opaqueDef, opt);
+  Stat opaqueComposite, opaqueNosync;
   std::printf("bench render: %zu particles, %dx%d, %s mode, %d frames, PNG level %d\nrenderer: %s\n", P.size(), width,
               height, profiled.mode().c_str(), frames, level, profiled.rendererString().c_str());
   Stat upload, splat, composite, solids, readback, overlay, png, hash, total, nosync, pngBytes, cpuRender, cpuPng;
@@ -150,8 +162,13 @@ int cmdBench(const std::vector<std::string>& args) {
   {
     const Frame& first = profiled.render(in);  // warm-up: shader compilation, first-use costs
     if (!save.empty()) writePngAtomic(save, first.width, first.height, first.rgba.data(), level);
+    if (opaqueProfiled) opaqueProfiled->render(in);
   }
   for (int k = 0; k < frames; ++k) {
+    if (opaqueProfiled) {
+      opaqueProfiled->render(in);
+      opaqueComposite.v.push_back(opaqueProfiled->lastTimings().composite);
+    }
     const Frame& fr = profiled.render(in);
     const RenderTimings t = profiled.lastTimings();
     upload.v.push_back(t.upload);
@@ -189,11 +206,20 @@ int cmdBench(const std::vector<std::string>& args) {
   {
     Renderer plain(scene.render, opt);
     plain.render(in);
+    std::optional<Renderer> opaque;
+    if (liquid) {
+      opaque.emplace(opaqueDef, opt);
+      opaque->render(in);
+    }
     for (int k = 0; k < frames; ++k) {
       const double c0 = processCpuMs();
       plain.render(in);
       cpuRender.v.push_back(processCpuMs() - c0);
       nosync.v.push_back(plain.lastTimings().total);
+      if (opaque) {
+        opaque->render(in);
+        opaqueNosync.v.push_back(opaque->lastTimings().total);
+      }
     }
   }
   fs::remove_all(tmp);
@@ -215,12 +241,14 @@ int cmdBench(const std::vector<std::string>& args) {
   auto row = [](const char* name, const Stat& s) { std::printf("%-22s %9.2f %9.2f\n", name, s.mean(), s.best()); };
   row("upload (CPU, grid)", upload);
   row(profiled.mode() == "liquid" ? "splat" : "discs", splat);
-  if (profiled.mode() == "liquid") row("composite", composite);
+  if (liquid) row("composite", composite);
+  if (liquid) row("composite, opaque water", opaqueComposite);
   row("solids", solids);
   row("readback", readback);
   row("overlay (CPU)", overlay);
   row("render, synced", total);
   row("render, no sync", nosync);
+  if (liquid) row("same, opaque water", opaqueNosync);
   row("PNG encode", png);
   row("XXH64 of pixels", hash);
   row("PNG, coder only", encodeOwn);

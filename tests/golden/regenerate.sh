@@ -17,3 +17,13 @@ gen() {  # gen NAME [run flags...]
 gen liquid_dam_break --frames 9 --every 4
 gen particles_pressure --frames 7 --every 3 --color-by pressure
 gen shapes_overlay --frames 6 --every 5 --overlay
+# shapes_overlay also stands for a run made before manifests listed their files (tests/app/
+# test_app_output_folder.cpp reruns into a copy of it): its manifest keeps no "files".
+python3 - "$here/shapes_overlay/manifest.json" <<'PY'
+import collections, json, sys
+path = sys.argv[1]
+raw = open(path).read()
+m = json.loads(raw, object_pairs_hook=collections.OrderedDict)
+m.pop("files", None)
+open(path, "w").write(json.dumps(m, indent=1, ensure_ascii=False) + ("\n" if raw.endswith("\n") else ""))
+PY

@@ -128,6 +128,17 @@ struct RenderDef {
   std::array<double, 3> water{0.10, 0.45, 0.85};
   std::array<double, 3> solid{0.55, 0.52, 0.48};
   double splatRadius = 2.0;  ///< splat radius in particle spacings
+  /// Liquid mode: the share of each colour channel of what is behind the water (background,
+  /// solids) that a full layer of water lets through; thinner water (edges, spray) lets through
+  /// transmission^fill (Beer–Lambert, its thickness following the field's fill). 0 0 0: opaque.
+  std::array<double, 3> transmission{0.25, 0.4, 0.5};
+  /// Liquid mode: how far what is seen through the water is shifted where the water's thickness
+  /// changes (its front face tilts: refraction), in particle spacings at the steepest. 0: none.
+  double refraction = 1.0;
+  static constexpr double kMaxRefraction = 4;
+  /// Side [m] of square tiles drawn into the background, world-aligned (something to see the
+  /// water's refraction against); 0: a plain background.
+  double tiles = 0;
   CameraDef camera;
 };
 

@@ -106,6 +106,7 @@
   X(Uniform2fv)               \
   X(Uniform3f)                \
   X(Uniform3fv)               \
+  X(Uniform4f)                \
   X(Uniform3i)                \
   X(Uniform4i)                \
   X(UseProgram)               \
@@ -229,6 +230,7 @@ class UseApi {
 #define glUniform2fv SPH2D_GL(Uniform2fv)
 #define glUniform3f SPH2D_GL(Uniform3f)
 #define glUniform3fv SPH2D_GL(Uniform3fv)
+#define glUniform4f SPH2D_GL(Uniform4f)
 #define glUniform3i SPH2D_GL(Uniform3i)
 #define glUniform4i SPH2D_GL(Uniform4i)
 #define glUseProgram SPH2D_GL(UseProgram)

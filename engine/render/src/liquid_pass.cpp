@@ -42,7 +42,7 @@ class LiquidPass final : public RenderPass {
   LiquidPass(const RenderDef& def, const RenderOptions& opt, SpriteBatch& sprites)
       : def_(def), opt_(opt), sprites_(sprites) {
     splatProg_ = gl::program("splat.vert", "splat.frag");
-    compositeProg_ = gl::program("solid.vert", "composite.frag");
+    compositeProg_ = gl::program("solid.vert", "composite.frag", seeThrough());
     glGenVertexArrays(1, &tileVao_);
     glGenBuffers(1, &tileVbo_);
     glBindVertexArray(tileVao_);
@@ -54,6 +54,7 @@ class LiquidPass final : public RenderPass {
   const char* mode() const override { return "liquid"; }
   float spriteDiameter(double spacingPx) const override { return float(2.0 * def_.splatRadius * spacingPx); }
   int spriteShrink(double spacingPx) const override { return spriteDiameter(spacingPx) >= 8.0f ? 2 : 1; }
+  bool solidsBehind() const override { return true; }
 
   void targetsChanged() override {
     fieldW_ = fieldH_ = 0;  // recreated at the next splat
@@ -279,11 +280,18 @@ class LiquidPass final : public RenderPass {
     glDisable(GL_BLEND);
   }
 
+  /// The composite's define when the water lets through what is behind it (a transmission above
+  /// 0): without it the program neither samples the backdrop nor mixes it in.
+  const char* seeThrough() const {
+    const auto& t = def_.transmission;
+    return t[0] > 0 || t[1] > 0 || t[2] > 0 ? "#define SEE_THROUGH\n" : "";
+  }
+
   /// The field becomes water over the tiles the fluid can reach (shaders/composite.frag).
   void composite(const PassFrame& f) {
     const int EW = f.geo.EW, EH = f.geo.EH;
     if (tinted_ && !compositeTintProg_)
-      compositeTintProg_ = gl::program("solid.vert", "composite.frag", "#define TINT\n");
+      compositeTintProg_ = gl::program("solid.vert", "composite.frag", std::string("#define TINT\n") + seeThrough());
     const GLuint cp = tinted_ ? compositeTintProg_ : compositeProg_;
     // The colour target still holds the last frame: background and solids, and water over the
     // rows its tiles covered. Only those rows go back to the background; the tiles of this
@@ -302,7 +310,10 @@ class LiquidPass final : public RenderPass {
     glActiveTexture(GL_TEXTURE1);
     glBindTexture(GL_TEXTURE_2D, auxTex_);
     glActiveTexture(GL_TEXTURE2);
-    glBindTexture(GL_TEXTURE_2D, f.color.background);
+    glBindTexture(GL_TEXTURE_2D, f.color.source);
+    glActiveTexture(GL_TEXTURE4);
+    glBindTexture(GL_TEXTURE_2D, f.color.plain);
+    glUniform1i(gl::uniform(cp, "uPlain"), 4);
     if (tinted_) {
       glActiveTexture(GL_TEXTURE3);
       glBindTexture(GL_TEXTURE_2D, tintTex_);
@@ -330,6 +341,19 @@ class LiquidPass final : public RenderPass {
     const double foamLo = opt_.foamSpeed > 0 ? opt_.foamSpeed : 0.35 * std::sqrt(std::max(f.in.gravity, 1e-6) * camH);
     glUniform2f(gl::uniform(cp, "uFoamSpeed"), float(foamLo), float(2 * foamLo));
     glUniform1f(gl::uniform(cp, "uSpacingPx"), float(f.spacingPx));
+    // Beer–Lambert per channel: ln of what a full layer lets through (a floor for a channel it
+    // stops). Without SEE_THROUGH the uniforms are not in the program (location −1: ignored).
+    float logT[3];
+    for (int k = 0; k < 3; ++k) logT[k] = float(std::log(std::max(def_.transmission[k], 1e-9)));
+    glUniform3fv(gl::uniform(cp, "uLogTransmission"), 1, logT);
+    const auto bgColor = color3(def_.background);
+    glUniform3fv(gl::uniform(cp, "uBgColor"), 1, bgColor.data());
+    // The field's steepest slope, across the straight edge of a bulk, is (32/35) r / (π r²/4)
+    // = 1.164/r per pixel (r = the sprite's radius in pixels; the kernel (1 − q²)³'s integral
+    // across the edge over its integral over the disc): the shift in pixels per unit of slope
+    // that makes the steepest shift `refraction` spacings.
+    const double rPx = def_.splatRadius * f.spacingPx;
+    glUniform1f(gl::uniform(cp, "uRefractPx"), float(def_.refraction * f.spacingPx * rPx / 1.164));
     glBindVertexArray(tileVao_);
     if (tileVertices_) glDrawArrays(GL_TRIANGLES, 0, tileVertices_);
   }

@@ -48,19 +48,23 @@ struct StageTimer {
 /// The colour target the frame is drawn into (the image plus guard bands) and its background.
 struct ColorTarget {
   GLuint fbo = 0, tex = 0;
-  GLuint background = 0;     ///< the background texture, same size
+  GLuint background = 0;     ///< the background texture, same size (static solids drawn in)
   GLuint backgroundFbo = 0;  ///< its framebuffer
-  bool copyImage = true;     ///< glCopyImageSubData exists (OpenGL 4.3); else rows are blitted (3.3)
+  /// What a frame starts from and the liquid sees through the water: the background, or the
+  /// liquid's backdrop (the background with the moving bodies drawn in, Scenery::backdrop).
+  GLuint source = 0, sourceFbo = 0;
+  GLuint plain = 0;       ///< the background without solids (the liquid tells solids from it)
+  bool copyImage = true;  ///< glCopyImageSubData exists (OpenGL 4.3); else rows are blitted (3.3)
   int EW = 0, EH = 0;
-  /// Starts the frame: copies the background into the colour target and binds it.
+  /// Starts the frame: copies the source into the colour target and binds it.
   void startFrame() const { startFrameRows(0, EH); }
   /// Starts the frame when only rows [y0, y1) (window rows, from the world's top) differ from
-  /// the background and solids: copies the background over those rows and binds the target.
+  /// the source: copies the source over those rows and binds the target.
   void startFrameRows(int y0, int y1) const {
     if (y1 > y0 && copyImage) {
-      glCopyImageSubData(background, GL_TEXTURE_2D, 0, 0, y0, 0, tex, GL_TEXTURE_2D, 0, 0, y0, 0, EW, y1 - y0, 1);
+      glCopyImageSubData(source, GL_TEXTURE_2D, 0, 0, y0, 0, tex, GL_TEXTURE_2D, 0, 0, y0, 0, EW, y1 - y0, 1);
     } else if (y1 > y0) {  // the same texels, copied by a 1:1 blit (no filtering, no scissor: gl_state.hpp)
-      glBindFramebuffer(GL_READ_FRAMEBUFFER, backgroundFbo);
+      glBindFramebuffer(GL_READ_FRAMEBUFFER, sourceFbo);
       glBindFramebuffer(GL_DRAW_FRAMEBUFFER, fbo);
       glBlitFramebuffer(0, y0, EW, y1, 0, y0, EW, y1, GL_COLOR_BUFFER_BIT, GL_NEAREST);
     }
@@ -110,6 +114,9 @@ class RenderPass {
   /// (where moving bodies were drawn over the last frame). Passes that start every frame
   /// from the whole background need nothing.
   virtual void restoreRows(std::pair<int, int> rows) { (void)rows; }
+  /// True when the solids are drawn behind what the pass draws (into the frame's source: the
+  /// liquid sees them through the water); false: over it, after the pass.
+  virtual bool solidsBehind() const { return false; }
   /// CPU drawing into the read-back frame (the colour bar); `textScale` is the font scale.
   virtual void annotate(Frame& /*frame*/, int /*textScale*/) const {}
   /// True when the last draw() used instanced quads instead of points.

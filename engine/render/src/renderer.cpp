@@ -239,6 +239,7 @@ struct Renderer::Impl {
     solidsSeen = solidsHash(in);
     color.background = scenery.background();
     color.backgroundFbo = scenery.backgroundFbo();
+    color.plain = scenery.plainBackground();
     color.EW = geo.EW;
     color.EH = geo.EH;
     pass->targetsChanged();
@@ -256,7 +257,10 @@ struct Renderer::Impl {
     // solids are drawn again where they are, and where they were goes back to the background.
     if (const std::uint64_t h = solidsHash(in); h != solidsSeen) {
       solidsSeen = h;
-      scenery.rebuildSolids(geo, in);
+      scenery.rebuildSolids(def, geo, in);
+      color.background = scenery.background();
+      color.backgroundFbo = scenery.backgroundFbo();
+      color.plain = scenery.plainBackground();
       pass->solidsChanged();
     }
 
@@ -274,6 +278,23 @@ struct Renderer::Impl {
     glViewport(0, 0, geo.EW, geo.EH);
     timer.end(timings.upload);
 
+    if (pass->solidsBehind()) {
+      // The moving bodies into the backdrop the water is seen against; the target's rows where
+      // they were and are start from it.
+      std::pair<int, int> now;
+      const auto [tex, fbo] = scenery.backdrop(d, geo, in, movingRows, now);
+      color.source = tex;
+      color.sourceFbo = fbo;
+      pass->restoreRows(movingRows);
+      pass->restoreRows(now);
+      movingRows = now;
+      pass->draw(f, timer, timings);
+      if (opt.outline) drawOutline(in, pass->changedRows());
+      timer.end(timings.solids);
+      return;
+    }
+    color.source = color.background;
+    color.sourceFbo = color.backgroundFbo;
     pass->restoreRows(movingRows);  // where moving bodies were last frame goes back to the background
     pass->draw(f, timer, timings);
     const auto rows = pass->changedRows();  // solids on top, where the pass may have drawn over them

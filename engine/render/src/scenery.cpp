@@ -25,13 +25,34 @@ void Scenery::release() {
   glDeleteBuffers(2, buffers);
   glDeleteTextures(1, &bgTex_);
   glDeleteFramebuffers(1, &bgFbo_);
+  const GLuint textures[2] = {sceneTex_, backdropTex_}, fbos[2] = {sceneFbo_, backdropFbo_};
+  glDeleteTextures(2, textures);
+  glDeleteFramebuffers(2, fbos);
   bgProg_ = solidProg_ = emptyVao_ = solidVao_ = movingVao_ = solidVbo_ = movingVbo_ = bgTex_ = bgFbo_ = 0;
+  sceneTex_ = sceneFbo_ = backdropTex_ = backdropFbo_ = 0;
   solidCount_ = 0;
 }
 
 void Scenery::build(const RenderDef& def, const FrameGeometry& geo, const RenderInput& in) {
   buildBackground(def, geo);
   buildSolids(geo, in);
+  // The background with the static solids: what a frame starts from and the water is seen
+  // against (the liquid composite samples it between texels where the water shifts it).
+  if (sceneFbo_) glDeleteFramebuffers(1, &sceneFbo_);
+  sceneFbo_ = gl::target(GL_RGBA8, GL_RGBA, GL_UNSIGNED_BYTE, geo.EW, geo.EH, sceneTex_);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, bgFbo_);
+  glBindFramebuffer(GL_DRAW_FRAMEBUFFER, sceneFbo_);
+  glBlitFramebuffer(0, 0, geo.EW, geo.EH, 0, 0, geo.EW, geo.EH, GL_COLOR_BUFFER_BIT, GL_NEAREST);
+  glBindFramebuffer(GL_FRAMEBUFFER, sceneFbo_);
+  glViewport(0, 0, geo.EW, geo.EH);
+  drawSolids(def, 0, geo.EH);
+  if (backdropFbo_) {  // a new size or new solids: the backdrop starts again from the background
+    glDeleteTextures(1, &backdropTex_);
+    glDeleteFramebuffers(1, &backdropFbo_);
+    backdropTex_ = backdropFbo_ = 0;
+  }
 }
 
 void Scenery::buildBackground(const RenderDef& def, const FrameGeometry& geo) {
@@ -43,6 +64,9 @@ void Scenery::buildBackground(const RenderDef& def, const FrameGeometry& geo) {
               float(def.background[2]));
   glUniform1f(gl::uniform(bgProg_, "uGuard"), float(geo.guard));
   glUniform1f(gl::uniform(bgProg_, "uHeight"), float(def.height));
+  const std::vector<double>& ext = geo.ext;
+  glUniform4f(gl::uniform(bgProg_, "uTiles"), float(ext[0]), float(ext[3]), float((ext[2] - ext[0]) / geo.EW),
+              float(def.tiles));
   glBindVertexArray(emptyVao_);
   glDrawArrays(GL_TRIANGLES, 0, 3);
 }
@@ -126,7 +150,35 @@ void Scenery::drawSolids(const RenderDef& def, int rowFirst, int rowLast) const 
 
 std::pair<int, int> Scenery::drawMoving(const RenderDef& def, const FrameGeometry& geo, const RenderInput& in) {
   if (in.moving.empty()) return {0, 0};
-  const std::vector<float> tri = solidTriangles(geo, in.origin, in.moving);
+  return drawMovingTriangles(def, geo, solidTriangles(geo, in.origin, in.moving));
+}
+
+std::pair<GLuint, GLuint> Scenery::backdrop(const RenderDef& def, const FrameGeometry& geo, const RenderInput& in,
+                                            std::pair<int, int> restore, std::pair<int, int>& rows) {
+  rows = {0, 0};
+  const std::vector<float> tri = in.moving.empty() ? std::vector<float>() : solidTriangles(geo, in.origin, in.moving);
+  if (tri.empty() && !backdropFbo_) return {sceneTex_, sceneFbo_};
+  if (!backdropFbo_) {  // the first moving body: the backdrop starts as the whole background
+    backdropFbo_ = gl::target(GL_RGBA8, GL_RGBA, GL_UNSIGNED_BYTE, geo.EW, geo.EH, backdropTex_);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    restore = {0, geo.EH};
+  }
+  restore.second = std::min(restore.second, geo.EH);
+  if (restore.first < restore.second) {  // a 1:1 blit of the same texels (gl_state.hpp: no scissor)
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, sceneFbo_);
+    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, backdropFbo_);
+    glBlitFramebuffer(0, restore.first, geo.EW, restore.second, 0, restore.first, geo.EW, restore.second,
+                      GL_COLOR_BUFFER_BIT, GL_NEAREST);
+  }
+  glBindFramebuffer(GL_FRAMEBUFFER, backdropFbo_);
+  glViewport(0, 0, geo.EW, geo.EH);
+  if (!tri.empty()) rows = drawMovingTriangles(def, geo, tri);
+  return {backdropTex_, backdropFbo_};
+}
+
+std::pair<int, int> Scenery::drawMovingTriangles(const RenderDef& def, const FrameGeometry& geo,
+                                                 const std::vector<float>& tri) {
   if (tri.empty()) return {0, 0};
   float lo = tri[1], hi = tri[1];
   for (std::size_t k = 1; k < tri.size(); k += 2) {

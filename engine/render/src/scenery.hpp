@@ -1,12 +1,15 @@
 // scenery.hpp — what does not move during a run: the background and the solids.
 //
-// Design: the background (shaders/background.frag, a vertical gradient) is drawn once per
-// target size into a texture; each frame starts as a copy of it, and the liquid composite reads
-// it, so both agree to the bit. The solids are the World's colliders as triangles in the
-// targets' NDC, built once per camera: polygons as fans, circles as 64-gons, segments (edges,
-// chain links, zero thickness) as 3 px wide quads. Both are rebuilt when the guard band changes,
-// the solids alone when they change (a game edits its level: Renderer compares a hash of them).
-// Moving bodies are the exception: their triangles are built and drawn every frame.
+// Design: the background (shaders/background.frag, a vertical gradient, tiles when asked) is
+// drawn once per target size into a texture, and into a second one with the static solids drawn
+// over it; each frame starts as a copy of that, and the liquid composite reads both (what is
+// behind the water, and where solids are), so all agree to the bit. The solids are the World's
+// colliders as triangles in the targets' NDC, built once per camera: polygons as fans, circles as
+// 64-gons, segments (edges, chain links, zero thickness) as 3 px wide quads. Both are rebuilt
+// when the guard band changes or the solids change (a game edits its level: Renderer compares a
+// hash of them). Moving bodies are the exception: their triangles are built every frame, drawn
+// over the frame (particles mode) or into the backdrop, a copy of the background that the liquid
+// composite sees through the water (backdrop()).
 #pragma once
 
 #include "camera.hpp"
@@ -25,18 +28,26 @@ class Scenery {
   void release();
   /// (Re)draws the background for targets of `geo` and rebuilds the solids of `in` (local frame).
   void build(const RenderDef& def, const FrameGeometry& geo, const RenderInput& in);
-  /// Rebuilds the solids of `in` only (the static solids changed; the background stays).
-  void rebuildSolids(const FrameGeometry& geo, const RenderInput& in) { buildSolids(geo, in); }
-  /// The background texture (RGBA8, the targets' size).
-  GLuint background() const { return bgTex_; }
+  /// Rebuilds the solids of `in` and the background they are drawn into (the static solids changed).
+  void rebuildSolids(const RenderDef& def, const FrameGeometry& geo, const RenderInput& in) { build(def, geo, in); }
+  /// The background texture (RGBA8, the targets' size), static solids included.
+  GLuint background() const { return sceneTex_; }
   /// The framebuffer of the background texture.
-  GLuint backgroundFbo() const { return bgFbo_; }
+  GLuint backgroundFbo() const { return sceneFbo_; }
+  /// The plain background, without solids (the liquid composite tells solids from it).
+  GLuint plainBackground() const { return bgTex_; }
   /// Draws the solids in `def.solid`'s colour into the bound framebuffer, over the target rows
   /// [rowFirst, rowLast) only (the rest still shows them from an earlier frame).
   void drawSolids(const RenderDef& def, int rowFirst, int rowLast) const;
   /// Draws the moving bodies of `in` (their pose this frame) over the whole bound target;
   /// returns the target rows [first, last) they cover (empty when there are none).
   std::pair<int, int> drawMoving(const RenderDef& def, const FrameGeometry& geo, const RenderInput& in);
+  /// The liquid mode's backdrop of this frame: the background with the moving bodies of `in`
+  /// drawn in. Target rows `restore` (where they were drawn last frame) go back to the background
+  /// first; `rows` gets the rows they cover now. Returns the backdrop's texture and framebuffer:
+  /// the background's own while no moving body was ever drawn.
+  std::pair<GLuint, GLuint> backdrop(const RenderDef& def, const FrameGeometry& geo, const RenderInput& in,
+                                     std::pair<int, int> restore, std::pair<int, int>& rows);
   /// Draws `curves` (world coordinates) as lines `widthPx` wide in `color` into the bound
   /// target, over the target rows [rowFirst, rowLast) only.
   void drawOutline(const FrameGeometry& geo, const std::vector<SurfaceCurve>& curves, const float color[3],
@@ -48,7 +59,14 @@ class Scenery {
 
   GLuint bgProg_ = 0, solidProg_ = 0, emptyVao_ = 0, solidVao_ = 0, solidVbo_ = 0, bgTex_ = 0, bgFbo_ = 0;
   GLsizei solidCount_ = 0;
-  GLuint movingVao_ = 0, movingVbo_ = 0;  // also the outline's: each uploads its triangles before drawing
+  /// The moving bodies' triangles of `in` (NDC) uploaded and drawn into the bound framebuffer;
+  /// returns the target rows they cover.
+  std::pair<int, int> drawMovingTriangles(const RenderDef& def, const FrameGeometry& geo,
+                                          const std::vector<float>& tri);
+
+  GLuint movingVao_ = 0, movingVbo_ = 0;      // also the outline's: each uploads its triangles before drawing
+  GLuint sceneTex_ = 0, sceneFbo_ = 0;        // the background with the static solids
+  GLuint backdropTex_ = 0, backdropFbo_ = 0;  // the liquid's backdrop, made at the first moving body
 };
 
 }  // namespace sph2d

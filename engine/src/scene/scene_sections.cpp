@@ -451,7 +451,9 @@ void readRender(const Reader& r, const json& root, SceneDef& s) {
   const json& j = root.at("render");
   const std::string p = "render";
   r.requireObject(j, p);
-  r.checkKeys(j, p, {"width", "height", "mode", "background", "water", "solid", "splat_radius", "camera"});
+  r.checkKeys(j, p,
+              {"width", "height", "mode", "background", "water", "solid", "splat_radius", "transmission", "refraction",
+               "tiles", "camera"});
   RenderDef& d = s.render;
   d.width = r.integer(j, p, "width", d.width, 16, 8192);
   d.height = r.integer(j, p, "height", d.height, 16, 8192);
@@ -460,6 +462,9 @@ void readRender(const Reader& r, const json& root, SceneDef& s) {
   d.water = r.color(j, p, "water", d.water);
   d.solid = r.color(j, p, "solid", d.solid);
   d.splatRadius = r.number(j, p, "splat_radius", d.splatRadius, 0.25, 8);
+  d.transmission = r.color(j, p, "transmission", d.transmission);
+  d.refraction = r.number(j, p, "refraction", d.refraction, 0, RenderDef::kMaxRefraction);
+  d.tiles = r.number(j, p, "tiles", d.tiles, 0, 1e6);
   if (j.contains("camera")) readCamera(r, j.at("camera"), d.camera);
 }
 

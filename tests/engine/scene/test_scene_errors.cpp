@@ -84,7 +84,8 @@ TEST_CASE("bad input: an unknown key lists the allowed keys and suggests the nea
   // Nothing close: no suggestion, still the list.
   e = errorOf("{\"render\": {\"zoom\": 2}}");
   CHECK(e.message ==
-        "unknown key 'zoom'; allowed keys: width, height, mode, background, water, solid, splat_radius, camera");
+        "unknown key 'zoom'; allowed keys: width, height, mode, background, water, solid, splat_radius, "
+        "transmission, refraction, tiles, camera");
 
   // A key with a control character is shown escaped.
   e = errorOf("{\"a\\u0001b\": 1}");

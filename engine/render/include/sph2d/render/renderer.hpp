@@ -10,9 +10,13 @@
 //                blurred along each row, so light scatters sideways and no
 //                vertical seams appear) and the local fill; uploaded as a small
 //                RG32F texture, sampled bilinearly
+//     backdrop   the background and static solids (drawn once), the moving bodies
+//                drawn into a copy each frame: what the water is in front of
 //     composite  field → liquid: anti-aliased edge, shading from the field's
 //                gradient (light from above), colour from the depth of water
-//                above, foam where the weighted speed is high
+//                above, the backdrop seen through it (absorbed per channel by
+//                its thickness, shifted where its surface tilts), foam where
+//                the weighted speed is high
 //     grains     a granular material's particles as discs in its colour
 //     blobs      particle groups as solid blobs in their colour with a darker outline
 //                (their own splat target, then shaders/blob.frag over the water)
@@ -20,7 +24,8 @@
 //     discs      one anti-aliased disc per particle coloured by a field (speed,
 //                pressure, density, age) on a ramp, plus a colour bar with its range
 //   both
-//     solids     Box2D fixtures with their real shapes
+//     solids     Box2D fixtures with their real shapes (liquid: in the backdrop; particles:
+//                over the discs)
 //   render(): the frame as an image
 //     readback   glReadPixels into RGBA8, rows top-down (the camera flips y)
 //     overlay    optional text (frame, time, particle count) and the colour bar, drawn on the CPU

@@ -1,0 +1,233 @@
+// The liquid mode's water as a material: what is behind it (background, solids) is seen through
+// it, absorbed per colour channel by its thickness (Beer–Lambert) and shifted where its surface
+// tilts (refraction). Synthetic frames of a still lattice of particles, rendered with and without
+// what is behind.
+#include <doctest/doctest.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <cstdlib>
+#include <vector>
+
+#include "sph2d/render/png_io.hpp"
+#include "sph2d/render/renderer.hpp"
+#include "sph2d/scene.hpp"
+
+using namespace sph2d;
+
+namespace {
+
+constexpr double kDx = 0.0125;  // 3 px at 240 px/m, like the dam break
+
+/// A box collider x0..x1 × y0..y1 (counter-clockwise).
+Collider boxCollider(double x0, double y0, double x1, double y1) {
+  Collider c;
+  c.vertices = {Vec2(Real(x0), Real(y0)), Vec2(Real(x1), Real(y0)), Vec2(Real(x1), Real(y1)), Vec2(Real(x0), Real(y1))};
+  c.normals = {Vec2(0, -1), Vec2(1, 0), Vec2(0, 1), Vec2(-1, 0)};
+  c.lo = c.vertices[0];
+  c.hi = c.vertices[2];
+  return c;
+}
+
+/// Square lattices of still particles (spacing `step` each) and what is behind them, seen by a
+/// fixed camera at 240 px per metre: x −0.1 .. 1.9, y −0.1 .. 1.025 in 480 × 270 px.
+struct Pool {
+  ParticleBuffer B;
+  std::vector<Collider> solids;
+  RenderDef def;
+  std::uint32_t nextId = 0;
+  Pool() {
+    def.width = 480;
+    def.height = 270;
+    def.camera.automatic = false;
+    def.camera.min = Vec2d(-0.1, -0.1);
+    def.camera.max = Vec2d(1.9, 1.025);
+  }
+  void fill(double x0, double x1, double y0, double y1, double step) {
+    for (double y = y0 + step / 2; y < y1; y += step)
+      for (double x = x0 + step / 2; x < x1; x += step) B.push(Vec2(Real(x), Real(y)), Vec2(0, 0), nextId++, 1000);
+  }
+  /// The frame with the particles (or none) and the solids (or none).
+  Frame render(bool particles, bool withSolids) const {
+    RenderInput in;
+    ParticleBuffer none;
+    in.particles = particles ? B.view() : none.view();
+    in.spacing = kDx;
+    std::vector<Collider> noSolids;
+    in.colliders = withSolids ? &solids : &noSolids;
+    Renderer r(def);
+    Frame f = r.render(in);
+    if (const char* dump = std::getenv("SPH2D_TEST_DUMP")) writePngAtomic(dump, f.width, f.height, f.rgba.data());
+    return f;
+  }
+};
+
+/// Pixel (column, row) of world point (x, y) in the Pool's camera.
+std::array<int, 2> pixelOf(double x, double y) {
+  const double pxPerM = 240;
+  return {int(std::floor((x + 0.1) * pxPerM)), int(std::floor((1.025 - y) * pxPerM))};
+}
+
+int channel(const Frame& f, int col, int row, int c) {
+  return f.rgba[4 * (std::size_t(row) * std::size_t(f.width) + std::size_t(col)) + std::size_t(c)];
+}
+
+}  // namespace
+
+TEST_CASE("liquid: a dark body behind the water shows through it by the water's transmission per channel") {
+  // A grey background and a dark body x 0.4..0.7, y 0.1..0.4 behind a pool of water (0..1.2 ×
+  // 0..0.6). Against opaque water (transmission 0, the same frame otherwise), each channel of
+  // the water over the body changes by the share the water lets through of the body's
+  // difference from the background: the transmission of a full layer.
+  Pool pool;
+  pool.def.background = {0.4, 0.4, 0.4};
+  pool.def.water = {0.3, 0.5, 0.8};
+  pool.def.solid = {0.02, 0.02, 0.02};
+  pool.def.refraction = 1;
+  pool.fill(0, 1.2, 0, 0.6, kDx);
+  pool.solids = {boxCollider(0.4, 0.1, 0.7, 0.4)};
+  pool.def.transmission = {0, 0, 0};
+  const Frame opaque = pool.render(true, true), opaqueWithout = pool.render(true, false);
+  pool.def.transmission = {0.2, 0.45, 0.7};
+  const Frame with = pool.render(true, true);
+  // The bulk over the body, 3 spacings inside its edges (the refraction's reach is 1).
+  const double in = 3 * kDx;
+  auto share = [&](double x0, double x1) {
+    std::array<double, 3> s{};
+    const auto lo = pixelOf(x0 + in, 0.4 - in), hi = pixelOf(x1 - in, 0.1 + in);
+    int n = 0;
+    for (int row = lo[1]; row <= hi[1]; ++row)
+      for (int col = lo[0]; col <= hi[0]; ++col, ++n)
+        for (int c = 0; c < 3; ++c) s[std::size_t(c)] += channel(with, col, row, c) - channel(opaque, col, row, c);
+    for (int c = 0; c < 3; ++c)
+      s[std::size_t(c)] /= n * 255 * (pool.def.solid[std::size_t(c)] - pool.def.background[std::size_t(c)]);
+    return s;
+  };
+  const auto bulk = share(0.4, 0.7);
+  MESSAGE("share passed: " << bulk[0] << " " << bulk[1] << " " << bulk[2]);
+  for (int c = 0; c < 3; ++c) {
+    CAPTURE(c);
+    CHECK(std::fabs(bulk[std::size_t(c)] - pool.def.transmission[std::size_t(c)]) < 0.02);
+  }
+  // Opaque water hides the body: over it only the depth shading's light, which the body keeps
+  // from spreading sideways, differs (a few levels).
+  const auto lo = pixelOf(0.4 + in, 0.4 - in), hi = pixelOf(0.7 - in, 0.1 + in);
+  int worst = 0;
+  for (int row = lo[1]; row <= hi[1]; ++row)
+    for (int col = lo[0]; col <= hi[0]; ++col)
+      for (int c = 0; c < 3; ++c)
+        worst = std::max(worst, std::abs(channel(opaque, col, row, c) - channel(opaqueWithout, col, row, c)));
+  MESSAGE("opaque water over the body: at most " << worst << " levels from the water without it");
+  CHECK(worst <= 4);
+}
+
+TEST_CASE("liquid: thinner water lets more of what is behind it through") {
+  // Tiles behind a dense pool (the lattice spacing) and a sparse one (1.25 times the spacing:
+  // a fill of 0.64). The share of a joint's brightness the water passes (the frames with and
+  // without the tiles, with and without the water) is the transmission of a full layer in the
+  // dense pool and about its 0.64th power in the sparse one.
+  Pool pool;
+  pool.def.transmission = {0.2, 0.45, 0.7};
+  pool.def.refraction = 0;
+  pool.fill(-0.1, 0.85, 0, 0.6, kDx);
+  pool.fill(0.95, 1.9, 0, 0.6, 1.25 * kDx);
+  const Frame water = pool.render(true, false), nothing = pool.render(false, false);
+  pool.def.tiles = 0.1;
+  const Frame waterTiles = pool.render(true, false), tiles = pool.render(false, false);
+  auto share = [&](double x0, double x1, int c) {
+    // Along the joint y = 0.3 (a row of pixels on each side), between vertical joints.
+    double num = 0, den = 0;
+    for (double x = x0; x < x1; x += 1.0 / 240) {
+      if (std::fabs(x / 0.1 - std::round(x / 0.1)) < 0.15) continue;
+      const auto p = pixelOf(x, 0.3);
+      for (int row = p[1] - 1; row <= p[1] + 1; ++row) {
+        num += channel(waterTiles, p[0], row, c) - channel(water, p[0], row, c);
+        den += channel(tiles, p[0], row, c) - channel(nothing, p[0], row, c);
+      }
+    }
+    REQUIRE(den > 1000);
+    return num / den;
+  };
+  for (int c = 0; c < 3; ++c) {
+    CAPTURE(c);
+    const double t = pool.def.transmission[std::size_t(c)];
+    const double dense = share(0.1, 0.75, c), sparse = share(1.05, 1.8, c);
+    MESSAGE("channel " << c << ": dense water passes " << dense << ", sparse " << sparse);
+    CHECK(std::fabs(dense - t) < 0.05);
+    CHECK(sparse > dense + 0.05);
+    CHECK(std::fabs(sparse - std::pow(t, 0.64)) < 0.08);
+  }
+}
+
+TEST_CASE("liquid: the water's fringe along a body leaves the body's edge as it is drawn") {
+  // Water beside a body (the particles end at its face, as a solver leaves them): the body is
+  // drawn to its edge, every pixel inside it its own colour, whatever the field's fringe over
+  // it (the field reaches two spacings past the particles).
+  Pool beside;
+  beside.def.solid = {0.9, 0.3, 0.2};
+  beside.fill(0, 0.4, 0, 0.6, kDx);
+  beside.fill(0.7, 1.2, 0, 0.6, kDx);
+  beside.fill(0.4, 0.7, 0.4, 0.6, kDx);
+  beside.solids = {boxCollider(0.4, 0.0, 0.7, 0.4)};
+  const Frame f = beside.render(true, true);
+  const auto blo = pixelOf(0.4, 0.4), bhi = pixelOf(0.7, 0.0);
+  int wrong = 0, inside = 0;
+  for (int row = blo[1] + 1; row < bhi[1]; ++row)
+    for (int col = blo[0] + 1; col < bhi[0]; ++col, ++inside)
+      for (int c = 0; c < 3; ++c)
+        wrong += std::abs(channel(f, col, row, c) - int(std::lround(beside.def.solid[std::size_t(c)] * 255))) > 1;
+  CHECK(inside > 5000);
+  CHECK(wrong == 0);
+}
+
+TEST_CASE("liquid: refraction shifts what is behind the water where its surface tilts, and nowhere else") {
+  // Tiles behind a pool whose surface is at y = 0.6: a joint one spacing below the surface
+  // (where the water's thickness falls towards the air) and one deep in the bulk. The joint is
+  // found in the difference of the frames with and without the tiles (what the water lets
+  // through of them, its own shading removed). Seen through the water the near joint appears
+  // shifted towards the thinner water (up), by at most the refraction's spacings; the deep one
+  // stays where it is.
+  auto jointRow = [](const Frame& a, const Frame& b, double x, double y) {
+    // The centroid of the difference's brightness within 4 px of the joint's true row, to a
+    // fraction of a pixel.
+    const auto p = pixelOf(x, y);
+    double m = 0, w = 0;
+    for (int row = p[1] - 4; row <= p[1] + 4; ++row) {
+      double e = 0;
+      for (int c = 0; c < 3; ++c) e += channel(a, p[0], row, c) - channel(b, p[0], row, c);
+      e = std::max(0.0, e);
+      m += e * row;
+      w += e;
+    }
+    CAPTURE(x);
+    CAPTURE(y);
+    REQUIRE(w > 10);
+    return m / w;
+  };
+  const double tile = (0.6 - kDx) / 5;  // joints at y = k·tile: 0.5875 (near) and 0.235 (deep)
+  double shiftNear[2] = {0, 0}, shiftDeep[2] = {0, 0};
+  for (int k = 0; k < 2; ++k) {
+    Pool pool;
+    pool.def.transmission = {0.6, 0.6, 0.6};
+    pool.def.water = {0.1, 0.2, 0.3};  // dark: the surface's highlight stays below white
+    pool.def.refraction = k == 0 ? 0 : 0.75;
+    pool.fill(-0.1, 1.9, 0, 0.6, kDx);
+    const Frame water = pool.render(true, false), nothing = pool.render(false, false);
+    pool.def.tiles = tile;
+    const Frame waterTiles = pool.render(true, false), tiles = pool.render(false, false);
+    for (const double x : {0.3, 0.9, 1.5}) {  // columns between the vertical joints
+      shiftNear[k] += (jointRow(waterTiles, water, x, 5 * tile) - jointRow(tiles, nothing, x, 5 * tile)) / 3;
+      shiftDeep[k] += (jointRow(waterTiles, water, x, 2 * tile) - jointRow(tiles, nothing, x, 2 * tile)) / 3;
+    }
+  }
+  MESSAGE("joint one spacing under the surface moved " << shiftNear[0] << " px without refraction, " << shiftNear[1]
+                                                       << " px with 0.75 spacings; deep joint " << shiftDeep[0] << ", "
+                                                       << shiftDeep[1] << " px");
+  CHECK(std::fabs(shiftNear[0]) < 0.2);
+  CHECK(std::fabs(shiftDeep[0]) < 0.2);
+  CHECK(std::fabs(shiftDeep[1]) < 0.2);
+  CHECK(shiftNear[1] < -0.5);             // up (rows run top-down), towards the thinner water
+  CHECK(shiftNear[1] > -0.75 * 3 - 0.3);  // at most the refraction's 0.75 spacings of 3 px
+}
