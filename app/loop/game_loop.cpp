@@ -156,6 +156,8 @@ void GameLoop::capture(std::int64_t f) {
   q.input.spacing = world_.spacing();
   q.input.colliders = &q.colliders;
   q.input.moving = world_.movingColliders();  // where the moving bodies are in this frame
+  q.diffuse.assign(world_.diffuse());
+  q.input.diffuse = q.diffuse.view();
   q.input.materialColors = materialColors(world_);
   q.input.materialGranular = materialGranular(world_);
   q.input.gravity = world_.scene().gravity.norm();

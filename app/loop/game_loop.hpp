@@ -161,6 +161,7 @@ class GameLoop {
     bool active = false;
     FrameState state;
     ParticleBuffer particles;  ///< copies of the fields the renderer reads
+    DiffuseBuffer diffuse;     ///< and of the foam, spray and bubbles
     std::vector<Collider> colliders;
     RenderInput input;
   } pending_;

@@ -1,7 +1,7 @@
 // The liquid mode's water as a material: what is behind it (background, solids) is seen through
 // it, absorbed per colour channel by its thickness (Beer–Lambert) and shifted where its surface
-// tilts (refraction). Synthetic frames of a still lattice of particles, rendered with and without
-// what is behind.
+// tilts (refraction); foam, spray and bubbles drawn over it. Synthetic frames of still lattices
+// of particles, rendered with and without what is behind, and a dam break with effects.foam.
 #include <doctest/doctest.h>
 
 #include <algorithm>
@@ -14,6 +14,7 @@
 #include "sph2d/render/png_io.hpp"
 #include "sph2d/render/renderer.hpp"
 #include "sph2d/scene.hpp"
+#include "sph2d/world.hpp"
 
 using namespace sph2d;
 
@@ -230,4 +231,68 @@ TEST_CASE("liquid: refraction shifts what is behind the water where its surface 
   CHECK(std::fabs(shiftDeep[1]) < 0.2);
   CHECK(shiftNear[1] < -0.5);             // up (rows run top-down), towards the thinner water
   CHECK(shiftNear[1] > -0.75 * 3 - 0.3);  // at most the refraction's 0.75 spacings of 3 px
+}
+
+TEST_CASE("liquid: foam, spray and bubbles are drawn where they are, light over the water and the air") {
+  // A dam break with effects.foam after its impact: the frame with the diffuse particles against
+  // the same frame without them. Every pixel that changes lies within a spacing of one of them,
+  // and most get lighter.
+  SceneDef s;
+  s.solver.spacing = 0.02;
+  BodyDef tank;
+  for (const auto& box : {std::array<double, 4>{1.0, -0.1, 1.2, 0.1}, std::array<double, 4>{-0.1, 0.6, 0.1, 0.8},
+                          std::array<double, 4>{2.1, 0.6, 0.1, 0.8}}) {
+    ShapeDef b;
+    b.type = ShapeDef::Type::Box;
+    b.center = Vec2d(box[0], box[1]);
+    b.halfSize = Vec2d(box[2], box[3]);
+    tank.fixtures.push_back(b);
+  }
+  s.bodies.push_back(tank);
+  FluidBlockDef column;
+  column.min = Vec2d(0, 0);
+  column.max = Vec2d(0.5, 1.0);
+  s.blocks.push_back(column);
+  s.effects.foam = true;
+  s.render.width = 480;
+  s.render.height = 270;
+  World world(s, WorldOptions{2});
+  for (int f = 0; f < 75; ++f) world.stepFrame();
+  const DiffuseParticles d = world.diffuse();
+  REQUIRE(d.size() > 20);
+  RenderInput in;
+  in.particles = world.particles();
+  in.origin = world.origin();
+  in.spacing = world.spacing();
+  in.colliders = &world.colliders();
+  Renderer plainR(s.render), foamR(s.render);
+  const Frame plain = plainR.render(in);
+  in.diffuse = d;
+  const Frame foamy = foamR.render(in);
+  if (const char* dump = std::getenv("SPH2D_TEST_DUMP"))
+    writePngAtomic(dump, foamy.width, foamy.height, foamy.rgba.data());
+  const std::vector<double> cam = foamR.cameraRect();
+  const double pxPerM = foamy.width / (cam[2] - cam[0]);
+  int changed = 0, lighter = 0, far = 0;
+  for (int row = 0; row < foamy.height; ++row)
+    for (int col = 0; col < foamy.width; ++col) {
+      int before = 0, after = 0;
+      for (int c = 0; c < 3; ++c) {
+        before += channel(plain, col, row, c);
+        after += channel(foamy, col, row, c);
+      }
+      if (before == after && channel(plain, col, row, 0) == channel(foamy, col, row, 0)) continue;
+      ++changed;
+      lighter += after > before;
+      const double x = cam[0] + (col + 0.5) / pxPerM - in.origin.x(), y = cam[3] - (row + 0.5) / pxPerM - in.origin.y();
+      double nearest = 1e9;
+      for (std::size_t k = 0; k < d.size(); ++k)
+        nearest = std::min(nearest, std::hypot(double(d.x[k].x()) - x, double(d.x[k].y()) - y));
+      far += nearest > in.spacing + 1.5 / pxPerM;
+    }
+  MESSAGE(d.size() << " diffuse particles change " << changed << " pixels, " << lighter << " lighter, " << far
+                   << " farther than a spacing from them");
+  CHECK(changed > int(d.size()) / 2);
+  CHECK(lighter > changed * 8 / 10);
+  CHECK(far == 0);
 }

@@ -244,6 +244,23 @@ enum class BudgetPolicy {
   RecycleOldest,  ///< the oldest particles (smallest ids) are removed to make room
 };
 
+/// Foam, spray and bubbles (`effects.foam`, sph2d/foam.hpp): the thresholds [lo, hi] between
+/// which each potential rises from 0 to 1, how many diffuse particles a liquid particle sheds
+/// per second at full potentials, their lifetimes and motion, and their largest number.
+struct FoamDef {
+  Vec2d trappedAir{2, 10};  ///< Σ |v_ij| (1 − v̂_ij·x̂_ij) W̃ [m/s]
+  Vec2d waveCrest{0.5, 3};  ///< κ̃ where the surface moves outward
+  Vec2d energy{1, 10};      ///< ½|v|² [J/kg]
+  double rate = 100;        ///< diffuse particles per second at full potentials [1/s]
+  Vec2d lifetime{1, 3};     ///< each lives a time drawn uniformly between these [s]
+  double buoyancy = 2;      ///< bubbles: the upward push, in multiples of |g|
+  double drag = 20;         ///< bubbles: the rate they take the liquid's velocity [1/s]
+  std::size_t maxParticles = 50000;
+  static constexpr double kMaxThreshold = 1e6, kMaxRate = 1e5, kMaxLifetime = 1e4;
+  static constexpr double kMaxBuoyancy = 100, kMaxDrag = 1e4;
+  static constexpr std::size_t kMaxParticles = 4000000;
+};
+
 /// The effects a scene calls for. Absent effects cost nothing.
 struct EffectsDef {
   bool xsph = false;
@@ -259,6 +276,8 @@ struct EffectsDef {
   std::vector<EmitterDef> emitters;
   std::size_t budget = 0;  ///< particle budget (0: max_particles)
   BudgetPolicy budgetPolicy = BudgetPolicy::StopEmitting;
+  bool foam = false;  ///< foam, spray and bubbles (sph2d/foam.hpp)
+  FoamDef foamDef;
 };
 
 /// A whole scene: the solids, the fluid, the solver, the clock and the camera.

@@ -21,6 +21,7 @@
 #include <vector>
 
 #include "sph2d/boundary.hpp"
+#include "sph2d/foam.hpp"
 #include "sph2d/groups.hpp"
 #include "sph2d/id_range.hpp"
 #include "sph2d/particle_events.hpp"
@@ -326,6 +327,9 @@ class World {
   /// clockwise), from the particles of options.material or of every material. Costs one pass
   /// over the particles and one over the nodes around them; nothing is kept.
   std::vector<SurfaceCurve> surfaceCurves(const SurfaceOptions& options = {}) const;
+  /// The diffuse particles of `effects.foam` (sph2d/foam.hpp): spray, foam and bubbles, in the
+  /// local frame (add origin()); empty without the effect. Valid until the next step.
+  DiffuseParticles diffuse() const;
   /// Sets (or with an empty listener clears) the particle contact listener: after each step
   /// the pairs of particles touching that `filter` takes (particle_events.hpp). While none is
   /// set nothing is computed; with one, a search around each particle of either side.

@@ -27,6 +27,7 @@
 // its material's), which a second composite (shaders/blob.frag) draws over the water as solid
 // blobs with a darker outline. A frame without group particles has neither pass nor target.
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 #include "depth_grid.hpp"
@@ -160,6 +161,7 @@ class LiquidPass final : public RenderPass {
     glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
     glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, grid_.width(), grid_.height(), GL_RG, GL_FLOAT, grid_.aux().data());
     tileRows_ = grid_.tiles(float(def_.splatRadius * f.spacingPx), EW, EH, tiles_);
+    packDiffuse(f);
     tileVertices_ = GLsizei(tiles_.size() / 2);
     glBindBuffer(GL_ARRAY_BUFFER, tileVbo_);
     glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(tiles_.size() * sizeof(float)), tiles_.empty() ? nullptr : tiles_.data(),
@@ -179,6 +181,7 @@ class LiquidPass final : public RenderPass {
     splat(f);
     timer.end(timings.splat);
     composite(f);
+    if (anyDiffuse()) drawDiffuse(f);
     if (!blobs_.empty()) drawBlobs(f);
     if (!grains_.empty()) drawGrains(f);
     timer.end(timings.composite);
@@ -238,6 +241,65 @@ class LiquidPass final : public RenderPass {
     }
     glDisable(GL_BLEND);
     glViewport(0, 0, EW, EH);
+  }
+
+  /// Foam, spray and bubbles' sprites (x, y, colour, alpha; one list per kind), and the target
+  /// rows they cover joined to the tiles' (where the next frame starts from the backdrop again).
+  void packDiffuse(const PassFrame& f) {
+    for (auto& v : diffuse_) v.clear();
+    const DiffuseParticles& d = f.in.diffuse;
+    if (d.size() == 0) return;
+    const double radius = 0.5 * diffuseDiameter(f, 1) + 1;  // foam's: the largest
+    int lo = f.geo.EH, hi = 0;
+    for (std::size_t k = 0; k < d.size(); ++k) {
+      // White spray and foam, pale blue bubbles (dimmer: seen through the water).
+      static const std::uint32_t kColor[3] = {0xF0F6FFu, 0xF8FAFCu, 0xDCEEFFu};
+      static const float kAlpha[3] = {0.9f, 0.95f, 0.6f};
+      const int kind = std::min(2, int(d.kind[k]));
+      const float life = float(d.life[k]), age = float(d.age[k]);
+      const float t = std::min(1.0f, std::max(0.0f, (age - 0.7f * life) / std::max(0.3f * life, 1e-6f)));
+      const float alpha = kAlpha[kind] * (1.0f - t * t * (3.0f - 2.0f * t));
+      const Vec2& x = d.x[k];
+      diffuse_[std::size_t(kind)].insert(diffuse_[std::size_t(kind)].end(), {x.x(), x.y(), float(kColor[kind]), alpha});
+      const double ndcY = double(x.y()) * f.scale[1] + f.offset[1];
+      const double row = (ndcY + 1) * 0.5 * f.geo.EH;
+      if (!(row > -radius && row < f.geo.EH + radius)) continue;
+      lo = std::min(lo, int(std::floor(row - radius)));
+      hi = std::max(hi, int(std::ceil(row + radius)));
+    }
+    lo = std::max(lo, 0);
+    hi = std::min(hi, f.geo.EH);
+    if (lo < hi)
+      tileRows_ = tileRows_.first < tileRows_.second
+                      ? std::pair<int, int>{std::min(tileRows_.first, lo), std::max(tileRows_.second, hi)}
+                      : std::pair<int, int>{lo, hi};
+  }
+
+  /// A diffuse particle's disc [px]: spray 0.8 spacings, foam 1.2, bubbles 0.8 (at least 2 px).
+  static float diffuseDiameter(const PassFrame& f, int kind) {
+    return float(std::max(2.0, (kind == 1 ? 1.2 : 0.8) * f.spacingPx));
+  }
+
+  bool anyDiffuse() const { return !diffuse_[0].empty() || !diffuse_[1].empty() || !diffuse_[2].empty(); }
+
+  /// The diffuse particles over the water, each a small disc (shaders/particles.frag): bubbles,
+  /// then spray, then foam on top.
+  void drawDiffuse(const PassFrame& f) {
+    if (!grainProg_) grainProg_ = gl::program("splat.vert", "particles.frag");
+    glViewport(0, 0, f.geo.EW, f.geo.EH);
+    glEnable(GL_BLEND);
+    glBlendFuncSeparate(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA, GL_ZERO, GL_ONE);
+    for (const int kind : {2, 0, 1}) {
+      const std::vector<float>& s = diffuse_[std::size_t(kind)];
+      if (s.empty()) continue;
+      const float diameter = diffuseDiameter(f, kind);
+      const bool quads = diameter > sprites_.maxPoint();
+      sprites_.upload(s);
+      sprites_.setUniforms(grainProg_, f.scale, f.offset, diameter, f.geo.EW, f.geo.EH, quads);
+      glUniform1i(glGetUniformLocation(grainProg_, "uOwnColor"), 1);
+      sprites_.draw(GLsizei(s.size() / 4), quads);
+    }
+    glDisable(GL_BLEND);
   }
 
   /// The groups' blobs over the water (shaders/blob.frag), over the tiles the fluid can reach.
@@ -376,6 +438,7 @@ class LiquidPass final : public RenderPass {
   GLuint fieldTex_ = 0, fieldFbo_ = 0, auxTex_ = 0, tileVao_ = 0, tileVbo_ = 0;
   int fieldW_ = 0, fieldH_ = 0;  // the splat target: full resolution, or half when sprites are wide
   GLsizei tileVertices_ = 0;
+  std::array<std::vector<float>, 3> diffuse_;    // spray, foam, bubbles: x, y, colour, alpha (packDiffuse)
   std::pair<int, int> tileRows_{0, 0};           // target rows this frame's tiles cover
   std::pair<int, int> drawnRows_{0, 1 << 30};    // rows of the colour target that are not background
   std::pair<int, int> changedRows_{0, 1 << 30};  // rows the last composite restored or drew

@@ -48,6 +48,7 @@ RenderInput inputOf(const World& world, const Real* age) {
   in.age = age;  // null: the World's own ages when its scene has lifetimes (agesOf)
   in.materialColors = materialColors(world);
   in.materialGranular = materialGranular(world);
+  in.diffuse = world.diffuse();
   in.gravity = world.scene().gravity.norm();
   in.frame = world.frame();
   in.time = world.time();

@@ -7,6 +7,7 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -242,6 +243,38 @@ void readLifetime(const Reader& r, const json& j, EffectsDef& e) {
   e.maxAge = r.number(t, q, "max_age", e.maxAge, 0, 1e9, true);
 }
 
+void readFoam(const Reader& r, const json& j, EffectsDef& e) {
+  if (!j.contains("foam")) return;
+  const auto& f = j.at("foam");
+  const std::string q = "effects.foam";
+  r.requireObject(f, q);
+  r.checkKeys(f, q, {"trapped_air", "wave_crest", "energy", "rate", "lifetime", "buoyancy", "drag", "max_particles"});
+  e.foam = true;
+  FoamDef& d = e.foamDef;
+  // [lo, hi] with lo < hi (lo ≤ hi for the lifetime), both in [lo0, hi0].
+  auto range = [&](const char* key, Vec2d& v, double lo0, double hi0, bool equalOk) {
+    if (!f.contains(key)) return;
+    const Vec2d got = r.vec2(f, q, key, v);
+    const std::string k = Reader::sub(q, key);
+    if (!(got.x() >= lo0 && got.y() <= hi0 && (equalOk ? got.x() <= got.y() : got.x() < got.y()))) {
+      std::ostringstream o;
+      o << "expected [low, high] with " << lo0 << " <= low " << (equalOk ? "<=" : "<") << " high <= " << hi0
+        << ", got [" << got.x() << ", " << got.y() << "]";
+      r.fail(k, o.str());
+    }
+    v = got;
+  };
+  range("trapped_air", d.trappedAir, 0, FoamDef::kMaxThreshold, false);
+  range("wave_crest", d.waveCrest, 0, FoamDef::kMaxThreshold, false);
+  range("energy", d.energy, 0, FoamDef::kMaxThreshold, false);
+  range("lifetime", d.lifetime, 1e-3, FoamDef::kMaxLifetime, true);
+  d.rate = r.number(f, q, "rate", d.rate, 0, FoamDef::kMaxRate);
+  d.buoyancy = r.number(f, q, "buoyancy", d.buoyancy, 0, FoamDef::kMaxBuoyancy);
+  d.drag = r.number(f, q, "drag", d.drag, 0, FoamDef::kMaxDrag);
+  d.maxParticles =
+      std::size_t(r.integer64(f, q, "max_particles", (long long)d.maxParticles, 1, (long long)FoamDef::kMaxParticles));
+}
+
 void readSinks(const Reader& r, const json& j, EffectsDef& e) {
   if (!j.contains("sinks")) return;
   const auto& a = j.at("sinks");
@@ -434,13 +467,15 @@ void readEffects(const Reader& r, const json& root, SceneDef& s) {
   const json& j = root.at("effects");
   const std::string p = "effects";
   r.requireObject(j, p);
-  r.checkKeys(j, p, {"xsph", "shifting", "force_fields", "surface_tension", "lifetime", "sinks", "emitters", "budget"});
+  r.checkKeys(
+      j, p, {"xsph", "shifting", "force_fields", "surface_tension", "lifetime", "sinks", "emitters", "budget", "foam"});
   EffectsDef& e = s.effects;
   readShifting(r, j, e);
   readXsph(r, j, e);
   readForceFields(r, j, e);
   readSurfaceTension(r, j, e);
   readLifetime(r, j, e);
+  readFoam(r, j, e);
   readSinks(r, j, e);
   readEmitters(r, j, e, s);
   readBudget(r, j, e);

@@ -150,6 +150,7 @@ std::uint32_t World::addMaterial(const MaterialDef& m) {
     w.buildStages();
   }
   if (granular) granular->materialsChanged(w.materials, w.scene.solver);
+  if (w.foam) w.foam->setGranular(w.granularMaterials());
   if (w.materials.size() == 2) {  // from now on each particle says which (every one there now: the first)
     w.P.fieldU32(ParticleStore::kMaterial);
     w.refreshView();
@@ -194,6 +195,12 @@ double World::totalConcentration(std::uint32_t material) const {
   const std::vector<std::uint32_t>* m = P.findU32(ParticleStore::kMaterial);
   for (std::size_t i = 0; i < P.size(); ++i) sum += (m ? (*m)[i] : 0u) == material ? 1.0 : 0.0;
   return sum;
+}
+
+std::vector<std::uint8_t> World::Impl::granularMaterials() const {
+  std::vector<std::uint8_t> g;
+  for (const MaterialDef& m : materials) g.push_back(m.granular() ? 1 : 0);
+  return g;
 }
 
 }  // namespace sph2d

@@ -106,15 +106,15 @@ void World::Impl::buildStages() {
   if (bodySamplesOn())
     stages.add(plainStage("body_forces",
                           [this](StepContext& c) { moving.samples.react(c.time, double(c.dt), moving.solids); }));
-  addParticleSystemStages(stages);
+  addParticleSystemStages(stages, true);
 
   drift.clear();
   if (!sources.emitters.empty()) drift.add(plainStage("emit", [this](StepContext& c) { emit(c.dt); }));
   drift.add(Stage{"drift", [](StepContext& c) { return stageDrift(c); }});
-  addParticleSystemStages(drift);
+  addParticleSystemStages(drift, false);
 }
 
-void World::Impl::addParticleSystemStages(StageList& list) {
+void World::Impl::addParticleSystemStages(StageList& list, bool full) {
   const std::vector<Real>* k = P.find(ParticleStore::kGroupStiffness);
   if (k && std::any_of(k->begin(), k->end(), [](Real s) { return s > 0 && s < 1; }))
     list.add(plainStage("groups_before_collide", [this](StepContext& c) { groupsBeforeCollide(c); }));
@@ -123,6 +123,8 @@ void World::Impl::addParticleSystemStages(StageList& list) {
   list.add(plainStage("collide", [](StepContext& c) { stageCollide(c); }));
   if (!moving.solids.bodies.empty()) list.add(plainStage("bodies", [this](StepContext& c) { collideMoving(c); }));
   if (P.findU32(ParticleStore::kGroup)) list.add(plainStage("groups", [this](StepContext& c) { matchGroups(c); }));
+  // Foam reads the liquid's neighbour lists: before any slot is removed or wrapped.
+  if (foam && full) list.add(plainStage("foam", [this](StepContext& c) { foam->step(c); }));
   if (periodic.any()) list.add(plainStage("wrap", [](StepContext& c) { stageWrap(c); }));
   if (scene.effects.lifetime) list.add(plainStage("lifetimes", [this](StepContext& c) { lifetimes(c.dt); }));
   if (!scene.effects.sinks.empty()) list.add(plainStage("sinks", [this](StepContext&) { sinks(); }));

@@ -171,6 +171,7 @@ void World::initPhases(std::string& phase) {
   w.solver = makeSolver(sd);
   w.initMaterials();
   w.effects = makeEffects(scene);
+  if (scene.effects.foam) w.foam = std::make_unique<FoamSystem>(scene.effects.foamDef, w.granularMaterials());
   for (std::size_t k = 0; k < scene.effects.emitters.size(); ++k)
     w.checkSceneMaterial(scene.effects.emitters[k].material, "effects.emitters[" + std::to_string(k) + "].material");
   for (std::size_t k = 0; k < scene.blocks.size(); ++k)
@@ -456,6 +457,8 @@ bool World::Impl::viewCurrent() const {
 }
 
 void World::Impl::refreshView() const { view = viewOf(P); }
+
+DiffuseParticles World::diffuse() const { return impl_->foam ? impl_->foam->view() : DiffuseParticles{}; }
 
 const Particles& World::particles() const {
   // Every change of the particles refreshes the view; this is the net for one that did not, and

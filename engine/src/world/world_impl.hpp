@@ -37,6 +37,7 @@
 #include "step/stages.hpp"
 #include "world/box2d_bridge.hpp"
 #include "world/contacts.hpp"
+#include "world/foam.hpp"
 #include "world/moving_bodies.hpp"
 #include "world/particle_index.hpp"
 #include "world/particle_sources.hpp"
@@ -97,10 +98,13 @@ struct World::Impl {
   void initMaterialFields(std::size_t from);
 
   // The subsystems.
-  ParticleSources sources;                  ///< emitters, the budget, removals
-  MovingBodies moving;                      ///< the kinematic and dynamic bodies
-  StaticBridge statics;                     ///< the static bodies read from the b2World
-  ContactTracker contacts;                  ///< contact tracking (off until a game turns it on)
+  ParticleSources sources;           ///< emitters, the budget, removals
+  MovingBodies moving;               ///< the kinematic and dynamic bodies
+  StaticBridge statics;              ///< the static bodies read from the b2World
+  ContactTracker contacts;           ///< contact tracking (off until a game turns it on)
+  std::unique_ptr<FoamSystem> foam;  ///< effects.foam's diffuse particles (null without it)
+  /// 1 per granular material, by index (what sheds no foam).
+  std::vector<std::uint8_t> granularMaterials() const;
   ParticleIndex index;                      ///< lookups by id and by region
   DestructionListener destructionListener;  ///< the game's (empty: none; then nothing is collected)
   ParticleContactListener contactListener;  ///< the game's particle contact listener (empty: none)
@@ -195,7 +199,9 @@ struct World::Impl {
   /// (Re)builds the substep's stage list from the solver, the enabled effects and the particle system.
   void buildStages();
   /// Appends collide, wrap, lifetimes and sinks (those the scene needs) to `list`.
-  void addParticleSystemStages(StageList& list);
+  /// The particle system's stages after the solver's; `full`: the substep's list (false: the
+  /// drift-only one, which has no neighbour lists of its own).
+  void addParticleSystemStages(StageList& list, bool full);
   /// The substep length the solver's and the enabled effects' limits allow now.
   Real stableDt();
   /// The fastest speed an enabled emitter may give a particle within the next frame (0: none).

@@ -54,6 +54,7 @@
 #include <vector>
 
 #include "sph2d/boundary.hpp"
+#include "sph2d/foam.hpp"
 #include "sph2d/particles.hpp"
 #include "sph2d/render/image.hpp"
 #include "sph2d/render/render_env.hpp"  // EnvSetting, pinRenderEnvironment(), cpuSummary()
@@ -109,6 +110,9 @@ struct RenderInput {
   /// 1 per granular material, by index (materialGranular(World)): the liquid mode draws their
   /// particles as grains, each a disc in its material's colour, and no liquid surface for them.
   std::vector<std::uint8_t> materialGranular;
+  /// Foam, spray and bubbles (World::diffuse(), local frame): the liquid mode draws them over
+  /// the water as small light discs, fading out over the last 30 % of their lifetimes.
+  DiffuseParticles diffuse;
   double gravity = 9.81;    ///< |g| [m/s²], scales the default foam speed
   std::uint64_t frame = 0;  ///< for the overlay
   double time = 0;          ///< simulated time [s], for the overlay
