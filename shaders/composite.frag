@@ -36,6 +36,7 @@ uniform vec3 uFoam;
 uniform float uInvDepth;     // 1 / metres of water that darken by 1/e
 uniform vec2 uFoamSpeed;     // foam starts, foam full [m/s]
 uniform float uSpacingPx;    // particle spacing [px]
+uniform float uTapPx;        // the gradient's taps: 0.75 spacing, at least one pixel [px]
 uniform vec3 uLogTransmission;  // ln of the share of each channel a full layer lets through
 uniform float uRefractPx;    // shift [px] of what is behind per unit of the fill's slope [1/px]
 uniform vec3 uBgColor;       // the background's colour (render.background)
@@ -46,15 +47,22 @@ void main() {
   vec2 vUv = gl_FragCoord.xy * uTexel;
   vec2 c = texture(uField, vUv).rg;
   float f = c.r * uInvBulk;
-  float fl = texture(uField, vUv - vec2(uTexel.x, 0.0)).r * uInvBulk;
-  float fr = texture(uField, vUv + vec2(uTexel.x, 0.0)).r * uInvBulk;
-  float fa = texture(uField, vUv - vec2(0.0, uTexel.y)).r * uInvBulk;  // world above
-  float fb = texture(uField, vUv + vec2(0.0, uTexel.y)).r * uInvBulk;  // world below
-  vec2 grad = vec2(fr - fl, fa - fb) * 0.5;  // per pixel, world orientation (y up)
+  // Four taps 0.75 spacing away (uTapPx): their central differences give the gradient, and
+  // where the fluid is dense they low-pass the field with the centre, so that the surface does
+  // not show each particle out of line as a bump; sparse fluid (spray, lone drops) keeps its
+  // own field, which the low-pass would take below the edge's threshold.
+  vec2 t = uTexel * uTapPx;
+  float fl = texture(uField, vUv - vec2(t.x, 0.0)).r * uInvBulk;
+  float fr = texture(uField, vUv + vec2(t.x, 0.0)).r * uInvBulk;
+  float fa = texture(uField, vUv - vec2(0.0, t.y)).r * uInvBulk;  // world above
+  float fb = texture(uField, vUv + vec2(0.0, t.y)).r * uInvBulk;  // world below
+  vec2 grad = vec2(fr - fl, fa - fb) * (0.5 / uTapPx);  // per pixel, world orientation (y up)
   float g = length(grad);
   vec2 aux = texture(uAux, vUv * uAuxScale).rg;
+  float dense = smoothstep(0.15, 0.55, aux.g);
+  f = mix(f, (2.0 * f + fl + fr + fa + fb) / 6.0, dense);
   vec3 bg = texelFetch(uBg, ivec2(gl_FragCoord.xy), 0).rgb;
-  float threshold = mix(0.24, 0.5, smoothstep(0.15, 0.55, aux.g));
+  float threshold = mix(0.24, 0.5, dense);
   // Over a solid the water shows only where the fluid covers it (a body the water flows in
   // front of): the fringe of the field along a body's faces, where the fluid only meets it,
   // leaves the body's edge as it is drawn.

@@ -403,6 +403,7 @@ class LiquidPass final : public RenderPass {
     const double foamLo = opt_.foamSpeed > 0 ? opt_.foamSpeed : 0.35 * std::sqrt(std::max(f.in.gravity, 1e-6) * camH);
     glUniform2f(gl::uniform(cp, "uFoamSpeed"), float(foamLo), float(2 * foamLo));
     glUniform1f(gl::uniform(cp, "uSpacingPx"), float(f.spacingPx));
+    glUniform1f(gl::uniform(cp, "uTapPx"), float(std::max(1.0, 0.75 * f.spacingPx)));
     // Beer–Lambert per channel: ln of what a full layer lets through (a floor for a channel it
     // stops). Without SEE_THROUGH the uniforms are not in the program (location −1: ignored).
     float logT[3];
