@@ -342,3 +342,42 @@ TEST_CASE("liquid: a surface whose particles are out of line by a fraction of a 
   CHECK(std::fabs(mean - (0.421875 - 0.3) * 640) < 8);
   CHECK(rms < 0.1 * 8);
 }
+
+TEST_CASE("liquid: a lone particle in the air is drawn as a droplet of its own area") {
+  // Five lone particles a metre apart above nothing, at 4, 6 and 8 px per spacing: each is a
+  // drop whose drawn area (pixels that differ from the background by more than 30 levels in
+  // some channel) is about the particle's own area, a spacing squared (the area the fluid's
+  // particles stand for), not a dot of a pixel or two.
+  for (const double pxPerSpacing : {4.0, 6.0, 8.0}) {
+    CAPTURE(pxPerSpacing);
+    const double dx = 0.01, pxPerM = pxPerSpacing / dx;
+    ParticleBuffer B;
+    for (std::uint32_t k = 0; k < 5; ++k) B.push(Vec2(Real(0.1 + 0.15 * k), Real(0.1)), Vec2(0, 0), k, 1000);
+    RenderDef def;
+    def.width = 480;
+    def.height = 270;
+    def.camera.automatic = false;
+    def.camera.min = Vec2d(0, 0);
+    def.camera.max = Vec2d(480 / pxPerM, 270 / pxPerM);
+    RenderInput in;
+    ParticleBuffer none;
+    in.spacing = dx;
+    in.particles = none.view();
+    Renderer r0(def), r1(def);
+    const Frame empty = r0.render(in);
+    in.particles = B.view();
+    const Frame drops = r1.render(in);
+    int covered = 0;
+    for (int row = 0; row < drops.height; ++row)
+      for (int col = 0; col < drops.width; ++col) {
+        int worst = 0;
+        for (int c = 0; c < 3; ++c)
+          worst = std::max(worst, std::abs(channel(drops, col, row, c) - channel(empty, col, row, c)));
+        covered += worst > 30;
+      }
+    const double area = covered / 5.0 / (pxPerSpacing * pxPerSpacing);
+    MESSAGE(pxPerSpacing << " px per spacing: a lone drop covers " << area << " spacings squared");
+    CHECK(area > 0.7);
+    CHECK(area < 1.6);
+  }
+}
