@@ -129,7 +129,7 @@ struct GameObjects {
   int fw = W, fh = H;
   GLuint fbo = 0, colorTex = 0, depthRb = 0, readFbo = 0, readTex = 0;
   GLuint prog = 0, vao = 0, vbo = 0, ebo = 0, unpackPbo = 0, packPbo = 0, sampler = 0;
-  GLuint tex[4] = {0, 0, 0, 0};
+  GLuint tex[7] = {0, 0, 0, 0, 0, 0, 0};
 
   explicit GameObjects(int w = W, int h = H) : fw(w), fh(h) {
     glGenTextures(1, &colorTex);
@@ -159,7 +159,7 @@ struct GameObjects {
     glGenFramebuffers(1, &readFbo);
     glBindFramebuffer(GL_FRAMEBUFFER, readFbo);
     glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, readTex, 0);
-    glGenTextures(4, tex);
+    glGenTextures(7, tex);
     for (GLuint t : tex) {
       glBindTexture(GL_TEXTURE_2D, t);
       glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, 4, 4, 0, GL_RGBA, GL_UNSIGNED_BYTE, nullptr);
@@ -221,8 +221,8 @@ struct GameObjects {
 };
 
 /// Sets state far from GL's defaults, everything a game might have left set when it calls
-/// draw(): framebuffers, program, vertex array, buffers, textures on units 0 to 3 with a mipmap
-/// sampler on 0 to 2, the active unit 3, viewport, scissor, blending, depth and stencil tests,
+/// draw(): framebuffers, program, vertex array, buffers, textures on units 0 to 6 with a mipmap
+/// sampler on each, the active unit 3, viewport, scissor, blending, depth and stencil tests,
 /// culling, clear colour, colour mask, polygon mode, sprite origin, point size, pixel store,
 /// sRGB, dithering, alpha to coverage, a clip distance, logic op, polygon smoothing, rasterizer
 /// discard, provoking vertex (the last two the renderer never needs to touch).
@@ -239,10 +239,10 @@ inline void setGameState(const GameObjects& g, bool compatibility = false) {
   glBindBuffer(GL_ARRAY_BUFFER, g.vbo);
   glBindBuffer(GL_PIXEL_UNPACK_BUFFER, g.unpackPbo);
   glBindBuffer(GL_PIXEL_PACK_BUFFER, g.packPbo);
-  for (int u = 0; u < 4; ++u) {
+  for (int u = 0; u < 7; ++u) {
     glActiveTexture(GLenum(GL_TEXTURE0 + u));
     glBindTexture(GL_TEXTURE_2D, g.tex[u]);
-    if (u < 3) glBindSampler(GLuint(u), g.sampler);
+    glBindSampler(GLuint(u), g.sampler);  // the renderer's units 0 to 5 and one beyond them
   }
   glActiveTexture(GL_TEXTURE3);
   glViewport(5, 7, 33, 21);
@@ -324,7 +324,7 @@ inline std::vector<Item> snapshot(bool compatibility = false) {
   ints("active texture", GL_ACTIVE_TEXTURE);
   GLint active = 0;
   glGetIntegerv(GL_ACTIVE_TEXTURE, &active);
-  for (int u = 0; u < 4; ++u) {
+  for (int u = 0; u < 7; ++u) {
     glActiveTexture(GLenum(GL_TEXTURE0 + u));
     const std::string unit = "unit " + std::to_string(u);
     ints((unit + " texture 2D").c_str(), GL_TEXTURE_BINDING_2D);

@@ -40,7 +40,7 @@ ContextInfo currentContext();
 
 /// The texture units the Renderer binds textures on (and unbinds sampler objects from):
 /// 0 .. kTextureUnits - 1.
-constexpr int kTextureUnits = 3;
+constexpr int kTextureUnits = 6;
 
 /// Sets the state the passes rely on (see the design note); the active texture unit is 0.
 void setDrawState(const ContextInfo& ctx);

@@ -30,13 +30,29 @@ Real uniform(std::uint64_t key) {
   return Real(double(key >> 11) * (1.0 / 9007199254740992.0));
 }
 
-/// (min(I, hi) − min(I, lo)) / (hi − lo): 0 below lo, 1 above hi.
-Real clampedPotential(Real v, const Vec2d& range) {
-  const Real lo = Real(range.x()), hi = Real(range.y());
+/// (min(I, hi) − min(I, lo)) / (hi − lo): 0 below lo, 1 above hi (in double: the scene's
+/// bounds differ in double, not always in float).
+double clampedPotential(double v, const Vec2d& range) {
+  const double lo = range.x(), hi = range.y();
   return (std::min(v, hi) - std::min(v, lo)) / (hi - lo);
 }
 
 }  // namespace
+
+bool FoamSystem::liquid(const std::vector<std::uint32_t>* group, const std::vector<std::uint32_t>* material,
+                        std::size_t i) const {
+  if (group && (*group)[i]) return false;
+  const std::uint32_t m = material ? (*material)[i] : 0u;  // one material: no field, material 0
+  return !(m < granular_.size() && granular_[m]);
+}
+
+void FoamSystem::clear() {
+  x_.clear();
+  v_.clear();
+  age_.clear();
+  life_.clear();
+  kind_.clear();
+}
 
 void FoamSystem::step(StepContext& c) {
   advance(c);
@@ -51,6 +67,8 @@ void FoamSystem::advance(StepContext& c) {
   const Real full = Real(kPi<double> * double(R2) / double(c.dx * c.dx));
   const Vec2 g = c.gravity;
   const Real buoyancy = Real(def_.buoyancy), dragStep = std::min(Real(1), Real(def_.drag) * dt);
+  const std::vector<std::uint32_t>* group = P.findU32(ParticleStore::kGroup);
+  const std::vector<std::uint32_t>* material = P.findU32(ParticleStore::kMaterial);
   alive_.assign(n, 0);
   // Each diffuse particle from the liquid around it alone (a gather): any thread count.
   c.pool.parallelFor(n, kBlock, [&](std::size_t b, std::size_t e) {
@@ -59,6 +77,7 @@ void FoamSystem::advance(StepContext& c) {
       Real w = 0, count = 0;
       Vec2 vf = Vec2::Zero();
       c.grid.forCandidates(p, [&](std::uint32_t j) {
+        if (!liquid(group, material, j)) return;  // grains and groups are no water to be in
         Real dx = p.x() - P.x[j].x(), dy = p.y() - P.x[j].y();
         c.periodic.nearest(dx, dy);
         const Real r2 = dx * dx + dy * dy;
@@ -86,6 +105,7 @@ void FoamSystem::advance(StepContext& c) {
         Vec2 vc = v;
         alive = !c.boundary.resolve(x, vc, p, c.clearance);  // it met a solid: gone
       }
+      if (alive) c.periodic.wrap(x);
       x_[k] = x;
       v_[k] = v;
       age_[k] = age;
@@ -120,11 +140,6 @@ void FoamSystem::shed(StepContext& c) {
   const Real R = c.R, R2 = R * R, invR = Real(1) / R, dt = c.dt;
   const std::vector<std::uint32_t>* group = P.findU32(ParticleStore::kGroup);
   const std::vector<std::uint32_t>* material = P.findU32(ParticleStore::kMaterial);
-  auto sheds = [&](std::size_t i) {
-    if (group && (*group)[i]) return false;
-    if (material && (*material)[i] < granular_.size() && granular_[(*material)[i]]) return false;
-    return true;
-  };
   auto pairs = [&](std::size_t i, auto&& f) {
     const std::uint32_t* nb = c.nbr.of(i);
     for (std::uint32_t k = 0; k < c.nbr.count[i]; ++k) {
@@ -160,9 +175,9 @@ void FoamSystem::shed(StepContext& c) {
   c.pool.parallelFor(n, kBlock, [&](std::size_t b, std::size_t e) {
     for (std::size_t i = b; i < e; ++i) {
       count_[i] = 0;
-      if (!sheds(i)) continue;
+      if (!liquid(group, material, i)) continue;
       const Vec2 vi = P.v[i];
-      const Real energy = clampedPotential(Real(0.5) * vi.squaredNorm(), d.energy);
+      const double energy = clampedPotential(0.5 * double(vi.squaredNorm()), d.energy);
       if (energy <= 0) continue;
       const Vec2 ni = normal_[i];
       const Real speed = vi.norm();
@@ -172,23 +187,30 @@ void FoamSystem::shed(StepContext& c) {
         const Vec2 vij = vi - P.v[j];
         const Real vn = vij.norm();
         if (vn > 0) trapped += vn * (Real(1) - vij.dot(xhat) / vn) * wt;
-        if (outward && xhat.dot(ni) > 0) crest += (Real(1) - ni.dot(normal_[j])) * wt;  // j behind i's surface
+        // κ̃ over the surface particles behind i's surface (0 along a flat one, the more its
+        // normals fan out the larger); particles inside have no normal and do not count.
+        if (outward && xhat.dot(ni) > 0 && normal_[j].squaredNorm() > 0) crest += (Real(1) - ni.dot(normal_[j])) * wt;
       });
-      const Real expected = energy *
-                            (Real(d.rate) * clampedPotential(trapped, d.trappedAir) +
-                             Real(d.rate) * clampedPotential(crest, d.waveCrest)) *
-                            dt;
+      double expected =
+          energy * d.rate * (clampedPotential(trapped, d.trappedAir) + clampedPotential(crest, d.waveCrest)) * dt;
+      if (!std::isfinite(expected)) expected = 0;
       const std::uint64_t key = (std::uint64_t(P.id[i]) << 32) ^ timeBits;
-      count_[i] = std::uint32_t(std::min(Real(1e6), std::floor(expected + uniform(key))));
+      count_[i] = std::uint32_t(std::min(1e6, std::floor(expected + double(uniform(key)))));
     }
   });
-  // Where each one's go, in slot order, up to the largest number.
+  // Where each one's go, in slot order. Beyond the largest number every count is scaled down
+  // alike (the room shared over the whole liquid, not given to its first slots).
+  std::uint64_t wanted = 0;
+  for (std::size_t i = 0; i < n; ++i) wanted += count_[i];
+  const std::uint64_t room = def_.maxParticles > x_.size() ? def_.maxParticles - x_.size() : 0;
+  if (wanted > room) {
+    const double share = double(room) / double(wanted);
+    for (std::size_t i = 0; i < n; ++i) count_[i] = std::uint32_t(std::floor(double(count_[i]) * share));
+  }
   offset_.resize(n);
   std::uint64_t total = x_.size();
   for (std::size_t i = 0; i < n; ++i) {
     offset_[i] = total;
-    const std::uint64_t room = def_.maxParticles > total ? def_.maxParticles - total : 0;
-    count_[i] = std::uint32_t(std::min<std::uint64_t>(count_[i], room));
     total += count_[i];
   }
   if (total == x_.size()) return;
@@ -206,7 +228,9 @@ void FoamSystem::shed(StepContext& c) {
         const Real a = Real(2 * kPi<double>) * uniform(key ^ 1), r = half * std::sqrt(uniform(key ^ 2));
         const std::size_t s = std::size_t(offset_[i]) + k;
         // Within half a spacing of it, somewhere along its path in the substep.
-        x_[s] = P.x[i] - P.v[i] * (dt * uniform(key ^ 3)) + r * Vec2(std::cos(a), std::sin(a));
+        Vec2 at = P.x[i] - P.v[i] * (dt * uniform(key ^ 3)) + r * Vec2(std::cos(a), std::sin(a));
+        c.periodic.wrap(at);
+        x_[s] = at;
         v_[s] = P.v[i];
         age_[s] = 0;
         life_[s] = lo + span * uniform(key ^ 4);

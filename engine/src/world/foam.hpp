@@ -20,10 +20,14 @@ class FoamSystem {
   /// the liquid sheds new ones.
   void step(StepContext& c);
   DiffuseParticles view() const { return {x_.data(), v_.data(), age_.data(), life_.data(), kind_.data(), x_.size()}; }
+  /// No diffuse particle (World::load: those of another state would not belong).
+  void clear();
   /// The World's materials changed.
   void setGranular(std::vector<std::uint8_t> granular) { granular_ = std::move(granular); }
 
  private:
+  /// True for a particle of the liquid: not in a group, not of a granular material.
+  bool liquid(const std::vector<std::uint32_t>* group, const std::vector<std::uint32_t>* material, std::size_t i) const;
   void advance(StepContext& c);
   void shed(StepContext& c);
 

@@ -501,6 +501,7 @@ void World::load(std::istream& input) {
   w.index.clear();
   w.lastContacts.clear();  // the particle contact listener's `began` is of the loaded state on
   w.contacts.beginStep();  // the contacts of the state before the load are not this state's
+  if (w.foam) w.foam->clear();  // foam is not saved: the loaded state's grows again
   w.refreshView();
   w.abandonedIn.clear();  // an interrupted World is this state now, and steps again
 }
