@@ -43,6 +43,9 @@ uniform vec3 uBgColor;       // the background's colour (render.background)
 #ifdef TINT
 uniform sampler2D uTint;     // RGBA: sum w*colour, sum w (the field's resolution, bilinear)
 #endif
+#ifdef MATERIAL_T
+uniform sampler2D uAbsorb;   // RGBA: sum w*ln(transmission), sum w: each material's own
+#endif
 void main() {
   vec2 vUv = gl_FragCoord.xy * uTexel;
   vec2 c = texture(uField, vUv).rg;
@@ -99,8 +102,14 @@ void main() {
   // Behind: the ray bends towards the thicker water (+grad in the world; rows run top-down).
   vec2 seenAt = gl_FragCoord.xy + vec2(grad.x, -grad.y) * uRefractPx;
   vec3 behind = texture(uBg, seenAt * uTexel).rgb;
-  vec3 full = exp(uLogTransmission);
-  vec3 through = exp(uLogTransmission * clamp(f, 0.0, 1.0));
+#ifdef MATERIAL_T
+  vec4 ab = texture(uAbsorb, vUv);
+  vec3 logT = ab.rgb / max(ab.a, 1e-6);
+#else
+  vec3 logT = uLogTransmission;
+#endif
+  vec3 full = exp(logT);
+  vec3 through = exp(logT * clamp(f, 0.0, 1.0));
   vec3 scatter = max((water * lambert - full * uBgColor) / max(vec3(1.0) - full, vec3(1e-3)), vec3(0.0));
   water = mix(scatter, behind, through) + vec3(spec) + SURFACE * rim;
 #else

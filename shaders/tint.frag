@@ -7,6 +7,9 @@ in float vWeight;
 in vec2 vCorner;
 uniform bool uQuads;
 out vec4 outTint;
+// With ABSORB: the value is the material's transmission, 8 bits a channel as the colour is, and
+// the target gets RGB = sum of w * ln(transmission) (the composite divides: Beer-Lambert's
+// exponent per unit of thickness where materials meet, the thickness-weighted mean).
 void main() {
   vec2 d = (uQuads ? vCorner : gl_PointCoord) * 2.0 - 1.0;
   float q2 = dot(d, d);
@@ -15,5 +18,9 @@ void main() {
   float w = a * a * a * vWeight;
   uint c = uint(vValue);
   vec3 rgb = vec3(float((c >> 16) & 255u), float((c >> 8) & 255u), float(c & 255u)) / 255.0;
+#ifdef ABSORB
+  outTint = vec4(w * log(max(rgb, vec3(1e-3))), w);
+#else
   outTint = vec4(w * rgb, w);
+#endif
 }

@@ -160,6 +160,7 @@ void GameLoop::capture(std::int64_t f) {
   q.input.diffuse = q.diffuse.view();
   q.input.materialColors = materialColors(world_);
   q.input.materialGranular = materialGranular(world_);
+  q.input.materialTransmission = materialTransmission(world_);
   q.input.gravity = world_.scene().gravity.norm();
   q.input.frame = world_.frame();
   q.input.time = world_.time();

@@ -295,6 +295,11 @@ TEST_CASE("liquid: foam, spray and bubbles are drawn where they are, light over 
   CHECK(changed > int(d.size()) / 2);
   CHECK(lighter > changed * 8 / 10);
   CHECK(far == 0);
+  // The next frame without them, on the same renderer: what they covered (in the air too, where
+  // the composite does not draw) is back to the backdrop, the frame a fresh renderer draws.
+  in.diffuse = DiffuseParticles{};
+  const Frame after = foamR.render(in);
+  CHECK(after.rgba == plain.rgba);
 }
 
 TEST_CASE("liquid: a surface whose particles are out of line by a fraction of a spacing is drawn flat") {
@@ -379,5 +384,74 @@ TEST_CASE("liquid: a lone particle in the air is drawn as a droplet of its own a
     MESSAGE(pxPerSpacing << " px per spacing: a lone drop covers " << area << " spacings squared");
     CHECK(area > 0.7);
     CHECK(area < 1.6);
+  }
+}
+
+TEST_CASE("liquid: each material is seen through by its own transmission") {
+  // Two materials side by side over one dark body: water (transmission 0.2 0.45 0.7) and an ink
+  // that lets nothing through (0 0 0). Over the body the water's pixels change by its share of
+  // the body's contrast and the ink's not at all (against the same frame without the body).
+  Pool pool;
+  pool.def.background = {0.4, 0.4, 0.4};
+  pool.def.water = {0.3, 0.5, 0.8};
+  pool.def.solid = {0.02, 0.02, 0.02};
+  pool.fill(0, 0.6, 0, 0.6, kDx);
+  const std::size_t waterCount = pool.B.size();
+  pool.fill(0.6, 1.2, 0, 0.6, kDx);
+  pool.B.material.assign(pool.B.size(), 0);
+  for (std::size_t k = waterCount; k < pool.B.size(); ++k) pool.B.material[k] = 1;
+  pool.solids = {boxCollider(0.15, 0.1, 1.05, 0.4)};
+  auto render = [&](bool body, bool particles = true) {
+    RenderInput in;
+    ParticleBuffer empty;
+    in.particles = particles ? pool.B.view() : empty.view();
+    in.spacing = kDx;
+    std::vector<Collider> none;
+    in.colliders = body ? &pool.solids : &none;
+    in.materialColors = {0x4D80CCu, 0x4D80CCu};  // the same colour: only the transmissions differ
+    in.materialTransmission = {{0.2f, 0.45f, 0.7f}, {0.0f, 0.0f, 0.0f}};
+    Renderer r(pool.def);
+    return Frame(r.render(in));
+  };
+  const Frame with = render(true), without = render(false);
+  const Frame body = render(true, false), plain = render(false, false);  // what is behind
+  auto meanChange = [&](double x0, double x1, int c) {
+    double change = 0, contrast = 0;
+    const auto lo = pixelOf(x0, 0.35), hi = pixelOf(x1, 0.15);
+    for (int row = lo[1]; row <= hi[1]; ++row)
+      for (int col = lo[0]; col <= hi[0]; ++col) {
+        change += channel(with, col, row, c) - channel(without, col, row, c);
+        contrast += channel(body, col, row, c) - channel(plain, col, row, c);
+      }
+    return change / contrast;
+  };
+  for (int c = 0; c < 3; ++c) {
+    CAPTURE(c);
+    const double water = meanChange(0.2, 0.5, c), ink = meanChange(0.7, 1.0, c);
+    MESSAGE("channel " << c << ": the water passes " << water << " of the body's contrast, the ink " << ink);
+    CHECK(std::fabs(water - std::array<double, 3>{0.2, 0.45, 0.7}[std::size_t(c)]) < 0.03);
+    CHECK(std::fabs(ink) < 0.01);
+  }
+}
+
+TEST_CASE("liquid: a scene's materials take their transmission, or the render's") {
+  const SceneDef s = parseScene(R"({"fluid": [{"min": [0, 0], "max": [1, 1]}],
+      "render": {"transmission": [0.1, 0.2, 0.3]},
+      "materials": [{"name": "water"}, {"name": "ink", "transmission": [0, 0, 0.05]}]})",
+                                "inline.json");
+  REQUIRE(s.materials.size() == 2);
+  CHECK(s.materials[0].transmission == std::array<double, 3>{0.1, 0.2, 0.3});
+  CHECK(s.materials[1].transmission == std::array<double, 3>{0, 0, 0.05});
+  World w(s, WorldOptions{1});
+  const std::vector<std::array<float, 3>> t = materialTransmission(w);
+  REQUIRE(t.size() == 2);
+  CHECK(t[1][2] == 0.05f);
+  try {
+    (void)parseScene(R"({"fluid": [{"min": [0, 0], "max": [1, 1]}],
+        "materials": [{"name": "water", "transmission": [0, 0, 2]}]})",
+                     "inline.json");
+    FAIL("a transmission above 1 was accepted");
+  } catch (const SceneError& e) {
+    CHECK(e.key == "materials[0].transmission");
   }
 }

@@ -43,7 +43,6 @@ class LiquidPass final : public RenderPass {
   LiquidPass(const RenderDef& def, const RenderOptions& opt, SpriteBatch& sprites)
       : def_(def), opt_(opt), sprites_(sprites) {
     splatProg_ = gl::program("splat.vert", "splat.frag");
-    compositeProg_ = gl::program("solid.vert", "composite.frag", seeThrough());
     glGenVertexArrays(1, &tileVao_);
     glGenBuffers(1, &tileVbo_);
     glBindVertexArray(tileVao_);
@@ -59,7 +58,7 @@ class LiquidPass final : public RenderPass {
 
   void targetsChanged() override {
     fieldW_ = fieldH_ = 0;  // recreated at the next splat
-    tintW_ = tintH_ = blobW_ = blobH_ = 0;
+    tintW_ = tintH_ = blobW_ = blobH_ = absorbW_ = absorbH_ = 0;
     grid_.solidsChanged();
     drawnRows_ = {0, 1 << 30};  // a new colour target: the whole background at the next frame
   }
@@ -70,18 +69,22 @@ class LiquidPass final : public RenderPass {
   }
 
   void release() override {
-    for (GLuint p : {splatProg_, compositeProg_, tintProg_, compositeTintProg_, grainProg_, blobProg_})
+    for (GLuint p : {splatProg_, tintProg_, absorbProg_, grainProg_, blobProg_})
       if (p) glDeleteProgram(p);
-    const GLuint textures[4] = {fieldTex_, auxTex_, tintTex_, blobTex_};
-    glDeleteTextures(4, textures);
-    const GLuint fbos[3] = {fieldFbo_, tintFbo_, blobFbo_};
-    glDeleteFramebuffers(3, fbos);
+    for (GLuint& p : compositeProgs_) {
+      if (p) glDeleteProgram(p);
+      p = 0;
+    }
+    const GLuint textures[5] = {fieldTex_, auxTex_, tintTex_, blobTex_, absorbTex_};
+    glDeleteTextures(5, textures);
+    const GLuint fbos[4] = {fieldFbo_, tintFbo_, blobFbo_, absorbFbo_};
+    glDeleteFramebuffers(4, fbos);
     glDeleteVertexArrays(1, &tileVao_);
     glDeleteBuffers(1, &tileVbo_);
-    splatProg_ = compositeProg_ = fieldTex_ = auxTex_ = fieldFbo_ = tileVao_ = tileVbo_ = 0;
-    tintProg_ = compositeTintProg_ = tintTex_ = tintFbo_ = grainProg_ = 0;
+    splatProg_ = fieldTex_ = auxTex_ = fieldFbo_ = tileVao_ = tileVbo_ = 0;
+    tintProg_ = tintTex_ = tintFbo_ = grainProg_ = absorbProg_ = absorbTex_ = absorbFbo_ = 0;
     blobProg_ = blobTex_ = blobFbo_ = 0;
-    tintW_ = tintH_ = blobW_ = blobH_ = 0;
+    tintW_ = tintH_ = blobW_ = blobH_ = absorbW_ = absorbH_ = 0;
   }
 
   /// True for the particle in slot i when its material is granular (drawn as a grain).
@@ -153,6 +156,7 @@ class LiquidPass final : public RenderPass {
         packedTint_[4 * k + 3] = grainAt(f.in, i) || blobAt(f.in, i) ? 0.0f : f.weight[k];
       }
     }
+    chooseTransmission(f);
     const int EW = f.geo.EW, EH = f.geo.EH;
     if (grid_.resize(EW, EH, f.spacingPx))
       gl::makeTexture(auxTex_, GL_RG32F, GL_RG, GL_FLOAT, grid_.width(), grid_.height(), GL_LINEAR);
@@ -228,6 +232,15 @@ class LiquidPass final : public RenderPass {
       glClear(GL_COLOR_BUFFER_BIT);
       sprites_.upload(packedTint_);
       sprites_.setUniforms(tintProg_, f.scale, f.offset, fieldDiameter, fw, fh, quads_);
+      sprites_.draw(GLsizei(f.order.size()), quads_);
+    }
+    if (perMaterial_) {  // the materials' transmissions, alike, into the absorption target
+      if (!absorbProg_) absorbProg_ = gl::program("splat.vert", "tint.frag", "#define ABSORB\n");
+      sizeTarget(GL_RGBA32F, GL_RGBA, fw, fh, shrink, absorbFbo_, absorbTex_, absorbW_, absorbH_);
+      glBindFramebuffer(GL_FRAMEBUFFER, absorbFbo_);
+      glClear(GL_COLOR_BUFFER_BIT);
+      sprites_.upload(packedAbsorb_);
+      sprites_.setUniforms(absorbProg_, f.scale, f.offset, fieldDiameter, fw, fh, quads_);
       sprites_.draw(GLsizei(f.order.size()), quads_);
     }
     if (!blobs_.empty()) {  // the groups' particles, in their colours, into the blob target
@@ -342,19 +355,54 @@ class LiquidPass final : public RenderPass {
     glDisable(GL_BLEND);
   }
 
-  /// The composite's define when the water lets through what is behind it (a transmission above
-  /// 0): without it the program neither samples the backdrop nor mixes it in.
-  const char* seeThrough() const {
-    const auto& t = def_.transmission;
-    return t[0] > 0 || t[1] > 0 || t[2] > 0 ? "#define SEE_THROUGH\n" : "";
+  /// This frame's transmission: each material's own (RenderInput::materialTransmission) where
+  /// materials of different transmission meet, splatted like their colours (packedAbsorb_: each
+  /// one's 8 bits a channel); else the one they share, or the render's. `seeThrough_` when any
+  /// lets something through: the composite's SEE_THROUGH (without it the program neither samples
+  /// the backdrop nor mixes it in).
+  void chooseTransmission(const PassFrame& f) {
+    const auto& mt = f.in.materialTransmission;
+    transmission_ = mt.empty() ? color3(def_.transmission) : mt.front();
+    perMaterial_ = false;
+    bool any = false;
+    for (const auto& t : mt) {
+      perMaterial_ = perMaterial_ || t != mt.front();
+      any = any || t[0] > 0 || t[1] > 0 || t[2] > 0;
+    }
+    perMaterial_ = perMaterial_ && tinted_;
+    seeThrough_ = transmission_[0] > 0 || transmission_[1] > 0 || transmission_[2] > 0 || (perMaterial_ && any);
+    if (!perMaterial_) return;
+    const Particles& P = f.in.particles;
+    const std::size_t n = f.order.size();
+    packedAbsorb_.resize(n * 4);
+    for (std::size_t k = 0; k < n; ++k) {
+      const std::size_t i = f.order[k];
+      const std::uint32_t m = P.material[i];
+      std::uint32_t c = 0;
+      for (int ch = 0; ch < 3; ++ch)
+        c = (c << 8) | std::uint32_t(std::lround(std::clamp(m < mt.size() ? mt[m][ch] : 0.0f, 0.0f, 1.0f) * 255));
+      packedAbsorb_[4 * k] = packedTint_[4 * k];
+      packedAbsorb_[4 * k + 1] = packedTint_[4 * k + 1];
+      packedAbsorb_[4 * k + 2] = float(c);
+      packedAbsorb_[4 * k + 3] = packedTint_[4 * k + 3];
+    }
+  }
+
+  /// The composite's program for this frame (TINT, SEE_THROUGH, MATERIAL_T), compiled at first use.
+  GLuint compositeProgram() {
+    const int key = (tinted_ ? 1 : 0) | (seeThrough_ ? 2 : 0) | (perMaterial_ ? 4 : 0);
+    GLuint& p = compositeProgs_[std::size_t(key)];
+    if (!p)
+      p = gl::program("solid.vert", "composite.frag",
+                      std::string(tinted_ ? "#define TINT\n" : "") + (seeThrough_ ? "#define SEE_THROUGH\n" : "") +
+                          (perMaterial_ ? "#define MATERIAL_T\n" : ""));
+    return p;
   }
 
   /// The field becomes water over the tiles the fluid can reach (shaders/composite.frag).
   void composite(const PassFrame& f) {
     const int EW = f.geo.EW, EH = f.geo.EH;
-    if (tinted_ && !compositeTintProg_)
-      compositeTintProg_ = gl::program("solid.vert", "composite.frag", std::string("#define TINT\n") + seeThrough());
-    const GLuint cp = tinted_ ? compositeTintProg_ : compositeProg_;
+    const GLuint cp = compositeProgram();
     // The colour target still holds the last frame: background and solids, and water over the
     // rows its tiles covered. Only those rows go back to the background; the tiles of this
     // frame write every pixel they cover.
@@ -380,6 +428,11 @@ class LiquidPass final : public RenderPass {
       glActiveTexture(GL_TEXTURE3);
       glBindTexture(GL_TEXTURE_2D, tintTex_);
       glUniform1i(gl::uniform(cp, "uTint"), 3);
+    }
+    if (perMaterial_) {
+      glActiveTexture(GL_TEXTURE5);
+      glBindTexture(GL_TEXTURE_2D, absorbTex_);
+      glUniform1i(gl::uniform(cp, "uAbsorb"), 5);
     }
     glActiveTexture(GL_TEXTURE0);
     glUniform1i(gl::uniform(cp, "uField"), 0);
@@ -407,7 +460,7 @@ class LiquidPass final : public RenderPass {
     // Beer–Lambert per channel: ln of what a full layer lets through (a floor for a channel it
     // stops). Without SEE_THROUGH the uniforms are not in the program (location −1: ignored).
     float logT[3];
-    for (int k = 0; k < 3; ++k) logT[k] = float(std::log(std::max(def_.transmission[k], 1e-9)));
+    for (int k = 0; k < 3; ++k) logT[k] = float(std::log(std::max(double(transmission_[std::size_t(k)]), 1e-9)));
     glUniform3fv(gl::uniform(cp, "uLogTransmission"), 1, logT);
     const auto bgColor = color3(def_.background);
     glUniform3fv(gl::uniform(cp, "uBgColor"), 1, bgColor.data());
@@ -424,12 +477,19 @@ class LiquidPass final : public RenderPass {
   RenderDef def_;
   RenderOptions opt_;
   SpriteBatch& sprites_;
-  GLuint splatProg_ = 0, compositeProg_ = 0;
+  GLuint splatProg_ = 0;
   // More than one material (made on the first such frame): the tint pass and its target.
-  GLuint tintProg_ = 0, compositeTintProg_ = 0, tintTex_ = 0, tintFbo_ = 0;
+  GLuint tintProg_ = 0, tintTex_ = 0, tintFbo_ = 0;
   int tintW_ = 0, tintH_ = 0;
-  bool tinted_ = false;   // this frame draws each material in its colour
-  GLuint grainProg_ = 0;  // the grains' discs (made on the first frame with grains)
+  // Each material's transmission where they differ: its splat target and packing (chooseTransmission).
+  GLuint absorbProg_ = 0, absorbTex_ = 0, absorbFbo_ = 0;
+  int absorbW_ = 0, absorbH_ = 0;
+  std::vector<float> packedAbsorb_;
+  bool perMaterial_ = false, seeThrough_ = false;
+  std::array<float, 3> transmission_{0, 0, 0};
+  std::array<GLuint, 8> compositeProgs_{};  // by TINT | SEE_THROUGH | MATERIAL_T
+  bool tinted_ = false;                     // this frame draws each material in its colour
+  GLuint grainProg_ = 0;                    // the grains' discs (made on the first frame with grains)
   // Particle groups (made on the first frame with one): their splat target and composite.
   GLuint blobProg_ = 0, blobTex_ = 0, blobFbo_ = 0;
   int blobW_ = 0, blobH_ = 0;

@@ -48,6 +48,7 @@ RenderInput inputOf(const World& world, const Real* age) {
   in.age = age;  // null: the World's own ages when its scene has lifetimes (agesOf)
   in.materialColors = materialColors(world);
   in.materialGranular = materialGranular(world);
+  in.materialTransmission = materialTransmission(world);
   in.diffuse = world.diffuse();
   in.gravity = world.scene().gravity.norm();
   in.frame = world.frame();
@@ -64,6 +65,13 @@ std::vector<std::uint32_t> materialColors(const World& world) {
     for (const double v : m.color) c = (c << 8) | std::uint32_t(std::lround(std::clamp(v, 0.0, 1.0) * 255));
     out.push_back(c);
   }
+  return out;
+}
+
+std::vector<std::array<float, 3>> materialTransmission(const World& world) {
+  std::vector<std::array<float, 3>> out;
+  for (const MaterialDef& m : world.materials())
+    out.push_back({float(m.transmission[0]), float(m.transmission[1]), float(m.transmission[2])});
   return out;
 }
 

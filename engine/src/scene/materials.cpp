@@ -120,8 +120,8 @@ void readMaterials(const Reader& r, const nlohmann::json& root, SceneDef& s) {
     const nlohmann::json& j = arr[k];
     r.requireObject(j, p);
     r.checkKeys(j, p,
-                {"name", "density", "viscosity", "color", "miscible_with", "diffusion", "tension_with", "kind",
-                 "friction_angle", "cohesion"});
+                {"name", "density", "viscosity", "color", "transmission", "miscible_with", "diffusion", "tension_with",
+                 "kind", "friction_angle", "cohesion"});
     MaterialDef m;
     if (!j.contains("name")) r.fail(Reader::sub(p, "name"), "missing; expected the material's name");
     m.name = r.string(j, p, "name", "", {});
@@ -132,6 +132,7 @@ void readMaterials(const Reader& r, const nlohmann::json& root, SceneDef& s) {
                          MaterialDef::kMaxDensity);
     if (j.contains("viscosity")) m.viscosity = r.number(j, p, "viscosity", 0, 0, MaterialDef::kMaxViscosity);
     m.color = r.color(j, p, "color", s.render.water);
+    m.transmission = r.color(j, p, "transmission", s.render.transmission);
     m.diffusion = r.number(j, p, "diffusion", m.diffusion, 0, MaterialDef::kMaxDiffusion);
     if (r.string(j, p, "kind", "fluid", {"fluid", "granular"}) == "granular") m.kind = MaterialDef::Kind::granular;
     for (const char* key : {"friction_angle", "cohesion"})

@@ -110,6 +110,9 @@ struct RenderInput {
   /// 1 per granular material, by index (materialGranular(World)): the liquid mode draws their
   /// particles as grains, each a disc in its material's colour, and no liquid surface for them.
   std::vector<std::uint8_t> materialGranular;
+  /// Each material's transmission (materialTransmission(World): MaterialDef::transmission), 0..1
+  /// per channel: the liquid mode sees through each material by its own. Empty: the render's.
+  std::vector<std::array<float, 3>> materialTransmission;
   /// Foam, spray and bubbles (World::diffuse(), local frame): the liquid mode draws them over
   /// the water as small light discs, fading out over the last 30 % of their lifetimes.
   DiffuseParticles diffuse;
@@ -234,6 +237,8 @@ inline const Real* agesOf(const RenderInput& in) {
 std::vector<std::uint32_t> materialColors(const World& world);
 /// 1 for each granular material of `world`, by index (empty when it has none).
 std::vector<std::uint8_t> materialGranular(const World& world);
+/// Each material's transmission (MaterialDef::transmission), by index.
+std::vector<std::array<float, 3>> materialTransmission(const World& world);
 
 /// The camera of `def` for a RenderInput (same rules as above).
 std::vector<double> resolveCamera(const RenderDef& def, const RenderInput& in);
