@@ -82,6 +82,7 @@ int cmdRender(const std::vector<std::string>& args) {
   in.age = snap.age.empty() ? nullptr : snap.age.data();
   in.materialColors = materialColors(world);
   in.materialGranular = materialGranular(world);
+  in.materialTransmission = materialTransmission(world);
   in.gravity = scene.gravity.norm();
   in.frame = snap.frame;
   in.time = snap.time;

@@ -446,6 +446,19 @@ TEST_CASE("liquid: a scene's materials take their transmission, or the render's"
   const std::vector<std::array<float, 3>> t = materialTransmission(w);
   REQUIRE(t.size() == 2);
   CHECK(t[1][2] == 0.05f);
+  // Without a materials table the one material is the render's: its transmission too.
+  const SceneDef plain = parseScene(R"({"fluid": [{"min": [0, 0], "max": [1, 1]}],
+      "render": {"transmission": [0, 0, 0]}})",
+                                    "inline.json");
+  World one(plain, WorldOptions{1});
+  const std::vector<std::array<float, 3>> t1 = materialTransmission(one);
+  REQUIRE(t1.size() == 1);
+  CHECK(t1[0] == std::array<float, 3>{0, 0, 0});
+  MaterialDef bad;
+  bad.name = "glass";
+  bad.transmission = {0, 0, 1.5};
+  CHECK_THROWS_WITH_AS(one.addMaterial(bad), doctest::Contains("transmission components must be in 0..1"),
+                       std::invalid_argument);
   try {
     (void)parseScene(R"({"fluid": [{"min": [0, 0], "max": [1, 1]}],
         "materials": [{"name": "water", "transmission": [0, 0, 2]}]})",

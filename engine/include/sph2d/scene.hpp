@@ -153,7 +153,8 @@ struct MaterialDef {
   double viscosity = -1;                          ///< kinematic ν [m²/s]; < 0: the solver's (solver.viscosity)
   std::array<double, 3> color{0.10, 0.45, 0.85};  ///< drawn colour, linear RGB in 0..1
   /// Liquid mode: the share of each channel of what is behind it that a full layer lets through
-  /// (RenderDef::transmission, per material; a scene's default is its render's).
+  /// (RenderDef::transmission, per material). A scene's materials default to its render's; one
+  /// made in code (World::addMaterial) has this unless the game sets it.
   std::array<double, 3> transmission{0.25, 0.4, 0.5};
   std::vector<std::string> miscibleWith;          ///< the materials it mixes with, by name
   double diffusion = 1e-3;  ///< D [m²/s] of dc/dt = D∇²c with a material it mixes with (the pair's mean)

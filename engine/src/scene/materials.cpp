@@ -40,6 +40,7 @@ std::vector<MaterialDef> sceneMaterials(const SceneDef& scene) {
   m.density = scene.solver.restDensity;
   m.viscosity = scene.solver.viscosity;
   m.color = scene.render.water;
+  m.transmission = scene.render.transmission;
   return {m};
 }
 
@@ -70,6 +71,8 @@ std::string materialProblem(const std::vector<MaterialDef>& materials, const Mat
     o << "kind \"granular\" needs the game solver's grid projection (solver.grid_cell above 0, its default 2)";
   for (double c : m.color)
     if (o.tellp() == 0 && !(c >= 0 && c <= 1)) o << "color components must be in 0..1, got " << c;
+  for (double t : m.transmission)
+    if (o.tellp() == 0 && !(t >= 0 && t <= 1)) o << "transmission components must be in 0..1, got " << t;
   if (o.tellp() != 0) return o.str();
   for (const MaterialDef& other : materials)
     if (other.name == m.name) return "the name \"" + m.name + "\" is taken (materials: " + names(materials) + ")";

@@ -144,6 +144,7 @@ void FoamSystem::shed(StepContext& c) {
     const std::uint32_t* nb = c.nbr.of(i);
     for (std::uint32_t k = 0; k < c.nbr.count[i]; ++k) {
       const std::uint32_t j = nb[k];
+      if (!liquid(group, material, j)) continue;  // grains and groups are not the liquid's surface or flow
       Real dx = P.x[i].x() - P.x[j].x(), dy = P.x[i].y() - P.x[j].y();
       c.periodic.nearest(dx, dy);
       const Real r2 = dx * dx + dy * dy;
@@ -203,14 +204,18 @@ void FoamSystem::shed(StepContext& c) {
   std::uint64_t wanted = 0;
   for (std::size_t i = 0; i < n; ++i) wanted += count_[i];
   const std::uint64_t room = def_.maxParticles > x_.size() ? def_.maxParticles - x_.size() : 0;
-  if (wanted > room) {
+  if (wanted > room) {  // rounded by each particle's hash (counts are mostly 0 or 1), then clamped
     const double share = double(room) / double(wanted);
-    for (std::size_t i = 0; i < n; ++i) count_[i] = std::uint32_t(std::floor(double(count_[i]) * share));
+    for (std::size_t i = 0; i < n; ++i) {
+      const std::uint64_t key = ((std::uint64_t(P.id[i]) << 32) ^ timeBits) ^ 5;
+      count_[i] = std::uint32_t(std::floor(double(count_[i]) * share + double(uniform(key))));
+    }
   }
   offset_.resize(n);
   std::uint64_t total = x_.size();
   for (std::size_t i = 0; i < n; ++i) {
     offset_[i] = total;
+    count_[i] = std::uint32_t(std::min<std::uint64_t>(count_[i], room - std::min(room, total - x_.size())));
     total += count_[i];
   }
   if (total == x_.size()) return;

@@ -146,7 +146,22 @@ TEST_CASE("foam: with an emitter, lifetimes and a sink (particles added and remo
     hashes[k] = all.digest();
   }
   MESSAGE("fountain: up to " << most << " diffuse particles");
+  CHECK(most > 0);
   CHECK(hashes[0] == hashes[1]);
+
+  // A small cap: the foam fills it (each count rounded by its particle's hash when the room is
+  // short, not all rounded down to none) and never exceeds it.
+  SceneDef capped = damBreak();
+  capped.effects.foamDef.maxParticles = 20;
+  World w(capped, WorldOptions{2});
+  std::size_t top = 0;
+  for (int f = 0; f < 90; ++f) {
+    w.stepFrame();
+    top = std::max(top, w.diffuse().size());
+  }
+  MESSAGE("with max_particles 20: at most " << top);
+  CHECK(top <= 20);
+  CHECK(top >= 15);
 }
 
 TEST_CASE("foam: a dam break's impact makes spray, foam and bubbles, each gone within its lifetime") {

@@ -111,7 +111,8 @@ struct RenderInput {
   /// particles as grains, each a disc in its material's colour, and no liquid surface for them.
   std::vector<std::uint8_t> materialGranular;
   /// Each material's transmission (materialTransmission(World): MaterialDef::transmission), 0..1
-  /// per channel: the liquid mode sees through each material by its own. Empty: the render's.
+  /// per channel: the liquid mode sees through each material by its own (with materialColors and
+  /// a material per particle; else all by the first's). Empty: the render's.
   std::vector<std::array<float, 3>> materialTransmission;
   /// Foam, spray and bubbles (World::diffuse(), local frame): the liquid mode draws them over
   /// the water as small light discs, fading out over the last 30 % of their lifetimes.
