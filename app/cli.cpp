@@ -237,7 +237,9 @@ const char* kRenderFlagsHelp =
     "  --overlay       draw frame number, simulated time and particle count\n"
     "  --outline       draw the fluid's outline (World::surfaceCurves) over it\n"
     "  --foam-speed V  liquid: foam starts at V m/s, full at 2V (default 0.35·sqrt(g·view height))\n"
-    "  --depth-scale D liquid: D metres of water above darken the colour by 1/e (default 1)\n";
+    "  --depth-scale D liquid: D metres of water above darken the colour by 1/e (default 1)\n"
+    "  --splat P       liquid: where the field is summed: cpu, gl (point sprites) or auto (the\n"
+    "                  default: cpu when the OpenGL is a software rasterizer such as llvmpipe)\n";
 
 bool parseRenderFlag(ArgReader& a, RenderOptions& o) {
   const std::string s = a.arg();
@@ -264,6 +266,16 @@ bool parseRenderFlag(ArgReader& a, RenderOptions& o) {
   } else if (s == "--foam-speed") {
     o.foamSpeed = parseNumber(s, value());
     if (!(o.foamSpeed > 0)) throw UsageError("--foam-speed must be > 0");
+  } else if (s == "--splat") {
+    const std::string v = value();
+    if (v == "auto")
+      o.splat = RenderOptions::Splat::Auto;
+    else if (v == "cpu")
+      o.splat = RenderOptions::Splat::Cpu;
+    else if (v == "gl")
+      o.splat = RenderOptions::Splat::Gl;
+    else
+      throw UsageError("--splat expects auto, cpu or gl, got '" + v + "'");
   } else if (s == "--depth-scale") {
     o.depthScale = parseNumber(s, value());
     if (!(o.depthScale > 0)) throw UsageError("--depth-scale must be > 0");

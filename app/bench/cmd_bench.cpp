@@ -35,7 +35,9 @@ const char* kBenchHelp =
     "Stages are timed with glFinish between them; the 'render, no sync' row is the\n"
     "same frame without those fences, as `sph2d run` renders it. In liquid mode the\n"
     "'opaque water' rows render the same frames, alternately, with render.transmission\n"
-    "0 (nothing seen through the water): what the see-through costs. The CPU rows are the\n"
+    "0 (nothing seen through the water): what the see-through costs; the 'splat (gl)' and\n"
+    "'splat (cpu)' rows render them, alike, with the liquid's field summed by the path not\n"
+    "chosen (--splat): what the choice saves. The CPU rows are the\n"
     "process's CPU time (every thread: llvmpipe's too) per frame, which other processes\n"
     "on a shared machine disturb less than wall time. --save writes the frame.\n"
     "\n"
@@ -155,6 +157,15 @@ int cmdBench(const std::vector<std::string>& args) {
   std::optional<Renderer> opaqueProfiled;
   if (liquid) opaqueProfiled.emplace(opaqueDef, opt);
   Stat opaqueComposite, opaqueNosync;
+  // The liquid's splat by the other path (CPU sums or GL point sprites, RenderOptions::splat),
+  // the same frames in the same run: what the path chosen saves.
+  RenderOptions otherOpt = opt;
+  const std::string splatPath = profiled.splatPath();
+  otherOpt.splat = splatPath == "cpu" ? RenderOptions::Splat::Gl : RenderOptions::Splat::Cpu;
+  std::optional<Renderer> otherProfiled;
+  if (liquid) otherProfiled.emplace(scene.render, otherOpt);
+  const std::string otherPath = otherProfiled ? otherProfiled->splatPath() : std::string();
+  Stat otherSplat, otherNosync;
   std::printf("bench render: %zu particles, %dx%d, %s mode, %d frames, PNG level %d\nrenderer: %s\n", P.size(), width,
               height, profiled.mode().c_str(), frames, level, profiled.rendererString().c_str());
   Stat upload, splat, composite, solids, readback, overlay, png, hash, total, nosync, pngBytes, cpuRender, cpuPng;
@@ -163,11 +174,16 @@ int cmdBench(const std::vector<std::string>& args) {
     const Frame& first = profiled.render(in);  // warm-up: shader compilation, first-use costs
     if (!save.empty()) writePngAtomic(save, first.width, first.height, first.rgba.data(), level);
     if (opaqueProfiled) opaqueProfiled->render(in);
+    if (otherProfiled) otherProfiled->render(in);
   }
   for (int k = 0; k < frames; ++k) {
     if (opaqueProfiled) {
       opaqueProfiled->render(in);
       opaqueComposite.v.push_back(opaqueProfiled->lastTimings().composite);
+    }
+    if (otherProfiled) {
+      otherProfiled->render(in);
+      otherSplat.v.push_back(otherProfiled->lastTimings().splat);
     }
     const Frame& fr = profiled.render(in);
     const RenderTimings t = profiled.lastTimings();
@@ -206,10 +222,12 @@ int cmdBench(const std::vector<std::string>& args) {
   {
     Renderer plain(scene.render, opt);
     plain.render(in);
-    std::optional<Renderer> opaque;
+    std::optional<Renderer> opaque, other;
     if (liquid) {
       opaque.emplace(opaqueDef, opt);
       opaque->render(in);
+      other.emplace(scene.render, otherOpt);
+      other->render(in);
     }
     for (int k = 0; k < frames; ++k) {
       const double c0 = processCpuMs();
@@ -219,6 +237,10 @@ int cmdBench(const std::vector<std::string>& args) {
       if (opaque) {
         opaque->render(in);
         opaqueNosync.v.push_back(opaque->lastTimings().total);
+      }
+      if (other) {
+        other->render(in);
+        otherNosync.v.push_back(other->lastTimings().total);
       }
     }
   }
@@ -240,7 +262,9 @@ int cmdBench(const std::vector<std::string>& args) {
   std::printf("%-22s %9s %9s\n", "stage", "mean ms", "best ms");
   auto row = [](const char* name, const Stat& s) { std::printf("%-22s %9.2f %9.2f\n", name, s.mean(), s.best()); };
   row("upload (CPU, grid)", upload);
-  row(profiled.mode() == "liquid" ? "splat" : "discs", splat);
+  const std::string splatRow = "splat (" + splatPath + ")", otherRow = "splat (" + otherPath + ")";
+  row(liquid ? splatRow.c_str() : "discs", splat);
+  if (liquid) row(otherRow.c_str(), otherSplat);
   if (liquid) row("composite", composite);
   if (liquid) row("composite, opaque water", opaqueComposite);
   row("solids", solids);
@@ -249,6 +273,8 @@ int cmdBench(const std::vector<std::string>& args) {
   row("render, synced", total);
   row("render, no sync", nosync);
   if (liquid) row("same, opaque water", opaqueNosync);
+  const std::string otherSame = "same, splat (" + otherPath + ")";
+  if (liquid) row(otherSame.c_str(), otherNosync);
   row("PNG encode", png);
   row("XXH64 of pixels", hash);
   row("PNG, coder only", encodeOwn);

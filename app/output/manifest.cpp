@@ -35,6 +35,7 @@ json renderOptionsJson(const RenderOptions& o) {
   j["outline"] = o.outline;
   j["foam_speed"] = o.foamSpeed;
   j["depth_scale"] = o.depthScale;
+  j["splat"] = o.splat == RenderOptions::Splat::Cpu ? "cpu" : o.splat == RenderOptions::Splat::Gl ? "gl" : "auto";
   return j;
 }
 
@@ -57,6 +58,9 @@ RunManifest::RunManifest(const RunArgs& a, const SceneDef& scene, const Renderer
                  {"png_level", a.pngLevel},
                  {"mode", renderer.mode()}};
   j_["render"] = renderOptionsJson(a.render);
+  // The splat's path as resolved for this renderer (RenderOptions::splat), so that a check
+  // elsewhere sums the field as this run did; "auto" in particles mode (no splat).
+  j_["render"]["splat"] = renderer.splatPath().empty() ? std::string("auto") : renderer.splatPath();
   j_["run"] = {{"frames", frames},     {"every", a.every}, {"threads", threads},     {"fps", scene.fps},
                {"export", exportName}, {"video", a.video}, {"realtime", a.realtime}, {"inputs", a.inputs}};
   j_["frames"] = json::array();

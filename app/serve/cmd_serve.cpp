@@ -146,7 +146,7 @@ ServeArgs parseServeArgs(const std::vector<std::string>& a) {
           "' for serve; options: --port, --bind, --record, --threads, "
           "--max-clients, --format, --quality, --catch-up, --max-event-particles, --max-particles-per-second, "
           "--max-particles, --mode, --color-by, --range, --overlay, "
-          "--foam-speed, --depth-scale, --quiet (see sph2d serve --help)");
+          "--foam-speed, --depth-scale, --splat, --quiet (see sph2d serve --help)");
     else if (r.scene.empty())
       r.scene = s;
     else

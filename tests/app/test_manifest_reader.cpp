@@ -99,6 +99,17 @@ TEST_CASE("manifest reader: render options outside what sph2d run writes are ref
   m["render"]["foam_speed"] = -1;
   CHECK(refusal(m).find("'render.foam_speed'") != std::string::npos);
   m = good;
+  m["render"]["splat"] = "vulkan";
+  CHECK(refusal(m).find("'render.splat' is missing or not \"auto\", \"cpu\" or \"gl\"") != std::string::npos);
+  m = good;
+  m["render"]["splat"] = 1;
+  CHECK(refusal(m).find("'render.splat'") != std::string::npos);
+  m = good;
+  m["render"]["splat"] = "gl";  // the path the run summed its splat by, taken by a check
+  CHECK(parseManifest(m.dump(), "m.json").render.splat == sph2d::RenderOptions::Splat::Gl);
+  m["render"].erase("splat");  // a manifest from before the CPU's splat: the renderer chooses
+  CHECK(parseManifest(m.dump(), "m.json").render.splat == sph2d::RenderOptions::Splat::Auto);
+  m = good;
   m["render"]["range"] = json::array({0, 2.5});
   m["render"]["mode"] = "particles";
   const ManifestView v = parseManifest(m.dump(), "m.json");

@@ -29,7 +29,9 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstring>
 
+#include "cpu_splat.hpp"
 #include "depth_grid.hpp"
 #include "render_pass.hpp"
 
@@ -43,6 +45,7 @@ class LiquidPass final : public RenderPass {
   LiquidPass(const RenderDef& def, const RenderOptions& opt, SpriteBatch& sprites)
       : def_(def), opt_(opt), sprites_(sprites) {
     splatProg_ = gl::program("splat.vert", "splat.frag");
+    cpuSplat_ = opt.splat == RenderOptions::Splat::Cpu || (opt.splat == RenderOptions::Splat::Auto && softwareGl());
     glGenVertexArrays(1, &tileVao_);
     glGenBuffers(1, &tileVbo_);
     glBindVertexArray(tileVao_);
@@ -52,6 +55,7 @@ class LiquidPass final : public RenderPass {
   }
 
   const char* mode() const override { return "liquid"; }
+  const char* splatPath() const override { return cpuSplat_ ? "cpu" : "gl"; }
   float spriteDiameter(double spacingPx) const override { return float(2.0 * def_.splatRadius * spacingPx); }
   int spriteShrink(double spacingPx) const override { return spriteDiameter(spacingPx) >= 8.0f ? 2 : 1; }
   bool solidsBehind() const override { return true; }
@@ -85,6 +89,16 @@ class LiquidPass final : public RenderPass {
     tintProg_ = tintTex_ = tintFbo_ = grainProg_ = absorbProg_ = absorbTex_ = absorbFbo_ = 0;
     blobProg_ = blobTex_ = blobFbo_ = 0;
     tintW_ = tintH_ = blobW_ = blobH_ = absorbW_ = absorbH_ = 0;
+  }
+
+  /// True when the current context's OpenGL is a software rasterizer (Mesa's llvmpipe, softpipe
+  /// or swrast): there the CPU sums the splat (cpu_splat.hpp).
+  static bool softwareGl() {
+    const char* r = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
+    if (!r) return false;
+    for (const char* name : {"llvmpipe", "softpipe", "swrast"})
+      if (std::strstr(r, name)) return true;
+    return false;
   }
 
   /// True for the particle in slot i when its material is granular (drawn as a grain).
@@ -140,7 +154,6 @@ class LiquidPass final : public RenderPass {
         grains_.insert(grains_.end(), {P.x[i].x(), P.x[i].y(), float(c), f.weight[k]});
       }
     }
-    sprites_.upload(packed_);
     // More than one material: each particle's material colour too (uploaded by splat()).
     const std::vector<std::uint32_t>& colors = f.in.materialColors;
     tinted_ = !colors.empty() && P.material.size() == P.size();
@@ -192,12 +205,12 @@ class LiquidPass final : public RenderPass {
   }
 
  private:
-  /// Makes the float target `fbo` (texture `tex`, now w × h) fw × fh when its size changed,
-  /// sampled bilinearly when the field is shrunk: the splat field (RG), the tint and the blobs
-  /// (RGBA).
-  static void sizeTarget(GLenum internal, GLenum format, int fw, int fh, int shrink, GLuint& fbo, GLuint& tex, int& w,
+  /// Makes the float target `fbo` (texture `tex`, now w × h) fw × fh when its size changed
+  /// (then returns true), sampled bilinearly when the field is shrunk: the splat field (RG), the
+  /// tint and the blobs (RGBA).
+  static bool sizeTarget(GLenum internal, GLenum format, int fw, int fh, int shrink, GLuint& fbo, GLuint& tex, int& w,
                          int& h) {
-    if (fw == w && fh == h) return;
+    if (fw == w && fh == h) return false;
     if (fbo) glDeleteFramebuffers(1, &fbo);
     fbo = gl::target(internal, format, GL_FLOAT, fw, fh, tex);
     const GLint filter = shrink > 1 ? GL_LINEAR : GL_NEAREST;
@@ -205,55 +218,74 @@ class LiquidPass final : public RenderPass {
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, filter);
     w = fw;
     h = fh;
+    return true;
   }
 
   /// Σw and Σw·speed into the RG32F field (shaders/splat.*); at half resolution when sprites
   /// are at least 8 px wide (a quarter of the fragments; the composite samples it bilinearly).
+  /// Then, alike, the materials' colours, their transmissions and the groups' particles into
+  /// their RGBA32F targets, when the frame has them.
   void splat(const PassFrame& f) {
     const int EW = f.geo.EW, EH = f.geo.EH;
-    const float diameter = spriteDiameter(f.spacingPx);
     const int shrink = spriteShrink(f.spacingPx);
-    const int fw = (EW + shrink - 1) / shrink, fh = (EH + shrink - 1) / shrink;
-    sizeTarget(GL_RG32F, GL_RG, fw, fh, shrink, fieldFbo_, fieldTex_, fieldW_, fieldH_);
-    const float fieldDiameter = diameter * float(fw) / float(EW);
-    quads_ = fieldDiameter > sprites_.maxPoint();
-    glViewport(0, 0, fw, fh);
-    glBindFramebuffer(GL_FRAMEBUFFER, fieldFbo_);
+    SplatTarget t;
+    t.w = (EW + shrink - 1) / shrink;
+    t.h = (EH + shrink - 1) / shrink;
+    t.shrink = shrink;
+    t.diameter = spriteDiameter(f.spacingPx) * float(t.w) / float(EW);
+    quads_ = !cpuSplat_ && t.diameter > sprites_.maxPoint();
+    glViewport(0, 0, t.w, t.h);
     glClearColor(0, 0, 0, 0);
-    glClear(GL_COLOR_BUFFER_BIT);
     glEnable(GL_BLEND);
     glBlendFunc(GL_ONE, GL_ONE);
-    sprites_.setUniforms(splatProg_, f.scale, f.offset, fieldDiameter, fw, fh, quads_);
-    sprites_.draw(GLsizei(f.order.size()), quads_);
-    if (tinted_) {  // the materials' colours, splatted alike into the tint target
+    const std::size_t n = f.order.size();
+    fillTarget(f, t, SplatSum::Field, splatProg_, packed_, n, cpuTargets_[0], fieldFbo_, fieldTex_, fieldW_, fieldH_);
+    if (tinted_) {  // the materials' colours
       if (!tintProg_) tintProg_ = gl::program("splat.vert", "tint.frag");
-      sizeTarget(GL_RGBA32F, GL_RGBA, fw, fh, shrink, tintFbo_, tintTex_, tintW_, tintH_);
-      glBindFramebuffer(GL_FRAMEBUFFER, tintFbo_);
-      glClear(GL_COLOR_BUFFER_BIT);
-      sprites_.upload(packedTint_);
-      sprites_.setUniforms(tintProg_, f.scale, f.offset, fieldDiameter, fw, fh, quads_);
-      sprites_.draw(GLsizei(f.order.size()), quads_);
+      fillTarget(f, t, SplatSum::Tint, tintProg_, packedTint_, n, cpuTargets_[1], tintFbo_, tintTex_, tintW_, tintH_);
     }
-    if (perMaterial_) {  // the materials' transmissions, alike, into the absorption target
+    if (perMaterial_) {  // the materials' transmissions
       if (!absorbProg_) absorbProg_ = gl::program("splat.vert", "tint.frag", "#define ABSORB\n");
-      sizeTarget(GL_RGBA32F, GL_RGBA, fw, fh, shrink, absorbFbo_, absorbTex_, absorbW_, absorbH_);
-      glBindFramebuffer(GL_FRAMEBUFFER, absorbFbo_);
-      glClear(GL_COLOR_BUFFER_BIT);
-      sprites_.upload(packedAbsorb_);
-      sprites_.setUniforms(absorbProg_, f.scale, f.offset, fieldDiameter, fw, fh, quads_);
-      sprites_.draw(GLsizei(f.order.size()), quads_);
+      fillTarget(f, t, SplatSum::Absorb, absorbProg_, packedAbsorb_, n, cpuTargets_[2], absorbFbo_, absorbTex_,
+                 absorbW_, absorbH_);
     }
-    if (!blobs_.empty()) {  // the groups' particles, in their colours, into the blob target
+    if (!blobs_.empty()) {  // the groups' particles, in their colours
       if (!tintProg_) tintProg_ = gl::program("splat.vert", "tint.frag");
-      sizeTarget(GL_RGBA32F, GL_RGBA, fw, fh, shrink, blobFbo_, blobTex_, blobW_, blobH_);
-      glBindFramebuffer(GL_FRAMEBUFFER, blobFbo_);
-      glClear(GL_COLOR_BUFFER_BIT);
-      sprites_.upload(blobs_);
-      sprites_.setUniforms(tintProg_, f.scale, f.offset, fieldDiameter, fw, fh, quads_);
-      sprites_.draw(GLsizei(blobs_.size() / 4), quads_);
+      fillTarget(f, t, SplatSum::Tint, tintProg_, blobs_, blobs_.size() / 4, cpuTargets_[3], blobFbo_, blobTex_, blobW_,
+                 blobH_);
     }
     glDisable(GL_BLEND);
     glViewport(0, 0, EW, EH);
+  }
+
+  /// The size of this frame's splat targets and the sprites' diameter in their texels.
+  struct SplatTarget {
+    int w = 0, h = 0, shrink = 1;
+    float diameter = 0;
+  };
+
+  /// One splat target (`fbo`, `tex`, made t.w × t.h when its size changed) filled with the first
+  /// `n` sprites of `packed`: drawn by `prog` with additive blending (the caller's), or summed
+  /// on the CPU into `cpu` (cpu_splat.hpp) and its changed rows uploaded.
+  void fillTarget(const PassFrame& f, const SplatTarget& t, SplatSum sum, GLuint prog, const std::vector<float>& packed,
+                  std::size_t n, CpuSplatTarget& cpu, GLuint& fbo, GLuint& tex, int& w, int& h) {
+    const bool rg = sum == SplatSum::Field;
+    if (sizeTarget(rg ? GL_RG32F : GL_RGBA32F, rg ? GL_RG : GL_RGBA, t.w, t.h, t.shrink, fbo, tex, w, h)) cpu.reset();
+    if (cpuSplat_) {
+      const auto [y0, y1] = cpu.sum(packed, n, f.scale, f.offset, t.diameter, t.w, t.h, sum);
+      if (y0 >= y1) return;
+      glBindTexture(GL_TEXTURE_2D, tex);
+      glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+      const std::size_t rowFloats = std::size_t(t.w) * std::size_t(splatChannels(sum));
+      glTexSubImage2D(GL_TEXTURE_2D, 0, 0, y0, t.w, y1 - y0, rg ? GL_RG : GL_RGBA, GL_FLOAT,
+                      cpu.texels() + std::size_t(y0) * rowFloats);
+      return;
+    }
+    glBindFramebuffer(GL_FRAMEBUFFER, fbo);
+    glClear(GL_COLOR_BUFFER_BIT);
+    sprites_.upload(packed);
+    sprites_.setUniforms(prog, f.scale, f.offset, t.diameter, t.w, t.h, quads_);
+    sprites_.draw(GLsizei(n), quads_);
   }
 
   /// Foam, spray and bubbles' sprites (x, y, colour, alpha; one list per kind), and the target
@@ -478,6 +510,8 @@ class LiquidPass final : public RenderPass {
   RenderOptions opt_;
   SpriteBatch& sprites_;
   GLuint splatProg_ = 0;
+  bool cpuSplat_ = false;                     // the splat targets summed on the CPU (cpu_splat.hpp), not drawn
+  std::array<CpuSplatTarget, 4> cpuTargets_;  // theirs: the field, tint, transmissions, blobs
   // More than one material (made on the first such frame): the tint pass and its target.
   GLuint tintProg_ = 0, tintTex_ = 0, tintFbo_ = 0;
   int tintW_ = 0, tintH_ = 0;

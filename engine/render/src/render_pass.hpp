@@ -90,6 +90,8 @@ class RenderPass {
   virtual ~RenderPass() = default;
   /// "liquid" or "particles".
   virtual const char* mode() const = 0;
+  /// Where the splat is summed: "cpu" or "gl" (liquid), "" (a pass without one).
+  virtual const char* splatPath() const { return ""; }
   /// Sprite diameter [px] at full resolution for a particle spacing of `spacingPx`.
   virtual float spriteDiameter(double spacingPx) const = 0;
   /// How many times smaller than the targets the sprites' own target is (1, or 2 for the

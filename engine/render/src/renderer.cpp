@@ -424,6 +424,7 @@ Renderer::~Renderer() = default;
 std::string Renderer::rendererString() const { return impl_->glInfo.renderer + " / " + impl_->glInfo.version; }
 std::vector<double> Renderer::cameraRect() const { return impl_->geo.cam; }
 std::string Renderer::mode() const { return impl_->pass->mode(); }
+std::string Renderer::splatPath() const { return impl_->pass->splatPath(); }
 RenderTimings Renderer::lastTimings() const { return impl_->timings; }
 bool Renderer::usedQuads() const { return impl_->pass->usedQuads(); }
 float Renderer::maxPointSize() const { return impl_->sprites.maxPoint(); }

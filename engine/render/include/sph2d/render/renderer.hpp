@@ -92,6 +92,10 @@ struct RenderOptions {
   std::optional<std::array<double, 3>> foam;       ///< foam colour (default: 0.9, 0.95, 1)
   std::optional<std::array<double, 3>> text;       ///< overlay and colour-bar text (default: 0.92 grey)
   bool profile = false;                            ///< glFinish after each stage so lastTimings() is per stage (slower)
+  /// Liquid mode: where the splat's sums are made. Auto: on the CPU when the OpenGL is a software
+  /// rasterizer (llvmpipe, softpipe, swrast: their cost is each point's set-up, not the sum),
+  /// else by the GL's point sprites. The two give the same frame to float rounding.
+  enum class Splat { Auto, Gl, Cpu } splat = Splat::Auto;
 };
 
 /// What to draw. Particles are in the engine's local frame (add `origin` for world coordinates).
@@ -209,6 +213,8 @@ class Renderer {
   std::vector<double> cameraRect() const;
   /// The mode in use: "liquid" or "particles".
   std::string mode() const;
+  /// Where the liquid's splat is summed (RenderOptions::splat): "cpu" or "gl"; "" in particles mode.
+  std::string splatPath() const;
   /// Stage times of the last render() or draw().
   RenderTimings lastTimings() const;
   /// True when the last render() or draw() drew instanced quads because sprites exceeded the point-size limit.
