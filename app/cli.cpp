@@ -268,14 +268,7 @@ bool parseRenderFlag(ArgReader& a, RenderOptions& o) {
     if (!(o.foamSpeed > 0)) throw UsageError("--foam-speed must be > 0");
   } else if (s == "--splat") {
     const std::string v = value();
-    if (v == "auto")
-      o.splat = RenderOptions::Splat::Auto;
-    else if (v == "cpu")
-      o.splat = RenderOptions::Splat::Cpu;
-    else if (v == "gl")
-      o.splat = RenderOptions::Splat::Gl;
-    else
-      throw UsageError("--splat expects auto, cpu or gl, got '" + v + "'");
+    if (!parseSplatPath(v, o.splat)) throw UsageError("--splat expects auto, cpu or gl, got '" + v + "'");
   } else if (s == "--depth-scale") {
     o.depthScale = parseNumber(s, value());
     if (!(o.depthScale > 0)) throw UsageError("--depth-scale must be > 0");

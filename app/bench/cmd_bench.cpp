@@ -161,7 +161,7 @@ int cmdBench(const std::vector<std::string>& args) {
   // the same frames in the same run: what the path chosen saves.
   RenderOptions otherOpt = opt;
   const std::string splatPath = profiled.splatPath();
-  otherOpt.splat = splatPath == "cpu" ? RenderOptions::Splat::Gl : RenderOptions::Splat::Cpu;
+  otherOpt.splat = splatPath == "cpu" ? SplatPath::Gl : SplatPath::Cpu;
   std::optional<Renderer> otherProfiled;
   if (liquid) otherProfiled.emplace(scene.render, otherOpt);
   const std::string otherPath = otherProfiled ? otherProfiled->splatPath() : std::string();

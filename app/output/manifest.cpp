@@ -35,7 +35,7 @@ json renderOptionsJson(const RenderOptions& o) {
   j["outline"] = o.outline;
   j["foam_speed"] = o.foamSpeed;
   j["depth_scale"] = o.depthScale;
-  j["splat"] = o.splat == RenderOptions::Splat::Cpu ? "cpu" : o.splat == RenderOptions::Splat::Gl ? "gl" : "auto";
+  j["splat"] = splatPathName(o.splat);
   return j;
 }
 

@@ -101,15 +101,12 @@ RenderOptions renderOptions(const json& j) {
   }
   o.foamSpeed = finiteAt(j, "foam_speed", w, 0);
   o.depthScale = finiteAt(j, "depth_scale", w, 0);
-  if (j.contains("splat")) {  // manifests written before the CPU's splat existed have none
+  // Manifests written before the CPU's splat existed have none: their frames came from the GL's
+  // point sprites.
+  o.splat = SplatPath::Gl;
+  if (j.contains("splat")) {
     const json& v = j["splat"];
-    if (v == "auto")
-      o.splat = RenderOptions::Splat::Auto;
-    else if (v == "cpu")
-      o.splat = RenderOptions::Splat::Cpu;
-    else if (v == "gl")
-      o.splat = RenderOptions::Splat::Gl;
-    else
+    if (!v.is_string() || !parseSplatPath(v.get<std::string>(), o.splat))
       throw Malformed{w + "splat", "\"auto\", \"cpu\" or \"gl\""};
   }
   return o;

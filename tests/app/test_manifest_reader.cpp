@@ -105,10 +105,10 @@ TEST_CASE("manifest reader: render options outside what sph2d run writes are ref
   m["render"]["splat"] = 1;
   CHECK(refusal(m).find("'render.splat'") != std::string::npos);
   m = good;
-  m["render"]["splat"] = "gl";  // the path the run summed its splat by, taken by a check
-  CHECK(parseManifest(m.dump(), "m.json").render.splat == sph2d::RenderOptions::Splat::Gl);
-  m["render"].erase("splat");  // a manifest from before the CPU's splat: the renderer chooses
-  CHECK(parseManifest(m.dump(), "m.json").render.splat == sph2d::RenderOptions::Splat::Auto);
+  m["render"]["splat"] = "cpu";  // the path the run summed its splat by, taken by a check
+  CHECK(parseManifest(m.dump(), "m.json").render.splat == sph2d::SplatPath::Cpu);
+  m["render"].erase("splat");  // a manifest from before the CPU's splat: its frames are the GL's
+  CHECK(parseManifest(m.dump(), "m.json").render.splat == sph2d::SplatPath::Gl);
   m = good;
   m["render"]["range"] = json::array({0, 2.5});
   m["render"]["mode"] = "particles";

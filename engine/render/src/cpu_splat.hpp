@@ -7,9 +7,13 @@
 // few multiply-adds a texel. A texel (ix, iy) of a w × h target (iy from the bottom, as the
 // GL's window rows) takes a sprite of diameter D centred at window position (xw, yw) when
 // q² = |2 (ix + ½ − xw, iy + ½ − yw) / D|² < 1, with w = (1 − q²)³ × the particle's weight: the
-// point sprite's gl_PointCoord and discard. The sprites are added in their order (id order, as
-// the GL draws them), so each texel's sum runs in the same order as the GL's blending; the
-// frames of the two paths differ by float rounding (at most one level of a channel measured).
+// point sprite's gl_PointCoord and discard (the caller gives D at least the GL's smallest point
+// size, as the GL clamps it). The sprites are added in their order (id order, as the GL draws
+// them), so each texel's sum runs in the same order as the GL's blending; the frames of the two
+// paths differ by float rounding and by llvmpipe's fixed-point sprite sizes (at most 2 levels
+// of a channel in under 1 % of the pixels, tests/app/test_renderer_splat.cpp). Unlike a GL
+// point, a sprite whose centre is off the target still adds its part; the targets' guard band
+// (camera.hpp) keeps every centre that reaches the image inside them, so the frames agree.
 // The target is cut into bands of 32 rows, each summed from the sprites that reach it (kept
 // in their order); two threads take a half of the bands each when the frame is large enough.
 // A texel's sum is the same whichever band or thread makes it. Only rows that held or now hold
@@ -41,8 +45,9 @@ class CpuSplatTarget {
   /// bottom: local → NDC by `scale` and `offset`, each sprite `diameterPx` texels wide. Returns
   /// the rows [first, last) that may differ from the last sum's (all of them after a change of
   /// size or kind, or reset()): the rows to upload.
+  /// On an exception (memory) the next sum returns every row.
   std::pair<int, int> sum(const std::vector<float>& packed, std::size_t n, const float scale[2], const float offset[2],
-                          float diameterPx, int w, int h, SplatSum sum);
+                          float diameterPx, int w, int h, SplatSum kind);
   /// The texels of the last sum (w × h × channels floats).
   const float* texels() const { return texels_.data(); }
   /// Forgets what the texture holds: the next sum returns every row.
@@ -50,11 +55,15 @@ class CpuSplatTarget {
 
   /// A sprite in the target's texels: its window position and the texels it can cover.
   struct Sprite {
-    float xw, yw, value, weight;
+    float xw, yw, weight;
+    float k[4];  ///< the kernel weight's factor in each channel
     int x0, x1, y0, y1;
   };
 
  private:
+  std::pair<int, int> sumAll(const std::vector<float>& packed, std::size_t n, const float scale[2],
+                             const float offset[2], float diameterPx, int w, int h, SplatSum kind);
+  std::vector<float> scratch_[2];  ///< a row of squared x distances per thread
   std::vector<float> texels_;
   int w_ = 0, h_ = 0, channels_ = 0;
   std::pair<int, int> rows_{0, 0};  ///< rows the last sum touched

@@ -45,7 +45,7 @@ class LiquidPass final : public RenderPass {
   LiquidPass(const RenderDef& def, const RenderOptions& opt, SpriteBatch& sprites)
       : def_(def), opt_(opt), sprites_(sprites) {
     splatProg_ = gl::program("splat.vert", "splat.frag");
-    cpuSplat_ = opt.splat == RenderOptions::Splat::Cpu || (opt.splat == RenderOptions::Splat::Auto && softwareGl());
+    cpuSplat_ = opt.splat == SplatPath::Cpu || (opt.splat == SplatPath::Auto && softwareGl());
     glGenVertexArrays(1, &tileVao_);
     glGenBuffers(1, &tileVbo_);
     glBindVertexArray(tileVao_);
@@ -91,12 +91,12 @@ class LiquidPass final : public RenderPass {
     tintW_ = tintH_ = blobW_ = blobH_ = absorbW_ = absorbH_ = 0;
   }
 
-  /// True when the current context's OpenGL is a software rasterizer (Mesa's llvmpipe, softpipe
-  /// or swrast): there the CPU sums the splat (cpu_splat.hpp).
+  /// True when the current context's OpenGL is a software rasterizer (Mesa's llvmpipe or
+  /// softpipe, or its classic "Software Rasterizer"): there the CPU sums the splat (cpu_splat.hpp).
   static bool softwareGl() {
     const char* r = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
     if (!r) return false;
-    for (const char* name : {"llvmpipe", "softpipe", "swrast"})
+    for (const char* name : {"llvmpipe", "softpipe", "Software Rasterizer"})
       if (std::strstr(r, name)) return true;
     return false;
   }
@@ -267,16 +267,19 @@ class LiquidPass final : public RenderPass {
   /// One splat target (`fbo`, `tex`, made t.w × t.h when its size changed) filled with the first
   /// `n` sprites of `packed`: drawn by `prog` with additive blending (the caller's), or summed
   /// on the CPU into `cpu` (cpu_splat.hpp) and its changed rows uploaded.
-  void fillTarget(const PassFrame& f, const SplatTarget& t, SplatSum sum, GLuint prog, const std::vector<float>& packed,
-                  std::size_t n, CpuSplatTarget& cpu, GLuint& fbo, GLuint& tex, int& w, int& h) {
-    const bool rg = sum == SplatSum::Field;
+  void fillTarget(const PassFrame& f, const SplatTarget& t, SplatSum kind, GLuint prog,
+                  const std::vector<float>& packed, std::size_t n, CpuSplatTarget& cpu, GLuint& fbo, GLuint& tex,
+                  int& w, int& h) {
+    const bool rg = kind == SplatSum::Field;
     if (sizeTarget(rg ? GL_RG32F : GL_RGBA32F, rg ? GL_RG : GL_RGBA, t.w, t.h, t.shrink, fbo, tex, w, h)) cpu.reset();
     if (cpuSplat_) {
-      const auto [y0, y1] = cpu.sum(packed, n, f.scale, f.offset, t.diameter, t.w, t.h, sum);
+      // The GL draws a point at least its smallest size wide (1 px on llvmpipe): so does the CPU.
+      const auto [y0, y1] =
+          cpu.sum(packed, n, f.scale, f.offset, std::max(t.diameter, sprites_.minPoint()), t.w, t.h, kind);
       if (y0 >= y1) return;
       glBindTexture(GL_TEXTURE_2D, tex);
       glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
-      const std::size_t rowFloats = std::size_t(t.w) * std::size_t(splatChannels(sum));
+      const std::size_t rowFloats = std::size_t(t.w) * std::size_t(splatChannels(kind));
       glTexSubImage2D(GL_TEXTURE_2D, 0, 0, y0, t.w, y1 - y0, rg ? GL_RG : GL_RGBA, GL_FLOAT,
                       cpu.texels() + std::size_t(y0) * rowFloats);
       return;

@@ -43,4 +43,28 @@ std::string colorFieldName(ColorField f) {
   return "?";
 }
 
+bool parseSplatPath(const std::string& s, SplatPath& out) {
+  if (s == "auto")
+    out = SplatPath::Auto;
+  else if (s == "gl")
+    out = SplatPath::Gl;
+  else if (s == "cpu")
+    out = SplatPath::Cpu;
+  else
+    return false;
+  return true;
+}
+
+std::string splatPathName(SplatPath p) {
+  switch (p) {
+    case SplatPath::Gl:
+      return "gl";
+    case SplatPath::Cpu:
+      return "cpu";
+    case SplatPath::Auto:
+      break;
+  }
+  return "auto";
+}
+
 }  // namespace sph2d

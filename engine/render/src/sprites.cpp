@@ -35,6 +35,7 @@ void SpriteBatch::init() {
   GLfloat range[2] = {1, 255};
   glGetFloatv(GL_POINT_SIZE_RANGE, range);
   maxPoint_ = std::max(1.0f, range[1]);
+  minPoint_ = std::clamp(range[0], 0.0f, maxPoint_);
   glGenBuffers(1, &particleVbo_);
   glGenBuffers(1, &cornerVbo_);
   const float corners[8] = {-1, -1, 1, -1, -1, 1, 1, 1};

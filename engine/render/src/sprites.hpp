@@ -30,6 +30,8 @@ class SpriteBatch {
   void release();
   /// The driver's largest point sprite [px] (255 on llvmpipe).
   float maxPoint() const { return maxPoint_; }
+  /// The driver's smallest point sprite [px] (1 on llvmpipe): smaller sizes are drawn this wide.
+  float minPoint() const { return minPoint_; }
   /// Uploads `packed` (4 floats per particle: x, y, value, weight in the engine's local frame).
   void upload(const std::vector<float>& packed);
   /// Uses `prog` (splat.vert + a fragment shader) and sets its sprite uniforms: the local →
@@ -41,7 +43,7 @@ class SpriteBatch {
 
  private:
   GLuint particleVbo_ = 0, cornerVbo_ = 0, pointVao_ = 0, quadVao_ = 0;
-  float maxPoint_ = 255.0f;
+  float maxPoint_ = 255.0f, minPoint_ = 1.0f;
 };
 
 }  // namespace sph2d

@@ -74,6 +74,17 @@ bool parseColorField(const std::string& s, ColorField& out);
 /// "speed", "pressure", "density", "age", "color" or "material".
 std::string colorFieldName(ColorField f);
 
+/// Where the liquid's splat is summed (RenderOptions::splat).
+enum class SplatPath {
+  Auto,  ///< the CPU when the OpenGL is a software rasterizer (llvmpipe, softpipe), else the GL
+  Gl,    ///< the GL's point sprites (shaders/splat.*)
+  Cpu,   ///< summed on the CPU and uploaded
+};
+/// Parses "auto", "gl" or "cpu"; returns false for anything else.
+bool parseSplatPath(const std::string& s, SplatPath& out);
+/// "auto", "gl" or "cpu".
+std::string splatPathName(SplatPath p);
+
 /// Render settings that the scene format does not carry (yet): they come from
 /// the command line. Unset optionals take the documented defaults.
 struct RenderOptions {
@@ -95,7 +106,7 @@ struct RenderOptions {
   /// Liquid mode: where the splat's sums are made. Auto: on the CPU when the OpenGL is a software
   /// rasterizer (llvmpipe, softpipe, swrast: their cost is each point's set-up, not the sum),
   /// else by the GL's point sprites. The two give the same frame to float rounding.
-  enum class Splat { Auto, Gl, Cpu } splat = Splat::Auto;
+  SplatPath splat = SplatPath::Auto;
 };
 
 /// What to draw. Particles are in the engine's local frame (add `origin` for world coordinates).
