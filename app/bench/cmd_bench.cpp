@@ -219,6 +219,7 @@ int cmdBench(const std::vector<std::string>& args) {
     bytesZlib.v.push_back(double(encoded.size()));
   }
   opt.profile = false;
+  otherOpt.profile = false;
   {
     Renderer plain(scene.render, opt);
     plain.render(in);

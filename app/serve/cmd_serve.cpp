@@ -145,7 +145,7 @@ ServeArgs parseServeArgs(const std::vector<std::string>& a) {
           "unknown option '" + s +
           "' for serve; options: --port, --bind, --record, --threads, "
           "--max-clients, --format, --quality, --catch-up, --max-event-particles, --max-particles-per-second, "
-          "--max-particles, --mode, --color-by, --range, --overlay, "
+          "--max-particles, --mode, --color-by, --range, --overlay, --outline, "
           "--foam-speed, --depth-scale, --splat, --quiet (see sph2d serve --help)");
     else if (r.scene.empty())
       r.scene = s;

@@ -22,10 +22,13 @@ using namespace rctest;
 
 TEST_CASE(
     "draw() into the game's framebuffer: every piece of GL state the game set is given back and the pixels are the OSMesa path's") {
-  for (const std::string mode : {"liquid", "particles"}) {
-    CAPTURE(mode);
+  // "liquid/gl": the splat by the GL's point sprites (a hardware GL's default; llvmpipe's is the CPU's).
+  for (const std::string path : {"liquid", "liquid/gl", "particles"}) {
+    CAPTURE(path);
+    const std::string mode = path.substr(0, path.find('/'));
     const SceneDef s = gameScene(mode);
-    const RenderOptions o = optionsFor(mode);
+    RenderOptions o = optionsFor(mode);
+    if (path == "liquid/gl") o.splat = SplatPath::Gl;
     const auto world = steppedWorld(s, 12);
     REQUIRE(world->movingColliders().size() == 2);  // the crate and the paddle are drawn too
     const std::vector<unsigned char> reference = osmesaFrame(*world, s, o);
@@ -34,6 +37,7 @@ TEST_CASE(
     GameObjects g;
     Renderer renderer(currentGlContext, s.render, o);
     CHECK(renderer.usesCurrentContext());
+    CHECK(renderer.splatPath() == (mode == "particles" ? "" : path == "liquid/gl" ? "gl" : "cpu"));
     setGameState(g);
     const std::vector<Item> before = snapshot();
     renderer.draw(*world, GlTarget{g.fbo, std::array<int, 4>{0, 0, W, H}});
@@ -200,10 +204,12 @@ TEST_CASE(
 
 TEST_CASE(
     "draw() in a compatibility-profile context: the game's alpha test, point sprites off, colour clamping, polygon stipple and pixel transfer change nothing and are given back") {
-  for (const std::string mode : {"liquid", "particles"}) {
-    CAPTURE(mode);
+  for (const std::string path : {"liquid", "liquid/gl", "particles"}) {  // liquid/gl: the GL's point sprites
+    CAPTURE(path);
+    const std::string mode = path.substr(0, path.find('/'));
     const SceneDef s = gameScene(mode);
-    const RenderOptions o = optionsFor(mode);
+    RenderOptions o = optionsFor(mode);
+    if (path == "liquid/gl") o.splat = SplatPath::Gl;
     const auto world = steppedWorld(s, 12);
     const std::vector<unsigned char> reference = osmesaFrame(*world, s, o);
     GameContext game(true);

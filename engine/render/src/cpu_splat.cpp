@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <system_error>
 #include <thread>
 
@@ -58,6 +59,13 @@ void splatRows(const std::vector<Sprite>& sprites, const std::vector<std::uint32
 }
 
 }  // namespace
+
+bool softwareRasterizer(const char* glRenderer) {
+  if (!glRenderer) return false;
+  for (const char* name : {"llvmpipe", "softpipe", "Software Rasterizer"})
+    if (std::strstr(glRenderer, name)) return true;
+  return false;
+}
 
 std::pair<int, int> CpuSplatTarget::sum(const std::vector<float>& packed, std::size_t n, const float scale[2],
                                         const float offset[2], float diameterPx, int w, int h, SplatSum kind) {

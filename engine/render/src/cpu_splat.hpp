@@ -34,6 +34,10 @@ enum class SplatSum {
   Absorb,  ///< RGBA: w × ln(max(colour / 255, 1e-3)), w (shaders/tint.frag with ABSORB)
 };
 
+/// True when `glRenderer` (GL_RENDERER) names a software rasterizer: Mesa's llvmpipe or softpipe,
+/// or its classic "Software Rasterizer" (RenderOptions::splat's auto takes the CPU there).
+bool softwareRasterizer(const char* glRenderer);
+
 /// Channels of a target of `sum` (2 or 4).
 inline int splatChannels(SplatSum sum) { return sum == SplatSum::Field ? 2 : 4; }
 

@@ -2,10 +2,11 @@
 //
 // Design: a blobby (metaball) density field, after Blinn, "A Generalization of Algebraic Surface
 // Drawing" (1982), cut at an iso-level and shaded in screen space:
-//  1. splat: each particle is a point sprite (shaders/splat.*) adding w = (1 − q²)³ × its age
-//     fade, and w·|v|, into an RG32F target with additive blending; when sprites are at least
-//     8 px wide the target has half the image's resolution (a quarter of the fragments) and the
-//     composite reads it bilinearly;
+//  1. splat: each particle adds w = (1 − q²)³ × its age fade, and w·|v|, into an RG32F target:
+//     as a point sprite (shaders/splat.*) with additive blending, or summed on the CPU in the
+//     same order and uploaded (cpu_splat.hpp: RenderOptions::splat, the default on a software
+//     rasterizer); when sprites are at least 8 px wide the target has half the image's
+//     resolution (a quarter of the texels) and the composite reads it bilinearly;
 //  2. depth grid: on the CPU, the depth of water above and the local fill (depth_grid.hpp),
 //     uploaded as a small RG32F texture, and the tiles of the image the fluid can reach;
 //  3. composite: over those tiles only, the field becomes water (shaders/composite.frag:
@@ -29,7 +30,6 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <cstring>
 
 #include "cpu_splat.hpp"
 #include "depth_grid.hpp"
@@ -91,15 +91,9 @@ class LiquidPass final : public RenderPass {
     tintW_ = tintH_ = blobW_ = blobH_ = absorbW_ = absorbH_ = 0;
   }
 
-  /// True when the current context's OpenGL is a software rasterizer (Mesa's llvmpipe or
-  /// softpipe, or its classic "Software Rasterizer"): there the CPU sums the splat (cpu_splat.hpp).
-  static bool softwareGl() {
-    const char* r = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
-    if (!r) return false;
-    for (const char* name : {"llvmpipe", "softpipe", "Software Rasterizer"})
-      if (std::strstr(r, name)) return true;
-    return false;
-  }
+  /// True when the current context's OpenGL is a software rasterizer: there the CPU sums the
+  /// splat (cpu_splat.hpp).
+  static bool softwareGl() { return softwareRasterizer(reinterpret_cast<const char*>(glGetString(GL_RENDERER))); }
 
   /// True for the particle in slot i when its material is granular (drawn as a grain).
   static bool grainAt(const RenderInput& in, std::size_t i) {
@@ -221,8 +215,8 @@ class LiquidPass final : public RenderPass {
     return true;
   }
 
-  /// Σw and Σw·speed into the RG32F field (shaders/splat.*); at half resolution when sprites
-  /// are at least 8 px wide (a quarter of the fragments; the composite samples it bilinearly).
+  /// Σw and Σw·speed into the RG32F field (shaders/splat.* or the CPU's sums); at half
+  /// resolution when sprites are at least 8 px wide (the composite samples it bilinearly).
   /// Then, alike, the materials' colours, their transmissions and the groups' particles into
   /// their RGBA32F targets, when the frame has them.
   void splat(const PassFrame& f) {

@@ -76,7 +76,7 @@ std::string colorFieldName(ColorField f);
 
 /// Where the liquid's splat is summed (RenderOptions::splat).
 enum class SplatPath {
-  Auto,  ///< the CPU when the OpenGL is a software rasterizer (llvmpipe, softpipe), else the GL
+  Auto,  ///< the CPU when the OpenGL is a software rasterizer (llvmpipe, softpipe), else the GL's
   Gl,    ///< the GL's point sprites (shaders/splat.*)
   Cpu,   ///< summed on the CPU and uploaded
 };
@@ -103,9 +103,9 @@ struct RenderOptions {
   std::optional<std::array<double, 3>> foam;       ///< foam colour (default: 0.9, 0.95, 1)
   std::optional<std::array<double, 3>> text;       ///< overlay and colour-bar text (default: 0.92 grey)
   bool profile = false;                            ///< glFinish after each stage so lastTimings() is per stage (slower)
-  /// Liquid mode: where the splat's sums are made. Auto: on the CPU when the OpenGL is a software
-  /// rasterizer (llvmpipe, softpipe, swrast: their cost is each point's set-up, not the sum),
-  /// else by the GL's point sprites. The two give the same frame to float rounding.
+  /// Liquid mode: where the splat's sums are made (SplatPath). Auto: on the CPU when the OpenGL
+  /// is a software rasterizer (llvmpipe, softpipe: their cost is each point's set-up, not the
+  /// sum), else by the GL's point sprites. The two give the same frame to float rounding.
   SplatPath splat = SplatPath::Auto;
 };
 
