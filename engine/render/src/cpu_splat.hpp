@@ -45,7 +45,7 @@ inline int splatChannels(SplatSum sum) { return sum == SplatSum::Field ? 2 : 4; 
 class CpuSplatTarget {
  public:
   /// Sums the first `n` sprites of `packed` (x, y, value, weight per sprite, the engine's local
-  /// frame; weight 0 adds nothing) into w × h texels of splatChannels(sum) floats, rows from the
+  /// frame; weight 0 adds nothing) into w × h texels of splatChannels(kind) floats, rows from the
   /// bottom: local → NDC by `scale` and `offset`, each sprite `diameterPx` texels wide. Returns
   /// the rows [first, last) that may differ from the last sum's (all of them after a change of
   /// size or kind, or reset()): the rows to upload.
