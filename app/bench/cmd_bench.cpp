@@ -176,15 +176,16 @@ int cmdBench(const std::vector<std::string>& args) {
     if (opaqueProfiled) opaqueProfiled->render(in);
     if (otherProfiled) otherProfiled->render(in);
   }
+  // A comparison renderer (opaque water, the other splat path), when it exists, renders the
+  // frame too and records one of its stages.
+  auto alongside = [&](std::optional<Renderer>& r, Stat& s, double RenderTimings::*stage) {
+    if (!r) return;
+    r->render(in);
+    s.v.push_back(r->lastTimings().*stage);
+  };
   for (int k = 0; k < frames; ++k) {
-    if (opaqueProfiled) {
-      opaqueProfiled->render(in);
-      opaqueComposite.v.push_back(opaqueProfiled->lastTimings().composite);
-    }
-    if (otherProfiled) {
-      otherProfiled->render(in);
-      otherSplat.v.push_back(otherProfiled->lastTimings().splat);
-    }
+    alongside(opaqueProfiled, opaqueComposite, &RenderTimings::composite);
+    alongside(otherProfiled, otherSplat, &RenderTimings::splat);
     const Frame& fr = profiled.render(in);
     const RenderTimings t = profiled.lastTimings();
     upload.v.push_back(t.upload);
@@ -235,14 +236,8 @@ int cmdBench(const std::vector<std::string>& args) {
       plain.render(in);
       cpuRender.v.push_back(processCpuMs() - c0);
       nosync.v.push_back(plain.lastTimings().total);
-      if (opaque) {
-        opaque->render(in);
-        opaqueNosync.v.push_back(opaque->lastTimings().total);
-      }
-      if (other) {
-        other->render(in);
-        otherNosync.v.push_back(other->lastTimings().total);
-      }
+      alongside(opaque, opaqueNosync, &RenderTimings::total);
+      alongside(other, otherNosync, &RenderTimings::total);
     }
   }
   fs::remove_all(tmp);
