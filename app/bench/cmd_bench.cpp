@@ -169,7 +169,8 @@ int cmdBench(const std::vector<std::string>& args) {
   std::printf("bench render: %zu particles, %dx%d, %s mode, %d frames, PNG level %d\nrenderer: %s\n", P.size(), width,
               height, profiled.mode().c_str(), frames, level, profiled.rendererString().c_str());
   Stat upload, splat, composite, solids, readback, overlay, png, hash, total, nosync, pngBytes, cpuRender, cpuPng;
-  Stat encodeOwn, encodeZlib, bytesOwn, bytesZlib;  // level L's coder against zlib (libpng) with the same filter
+  // Level L's coder against libdeflate level 1 and zlib (libpng) with level L's filter.
+  Stat encodeOwn, encodeLibdeflate, encodeZlib, bytesOwn, bytesLibdeflate, bytesZlib;
   {
     const Frame& first = profiled.render(in);  // warm-up: shader compilation, first-use costs
     if (!save.empty()) writePngAtomic(save, first.width, first.height, first.rgba.data(), level);
@@ -213,6 +214,15 @@ int cmdBench(const std::vector<std::string>& args) {
     encodePng(fr.width, fr.height, fr.rgba.data(), settings, encoded);
     encodeOwn.v.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
     bytesOwn.v.push_back(double(encoded.size()));
+    // libdeflate at level 1 (filter NONE): the default coder before the run coder.
+    PngSettings libdeflate = settings;
+    libdeflate.deflater = PngSettings::Deflater::Libdeflate;
+    libdeflate.level = 1;
+    t0 = std::chrono::steady_clock::now();
+    encodePng(fr.width, fr.height, fr.rgba.data(), libdeflate, encoded);
+    encodeLibdeflate.v.push_back(
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+    bytesLibdeflate.v.push_back(double(encoded.size()));
     settings.deflater = PngSettings::Deflater::Zlib;
     t0 = std::chrono::steady_clock::now();
     encodePng(fr.width, fr.height, fr.rgba.data(), settings, encoded);
@@ -274,6 +284,7 @@ int cmdBench(const std::vector<std::string>& args) {
   row("PNG encode", png);
   row("XXH64 of pixels", hash);
   row("PNG, coder only", encodeOwn);
+  row("PNG, libdeflate 1", encodeLibdeflate);
   row("PNG, zlib (libpng)", encodeZlib);
   Stat sum;
   for (std::size_t k = 0; k < nosync.v.size(); ++k) sum.v.push_back(nosync.v[k] + png.v[k]);
@@ -285,10 +296,17 @@ int cmdBench(const std::vector<std::string>& args) {
   row("CPU: render + PNG", cpuSum);
   row("surface curves (CPU)", surface);
   std::printf("surface: %zu curves\n", curves);
-  std::printf("PNG level %d: %s, %.0f KB; zlib through libpng with its settings %.0f KB, %.2fx the coder's time\n",
-              level, pngSettings(level).deflater == PngSettings::Deflater::Libdeflate ? "libdeflate" : "zlib",
-              bytesOwn.mean() / 1024.0, bytesZlib.mean() / 1024.0,
-              encodeZlib.mean() / std::max(encodeOwn.mean(), 1e-9));
+  const PngSettings::Deflater coder = pngSettings(level).deflater;
+  std::printf(
+      "PNG level %d: %s, %.0f KB; libdeflate level 1 %.0f KB, %.2fx the coder's time; zlib through libpng with its "
+      "settings %.0f KB, %.2fx\n",
+      level,
+      coder == PngSettings::Deflater::Runs         ? "run coder"
+      : coder == PngSettings::Deflater::Libdeflate ? "libdeflate"
+                                                   : "zlib",
+      bytesOwn.mean() / 1024.0, bytesLibdeflate.mean() / 1024.0,
+      encodeLibdeflate.mean() / std::max(encodeOwn.mean(), 1e-9), bytesZlib.mean() / 1024.0,
+      encodeZlib.mean() / std::max(encodeOwn.mean(), 1e-9));
   std::printf("PNG size %.0f KB; sprites as %s\n", pngBytes.mean() / 1024.0,
               profiled.usedQuads() ? "instanced quads" : "points");
   return 0;

@@ -3,6 +3,7 @@
 #include "sph2d/render/png_io.hpp"
 
 #include "file_io.hpp"
+#include "png_runs.hpp"
 #include "sph2d/render/particle_export.hpp"
 
 #include <libdeflate.h>
@@ -135,8 +136,8 @@ PngSettings pngSettings(int level) {
     s.filters = PNG_ALL_FILTERS;
   } else {  // 1: the fastest measured on the dam break's frames (docs/RENDERING.md "PNG settings")
     s.strategy = Z_DEFAULT_STRATEGY;
-    s.filters = PNG_FILTER_NONE;
-    s.deflater = PngSettings::Deflater::Libdeflate;
+    s.filters = PNG_FILTER_SUB;
+    s.deflater = PngSettings::Deflater::Runs;
   }
   return s;
 }
@@ -153,6 +154,34 @@ void putChunk(std::vector<std::uint8_t>& out, const char type[4], const std::uin
   out.insert(out.end(), type, type + 4);
   if (n) out.insert(out.end(), data, data + n);
   be32(libdeflate_crc32(0, out.data() + at, n + 4));
+}
+
+/// A PNG of one IDAT chunk holding the zlib stream `z` (n bytes) into `out` (replaced).
+void putPng(int width, int height, bool keepAlpha, const std::uint8_t* z, std::size_t n,
+            std::vector<std::uint8_t>& out) {
+  out.clear();
+  out.reserve(n + 64);
+  static const std::uint8_t signature[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
+  out.insert(out.end(), signature, signature + 8);
+  std::uint8_t ihdr[13];
+  for (int k = 0; k < 4; ++k) {
+    ihdr[k] = std::uint8_t(std::uint32_t(width) >> (24 - 8 * k));
+    ihdr[4 + k] = std::uint8_t(std::uint32_t(height) >> (24 - 8 * k));
+  }
+  ihdr[8] = 8;                         // bit depth
+  ihdr[9] = keepAlpha ? 6 : 2;         // RGBA or RGB
+  ihdr[10] = ihdr[11] = ihdr[12] = 0;  // deflate, adaptive filtering, no interlace
+  putChunk(out, "IHDR", ihdr, sizeof ihdr);
+  putChunk(out, "IDAT", z, n);
+  putChunk(out, "IEND", nullptr, 0);
+}
+
+/// encodePng with the run coder (png_runs.hpp).
+void encodeRuns(int width, int height, const std::uint8_t* rgba, const PngSettings& s, std::vector<std::uint8_t>& out) {
+  const bool keepAlpha = s.input == PngSettings::Input::Rgba;
+  thread_local std::vector<std::uint8_t> z;
+  deflateRunsPng(width, height, rgba, keepAlpha ? 4 : 3, z);
+  putPng(width, height, keepAlpha, z.data(), z.size(), out);
 }
 
 /// encodePng with libdeflate: filter NONE, RGB (or RGBA with Input::Rgba) rows behind their
@@ -190,21 +219,7 @@ void encodeLibdeflate(int width, int height, const std::uint8_t* rgba, const Png
   z.resize(libdeflate_zlib_compress_bound(comp.c, n));
   const std::size_t zn = libdeflate_zlib_compress(comp.c, raw.data(), n, z.data(), z.size());
   if (zn == 0) throw std::runtime_error("libdeflate could not compress the image");
-  out.clear();
-  out.reserve(zn + 64);
-  static const std::uint8_t signature[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
-  out.insert(out.end(), signature, signature + 8);
-  std::uint8_t ihdr[13];
-  for (int k = 0; k < 4; ++k) {
-    ihdr[k] = std::uint8_t(std::uint32_t(width) >> (24 - 8 * k));
-    ihdr[4 + k] = std::uint8_t(std::uint32_t(height) >> (24 - 8 * k));
-  }
-  ihdr[8] = 8;                         // bit depth
-  ihdr[9] = keepAlpha ? 6 : 2;         // RGBA or RGB
-  ihdr[10] = ihdr[11] = ihdr[12] = 0;  // deflate, adaptive filtering, no interlace
-  putChunk(out, "IHDR", ihdr, sizeof ihdr);
-  putChunk(out, "IDAT", z.data(), zn);
-  putChunk(out, "IEND", nullptr, 0);
+  putPng(width, height, keepAlpha, z.data(), zn, out);
 }
 
 }  // namespace
@@ -214,6 +229,7 @@ void encodePng(int width, int height, const std::uint8_t* rgba, const PngSetting
   if (width <= 0 || height <= 0) throw std::runtime_error("encodePng: empty image");
   if (settings.deflater == PngSettings::Deflater::Libdeflate)
     return encodeLibdeflate(width, height, rgba, settings, out);
+  if (settings.deflater == PngSettings::Deflater::Runs) return encodeRuns(width, height, rgba, settings, out);
   const std::size_t w = std::size_t(width), h = std::size_t(height);
   thread_local std::vector<std::uint8_t> packed;
   thread_local std::vector<png_bytep> rows;

@@ -23,15 +23,17 @@ struct PngSettings {
   /// RGB rows itself, or the file keeps A (an RGBA PNG).
   enum class Input { Filler, PackedRgb, Rgba } input = Input::Filler;
   bool wholeImage = false;  ///< every row in one png_write_image call (else png_write_row per row)
-  /// The deflate coder: zlib through libpng, or libdeflate (its level, filter NONE on every
-  /// row, the whole image in one IDAT chunk; strategy, memLevel, windowBits, bufferSize and
-  /// wholeImage do not apply).
-  enum class Deflater { Zlib, Libdeflate } deflater = Deflater::Zlib;
+  /// The deflate coder: zlib through libpng; libdeflate (its level, filter NONE on every row,
+  /// the whole image in one IDAT chunk); or sph2d's run coder (the SUB filter on every row,
+  /// matches only of the pixel to the left and the row above, the image in two strips on two
+  /// threads, one IDAT chunk; `level` does not apply either). For libdeflate and the run coder
+  /// strategy, filters, memLevel, windowBits, bufferSize and wholeImage do not apply.
+  enum class Deflater { Zlib, Libdeflate, Runs } deflater = Deflater::Zlib;
 };
 
 /// The settings of PNG level `level` 0..9: 1 (the default, the fastest measured on the dam
-/// break's frames) is zlib's level 1 without a PNG filter; 0 stores; 2 is the SUB filter with
-/// run-length matching (smaller files, slower); 3..9 are zlib's level with every filter.
+/// break's frames) is sph2d's run coder; 0 stores; 2 is zlib's SUB filter with run-length
+/// matching (smaller files, slower); 3..9 are zlib's level with every filter.
 PngSettings pngSettings(int level);
 
 /// Encodes RGBA8 pixels (rows top-down) as a PNG with libpng into `out` (replaced).
