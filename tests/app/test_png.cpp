@@ -203,6 +203,19 @@ TEST_CASE("PNG run coder: every image decodes to its pixels, in one strip and in
   for (int y = 220; y < 230; ++y)  // noise in the rows around the strips' boundary
     for (int x = 0; x < 600; x += 3) blocks.rgba[(std::size_t(y) * 600 + std::size_t(x)) * 4] = std::uint8_t(rng());
   images.emplace_back(blocks, "blocks");
+  // Rows at deflate's window: 32,767 and 32,765 bytes (the longest distances, 10 to 13 extra
+  // bits), then 32,770 and 32,769 (just past it: no match of the row above), each row repeated.
+  for (auto [w, bpp] : {std::pair{10922, 3}, {8191, 4}, {10923, 3}, {8192, 4}}) {
+    Frame f = image(w, 3);
+    for (int x = 0; x < w; ++x)
+      for (int c = 0; c < 4; ++c) f.rgba[std::size_t(x) * 4 + std::size_t(c)] = std::uint8_t(rng());
+    for (int y = 1; y < 3; ++y)
+      std::copy(f.rgba.begin(), f.rgba.begin() + 4 * w, f.rgba.begin() + std::ptrdiff_t(y) * 4 * w);
+    images.emplace_back(f, std::to_string(w) + " wide, repeated rows (" + std::to_string(bpp) + " bytes a pixel)");
+  }
+  Frame low = image(65536, 2);  // two strips of one row each
+  for (std::size_t p = 0; p < low.rgba.size(); ++p) low.rgba[p] = std::uint8_t(p % 4 == 0 ? rng() % 4 : p / 4096);
+  images.emplace_back(low, "65536x2");
   Frame wide = image(11000, 3);  // a row of 33,001 bytes: no match reaches the row above
   for (std::size_t p = 0; p < wide.rgba.size(); ++p) wide.rgba[p] = std::uint8_t(p / 4000 * 37 + (p % 4 == 1));
   images.emplace_back(wide, "11000 wide");

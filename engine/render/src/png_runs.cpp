@@ -8,6 +8,9 @@
 #include <algorithm>
 #include <cstring>
 #include <exception>
+#include <stdexcept>
+#include <string>
+#include <system_error>
 #include <thread>
 
 namespace sph2d {
@@ -368,6 +371,9 @@ void codeStrip(const std::uint8_t* image, std::size_t w, int y0, int y1, bool la
 }  // namespace
 
 void deflateRunsPng(int width, int height, const std::uint8_t* rgba, int bpp, std::vector<std::uint8_t>& out) {
+  if (width < 1 || height < 1 || (bpp != 3 && bpp != 4))
+    throw std::invalid_argument("deflateRunsPng: a " + std::to_string(width) + " x " + std::to_string(height) +
+                                " image of " + std::to_string(bpp) + " bytes a pixel (at least 1 x 1, 3 or 4)");
   const std::size_t w = std::size_t(width), rowBytes = 1 + w * std::size_t(bpp);
   // The strips depend on the image alone, never on the threads at hand.
   const int strips = rowBytes * std::size_t(height) >= kStripBytes && height >= 2 ? 2 : 1;
@@ -376,21 +382,27 @@ void deflateRunsPng(int width, int height, const std::uint8_t* rgba, int bpp, st
   const int mid = strips == 2 ? height / 2 : height;
   if (strips == 2) {
     std::exception_ptr failed;
-    std::thread helper([&] {
+    auto second = [&] {
       try {
         bpp == 4 ? codeStrip<4>(rgba, w, mid, height, true, scratch[1])
                  : codeStrip<3>(rgba, w, mid, height, true, scratch[1]);
       } catch (...) {
         failed = std::current_exception();
       }
-    });
+    };
+    std::thread helper;
+    try {
+      helper = std::thread(second);
+    } catch (const std::system_error&) {  // no thread to be had: the same bytes on this one
+      second();
+    }
     try {
       bpp == 4 ? codeStrip<4>(rgba, w, 0, mid, false, scratch[0]) : codeStrip<3>(rgba, w, 0, mid, false, scratch[0]);
     } catch (...) {
-      helper.join();
+      if (helper.joinable()) helper.join();
       throw;
     }
-    helper.join();
+    if (helper.joinable()) helper.join();
     if (failed) std::rethrow_exception(failed);
   } else {
     bpp == 4 ? codeStrip<4>(rgba, w, 0, height, true, scratch[0]) : codeStrip<3>(rgba, w, 0, height, true, scratch[0]);

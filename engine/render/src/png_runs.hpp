@@ -19,7 +19,10 @@ namespace sph2d {
 
 /// The zlib stream (RFC 1950) of the PNG scanlines of an image of RGBA8 pixels (rows top-down,
 /// 4 bytes a pixel): each row is filter byte 1 (SUB) and the row's filtered bytes, RGB (`bpp` 3:
-/// the A bytes dropped) or RGBA (`bpp` 4). Replaces `out`. Throws std::bad_alloc only.
+/// the A bytes dropped) or RGBA (`bpp` 4). Replaces `out`. Each thread that codes keeps its
+/// scratch (about twice the largest image's scanlines) for the next frame. Without a second
+/// thread to be had, both strips are coded on the calling one (the same bytes). Throws
+/// std::invalid_argument for an empty image or another `bpp`, and std::bad_alloc.
 void deflateRunsPng(int width, int height, const std::uint8_t* rgba, int bpp, std::vector<std::uint8_t>& out);
 
 }  // namespace sph2d
