@@ -68,6 +68,15 @@ class Solver {
   /// body the opposite. False (the default): the bodies meet the fluid by the `bodies`
   /// stage's contacts alone (and the game solver's grid).
   virtual bool movingSamples() const { return false; }
+  /// True when the solver itself says which of an elastic group's particles' moves are their
+  /// own position corrections (groupMoves()): the World's groups stage takes those into their
+  /// velocity (world/groups.cpp). False (the default): the groups stage takes each such
+  /// particle's whole move over the substep, less its velocity.
+  virtual bool groupCorrections() const { return false; }
+  /// With groupCorrections(): per slot, the move of the last substep's corrections that an
+  /// elastic group's particle takes into its velocity (its own, not its pairs' with the
+  /// others); null when no particle is in an elastic group.
+  virtual const std::vector<Vec2>* groupMoves() const { return nullptr; }
   /// Iterations and residuals of the last substep (explicit solvers: all zero).
   virtual SolverStats stats() const { return {}; }
   /// Writes what the solver carries from one substep to the next outside the particle

@@ -98,6 +98,8 @@ void World::Impl::matchGroups(StepContext& c) {
   const std::vector<Real>& stiffness = *P.find(ParticleStore::kGroupStiffness);
   const std::vector<Real>* yield = P.find(ParticleStore::kGroupYield);
   const Real damp = Real(std::exp(-kElasticDamping * double(dt)));
+  const std::vector<Vec2>* own = solver->groupCorrections() ? solver->groupMoves() : nullptr;
+  if (own && own->size() != P.size()) own = nullptr;
   std::vector<Real>* qxw = P.find(ParticleStore::kGroupQx);  // the rest shape, which plasticity moves
   std::vector<Real>* qyw = P.find(ParticleStore::kGroupQy);
   for (std::size_t i = 0; i < P.size(); ++i) {
@@ -128,10 +130,14 @@ void World::Impl::matchGroups(StepContext& c) {
       const Vec2 d(Real(k * (gx - double(P.x[i].x()))), Real(k * (gy - double(P.x[i].y()))));
       P.x[i] += d;
       // Its velocity takes the shape's pull, d/dt, and the solver's corrections of its position
-      // this substep, which a liquid's velocity leaves out (the game solver's density solve):
-      // left out, a jelly at rest kept −dt·g of velocity and never read as still. Not the
-      // collisions' pushes: they set the velocity themselves (with a body's reaction).
-      if (groupBefore.size() == P.size()) P.v[i] += (groupBefore[i].x - P.xPrev[i]) / dt - groupBefore[i].v;
+      // this substep, which a liquid's velocity leaves out: left out, a jelly at rest kept −dt·g
+      // of velocity and never read as still. Not the collisions' pushes: they set the velocity
+      // themselves (with a body's reaction). The game solver says which moves are its own
+      // corrections (not those of its pairs with the liquid: Solver::groupMoves, pbf_groups.cpp).
+      if (own)
+        P.v[i] += (*own)[i] / dt;
+      else if (groupBefore.size() == P.size())
+        P.v[i] += (groupBefore[i].x - P.xPrev[i]) / dt - groupBefore[i].v;
       P.v[i] += d / dt;
       // Internal friction: the velocity relative to the group's rigid motion decays at
       // kElasticDamping per second (the rigid motion itself, momentum and spin, is kept).

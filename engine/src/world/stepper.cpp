@@ -116,7 +116,7 @@ void World::Impl::buildStages() {
 
 void World::Impl::addParticleSystemStages(StageList& list, bool full) {
   const std::vector<Real>* k = P.find(ParticleStore::kGroupStiffness);
-  if (k && std::any_of(k->begin(), k->end(), [](Real s) { return s > 0 && s < 1; }))
+  if (k && !solver->groupCorrections() && std::any_of(k->begin(), k->end(), [](Real s) { return s > 0 && s < 1; }))
     list.add(plainStage("groups_before_collide", [this](StepContext& c) { groupsBeforeCollide(c); }));
   else
     groupBefore.clear();

@@ -383,19 +383,33 @@ MomentumRun momentumRun(const char* solver, bool withRigid, bool withJelly, bool
 }  // namespace
 
 TEST_CASE("groups: momentum of water, a rigid and an elastic group and a Box2D body holds in zero gravity") {
-  // wcsph (no position corrections): momentum is exchanged between them and their sum holds,
-  // all together and with each partner alone (a gain at one collision cannot hide behind a loss
-  // at another). The game solver gains 5 to 20 % at these collisions: its grid's transfer and a
-  // jelly's position-based support (docs/notes/free-blob-momentum.md).
-  const MomentumRun all = momentumRun("wcsph", true, true, true);
-  CHECK(all.rigid > 0.1);  // each was pushed
-  CHECK(all.jelly > 0.1);
-  CHECK(all.box > 0.1);
-  CHECK(all.worst < 0.01);
-  const MomentumRun rigid = momentumRun("wcsph", true, false, false), jelly = momentumRun("wcsph", false, true, false),
-                    box = momentumRun("wcsph", false, false, true);
-  CHECK(rigid.rigid > 0.1);
-  CHECK(jelly.jelly > 0.1);
-  CHECK(box.box > 0.1);
-  CHECK(std::max({rigid.worst, jelly.worst, box.worst}) < 0.01);
+  // Momentum is exchanged between them and their sum holds, all together and with each partner
+  // alone (a gain at one collision cannot hide behind a loss at another). wcsph has no position
+  // corrections: within 1 %. The game solver does not hold 5 %: its grid's transfer through
+  // faces the meeting blobs fill in part loses some (water thrown at still water: 3.8 %), and
+  // its voxel coupling of a body gains some; measured 5.4 % with the rigid group, 6.0 % with
+  // the box, 7.2 % all together. Its bounds keep that from growing (docs/notes/
+  // free-blob-momentum.md). A jelly once took the moves of its pairs with the water into its
+  // velocity, the water not: it gained 20.4 %; taking only its own corrections, 4.7 %.
+  struct Bounds {
+    const char* solver;
+    double all, rigid, jelly, box;
+  };
+  for (const Bounds& b : {Bounds{"wcsph", 0.01, 0.01, 0.01, 0.01}, Bounds{"game", 0.085, 0.065, 0.055, 0.07}}) {
+    CAPTURE(b.solver);
+    const MomentumRun all = momentumRun(b.solver, true, true, true);
+    CHECK(all.rigid > 0.1);  // each was pushed
+    CHECK(all.jelly > 0.1);
+    CHECK(all.box > 0.1);
+    CHECK(all.worst < b.all);
+    const MomentumRun rigid = momentumRun(b.solver, true, false, false),
+                      jelly = momentumRun(b.solver, false, true, false),
+                      box = momentumRun(b.solver, false, false, true);
+    CHECK(rigid.rigid > 0.1);
+    CHECK(jelly.jelly > 0.1);
+    CHECK(box.box > 0.1);
+    CHECK(rigid.worst < b.rigid);
+    CHECK(jelly.worst < b.jelly);
+    CHECK(box.worst < b.box);
+  }
 }

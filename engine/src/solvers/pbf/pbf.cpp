@@ -170,6 +170,7 @@ std::size_t Pbf::solve(StepContext& c) {
   }
   dLambda_.resize(n);
   lOld_.resize(n);
+  startElastic(c);
   wallGrad_.resize(n);
   const int maxIt = std::max(iterations_, maxIterations_);
   int used = 0;
@@ -273,6 +274,7 @@ std::size_t Pbf::solve(StepContext& c) {
       if (maxCompression_ <= toleranceMax_) break;
     }
   }
+  if (!ownVel_.empty()) ownMoves(c);
   stats_.pressureIterations = used + local;  // corrections applied
   stats_.densityError = double(meanCompression_);
   if (!split) {  // the last pass's (the local iterations may have gone on)
@@ -344,6 +346,8 @@ std::size_t Pbf::predict(StepContext& c, std::vector<Real>& lambda) {
   const Real pushout = Real(2) * pushoutSpeed_ * dt / c.dx;
   const std::vector<Real>* ratioField = P.find(ParticleStore::kRestRatio);  // m_i = r_i m with a density contrast
   const Real* ratio = ratioField ? ratioField->data() : nullptr;
+  markElastic(c);
+  const bool elastic = !ownVel_.empty();
   const std::size_t first = firstBad(c.pool, P.size(), [&](std::size_t b, std::size_t e) {
     std::size_t bad = kNone;
     Vec2d push(0, 0);
@@ -355,7 +359,7 @@ std::size_t Pbf::predict(StepContext& c, std::vector<Real>& lambda) {
       }
       const Vec2 x0 = P.x[i];
       Vec2 x = x0 + v * dt;
-      if (shift) x += (*shift)[i];
+      if (shift && !(elastic && ownVel_[i])) x += (*shift)[i];
       Vec2 vd = v;  // resolve()'s velocity response is not used: v follows from the positions
       const Vec2 xFree = x;
       // clearOf: resolve would find no collider near the move (most particles; exact).

@@ -150,6 +150,12 @@ class Pbf final : public Solver {
   /// Reads what saveState() wrote.
   void loadState(StateIn& in) override;
 
+  /// With corrections that move positions only (correction_to_velocity < 1: game), an elastic
+  /// group's particles take only their own corrections into velocity (pbf_groups.cpp).
+  bool groupCorrections() const override { return toVelocity_ < 1; }
+  /// The elastic groups' particles' own moves of the last solve, times 1 − kc (in cross_).
+  const std::vector<Vec2>* groupMoves() const override { return ownVel_.empty() ? nullptr : &cross_; }
+
   /// [grid → neighbours, when effects run] → external → effects → predict →
   /// predicted_grid → predicted_neighbours → density_solve → density → velocity.
   std::vector<Stage> stages(bool effects) override;
@@ -237,6 +243,27 @@ class Pbf final : public Solver {
   mutable std::vector<Real> speedScratch_, speedTop_;  ///< robustSpeed(): squared speeds, each block's largest
   mutable std::vector<Real> depthScratch_;             ///< maxTimeStep(): the highest particle per strip (columnDepths)
   std::unique_ptr<GridProjection> projection_;         ///< the coarse-grid projection (grid_cell > 0)
+
+  // Elastic groups under corrections that move positions only (pbf_groups.cpp). A jelly is held
+  // up by its own density solve (its pairs, the walls) and its shape matching, both moves of
+  // positions, so its particles take those moves into velocity; the moves of their pairs with
+  // other particles stay positions on both sides, as the liquid's do (taken on one side, a
+  // block of water thrown at a jelly gained 20 % of its momentum), and the grid's compression
+  // shift does not move them (as velocity it stopped the jelly being pushed at all).
+  /// Marks the particles of elastic groups (ownVel_; left empty when there are none or the
+  /// corrections become velocity anyway).
+  void markElastic(const StepContext& c);
+  /// At the solve's start (the slots were reordered since the prediction): marks them again,
+  /// clears the cross moves and keeps the positions.
+  void startElastic(const StepContext& c);
+  /// After the solve: the marked particles' own moves, (1 − kc)(x − start − cross), into cross_
+  /// (the World's groups stage adds them over dt to their velocity: groupMoves()).
+  void ownMoves(const StepContext& c);
+  std::vector<std::uint8_t> ownVel_;  ///< per particle: 1 in an elastic group (empty: none)
+  /// Per particle: the moves of its pairs with unmarked particles, combined over the iterations
+  /// as the positions are (Chebyshev: the last, the one before, the next).
+  std::vector<Vec2> cross_, crossOld_, crossNew_;
+  std::vector<Vec2> xStart_;  ///< the positions the solve started from (marked particles)
 
   Real d0_ = 0, eps_ = 0, invWdq_ = 0, sCorrScale_ = 0;
   Real meanCompression_ = 0, maxCompression_ = 0;

@@ -360,6 +360,7 @@ std::size_t Pbf::correct(StepContext& c, std::vector<Real>& lambda, Real omega,
   const Real* L = dLambda_.data();
   const bool cheb = omega != Real(1);
   const Real* invRatio = invRatio_.empty() ? nullptr : invRatio_.data();  // 1/r_i: a density contrast
+  const bool elastic = !ownVel_.empty();                                  // elastic groups' particles (pbf_groups.cpp)
   xNew_.resize(P.size());
   const std::size_t count = list ? list->size() : P.size();
   const std::size_t step = list ? kLocalBlock : kBlock;
@@ -378,12 +379,11 @@ std::size_t Pbf::correct(StepContext& c, std::vector<Real>& lambda, Real omega,
       const std::uint32_t* nb = c.nbr.of(i);
       const Grad* gc = gradCache_[i / kBlock].data() + c.nbr.start[i];
       const Real li = L[i];
-      Real tx = 0, ty = 0;
-      for (std::uint32_t k = 0; k < cnt; ++k) {
-        const std::uint32_t j = nb[k];
-        Real f = li + L[j];
+      // The pair's factor: Δλ_i + Δλ_j, and s_corr = −k (W(r)/W(Δq))^n (|G_ij| = V gK a²/r·r
+      // gives a back).
+      auto pairFactor = [&](std::uint32_t k) {
+        Real f = li + L[nb[k]];
         if (tensile) {
-          // s_corr = −k (W(r)/W(Δq))^n; |G_ij| = V gK a²/r·r gives a back.
           const Real gr = std::sqrt(gc[k].x * gc[k].x + gc[k].y * gc[k].y) * invVg;  // a²
           const Real a = std::sqrt(gr);
           const Real ratio = wRatio * a * a * a;  // W(r)/W(Δq)
@@ -391,8 +391,30 @@ std::size_t Pbf::correct(StepContext& c, std::vector<Real>& lambda, Real omega,
           for (int t = 1; t < sn; ++t) p *= ratio;
           f += sCorrScale_ * p;
         }
+        return f;
+      };
+      Real tx = 0, ty = 0;
+      for (std::uint32_t k = 0; k < cnt; ++k) {
+        const Real f = pairFactor(k);
         tx += f * gc[k].x;
         ty += f * gc[k].y;
+      }
+      if (elastic && ownVel_[i]) {
+        // An elastic group's particle: the part of its move its pairs with the others make
+        // (pbf_groups.cpp), combined over the iterations as its position is.
+        Real cx = 0, cy = 0;
+        for (std::uint32_t k = 0; k < cnt; ++k) {
+          if (ownVel_[nb[k]]) continue;
+          const Real f = pairFactor(k);
+          cx += f * gc[k].x;
+          cy += f * gc[k].y;
+        }
+        Vec2 dc(cx, cy);
+        if constexpr (kContrast) dc *= invRatio[i];
+        if (list)
+          cross_[i] += dc;
+        else
+          crossNew_[i] = cheb ? Vec2(crossOld_[i] + (cross_[i] + dc - crossOld_[i]) * omega) : Vec2(cross_[i] + dc);
       }
       const Vec2 dWall = wallGrad_[i] * li;
       // The walls' share in momentum: m·dWall (m_i = r_i m moves by dWall/r_i).
@@ -436,6 +458,10 @@ std::size_t Pbf::correct(StepContext& c, std::vector<Real>& lambda, Real omega,
   // x^{k−1} ← x^k, x^k ← x^{k+1}: buffers rotate, nothing is copied.
   xOld_.swap(P.x);
   P.x.swap(xNew_);
+  if (elastic) {
+    crossOld_.swap(cross_);
+    cross_.swap(crossNew_);
+  }
   return first;
 }
 
