@@ -88,7 +88,7 @@ void World::Impl::groupsBeforeCollide(const StepContext& c) {
   });
 }
 
-void World::Impl::matchGroups(StepContext& c) {
+void World::Impl::matchGroups(StepContext& c, bool full) {
   const Real dt = c.dt;
   std::vector<GroupSums>& sums = groupScratch;
   groupSums(sums);
@@ -98,7 +98,8 @@ void World::Impl::matchGroups(StepContext& c) {
   const std::vector<Real>& stiffness = *P.find(ParticleStore::kGroupStiffness);
   const std::vector<Real>* yield = P.find(ParticleStore::kGroupYield);
   const Real damp = Real(std::exp(-kElasticDamping * double(dt)));
-  const std::vector<Vec2>* own = solver->groupCorrections() ? solver->groupMoves() : nullptr;
+  // The solver's own corrections of this substep (none in a drift: they are the last full one's).
+  const std::vector<Vec2>* own = full && solver->groupCorrections() ? solver->groupMoves() : nullptr;
   if (own && own->size() != P.size()) own = nullptr;
   std::vector<Real>* qxw = P.find(ParticleStore::kGroupQx);  // the rest shape, which plasticity moves
   std::vector<Real>* qyw = P.find(ParticleStore::kGroupQy);
@@ -115,7 +116,7 @@ void World::Impl::matchGroups(StepContext& c) {
       P.x[i] = Vec2(Real(gx), Real(gy));
       P.v[i] = Vec2(Real(s.mvx / s.m - omega * (gy - cy)), Real(s.mvy / s.m + omega * (gx - cx)));
     } else {  // elastic: a share of the way, the velocity with it
-      if (yield && (*yield)[i] > 0) {
+      if (full && yield && (*yield)[i] > 0) {
         // Plastic: beyond the yield strain its place in the rest shape takes the excess (rotated
         // back into the rest frame), so the shape it springs back to is the deformed one.
         const double ex = double(P.x[i].x()) - gx, ey = double(P.x[i].y()) - gy, e = std::sqrt(ex * ex + ey * ey);
@@ -127,7 +128,8 @@ void World::Impl::matchGroups(StepContext& c) {
           (*qyw)[i] += Real(ry);
         }
       }
-      const Vec2 d(Real(k * (gx - double(P.x[i].x()))), Real(k * (gy - double(P.x[i].y()))));
+      const double pull = full ? k : 0.0;  // a drift: no pull (matchGroups' comment)
+      const Vec2 d(Real(pull * (gx - double(P.x[i].x()))), Real(pull * (gy - double(P.x[i].y()))));
       P.x[i] += d;
       // Its velocity takes the shape's pull, d/dt, and the solver's corrections of its position
       // this substep, which a liquid's velocity leaves out: left out, a jelly at rest kept −dt·g

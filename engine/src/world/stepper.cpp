@@ -122,7 +122,8 @@ void World::Impl::addParticleSystemStages(StageList& list, bool full) {
     groupBefore.clear();
   list.add(plainStage("collide", [](StepContext& c) { stageCollide(c); }));
   if (!moving.solids.bodies.empty()) list.add(plainStage("bodies", [this](StepContext& c) { collideMoving(c); }));
-  if (P.findU32(ParticleStore::kGroup)) list.add(plainStage("groups", [this](StepContext& c) { matchGroups(c); }));
+  if (P.findU32(ParticleStore::kGroup))
+    list.add(plainStage("groups", [this, full](StepContext& c) { matchGroups(c, full); }));
   // Foam reads the liquid's neighbour lists: before any slot is removed or wrapped.
   if (foam && full) list.add(plainStage("foam", [this](StepContext& c) { foam->step(c); }));
   if (periodic.any()) list.add(plainStage("wrap", [](StepContext& c) { stageWrap(c); }));

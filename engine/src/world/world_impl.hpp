@@ -265,8 +265,10 @@ struct World::Impl {
   // groups.cpp
   /// The groups stage: each group's particles towards the best-fit rigid placement of its
   /// rest shape (all the way when rigid), their velocities with them; then out of the static
-  /// solids (a rigid group as one).
-  void matchGroups(StepContext& c);
+  /// solids (a rigid group as one). In a drift (`full` false: a sliver of a step, no solver
+  /// stage) an elastic group is neither pulled nor yields: its stiffness is a share per
+  /// substep, and the pull over a microsecond's dt became a velocity of hundreds of m/s.
+  void matchGroups(StepContext& c, bool full);
   /// Before the collisions (with an elastic group): each elastic group particle's position and
   /// velocity, so that matchGroups can tell the solver's corrections from the collisions'.
   void groupsBeforeCollide(const StepContext& c);

@@ -5,9 +5,12 @@
 // pairs with the liquid (and rigid groups) move stays a move of positions on both sides, and the
 // grid's compression shift leaves them where they are. Momentum: each pair's two moves are
 // opposite (equal masses over the inverse mass ratios), so a jelly's pairs among themselves
-// add up to nothing, and the liquid exchanges momentum with a jelly through the grid
-// projection, as with itself. Sums per particle, each by its own block: the same bits for any
-// thread count.
+// add up to nothing (but in the local iterations, where a listed particle moves and its
+// unlisted neighbour does not), and the liquid exchanges momentum with a jelly through the
+// grid projection, as with itself. "Own" pairs are those with any elastic group's particle
+// (two jellies touching push each other by velocity); a rigid group's particles count as
+// the liquid's. The prediction's sweep out of the solids is left to the collide stage. Sums per particle, each by its
+// own block: the same bits for any thread count.
 #include "solvers/pbf/pbf.hpp"
 
 namespace sph2d {
