@@ -6,8 +6,9 @@
 // pixel above (distance one row), taking the longer run; everything else is a literal. Each
 // block of about 64k symbols gets its own Huffman codes (RFC 1951 dynamic blocks, lengths limited
 // to 15 bits by moving leaves up until the Kraft sum is exact). No hashing and no search: on the
-// dam break's 960×540 frames it codes in about two thirds of libdeflate level 1's time, to
-// files 5–10 % larger. Large images are cut into two strips of rows coded on two threads; each
+// dam break's 960×540 frames it takes 0.78 of libdeflate level 1's CPU time for files 1.05× as
+// large, and on two threads 0.35–0.5 of its wall time (docs/RENDERING.md, "PNG settings").
+// Large images are cut into two strips of rows coded on two threads; each
 // strip ends on a byte boundary (an empty stored block) and the strips' matches may reach back
 // into the rows before them, so the bytes do not depend on the thread count.
 #pragma once
