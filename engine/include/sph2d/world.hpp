@@ -185,7 +185,9 @@ class World {
   std::uint64_t frame() const;
   /// The substep length [s] the limits (CFL, force, effects) allow in the current state.
   double stableTimeStep() const;
-  /// Particle mass [kg] of the first material (a particle of material k: × its density over the first's).
+  /// A particle's mass [kg per metre of depth] of the first material: its rest density times the
+  /// spacing squared, the area it fills at rest (a particle of material k: × its density over the
+  /// first's). Momentum, energy and the exchanges with bodies and walls count this mass.
   Real particleMass() const;
   /// Kernel support R [m].
   Real support() const;

@@ -132,7 +132,7 @@ class Granular final : public Effect {
     const bool count = t.walls && c.wall;
     if (count) wallBlock_.assign((n + kBlock - 1) / kBlock, Vec2d(0, 0));
     const std::size_t bad = implicit_.apply(c, t, w, count, wallBlock_);
-    if (count) c.wall->force += sumInOrder(wallBlock_, (n + kBlock - 1) / kBlock) * double(c.mass);
+    if (count) c.wall->force += sumInOrder(wallBlock_, (n + kBlock - 1) / kBlock) * double(c.momentumMass);
     if (bad != kNone) return bad;
     nextViscosity(c, t, mat, ratio, nu, wallNu, nuMax);
     return kNone;

@@ -97,7 +97,7 @@ class LaplacianViscosity final : public Effect {
       first = implicit_.apply(c, t, wt, count, wallBlock_);
     else
       first = explicitStep(c, t, wt, count);
-    if (count) c.wall->force += sumInOrder(wallBlock_, blocks) * double(c.mass);
+    if (count) c.wall->force += sumInOrder(wallBlock_, blocks) * double(c.momentumMass);
     return first;
   }
 
@@ -209,8 +209,8 @@ class LaplacianViscosity final : public Effect {
             const Vec2 aBody = -lv * vK;
             acc += aBody;
             if (moving->placed[body].dynamic)
-              moving->addReaction(b / kBlock, body, aBody.cast<double>() * (double(c.mass) * double(ri)),
-                                  -double(tv) * double(vK) * (double(c.mass) * double(ri)));
+              moving->addReaction(b / kBlock, body, aBody.cast<double>() * (double(c.momentumMass) * double(ri)),
+                                  -double(tv) * double(vK) * (double(c.momentumMass) * double(ri)));
           });
         }
         P.a[i] += acc;

@@ -238,8 +238,8 @@ std::size_t ImplicitViscosity::apply(StepContext& c, const ViscosityTerm& t, con
       continue;
     }
     const MovingSolid& m = c.solids->bodies[k];
-    const double mass = 1.0 / (m.invMass * double(c.mass));
-    const double inertia = m.invInertia > 0 ? 1.0 / (m.invInertia * double(c.mass)) : 1.0;
+    const double mass = 1.0 / (m.invMass * double(c.momentumMass));
+    const double inertia = m.invInertia > 0 ? 1.0 / (m.invInertia * double(c.momentumMass)) : 1.0;
     bodyDiag_[k].v = Vec2d(mass, mass);
     bodyDiag_[k].w = inertia;
     b_.b[k].v = m.v * mass;
@@ -314,7 +314,7 @@ std::size_t ImplicitViscosity::apply(StepContext& c, const ViscosityTerm& t, con
       if (t.walls && count) wallAcc -= x_.p[i] * (wallG[i] * double(si));
       if (shapes && shapes->start[i] < shapes->start[i + 1]) {
         const double vK = double(t.wallFactor) * double(IR[i] * si) * (w.nuRel ? double(w.nuRel[i]) : 1.0);
-        const double mass = double(c.mass) * double(si);
+        const double mass = double(c.momentumMass) * double(si);
         for (std::uint32_t k = shapes->start[i]; k < shapes->start[i + 1]; ++k) {
           const ShapeContacts::Contact& ct = shapes->list[k];
           if (!isDynamic(ct.body)) continue;
@@ -339,7 +339,7 @@ std::size_t ImplicitViscosity::apply(StepContext& c, const ViscosityTerm& t, con
                               sum += moving->volume[*p] * t.W.laplacianR2((xi - moving->x[*p]).squaredNorm());
                             const Vec2 lv = (vi - (u.v + perp(arm) * u.w).cast<Real>()) * sum;
                             const Real tv = BodySamples::torque(arm, lv);
-                            const double mass = double(c.mass) * double(si);
+                            const double mass = double(c.momentumMass) * double(si);
                             moving->addReaction(lo / kBlock, body, (-lv * vK).cast<double>() * mass,
                                                 -double(tv) * double(vK) * mass);
                           });

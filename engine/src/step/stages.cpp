@@ -486,7 +486,7 @@ void stageCollide(StepContext& c) {
         return s;
       },
       [](const Vec2d& a, const Vec2d& b) { return Vec2d(a + b); });
-  if (c.wall) c.wall->sum.collision += dv * double(c.mass);
+  if (c.wall) c.wall->sum.collision += dv * double(c.momentumMass);
 }
 
 Real maxSpeedOf(const ParticleStore& P, ThreadPool& pool) {

@@ -102,7 +102,16 @@ struct StepContext {
   /// changed a since (force_limit; integrate reads a only), else −1: the `max_acceleration`
   /// stage then need not measure it again.
   Real accelMeasured = -1;
-  Real mass = 0;     ///< particle mass
+  /// The mass in the density sums (ρ = m Σ W): ρ0 over a square lattice's kernel sum, so that
+  /// the lattice at spacing dx reads ρ0. A kernel of short support sums higher than its
+  /// integral on a lattice (the game preset's, 2 spacings: 1.27×), so this is less than ρ0 dx².
+  Real mass = 0;
+  /// A particle's mass wherever momentum or energy leaves the particles (bodies, walls, groups,
+  /// the World's queries): ρ0 dx², the rest density over the area a particle fills at rest. With
+  /// `mass` there the water was lighter than its density to a body floating by the grid's
+  /// pressure ρ0κ: a game solver's crate hit by water gained momentum (docs/notes/
+  /// free-blob-momentum.md).
+  Real momentumMass = 0;
   Real rho0 = 1000;  ///< rest density
   Vec2 gravity = Vec2::Zero();
   Real clearance = 0;  ///< distance kept from solid surfaces

@@ -48,7 +48,7 @@ void World::Impl::groupSums(std::vector<GroupSums>& sums) const {
   std::uint32_t count = 0;
   for (const std::uint32_t g : group) count = std::max(count, g);
   sums.assign(count, GroupSums{});
-  auto massOf = [&](std::size_t i) { return double(mass) * (ratio ? double((*ratio)[i]) : 1.0); };
+  auto massOf = [&](std::size_t i) { return double(momentumMass) * (ratio ? double((*ratio)[i]) : 1.0); };
   for (std::size_t i = 0; i < P.size(); ++i) {
     if (!group[i]) continue;
     GroupSums& s = sums[group[i] - 1];

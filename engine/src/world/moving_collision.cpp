@@ -375,7 +375,7 @@ void World::Impl::collideMoving(StepContext& c, bool atStart) {
     Vec2d r;
     double vn;
     if (moving.hitBody[i] < 0 || !approach(i, r, vn)) continue;
-    const double m0 = ratio ? double(c.mass) * double((*ratio)[i]) : double(c.mass);
+    const double m0 = ratio ? double(c.momentumMass) * double((*ratio)[i]) : double(c.momentumMass);
     const std::size_t k = std::size_t(moving.hitBody[i]);
     const MovingSolid& m = bodies[k];
     const Vec2d& n = moving.hitNormal[i];

@@ -182,7 +182,7 @@ double World::kineticEnergy() const {
   const std::vector<Real>* ratio = P.find(ParticleStore::kRestRatio);  // m_i = r_i m
   double e = 0;
   for (std::size_t i = 0; i < P.size(); ++i)
-    e += 0.5 * double(impl_->mass) * (ratio ? double((*ratio)[i]) : 1.0) * double(P.v[i].squaredNorm());
+    e += 0.5 * double(impl_->momentumMass) * (ratio ? double((*ratio)[i]) : 1.0) * double(P.v[i].squaredNorm());
   return e;
 }
 

@@ -41,6 +41,7 @@ StepContext World::Impl::context(Real dt) {
   c.dx = dx;
   c.dt = dt;
   c.mass = mass;
+  c.momentumMass = momentumMass;
   c.rho0 = Real(scene.solver.restDensity);
   c.gravity = Vec2(Real(scene.gravity.x()), Real(scene.gravity.y()));
   c.clearance = kClearance * dx;

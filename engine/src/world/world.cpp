@@ -216,8 +216,10 @@ void World::initPhases(std::string& phase) {
 
   w.dx = Real(sd.spacing);
   w.R = Real(sd.supportRatio * sd.spacing);
-  // Mass so that a full square lattice at spacing dx has exactly ρ0.
+  // The density sums' mass, so that a full square lattice at spacing dx has exactly ρ0; the
+  // mass of momentum, ρ0 over the area dx² each particle fills at rest (StepContext).
   w.mass = Real(sd.restDensity / latticeSum(*w.solver, double(w.R), sd.spacing));
+  w.momentumMass = Real(sd.restDensity * sd.spacing * sd.spacing);
 
   if (scene.periodic.any()) {
     const PeriodicDef& pd = scene.periodic;
@@ -477,7 +479,7 @@ const SceneDef& World::scene() const { return impl_->scene; }
 double World::time() const { return impl_->time; }
 std::uint64_t World::frame() const { return impl_->frames; }
 double World::stableTimeStep() const { return double(impl_->stableDt()); }
-Real World::particleMass() const { return impl_->mass; }
+Real World::particleMass() const { return impl_->momentumMass; }
 Real World::support() const { return impl_->R; }
 Real World::spacing() const { return impl_->dx; }
 int World::threads() const { return impl_->pool.size(); }

@@ -66,8 +66,10 @@ struct World::Impl {
   EffectList effects;
   StageList stages;  ///< the substep, built by buildStages()
   StageList drift;   ///< a sliver of a step: drift and the particle system (buildStages())
-  Real dx = 0, R = 0, mass = 0;
-  PeriodicBox periodic;  ///< the scene's periodic box in the local frame
+  Real dx = 0, R = 0;
+  Real mass = 0;          ///< the density sums' particle mass (StepContext::mass)
+  Real momentumMass = 0;  ///< a particle's mass in momentum and energy (StepContext::momentumMass)
+  PeriodicBox periodic;   ///< the scene's periodic box in the local frame
   double time = 0;
   std::uint64_t frames = 0, steps = 0;
   int lastSubsteps = 0;

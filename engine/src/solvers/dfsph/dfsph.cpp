@@ -230,7 +230,7 @@ void Dfsph::lumpBodies(StepContext& c) {
       sumG_[t.body] += std::hypot(double(t.gx), double(t.gy));
       sumT_[t.body] += std::fabs(double(t.t));
     }
-  const double m = double(c.mass);
+  const double m = double(c.momentumMass);
   c.pool.parallelFor(c.P.size(), kBlock, [&](std::size_t b, std::size_t e) {
     const std::vector<MovTerm>& T = movTerms_[b / kBlock];
     for (std::size_t i = b; i < e; ++i) {
@@ -253,7 +253,7 @@ void Dfsph::lumpBodies(StepContext& c) {
 /// (BodySamples::addReaction: particles in order within a block, blocks summed in order).
 void Dfsph::react(StepContext& c) {
   BodySamples& S = *c.bodySamples;
-  const double m = double(c.mass);
+  const double m = double(c.momentumMass);
   c.pool.parallelFor(c.P.size(), kBlock, [&](std::size_t b, std::size_t e) {
     const std::vector<MovTerm>& T = movTerms_[b / kBlock];
     for (std::size_t i = b; i < e; ++i) {

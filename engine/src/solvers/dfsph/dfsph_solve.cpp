@@ -62,7 +62,7 @@ void Dfsph::solve(StepContext& c, bool divergence) {
     if (cheb_ > 0 && it > chebStart && err > lastErr) chebStart = it + kChebDelay;
     lastErr = err;
   }
-  if (c.wall) c.wall->sum.samples += wall * double(c.mass);
+  if (c.wall) c.wall->sum.samples += wall * double(c.momentumMass);
   if (moving_) {
     react(c);
     dvBase_ = dv_;
@@ -249,7 +249,7 @@ Vec2d Dfsph::correctPass(StepContext& c, std::vector<Real>& kappa, Real w) {
 /// Δω_k = Δω_prev + m dt Σ_i Q_i T_ik / I_k, the blocks' sums in block order.
 void Dfsph::bodyResponse(const StepContext& c, std::size_t blocks) {
   const std::size_t K = dv_.size();
-  const double mdt = double(c.mass) * double(c.dt);
+  const double mdt = double(c.momentumMass) * double(c.dt);
   for (std::size_t k = 0; k < K; ++k) {
     Vec2d g(0, 0);
     double t = 0;

@@ -116,7 +116,7 @@ std::size_t GridProjection::transferToParticles(StepContext& c) {
   // telescopes to these end terms on a grid of uniform mass ρ0h² a face; a moving body's faces
   // are not static (the body takes their impulse).
   const bool countWall = c.wall != nullptr;
-  const double wallP = double(c.mass) / (double(c.dx) * double(c.dx)) * double(h_) * double(dt), wallM = double(c.mass);
+  const double wallM = double(c.momentumMass), wallP = wallM / (double(c.dx) * double(c.dx)) * double(h_) * double(dt);
   double wallAxis[2] = {0, 0};
   // The u faces and the v faces are independent: two tasks, each serial. Open faces
   // next to fluid take the pressure gradient; closed faces next to fluid lose their

@@ -354,8 +354,8 @@ std::size_t pressureForce(StepContext& c, const Spiky<Real>& spiky, const Viscos
           const Vec2 aBody = -(gb * pK) - lv * vK;
           acc += aBody;
           if (moving->placed[body].dynamic)
-            moving->addReaction(b / kBlock, body, aBody.cast<double>() * double(c.mass),
-                                -(double(tb) * double(pK) + double(tv) * double(vK)) * double(c.mass));
+            moving->addReaction(b / kBlock, body, aBody.cast<double>() * double(c.momentumMass),
+                                -(double(tb) * double(pK) + double(tv) * double(vK)) * double(c.momentumMass));
         });
       }
       P.a[i] = acc;
@@ -365,7 +365,7 @@ std::size_t pressureForce(StepContext& c, const Spiky<Real>& spiky, const Viscos
     return bad;
   });
   // The World multiplies it by the substep integrate takes (force_limit may still shorten it).
-  if (c.wall) c.wall->force += sumInOrder(wallBlock, blocks) * double(c.mass);
+  if (c.wall) c.wall->force += sumInOrder(wallBlock, blocks) * double(c.momentumMass);
   return first;
 }
 

@@ -573,8 +573,8 @@ std::size_t Pbf::velocity(StepContext& c) {
   // velocities among the particles, which keeps their sum up to the density ratio).
   if (c.wall && kc > 0) {
     const Vec2d* moved = velocityFromSnapshot_ ? wallMoveVel_ : wallMove_;  // pushout_speed: the first solve's
-    c.wall->sum.samples += moved[0] * (double(c.mass) * double(kc) / double(c.dt));
-    c.wall->sum.collision += moved[1] * (double(c.mass) * double(kc) / double(c.dt));
+    c.wall->sum.samples += moved[0] * (double(c.momentumMass) * double(kc) / double(c.dt));
+    c.wall->sum.collision += moved[1] * (double(c.momentumMass) * double(kc) / double(c.dt));
   }
   return first;
 }

@@ -311,8 +311,8 @@ class Wcsph final : public Solver {
             }
             acc += aBody;
             if (moving->placed[body].dynamic)
-              moving->addReaction(b / kBlock, body, aBody.cast<double>() * (double(c.mass) / double(invRi)),
-                                  torque * (double(c.mass) / double(invRi)));
+              moving->addReaction(b / kBlock, body, aBody.cast<double>() * (double(c.momentumMass) / double(invRi)),
+                                  torque * (double(c.momentumMass) / double(invRi)));
           });
         }
         acc += c.gravity;
@@ -324,7 +324,7 @@ class Wcsph final : public Solver {
     });
     // The walls' force on the fluid, Σ m a_wall in block order; the World multiplies it by the
     // substep integrate takes (force_limit may still shorten it).
-    if (c.wall) c.wall->force += sumInOrder(wallBlock_, blocks) * double(c.mass);
+    if (c.wall) c.wall->force += sumInOrder(wallBlock_, blocks) * double(c.momentumMass);
     return first;
   }
 
