@@ -386,17 +386,19 @@ MomentumRun momentumRun(const char* solver, bool withRigid, bool withJelly, bool
 TEST_CASE("groups: momentum of water, a rigid and an elastic group and a Box2D body holds in zero gravity") {
   // Momentum is exchanged between them and their sum holds, all together and with each partner
   // alone (a gain at one collision cannot hide behind a loss at another). wcsph has no position
-  // corrections: within 1 %. The game solver does not hold 5 %: its grid's transfer through
-  // faces the meeting blobs fill in part loses some (water thrown at still water: 3.8 %), and
-  // its voxel coupling of a body gains some; measured 5.4 % with the rigid group, 6.0 % with
-  // the box, 7.2 % all together. Its bounds keep that from growing (docs/notes/
-  // free-blob-momentum.md). A jelly once took the moves of its pairs with the water into its
-  // velocity, the water not: it gained 20.4 %; taking only its own corrections, 4.7 %.
+  // corrections: within 1 %. The game solver does not hold 5 % with the groups: its grid's
+  // transfer through faces the meeting blobs fill in part gains or loses some (water thrown at
+  // still water: 3.8 %); measured 5.4 % with the rigid group, 4.3 % with the box, 7.2 % all
+  // together. Its bounds keep that from growing (docs/notes/free-blob-momentum.md). A jelly once
+  // took the moves of its pairs with the water into its velocity, the water not: it gained
+  // 20.4 %; taking only its own corrections, 4.7 %. The box gained 6.0 % while the particles'
+  // momentum counted the density sums' mass (0.79 ρ0·dx² at the game preset's support) and the
+  // grid pushed the box with ρ0κ.
   struct Bounds {
     const char* solver;
     double all, rigid, jelly, box;
   };
-  for (const Bounds& b : {Bounds{"wcsph", 0.01, 0.01, 0.01, 0.01}, Bounds{"game", 0.085, 0.065, 0.055, 0.07}}) {
+  for (const Bounds& b : {Bounds{"wcsph", 0.01, 0.01, 0.01, 0.01}, Bounds{"game", 0.085, 0.065, 0.055, 0.05}}) {
     CAPTURE(b.solver);
     const MomentumRun all = momentumRun(b.solver, true, true, true);
     CHECK(all.rigid > 0.1);  // each was pushed
