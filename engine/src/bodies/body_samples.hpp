@@ -108,8 +108,8 @@ struct BodySamples {
   /// are placed, and the neighbour lists hold them.
   bool active() const { return !placed.empty(); }
 
-  /// Adds what particle mass·acceleration `ma` (double) with torque arm sum `torque` one block's
-  /// particle felt from body k's samples to the block's partial. Call from the block's own job.
+  /// Adds what momentum mass·acceleration `ma` (double; StepContext::momentumMass) with torque arm sum `torque` one
+  /// block's particle felt from body k's samples to the block's partial. Call from the block's own job.
   void addReaction(std::size_t block, std::uint32_t k, const Vec2d& ma, double torque) {
     std::vector<Reaction>& r = perBlock[block];
     for (Reaction& e : r)

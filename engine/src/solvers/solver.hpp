@@ -34,7 +34,7 @@ class Solver {
   /// equilibrium (0: start uncompressed).
   virtual double hydrostaticFactor() const = 0;
   /// The kernel the solver sums density with, W(r) for support R (double):
-  /// the World sets the particle mass so a square lattice has density ρ0.
+  /// the World sets the density sums' mass (StepContext::mass) so a square lattice has density ρ0.
   virtual double densityKernel(double r, double R) const = 0;
   /// Density and pressure of the current positions (for a complete initial state).
   virtual void prepare(StepContext& c) = 0;
