@@ -211,10 +211,11 @@ inline double sumY(const World& w) {
   return s;
 }
 
-/// Σ m g y over the particles [J per metre of depth]: the potential energy for gravity g downwards.
+/// Σ m g y over the particles [J per metre of depth]: the potential energy for gravity g downwards
+/// (materials of one density: m is World::particleMass for all; World::kineticEnergy weighs each).
 inline double potentialEnergy(const World& w, double g = 9.81) { return double(w.particleMass()) * g * sumY(w); }
 
-/// Σ m v [kg m/s per metre of depth].
+/// Σ m v [kg m/s per metre of depth] (materials of one density, as potentialEnergy).
 inline Vec2d momentum(const World& w) {
   Vec2d m(0, 0);
   for (std::size_t i = 0; i < w.particleCount(); ++i)
