@@ -259,7 +259,9 @@ TEST_CASE("an interrupted World steps again after load(): to the same hash as th
   std::stringstream saved;
   ref.save(saved);
   std::atomic<bool> stop{false};
-  auto w = spreadWorld(100000, &stop, 2);
+  // A frame of 400,000 particles takes seconds (the test above), so the flag lands mid-step;
+  // with 100,000 a fast hour finished the frame inside the 200 ms.
+  auto w = spreadWorld(400000, &stop, 2);
   std::thread setter([&] {
     std::this_thread::sleep_for(std::chrono::milliseconds(200));
     stop.store(true);
