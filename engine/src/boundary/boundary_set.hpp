@@ -14,8 +14,9 @@
 //
 // resolve() is the swept collision: a particle that crossed a surface during
 // the substep (ray from its previous position) is put back on the side it
-// came from, then kept `clearance` away from every surface; its velocity
-// follows the fixture's restitution and Coulomb friction.
+// came from, then kept `clearance` away from every surface, and never left beyond
+// one (stopShort); its velocity follows the fixture's restitution and Coulomb
+// friction (swept_collision.cpp; the rest here in boundary_set.cpp).
 #pragma once
 
 #include <algorithm>
@@ -160,6 +161,12 @@ struct BoundarySet {
   bool blocks(const Vec2& a, const Vec2& b) const;
   /// Swept collision of one particle (x, v) that moved from xOld. Returns true on contact.
   bool resolve(Vec2& x, Vec2& v, const Vec2& xOld, Real clearance) const;
+  /// resolve()'s last step: x, once corrected, must be reachable from xOld without crossing a
+  /// surface; at the first crossing it stops short of it (and v loses the speed into it).
+  void stopShort(Vec2& x, Vec2& v, const Vec2& xOld, Real clearance) const;
+  /// The first solid surface the path p0 → p1 crosses (colliders within `margin` of it): its
+  /// point and normal (facing p0's side); nullptr when it crosses none.
+  const Collider* firstCrossing(const Vec2& p0, const Vec2& p1, Real margin, Vec2& hit, Vec2& n) const;
 };
 
 }  // namespace sph2d
