@@ -1,6 +1,7 @@
 // sph2d run's exports: CSV and VTK particles and bodies, video, PNG level, sph2d render of an
 // exported frame, and images written to a device.
 #include <doctest/doctest.h>
+#include <cstdio>
 
 #include <fcntl.h>
 #include <signal.h>
@@ -72,24 +73,34 @@ TEST_CASE("--export csv writes bodies_NNNNN.csv with each kinematic body's pose 
 TEST_CASE("--export csv writes the dynamic crates of floating_crates.json too, each row's velocity that of its x, y") {
   // Every frame kept: a row's (vx, vy) is the velocity of the point (x, y) (the body origin),
   // so it matches the origin's move over the frame (Box2D moves a body by its new velocity:
-  // x(n+1) = x(n) + dt v(n+1), the rotation's part included up to its second order).
+  // x(n+1) = x(n) + dt v(n+1), the rotation's part included up to its second order). Not on a
+  // frame where Box2D's position correction separates two bodies in contact (a crate against
+  // the turning bar: 3 of 195 rows here, up to 0.5 m/s), so the rows are counted, frame by frame.
   const std::string dir = freshDir("export_crates");
   REQUIRE(run("run " + q(asset("scenes/floating_crates.json")) + " --frames 40 --quiet --export csv --out " + q(dir))
               .code == 0);
-  const auto a = bodyRows(dir + "/bodies_00038.csv"), b = bodyRows(dir + "/bodies_00039.csv");
-  REQUIRE(a.size() == 5);  // the turning bar and four crates, boundaries[1..5]
-  REQUIRE(b.size() == 5);
   const double dt = 1.0 / 60;
-  int checked = 0;
-  for (std::size_t k = 0; k < b.size(); ++k) {
-    INFO("body " << b[k][0]);
-    CHECK(b[k][0] == double(k + 1));
-    const double vx = (b[k][1] - a[k][1]) / dt, vy = (b[k][2] - a[k][2]) / dt;
-    CHECK(std::abs(vx - b[k][4]) < 0.01 + 0.02 * std::abs(b[k][4]));
-    CHECK(std::abs(vy - b[k][5]) < 0.01 + 0.02 * std::abs(b[k][5]));
-    checked += std::abs(b[k][4]) + std::abs(b[k][5]) > 0.01;
+  int rows = 0, matching = 0, moving = 0;
+  for (int f = 1; f < 40; ++f) {
+    char name[64];
+    std::snprintf(name, sizeof name, "/bodies_%05d.csv", f - 1);
+    const auto a = bodyRows(dir + name);
+    std::snprintf(name, sizeof name, "/bodies_%05d.csv", f);
+    const auto b = bodyRows(dir + name);
+    REQUIRE(a.size() == 5);  // the turning bar and four crates, boundaries[1..5]
+    REQUIRE(b.size() == 5);
+    for (std::size_t k = 0; k < b.size(); ++k) {
+      CHECK(b[k][0] == double(k + 1));
+      const double vx = (b[k][1] - a[k][1]) / dt, vy = (b[k][2] - a[k][2]) / dt;
+      ++rows;
+      matching += std::abs(vx - b[k][4]) < 0.01 + 0.02 * std::abs(b[k][4]) &&
+                  std::abs(vy - b[k][5]) < 0.01 + 0.02 * std::abs(b[k][5]);
+      moving += std::abs(b[k][4]) + std::abs(b[k][5]) > 0.01;
+    }
   }
-  CHECK(checked >= 3);  // most bodies are moving at 0.65 s
+  MESSAGE(matching << " of " << rows << " rows match the origin's move, " << moving << " moving");
+  CHECK(matching >= rows * 9 / 10);
+  CHECK(moving >= rows / 2);  // most bodies are moving
 }
 
 TEST_CASE("--export csv and vtk write each kept frame's particles in id order, world coordinates") {
