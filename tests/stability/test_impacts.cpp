@@ -52,6 +52,14 @@ bool inside(const std::vector<Vec2d>& poly, const Vec2d& p) {
 /// of wcsph and muller2003 and pbf's bounded pushout, wcsph threw one at 2.82). What is left
 /// is the impulsive pressure at the jet's blunt front, which no solver here bounds per particle.
 constexpr double kSpecificEnergyBound = 2.5;
+/// The game solver's (the default's): measured 1.18 / 1.17 / 1.13 / 1.22 on the four funnels here
+/// (the worst particles in the free jet at its nozzle, under the arena's lid), up to 1.54 on
+/// other funnels and nozzle heights (docs/notes/impact-energy.md: the front's first contact).
+/// It was 1.32 / 1.64 / 1.26 / 1.67 here, and 2.60 at 80 m/s, while the grid's PIC share was
+/// taken once per substep whatever the move: a particle crossing six cells of the grid in a
+/// substep kept the projection's noise on a stream two cells wide, and it built up along the
+/// jet (GridProjection::transferToParticles).
+constexpr double kGameSpecificEnergyBound = 1.6;
 
 struct JetCase {
   double leftAngle, rightAngle;  ///< the teeth's vertex angles [°]
@@ -119,7 +127,7 @@ void zigzagFunnel(const std::string& solver, const JetCase& jc) {
   CHECK(totalWorst <= 1.0);
   // Once single particles left at 6.7-7.9 times the jet's specific energy (pbf), and the game
   // solver stopped with a NaN position; docs/STABILITY.md has each solver's figure.
-  CHECK(eWorst <= kSpecificEnergyBound);
+  CHECK(eWorst <= (solver == "game" ? kGameSpecificEnergyBound : kSpecificEnergyBound));
 }
 
 void funnelHeadOn(const std::string& solver) { zigzagFunnel(solver, JetCase{25, 25, Vec2d(0, -1), 50}); }
