@@ -9,6 +9,7 @@
 // stopShort() then sweeps the whole corrected path once more from the start.
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "boundary/boundary_set.hpp"
 
@@ -136,11 +137,10 @@ bool circlePush(const Collider& c, Vec2& x, Real clearance, Vec2& nOut) {
 }
 
 // --- two-sided segment ------------------------------------------------------
-// A segment's ends count a ten-thousandth of its length beyond themselves: a path through a
+// A segment's ends count 16 float steps of their coordinates beyond themselves: a path through a
 // chain's vertex, between its two segments, is then seen by one of them despite the rounding
 // (it passed between them: 1 of 116,000 random moves in acute valleys).
 bool segmentSweep(const Collider& c, const Vec2& p0, const Vec2& p1, Vec2& hit, Vec2& nHit) {
-  const Real reach = Real(1e-4);
   const Vec2& a = c.vertices[0];
   const Vec2& b = c.vertices[1];
   const Vec2 e = b - a;
@@ -151,7 +151,12 @@ bool segmentSweep(const Collider& c, const Vec2& p0, const Vec2& p1, Vec2& hit, 
   if (den == 0) return false;
   const Real t = cross2(a - p0, e) / den;  // along the path
   const Real u = cross2(a - p0, d) / den;  // along the segment
-  if (t < 0 || t > 1 || u < -reach || u > 1 + reach) return false;
+  if (t < 0 || t > 1) return false;
+  if (u < 0 || u > 1) {
+    const Real size = std::max({Real(1), std::abs(a.x()), std::abs(a.y()), std::abs(b.x()), std::abs(b.y())});
+    const Real reach = Real(16) * std::numeric_limits<Real>::epsilon() * size / e.norm();
+    if (u < -reach || u > 1 + reach) return false;
+  }
   hit = p0 + d * t;
   Vec2 n(-e.y(), e.x());
   n.normalize();
@@ -178,6 +183,37 @@ bool segmentPush(const Collider& c, Vec2& x, const Vec2& xOld, Real clearance, V
   }
   x = q + nOut * clearance;
   return true;
+}
+
+// --- near a box ---------------------------------------------------------------
+/// The colliders whose bounding box meets [lo, hi]: up to 64 from the bins, in index order.
+struct Near {
+  std::uint32_t ids[64];
+  std::size_t n = 0;
+  bool overflow = false;  ///< more than 64: every collider is scanned (BoundarySet::forCollidersNear)
+  Vec2 lo, hi;
+};
+
+Near near(const BoundarySet& set, const Vec2& lo, const Vec2& hi) {
+  Near r;
+  r.lo = lo;
+  r.hi = hi;
+  r.n = set.collidersMeeting(lo, hi, r.ids, 64, r.overflow);
+  std::sort(r.ids, r.ids + r.n);  // a fixed order: collider index
+  return r;
+}
+
+/// Calls f(c) for each collider of `r`, in index order (a finely cut chain or a dense level
+/// meets more than 64 boxes: then all of them, by a scan; dropping the rest let a particle
+/// through a chain of 1 cm segments).
+template <class F>
+void forEach(const BoundarySet& set, const Near& r, F&& f) {
+  if (!r.overflow) {
+    for (std::size_t q = 0; q < r.n; ++q) f(set.colliders[r.ids[q]]);
+    return;
+  }
+  for (const Collider& c : set.colliders)
+    if (!(c.hi.x() < r.lo.x() || c.hi.y() < r.lo.y() || c.lo.x() > r.hi.x() || c.lo.y() > r.hi.y())) f(c);
 }
 
 // --- by kind ------------------------------------------------------------------
@@ -223,20 +259,15 @@ bool BoundarySet::blocks(const Vec2& a, const Vec2& b) const {
 
 bool BoundarySet::resolve(Vec2& x, Vec2& v, const Vec2& xOld, Real clearance) const {
   // Swept box of the move, grown by the clearance.
-  const Vec2 lo = x.cwiseMin(xOld) - Vec2(clearance, clearance);
-  const Vec2 hi = x.cwiseMax(xOld) + Vec2(clearance, clearance);
-  std::uint32_t cand[64];
-  bool overflow = false;
-  const int nc = int(collidersMeeting(lo, hi, cand, 64, overflow));
-  if (nc == 0) return false;
-  std::sort(cand, cand + nc);  // fixed resolution order: collider index
+  const Near cand =
+      near(*this, x.cwiseMin(xOld) - Vec2(clearance, clearance), x.cwiseMax(xOld) + Vec2(clearance, clearance));
+  if (cand.n == 0) return false;
 
   bool contact = false;
   Vec2 from = xOld;
   for (int pass = 0; pass < 2; ++pass) {
     bool moved = false;
-    for (int q = 0; q < nc; ++q) {
-      const Collider& c = colliders[cand[q]];
+    forEach(*this, cand, [&](const Collider& c) {
       Vec2 hit, n;
       if (sweep(c, from, x, hit, n)) {
         x = hit + n * clearance;
@@ -247,7 +278,7 @@ bool BoundarySet::resolve(Vec2& x, Vec2& v, const Vec2& xOld, Real clearance) co
         respond(v, n, c.friction, c.restitution);
         contact = moved = true;
       }
-    }
+    });
     if (!moved) break;
     from = x;  // the second pass checks the corrections themselves
   }
@@ -256,28 +287,26 @@ bool BoundarySet::resolve(Vec2& x, Vec2& v, const Vec2& xOld, Real clearance) co
 }
 
 const Collider* BoundarySet::firstCrossing(const Vec2& p0, const Vec2& p1, Real margin, Vec2& hit, Vec2& n) const {
-  const Vec2 lo = p0.cwiseMin(p1) - Vec2(margin, margin), hi = p0.cwiseMax(p1) + Vec2(margin, margin);
-  std::uint32_t cand[64];
-  bool overflow = false;
-  const int nc = int(collidersMeeting(lo, hi, cand, 64, overflow));
+  const Near cand = near(*this, p0.cwiseMin(p1) - Vec2(margin, margin), p0.cwiseMax(p1) + Vec2(margin, margin));
   const Vec2 d = p1 - p0;
   const Real len2 = d.squaredNorm();
-  if (nc == 0 || !(len2 > 0)) return nullptr;
-  std::sort(cand, cand + nc);
+  if (cand.n == 0 || !(len2 > 0)) return nullptr;
   Real tFirst = 2;
   const Collider* first = nullptr;
-  for (int q = 0; q < nc; ++q) {
-    const Collider& c = colliders[cand[q]];
+  forEach(*this, cand, [&](const Collider& c) {
     Vec2 h, m;
-    if (!sweep(c, p0, p1, h, m)) continue;
+    if (!sweep(c, p0, p1, h, m)) return;
     const Real t = (h - p0).dot(d) / len2;
+    // A path that starts on a two-sided segment's line leaves it to the side resolve() chose
+    // (which side it came from is not known): not a crossing.
+    if (c.kind == Collider::Kind::Segment && !(t > 0)) return;
     if (t < tFirst) {  // ties: the lower collider index (candidates in index order)
       tFirst = t;
       hit = h;
       n = m;
       first = &c;
     }
-  }
+  });
   return first;
 }
 
@@ -299,7 +328,11 @@ void BoundarySet::stopShort(Vec2& x, Vec2& v, const Vec2& xOld, Real clearance) 
   const Real back = std::min(Real(0.25) * clearance, Real(0.5) * t * len);
   Vec2 y = hit - d * (back / len) + n * (Real(0.01) * clearance);
   Vec2 hit2, n2;
-  if (firstCrossing(xOld, y, clearance, hit2, n2)) y = xOld;
+  const Collider* second = firstCrossing(xOld, y, clearance, hit2, n2);
+  if (second) {
+    y = xOld;
+    respond(v, n2, second->friction, second->restitution);  // nor into that one
+  }
   x = y;
   respond(v, n, first->friction, first->restitution);
 }
