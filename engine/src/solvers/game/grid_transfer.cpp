@@ -181,14 +181,14 @@ std::size_t GridProjection::transferToParticles(StepContext& c) {
       Vec2 vp = v0 + sampleFaces(du_, dv_, w);  // FLIP: the change of the grid velocity
       if (pic_ > 0) {
         // PIC share: towards the projected grid velocity itself (smooths particle noise), once
-        // per cell the particle crossed in the substep, at least once: 1 − (1 − pic)^n. FLIP
+        // per cell its velocity carries it in the substep, at least once: 1 − (1 − pic)^n. FLIP
         // keeps the part of a particle's velocity the grid does not carry, and with it the
         // projection's noise; a 50 m/s jet crosses six cells a substep, and with the share
         // once per substep that noise built up along a stream two cells wide (particles at
         // 1.6 times the jet's specific energy, 2.6 at 80 m/s; tests/stability/test_impacts.cpp).
         const Vec2 ug = sampleFaces(uNew_, vNew_, w);
         const Real cells = std::sqrt(v0.squaredNorm()) * dt * invH_;
-        const Real share = cells > 1 ? Real(1) - std::exp(cells * logKeep) : pic_;
+        const Real share = cells > 1 && pic_ < 1 ? Real(1) - std::exp(cells * logKeep) : pic_;
         vp += (ug - vp) * share;
       }
       if (flipClamp_) vp = clampToFaces(vp, v0, w);

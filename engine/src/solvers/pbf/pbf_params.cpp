@@ -62,8 +62,8 @@ std::vector<SolverParam> pbfParams(bool game) {
        "grid solve: the density change per substep its largest residual may stand for"},
       {"grid_max_iterations", 200, 1, 10000, "grid solve: conjugate-gradient iterations at most"},
       {"grid_pic", g(0, 0.05), 0, 1,
-       "share of the projected grid velocity the particles take per grid cell they crossed in the substep, at least "
-       "once (PIC; the rest is the FLIP change)"},
+       "share of the projected grid velocity the particles take per grid cell their velocity carries them in the "
+       "substep, at least once (PIC; the rest is the FLIP change)"},
       {"grid_flip_clamp", 0, 0, 1,
        "1: the transfer makes no particle faster than it was or than the projected velocities of the faces it samples "
        "reach (no new extreme of speed)"},
