@@ -73,8 +73,9 @@ using test::minPairDistance;
 /// measured 0.37 for pbf, 0.19 for dfsph), nothing escapes. muller2003: farther than
 /// 0.03 dx. Below ρ0 its clamped pressure pushes no pair apart, so its closest pair rests
 /// wherever the collisions before left it: 0.088 dx without the impact viscosity (the
-/// particles thrown out of the overlap collide at more than 0.2 c = 5 m/s), 0.038 dx with
-/// it, and 0.037–0.19 dx for impact_speed 0.1–0.6 (measured); every run parts the pairs
+/// particles thrown out of the overlap collide at more than 0.1 c = 2.5 m/s), 0.19 dx with
+/// it (0.038 dx with it from 0.2 c), and 0.037–0.19 dx for impact_speed 0.1–0.6 (measured);
+/// every run parts the pairs
 /// from 0. It read 0.17 dx before the viscosity's per-pair cap (viscosity.cpp), when the
 /// viscous coupling of the pressed pair overshot every substep (dt·coupling 0.8).
 ///
