@@ -52,8 +52,10 @@ bool inside(const std::vector<Vec2d>& poly, const Vec2d& p) {
 /// of wcsph and muller2003 and pbf's bounded pushout, wcsph threw one at 2.82). What is left
 /// is the impulsive pressure at the jet's blunt front, which no solver here bounds per particle.
 constexpr double kSpecificEnergyBound = 2.5;
-/// The game solver's (the default's): measured 1.18 / 1.17 / 1.13 / 1.22 / 1.16 on the five funnels
-/// here (the worst particles in the free jet at its nozzle, under the arena's lid), up to 1.72 on
+/// The game solver's (the default's): measured 1.18 / 1.18 / 1.08 / 1.22 / 1.16 on the five funnels
+/// here (the worst particles in the free jet at its nozzle, under the arena's lid; 1.18 / 1.17 /
+/// 1.13 / 1.22 / 1.16 before the grid's momentum balance changed these chaotic runs,
+/// docs/notes/free-blob-momentum.md), up to 1.72 on
 /// other funnels and nozzle heights (docs/notes/impact-energy.md: the front's first contact). It
 /// was 1.30 / 1.63 / 1.32 / 1.67 / 1.65 while the grid's PIC share was taken once per substep
 /// whatever the move: a particle crossing six cells of the grid in a substep kept the

@@ -43,11 +43,14 @@ struct MovingSolid {
   Vec2d centroid{0, 0};         ///< the union's centroid, body coordinates from the centre of mass
   double invMass = 0;           ///< 1/mass: 0 for a kinematic body (the fluid does not move it)
   double invInertia = 0;        ///< 1/(rotational inertia about the centre of mass), 0 when it cannot turn
-  Vec2d gravity{0, 0};          ///< the b2World's gravity times the body's gravity scale (dynamic only)
-  double sweptTheta = 0;        ///< the pose the particles last saw it at (the last substep's end; the
-  Vec2d sweptOrigin{0, 0};      ///< capture, or the last step's end when Box2D then moved it elsewhere)
-  Vec2d impulse{0, 0};          ///< the fluid's linear impulse on it during this step [kg m/s]
-  double angularImpulse = 0;    ///< … and angular impulse about the centre of mass [kg m²/s]
+  /// Box2D holds it beyond the fluid (a dynamic body with a touching contact or a joint at the
+  /// step's start): what the fluid gives it, Box2D may take away.
+  bool held = false;
+  Vec2d gravity{0, 0};        ///< the b2World's gravity times the body's gravity scale (dynamic only)
+  double sweptTheta = 0;      ///< the pose the particles last saw it at (the last substep's end; the
+  Vec2d sweptOrigin{0, 0};    ///< capture, or the last step's end when Box2D then moved it elsewhere)
+  Vec2d impulse{0, 0};        ///< the fluid's linear impulse on it during this step [kg m/s]
+  double angularImpulse = 0;  ///< … and angular impulse about the centre of mass [kg m²/s]
 
   /// True for a body the fluid pushes (dynamic, with mass).
   bool dynamic() const { return invMass > 0; }

@@ -314,6 +314,10 @@ void World::Impl::captureBodies() {
       const double ic = double(body->GetInertia()) - bodyMass * m.localCenter.squaredNorm();
       m.invInertia = body->IsFixedRotation() || !(ic > 0) ? 0.0 : 1.0 / ic;
       m.gravity = Vec2d(g.x, g.y) * double(body->GetGravityScale());
+      m.held = body->GetJointList() != nullptr;
+      for (const b2ContactEdge* e = body->GetContactList(); e && !m.held; e = e->next)
+        m.held = e->contact->IsTouching() && e->contact->IsEnabled() && !e->contact->GetFixtureA()->IsSensor() &&
+                 !e->contact->GetFixtureB()->IsSensor();
     }
     for (const Collider& c : m.shapes) {
       if (c.kind == Collider::Kind::Circle)

@@ -30,6 +30,7 @@ void GridProjection::markBodies(const StepContext& c) {
     st.omega = m.omega;
     st.invMass = m.invMass;
     st.invInertia = m.invInertia;
+    st.held = m.held;
     // The body's cells, anchored indices [bI0, bI0 + bn) × [bJ0, bJ0 + bm), over its whole
     // reach (the grid may hold only part of it): a cell is the body's when its centre lies
     // at least half a cell inside, so the fluid cells around have their centres (where

@@ -134,10 +134,14 @@ void GridPcg::groundPockets() {
       if (ra != rb) root[std::size_t(std::max(ra, rb))] = std::min(ra, rb);  // the lower index is the root
     }
   }
+  regionOf_.resize(m);
+  regions_ = 0;
   for (std::size_t a = 0; a < m; ++a) {
     const std::int32_t r = find(std::int32_t(a));
     if (vented_[a]) vented_[std::size_t(r)] = 1;
     root[a] = r;
+    // Regions numbered in order of their roots (a root is its region's first unknown).
+    regionOf_[a] = std::size_t(r) == a ? std::int32_t(regions_++) : regionOf_[std::size_t(r)];
   }
   // Pocket numbers in order of their roots; −1 for cells of a vented region.
   pocketCells_.clear();

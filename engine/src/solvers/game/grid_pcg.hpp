@@ -80,6 +80,11 @@ class GridPcg {
   const std::vector<std::int32_t>& cells() const { return cells_; }
   /// The sealed pockets the last factor() grounded.
   std::size_t pockets() const { return pocketLast_.size(); }
+  /// Per unknown, its region: the fluid cells joined by open faces, numbered 0.. in order of
+  /// their first unknowns (set by factor()).
+  const std::vector<std::int32_t>& regionOf() const { return regionOf_; }
+  /// The regions' count.
+  std::size_t regions() const { return regions_; }
   /// Calls f(a, i, j) for every unknown a (cell (i, j)), in cell order, row by row.
   template <class F>
   void forUnknowns(F f) const {
@@ -111,6 +116,8 @@ class GridPcg {
   std::vector<Real> precon_, precon2_;  ///< MIC(0) factor: 1/diag(L), and its square
   std::vector<std::uint8_t> vented_;    ///< per unknown: an open face to air (then per region root: the region has one)
   std::vector<std::int32_t> pocketOf_;  ///< per unknown: its sealed pocket (−1: a vented region)
+  std::vector<std::int32_t> regionOf_;  ///< per unknown: its region (regionOf())
+  std::size_t regions_ = 0;
   std::vector<std::int32_t> pocketCells_, pocketLast_;  ///< per pocket: its cell count, its grounded (last) unknown
 };
 

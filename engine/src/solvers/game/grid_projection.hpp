@@ -43,7 +43,8 @@
 // a projection is four steps of a few tasks each (project()): the cells'
 // weights, their classification and the matrix beside the u and v faces'
 // velocities; the pressure solve beside the shift's solve and face moves; the
-// u beside the v faces' changes; then the particles in blocks.
+// u beside the v faces' changes; then the particles in blocks. The momentum balance
+// (grid_momentum.cpp) sums each cluster's particles in slot order on one thread.
 #pragma once
 
 #include <cstdint>
@@ -152,6 +153,16 @@ class GridProjection {
   Vec2 sampleFaces(const std::vector<Real>& u, const std::vector<Real>& v, const FaceWeights& w) const;
   /// vp no faster than v0, or than the projected velocities of the faces `w` samples together.
   Vec2 clampToFaces(const Vec2& vp, const Vec2& v0, const FaceWeights& w) const;
+  /// The clusters of the momentum balance (grid_momentum.cpp): the fluid regions no wall or
+  /// kinematic body holds, joined through the dynamic bodies they touch, with an interior cell
+  /// (clusterOf_, per region then per body; cellCluster_). False when there is none.
+  bool momentumClusters();
+  /// The cluster a particle at (px, py) (cell units) belongs to, −1 for none.
+  std::int32_t clusterAt(Real px, Real py) const;
+  /// Takes out each cluster's imbalance (its particles' Σ m Δv from the transfer plus its
+  /// dynamic bodies' impulse) as one velocity change of its particles and bodies. Returns the
+  /// first particle it leaves non-finite or above the speed limit, or kNone.
+  std::size_t balanceMomentum(StepContext& c);
 
  public:
   Real pic_ = 0;          ///< share of the projected grid velocity given to the particles (PIC; the rest FLIP)
@@ -159,6 +170,9 @@ class GridProjection {
   /// grid_flip_clamp: a particle's new speed stays within its old one or what the projected
   /// velocities of the faces it samples reach (grid_projection.cpp, clampToFaces).
   bool flipClamp_ = false;
+  /// grid_conserve: a fluid region no wall holds keeps its momentum with the dynamic bodies it
+  /// touches through the transfer (grid_momentum.cpp).
+  bool conserve_ = true;
   /// Per particle (slot order), the move the last projection's compression shift asks for
   /// (empty when the shift is off); read by the prediction of the same substep.
   const std::vector<Vec2>& shift() const { return shift_; }
@@ -214,6 +228,7 @@ class GridProjection {
   struct BodyState {
     Vec2d centre{0, 0}, v{0, 0};
     double omega = 0, invMass = 0, invInertia = 0;
+    bool held = false;  ///< Box2D holds it (MovingSolid::held): a wall to the momentum balance
     double T[3][3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};  ///< the faces' correction (markBodies)
     /// g = T·(n, r × n) of a face at `face` with normal n into the body.
     void coupling(const Vec2d& n, const Vec2d& face, double g[3]) const;
@@ -230,6 +245,17 @@ class GridProjection {
   mutable std::vector<double> bodySum_;  ///< addCoupled()'s scratch: Gᵀ·in per body (the main solve only)
   std::vector<std::uint8_t> bodyCells_;  ///< markBodies' scratch: one body's cells over its box
   std::vector<double> bodyImpulse_;      ///< solve()'s scratch: each body's impulse Gᵀκ
+  // The momentum balance (grid_momentum.cpp).
+  static constexpr std::int32_t kNoFluid = -2;  ///< cellCluster_ of a cell that is not fluid
+  std::vector<std::int32_t> clusterRoot_;       ///< union-find over the regions, then the bodies
+  std::vector<std::uint8_t> clusterWalled_;     ///< per region or body: held by a wall, has an interior cell
+  std::vector<std::int32_t> clusterOf_;         ///< per region, then per body: its cluster (−1: none)
+  std::size_t clusters_ = 0;
+  std::vector<std::int32_t> cellCluster_;  ///< per cell: its cluster (−1: none, kNoFluid: not a fluid cell)
+  std::vector<std::int32_t> partCluster_;  ///< per particle: its cluster (−1: none)
+  std::vector<Vec2> partDelta_;            ///< per particle: the transfer's change of its velocity
+  std::vector<double> clusterSum_;         ///< per cluster: Σ m Δv and Σ m
+  std::vector<Vec2> clusterShift_;         ///< per cluster: the velocity change that balances it
 };
 
 }  // namespace sph2d

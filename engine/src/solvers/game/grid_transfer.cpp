@@ -172,13 +172,19 @@ std::size_t GridProjection::transferToParticles(StepContext& c) {
     shift_.resize(P.size());
   else
     shift_.clear();
-  return firstBad(c.pool, P.size(), [&](std::size_t b, std::size_t e) {
+  const bool balancing = conserve_ && momentumClusters();
+  if (balancing) {
+    partCluster_.resize(P.size());
+    partDelta_.resize(P.size());
+  }
+  const std::size_t badSlot = firstBad(c.pool, P.size(), [&](std::size_t b, std::size_t e) {
     std::size_t bad = kNone;
     for (std::size_t p = b; p < e; ++p) {
       const Real px = P.x[p].x() * invH_ - Real(I0_), py = P.x[p].y() * invH_ - Real(J0_);
       const FaceWeights w = faceWeights(px, py);  // the same for every face field
       const Vec2 v0 = P.v[p];
-      Vec2 vp = v0 + sampleFaces(du_, dv_, w);  // FLIP: the change of the grid velocity
+      const Vec2 flip = sampleFaces(du_, dv_, w);  // FLIP: the change of the grid velocity
+      Vec2 vp = v0 + flip;
       if (pic_ > 0) {
         // PIC share: towards the projected grid velocity itself (smooths particle noise), once
         // per cell its velocity carries it in the substep, at least once: 1 − (1 − pic)^n. FLIP
@@ -194,10 +200,16 @@ std::size_t GridProjection::transferToParticles(StepContext& c) {
       if (flipClamp_) vp = clampToFaces(vp, v0, w);
       P.v[p] = vp;
       if (shifting) shift_[p] = sampleFaces(su_, sv_, w);
+      if (balancing) {
+        partCluster_[p] = clusterAt(px, py);
+        partDelta_[p] = vp - v0;
+      }
       if (bad == kNone && (!allFinite(P.v[p]) || P.v[p].squaredNorm() > vmax2)) bad = p;
     }
     return bad;
   });
+  if (balancing && badSlot == kNone) return balanceMomentum(c);
+  return badSlot;
 }
 
 Vec2 GridProjection::clampToFaces(const Vec2& vp, const Vec2& v0, const FaceWeights& w) const {

@@ -49,6 +49,7 @@ Pbf::Pbf(const SolverDef& d)
   if (projection_) projection_->pic_ = Real(d.param("grid_pic"));
   if (projection_) projection_->surface_ = d.param("grid_surface") > 0;
   if (projection_) projection_->flipClamp_ = d.param("grid_flip_clamp") > 0;
+  if (projection_) projection_->conserve_ = d.param("grid_conserve") > 0;
 }
 
 void Pbf::prepare(StepContext& c) {

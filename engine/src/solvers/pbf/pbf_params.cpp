@@ -64,6 +64,10 @@ std::vector<SolverParam> pbfParams(bool game) {
       {"grid_pic", g(0, 0.05), 0, 1,
        "share of the projected grid velocity the particles take per grid cell their velocity carries them in the "
        "substep, at least once (PIC; the rest is the FLIP change)"},
+      {"grid_conserve", 1, 0, 1,
+       "1: a fluid region no wall, kinematic body or Box2D-held body holds, with an interior cell, keeps its momentum "
+       "with the dynamic bodies it touches through the grid's transfer (its imbalance taken out as one velocity "
+       "change)"},
       {"grid_flip_clamp", 0, 0, 1,
        "1: the transfer makes no particle faster than it was or than the projected velocities of the faces it samples "
        "reach (no new extreme of speed)"},

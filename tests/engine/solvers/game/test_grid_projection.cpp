@@ -289,8 +289,9 @@ TEST_CASE("grid projection: a free blob in zero gravity keeps its momentum, at a
   // and the pressure that removed the false compression at the blob's front slowed it by 7 % a
   // second at 0.3 m/s (docs/notes/free-blob-momentum.md). Squeezed along x as well (a strain of
   // 1/s about its centre, which adds no momentum) its own pressure reshapes it, and the transfer
-  // of that pressure through faces the surface fills in part leaves its mean velocity within
-  // 0.03 m/s (measured 0.012 to 0.026).
+  // of that pressure through faces the surface fills in part moved its mean velocity by 0.012
+  // to 0.026 m/s, until the transfer's imbalance in a region no wall holds was taken out
+  // (grid_momentum.cpp): float rounding now, 2e-6 to 6e-6 m/s.
   for (const double dx : {0.02, 0.01})
     for (const double U : {0.3, 1.5})
       for (const bool strained : {false, true}) {
@@ -312,6 +313,117 @@ TEST_CASE("grid projection: a free blob in zero gravity keeps its momentum, at a
         }
         MESSAGE("dx " << dx << ", U " << U << " m/s" << std::string(strained ? ", strained" : "")
                       << ": the mean velocity within " << worst << " m/s over 1 s");
-        CHECK(worst < (strained ? 0.03 : 1e-6 * U));
+        CHECK(worst < (strained ? 1e-4 : 1e-6 * U));
       }
+}
+
+namespace {
+
+/// Water thrown at still water in zero gravity, far from every wall (a block 0.4 m × 0.3 m at
+/// `speed` along `angleDeg` into one 0.3 m × 0.25 m at rest, in a tank 8 m × 6 m): the largest
+/// change of the total momentum over 0.8 s, as a share of the start's.
+double meetingMomentumChange(double speed, double angleDeg, bool conserve) {
+  SceneDef s = test::tank("game", 8.0, 6.0, 0.02);
+  s.gravity = Vec2d(0, 0);
+  s.solver.params["grid_conserve"] = conserve ? 1 : 0;
+  const double a = angleDeg * test::kPi / 180;
+  s.blocks = {test::block({2.0, 2.9}, {2.4, 3.2}, Vec2d(speed * std::cos(a), speed * std::sin(a))),
+              test::block({2.7, 2.9}, {3.0, 3.15}, Vec2d(0, 0))};
+  World w(s, WorldOptions{2});
+  const Vec2d p0 = test::momentum(w);
+  double worst = 0, nearest = 1e9;  // nearest: the closest any particle came to a wall [m]
+  for (int f = 0; f < 48; ++f) {
+    w.stepFrame();
+    worst = std::max(worst, (test::momentum(w) - p0).norm() / p0.norm());
+    for (std::size_t i = 0; i < w.particleCount(); ++i) {
+      const Vec2d x = w.worldPosition(i);
+      nearest = std::min({nearest, x.x(), 8.0 - x.x(), x.y(), 6.0 - x.y()});
+    }
+  }
+  REQUIRE(nearest > 0.5);  // nothing outside acted on the water
+  return worst;
+}
+
+}  // namespace
+
+TEST_CASE("grid projection: water thrown at still water in zero gravity keeps the momentum of both") {
+  // Where the two blobs meet, the grid's faces are filled in part, and the particles took each
+  // face's pressure change by their weight on it: the sum no longer telescoped, and the pair
+  // lost 2-7 % of its momentum with nothing outside acting. A region no wall holds now keeps
+  // its momentum through the transfer (grid_conserve, grid_momentum.cpp); the spray the meeting
+  // throws, a few particles with no interior cell, is left out of it (measured within 0.002 %,
+  // 0.045 % where the 2.5 m/s head-on meeting threw spray).
+  for (const double speed : {0.7, 1.0, 2.5})
+    for (const double angle : {0.0, 12.0, -25.0}) {
+      const double kept = meetingMomentumChange(speed, angle, true);
+      MESSAGE(speed << " m/s at " << angle << "°: the total momentum within " << 100 * kept << " %");
+      CHECK(kept < 1e-3);
+    }
+  // The mechanism: without the balance the meeting loses momentum.
+  const double lost = meetingMomentumChange(1.0, 0.0, false);
+  MESSAGE("without the balance: " << 100 * lost << " %");
+  CHECK(lost > 0.01);
+}
+
+TEST_CASE("grid projection: water a wall holds is left to the wall (grid_conserve changes no bit)") {
+  // The balance acts only on regions that meet no wall and no kinematic body: a wall takes
+  // whatever the particles do not, so there is no conservation law to restore. A tank sloshing
+  // without leaving its floor has the same bits with and without it.
+  std::uint64_t hash[2] = {0, 0};
+  for (const int conserve : {0, 1}) {
+    SceneDef s = test::tank("game", 2.0, 1.0, 0.02);
+    s.solver.params["grid_conserve"] = conserve;
+    s.blocks = {test::block({0.02, 0.02}, {1.98, 0.4}, Vec2d(0.3, 0))};
+    World w(s, WorldOptions{2});
+    for (int f = 0; f < 60; ++f) w.stepFrame();
+    hash[conserve] = w.stateHash();
+  }
+  CHECK(hash[0] == hash[1]);
+}
+
+namespace {
+
+/// Water in a dynamic cup (inner 0.6 m × 0.4 m, walls 0.1 m, of `density`) resting on a tank's
+/// floor, filled 0.3 m: the water's mean height over 2 to 6 s.
+double cupWaterHeight(double density, bool conserve) {
+  SceneDef s = test::tank("game", 4.0, 2.0, 0.02);
+  s.solver.params["grid_conserve"] = conserve ? 1 : 0;
+  BodyDef cup;
+  cup.type = BodyDef::Type::Dynamic;
+  cup.position = Vec2d(2.0, 0.0);
+  const double iw = 0.6, ih = 0.4, wall = 0.1;
+  for (ShapeDef part : {boxShape({0, wall / 2}, {iw / 2 + wall, wall / 2}),
+                        boxShape({-iw / 2 - wall / 2, wall + ih / 2}, {wall / 2, ih / 2}),
+                        boxShape({iw / 2 + wall / 2, wall + ih / 2}, {wall / 2, ih / 2})}) {
+    part.density = density;
+    part.friction = 0.5;
+    cup.fixtures.push_back(part);
+  }
+  s.bodies.push_back(cup);
+  s.blocks = {test::block({2.0 - iw / 2 + 0.01, wall + 0.01}, {2.0 + iw / 2 - 0.01, wall + 0.3})};
+  World w(s, WorldOptions{2});
+  double sum = 0;
+  int samples = 0;
+  for (int f = 1; f <= 360; ++f) {
+    w.stepFrame();
+    if (f < 120 || f % 20 != 0) continue;
+    sum += test::sumY(w) / double(w.particleCount());
+    ++samples;
+  }
+  return sum / samples;
+}
+
+}  // namespace
+
+TEST_CASE("grid projection: a dynamic body Box2D holds is a wall to the momentum balance (water in a cup)") {
+  // A cup resting on the floor holds its water up with the pressure on its bottom, and the
+  // floor holds the cup. Taken for a free partner, the cup's share of the balance was undone by
+  // Box2D each frame while the water kept its own: the water sat 3.4 cm lower in a cup of density
+  // 100 and moved faster. A body with a touching contact or a joint is held (MovingSolid::held).
+  for (const double density : {100.0, 500.0}) {
+    const double off = cupWaterHeight(density, false), on = cupWaterHeight(density, true);
+    MESSAGE("cup of density " << density << ": the water's mean height " << on << " m, " << off
+                              << " m without the balance");
+    CHECK(std::fabs(on - off) < 0.003);
+  }
 }
