@@ -43,8 +43,9 @@ struct MovingSolid {
   Vec2d centroid{0, 0};         ///< the union's centroid, body coordinates from the centre of mass
   double invMass = 0;           ///< 1/mass: 0 for a kinematic body (the fluid does not move it)
   double invInertia = 0;        ///< 1/(rotational inertia about the centre of mass), 0 when it cannot turn
-  /// Box2D holds it beyond the fluid (a dynamic body with a touching contact or a joint at the
-  /// step's start): what the fluid gives it, Box2D may take away.
+  /// Box2D holds it beyond the fluid: a joint, or a static fixture its shapes touch at the
+  /// step's start (World::Impl::holdBody, from the poses, so that a loaded World holds it as
+  /// the saved one did). What the fluid gives it, Box2D may take away.
   bool held = false;
   Vec2d gravity{0, 0};        ///< the b2World's gravity times the body's gravity scale (dynamic only)
   double sweptTheta = 0;      ///< the pose the particles last saw it at (the last substep's end; the

@@ -314,10 +314,6 @@ void World::Impl::captureBodies() {
       const double ic = double(body->GetInertia()) - bodyMass * m.localCenter.squaredNorm();
       m.invInertia = body->IsFixedRotation() || !(ic > 0) ? 0.0 : 1.0 / ic;
       m.gravity = Vec2d(g.x, g.y) * double(body->GetGravityScale());
-      m.held = body->GetJointList() != nullptr;
-      for (const b2ContactEdge* e = body->GetContactList(); e && !m.held; e = e->next)
-        m.held = e->contact->IsTouching() && e->contact->IsEnabled() && !e->contact->GetFixtureA()->IsSensor() &&
-                 !e->contact->GetFixtureB()->IsSensor();
     }
     for (const Collider& c : m.shapes) {
       if (c.kind == Collider::Kind::Circle)
@@ -336,6 +332,7 @@ void World::Impl::captureBodies() {
         m.sweptTheta = l.theta;
         m.sweptOrigin = l.origin;
       }
+    if (m.dynamic()) holdBody(m);
     moving.solids.bodies.push_back(std::move(m));
   }
   // The `bodies` stage exists only with moving bodies, `body_gravity` and `body_walls` only with a dynamic one.

@@ -99,6 +99,47 @@ bool collideWithStatic(const b2Shape* a, const b2Transform& xa, const b2Shape* b
 
 }  // namespace
 
+template <class F>
+void World::Impl::forStaticContacts(const MovingSolid& m, const b2Transform& xa, F f) const {
+  b2ContactFilter filter;  // Box2D's default: the fixtures' categories, masks and groups
+  for (const b2Fixture* fa = m.body->GetFixtureList(); fa; fa = fa->GetNext()) {
+    if (fa->IsSensor()) continue;
+    b2AABB boxA;
+    fa->GetShape()->ComputeAABB(&boxA, xa, 0);
+    for (const b2Body* sb = b2->GetBodyList(); sb; sb = sb->GetNext()) {
+      if (sb->GetType() != b2_staticBody) continue;
+      for (const b2Fixture* fb = sb->GetFixtureList(); fb; fb = fb->GetNext()) {
+        if (fb->IsSensor() || !filter.ShouldCollide(const_cast<b2Fixture*>(fa), const_cast<b2Fixture*>(fb))) continue;
+        const b2Shape* shape = fb->GetShape();
+        for (int child = 0; child < shape->GetChildCount(); ++child) {
+          b2AABB boxB;
+          shape->ComputeAABB(&boxB, sb->GetTransform(), child);
+          if (!b2TestOverlap(boxA, boxB)) continue;
+          b2WorldManifold wm;
+          int points = 0;
+          if (!collideWithStatic(fa->GetShape(), xa, shape, child, sb->GetTransform(), wm, points) || points == 0)
+            continue;
+          double deepest = 0;
+          for (int k = 0; k < points; ++k) deepest = std::min(deepest, double(wm.separations[k]));
+          f(Vec2d(wm.normal.x, wm.normal.y), deepest);  // from the body into the static fixture
+        }
+      }
+    }
+  }
+}
+
+void World::Impl::holdBody(MovingSolid& m) const {
+  // Box2D holds a body that has a joint or rests on a static fixture (a touching manifold: its
+  // points within the shapes' skins): the grid's momentum balance leaves its cluster alone.
+  m.held = m.body->GetJointList() != nullptr;
+  if (m.held) return;
+  double theta;
+  Vec2d o;
+  m.pose(0, theta, o);
+  const b2Transform xa(b2Vec2(float(o.x() + origin.x()), float(o.y() + origin.y())), b2Rot(float(theta)));
+  forStaticContacts(m, xa, [&](const Vec2d&, double) { m.held = true; });
+}
+
 void World::Impl::bodyWalls(StepContext& c) {
   // A dynamic body moves through a step along its velocity (moving_solid.hpp); Box2D's contacts
   // act on it only when Box2D next steps it (once a frame in a game's b2World, and in the
@@ -116,33 +157,11 @@ void World::Impl::bodyWalls(StepContext& c) {
     Vec2d o;
     m.pose(tau1, theta, o);
     const b2Transform xa(b2Vec2(float(o.x() + origin.x()), float(o.y() + origin.y())), b2Rot(float(theta)));
-    for (const b2Fixture* fa = m.body->GetFixtureList(); fa; fa = fa->GetNext()) {
-      if (fa->IsSensor()) continue;
-      b2AABB boxA;
-      fa->GetShape()->ComputeAABB(&boxA, xa, 0);
-      for (const b2Body* sb = b2->GetBodyList(); sb; sb = sb->GetNext()) {
-        if (sb->GetType() != b2_staticBody) continue;
-        for (const b2Fixture* fb = sb->GetFixtureList(); fb; fb = fb->GetNext()) {
-          if (fb->IsSensor()) continue;
-          const b2Shape* shape = fb->GetShape();
-          for (int child = 0; child < shape->GetChildCount(); ++child) {
-            b2AABB boxB;
-            shape->ComputeAABB(&boxB, sb->GetTransform(), child);
-            if (!b2TestOverlap(boxA, boxB)) continue;
-            b2WorldManifold wm;
-            int points = 0;
-            if (!collideWithStatic(fa->GetShape(), xa, shape, child, sb->GetTransform(), wm, points) || points == 0)
-              continue;
-            double deepest = 0;
-            for (int k = 0; k < points; ++k) deepest = std::min(deepest, double(wm.separations[k]));
-            if (deepest > -kRunInto) continue;
-            const Vec2d n(wm.normal.x, wm.normal.y);  // from the body into the static fixture
-            const double vn = m.v.dot(n);
-            if (vn > 0) m.changeVelocity(tau0, -vn * n, 0);
-          }
-        }
-      }
-    }
+    forStaticContacts(m, xa, [&](const Vec2d& n, double deepest) {
+      if (deepest > -kRunInto) return;
+      const double vn = m.v.dot(n);
+      if (vn > 0) m.changeVelocity(tau0, -vn * n, 0);
+    });
   }
 }
 

@@ -161,6 +161,14 @@ struct World::Impl {
   /// The `body_walls` stage: a dynamic body whose shapes would, by the substep's end, overlap a
   /// static fixture deeper than Box2D's contact distance loses the part of its velocity into it.
   void bodyWalls(StepContext& c);
+  /// Sets whether Box2D holds dynamic body m at the step's start (MovingSolid::held): a joint, or
+  /// a static fixture its shapes touch at their pose then (from the poses alone, as bodyWalls
+  /// tests them, so a loaded World holds it as the saved one did).
+  void holdBody(MovingSolid& m) const;
+  /// Calls f(n, deepest) for each static fixture child dynamic body m's shapes touch at pose xa
+  /// (n from the body into the fixture; deepest, the most negative separation of its points).
+  template <class F>
+  void forStaticContacts(const MovingSolid& m, const b2Transform& xa, F f) const;
   /// The `bodies` stage: particles that entered a moving body during the substep are put
   /// back on its surface, their velocity into it replaced by the body's (free slip); with a
   /// dynamic body they meet as an inelastic contact, and the body takes the impulse.

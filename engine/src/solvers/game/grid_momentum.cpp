@@ -16,7 +16,7 @@
 // of kinetic energy that restores the balance. Pressure is instantaneous through a connected
 // incompressible region, so the correction reaches no further than the pressure did. A
 // region a wall holds is left as it is: the wall takes whatever the particles do not; so is a
-// cluster with a dynamic body that Box2D holds (a touching contact or a joint: a cup resting on
+// cluster with a dynamic body that Box2D holds (a joint, or a static fixture it rests on: a cup resting on
 // the floor passed the pressure's push on its bottom to the water it held, 3.4 cm lower). So is
 // a cluster with no interior cell (four fluid neighbours): spray of a few particles, all
 // surface, whose grid pressure stands for no resolved flow; balanced, clusters of one to six
