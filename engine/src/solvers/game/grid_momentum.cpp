@@ -17,7 +17,7 @@
 // incompressible region, so the correction reaches no further than the pressure did. A
 // region a wall holds is left as it is: the wall takes whatever the particles do not; so is a
 // cluster with a dynamic body that Box2D holds (a joint, or a static fixture it rests on: a cup resting on
-// the floor passed the pressure's push on its bottom to the water it held, 3.4 cm lower). So is
+// the floor passed the pressure's push on its bottom to the water it held, 3.3 cm lower). So is
 // a cluster with no interior cell (four fluid neighbours): spray of a few particles, all
 // surface, whose grid pressure stands for no resolved flow; balanced, clusters of one to six
 // particles took shifts of up to 10 m/s in an 80 m/s jet's spray.

@@ -183,8 +183,7 @@ std::size_t GridProjection::transferToParticles(StepContext& c) {
       const Real px = P.x[p].x() * invH_ - Real(I0_), py = P.x[p].y() * invH_ - Real(J0_);
       const FaceWeights w = faceWeights(px, py);  // the same for every face field
       const Vec2 v0 = P.v[p];
-      const Vec2 flip = sampleFaces(du_, dv_, w);  // FLIP: the change of the grid velocity
-      Vec2 vp = v0 + flip;
+      Vec2 vp = v0 + sampleFaces(du_, dv_, w);  // FLIP: the change of the grid velocity
       if (pic_ > 0) {
         // PIC share: towards the projected grid velocity itself (smooths particle noise), once
         // per cell its velocity carries it in the substep, at least once: 1 − (1 − pic)^n. FLIP
