@@ -16,6 +16,7 @@
 
 #include <box2d/box2d.h>
 
+#include <array>
 #include <cmath>
 #include <vector>
 
@@ -47,6 +48,13 @@ struct MovingSolid {
   /// step's start (World::Impl::holdBody, from the poses, so that a loaded World holds it as
   /// the saved one did). What the fluid gives it, Box2D may take away.
   bool held = false;
+  /// Where it rests on static fixtures at the step's start (World::Impl::holdBody): one row
+  /// (n, r × n) per contact point, n from the body into the fixture, r from the centre of mass.
+  /// Within the step it does not move into them, as Box2D's resting contacts hold it: gravity
+  /// and the fluid's pushes go through changeVelocityResting(), and the grid projection's
+  /// coupled solve takes the response they leave (restingResponse()). What the fluid gives it
+  /// still goes whole to Box2D (`impulse`), which settles it against the contacts.
+  std::vector<std::array<double, 3>> rests;
   Vec2d gravity{0, 0};        ///< the b2World's gravity times the body's gravity scale (dynamic only)
   double sweptTheta = 0;      ///< the pose the particles last saw it at (the last substep's end; the
   Vec2d sweptOrigin{0, 0};    ///< capture, or the last step's end when Box2D then moved it elsewhere)
@@ -82,12 +90,29 @@ struct MovingSolid {
     v += dv;
     omega += dOmega;
   }
+  /// Changes the velocity by (dv, dω) at time τ as the resting contacts allow: the new
+  /// velocity without its part into the contacts it would move into (restrict()).
+  void changeVelocityResting(double tau, const Vec2d& dv, double dOmega) {
+    if (rests.empty()) return changeVelocity(tau, dv, dOmega);
+    double q[3] = {v.x() + dv.x(), v.y() + dv.y(), omega + dOmega};
+    restrict(q);
+    changeVelocity(tau, Vec2d(q[0], q[1]) - v, q[2] - omega);
+  }
   /// Gives the body the fluid's impulse (J about the centre of mass, L) at time τ.
   void push(double tau, const Vec2d& J, double L) {
     impulse += J;
     angularImpulse += L;
-    changeVelocity(tau, J * invMass, L * invInertia);
+    changeVelocityResting(tau, J * invMass, L * invInertia);
   }
+  /// The generalized velocity q = (v, ω) without its part into the resting contacts it moves
+  /// into: projected, in the metric of the body's mass (the least change of kinetic energy),
+  /// onto the velocities that hold those contacts still; contacts it leaves stay free (an
+  /// active set, grown until no contact is entered, at most once per contact).
+  void restrict(double q[3]) const;
+  /// The response to an impulse (J, L) that the resting contacts leave, W = M⁻¹ − M⁻¹Aᵀ(A M⁻¹
+  /// Aᵀ)⁺A M⁻¹ over those it is not moving off (A their rows): row-major 3 × 3, symmetric.
+  /// Without contacts, diag(1/m, 1/m, 1/I).
+  void restingResponse(double W[3][3]) const;
 };
 
 /// The moving bodies of one step.

@@ -364,7 +364,7 @@ bool World::Impl::insideMoving(const Vec2& p) const {
 void World::Impl::bodyGravity(StepContext& c) {
   const double tau0 = c.time - moving.solids.time0;
   for (MovingSolid& m : moving.solids.bodies)
-    if (m.dynamic()) m.changeVelocity(tau0, m.gravity * double(c.dt), 0);
+    if (m.dynamic()) m.changeVelocityResting(tau0, m.gravity * double(c.dt), 0);
 }
 
 std::vector<Collider> World::movingColliders() const {

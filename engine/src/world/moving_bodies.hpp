@@ -35,6 +35,10 @@ struct MovingBodies {
   std::vector<int> contactCount;      ///< per body: its approaching contacts
   std::vector<Vec2d> contactImpulse;  ///< … the contacts' impulse on it
   std::vector<double> contactTorque;  ///< … and their angular impulse
+  struct Response {
+    double w[3][3];
+  };
+  std::vector<Response> contactResponse;  ///< each body's response left by its resting contacts
 };
 
 }  // namespace sph2d

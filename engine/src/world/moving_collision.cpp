@@ -42,6 +42,9 @@ namespace {
 // a resting crate sinks a further g·dt²/2 (1.4 mm) within a frame before Box2D steps it.
 constexpr double kRunInto = 3 * b2_linearSlop;
 
+// Overlap of the skins at least this is a point resting on a static solid (MovingSolid::rests).
+constexpr double kResting = 0.5 * b2_linearSlop;
+
 /// Box2D's manifold of shape a (placed by xa) against child `child` of static shape b (placed
 /// by xb), its normal from a to b; false for a pair Box2D has no collide function for here.
 bool collideWithStatic(const b2Shape* a, const b2Transform& xa, const b2Shape* b, int child, const b2Transform& xb,
@@ -121,7 +124,7 @@ void World::Impl::forStaticContacts(const MovingSolid& m, const b2Transform& xa,
             continue;
           double deepest = 0;
           for (int k = 0; k < points; ++k) deepest = std::min(deepest, double(wm.separations[k]));
-          f(Vec2d(wm.normal.x, wm.normal.y), deepest);  // from the body into the static fixture
+          f(Vec2d(wm.normal.x, wm.normal.y), deepest, wm, points);  // normal: from the body into the fixture
         }
       }
     }
@@ -131,13 +134,27 @@ void World::Impl::forStaticContacts(const MovingSolid& m, const b2Transform& xa,
 void World::Impl::holdBody(MovingSolid& m) const {
   // Box2D holds a body that has a joint or rests on a static fixture (a touching manifold: its
   // points within the shapes' skins): the grid's momentum balance leaves its cluster alone.
+  // Each point of such a manifold is a resting contact for the step (MovingSolid::rests).
   m.held = m.body->GetJointList() != nullptr;
-  if (m.held) return;
+  m.rests.clear();
   double theta;
   Vec2d o;
   m.pose(0, theta, o);
   const b2Transform xa(b2Vec2(float(o.x() + origin.x()), float(o.y() + origin.y())), b2Rot(float(theta)));
-  forStaticContacts(m, xa, [&](const Vec2d&, double) { m.held = true; });
+  const Vec2d com = m.centreAt(0);
+  // A point rests when its skins overlap as Box2D leaves resting shapes (by about b2_linearSlop;
+  // one lifted off, a tilted crate's raised corner, overlaps less and may fall back). Only the
+  // normals: along the face the body stays free within the step, so that its path runs at least
+  // as far as Box2D's friction then lets it go (the water it pushed is ahead of it, never inside
+  // it).
+  forStaticContacts(m, xa, [&](const Vec2d& n, double, const b2WorldManifold& wm, int points) {
+    m.held = true;
+    for (int k = 0; k < points; ++k) {
+      if (double(wm.separations[k]) > -kResting) continue;
+      const Vec2d r = Vec2d(double(wm.points[k].x), double(wm.points[k].y)) - origin - com;
+      m.rests.push_back({n.x(), n.y(), r.x() * n.y() - r.y() * n.x()});
+    }
+  });
 }
 
 void World::Impl::bodyWalls(StepContext& c) {
@@ -157,7 +174,7 @@ void World::Impl::bodyWalls(StepContext& c) {
     Vec2d o;
     m.pose(tau1, theta, o);
     const b2Transform xa(b2Vec2(float(o.x() + origin.x()), float(o.y() + origin.y())), b2Rot(float(theta)));
-    forStaticContacts(m, xa, [&](const Vec2d& n, double deepest) {
+    forStaticContacts(m, xa, [&](const Vec2d& n, double deepest, const b2WorldManifold&, int) {
       if (deepest > -kRunInto) return;
       const double vn = m.v.dot(n);
       if (vn > 0) m.changeVelocity(tau0, -vn * n, 0);
@@ -390,16 +407,24 @@ void World::Impl::collideMoving(StepContext& c, bool atStart) {
   J.assign(bodies.size(), Vec2d(0, 0));
   L.assign(bodies.size(), 0.0);
   const std::vector<Real>* ratio = c.P.find(ParticleStore::kRestRatio);  // m_i = r_i m with a density contrast
+  // Each body's response as its resting contacts leave it (MovingSolid::restingResponse): a
+  // body held still by them meets the particle as a wall would.
+  std::vector<MovingBodies::Response>& W = moving.contactResponse;
+  W.resize(bodies.size());
+  for (std::size_t k = 0; k < bodies.size(); ++k)
+    if (count[k] > 0) bodies[k].restingResponse(W[k].w);
   for (std::size_t i = 0; i < c.P.size(); ++i) {
     Vec2d r;
     double vn;
     if (moving.hitBody[i] < 0 || !approach(i, r, vn)) continue;
     const double m0 = ratio ? double(c.momentumMass) * double((*ratio)[i]) : double(c.momentumMass);
     const std::size_t k = std::size_t(moving.hitBody[i]);
-    const MovingSolid& m = bodies[k];
     const Vec2d& n = moving.hitNormal[i];
     const double rn = r.x() * n.y() - r.y() * n.x();
-    const double invMeff = m.invMass + rn * rn * m.invInertia;
+    const double g[3] = {n.x(), n.y(), rn};
+    double invMeff = 0;  // g W gᵀ: 1/m + rn²/I for a body resting on nothing
+    for (int a = 0; a < 3; ++a)
+      for (int b = 0; b < 3; ++b) invMeff += g[a] * W[k].w[a][b] * g[b];
     const double j = -vn / (1.0 / m0 + double(count[k]) * invMeff);  // > 0, along n for the particle
     c.P.v[i] += (j / m0 * n).cast<Real>();
     J[k] -= j * n;

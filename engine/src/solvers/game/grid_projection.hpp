@@ -7,8 +7,8 @@
 // column's long (hydrostatic) mode needs ~(depth/dx)² Jacobi iterations. On a
 // MAC grid of cells a few spacings wide that mode is a small linear system:
 // the particles' velocities go to the grid faces (bilinear weights), cells
-// are solid (inside a collider), a moving body's (at least half a cell inside
-// a kinematic or dynamic Box2D body), fluid (enough particle weight) or air; a
+// are solid (inside a collider), a moving body's (more than a tenth of a cell
+// inside a kinematic or dynamic Box2D body), fluid (enough particle weight) or air; a
 // Poisson equation for κ = p/ρ0 makes the grid velocity divergence-free and
 // removes the cells' mean compression over one substep; the change of the
 // face velocities goes back to the particles (a FLIP increment, so nothing is
@@ -123,11 +123,11 @@ class GridProjection {
   /// The pressure system of the classified cells (pcg_: grid_pcg.hpp), the ghost surface's θ
   /// and the dynamic bodies' coupling rows with it.
   void assemble();
-  /// out += the dynamic bodies' response ρ0 h² G M⁻¹ Gᵀ·in (the coupled pressure solve's extra term).
+  /// out += the dynamic bodies' response ρ0 h² G W Gᵀ·in (the coupled pressure solve's extra term).
   void addCoupled(const std::vector<Real>& in, std::vector<Real>& out) const;
-  /// Marks the cells whose centre lies at least half a cell inside a moving body (kBody),
-  /// static solids excepted; makes a cell its centre covers less deeply fluid when it holds
-  /// any particle weight; computes each body's face correction T (bodies_).
+  /// Marks the cells whose centre lies more than a tenth of a cell inside a moving body (kBody),
+  /// static solids excepted; computes each body's face correction T and its response W as its
+  /// resting contacts leave it (bodies_).
   void markBodies(const StepContext& c);
   /// The coupling rows G: one per (fluid cell, dynamic body) pair whose faces touch (their
   /// regions vented: a sealed pocket has no dynamic body).
@@ -229,6 +229,10 @@ class GridProjection {
     Vec2d centre{0, 0}, v{0, 0};
     double omega = 0, invMass = 0, invInertia = 0;
     bool held = false;  ///< Box2D holds it (MovingSolid::held): a wall to the momentum balance
+    /// Its response to the pressure's impulse (J, L) as its resting contacts leave it
+    /// (MovingSolid::restingResponse): diag(1/m, 1/m, 1/I) for a body resting on nothing.
+    double W[3][3] = {{0, 0, 0}, {0, 0, 0}, {0, 0, 0}};
+    bool movable = false;                                ///< W is not zero: the pressure can move it
     double T[3][3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};  ///< the faces' correction (markBodies)
     /// g = T·(n, r × n) of a face at `face` with normal n into the body.
     void coupling(const Vec2d& n, const Vec2d& face, double g[3]) const;

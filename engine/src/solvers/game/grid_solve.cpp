@@ -69,15 +69,18 @@ void GridProjection::addCoupled(const std::vector<Real>& in, std::vector<Real>& 
   if (coupling_.empty()) return;
   // The dynamic bodies' response (Batty, Bertails & Bridson 2007, "A fast variational
   // framework for accurate solid-fluid coupling", on a voxelized body): the pressure's
-  // impulse Gᵀκ moves a body by M⁻¹Gᵀκ, which changes the flux through its faces by G·that.
+  // impulse Gᵀκ moves a body by W Gᵀκ (W = M⁻¹, less what its resting contacts hold:
+  // BodyState::W), which changes the flux through its faces by G·that. W is symmetric: the
+  // system stays so.
   bodySum_.assign(3 * bodies_.size(), 0.0);
   for (const Coupling& e : coupling_)
     for (int q = 0; q < 3; ++q)
       bodySum_[3 * std::size_t(e.body) + std::size_t(q)] += e.g[q] * double(in[std::size_t(e.unknown)]);
   for (std::size_t b = 0; b < bodies_.size(); ++b) {
-    bodySum_[3 * b + 0] *= couplingScale_ * bodies_[b].invMass;
-    bodySum_[3 * b + 1] *= couplingScale_ * bodies_[b].invMass;
-    bodySum_[3 * b + 2] *= couplingScale_ * bodies_[b].invInertia;
+    const double s[3] = {bodySum_[3 * b], bodySum_[3 * b + 1], bodySum_[3 * b + 2]};
+    const auto& W = bodies_[b].W;
+    for (int r = 0; r < 3; ++r)
+      bodySum_[3 * b + std::size_t(r)] = couplingScale_ * (W[r][0] * s[0] + W[r][1] * s[1] + W[r][2] * s[2]);
   }
   for (const Coupling& e : coupling_) {
     const double* t = &bodySum_[3 * std::size_t(e.body)];
