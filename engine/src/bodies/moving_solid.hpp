@@ -104,10 +104,10 @@ struct MovingSolid {
     angularImpulse += L;
     changeVelocityResting(tau, J * invMass, L * invInertia);
   }
-  /// The generalized velocity q = (v, ω) without its part into the resting contacts it moves
-  /// into: projected, in the metric of the body's mass (the least change of kinetic energy),
-  /// onto the velocities that hold those contacts still; contacts it leaves stay free (an
-  /// active set, grown until no contact is entered, at most once per contact).
+  /// The generalized velocity q = (v, ω) made the nearest, in the metric of the body's mass
+  /// (the least change of kinetic energy), that moves into none of the resting contacts: held
+  /// still at the contacts it would enter, free from those it leaves (a contact it would pull
+  /// on lets go).
   void restrict(double q[3]) const;
   /// The response to an impulse (J, L) that the resting contacts leave, W = M⁻¹ − M⁻¹Aᵀ(A M⁻¹
   /// Aᵀ)⁺A M⁻¹ over those it is not moving off (A their rows): row-major 3 × 3, symmetric.

@@ -2,16 +2,22 @@
 // step (moving_solid.hpp: MovingSolid::rests). Box2D holds such a body with its contacts only
 // when it next steps it; within the fluid's step nothing did, and a cup of water on the floor
 // sank under its water's weight in the grid's coupled pressure solve (the body gave way, its
-// water followed, Box2D then put the body back and the water kept the fall: 0.45 m/s of
-// downward flow that never stopped, 2 cm low, at density 500). Here the contacts act as
-// Box2D's resting contacts would: inelastic and without friction, a constraint
+// water followed, Box2D then put the body back and the water kept the fall: 0.6-1.05 m/s of
+// downward flow that never stopped, 5-9 cm low, in cups of 120-3000 kg/m²). Here the contacts
+// act as Box2D's resting contacts would: inelastic and without friction, a constraint
 // J q ≤ 0 per contact point on the generalized velocity q = (v, ω).
 //
 // Both functions project in the metric of the body's mass (inner product ⟨a, b⟩ = a M⁻¹ bᵀ):
 // the rows are made ⟨·,·⟩-orthogonal by Gram–Schmidt (a row that depends on the earlier ones,
 // such as a third point along one face, drops out), and each orthogonal row e takes
-// M⁻¹eᵀ (e·q) / ⟨e, e⟩ off the velocity.
+// M⁻¹eᵀ (e·q) / ⟨e, e⟩ off the velocity. restrict() solves the small quadratic program (the
+// velocity nearest q that enters no contact, so that a contact the body would pull on, as a
+// tall box pivoting on one corner, lets go); restingResponse() holds every contact the body
+// is not moving off, for the coupled solve's linear system.
 #include "bodies/moving_solid.hpp"
+
+#include <algorithm>
+#include <cmath>
 
 namespace sph2d {
 namespace {
@@ -20,6 +26,10 @@ namespace {
 /// a tenth of Box2D's sleep tolerance (b2_linearSleepTolerance), well above the velocity Box2D
 /// leaves a resting body with.
 constexpr double kLeaving = 0.1 * b2_linearSleepTolerance;
+
+/// restrict() tries every set of up to this many contacts (2^10 small projections at most; a
+/// body on the floor has two, in a corner three or four).
+constexpr std::size_t kMaxRestingSets = 10;
 
 /// Up to three ⟨·,·⟩-orthogonal rows spanning `rows` (those with `use`), in order.
 int orthogonalRows(const std::vector<std::array<double, 3>>& rows, const std::vector<bool>* use, const double m[3],
@@ -45,23 +55,50 @@ int orthogonalRows(const std::vector<std::array<double, 3>>& rows, const std::ve
 
 void MovingSolid::restrict(double q[3]) const {
   const double m[3] = {invMass, invMass, invInertia};
+  auto entering = [&](const std::array<double, 3>& a, const double* u) {
+    const double an = std::sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
+    const double un = std::sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
+    return a[0] * u[0] + a[1] * u[1] + a[2] * u[2] > 1e-12 * an * un;
+  };
+  bool any = false;
+  for (const auto& a : rests) any = any || entering(a, q);
+  if (!any) return;
+  // The velocity nearest q (in the mass metric) that enters no contact: the projection of q onto
+  // the contacts held at the optimum, which among the projections onto every set of contacts is
+  // the nearest that enters none (few contacts: every set is tried, in a fixed order).
   const double free[3] = {q[0], q[1], q[2]};
-  std::vector<bool> active(rests.size(), false);
-  for (std::size_t pass = 0; pass <= rests.size(); ++pass) {
-    bool grew = false;
-    for (std::size_t k = 0; k < rests.size(); ++k) {
-      const auto& a = rests[k];
-      if (!active[k] && a[0] * q[0] + a[1] * q[1] + a[2] * q[2] > 0) active[k] = grew = true;
+  const std::size_t n = std::min<std::size_t>(rests.size(), kMaxRestingSets);
+  std::vector<bool> use(rests.size(), false);
+  double best[3] = {0, 0, 0}, bestCost = -1;
+  for (std::size_t set = 1; set < (std::size_t(1) << n); ++set) {
+    for (std::size_t k = 0; k < rests.size(); ++k) use[k] = k < n && ((set >> k) & 1);
+    double e[3][3], ee[3], p[3] = {free[0], free[1], free[2]};
+    const int rows = orthogonalRows(rests, &use, m, e, ee);
+    for (int j = 0; j < rows; ++j) {
+      const double d = (e[j][0] * p[0] + e[j][1] * p[1] + e[j][2] * p[2]) / ee[j];
+      for (int r = 0; r < 3; ++r) p[r] -= m[r] * e[j][r] * d;
     }
-    if (!grew) return;
-    double e[3][3], ee[3];
-    const int n = orthogonalRows(rests, &active, m, e, ee);
-    for (int r = 0; r < 3; ++r) q[r] = free[r];
-    for (int j = 0; j < n; ++j) {
-      const double d = (e[j][0] * q[0] + e[j][1] * q[1] + e[j][2] * q[2]) / ee[j];
-      for (int r = 0; r < 3; ++r) q[r] -= m[r] * e[j][r] * d;
+    bool ok = true;
+    for (const auto& a : rests) ok = ok && !entering(a, p);
+    if (!ok) continue;
+    double cost = 0;
+    for (int r = 0; r < 3; ++r)
+      if (m[r] > 0) cost += (p[r] - free[r]) * (p[r] - free[r]) / m[r];
+    if (bestCost < 0 || cost < bestCost) {
+      bestCost = cost;
+      for (int r = 0; r < 3; ++r) best[r] = p[r];
     }
   }
+  if (bestCost < 0) {  // none (more contacts than were tried): hold every contact
+    double e[3][3], ee[3];
+    const int rows = orthogonalRows(rests, nullptr, m, e, ee);
+    for (int r = 0; r < 3; ++r) best[r] = free[r];
+    for (int j = 0; j < rows; ++j) {
+      const double d = (e[j][0] * best[0] + e[j][1] * best[1] + e[j][2] * best[2]) / ee[j];
+      for (int r = 0; r < 3; ++r) best[r] -= m[r] * e[j][r] * d;
+    }
+  }
+  for (int r = 0; r < 3; ++r) q[r] = best[r];
 }
 
 void MovingSolid::restingResponse(double W[3][3]) const {

@@ -42,7 +42,8 @@ namespace {
 // a resting crate sinks a further g·dt²/2 (1.4 mm) within a frame before Box2D steps it.
 constexpr double kRunInto = 3 * b2_linearSlop;
 
-// Overlap of the skins at least this is a point resting on a static solid (MovingSolid::rests).
+// A manifold point overlapping less than its deepest point by more than this has lifted off
+// (MovingSolid::rests): half of Box2D's slop, the depth it settles resting shapes within.
 constexpr double kResting = 0.5 * b2_linearSlop;
 
 /// Box2D's manifold of shape a (placed by xa) against child `child` of static shape b (placed
@@ -142,15 +143,16 @@ void World::Impl::holdBody(MovingSolid& m) const {
   m.pose(0, theta, o);
   const b2Transform xa(b2Vec2(float(o.x() + origin.x()), float(o.y() + origin.y())), b2Rot(float(theta)));
   const Vec2d com = m.centreAt(0);
-  // A point rests when its skins overlap as Box2D leaves resting shapes (by about b2_linearSlop;
-  // one lifted off, a tilted crate's raised corner, overlaps less and may fall back). Only the
-  // normals: along the face the body stays free within the step, so that its path runs at least
-  // as far as Box2D's friction then lets it go (the water it pushed is ahead of it, never inside
-  // it).
-  forStaticContacts(m, xa, [&](const Vec2d& n, double, const b2WorldManifold& wm, int points) {
+  // Every point of the manifold rests (its skins touch or overlap: Box2D settles resting shapes
+  // anywhere from touching to b2_linearSlop deep) except one lifted off: overlapping less than
+  // the manifold's deepest point by more than kResting (a tilted crate's raised corner, free to
+  // fall back). Only the normals: along the face the body stays free within the step, so that
+  // its path runs at least as far as Box2D's friction then lets it go (the water it pushed is
+  // ahead of it, never inside it).
+  forStaticContacts(m, xa, [&](const Vec2d& n, double deepest, const b2WorldManifold& wm, int points) {
     m.held = true;
     for (int k = 0; k < points; ++k) {
-      if (double(wm.separations[k]) > -kResting) continue;
+      if (double(wm.separations[k]) > deepest + kResting) continue;
       const Vec2d r = Vec2d(double(wm.points[k].x), double(wm.points[k].y)) - origin - com;
       m.rests.push_back({n.x(), n.y(), r.x() * n.y() - r.y() * n.x()});
     }

@@ -44,8 +44,14 @@ void GridProjection::markBodies(const StepContext& c) {
     st.invInertia = m.invInertia;
     st.held = m.held;
     if (m.dynamic()) m.restingResponse(st.W);
+    // W's entries below rounding of its largest possible (1/m, 1/I) are zero: a body its contacts
+    // hold still has W = 0 exactly, not a residue of either sign.
+    const double scale = 1e-12 * std::max(m.invMass, m.invInertia);
     for (int r = 0; r < 3; ++r)
-      for (int q = 0; q < 3; ++q) st.movable = st.movable || st.W[r][q] != 0;
+      for (int q = 0; q < 3; ++q) {
+        if (std::fabs(st.W[r][q]) <= scale) st.W[r][q] = 0;
+        st.movable = st.movable || st.W[r][q] != 0;
+      }
     // The body's cells, anchored indices [bI0, bI0 + bn) × [bJ0, bJ0 + bm), over its whole
     // reach (the grid may hold only part of it): a cell is the body's when its centre lies
     // more than kBodyDepth of a cell inside it (the faces' correction below keeps Archimedes'
@@ -167,12 +173,14 @@ void GridProjection::assembleCoupling() {
       if (type_[std::size_t(nb[q])] != kBody) continue;
       const std::int32_t body = bodyOf_[std::size_t(nb[q])];
       const BodyState& st = bodies_[std::size_t(body)];
-      if (!st.movable) continue;  // kinematic, or held still by its resting contacts: a moving wall only
+      if (!(st.invMass > 0)) continue;  // kinematic: a moving wall only
       std::size_t e = first;
       while (e < coupling_.size() && coupling_[e].body != body) ++e;
       if (e == coupling_.size()) {
+        // A body its resting contacts hold still (W = 0) still takes the pressure's impulse
+        // (handed to Box2D), but does not open the region.
         coupling_.push_back(Coupling{std::int32_t(a), body, {0, 0, 0}});
-        pcg_.vent(a);  // the body can move: the region is not sealed
+        if (st.movable) pcg_.vent(a);  // the body can move: the region is not sealed
       }
       double g[3];
       st.coupling(normals[q], faces[q], g);

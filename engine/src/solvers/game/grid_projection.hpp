@@ -232,7 +232,7 @@ class GridProjection {
     /// Its response to the pressure's impulse (J, L) as its resting contacts leave it
     /// (MovingSolid::restingResponse): diag(1/m, 1/m, 1/I) for a body resting on nothing.
     double W[3][3] = {{0, 0, 0}, {0, 0, 0}, {0, 0, 0}};
-    bool movable = false;                                ///< W is not zero: the pressure can move it
+    bool movable = false;  ///< W is not zero: the pressure can move it (and the region is not sealed)
     double T[3][3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};  ///< the faces' correction (markBodies)
     /// g = T·(n, r × n) of a face at `face` with normal n into the body.
     void coupling(const Vec2d& n, const Vec2d& face, double g[3]) const;
