@@ -18,6 +18,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 
 namespace sph2d {
 namespace {
@@ -31,12 +32,13 @@ constexpr double kLeaving = 0.1 * b2_linearSleepTolerance;
 /// body on the floor has two, in a corner three or four).
 constexpr std::size_t kMaxRestingSets = 10;
 
-/// Up to three ⟨·,·⟩-orthogonal rows spanning `rows` (those with `use`), in order.
-int orthogonalRows(const std::vector<std::array<double, 3>>& rows, const std::vector<bool>* use, const double m[3],
-                   double e[3][3], double ee[3]) {
+/// Up to three ⟨·,·⟩-orthogonal rows spanning those of `rows` whose bit is set in `use` (bit k
+/// for row k; rows past the mask's width are in it when its top bit is set), in order.
+int orthogonalRows(const std::vector<std::array<double, 3>>& rows, std::uint64_t use, const double m[3], double e[3][3],
+                   double ee[3]) {
   int n = 0;
   for (std::size_t k = 0; k < rows.size() && n < 3; ++k) {
-    if (use && !(*use)[k]) continue;
+    if (!((k < 64 ? use >> k : use >> 63) & 1)) continue;
     double a[3] = {rows[k][0], rows[k][1], rows[k][2]};
     const double norm0 = a[0] * a[0] * m[0] + a[1] * a[1] * m[1] + a[2] * a[2] * m[2];
     for (int j = 0; j < n; ++j) {
@@ -68,12 +70,10 @@ void MovingSolid::restrict(double q[3]) const {
   // the nearest that enters none (few contacts: every set is tried, in a fixed order).
   const double free[3] = {q[0], q[1], q[2]};
   const std::size_t n = std::min<std::size_t>(rests.size(), kMaxRestingSets);
-  std::vector<bool> use(rests.size(), false);
   double best[3] = {0, 0, 0}, bestCost = -1;
-  for (std::size_t set = 1; set < (std::size_t(1) << n); ++set) {
-    for (std::size_t k = 0; k < rests.size(); ++k) use[k] = k < n && ((set >> k) & 1);
+  for (std::uint64_t set = 1; set < (std::uint64_t(1) << n); ++set) {
     double e[3][3], ee[3], p[3] = {free[0], free[1], free[2]};
-    const int rows = orthogonalRows(rests, &use, m, e, ee);
+    const int rows = orthogonalRows(rests, set, m, e, ee);
     for (int j = 0; j < rows; ++j) {
       const double d = (e[j][0] * p[0] + e[j][1] * p[1] + e[j][2] * p[2]) / ee[j];
       for (int r = 0; r < 3; ++r) p[r] -= m[r] * e[j][r] * d;
@@ -91,7 +91,7 @@ void MovingSolid::restrict(double q[3]) const {
   }
   if (bestCost < 0) {  // none (more contacts than were tried): hold every contact
     double e[3][3], ee[3];
-    const int rows = orthogonalRows(rests, nullptr, m, e, ee);
+    const int rows = orthogonalRows(rests, ~std::uint64_t(0), m, e, ee);
     for (int r = 0; r < 3; ++r) best[r] = free[r];
     for (int j = 0; j < rows; ++j) {
       const double d = (e[j][0] * best[0] + e[j][1] * best[1] + e[j][2] * best[2]) / ee[j];
@@ -107,13 +107,14 @@ void MovingSolid::restingResponse(double W[3][3]) const {
     for (int c = 0; c < 3; ++c) W[r][c] = r == c ? m[r] : 0.0;
   // The contacts it rests on, not those it leaves: a body that water lifts off the floor
   // (Box2D gave it the lift at the last step) is free to rise in the coupled solve.
-  std::vector<bool> resting(rests.size());
+  std::uint64_t resting = 0;
   for (std::size_t k = 0; k < rests.size(); ++k) {
     const auto& a = rests[k];
-    resting[k] = a[0] * v.x() + a[1] * v.y() + a[2] * omega > -kLeaving;
+    if (a[0] * v.x() + a[1] * v.y() + a[2] * omega > -kLeaving)
+      resting |= std::uint64_t(1) << std::min<std::size_t>(k, 63);
   }
   double e[3][3], ee[3];
-  const int n = orthogonalRows(rests, &resting, m, e, ee);
+  const int n = orthogonalRows(rests, resting, m, e, ee);
   for (int j = 0; j < n; ++j)
     for (int r = 0; r < 3; ++r)
       for (int c = 0; c < 3; ++c) W[r][c] -= m[r] * e[j][r] * m[c] * e[j][c] / ee[j];

@@ -58,7 +58,6 @@ TEST_CASE("resting contacts: a tall box falling and spinning pivots on one corne
 TEST_CASE("resting contacts: over random boxes and velocities no contact pulls (the quadratic program's conditions)") {
   std::mt19937 rng(7);
   std::uniform_real_distribution<double> U(-1, 1);
-  int checked = 0;
   for (int n = 0; n < 20000; ++n) {
     const MovingSolid m = boxOnFloor(0.05 + 0.5 * (U(rng) + 1), 0.05 + 0.5 * (U(rng) + 1));
     double q[3] = {U(rng), U(rng), 3 * U(rng)};
@@ -77,9 +76,7 @@ TEST_CASE("resting contacts: over random boxes and velocities no contact pulls (
     CHECK(l1 >= -1e-9);
     if (dot(m.rests[0], q) < -1e-9) CHECK(std::fabs(l0) < 1e-9);
     if (dot(m.rests[1], q) < -1e-9) CHECK(std::fabs(l1) < 1e-9);
-    ++checked;
   }
-  CHECK(checked == 20000);
 }
 
 TEST_CASE("resting contacts: the response left is symmetric, and zero for a body they hold still") {
