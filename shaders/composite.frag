@@ -19,6 +19,12 @@
 //  - foam: towards white where the kernel-weighted speed is high;
 //  - with TINT defined (more than one material): the surface colour is the materials' colours
 //    weighted by the splat (uTint), the deep colour 0.3 of it.
+//  - interior: deep in the water (uAux's G above 1: DepthGrid's deep cells hold 2, a local
+//    fill is at most 1) the water is flat: the gradient's tilt, the highlight and the shift of
+//    what is behind fade out as G goes from 1 to 2, and the field at the pixel takes the
+//    low-passed one's place. With INTERIOR defined the program draws only that: the tiles
+//    where G is 2 all over (DepthGrid::tiles), from the centre sample alone, the same colour
+//    as the full program there.
 // Rows of this target run top-down in the world (the camera flips y). It is
 // drawn only over the tiles that fluid can reach (solid.vert: quads in NDC);
 // the rest of the frame keeps the background.
@@ -49,32 +55,8 @@ uniform sampler2D uAbsorb;   // RGBA: sum w*ln(transmission), sum w: each materi
 void main() {
   vec2 vUv = gl_FragCoord.xy * uTexel;
   vec2 c = texture(uField, vUv).rg;
-  float f = c.r * uInvBulk;
-  // Four taps 0.75 spacing away (uTapPx): their central differences give the gradient, and
-  // where the fluid is dense they low-pass the field with the centre, so that the surface does
-  // not show each particle out of line as a bump; sparse fluid (spray, lone drops) keeps its
-  // own field, which the low-pass would take below the edge's threshold.
-  vec2 t = uTexel * uTapPx;
-  float fl = texture(uField, vUv - vec2(t.x, 0.0)).r * uInvBulk;
-  float fr = texture(uField, vUv + vec2(t.x, 0.0)).r * uInvBulk;
-  float fa = texture(uField, vUv - vec2(0.0, t.y)).r * uInvBulk;  // world above
-  float fb = texture(uField, vUv + vec2(0.0, t.y)).r * uInvBulk;  // world below
-  vec2 grad = vec2(fr - fl, fa - fb) * (0.5 / uTapPx);  // per pixel, world orientation (y up)
-  float g = length(grad);
   vec2 aux = texture(uAux, vUv * uAuxScale).rg;
-  float dense = smoothstep(0.15, 0.55, aux.g);
-  f = mix(f, (2.0 * f + fl + fr + fa + fb) / 6.0, dense);
   vec3 bg = texelFetch(uBg, ivec2(gl_FragCoord.xy), 0).rgb;
-  float threshold = mix(0.24, 0.5, dense);
-  // Over a solid the water shows only where the fluid covers it (a body the water flows in
-  // front of): the fringe of the field along a body's faces, where the fluid only meets it,
-  // leaves the body's edge as it is drawn.
-  bool solid = bg != texelFetch(uPlain, ivec2(gl_FragCoord.xy), 0).rgb;
-  float cover = clamp((f - (solid ? max(threshold, 0.85) : threshold)) / max(g, 1e-3) + 0.5, 0.0, 1.0);
-  if (cover <= 0.0) {
-    outColor = vec4(bg, 1.0);
-    return;
-  }
 #ifdef TINT
   vec4 tint = texture(uTint, vUv);
   vec3 surfaceColor = tint.rgb / max(tint.a, 1e-6);
@@ -87,21 +69,68 @@ void main() {
   // Body: Beer-Lambert-like absorption of the light coming from above.
   float absorb = exp(-aux.r * uInvDepth);
   vec3 water = mix(DEEP, SURFACE, absorb);
-  // Surface normal from the field: it points out of the fluid (-grad), tilted by the slope.
-  float inside = smoothstep(threshold, threshold + 0.45, f);
-  vec3 n = vec3(-grad * (6.0 * (1.0 - 0.7 * inside)), 1.0);
-  n = n / sqrt(dot(n, n));
   vec3 l = vec3(-0.35, 0.8, 0.5);
   l = l / sqrt(dot(l, l));
+  float fc = c.r * uInvBulk;  // the field at the pixel, over the bulk's
+#ifdef INTERIOR
+  // The flat interior: what the full program draws where G is 2 (below): the field at the
+  // pixel alone, no tilt, no highlight, what is behind unshifted.
+  float cover = 1.0;
+  float inside = smoothstep(0.5, 0.95, fc);
+  float lambert = 1.0;
+  float spec = 0.0;
+  float rim = (1.0 - inside) * 0.3;
+#ifdef SEE_THROUGH
+  vec3 behind = bg;
+  float fill = clamp(fc, 0.0, 1.0);
+#endif
+#else
+  float f = fc;
+  // Four taps 0.75 spacing away (uTapPx): their central differences give the gradient, and
+  // where the fluid is dense they low-pass the field with the centre, so that the surface does
+  // not show each particle out of line as a bump; sparse fluid (spray, lone drops) keeps its
+  // own field, which the low-pass would take below the edge's threshold.
+  vec2 t = uTexel * uTapPx;
+  float fl = texture(uField, vUv - vec2(t.x, 0.0)).r * uInvBulk;
+  float fr = texture(uField, vUv + vec2(t.x, 0.0)).r * uInvBulk;
+  float fa = texture(uField, vUv - vec2(0.0, t.y)).r * uInvBulk;  // world above
+  float fb = texture(uField, vUv + vec2(0.0, t.y)).r * uInvBulk;  // world below
+  vec2 grad = vec2(fr - fl, fa - fb) * (0.5 / uTapPx);  // per pixel, world orientation (y up)
+  float g = length(grad);
+  float dense = smoothstep(0.15, 0.55, aux.g);
+  f = mix(f, (2.0 * f + fl + fr + fa + fb) / 6.0, dense);
+  float threshold = mix(0.24, 0.5, dense);
+  // Over a solid the water shows only where the fluid covers it (a body the water flows in
+  // front of): the fringe of the field along a body's faces, where the fluid only meets it,
+  // leaves the body's edge as it is drawn.
+  bool solid = bg != texelFetch(uPlain, ivec2(gl_FragCoord.xy), 0).rgb;
+  float cover = clamp((f - (solid ? max(threshold, 0.85) : threshold)) / max(g, 1e-3) + 0.5, 0.0, 1.0);
+  if (cover <= 0.0) {
+    outColor = vec4(bg, 1.0);
+    return;
+  }
+  // Towards the flat interior (G from 1 to 2): no tilt, highlight or shift, and the field at
+  // the pixel instead of the low-passed one.
+  float surf = 1.0 - smoothstep(1.0, 2.0, aux.g);
+  grad *= surf;
+  float fe = mix(fc, f, surf);
+  float inside = smoothstep(threshold, threshold + 0.45, fe);
+  // Surface normal from the field: it points out of the fluid (-grad), tilted by the slope.
+  vec3 n = vec3(-grad * (6.0 * (1.0 - 0.7 * inside)), 1.0);
+  n = n / sqrt(dot(n, n));
   float lambert = 1.0 + 0.55 * (dot(n, l) - l.z);
   vec3 h = l + vec3(0.0, 0.0, 1.0);
   h = h / sqrt(dot(h, h));
-  float spec = pow(max(dot(n, h), 0.0), 30.0) * 0.55 * (1.0 - inside);
+  float spec = pow(max(dot(n, h), 0.0), 30.0) * 0.55 * (1.0 - inside) * surf;
   float rim = (1.0 - inside) * 0.3;
 #ifdef SEE_THROUGH
   // Behind: the ray bends towards the thicker water (+grad in the world; rows run top-down).
   vec2 seenAt = gl_FragCoord.xy + vec2(grad.x, -grad.y) * uRefractPx;
   vec3 behind = texture(uBg, seenAt * uTexel).rgb;
+  float fill = clamp(fe, 0.0, 1.0);
+#endif
+#endif
+#ifdef SEE_THROUGH
 #ifdef MATERIAL_T
   vec4 ab = texture(uAbsorb, vUv);
   vec3 logT = ab.rgb / max(ab.a, 1e-6);
@@ -109,7 +138,7 @@ void main() {
   vec3 logT = uLogTransmission;
 #endif
   vec3 full = exp(logT);
-  vec3 through = exp(logT * clamp(f, 0.0, 1.0));
+  vec3 through = exp(logT * fill);
   vec3 scatter = max((water * lambert - full * uBgColor) / max(vec3(1.0) - full, vec3(1e-3)), vec3(0.0));
   water = mix(scatter, behind, through) + vec3(spec) + SURFACE * rim;
 #else

@@ -15,67 +15,10 @@
 #include "sph2d/render/renderer.hpp"
 #include "sph2d/scene.hpp"
 #include "sph2d/world.hpp"
+#include "support/liquid_pool.hpp"
 
 using namespace sph2d;
-
-namespace {
-
-constexpr double kDx = 0.0125;  // 3 px at 240 px/m, like the dam break
-
-/// A box collider x0..x1 × y0..y1 (counter-clockwise).
-Collider boxCollider(double x0, double y0, double x1, double y1) {
-  Collider c;
-  c.vertices = {Vec2(Real(x0), Real(y0)), Vec2(Real(x1), Real(y0)), Vec2(Real(x1), Real(y1)), Vec2(Real(x0), Real(y1))};
-  c.normals = {Vec2(0, -1), Vec2(1, 0), Vec2(0, 1), Vec2(-1, 0)};
-  c.lo = c.vertices[0];
-  c.hi = c.vertices[2];
-  return c;
-}
-
-/// Square lattices of still particles (spacing `step` each) and what is behind them, seen by a
-/// fixed camera at 240 px per metre: x −0.1 .. 1.9, y −0.1 .. 1.025 in 480 × 270 px.
-struct Pool {
-  ParticleBuffer B;
-  std::vector<Collider> solids;
-  RenderDef def;
-  std::uint32_t nextId = 0;
-  Pool() {
-    def.width = 480;
-    def.height = 270;
-    def.camera.automatic = false;
-    def.camera.min = Vec2d(-0.1, -0.1);
-    def.camera.max = Vec2d(1.9, 1.025);
-  }
-  void fill(double x0, double x1, double y0, double y1, double step) {
-    for (double y = y0 + step / 2; y < y1; y += step)
-      for (double x = x0 + step / 2; x < x1; x += step) B.push(Vec2(Real(x), Real(y)), Vec2(0, 0), nextId++, 1000);
-  }
-  /// The frame with the particles (or none) and the solids (or none).
-  Frame render(bool particles, bool withSolids) const {
-    RenderInput in;
-    ParticleBuffer none;
-    in.particles = particles ? B.view() : none.view();
-    in.spacing = kDx;
-    std::vector<Collider> noSolids;
-    in.colliders = withSolids ? &solids : &noSolids;
-    Renderer r(def);
-    Frame f = r.render(in);
-    if (const char* dump = std::getenv("SPH2D_TEST_DUMP")) writePngAtomic(dump, f.width, f.height, f.rgba.data());
-    return f;
-  }
-};
-
-/// Pixel (column, row) of world point (x, y) in the Pool's camera.
-std::array<int, 2> pixelOf(double x, double y) {
-  const double pxPerM = 240;
-  return {int(std::floor((x + 0.1) * pxPerM)), int(std::floor((1.025 - y) * pxPerM))};
-}
-
-int channel(const Frame& f, int col, int row, int c) {
-  return f.rgba[4 * (std::size_t(row) * std::size_t(f.width) + std::size_t(col)) + std::size_t(c)];
-}
-
-}  // namespace
+using namespace sph2d::test;
 
 TEST_CASE("liquid: a dark body behind the water shows through it by the water's transmission per channel") {
   // A grey background and a dark body x 0.4..0.7, y 0.1..0.4 behind a pool of water (0..1.2 ×

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 
 namespace sph2d {
 
@@ -136,53 +137,159 @@ void DepthGrid::build(const RenderInput& in, const std::vector<double>& ext, dou
     }
 }
 
-std::pair<int, int> DepthGrid::tiles(float spriteRadiusPx, int EW, int EH, std::vector<float>& out) {
+namespace {
+/// `a` becomes the window test over ±`reach` cells of each cell, along rows, then along columns
+/// (running counts; `tmp` and `count` are scratch): the cells whose window holds a set cell, or
+/// (`all`) whose whole window is set, cells beyond the grid counting as unset. The column pass
+/// runs row by row with a count per column, so that it reads the grid in order.
+void windowTest(std::vector<std::uint8_t>& a, std::vector<std::uint8_t>& tmp, std::vector<int>& count, int w, int h,
+                int reach, bool all) {
+  tmp.resize(a.size());
+  const int need = all ? 2 * reach + 1 : 1;
+  for (int y = 0; y < h; ++y) {
+    const std::uint8_t* r = &a[std::size_t(y) * std::size_t(w)];
+    std::uint8_t* o = &tmp[std::size_t(y) * std::size_t(w)];
+    int n = 0;
+    for (int x = 0; x < std::min(reach, w); ++x) n += r[x];
+    for (int x = 0; x < w; ++x) {
+      if (x + reach < w) n += r[x + reach];
+      if (x - reach - 1 >= 0) n -= r[x - reach - 1];
+      o[x] = n >= need;
+    }
+  }
+  count.assign(std::size_t(w), 0);
+  int* n = count.data();
+  for (int y = 0; y < std::min(reach, h); ++y) {
+    const std::uint8_t* r = &tmp[std::size_t(y) * std::size_t(w)];
+    for (int x = 0; x < w; ++x) n[x] += r[x];
+  }
+  for (int y = 0; y < h; ++y) {
+    if (y + reach < h) {
+      const std::uint8_t* r = &tmp[std::size_t(y + reach) * std::size_t(w)];
+      for (int x = 0; x < w; ++x) n[x] += r[x];
+    }
+    if (y - reach - 1 >= 0) {
+      const std::uint8_t* r = &tmp[std::size_t(y - reach - 1) * std::size_t(w)];
+      for (int x = 0; x < w; ++x) n[x] -= r[x];
+    }
+    std::uint8_t* o = &a[std::size_t(y) * std::size_t(w)];
+    for (int x = 0; x < w; ++x) o[x] = n[x] >= need;
+  }
+}
+}  // namespace
+
+void DepthGrid::markVisible(const float* rg, int tw, int th, int shrink, float tapPx, float bulk) {
+  // One bit per texel above the limit, 64 to a word, a row of words per texel row.
+  const float limit = 0.98f * (0.24f - 0.0005f) / (1.0f + 0.3536f / tapPx) * bulk;
+  field_ = FieldBits{tw, th, shrink, tapPx, (tw + 63) / 64};
+  hot_.assign(std::size_t(th) * std::size_t(field_.words), 0);
+  for (int y = 0; y < th; ++y) {
+    const float* row = rg + std::size_t(y) * std::size_t(tw) * 2;
+    std::uint64_t* bits = &hot_[std::size_t(y) * std::size_t(field_.words)];
+    for (int x0 = 0; x0 < tw; x0 += 64) {
+      std::uint64_t word = 0;
+      const int n = std::min(64, tw - x0);
+      for (int k = 0; k < n; ++k) word |= std::uint64_t(row[2 * (x0 + k)] > limit) << k;
+      bits[x0 / 64] = word;
+    }
+  }
+}
+
+void DepthGrid::keepVisible(std::uint8_t* row, int cy) {
+  // The texels the samples of a cell's pixels read: the pixels' centres ± tapPx, bilinear
+  // (texel k serves sample coordinates k − 0.5 .. k + 1.5 in texels), clamped to the edge. The
+  // field's rows the cell row reads are joined (or) into one, then each cell tests its columns.
+  const FieldBits& F = field_;
+  const float s = float(F.shrink);
+  auto first = [&](int p0, int n) {
+    return std::clamp(int(std::floor((float(p0) + 0.5f - F.tapPx) / s - 0.5f)), 0, n - 1);
+  };
+  auto last = [&](int p1, int n) {
+    return std::clamp(int(std::floor((float(p1) - 0.5f + F.tapPx) / s - 0.5f)) + 1, 0, n - 1);
+  };
+  if (F.w < 1 || F.h < 1) {
+    std::fill(row, row + w_, std::uint8_t(0));
+    return;
+  }
+  joined_.assign(std::size_t(F.words), 0);
+  for (int y = first(cy * cell_, F.h), y1 = last((cy + 1) * cell_, F.h); y <= y1; ++y) {
+    const std::uint64_t* bits = &hot_[std::size_t(y) * std::size_t(F.words)];
+    for (int wd = 0; wd < F.words; ++wd) joined_[std::size_t(wd)] |= bits[wd];
+  }
+  for (int cx = 0; cx < w_; ++cx) {
+    if (!row[cx]) continue;
+    const int x0 = first(cx * cell_, F.w), x1 = last((cx + 1) * cell_, F.w);
+    bool any = false;
+    for (int wd = x0 / 64; wd <= x1 / 64 && !any; ++wd) {
+      std::uint64_t m = joined_[std::size_t(wd)];
+      if (wd == x0 / 64) m &= ~std::uint64_t(0) << (x0 % 64);
+      if (wd == x1 / 64 && x1 % 64 < 63) m &= (std::uint64_t(1) << (x1 % 64 + 1)) - 1;
+      any = m != 0;
+    }
+    row[cx] = any;
+  }
+}
+
+std::pair<int, int> DepthGrid::tiles(float spriteRadiusPx, int EW, int EH, std::vector<float>& out,
+                                     std::size_t& interiorFirst, bool onlyVisible) {
   const int w = w_, h = h_;
   const int reach = int(std::ceil((spriteRadiusPx + 1.0f) / float(cell_)));
-  // Dilation by `reach` cells along rows, then along columns, with running counts of the
-  // active cells in the window.
-  active_.assign(std::size_t(w) * std::size_t(h), 0);
-  activeTmp_.assign(active_.size(), 0);
-  for (std::size_t k = 0; k < cover_.size(); ++k) active_[k] = cover_[k] > 0.0f;
-  for (int y = 0; y < h; ++y) {
-    const std::uint8_t* a = &active_[std::size_t(y) * std::size_t(w)];
-    std::uint8_t* o = &activeTmp_[std::size_t(y) * std::size_t(w)];
-    int count = 0;
-    for (int x = 0; x < std::min(reach, w); ++x) count += a[x];
-    for (int x = 0; x < w; ++x) {
-      if (x + reach < w) count += a[x + reach];
-      if (x - reach - 1 >= 0) count -= a[x - reach - 1];
-      o[x] = count > 0;
+  // Reachable: cells with water, dilated by `reach` cells. Deep: cells whose neighbours as far
+  // as `reach` all hold water (a local fill of kFull or more) and none is solid; their fill
+  // becomes kDeepFill (at most 1 elsewhere). Interior: deep cells
+  // whose eight neighbours are deep too, so that the fill sampled anywhere over them is kDeepFill.
+  const std::size_t cells = std::size_t(w) * std::size_t(h);
+  active_.resize(cells);
+  full_.resize(cells);
+  {
+    const float* cover = cover_.data();
+    const float* aux = aux_.data();
+    const std::uint8_t* solid = solid_.data();
+    std::uint8_t* a = active_.data();
+    std::uint8_t* fu = full_.data();
+    for (std::size_t k = 0; k < cells; ++k) {
+      a[k] = cover[k] > 0.0f;
+      fu[k] = (aux[2 * k + 1] >= kFull) & !solid[k];
     }
   }
-  for (int x = 0; x < w; ++x) {
-    int count = 0;
-    for (int y = 0; y < std::min(reach, h); ++y) count += activeTmp_[std::size_t(y) * std::size_t(w) + std::size_t(x)];
+  windowTest(active_, activeTmp_, count_, w, h, reach, false);
+  // The next cell of `row` (w cells) at or after x holding v, or w (memchr: most rows are empty).
+  auto next = [w](const std::uint8_t* row, int x, std::uint8_t v) {
+    const void* p = std::memchr(row + x, v, std::size_t(w - x));
+    return p ? int(static_cast<const std::uint8_t*>(p) - row) : w;
+  };
+  if (onlyVisible)
     for (int y = 0; y < h; ++y) {
-      if (y + reach < h) count += activeTmp_[std::size_t(y + reach) * std::size_t(w) + std::size_t(x)];
-      if (y - reach - 1 >= 0) count -= activeTmp_[std::size_t(y - reach - 1) * std::size_t(w) + std::size_t(x)];
-      active_[std::size_t(y) * std::size_t(w) + std::size_t(x)] = count > 0;
+      std::uint8_t* row = &active_[std::size_t(y) * std::size_t(w)];
+      if (next(row, 0, 1) < w) keepVisible(row, y);
     }
-  }
+  windowTest(full_, activeTmp_, count_, w, h, reach, true);
+  for (std::size_t k = 0; k < cells; ++k) aux_[2 * k + 1] = full_[k] ? kDeepFill : aux_[2 * k + 1];
+  windowTest(full_, activeTmp_, count_, w, h, 1, true);
+  // Each cell's kind (0: no tile, 1: the full program's, 2: interior) into activeTmp_, then the
+  // runs of kind 1 in each row, then those of kind 2.
+  std::uint8_t* kind = activeTmp_.data();
+  for (std::size_t k = 0; k < cells; ++k) kind[k] = std::uint8_t(active_[k] * (1 + full_[k]));
   out.clear();
   int rowFirst = h, rowLast = -1;
   auto ndcX = [&](int px) { return float(std::min(px, EW)) / float(EW) * 2.0f - 1.0f; };
   auto ndcY = [&](int py) { return float(std::min(py, EH)) / float(EH) * 2.0f - 1.0f; };
-  for (int y = 0; y < h; ++y)
-    for (int x = 0; x < w;) {
-      if (!active_[std::size_t(y) * std::size_t(w) + std::size_t(x)]) {
-        ++x;
-        continue;
+  for (std::uint8_t pass = 1; pass <= 2; ++pass) {
+    if (pass == 2) interiorFirst = out.size() / 2;
+    for (int y = 0; y < h; ++y) {
+      const std::uint8_t* row = kind + std::size_t(y) * std::size_t(w);
+      for (int x = next(row, 0, pass); x < w; x = next(row, x, pass)) {
+        int e = x;
+        while (e < w && row[e] == pass) ++e;
+        const float x0 = ndcX(x * cell_), x1 = ndcX(e * cell_), y0 = ndcY(y * cell_), y1 = ndcY((y + 1) * cell_);
+        const float q[12] = {x0, y0, x1, y0, x0, y1, x0, y1, x1, y0, x1, y1};
+        out.insert(out.end(), q, q + 12);
+        rowFirst = std::min(rowFirst, y);
+        rowLast = std::max(rowLast, y);
+        x = e;
       }
-      int e = x;
-      while (e < w && active_[std::size_t(y) * std::size_t(w) + std::size_t(e)]) ++e;
-      const float x0 = ndcX(x * cell_), x1 = ndcX(e * cell_), y0 = ndcY(y * cell_), y1 = ndcY((y + 1) * cell_);
-      const float q[12] = {x0, y0, x1, y0, x0, y1, x0, y1, x1, y0, x1, y1};
-      out.insert(out.end(), q, q + 12);
-      rowFirst = std::min(rowFirst, y);
-      rowLast = std::max(rowLast, y);
-      x = e;
     }
+  }
   if (rowLast < 0) return {0, 0};
   return {std::min(rowFirst * cell_, EH), std::min((rowLast + 1) * cell_, EH)};
 }

@@ -8,10 +8,13 @@
 //     rasterizer); when sprites are at least 8 px wide the target has half the image's
 //     resolution (a quarter of the texels) and the composite reads it bilinearly;
 //  2. depth grid: on the CPU, the depth of water above and the local fill (depth_grid.hpp),
-//     uploaded as a small RG32F texture, and the tiles of the image the fluid can reach;
+//     uploaded as a small RG32F texture, and the tiles of the image the fluid can reach (with
+//     the field summed on the CPU, only the cells where it can show water: a lone drop takes
+//     a few cells, not the sprite's reach around it);
 //  3. composite: over those tiles only, the field becomes water (shaders/composite.frag:
 //     thresholded edge, depth colour, shading from the field's gradient, foam); elsewhere the
-//     frame keeps its background.
+//     frame keeps its background. The tiles deep in the water take the interior program, which
+//     reads the field once instead of five times and draws what the full one draws there.
 // With more than one material (RenderInput::materialColors and a material per particle), the
 // particles are splatted once more into an RGBA32F tint target (shaders/tint.frag: Σ w·colour,
 // Σ w) and the composite (compiled with TINT) takes the surface colour from it: each material
@@ -168,15 +171,6 @@ class LiquidPass final : public RenderPass {
     if (grid_.resize(EW, EH, f.spacingPx))
       gl::makeTexture(auxTex_, GL_RG32F, GL_RG, GL_FLOAT, grid_.width(), grid_.height(), GL_LINEAR);
     grid_.build(f.in, f.geo.ext, f.pxPerM, f.order, f.weight);
-    glBindTexture(GL_TEXTURE_2D, auxTex_);
-    glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
-    glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, grid_.width(), grid_.height(), GL_RG, GL_FLOAT, grid_.aux().data());
-    tileRows_ = grid_.tiles(float(def_.splatRadius * f.spacingPx), EW, EH, tiles_);
-    packDiffuse(f);
-    tileVertices_ = GLsizei(tiles_.size() / 2);
-    glBindBuffer(GL_ARRAY_BUFFER, tileVbo_);
-    glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(tiles_.size() * sizeof(float)), tiles_.empty() ? nullptr : tiles_.data(),
-                 GL_STREAM_DRAW);
   }
 
   std::pair<int, int> changedRows() const override { return changedRows_; }
@@ -191,6 +185,7 @@ class LiquidPass final : public RenderPass {
   void draw(const PassFrame& f, StageTimer& timer, RenderTimings& timings) override {
     splat(f);
     timer.end(timings.splat);
+    layTiles(f);
     composite(f);
     if (anyDiffuse()) drawDiffuse(f);
     if (!blobs_.empty()) drawBlobs(f);
@@ -250,6 +245,28 @@ class LiquidPass final : public RenderPass {
     }
     glDisable(GL_BLEND);
     glViewport(0, 0, EW, EH);
+  }
+
+  /// The composite's tiles (DepthGrid::tiles) and the depth grid's upload; with the field
+  /// summed on the CPU and nothing but liquid in the frame (no grains, no groups' blobs, which
+  /// are drawn over the tiles' rows), only the cells where the field can show water
+  /// (DepthGrid::markVisible) take tiles. The frame is the same either way.
+  void layTiles(const PassFrame& f) {
+    const bool byField = cpuSplat_ && grains_.empty() && blobs_.empty();
+    if (byField)
+      grid_.markVisible(cpuTargets_[0].texels(), fieldW_, fieldH_, spriteShrink(f.spacingPx),
+                        float(std::max(1.0, 0.75 * f.spacingPx)), bulk(f));
+    std::size_t interiorFirst = 0;
+    tileRows_ = grid_.tiles(float(def_.splatRadius * f.spacingPx), f.geo.EW, f.geo.EH, tiles_, interiorFirst, byField);
+    glBindTexture(GL_TEXTURE_2D, auxTex_);
+    glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+    glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, grid_.width(), grid_.height(), GL_RG, GL_FLOAT, grid_.aux().data());
+    packDiffuse(f);
+    tileVertices_ = GLsizei(tiles_.size() / 2);
+    interiorFirst_ = GLsizei(interiorFirst);
+    glBindBuffer(GL_ARRAY_BUFFER, tileVbo_);
+    glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(tiles_.size() * sizeof(float)), tiles_.empty() ? nullptr : tiles_.data(),
+                 GL_STREAM_DRAW);
   }
 
   /// The size of this frame's splat targets and the sprites' diameter in their texels.
@@ -417,21 +434,22 @@ class LiquidPass final : public RenderPass {
     }
   }
 
-  /// The composite's program for this frame (TINT, SEE_THROUGH, MATERIAL_T), compiled at first use.
-  GLuint compositeProgram() {
-    const int key = (tinted_ ? 1 : 0) | (seeThrough_ ? 2 : 0) | (perMaterial_ ? 4 : 0);
+  /// The composite's program for this frame (TINT, SEE_THROUGH, MATERIAL_T; INTERIOR: the
+  /// interior tiles' program), compiled at first use.
+  GLuint compositeProgram(bool interior) {
+    const int key = (tinted_ ? 1 : 0) | (seeThrough_ ? 2 : 0) | (perMaterial_ ? 4 : 0) | (interior ? 8 : 0);
     GLuint& p = compositeProgs_[std::size_t(key)];
     if (!p)
       p = gl::program("solid.vert", "composite.frag",
                       std::string(tinted_ ? "#define TINT\n" : "") + (seeThrough_ ? "#define SEE_THROUGH\n" : "") +
-                          (perMaterial_ ? "#define MATERIAL_T\n" : ""));
+                          (perMaterial_ ? "#define MATERIAL_T\n" : "") + (interior ? "#define INTERIOR\n" : ""));
     return p;
   }
 
-  /// The field becomes water over the tiles the fluid can reach (shaders/composite.frag).
+  /// The field becomes water over the tiles the fluid can reach (shaders/composite.frag): the
+  /// full program over the tiles at the surface, the interior program over the rest.
   void composite(const PassFrame& f) {
-    const int EW = f.geo.EW, EH = f.geo.EH;
-    const GLuint cp = compositeProgram();
+    const int EH = f.geo.EH;
     // The colour target still holds the last frame: background and solids, and water over the
     // rows its tiles covered. Only those rows go back to the background; the tiles of this
     // frame write every pixel they cover.
@@ -443,6 +461,20 @@ class LiquidPass final : public RenderPass {
       changedRows_.second = std::max(changedRows_.second, tileRows_.second);
     }
     drawnRows_ = tileRows_;
+    glBindVertexArray(tileVao_);
+    if (interiorFirst_ > 0) {
+      useComposite(f, compositeProgram(false));
+      glDrawArrays(GL_TRIANGLES, 0, interiorFirst_);
+    }
+    if (tileVertices_ > interiorFirst_) {
+      useComposite(f, compositeProgram(true));
+      glDrawArrays(GL_TRIANGLES, interiorFirst_, tileVertices_ - interiorFirst_);
+    }
+  }
+
+  /// Makes `cp` (a composite program) current with this frame's textures and uniforms.
+  void useComposite(const PassFrame& f, GLuint cp) {
+    const int EW = f.geo.EW, EH = f.geo.EH;
     glUseProgram(cp);
     glActiveTexture(GL_TEXTURE0);
     glBindTexture(GL_TEXTURE_2D, fieldTex_);
@@ -499,8 +531,6 @@ class LiquidPass final : public RenderPass {
     // that makes the steepest shift `refraction` spacings.
     const double rPx = def_.splatRadius * f.spacingPx;
     glUniform1f(gl::uniform(cp, "uRefractPx"), float(def_.refraction * f.spacingPx * rPx / 1.164));
-    glBindVertexArray(tileVao_);
-    if (tileVertices_) glDrawArrays(GL_TRIANGLES, 0, tileVertices_);
   }
 
   RenderDef def_;
@@ -518,9 +548,9 @@ class LiquidPass final : public RenderPass {
   std::vector<float> packedAbsorb_;
   bool perMaterial_ = false, seeThrough_ = false;
   std::array<float, 3> transmission_{0, 0, 0};
-  std::array<GLuint, 8> compositeProgs_{};  // by TINT | SEE_THROUGH | MATERIAL_T
-  bool tinted_ = false;                     // this frame draws each material in its colour
-  GLuint grainProg_ = 0;                    // the grains' discs (made on the first frame with grains)
+  std::array<GLuint, 16> compositeProgs_{};  // by TINT | SEE_THROUGH | MATERIAL_T | INTERIOR
+  bool tinted_ = false;                      // this frame draws each material in its colour
+  GLuint grainProg_ = 0;                     // the grains' discs (made on the first frame with grains)
   // Particle groups (made on the first frame with one): their splat target and composite.
   GLuint blobProg_ = 0, blobTex_ = 0, blobFbo_ = 0;
   int blobW_ = 0, blobH_ = 0;
@@ -530,6 +560,7 @@ class LiquidPass final : public RenderPass {
   GLuint fieldTex_ = 0, fieldFbo_ = 0, auxTex_ = 0, tileVao_ = 0, tileVbo_ = 0;
   int fieldW_ = 0, fieldH_ = 0;  // the splat target: full resolution, or half when sprites are wide
   GLsizei tileVertices_ = 0;
+  GLsizei interiorFirst_ = 0;                    // the interior tiles' first vertex (DepthGrid::tiles)
   std::array<std::vector<float>, 3> diffuse_;    // spray, foam, bubbles: x, y, colour, alpha (packDiffuse)
   std::pair<int, int> tileRows_{0, 0};           // target rows this frame's tiles cover
   std::pair<int, int> drawnRows_{0, 1 << 30};    // rows of the colour target that are not background
