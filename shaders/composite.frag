@@ -105,13 +105,14 @@ void main() {
   // leaves the body's edge as it is drawn.
   bool solid = bg != texelFetch(uPlain, ivec2(gl_FragCoord.xy), 0).rgb;
   float cover = clamp((f - (solid ? max(threshold, 0.85) : threshold)) / max(g, 1e-3) + 0.5, 0.0, 1.0);
+  // Towards the flat interior (G from 1 to 2): covered, no tilt, highlight or shift, and the
+  // field at the pixel instead of the low-passed one.
+  float surf = 1.0 - smoothstep(1.0, 2.0, aux.g);
+  cover = max(cover, 1.0 - surf);
   if (cover <= 0.0) {
     outColor = vec4(bg, 1.0);
     return;
   }
-  // Towards the flat interior (G from 1 to 2): no tilt, highlight or shift, and the field at
-  // the pixel instead of the low-passed one.
-  float surf = 1.0 - smoothstep(1.0, 2.0, aux.g);
   grad *= surf;
   float fe = mix(fc, f, surf);
   float inside = smoothstep(threshold, threshold + 0.45, fe);

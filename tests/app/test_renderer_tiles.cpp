@@ -118,3 +118,100 @@ TEST_CASE("liquid: a lone drop's tiles cover a few cells around it, and the drop
   for (std::size_t p = 0; p < a.rgba.size(); ++p) worst = std::max(worst, std::abs(int(a.rgba[p]) - int(b.rgba[p])));
   CHECK(worst <= 2);
 }
+
+TEST_CASE("liquid: a sand pile beside the water is no deep water: the interior program stays in the water") {
+  // Water (x 0 .. 0.8) and sand (a granular material, x 1.0 .. 1.8) side by side, both 0.6 m
+  // deep. Grains add nothing to the liquid's field: under the sand the full program draws the
+  // backdrop between the grains, and the interior program must not draw water there. The frame
+  // as built against the one with the interior tiles drawn by the full program: the same to the
+  // bit; the magenta variant marks the water's depths and none of the sand.
+  Pool pool;
+  pool.fill(0.0, 0.8, 0.0, 0.6, kDx);
+  const std::size_t water = pool.B.size();
+  pool.fill(1.0, 1.8, 0.0, 0.6, kDx);
+  pool.B.material.assign(pool.B.size(), 0);
+  for (std::size_t k = water; k < pool.B.size(); ++k) pool.B.material[k] = 1;
+  auto render = [&] {
+    RenderInput in;
+    in.particles = pool.B.view();
+    in.spacing = kDx;
+    const std::vector<Collider> none;
+    in.colliders = &none;
+    in.materialColors = {0x3080D0u, 0xC8A870u};
+    in.materialGranular = {0, 1};
+    Renderer r(pool.def);
+    return Frame(r.render(in));
+  };
+  const Frame built = render();
+  Frame full, marked;
+  {
+    const ShaderDir dir(
+        compositeVariant("composite_one_program_sand", "void main() {", "#undef INTERIOR\nvoid main() {"));
+    full = render();
+  }
+  {
+    const ShaderDir dir(compositeVariant("composite_marked_sand", "void main() {",
+                                         "void main() {\n#ifdef INTERIOR\n  outColor = vec4(1.0, 0.0, 1.0, 1.0);\n"
+                                         "  return;\n#endif"));
+    marked = render();
+  }
+  CHECK(built.rgba == full.rgba);
+  int inWater = 0, inSand = 0;
+  for (int row = 0; row < marked.height; ++row)
+    for (int col = 0; col < marked.width; ++col) {
+      const double x = -0.1 + (col + 0.5) / 240;
+      if (!magenta(marked, col, row)) continue;
+      (x < 0.9 ? inWater : inSand) += 1;
+    }
+  MESSAGE("interior program over " << inWater << " px of the water and " << inSand << " of the sand");
+  CHECK(inWater > 10000);
+  CHECK(inSand == 0);
+}
+
+TEST_CASE("liquid: the tiles by the field draw the frame of the tiles by reach, to the bit") {
+  // Jittered pools with a body and background tiles behind, 600 spray particles scattered
+  // over the image, at odd and even image sizes and three spacings (the field at full and half
+  // resolution). One grain far off screen makes the same renderer take the tiles by reach (a
+  // frame with grains keeps them); it adds nothing on screen.
+  for (const int width : {480, 483})
+    for (const int height : {270, 271})
+      for (const double step : {kDx, 0.6 * kDx, 2.2 * kDx}) {
+        Pool pool;
+        pool.def.width = width;
+        pool.def.height = height;
+        pool.def.tiles = 0.1;
+        pool.solids = {boxCollider(0.8, 0.1, 1.0, 0.3)};
+        std::uint32_t h = 777u + std::uint32_t(width * 7 + height * 13 + int(step * 1e4));
+        auto rnd = [&] {
+          h = h * 1664525u + 1013904223u;
+          return double(h >> 8) / double(1u << 24);
+        };
+        for (double y = step / 2; y < 0.5; y += step)
+          for (double x = -0.1 + step / 2; x < 0.7; x += step)
+            pool.B.push(Vec2(Real(x + (rnd() - 0.5) * 0.6 * step), Real(y + (rnd() - 0.5) * 0.6 * step)), Vec2(0, 0),
+                        pool.nextId++, 1000);
+        for (int k = 0; k < 600; ++k)
+          pool.B.push(Vec2(Real(-0.1 + 2.0 * rnd()), Real(-0.1 + 1.125 * rnd())), Vec2(Real(3 * rnd()), 0),
+                      pool.nextId++, 1000);
+        auto render = [&](bool offscreenGrain) {
+          ParticleBuffer B = pool.B;
+          B.material.assign(B.size(), 0);
+          if (offscreenGrain) {
+            B.push(Vec2(Real(50), Real(50)), Vec2(0, 0), 999999u, 1000);
+            B.material.back() = 1;
+          }
+          RenderInput in;
+          in.particles = B.view();
+          in.spacing = step;
+          in.colliders = &pool.solids;
+          in.materialGranular = {0, 1};
+          Renderer r(pool.def);
+          return Frame(r.render(in));
+        };
+        const Frame a = render(false), b = render(true);
+        CAPTURE(width);
+        CAPTURE(height);
+        CAPTURE(step);
+        CHECK(a.rgba == b.rgba);
+      }
+}

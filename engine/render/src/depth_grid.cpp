@@ -50,15 +50,11 @@ void DepthGrid::buildSolidMask(const RenderInput& in, double x0, double y1, doub
   }
 }
 
-void DepthGrid::build(const RenderInput& in, const std::vector<double>& ext, double pxPerM,
-                      const std::vector<std::uint32_t>& order, const std::vector<float>& weight) {
-  const double spacingPx = in.spacing * pxPerM;
-  const int w = w_, h = h_, cell = cell_;
-  cover_.assign(std::size_t(w) * std::size_t(h), 0.0f);
+void DepthGrid::deposit(const RenderInput& in, const std::vector<std::uint32_t>& order, const float* weight, double x0,
+                        double y1, double cellM, float areaShare, std::vector<float>& out) const {
+  const int w = w_, h = h_;
+  out.assign(std::size_t(w) * std::size_t(h), 0.0f);
   const Particles& P = in.particles;
-  const double cellM = cell / pxPerM;
-  const double x0 = ext[0] - in.origin.x(), y1 = ext[3] - in.origin.y();
-  const float areaShare = float((spacingPx * spacingPx) / (double(cell) * double(cell)));
   // Cloud-in-cell deposit (bilinear weights): no aliasing between the lattice and the cells.
   for (std::size_t k = 0; k < order.size(); ++k) {
     const std::size_t i = order[k];
@@ -70,10 +66,49 @@ void DepthGrid::build(const RenderInput& in, const std::vector<double>& ext, dou
     const float wgt[4] = {(1 - tx) * (1 - ty) * m, tx * (1 - ty) * m, (1 - tx) * ty * m, tx * ty * m};
     for (int q = 0; q < 4; ++q) {
       const int xx = ix + (q & 1), yy = iy + (q >> 1);
-      if (xx >= 0 && yy >= 0 && xx < w && yy < h) cover_[std::size_t(yy) * std::size_t(w) + std::size_t(xx)] += wgt[q];
+      if (xx >= 0 && yy >= 0 && xx < w && yy < h) out[std::size_t(yy) * std::size_t(w) + std::size_t(xx)] += wgt[q];
     }
   }
-  for (float& c : cover_) c = std::min(c, 1.0f);
+  for (float& c : out) c = std::min(c, 1.0f);
+}
+
+void DepthGrid::localFill(const std::vector<float>& cover, float* out, std::size_t stride) const {
+  // The 3×3 mean of the coverage (inside without bounds checks, same order).
+  const int w = w_, h = h_;
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      float s = 0;
+      int n = 0;
+      if (y > 0 && x > 0 && y + 1 < h && x + 1 < w) {
+        for (int dy = -1; dy <= 1; ++dy) {
+          const float* c = &cover[std::size_t(y + dy) * std::size_t(w) + std::size_t(x - 1)];
+          s += c[0];
+          s += c[1];
+          s += c[2];
+        }
+        n = 9;
+      } else {
+        for (int dy = -1; dy <= 1; ++dy)
+          for (int dx = -1; dx <= 1; ++dx) {
+            const int xx = x + dx, yy = y + dy;
+            if (xx < 0 || yy < 0 || xx >= w || yy >= h) continue;
+            s += cover[std::size_t(yy) * std::size_t(w) + std::size_t(xx)];
+            ++n;
+          }
+      }
+      out[(std::size_t(y) * std::size_t(w) + std::size_t(x)) * stride] = s / float(n);
+    }
+}
+
+void DepthGrid::build(const RenderInput& in, const std::vector<double>& ext, double pxPerM,
+                      const std::vector<std::uint32_t>& order, const std::vector<float>& weight,
+                      const std::vector<float>* liquidWeight) {
+  const double spacingPx = in.spacing * pxPerM;
+  const int w = w_, h = h_, cell = cell_;
+  const double cellM = cell / pxPerM;
+  const double x0 = ext[0] - in.origin.x(), y1 = ext[3] - in.origin.y();
+  const float areaShare = float((spacingPx * spacingPx) / (double(cell) * double(cell)));
+  deposit(in, order, weight.data(), x0, y1, cellM, areaShare, cover_);
   if (solidsStale_) buildSolidMask(in, x0, y1, cellM);
   aux_.assign(std::size_t(w) * std::size_t(h) * 2, 0.0f);
   // Depth of water above, with the light scattered sideways as it goes down: row by row from
@@ -111,30 +146,15 @@ void DepthGrid::build(const RenderInput& in, const std::vector<double>& ext, dou
     }
     std::swap(carry, above);
   }
-  // Local fill: the 3×3 mean of the coverage (inside without bounds checks, same order).
-  for (int y = 0; y < h; ++y)
-    for (int x = 0; x < w; ++x) {
-      float s = 0;
-      int n = 0;
-      if (y > 0 && x > 0 && y + 1 < h && x + 1 < w) {
-        for (int dy = -1; dy <= 1; ++dy) {
-          const float* c = &cover_[std::size_t(y + dy) * std::size_t(w) + std::size_t(x - 1)];
-          s += c[0];
-          s += c[1];
-          s += c[2];
-        }
-        n = 9;
-      } else {
-        for (int dy = -1; dy <= 1; ++dy)
-          for (int dx = -1; dx <= 1; ++dx) {
-            const int xx = x + dx, yy = y + dy;
-            if (xx < 0 || yy < 0 || xx >= w || yy >= h) continue;
-            s += cover_[std::size_t(yy) * std::size_t(w) + std::size_t(xx)];
-            ++n;
-          }
-      }
-      aux_[(std::size_t(y) * std::size_t(w) + std::size_t(x)) * 2 + 1] = s / float(n);
-    }
+  localFill(cover_, aux_.data() + 1, 2);
+  // The water's own fill, for the deep cells (tiles()): grains and groups' particles add nothing
+  // to the field, so a sand pile is no deep water.
+  liquidFill_.clear();
+  if (liquidWeight) {
+    deposit(in, order, liquidWeight->data(), x0, y1, cellM, areaShare, liquidCover_);
+    liquidFill_.resize(std::size_t(w) * std::size_t(h));
+    localFill(liquidCover_, liquidFill_.data(), 1);
+  }
 }
 
 namespace {
@@ -178,10 +198,10 @@ void windowTest(std::vector<std::uint8_t>& a, std::vector<std::uint8_t>& tmp, st
 }
 }  // namespace
 
-void DepthGrid::markVisible(const float* rg, int tw, int th, int shrink, float tapPx, float bulk) {
+void DepthGrid::markVisible(const float* rg, int tw, int th, int EW, int EH, float tapPx, float bulk) {
   // One bit per texel above the limit, 64 to a word, a row of words per texel row.
   const float limit = 0.98f * (0.24f - 0.0005f) / (1.0f + 0.3536f / tapPx) * bulk;
-  field_ = FieldBits{tw, th, shrink, tapPx, (tw + 63) / 64};
+  field_ = FieldBits{tw, th, float(tw) / float(EW), float(th) / float(EH), tapPx, (tw + 63) / 64};
   hot_.assign(std::size_t(th) * std::size_t(field_.words), 0);
   for (int y = 0; y < th; ++y) {
     const float* row = rg + std::size_t(y) * std::size_t(tw) * 2;
@@ -196,29 +216,29 @@ void DepthGrid::markVisible(const float* rg, int tw, int th, int shrink, float t
 }
 
 void DepthGrid::keepVisible(std::uint8_t* row, int cy) {
-  // The texels the samples of a cell's pixels read: the pixels' centres ± tapPx, bilinear
-  // (texel k serves sample coordinates k − 0.5 .. k + 1.5 in texels), clamped to the edge. The
-  // field's rows the cell row reads are joined (or) into one, then each cell tests its columns.
+  // The texels the samples of a cell's pixels read: the pixels' centres ± tapPx, bilinear (a
+  // sample at x px reads texels ⌊x·w/EW − 0.5⌋ and the next: the texture spans the target),
+  // clamped to the edge. The field's rows the cell row reads are joined (or) into one, then
+  // each cell tests its columns.
   const FieldBits& F = field_;
-  const float s = float(F.shrink);
-  auto first = [&](int p0, int n) {
-    return std::clamp(int(std::floor((float(p0) + 0.5f - F.tapPx) / s - 0.5f)), 0, n - 1);
+  auto first = [&](int p0, int n, float scale) {
+    return std::clamp(int(std::floor((float(p0) + 0.5f - F.tapPx) * scale - 0.5f)), 0, n - 1);
   };
-  auto last = [&](int p1, int n) {
-    return std::clamp(int(std::floor((float(p1) - 0.5f + F.tapPx) / s - 0.5f)) + 1, 0, n - 1);
+  auto last = [&](int p1, int n, float scale) {
+    return std::clamp(int(std::floor((float(p1) - 0.5f + F.tapPx) * scale - 0.5f)) + 1, 0, n - 1);
   };
   if (F.w < 1 || F.h < 1) {
     std::fill(row, row + w_, std::uint8_t(0));
     return;
   }
   joined_.assign(std::size_t(F.words), 0);
-  for (int y = first(cy * cell_, F.h), y1 = last((cy + 1) * cell_, F.h); y <= y1; ++y) {
+  for (int y = first(cy * cell_, F.h, F.sy), y1 = last((cy + 1) * cell_, F.h, F.sy); y <= y1; ++y) {
     const std::uint64_t* bits = &hot_[std::size_t(y) * std::size_t(F.words)];
     for (int wd = 0; wd < F.words; ++wd) joined_[std::size_t(wd)] |= bits[wd];
   }
   for (int cx = 0; cx < w_; ++cx) {
     if (!row[cx]) continue;
-    const int x0 = first(cx * cell_, F.w), x1 = last((cx + 1) * cell_, F.w);
+    const int x0 = first(cx * cell_, F.w, F.sx), x1 = last((cx + 1) * cell_, F.w, F.sx);
     bool any = false;
     for (int wd = x0 / 64; wd <= x1 / 64 && !any; ++wd) {
       std::uint64_t m = joined_[std::size_t(wd)];
@@ -244,12 +264,13 @@ std::pair<int, int> DepthGrid::tiles(float spriteRadiusPx, int EW, int EH, std::
   {
     const float* cover = cover_.data();
     const float* aux = aux_.data();
+    const float* liquid = liquidFill_.empty() ? nullptr : liquidFill_.data();
     const std::uint8_t* solid = solid_.data();
     std::uint8_t* a = active_.data();
     std::uint8_t* fu = full_.data();
     for (std::size_t k = 0; k < cells; ++k) {
       a[k] = cover[k] > 0.0f;
-      fu[k] = (aux[2 * k + 1] >= kFull) & !solid[k];
+      fu[k] = ((liquid ? liquid[k] : aux[2 * k + 1]) >= kFull) & !solid[k];
     }
   }
   windowTest(active_, activeTmp_, count_, w, h, reach, false);

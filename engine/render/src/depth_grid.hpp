@@ -29,8 +29,11 @@ class DepthGrid {
   void solidsChanged() { solidsStale_ = true; }
   /// Deposits the particles of `in` (slots `order`, weights `weight` in that order) and computes
   /// the depth above and the local fill of every cell. `ext` is the targets' world rectangle.
+  /// `liquidWeight` (when some particles add nothing to the liquid's field: grains, groups'
+  /// particles): the weights of the field, which decide the deep cells (tiles()).
   void build(const RenderInput& in, const std::vector<double>& ext, double pxPerM,
-             const std::vector<std::uint32_t>& order, const std::vector<float>& weight);
+             const std::vector<std::uint32_t>& order, const std::vector<float>& weight,
+             const std::vector<float>* liquidWeight = nullptr);
   /// Two triangles (NDC of targets EW × EH) per run of cells in a row that the splat can reach:
   /// cells with water, dilated by `spriteRadiusPx` plus one pixel for the gradient taps. The
   /// runs of interior cells come last, from vertex `interiorFirst` on: the cells deep in the
@@ -43,13 +46,13 @@ class DepthGrid {
   std::pair<int, int> tiles(float spriteRadiusPx, int EW, int EH, std::vector<float>& out, std::size_t& interiorFirst,
                             bool onlyVisible = false);
   /// Marks the cells on whose pixels the composite can draw water, from its field (`rg`: tw × th
-  /// texels of Σw and Σw·speed, rows as the grid's, each texel `shrink` pixels wide; the bulk's
+  /// texels of Σw and Σw·speed spanning the EW × EH target, rows as the grid's; the bulk's
   /// Σw `bulk`; the gradient's taps `tapPx` away). The composite's edge is where f' − t > −g/2
   /// (shaders/composite.frag: f' the low-passed field over the bulk's, t ≥ 0.24 its threshold,
   /// g the gradient's length), and f' ≤ M, g ≤ √2·M/(2·tapPx) for M the largest field value
   /// the pixel's five bilinear samples read: water needs M > (0.24 − 0.0005)/(1 + 0.354/tapPx).
   /// A cell can when a texel above 0.98 of that lies within its pixels' samples' reach.
-  void markVisible(const float* rg, int tw, int th, int shrink, float tapPx, float bulk);
+  void markVisible(const float* rg, int tw, int th, int EW, int EH, float tapPx, float bulk);
 
   int width() const { return w_; }    ///< cells per row
   int height() const { return h_; }   ///< rows
@@ -60,6 +63,12 @@ class DepthGrid {
 
  private:
   void buildSolidMask(const RenderInput& in, double x0, double y1, double cellM);
+  /// `out` = the coverage of the particles `order` with weights `weight` (in that order), each
+  /// cell at most 1.
+  void deposit(const RenderInput& in, const std::vector<std::uint32_t>& order, const float* weight, double x0,
+               double y1, double cellM, float areaShare, std::vector<float>& out) const;
+  /// out[k·stride] = the 3×3 mean of `cover` around cell k.
+  void localFill(const std::vector<float>& cover, float* out, std::size_t stride) const;
   /// The local fill (the 3×3 mean of the coverage) from which a cell counts as holding water
   /// throughout: a disordered bulk's, whose coverage per cell scatters by about a tenth.
   static constexpr float kFull = 0.85f;
@@ -69,16 +78,18 @@ class DepthGrid {
 
   int w_ = 0, h_ = 0, cell_ = 0;
   bool solidsStale_ = true;
-  std::vector<float> cover_, aux_;    // coverage per cell; RG = depth above, local fill
-  std::vector<float> carry_, above_;  // one row each: depth carried down, blurred along the row
-  std::vector<float> open_;           // one row: 1 where the cell is not solid
-  std::vector<std::uint8_t> solid_;   // 1 where a cell's centre lies in a solid
+  std::vector<float> cover_, aux_;               // coverage per cell; RG = depth above, local fill
+  std::vector<float> liquidCover_, liquidFill_;  // the field's own coverage and fill (empty: cover_'s)
+  std::vector<float> carry_, above_;             // one row each: depth carried down, blurred along the row
+  std::vector<float> open_;                      // one row: 1 where the cell is not solid
+  std::vector<std::uint8_t> solid_;              // 1 where a cell's centre lies in a solid
   std::vector<std::uint8_t> active_, activeTmp_, full_;
   /// Clears the set cells of grid row cy (`row`) on whose pixels markVisible()'s field cannot
   /// show water (no texel above its limit where their samples read).
   void keepVisible(std::uint8_t* row, int cy);
   struct FieldBits {
-    int w = 0, h = 0, shrink = 1;
+    int w = 0, h = 0;
+    float sx = 1, sy = 1;  ///< texels per pixel across and down (1 or about 1/2)
     float tapPx = 1;
     int words = 0;  ///< 64-bit words a texel row
   };

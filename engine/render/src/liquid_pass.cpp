@@ -170,7 +170,13 @@ class LiquidPass final : public RenderPass {
     const int EW = f.geo.EW, EH = f.geo.EH;
     if (grid_.resize(EW, EH, f.spacingPx))
       gl::makeTexture(auxTex_, GL_RG32F, GL_RG, GL_FLOAT, grid_.width(), grid_.height(), GL_LINEAR);
-    grid_.build(f.in, f.geo.ext, f.pxPerM, f.order, f.weight);
+    // Grains and groups' particles add nothing to the field: the deep cells are the field's.
+    const bool onlyLiquid = grains_.empty() && blobs_.empty();
+    if (!onlyLiquid) {
+      liquidWeight_.resize(n);
+      for (std::size_t k = 0; k < n; ++k) liquidWeight_[k] = packed_[4 * k + 3];
+    }
+    grid_.build(f.in, f.geo.ext, f.pxPerM, f.order, f.weight, onlyLiquid ? nullptr : &liquidWeight_);
   }
 
   std::pair<int, int> changedRows() const override { return changedRows_; }
@@ -254,7 +260,7 @@ class LiquidPass final : public RenderPass {
   void layTiles(const PassFrame& f) {
     const bool byField = cpuSplat_ && grains_.empty() && blobs_.empty();
     if (byField)
-      grid_.markVisible(cpuTargets_[0].texels(), fieldW_, fieldH_, spriteShrink(f.spacingPx),
+      grid_.markVisible(cpuTargets_[0].texels(), fieldW_, fieldH_, f.geo.EW, f.geo.EH,
                         float(std::max(1.0, 0.75 * f.spacingPx)), bulk(f));
     std::size_t interiorFirst = 0;
     tileRows_ = grid_.tiles(float(def_.splatRadius * f.spacingPx), f.geo.EW, f.geo.EH, tiles_, interiorFirst, byField);
@@ -566,6 +572,7 @@ class LiquidPass final : public RenderPass {
   std::pair<int, int> drawnRows_{0, 1 << 30};    // rows of the colour target that are not background
   std::pair<int, int> changedRows_{0, 1 << 30};  // rows the last composite restored or drew
   std::vector<float> packed_, tiles_;            // particles (x, y, speed, weight) in id order; tile quads
+  std::vector<float> liquidWeight_;              // the field's weights in id order (with grains or blobs)
   DepthGrid grid_;
 };
 
