@@ -51,15 +51,21 @@ start_busy() {
   busy_pid=$!
 }
 cleanup() {
-  [ -n "$server" ] && kill "$server" 2>/dev/null
+  # Each step may fail (a server that already exited): under set -e a failing step would end
+  # the cleanup there and leave the busy loop running.
+  if [ -n "$server" ]; then kill "$server" 2>/dev/null || true; fi
   stop_busy
   rm -rf "$work"
 }
 trap cleanup EXIT
 trap 'exit 130' INT TERM
 serve_ok=1
-"$app" serve --help > /dev/null 2>&1 || serve_ok=0
-[ "$serve_ok" = 1 ] || echo "realtime.sh: $app has no serve command (configure with -DSPH2D_APP_SERVE=ON): no serve rows" >&2
+for bin in "$app" ${OTHER:-}; do
+  if ! "$bin" serve --help > /dev/null 2>&1; then
+    serve_ok=0
+    echo "realtime.sh: $bin has no serve command (configure with -DSPH2D_APP_SERVE=ON): no serve rows" >&2
+  fi
+done
 
 csv="measure,binary,busy,round,load1,dropped,late,wall_s,simulation_s,rendering_s,fps"
 
@@ -91,6 +97,7 @@ serve_once() {
   for _ in $(seq 1 600); do
     port=$(sed -n 's|.*http://127\.0\.0\.1:\([0-9]*\)/.*|\1|p' "$work/serve.log" | head -n 1)
     [ -n "$port" ] && break
+    kill -0 "$server" 2>/dev/null || break # it exited without serving
     sleep 0.1
   done
   [ -n "$port" ] || { cat "$work/serve.log"; exit 1; }
