@@ -22,6 +22,29 @@ bool magenta(const Frame& f, int col, int row) {
   return channel(f, col, row, 0) == 255 && channel(f, col, row, 1) == 0 && channel(f, col, row, 2) == 255;
 }
 
+/// A frame drawn three ways by `render` (a new Renderer each call): as built; with the interior
+/// tiles drawn by the full program (INTERIOR undefined); with the interior program painting
+/// magenta.
+struct ThreeWays {
+  Frame built, full, marked;
+};
+template <class Render>
+ThreeWays threeWays(const Render& render) {
+  ThreeWays t;
+  t.built = render();
+  {
+    const ShaderDir dir(compositeVariant("composite_one_program", "void main() {", "#undef INTERIOR\nvoid main() {"));
+    t.full = render();
+  }
+  {
+    const ShaderDir dir(compositeVariant("composite_marked", "void main() {",
+                                         "void main() {\n#ifdef INTERIOR\n  outColor = vec4(1.0, 0.0, 1.0, 1.0);\n"
+                                         "  return;\n#endif"));
+    t.marked = render();
+  }
+  return t;
+}
+
 }  // namespace
 
 TEST_CASE("liquid: deep water takes the interior program, which draws it as the full program does") {
@@ -45,18 +68,7 @@ TEST_CASE("liquid: deep water takes the interior program, which draws it as the 
       const double jx = jitter(), jy = jitter();
       pool.B.push(Vec2(Real(x + jx), Real(y + jy)), Vec2(0, 0), pool.nextId++, 1000);
     }
-  const Frame built = pool.render(true, true);
-  Frame full, marked;
-  {
-    const ShaderDir dir(compositeVariant("composite_one_program", "void main() {", "#undef INTERIOR\nvoid main() {"));
-    full = pool.render(true, true);
-  }
-  {
-    const ShaderDir dir(compositeVariant("composite_marked", "void main() {",
-                                         "void main() {\n#ifdef INTERIOR\n  outColor = vec4(1.0, 0.0, 1.0, 1.0);\n"
-                                         "  return;\n#endif"));
-    marked = pool.render(true, true);
-  }
+  const auto [built, full, marked] = threeWays([&] { return pool.render(true, true); });
   CHECK(built.rgba == full.rgba);
   // Magenta where the interior program drew; the pixels deeper than 8 spacings, away from the
   // body and the image's sides by as much, that it covered.
@@ -142,19 +154,7 @@ TEST_CASE("liquid: a sand pile beside the water is no deep water: the interior p
     Renderer r(pool.def);
     return Frame(r.render(in));
   };
-  const Frame built = render();
-  Frame full, marked;
-  {
-    const ShaderDir dir(
-        compositeVariant("composite_one_program_sand", "void main() {", "#undef INTERIOR\nvoid main() {"));
-    full = render();
-  }
-  {
-    const ShaderDir dir(compositeVariant("composite_marked_sand", "void main() {",
-                                         "void main() {\n#ifdef INTERIOR\n  outColor = vec4(1.0, 0.0, 1.0, 1.0);\n"
-                                         "  return;\n#endif"));
-    marked = render();
-  }
+  const auto [built, full, marked] = threeWays(render);
   CHECK(built.rgba == full.rgba);
   int inWater = 0, inSand = 0;
   for (int row = 0; row < marked.height; ++row)
