@@ -53,6 +53,15 @@ int orthogonalRows(const std::vector<std::array<double, 3>>& rows, std::uint64_t
   return n;
 }
 
+/// p without its parts along the `rows` ⟨·,·⟩-orthogonal rows e (orthogonalRows): p −= M⁻¹eᵀ
+/// (e·p)/⟨e, e⟩, row by row.
+void projectOut(const double m[3], const double e[3][3], const double ee[3], int rows, double p[3]) {
+  for (int j = 0; j < rows; ++j) {
+    const double d = (e[j][0] * p[0] + e[j][1] * p[1] + e[j][2] * p[2]) / ee[j];
+    for (int r = 0; r < 3; ++r) p[r] -= m[r] * e[j][r] * d;
+  }
+}
+
 }  // namespace
 
 void MovingSolid::restrict(double q[3]) const {
@@ -73,11 +82,7 @@ void MovingSolid::restrict(double q[3]) const {
   double best[3] = {0, 0, 0}, bestCost = -1;
   for (std::uint64_t set = 1; set < (std::uint64_t(1) << n); ++set) {
     double e[3][3], ee[3], p[3] = {free[0], free[1], free[2]};
-    const int rows = orthogonalRows(rests, set, m, e, ee);
-    for (int j = 0; j < rows; ++j) {
-      const double d = (e[j][0] * p[0] + e[j][1] * p[1] + e[j][2] * p[2]) / ee[j];
-      for (int r = 0; r < 3; ++r) p[r] -= m[r] * e[j][r] * d;
-    }
+    projectOut(m, e, ee, orthogonalRows(rests, set, m, e, ee), p);
     bool ok = true;
     for (const auto& a : rests) ok = ok && !entering(a, p);
     if (!ok) continue;
@@ -91,12 +96,8 @@ void MovingSolid::restrict(double q[3]) const {
   }
   if (bestCost < 0) {  // none (more contacts than were tried): hold every contact
     double e[3][3], ee[3];
-    const int rows = orthogonalRows(rests, ~std::uint64_t(0), m, e, ee);
     for (int r = 0; r < 3; ++r) best[r] = free[r];
-    for (int j = 0; j < rows; ++j) {
-      const double d = (e[j][0] * best[0] + e[j][1] * best[1] + e[j][2] * best[2]) / ee[j];
-      for (int r = 0; r < 3; ++r) best[r] -= m[r] * e[j][r] * d;
-    }
+    projectOut(m, e, ee, orthogonalRows(rests, ~std::uint64_t(0), m, e, ee), best);
   }
   for (int r = 0; r < 3; ++r) q[r] = best[r];
 }
