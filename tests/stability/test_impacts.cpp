@@ -50,7 +50,10 @@ bool inside(const std::vector<Vec2d>& poly, const Vec2d& p) {
 /// The most energetic particle's specific energy, as a share of the jet's, that every solver
 /// keeps below (docs/STABILITY.md: measured at most 2.32, dfsph; before the impact viscosity
 /// of wcsph and muller2003 and pbf's bounded pushout, wcsph threw one at 2.82). What is left
-/// is the impulsive pressure at the jet's blunt front, which no solver here bounds per particle.
+/// is the impulsive pressure at the jet's blunt front. It is no fixed multiple of the jet's
+/// energy: the impulse's tangential velocity grows like ln(b/x) towards a blunt front's corner
+/// (tests/stability/test_impact_impulse.cpp holds each solver's impact to that theory). This
+/// bound and the game solver's are regression bounds at this spacing.
 constexpr double kSpecificEnergyBound = 2.5;
 /// The game solver's (the default's): measured 1.18 / 1.18 / 1.08 / 1.22 / 1.16 on the five funnels
 /// here (the worst particles in the free jet at its nozzle, under the arena's lid; 1.18 / 1.17 /
