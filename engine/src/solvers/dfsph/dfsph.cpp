@@ -123,9 +123,9 @@ std::size_t Dfsph::densityAndFactor(StepContext& c, const WendlandC2<Real>& W) {
   const Real mGradFlat = mGradK * aFlat * aFlat * aFlat * (kFlatGradientQ * R);  // m|∇W| at q = 1/4, times r/|d|
   const Real self = W.value(0);
   // Below this the factor's denominator means no neighbours at all (a full
-  // neighbourhood gives about (ρ0/R)²).
+  // neighbourhood gives about 2 (ρ0/R)² at R = 2.5 dx).
   const Real eps = Real(1e-6) * (c.rho0 / R) * (c.rho0 / R);
-  const Real floor = kFactorFloor * (c.rho0 / R) * (c.rho0 / R);  // the header's (3)
+  const Real factorFloor = kFactorFloor * (c.rho0 / R) * (c.rho0 / R);  // the header's (3)
   const Vec2* X = P.x.data();
   const std::size_t firstBadSlot = firstBad(c.pool, n, [&](std::size_t b, std::size_t e) {
     std::size_t bad = kNone;
@@ -209,7 +209,7 @@ std::size_t Dfsph::densityAndFactor(StepContext& c, const WendlandC2<Real>& W) {
       P.rho[i] = rho;
       P.invRho[i] = Real(1) / rho;
       gradSum_[i] = Vec2(tx, ty);
-      alpha_[i] = denom > eps ? rho / std::max(denom, floor) : Real(0);
+      alpha_[i] = denom > eps ? rho / std::max(denom, factorFloor) : Real(0);
       if (!std::isfinite(rho) && bad == kNone) bad = i;
     }
     return bad;

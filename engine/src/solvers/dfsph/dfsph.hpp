@@ -13,7 +13,8 @@
 //       x_i − x_j (a stacked pair has a direction and a magnitude; coincident
 //       pairs take pairDelta's direction); G_i = Σ_j g_ij + Σ_b ρ0Ψ_b∇W_ib
 //   (3) α_i = ρ_i / max(|G_i|² + Σ_j |g_ij|², 0.01 (ρ0/R)²), the paper's factor (0 without
-//       neighbours) with its denominator at least a hundredth of a full neighbourhood's
+//       neighbours) with its denominator at least about a two-hundredth of a full
+//       neighbourhood's (about 2 (ρ0/R)² on a lattice at R = 2.5 dx)
 //   (4) Dρ_i/Dt = G_i·v_i − Σ_j g_ij·v_j
 //
 // Substep (stages()):
@@ -35,7 +36,7 @@
 //   B. v_i −= dt [Σ_j (δκ_i/ρ_i + δκ_j/ρ_j) g_ij + (δκ_i/ρ_i) Σ_b ρ0Ψ_b∇W_ib];
 //      κ_i += δκ_i. The wall term is the paper's single term, so B is the
 //      adjoint of A's prediction and a converged solve only removes energy.
-// The floor in (3): a lone pair at the kernel's edge (spray) has a denominator of 10⁻⁵ of a
+// The floor in (3): a lone pair at the kernel's edge (spray) has a denominator down to 10⁻⁵ of a
 // full neighbourhood's and a κ to match, since |∇W| vanishes there; warm-started into the next
 // substep, where a neighbour nearer than the edge has a larger ∇W, that κ became a kick (traced
 // in a 35 m/s jet at dx = 0.015: three lone drops went 5 → 66 → 165 → 1031 m/s over three
@@ -216,9 +217,10 @@ class Dfsph final : public Solver {
   static constexpr int kChebDelay = 5;             ///< plain iterations before the acceleration starts
   static constexpr Real kKneeDensity = Real(1.1);  ///< beyond ρ = 1.1 ρ0 the Jacobi step shrinks as 1.1 ρ0/ρ
   static constexpr Real kPushoutSpeed = Real(3);   ///< [m/s] existing compression is removed at most this fast
-  static constexpr Real kFactorFloor = Real(0.01);  ///< α's denominator ≥ this × (ρ0/R)², a full neighbourhood's order
-  std::vector<Vec2> vPrev_;                         ///< velocity before the last iteration (Chebyshev)
-  std::vector<Real> kPrev_;                         ///< κ before the last iteration (Chebyshev)
+  /// α's denominator is at least this × (ρ0/R)² (a full neighbourhood's: about 2).
+  static constexpr Real kFactorFloor = Real(0.01);
+  std::vector<Vec2> vPrev_;  ///< velocity before the last iteration (Chebyshev)
+  std::vector<Real> kPrev_;  ///< κ before the last iteration (Chebyshev)
   /// One neighbour entry of an iteration: the neighbour's slot and m∇W_ij.
   struct Pair {
     std::uint32_t j;
