@@ -54,8 +54,9 @@ bool inside(const std::vector<Vec2d>& poly, const Vec2d& p) {
 /// is the impulsive pressure at the jet's blunt front. It is no fixed multiple of the jet's
 /// energy: the impulse's tangential velocity grows like ln(b/x) towards a blunt front's corner
 /// (tests/stability/test_impact_impulse.cpp holds game's, dfsph's and pbf's impact to that
-/// theory), and every solver's worst particle here is higher at 15 mm than at 30 mm
-/// (docs/STABILITY.md). This bound and the game solver's are regression bounds, measured at
+/// theory), and like r^(π/α − 1) at a tooth's tip, a convex corner around which the fluid fills
+/// the angle α = 2π − θ (r^−0.46 at 25°): every solver's worst particle here is higher at 15 mm
+/// than at 30 mm, by × 1.2–2.0 against that singularity's × 1.9 (docs/STABILITY.md). This bound and the game solver's are regression bounds, measured at
 /// 30 and 15 mm.
 constexpr double kSpecificEnergyBound = 2.5;
 /// The game solver's (the default's): measured 1.18 / 1.18 / 1.08 / 1.22 / 1.16 on the five funnels
