@@ -13,6 +13,7 @@
 #include "cli.hpp"
 #include "commands.hpp"
 #include "sph2d/hash.hpp"
+#include "sph2d/render/frame_writer.hpp"
 #include "sph2d/render/png_io.hpp"
 #include "sph2d/render/renderer.hpp"
 #include "sph2d/scene.hpp"
@@ -35,11 +36,13 @@ const char* kBenchHelp =
     "(level L's, libdeflate level 1, zlib through libpng) and the fluid's outline as\n"
     "curves (World::surfaceCurves' work, one thread).\n"
     "Stages are timed with glFinish between them; the 'render, no sync' row is the\n"
-    "same frame without those fences, as `sph2d run` renders it. In liquid mode the\n"
-    "'opaque water' rows render the same frames, alternately, with render.transmission\n"
-    "0 (nothing seen through the water): what the see-through costs; the 'splat (gl)' and\n"
-    "'splat (cpu)' rows render them, alike, with the liquid's field summed by the path not\n"
-    "chosen (--splat): what the choice saves. The CPU rows are the\n"
+    "same frame without those fences, as `sph2d run` renders it; 'render | PNG' renders\n"
+    "K more frames as `sph2d run` does, each PNG written on the frame writer's thread\n"
+    "while the next frame renders (wall time per frame, first render to last file).\n"
+    "In liquid mode the 'opaque water' rows render the same frames, alternately, with\n"
+    "render.transmission 0 (nothing seen through the water): what the see-through costs;\n"
+    "the 'splat (gl)' and 'splat (cpu)' rows render them, alike, with the liquid's field\n"
+    "summed by the path not chosen (--splat): what the choice saves. The CPU rows are the\n"
     "process's CPU time (every thread: llvmpipe's too) per frame, which other processes\n"
     "on a shared machine disturb less than wall time. --save writes the frame.\n"
     "\n"
@@ -171,6 +174,7 @@ int cmdBench(const std::vector<std::string>& args) {
   std::printf("bench render: %zu particles, %dx%d, %s mode, %d frames, PNG level %d\nrenderer: %s\n", P.size(), width,
               height, profiled.mode().c_str(), frames, level, profiled.rendererString().c_str());
   Stat upload, splat, composite, solids, readback, overlay, png, hash, total, nosync, pngBytes, cpuRender, cpuPng;
+  Stat pipelined, cpuPipelined;  // render here, PNG on the writer's thread (one value: the run's mean)
   // Level L's coder against libdeflate level 1 and zlib (libpng) with level L's filter.
   Stat encodeOwn, encodeLibdeflate, encodeZlib, bytesOwn, bytesLibdeflate, bytesZlib;
   {
@@ -255,6 +259,22 @@ int cmdBench(const std::vector<std::string>& args) {
       alongside(opaque, opaqueNosync, &RenderTimings::total);
       alongside(other, otherNosync, &RenderTimings::total);
     }
+    // As `sph2d run` and the demo draw: the PNG on the FrameWriter's thread (its bounded
+    // queue) while this thread renders the next frame. Wall time from the first render to
+    // the last file written, per frame: the frame pipeline's throughput on two cores.
+    const auto t0 = std::chrono::steady_clock::now();
+    const double c0 = processCpuMs();
+    {
+      FrameWriter writer(tmp, level);
+      for (int k = 0; k < frames; ++k) {
+        const Frame& fr = plain.render(in);
+        writer.push(frames + k, fr.width, fr.height, fr.rgba);
+      }
+      writer.finish();
+    }
+    pipelined.v.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count() /
+                          frames);
+    cpuPipelined.v.push_back((processCpuMs() - c0) / frames);
   }
   fs::remove_all(tmp);
   // The fluid's outline as curves (sph2d/surface.hpp), on this thread alone: what a game pays
@@ -295,11 +315,13 @@ int cmdBench(const std::vector<std::string>& args) {
   Stat sum;
   for (std::size_t k = 0; k < nosync.v.size(); ++k) sum.v.push_back(nosync.v[k] + png.v[k]);
   row("render + PNG", sum);
+  row("render | PNG, 2 threads", pipelined);
   Stat cpuSum;
   for (std::size_t k = 0; k < cpuRender.v.size(); ++k) cpuSum.v.push_back(cpuRender.v[k] + cpuPng.v[k]);
   row("CPU: render, no sync", cpuRender);
   row("CPU: PNG encode", cpuPng);
   row("CPU: render + PNG", cpuSum);
+  row("CPU: render | PNG", cpuPipelined);
   row("surface curves (CPU)", surface);
   std::printf("surface: %zu curves\n", curves);
   const PngSettings::Deflater coder = pngSettings(level).deflater;

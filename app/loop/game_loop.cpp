@@ -3,11 +3,19 @@
 #include "loop/game_loop.hpp"
 
 #include <algorithm>
+#include <condition_variable>
+#include <deque>
 #include <exception>
+#include <memory>
 #include <thread>
 #include <utility>
 
 namespace sph2d::cli {
+
+int defaultStepThreads(bool stepsAhead) {
+  const int cores = int(std::thread::hardware_concurrency());
+  return stepsAhead ? std::max(1, cores - 1) : 0;  // 0: the World's default, every core
+}
 
 GameLoop::GameLoop(World& world, EventIntake& input, LoopObserver& observer, Renderer* renderer, LoopSettings settings)
     : world_(world),
@@ -40,6 +48,7 @@ LoopEnd GameLoop::run() {
 
 LoopEnd GameLoop::runFrames() {
   if (settings_.frames < 1) return LoopEnd::Finished;
+  if (runsAhead()) return runAhead();
   std::int64_t& f = status_.frame;
   f = 0;
   applyDue(0);
@@ -146,8 +155,9 @@ bool GameLoop::finishBoundary(bool drop) {
   return true;
 }
 
-void GameLoop::capture(std::int64_t f) {
-  Pending& q = pending_;
+void GameLoop::capture(std::int64_t f) { captureInto(pending_, f); }
+
+void GameLoop::captureInto(Pending& q, std::int64_t f) {
   q.particles.assign(world_.particles());  // with the ages and the particles' own colours, when there are
   q.colliders = world_.colliders();
   q.input = RenderInput{};
@@ -168,13 +178,28 @@ void GameLoop::capture(std::int64_t f) {
   q.active = true;
 }
 
+std::size_t GameLoop::Pending::bytes() const {
+  auto b = [](const auto& v) { return v.size() * sizeof(v[0]); };
+  const ParticleBuffer& P = particles;
+  return b(P.x) + b(P.v) + b(P.rho) + b(P.p) + b(P.id) + b(P.age) + b(P.color) + b(P.userData) + b(P.emitter) +
+         b(P.material) + b(P.mixedColor) + b(P.group) + b(diffuse.x) + b(diffuse.v) + b(diffuse.age) + b(diffuse.life) +
+         b(diffuse.kind) + b(colliders);
+}
+
 bool GameLoop::renderPending() {
   if (!pending_.active) return true;
-  pending_.active = false;
+  return renderSnapshot(pending_);
+}
+
+bool GameLoop::renderSnapshot(Pending& q) {
+  q.active = false;
   const auto r0 = std::chrono::steady_clock::now();
-  const Frame& image = renderer_->render(pending_.input);
-  status_.renderSeconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - r0).count();
-  return observer_.frame(pending_.state, image);
+  const Frame& image = renderer_->render(q.input);
+  {
+    std::lock_guard<std::mutex> lock(observer_.mutex());
+    status_.renderSeconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - r0).count();
+  }
+  return observer_.frame(q.state, image);
 }
 
 GameLoop::StepOutcome GameLoop::stepAndRender(double startAt) {
@@ -256,6 +281,156 @@ void GameLoop::holdPause() {
   }
   status_.paused = applier_.paused();
   if (!applier_.paused()) observer_.note("resumed at frame " + std::to_string(f));
+}
+
+bool GameLoop::runsAhead() const { return renderer_ && !settings_.realtime && !input_.liveOpen(); }
+
+LoopEnd GameLoop::runAhead() {
+  // The queue between the two threads: snapshots in frame order, and spent ones to reuse.
+  std::mutex m;
+  std::condition_variable cv;
+  std::deque<std::unique_ptr<Pending>> ready, spare;
+  std::deque<std::size_t> readySizes;
+  std::size_t readyBytes = 0;
+  bool producerDone = false;
+  std::atomic<bool> abandon{false};  // the rendering ended the loop: the stepping stops
+  std::exception_ptr stepError;
+  const auto slice = std::chrono::milliseconds(20);  // a stop is noticed within this while waiting
+
+  // A free snapshot once the queue has room (null: the loop is ending).
+  auto slot = [&]() -> std::unique_ptr<Pending> {
+    std::unique_lock<std::mutex> lock(m);
+    for (;;) {
+      if (abandon.load() || stopRequested()) return nullptr;
+      if (ready.empty() || (ready.size() < kAheadFrames && readyBytes < kAheadBytes)) break;
+      cv.wait_for(lock, slice);
+    }
+    if (spare.empty()) return std::make_unique<Pending>();
+    std::unique_ptr<Pending> q = std::move(spare.front());
+    spare.pop_front();
+    return q;
+  };
+  // Completes boundary f (stepped to, its events applied): tells the observer and queues the
+  // frame when it is kept. False: the loop is ending.
+  auto boundaryAt = [&](std::int64_t f) {
+    const bool kept = observer_.keeps(f);
+    observer_.boundary(world_, f, kept);
+    status_.done = f + 1;
+    if (!kept) return true;
+    std::unique_ptr<Pending> q = slot();
+    if (!q) return false;
+    captureInto(*q, f);
+    const std::size_t bytes = q->bytes();
+    std::lock_guard<std::mutex> lock(m);
+    ready.push_back(std::move(q));
+    readySizes.push_back(bytes);
+    readyBytes += bytes;
+    cv.notify_all();
+    return true;
+  };
+  std::thread producer([&] {
+    try {
+      std::int64_t& f = status_.frame;
+      f = 0;
+      applyDue(0);
+      bool more = boundaryAt(0);
+      while (more && f + 1 < settings_.frames && !stopRequested() && !abandon.load()) {
+        if (applier_.paused()) {
+          holdPause();  // headless with nothing live: a pause ends at once (with a warning if untimed)
+          continue;
+        }
+        const auto s0 = std::chrono::steady_clock::now();
+        world_.stepFrame();
+        status_.simSeconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - s0).count();
+        ++f;
+        for (const auto& w : world_.takeWarnings()) observer_.warn(w);
+        applyDue(f);
+        more = boundaryAt(f);
+        status_.paused = applier_.paused();
+        if (f + 1 < settings_.frames) observer_.progress(world_, status_, false);
+      }
+    } catch (...) {
+      stepError = std::current_exception();
+    }
+    std::lock_guard<std::mutex> lock(m);
+    producerDone = true;
+    cv.notify_all();
+  });
+
+  // This thread (the renderer's GL context's) draws the queue in order. Frames queued before
+  // a failed step are drawn before its error propagates, as in the interleaved loop.
+  LoopEnd end = LoopEnd::Finished;
+  std::exception_ptr renderError;
+  for (;;) {
+    std::unique_ptr<Pending> q;
+    {
+      std::unique_lock<std::mutex> lock(m);
+      while (ready.empty() && !producerDone && !stopRequested()) cv.wait_for(lock, slice);
+      if (ready.empty()) break;  // the stepping is done (or a stop came while waiting)
+      q = std::move(ready.front());
+      ready.pop_front();
+      readyBytes -= readySizes.front();
+      readySizes.pop_front();
+    }
+    bool more = true;
+    try {
+      more = renderSnapshot(*q);
+    } catch (...) {
+      renderError = std::current_exception();
+    }
+    {
+      std::lock_guard<std::mutex> lock(m);
+      spare.push_back(std::move(q));
+      cv.notify_all();
+    }
+    if (renderError || !more) {
+      end = LoopEnd::Ended;
+      break;
+    }
+    if (stopRequested()) break;  // the frame at hand is drawn; the queue's others are not
+  }
+  abandon = true;
+  cv.notify_all();
+  producer.join();
+  if (stepError) std::rethrow_exception(stepError);
+  if (renderError) std::rethrow_exception(renderError);
+  if (end == LoopEnd::Ended) return end;
+  if (stopRequested()) return LoopEnd::Interrupted;
+  observer_.progress(world_, status_, true);
+  return LoopEnd::Finished;
+}
+
+void GameLoop::SerialObserver::warn(const std::string& msg) {
+  std::lock_guard<std::mutex> lock(m_);
+  o_.warn(msg);
+}
+void GameLoop::SerialObserver::note(const std::string& msg) {
+  std::lock_guard<std::mutex> lock(m_);
+  o_.note(msg);
+}
+void GameLoop::SerialObserver::applied(const TimedEvent& e, std::int64_t frame) {
+  std::lock_guard<std::mutex> lock(m_);
+  o_.applied(e, frame);
+}
+void GameLoop::SerialObserver::notApplied(const TimedEvent& e, std::int64_t frame, const std::string& why) {
+  std::lock_guard<std::mutex> lock(m_);
+  o_.notApplied(e, frame, why);
+}
+void GameLoop::SerialObserver::boundary(const World& world, std::int64_t frame, bool rendered) {
+  std::lock_guard<std::mutex> lock(m_);
+  o_.boundary(world, frame, rendered);
+}
+bool GameLoop::SerialObserver::keeps(std::int64_t frame) {
+  std::lock_guard<std::mutex> lock(m_);
+  return o_.keeps(frame);
+}
+bool GameLoop::SerialObserver::frame(const FrameState& state, const Frame& image) {
+  std::lock_guard<std::mutex> lock(m_);
+  return o_.frame(state, image);
+}
+void GameLoop::SerialObserver::progress(const World& world, const LoopStatus& status, bool force) {
+  std::lock_guard<std::mutex> lock(m_);
+  o_.progress(world, status, force);
 }
 
 }  // namespace sph2d::cli

@@ -8,6 +8,15 @@
 //       ─> snapshot if kept (unless the loop is behind the wall clock: dropped)
 //   a snapshot still pending is rendered before a pause, at a stop and at the end.
 //
+// Headless with nothing live (no --realtime, no standard input: the run is a function of the
+// scene and its events files alone), the stepping runs ahead instead: one thread steps,
+// applies each boundary's events, tells the observer and snapshots every kept frame into a
+// queue of up to kAheadFrames frames and kAheadBytes bytes, while this thread renders the
+// queue in order. The first frame's shader compilation (about 0.3 s on llvmpipe) and the
+// frames whose step costs more than their render then overlap the rest instead of adding
+// up. The frames, the events and the hashes are the same either way; the observer's calls
+// are serialized (boundary() of later frames may come before frame() of earlier ones).
+//
 // Rendering overlaps the next step: the renderer draws a copy of what it reads
 // (positions, velocities, density, pressure, ids, ages, colliders) on the thread
 // that owns its GL context, while a second thread steps the World. The frame is
@@ -28,6 +37,7 @@
 #include <atomic>
 #include <chrono>
 #include <cstdint>
+#include <mutex>
 #include <string>
 
 #include "loop/event_intake.hpp"
@@ -98,12 +108,20 @@ class LoopObserver {
   /// True when frame `frame` is to be rendered (a kept frame).
   virtual bool keeps(std::int64_t frame) = 0;
   /// The rendered kept frame (valid during the call) of boundary `state`. Called while the
-  /// World steps on another thread: read what else it needs from the World in boundary().
+  /// World steps on another thread: read what else it needs from the World in boundary()
+  /// (keyed by frame: the World may have run ahead by several boundaries since).
   /// False ends the loop (after the step under way).
   virtual bool frame(const FrameState& state, const Frame& image) = 0;
   /// Called after each loop iteration and while paused; `force` at the last frame.
   virtual void progress(const World& world, const LoopStatus& status, bool force) {}
 };
+
+/// The simulation threads of a run without --threads: every core, but one fewer when the loop
+/// steps ahead of its drawing (headless, drawing, nothing live; GameLoop's design above): the
+/// renderer's thread then holds a core for the whole run, and a second step thread only
+/// contends with it (the demo on 2 cores: 2.00–2.09 s of wall time with one step thread,
+/// 2.22–2.29 s with two; docs/RENDERING.md).
+int defaultStepThreads(bool stepsAhead);
 
 /// The fixed-step loop over one World: events at frame boundaries, optional real-time
 /// pacing, rendering of the kept frames.
@@ -122,7 +140,33 @@ class GameLoop {
   /// Where the loop is.
   const LoopStatus& status() const { return status_; }
 
+  /// Headless runs step at most this many kept frames ahead of the one being rendered, and
+  /// hold at most kAheadBytes of snapshots (at least one frame whatever its size): 64 frames
+  /// of 10k particles take about 40 MB.
+  static constexpr std::size_t kAheadFrames = 64;
+  static constexpr std::size_t kAheadBytes = std::size_t(64) << 20;
+
  private:
+  /// The command's observer with every call serialized: in a headless run the stepping
+  /// thread calls boundary(), applied(), progress() … while this one calls frame().
+  class SerialObserver final : public LoopObserver {
+   public:
+    explicit SerialObserver(LoopObserver& o) : o_(o) {}
+    void warn(const std::string& m) override;
+    void note(const std::string& m) override;
+    void applied(const TimedEvent& e, std::int64_t frame) override;
+    void notApplied(const TimedEvent& e, std::int64_t frame, const std::string& why) override;
+    void boundary(const World& world, std::int64_t frame, bool rendered) override;
+    bool keeps(std::int64_t frame) override;
+    bool frame(const FrameState& state, const Frame& image) override;
+    void progress(const World& world, const LoopStatus& status, bool force) override;
+    std::mutex& mutex() { return m_; }
+
+   private:
+    LoopObserver& o_;
+    std::mutex m_;
+  };
+
   double wallNow() const;
   bool stopRequested() const;
   /// run()'s body (run() turns the World's Interrupted into LoopEnd::Interrupted).
@@ -137,6 +181,15 @@ class GameLoop {
   void capture(std::int64_t f);
   /// Renders the pending frame and hands it to the observer. False: the observer ended the loop.
   bool renderPending();
+  struct Pending;
+  /// Copies what the renderer reads of the World at boundary `f` into `q`.
+  void captureInto(Pending& q, std::int64_t f);
+  /// Renders `q` and hands it to the observer. False: the observer ended the loop.
+  bool renderSnapshot(Pending& q);
+  /// Whether this run steps ahead of its rendering (headless, rendering, nothing live).
+  bool runsAhead() const;
+  /// The headless loop: steps and boundaries on a second thread, rendering of the queue here.
+  LoopEnd runAhead();
   /// What stepAndRender did.
   enum class StepOutcome {
     Stepped,  ///< the World stepped one frame (and the pending frame, if any, was drawn)
@@ -149,14 +202,14 @@ class GameLoop {
 
   World& world_;
   EventIntake& input_;
-  LoopObserver& observer_;
+  SerialObserver observer_;
   Renderer* renderer_;
   LoopSettings settings_;
   FrameClock clock_;
   EventApplier applier_;
   LoopStatus status_;
   std::chrono::steady_clock::time_point start_;
-  /// The kept frame captured at its boundary and not rendered yet.
+  /// A kept frame captured at its boundary and not rendered yet.
   struct Pending {
     bool active = false;
     FrameState state;
@@ -164,6 +217,8 @@ class GameLoop {
     DiffuseBuffer diffuse;     ///< and of the foam, spray and bubbles
     std::vector<Collider> colliders;
     RenderInput input;
+    /// About the bytes the copies hold (what kAheadBytes counts).
+    std::size_t bytes() const;
   } pending_;
 };
 

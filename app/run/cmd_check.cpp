@@ -61,7 +61,8 @@ const char* kCheckHelp =
     "  --files         also check the PNG files beside the manifest: each listed frame's\n"
     "                  file decodes to its recorded hash, and no other frame_*.png is there\n"
     "  --out DIR       where the diff image goes (default: out/check-<scene name>)\n"
-    "  --threads T     simulation threads (default: all cores; frames do not depend on it)\n"
+    "  --threads T     simulation threads (default: all cores but one, which draws; frames do\n"
+    "                  not depend on it)\n"
     "  --quiet         print only the verdict\n";
 
 /// What `sph2d check` writes into its --out folder: this run's frame_NNNNN.png and diff_NNNNN.png.
@@ -349,8 +350,8 @@ int cmdCheck(const std::vector<std::string>& args) {
   }
   EventIntake input(scene, [](const std::string&) {});
   addManifestEvents(input, m, manifestPath, scene);
-  checkMemory(scene, true, 0);  // before anything is allocated
-  World world(scene, WorldOptions{threads});
+  checkMemory(scene, true, 0);                                                     // before anything is allocated
+  World world(scene, WorldOptions{threads ? threads : defaultStepThreads(true)});  // check draws, headless
   world.takeWarnings();
   Renderer renderer(scene.render, mv.render);
   const std::string here = renderer.rendererString();

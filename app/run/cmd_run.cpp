@@ -14,6 +14,7 @@
 #include <csignal>
 #include <cstdio>
 #include <filesystem>
+#include <map>
 #include <memory>
 #include <optional>
 
@@ -60,20 +61,25 @@ class RunOutputs : public LoopObserver {
   }
   void boundary(const World& world, std::int64_t frame, bool rendered) override {
     density.measure(world, frame);
-    // The export reads the World here (frame() runs while the World steps on), and only
-    // for a frame that will be rendered: a dropped frame is neither drawn nor exported.
-    snap_.reset();
+    // The export reads the World here (frame() runs while the World steps on, perhaps some
+    // boundaries ahead), and only for a frame that will be rendered: a dropped frame is
+    // neither drawn nor exported.
     if (a_.exportFormat && rendered) {
       const auto s0 = std::chrono::steady_clock::now();
       auto snap = std::make_shared<ParticleSnapshot>(snapshotOf(world));
       if (*a_.exportFormat == ExportFormat::Surface) snap->surface = world.surfaceCurves();
-      snap_ = std::move(snap);
+      snaps_[frame] = std::move(snap);
       exportSeconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - s0).count();
     }
   }
   bool keeps(std::int64_t frame) override { return frame % a_.every == 0; }
   bool frame(const FrameState& state, const Frame& image) override {
-    writer_->push(int(state.frame), image.width, image.height, image.rgba, std::move(snap_));
+    std::shared_ptr<const ParticleSnapshot> snap;
+    if (const auto it = snaps_.find(state.frame); it != snaps_.end()) {
+      snap = std::move(it->second);
+      snaps_.erase(it);
+    }
+    writer_->push(int(state.frame), image.width, image.height, image.rgba, std::move(snap));
     manifest_->addFrame(state.frame, state.time, xxh64(image.rgba.data(), image.rgba.size()), state.stateHash);
     return true;
   }
@@ -88,7 +94,8 @@ class RunOutputs : public LoopObserver {
   EventRecord& record_;
   FrameWriter* writer_;
   RunManifest* manifest_;
-  std::shared_ptr<const ParticleSnapshot> snap_;  ///< the export of the kept frame being rendered
+  /// The exports of the kept frames captured and not yet rendered, by frame.
+  std::map<std::int64_t, std::shared_ptr<const ParticleSnapshot>> snaps_;
 };
 
 /// What `sph2d run` writes into its folder: frames, exports, and the video and record files
@@ -186,7 +193,9 @@ int cmdRun(const std::vector<std::string>& args) {
   console.start();
   // The World reads the stop flag (set by SIGINT/SIGTERM once the loop starts): a signal ends
   // the step under way within milliseconds. Until then a signal ends the process at once.
-  World world(scene, WorldOptions{a.threads, &stopRequested});
+  const bool live = std::count(a.inputs.begin(), a.inputs.end(), "-") > 0;
+  const int threads = a.threads ? a.threads : defaultStepThreads(a.images && !a.realtime && !live);
+  World world(scene, WorldOptions{threads, &stopRequested});
   for (const auto& w : world.takeWarnings()) console.warn(w);
   std::unique_ptr<Renderer> renderer;
   std::unique_ptr<OutputJournal> journal;
@@ -238,7 +247,6 @@ int cmdRun(const std::vector<std::string>& args) {
   if (a.maxEventParticles) limits.perEvent = a.maxEventParticles;
   if (a.maxParticlesPerSecond) limits.perSecond = a.maxParticlesPerSecond;
   if (a.maxParticles) limits.budget = a.maxParticles;
-  const bool live = std::count(a.inputs.begin(), a.inputs.end(), "-") > 0;
   if (live) input.openLive(STDIN_FILENO, std::make_shared<LiveGate>(scene, limits));
 
   // The loop. A failure stops it; what was written stays, and the manifest says why.

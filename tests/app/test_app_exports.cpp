@@ -344,3 +344,30 @@ TEST_CASE("--export surface writes each kept frame's outlines as JSON and SVG, l
     CHECK(std::find(listed.begin(), listed.end(), f) != listed.end());
   CHECK(run("run " + q(kSmall) + " --frames 1 --export outline --out " + q(dir + "_bad")).code == 2);
 }
+
+TEST_CASE("a headless run that steps ahead of its drawing writes the frames and exports of one that does not") {
+  // With standard input open for live events the loop steps one frame while it draws the last;
+  // without it, the stepping runs up to GameLoop::kAheadFrames kept frames ahead of the
+  // drawing. The frames, both hashes and each frame's export (taken at its boundary, drawn
+  // and written frames later) must be the same.
+  const std::string a = freshDir("ahead_interleaved"), b = freshDir("ahead_runs_ahead");
+  const std::string args = " --frames 40 --every 3 --export csv --state-hash --quiet";
+  const Result ra = run("run " + q(kSmall) + args + " --input - --out " + q(a), "sleep 2 | ");
+  INFO(ra.out);
+  REQUIRE(ra.code == 0);
+  const Result rb = run("run " + q(kSmall) + args + " --threads 1 --out " + q(b));
+  INFO(rb.out);
+  REQUIRE(rb.code == 0);
+  const json ma = readManifest(a), mb = readManifest(b);
+  REQUIRE(ma.at("frames").size() == 14);
+  REQUIRE(mb.at("frames").size() == 14);
+  for (std::size_t k = 0; k < 14; ++k) {
+    CHECK(ma["frames"][k].at("rgba_xxh64") == mb["frames"][k].at("rgba_xxh64"));
+    CHECK(ma["frames"][k].at("state_hash") == mb["frames"][k].at("state_hash"));
+    char name[32];
+    std::snprintf(name, sizeof name, "/frame_%05d.csv", int(3 * k));
+    CHECK(readText(b + name) == readText(a + name));
+    CHECK(readParticlesCsv(b + name).frame == int(3 * k));
+  }
+  CHECK(filesEnding(b, ".csv").size() == 14);
+}
