@@ -315,7 +315,7 @@ int cmdBench(const std::vector<std::string>& args) {
   Stat sum;
   for (std::size_t k = 0; k < nosync.v.size(); ++k) sum.v.push_back(nosync.v[k] + png.v[k]);
   row("render + PNG", sum);
-  row("render | PNG, 2 threads", pipelined);
+  row("render | PNG, threaded", pipelined);
   Stat cpuSum;
   for (std::size_t k = 0; k < cpuRender.v.size(); ++k) cpuSum.v.push_back(cpuRender.v[k] + cpuPng.v[k]);
   row("CPU: render, no sync", cpuRender);

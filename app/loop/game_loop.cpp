@@ -13,8 +13,8 @@
 namespace sph2d::cli {
 
 int defaultStepThreads(bool stepsAhead) {
-  const int cores = int(std::thread::hardware_concurrency());
-  return stepsAhead ? std::max(1, cores - 1) : 0;  // 0: the World's default, every core
+  const int cores = int(std::thread::hardware_concurrency());   // 0 when unknown
+  return stepsAhead && cores > 0 ? std::max(1, cores - 1) : 0;  // 0: the World's default, every core
 }
 
 GameLoop::GameLoop(World& world, EventIntake& input, LoopObserver& observer, Renderer* renderer, LoopSettings settings)
@@ -179,7 +179,7 @@ void GameLoop::captureInto(Pending& q, std::int64_t f) {
 }
 
 std::size_t GameLoop::Pending::bytes() const {
-  auto b = [](const auto& v) { return v.size() * sizeof(v[0]); };
+  auto b = [](const auto& v) { return v.capacity() * sizeof(v[0]); };  // what the copy holds, reused or not
   const ParticleBuffer& P = particles;
   return b(P.x) + b(P.v) + b(P.rho) + b(P.p) + b(P.id) + b(P.age) + b(P.color) + b(P.userData) + b(P.emitter) +
          b(P.material) + b(P.mixedColor) + b(P.group) + b(diffuse.x) + b(diffuse.v) + b(diffuse.age) + b(diffuse.life) +
@@ -188,17 +188,14 @@ std::size_t GameLoop::Pending::bytes() const {
 
 bool GameLoop::renderPending() {
   if (!pending_.active) return true;
-  return renderSnapshot(pending_);
+  return renderSnapshot(pending_, status_.renderSeconds);
 }
 
-bool GameLoop::renderSnapshot(Pending& q) {
+bool GameLoop::renderSnapshot(Pending& q, double& seconds) {
   q.active = false;
   const auto r0 = std::chrono::steady_clock::now();
   const Frame& image = renderer_->render(q.input);
-  {
-    std::lock_guard<std::mutex> lock(observer_.mutex());
-    status_.renderSeconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - r0).count();
-  }
+  seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - r0).count();
   return observer_.frame(q.state, image);
 }
 
@@ -286,14 +283,16 @@ void GameLoop::holdPause() {
 bool GameLoop::runsAhead() const { return renderer_ && !settings_.realtime && !input_.liveOpen(); }
 
 LoopEnd GameLoop::runAhead() {
-  // The queue between the two threads: snapshots in frame order, and spent ones to reuse.
+  // The queue between the two threads: snapshots in frame order, and at most kSpares spent ones
+  // kept for reuse (the others are freed: a copy keeps the capacity of the largest frame it held).
+  constexpr std::size_t kSpares = 2;
   std::mutex m;
   std::condition_variable cv;
   std::deque<std::unique_ptr<Pending>> ready, spare;
   std::deque<std::size_t> readySizes;
   std::size_t readyBytes = 0;
   bool producerDone = false;
-  std::atomic<bool> abandon{false};  // the rendering ended the loop: the stepping stops
+  std::atomic<bool> abandon{false};  // the drawing ended the loop: the stepping stops
   std::exception_ptr stepError;
   const auto slice = std::chrono::milliseconds(20);  // a stop is noticed within this while waiting
 
@@ -306,8 +305,8 @@ LoopEnd GameLoop::runAhead() {
       cv.wait_for(lock, slice);
     }
     if (spare.empty()) return std::make_unique<Pending>();
-    std::unique_ptr<Pending> q = std::move(spare.front());
-    spare.pop_front();
+    std::unique_ptr<Pending> q = std::move(spare.back());
+    spare.pop_back();
     return q;
   };
   // Completes boundary f (stepped to, its events applied): tells the observer and queues the
@@ -325,6 +324,7 @@ LoopEnd GameLoop::runAhead() {
     ready.push_back(std::move(q));
     readySizes.push_back(bytes);
     readyBytes += bytes;
+    status_.aheadMost = std::max<std::uint64_t>(status_.aheadMost, ready.size());
     cv.notify_all();
     return true;
   };
@@ -356,45 +356,59 @@ LoopEnd GameLoop::runAhead() {
     producerDone = true;
     cv.notify_all();
   });
+  // Whatever this thread meets, the stepping thread is stopped and joined before it returns.
+  auto finish = [&] {
+    abandon = true;
+    cv.notify_all();
+    producer.join();
+  };
 
   // This thread (the renderer's GL context's) draws the queue in order. Frames queued before
   // a failed step are drawn before its error propagates, as in the interleaved loop.
   LoopEnd end = LoopEnd::Finished;
   std::exception_ptr renderError;
-  for (;;) {
-    std::unique_ptr<Pending> q;
-    {
-      std::unique_lock<std::mutex> lock(m);
-      while (ready.empty() && !producerDone && !stopRequested()) cv.wait_for(lock, slice);
-      if (ready.empty()) break;  // the stepping is done (or a stop came while waiting)
-      q = std::move(ready.front());
-      ready.pop_front();
-      readyBytes -= readySizes.front();
-      readySizes.pop_front();
+  double renderSeconds = 0;  // added to status_ once the stepping (which reads it in progress()) is joined
+  try {
+    for (;;) {
+      std::unique_ptr<Pending> q;
+      {
+        std::unique_lock<std::mutex> lock(m);
+        while (ready.empty() && !producerDone && !stopRequested()) cv.wait_for(lock, slice);
+        if (ready.empty()) break;  // the stepping is done (or a stop came while waiting)
+        q = std::move(ready.front());
+        ready.pop_front();
+        readyBytes -= readySizes.front();
+        readySizes.pop_front();
+      }
+      bool more = true;
+      try {
+        more = renderSnapshot(*q, renderSeconds);
+      } catch (...) {
+        renderError = std::current_exception();
+      }
+      {
+        std::lock_guard<std::mutex> lock(m);
+        if (spare.size() < kSpares) spare.push_back(std::move(q));
+        cv.notify_all();
+      }
+      q.reset();
+      if (renderError || !more) {
+        end = LoopEnd::Ended;
+        break;
+      }
+      if (stopRequested()) break;  // the frame at hand is drawn; the queue's others are not
     }
-    bool more = true;
-    try {
-      more = renderSnapshot(*q);
-    } catch (...) {
-      renderError = std::current_exception();
-    }
-    {
-      std::lock_guard<std::mutex> lock(m);
-      spare.push_back(std::move(q));
-      cv.notify_all();
-    }
-    if (renderError || !more) {
-      end = LoopEnd::Ended;
-      break;
-    }
-    if (stopRequested()) break;  // the frame at hand is drawn; the queue's others are not
+  } catch (...) {
+    finish();
+    throw;
   }
-  abandon = true;
-  cv.notify_all();
-  producer.join();
-  if (stepError) std::rethrow_exception(stepError);
+  finish();
+  status_.renderSeconds += renderSeconds;
+  // The drawing's end comes first: a step error is of a frame later than any drawn, which a
+  // failed write or check's first difference has already ended the loop before.
   if (renderError) std::rethrow_exception(renderError);
   if (end == LoopEnd::Ended) return end;
+  if (stepError) std::rethrow_exception(stepError);
   if (stopRequested()) return LoopEnd::Interrupted;
   observer_.progress(world_, status_, true);
   return LoopEnd::Finished;

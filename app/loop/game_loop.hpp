@@ -71,9 +71,11 @@ struct LoopStatus {
   std::uint64_t late = 0;     ///< frame periods forgotten: the simulation fell behind the wall clock
   double behindSeconds = 0;   ///< late × 1/fps
   double simSeconds = 0;      ///< wall seconds spent in World::stepFrame
-  double renderSeconds = 0;   ///< wall seconds spent in Renderer::render
-  int applied = 0;            ///< events applied
-  bool paused = false;        ///< between a pause and a resume
+  double renderSeconds = 0;   ///< wall seconds spent in Renderer::render (stepping ahead: once it ends)
+  /// The most kept frames the stepping held ahead of the drawing (0: the loop interleaves them).
+  std::uint64_t aheadMost = 0;
+  int applied = 0;      ///< events applied
+  bool paused = false;  ///< between a pause and a resume
 };
 
 /// A kept frame's boundary, as the loop captured it before stepping on.
@@ -140,9 +142,9 @@ class GameLoop {
   /// Where the loop is.
   const LoopStatus& status() const { return status_; }
 
-  /// Headless runs step at most this many kept frames ahead of the one being rendered, and
-  /// hold at most kAheadBytes of snapshots (at least one frame whatever its size): 64 frames
-  /// of 10k particles take about 40 MB.
+  /// Headless runs step at most this many kept frames ahead of the one being drawn, and queue
+  /// at most kAheadBytes of their copies (at least one frame whatever its size); two spent
+  /// copies are kept for reuse, the others freed. 64 frames of 10k particles take about 40 MB.
   static constexpr std::size_t kAheadFrames = 64;
   static constexpr std::size_t kAheadBytes = std::size_t(64) << 20;
 
@@ -160,7 +162,6 @@ class GameLoop {
     bool keeps(std::int64_t frame) override;
     bool frame(const FrameState& state, const Frame& image) override;
     void progress(const World& world, const LoopStatus& status, bool force) override;
-    std::mutex& mutex() { return m_; }
 
    private:
     LoopObserver& o_;
@@ -184,8 +185,9 @@ class GameLoop {
   struct Pending;
   /// Copies what the renderer reads of the World at boundary `f` into `q`.
   void captureInto(Pending& q, std::int64_t f);
-  /// Renders `q` and hands it to the observer. False: the observer ended the loop.
-  bool renderSnapshot(Pending& q);
+  /// Renders `q` (adding the wall seconds it took to `seconds`) and hands it to the observer.
+  /// False: the observer ended the loop.
+  bool renderSnapshot(Pending& q, double& seconds);
   /// Whether this run steps ahead of its rendering (headless, rendering, nothing live).
   bool runsAhead() const;
   /// The headless loop: steps and boundaries on a second thread, rendering of the queue here.
@@ -217,7 +219,7 @@ class GameLoop {
     DiffuseBuffer diffuse;     ///< and of the foam, spray and bubbles
     std::vector<Collider> colliders;
     RenderInput input;
-    /// About the bytes the copies hold (what kAheadBytes counts).
+    /// About the bytes the copies hold, their capacity (what kAheadBytes counts).
     std::size_t bytes() const;
   } pending_;
 };

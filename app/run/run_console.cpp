@@ -92,6 +92,9 @@ void RunConsole::summary(const World& world, const RunReport& r) const {
   if (r.pending && r.status == 0)
     std::printf("sph2d: %zu event%s never applied: stamped after the last frame (%d)\n", r.pending,
                 r.pending == 1 ? " was" : "s were", r.frames - 1);
+  if (r.loop.aheadMost > 0)
+    std::printf("sph2d: the simulation ran up to %llu kept frames ahead of the drawing\n",
+                (unsigned long long)r.loop.aheadMost);
   if (r.realtime)
     std::printf(
         "sph2d: realtime at %.4g fps: %llu frames dropped (stepped but not rendered, to keep up), %llu frames late "

@@ -352,12 +352,15 @@ TEST_CASE("a headless run that steps ahead of its drawing writes the frames and 
   // and written frames later) must be the same.
   const std::string a = freshDir("ahead_interleaved"), b = freshDir("ahead_runs_ahead");
   const std::string args = " --frames 40 --every 3 --export csv --state-hash --quiet";
-  const Result ra = run("run " + q(kSmall) + args + " --input - --out " + q(a), "sleep 2 | ");
+  // The pipe stays open (and empty) while the loop starts (the run then reads it to its end).
+  const Result ra = run("run " + q(kSmall) + args + " --input - --out " + q(a), "sleep 4 | ");
   INFO(ra.out);
   REQUIRE(ra.code == 0);
+  CHECK(ra.out.find("ran up to") == std::string::npos);  // interleaved
   const Result rb = run("run " + q(kSmall) + args + " --threads 1 --out " + q(b));
   INFO(rb.out);
   REQUIRE(rb.code == 0);
+  CHECK(rb.out.find("the simulation ran up to ") != std::string::npos);  // stepped ahead
   const json ma = readManifest(a), mb = readManifest(b);
   REQUIRE(ma.at("frames").size() == 14);
   REQUIRE(mb.at("frames").size() == 14);
