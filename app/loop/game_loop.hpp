@@ -122,7 +122,7 @@ class LoopObserver {
 /// steps ahead of its drawing (headless, drawing, nothing live; GameLoop's design above): the
 /// renderer's thread then holds a core for the whole run, and a second step thread only
 /// contends with it (the demo on 2 cores: 2.00–2.09 s of wall time with one step thread,
-/// 2.22–2.29 s with two; docs/RENDERING.md).
+/// 2.22–2.29 s with two; docs/PERFORMANCE.md).
 int defaultStepThreads(bool stepsAhead);
 
 /// The fixed-step loop over one World: events at frame boundaries, optional real-time
