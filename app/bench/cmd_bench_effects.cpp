@@ -163,7 +163,10 @@ int cmdBenchEffects(const std::vector<std::string>& args) {
   if (n0 == 0) throw UsageError("scene " + scenePath + " has no fluid to resample");
   base.solver.spacing *= std::sqrt(double(n0) / double(particles));
   base.maxParticles = std::size_t(particles) * 4 + 1000;
-  if (!solver.empty()) base.solver.type = solver;
+  if (!solver.empty() && solver != base.solver.type) {
+    base.solver.type = solver;
+    base.solver.params.clear();  // the scene's solver's parameters are not another's: each at its default
+  }
   const double nu = base.solver.viscosity > 0 ? base.solver.viscosity : 0.01;
   // "none": gravity and pressure only.
   SceneDef none = base;

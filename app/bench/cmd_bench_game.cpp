@@ -448,6 +448,17 @@ int cmdBenchGame(const std::vector<std::string>& args) {
     }
     for (Spec& p : specs) p.id = specId(p);
   }
+  // --set: each run's solver with every --set applied is one the World takes (ranges,
+  // combinations), before any run starts.
+  for (const Spec& p : specs) {
+    if (!p.peer.empty()) continue;
+    std::string base, second;
+    game_bench::splitPreset(p.preset, base, second);
+    SolverDef d = qualityPreset(base);
+    for (const std::string& kv : sets) applySet(d, kv);
+    if (const std::string why = solverDefProblem(d); !why.empty())
+      throw UsageError("--set (preset " + p.preset + "): " + why);
+  }
   const std::string assets = assetsPath;
   const std::string scenePath = assets + "/scenes/dam_break.json",
                     surgePath = assets + "/reference/martin_moyce_1952_surge_front.csv";

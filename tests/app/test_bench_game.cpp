@@ -83,6 +83,27 @@ TEST_CASE("bench game refuses a peer that is not an executable, and less than on
   CHECK(s.out.find("--seconds") != std::string::npos);
 }
 
+TEST_CASE("bench game refuses a --set value outside the key's range before any run, as a scene file would") {
+  // Above and below, a parameter and a shared key; --only's runs are checked as
+  // --presets' are. Nothing runs: no row is printed.
+  for (const std::string& set : {"max_move=50", "max_move=0.01", "support_ratio=9", "cfl=0", "grid_cell=17"}) {
+    for (const std::string& runs : {"--presets game --particles 600 --threads 1", "--only game-600-t1"}) {
+      INFO(set << " " << runs);
+      const Result r = run("bench game " + runs + " --seconds 0.25 --set " + set);
+      CHECK(r.code == 2);
+      const std::string key = set.substr(0, set.find('='));
+      CHECK(r.out.find("--set (preset game): solver." + key + ": value ") != std::string::npos);
+      CHECK(r.out.find("out of range; allowed: ") != std::string::npos);
+      CHECK(r.out.find("sph2d_game ") == std::string::npos);
+    }
+  }
+  // A combination the solver cannot run is refused the same way (the shift would become velocity).
+  const Result c =
+      run("bench game --presets game --particles 600 --seconds 0.25 --threads 1 --set correction_to_velocity=1");
+  CHECK(c.code == 2);
+  CHECK(c.out.find("solver.grid_shift") != std::string::npos);
+}
+
 TEST_CASE("bench game at two particle counts ends with the cost growth, per particle too, from its own rows") {
   const std::string dir = freshDir("bench_game_growth");
   const std::string csvPath = dir + "/game.csv";

@@ -112,6 +112,12 @@ SolverDef qualityPreset(const std::string& quality);
 /// tunes and its own parameters). Throws std::invalid_argument for an unknown type.
 SolverDef solverDefaults(const std::string& type);
 
+/// What is wrong with `def` as "solver.<key>: why" (a shared key or a parameter outside its
+/// range or not finite, a parameter its solver does not declare, an unknown type, a
+/// combination its solver cannot run), or "" when nothing. Parameters left out count at
+/// their defaults. The World refuses such a solver with a SceneError naming the key.
+std::string solverDefProblem(const SolverDef& def);
+
 /// The world rectangle the image shows (aspect preserved by widening).
 struct CameraDef {
   Vec2d min{0, 0};
@@ -156,7 +162,7 @@ struct MaterialDef {
   /// (RenderDef::transmission, per material). A scene's materials default to its render's; one
   /// made in code (World::addMaterial) has this unless the game sets it.
   std::array<double, 3> transmission{0.25, 0.4, 0.5};
-  std::vector<std::string> miscibleWith;          ///< the materials it mixes with, by name
+  std::vector<std::string> miscibleWith;  ///< the materials it mixes with, by name
   double diffusion = 1e-3;  ///< D [m²/s] of dc/dt = D∇²c with a material it mixes with (the pair's mean)
   /// Interface tension σ [N/m] with materials before it, by name (a pair that does not mix).
   std::vector<std::pair<std::string, double>> tensionWith;

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdint>
 #include <sstream>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -382,17 +383,31 @@ void readSolver(const Reader& r, const json& root, SceneDef& s) {
   // A preset's parameter values are the defaults a scene may change.
   for (const SolverParam& sp : solverParams(d.type))
     d.params[sp.key] = r.number(j, p, sp.key, d.params.count(sp.key) ? d.params.at(sp.key) : sp.def, sp.lo, sp.hi);
-  d.spacing = r.number(j, p, "spacing", d.spacing, 0, 10, true);
-  d.supportRatio = r.number(j, p, "support_ratio", d.supportRatio, 1.5, 4);
-  d.restDensity = r.number(j, p, "rest_density", d.restDensity, 0, 1e5, true);
-  d.soundSpeed = r.number(j, p, "sound_speed", d.soundSpeed, 0, 1e4, true);
-  d.viscosity = r.number(j, p, "viscosity", d.viscosity, 0, 100);
+  // The shared keys' ranges are the World's too (sharedSolverKeys).
+  auto range = [](const std::string& key) -> const SharedSolverKey& {
+    for (const SharedSolverKey& k : sharedSolverKeys())
+      if (key == k.key) return k;
+    throw std::logic_error("no shared solver key " + key);
+  };
+  auto num = [&](const char* key, double cur) {
+    const SharedSolverKey& k = range(key);
+    return r.number(j, p, key, cur, k.lo, k.hi, k.loOpen);
+  };
+  auto whole = [&](const char* key, int cur) {
+    const SharedSolverKey& k = range(key);
+    return r.integer(j, p, key, cur, int(k.lo), int(k.hi));
+  };
+  d.spacing = num("spacing", d.spacing);
+  d.supportRatio = num("support_ratio", d.supportRatio);
+  d.restDensity = num("rest_density", d.restDensity);
+  d.soundSpeed = num("sound_speed", d.soundSpeed);
+  d.viscosity = num("viscosity", d.viscosity);
   d.noSlip = r.boolean(j, p, "no_slip", d.noSlip);
-  d.cfl = r.number(j, p, "cfl", d.cfl, 0, 1, true);
-  d.maxSubsteps = r.integer(j, p, "max_substeps", d.maxSubsteps, 1, 100000);
+  d.cfl = num("cfl", d.cfl);
+  d.maxSubsteps = whole("max_substeps", d.maxSubsteps);
   d.clampNegativePressure = r.boolean(j, p, "clamp_negative_pressure", d.clampNegativePressure);
-  d.reorderInterval = r.integer(j, p, "reorder_interval", d.reorderInterval, 0, 1000000);
-  d.maxSpeed = r.number(j, p, "max_speed", d.maxSpeed, 0, 1e6, true);
+  d.reorderInterval = whole("reorder_interval", d.reorderInterval);
+  d.maxSpeed = num("max_speed", d.maxSpeed);
 }
 
 void readBoundaries(const Reader& r, const json& root, SceneDef& s) {

@@ -1,4 +1,6 @@
 // The solver registry: the solvers of solvers.def, looked up by scene name.
+#include <cmath>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 
@@ -76,9 +78,67 @@ void fillSolverDefaults(SolverDef& def) {
     if (!def.params.count(p.key)) def.params[p.key] = p.def;
 }
 
+const std::vector<SharedSolverKey>& sharedSolverKeys() {
+  // The ranges the scene loader enforces (scene_sections.cpp reads them from here).
+  static const std::vector<SharedSolverKey> k = {
+      {"spacing", 0, 10, true, [](const SolverDef& d) { return d.spacing; }},
+      {"support_ratio", 1.5, 4, false, [](const SolverDef& d) { return d.supportRatio; }},
+      {"rest_density", 0, 1e5, true, [](const SolverDef& d) { return d.restDensity; }},
+      {"sound_speed", 0, 1e4, true, [](const SolverDef& d) { return d.soundSpeed; }},
+      {"viscosity", 0, 100, false, [](const SolverDef& d) { return d.viscosity; }},
+      {"cfl", 0, 1, true, [](const SolverDef& d) { return d.cfl; }},
+      {"max_substeps", 1, 100000, false, [](const SolverDef& d) { return double(d.maxSubsteps); }},
+      {"reorder_interval", 0, 1000000, false, [](const SolverDef& d) { return double(d.reorderInterval); }},
+      {"max_speed", 0, 1e6, true, [](const SolverDef& d) { return d.maxSpeed; }},
+  };
+  return k;
+}
+
+namespace {
+std::string fmtValue(double v) {
+  if (v == std::floor(v) && std::fabs(v) < 1e15) return std::to_string(static_cast<long long>(v));
+  std::ostringstream o;
+  o << v;
+  return o.str();
+}
+
+/// {"solver.<key>", why} when v is not finite or outside [lo, hi] ((lo, hi] when loOpen).
+std::pair<std::string, std::string> outOfRange(const std::string& key, double v, double lo, double hi, bool loOpen) {
+  const bool below = loOpen ? !(v > lo) : !(v >= lo);
+  if (std::isfinite(v) && !below && !(v > hi)) return {};
+  return {"solver." + key, "value " + fmtValue(v) + " is out of range; allowed: " + (loOpen ? "> " : ">= ") +
+                               fmtValue(lo) + " and <= " + fmtValue(hi)};
+}
+}  // namespace
+
 std::pair<std::string, std::string> solverParamProblem(const SolverDef& def) {
+  // A SolverDef built in code (or changed after loading) is held to the loader's ranges:
+  // the shared keys, then each parameter, which must be one the solver declares.
+  for (const SharedSolverKey& k : sharedSolverKeys())
+    if (auto p = outOfRange(k.key, k.get(def), k.lo, k.hi, k.loOpen); !p.first.empty()) return p;
   const SolverInfo* e = find(def.type);
-  return e && e->check ? e->check(def) : std::pair<std::string, std::string>{};
+  if (!e) return {"solver.type", "unknown solver '" + def.type + "'"};
+  for (const auto& [key, value] : def.params) {
+    const SolverParam* sp = nullptr;
+    for (const SolverParam& q : e->params)
+      if (q.key == key) sp = &q;
+    if (!sp) {
+      std::string keys;
+      for (const SolverParam& q : e->params) keys += (keys.empty() ? "" : ", ") + q.key;
+      return {"solver." + key, "not a parameter of the " + def.type +
+                                   " solver (to change a solver's type, start from solverDefaults(\"" + def.type +
+                                   "\")); its parameters: " + keys};
+    }
+    if (auto p = outOfRange(key, value, sp->lo, sp->hi, false); !p.first.empty()) return p;
+  }
+  return e->check ? e->check(def) : std::pair<std::string, std::string>{};
+}
+
+std::string solverDefProblem(const SolverDef& def) {
+  SolverDef d = def;
+  fillSolverDefaults(d);
+  const auto p = solverParamProblem(d);
+  return p.first.empty() ? std::string() : p.first + ": " + p.second;
 }
 
 std::unique_ptr<Solver> makeSolver(const SolverDef& def) {

@@ -117,8 +117,21 @@ struct SolverInfo {
 /// Applies the tune of `def.type`'s solver (SolverInfo::tune), if it has one.
 void tuneSolverDefaults(SolverDef& def);
 
-/// What `def`'s solver says against its parameters (SolverInfo::check): {key, why}, or an
-/// empty key when nothing (or the solver has no check).
+/// A shared solver key's allowed range (the scene loader's and the World's): [lo, hi], or
+/// (lo, hi] when loOpen; `get` reads it from a SolverDef.
+struct SharedSolverKey {
+  const char* key;
+  double lo, hi;
+  bool loOpen;
+  double (*get)(const SolverDef& def);
+};
+/// The shared numeric keys of solver (spacing, support_ratio, ...) with their ranges.
+const std::vector<SharedSolverKey>& sharedSolverKeys();
+
+/// What is wrong with `def`, as {"solver.<key>", why}, or an empty key when nothing: a shared
+/// key or a parameter outside its range (or not finite), a parameter the solver does not
+/// declare, an unknown solver type, then what the solver's own check (SolverInfo::check)
+/// says against a combination.
 std::pair<std::string, std::string> solverParamProblem(const SolverDef& def);
 
 /// The solver a scene names. Throws std::invalid_argument for an unknown name.

@@ -4,6 +4,8 @@
 // checked against the sections parseScene reads before it.
 #include <doctest/doctest.h>
 
+#include <cmath>
+#include <cstdio>
 #include <string>
 
 #include "scene/json_reader.hpp"
@@ -11,6 +13,9 @@
 #include "scene/scene_sections.hpp"
 #include "solvers/solver.hpp"
 #include "sph2d/scene.hpp"
+#include "sph2d/world.hpp"
+#include "support/fixture.hpp"
+#include "test_util.hpp"
 
 using namespace sph2d;
 
@@ -71,6 +76,79 @@ TEST_CASE("readSolver fills every parameter the solver declares, with or without
   SceneDef w;
   CHECK(failure("{\"solver\": {\"type\": \"wcsph\", \"iterations\": 4}}", w, readSolver)
             .rfind("solver.iterations: unknown key", 0) == 0);
+}
+
+TEST_CASE(
+    "a solver built in code is held to the ranges a scene file is: the reader's message, and the World refuses it") {
+  // Every parameter of every solver, and every shared key, just outside each end of its range
+  // (and not a number): solverDefProblem names the key with the reader's own message.
+  auto readerSays = [](const std::string& type, const std::string& key, double v) {
+    SceneDef s;
+    char num[64];
+    std::snprintf(num, sizeof num, "%.17g", v);
+    const std::string m =
+        failure("{\"solver\": {\"type\": \"" + type + "\", \"" + key + "\": " + num + "}}", s, readSolver);
+    return m;
+  };
+  int checked = 0;
+  for (const std::string& type : solverNames()) {
+    for (const SolverParam& sp : solverParams(type)) {
+      for (double v : {sp.lo - 1e-3 * (1 + std::fabs(sp.lo)), sp.hi + 1e-3 * (1 + std::fabs(sp.hi))}) {
+        INFO(type << " " << sp.key << " = " << v);
+        SolverDef d = solverDefaults(type);
+        d.params[sp.key] = v;
+        const std::string why = solverDefProblem(d);
+        CHECK(why == readerSays(type, sp.key, v));
+        CHECK(why.rfind("solver." + sp.key + ": value ", 0) == 0);
+        ++checked;
+      }
+      SolverDef d = solverDefaults(type);
+      d.params[sp.key] = std::nan("");
+      CHECK(solverDefProblem(d).rfind("solver." + sp.key + ": value nan is out of range", 0) == 0);
+    }
+    for (const SharedSolverKey& k : sharedSolverKeys()) {
+      const double v = k.loOpen ? k.lo : k.lo - 1;  // just outside the low end ([lo or (lo)
+      INFO(type << " " << k.key << " = " << v);
+      SolverDef d = solverDefaults(type);
+      const std::string key = k.key;
+      if (key == "spacing") d.spacing = v;
+      if (key == "support_ratio") d.supportRatio = v;
+      if (key == "rest_density") d.restDensity = v;
+      if (key == "sound_speed") d.soundSpeed = v;
+      if (key == "viscosity") d.viscosity = v;
+      if (key == "cfl") d.cfl = v;
+      if (key == "max_substeps") d.maxSubsteps = int(v);
+      if (key == "reorder_interval") d.reorderInterval = int(v);
+      if (key == "max_speed") d.maxSpeed = v;
+      CHECK(k.get(d) == v);  // the setter above covers the key
+      CHECK(solverDefProblem(d).rfind("solver." + key + ": value ", 0) == 0);
+      ++checked;
+    }
+    // Another solver's parameter (or a misspelt one) is not this solver's.
+    SolverDef d = solverDefaults(type);
+    d.params["no_such_key"] = 1;
+    CHECK(solverDefProblem(d).rfind("solver.no_such_key: not a parameter of the " + type + " solver", 0) == 0);
+    CHECK(solverDefProblem(solverDefaults(type)).empty());
+  }
+  CHECK(checked > 100);
+  // The World refuses such a solver, naming the key, before it builds anything.
+  SceneDef s = test::wallScene(0.05, "game");
+  s.blocks.push_back(test::block({0, 0}, {0.5, 0.5}));
+  s.solver.params["max_move"] = 50;
+  try {
+    World w(s, WorldOptions{1});
+    FAIL("max_move 50 was accepted");
+  } catch (const SceneError& e) {
+    CHECK(e.key == "solver.max_move");
+    CHECK(e.message == "value 50 is out of range; allowed: >= 0.05 and <= 20");
+  }
+  s.solver.params["max_move"] = 10;
+  s.solver.supportRatio = 1;
+  CHECK_THROWS_AS(World(s, WorldOptions{1}), SceneError);
+  s.solver.supportRatio = 2;
+  World ok(s, WorldOptions{1});
+  ok.stepFrame();
+  CHECK(test::allFiniteState(ok));
 }
 
 TEST_CASE("a section reader leaves the scene's defaults when its key is absent") {

@@ -31,7 +31,7 @@ std::vector<SolverParam> pbfParams(bool game) {
       {"tensile_dq", 0.2, 0.01, 0.9, "s_corr reference distance Δq, in units of the support R"},
       {"xsph", 0.01, 0, 1, "XSPH velocity smoothing c"},
       {"max_dt", 1.0 / 60.0, 1e-5, 0.1, "largest substep (s)"},
-      {"max_move", g(1, 6), 0.05, 10, "dt ≤ max_move · R / v_speed: largest move per substep, in support radii"},
+      {"max_move", g(1, 6), 0.05, 20, "dt ≤ max_move · R / v_speed: largest move per substep, in support radii"},
       {"speed_quantile", g(0, 0.002), 0, 0.1,
        "v_speed is the speed this share of the particles exceeds (0: the largest): spray does not set the substep"},
       {"move_cap", g(0, 1.5), 0, 100,
