@@ -64,13 +64,6 @@ std::string join(const std::vector<std::string>& v) {
   return s;
 }
 
-std::string fmt(double v) {
-  if (v == std::floor(v) && std::fabs(v) < 1e15) return std::to_string(static_cast<long long>(v));
-  std::ostringstream o;
-  o << v;
-  return o.str();
-}
-
 std::string printable(const std::string& s) {
   std::string o;
   for (const char c : s) {
@@ -156,10 +149,7 @@ double Reader::number(const json& obj, const std::string& path, const std::strin
   const std::string p = sub(path, key);
   if (!j.is_number()) fail(p, "expected a number, got " + describe(j));
   const double v = j.get<double>();
-  const bool below = loOpen ? !(v > lo) : !(v >= lo);
-  if (!std::isfinite(v) || below || v > hi)
-    fail(p,
-         "value " + fmt(v) + " is out of range; allowed: " + (loOpen ? "> " : ">= ") + fmt(lo) + " and <= " + fmt(hi));
+  if (const std::string why = rangeProblem(v, lo, hi, loOpen); !why.empty()) fail(p, why);
   return v;
 }
 

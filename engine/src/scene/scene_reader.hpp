@@ -16,6 +16,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "core/range_message.hpp"  // fmt, rangeProblem
 #include "scene/json_reader.hpp"
 #include "sph2d/math.hpp"
 
@@ -33,10 +34,6 @@ std::string describe(const nlohmann::json& j);
 
 /// The strings separated by ", ".
 std::string join(const std::vector<std::string>& v);
-
-/// A number as messages write it: integral values without a decimal point, others as
-/// std::ostream writes a double (6 significant digits).
-std::string fmt(double v);
 
 /// A user's text as it may appear in a message: control characters escaped as \xHH.
 std::string printable(const std::string& s);

@@ -1,9 +1,9 @@
 // The solver registry: the solvers of solvers.def, looked up by scene name.
-#include <cmath>
-#include <sstream>
 #include <stdexcept>
 #include <string>
+#include <utility>
 
+#include "core/range_message.hpp"
 #include "solvers/solver.hpp"
 
 namespace sph2d {
@@ -95,19 +95,10 @@ const std::vector<SharedSolverKey>& sharedSolverKeys() {
 }
 
 namespace {
-std::string fmtValue(double v) {
-  if (v == std::floor(v) && std::fabs(v) < 1e15) return std::to_string(static_cast<long long>(v));
-  std::ostringstream o;
-  o << v;
-  return o.str();
-}
-
-/// {"solver.<key>", why} when v is not finite or outside [lo, hi] ((lo, hi] when loOpen).
+/// {"solver.<key>", why} when v is not finite or outside its range (the loader's message).
 std::pair<std::string, std::string> outOfRange(const std::string& key, double v, double lo, double hi, bool loOpen) {
-  const bool below = loOpen ? !(v > lo) : !(v >= lo);
-  if (std::isfinite(v) && !below && !(v > hi)) return {};
-  return {"solver." + key, "value " + fmtValue(v) + " is out of range; allowed: " + (loOpen ? "> " : ">= ") +
-                               fmtValue(lo) + " and <= " + fmtValue(hi)};
+  std::string why = rangeProblem(v, lo, hi, loOpen);
+  return why.empty() ? std::pair<std::string, std::string>{} : std::make_pair("solver." + key, std::move(why));
 }
 }  // namespace
 
