@@ -1,10 +1,10 @@
 // The game preset at a wall: a slab of water thrown at the walls of a closed tank in zero
-// gravity, head-on and obliquely, at several spacings and speeds, each from four starts.
-// Every particle that reaches a wall within a substep stops there, so the pile-up the
-// density solve inherits is as deep as the substep's move into the wall, in spacings:
-// the preset's move limit (max_move 6 supports) keeps it within what the local iterations
-// undo. Longer moves piled up (docs/notes/game-solver-rounds.md, "A step limit at walls"),
-// which the second half of the test shows on the same throws.
+// gravity, head-on, obliquely and into the corner, at several spacings and speeds, each from
+// more than one start. Every particle that reaches a wall within a substep stops there, so the
+// pile-up the density solve inherits is as deep as the substep's run into the wall, in
+// spacings: the preset's move limit (max_move 6 supports) keeps it within what the local
+// passes undo. Longer moves piled up (docs/notes/game-solver-rounds.md, "A step limit at
+// walls"), which the test shows on the same throws.
 #include <doctest/doctest.h>
 
 #include <algorithm>
@@ -48,38 +48,52 @@ Throw throwSlab(double dx, double speed, double angle, double x0, double maxMove
   return r;
 }
 
+/// Just under `supports` support radii (R = 2 dx, the preset's) a frame: at max_move 6 a
+/// frame of 10 or 12 takes two substeps, each running up to 5 or 6 R (10 to 12 spacings).
+double speedFor(double dx, double supports) { return 0.97 * supports * 2 * dx * 60; }
+
 }  // namespace
 
 TEST_CASE("stability: a slab thrown at the walls keeps its worst particle within the game preset's tolerance") {
-  // Speeds just under 12·R·60 (R = 2 dx): at max_move 12 every substep would last a frame,
-  // about 23 spacings a move; at the preset's 6 a frame takes two. Four starts each, since
-  // how deep a front runs into a wall depends on where the substeps fall.
-  struct Case {
-    double dx, speed, angle;
-  };
-  double worst = 0;
-  int piledLong = 0, throws = 0;
-  for (const Case c : {Case{0.005, 7, 0}, Case{0.005, 7, 30}, Case{0.004, 5.5, 0}, Case{0.003, 4.2, 15}}) {
-    CAPTURE(c.dx);
-    CAPTURE(c.speed);
-    CAPTURE(c.angle);
-    for (double x0 : {0.05, 0.08, 0.11, 0.14}) {
-      CAPTURE(x0);
-      const Throw preset = throwSlab(c.dx, c.speed, c.angle, x0, 6), longer = throwSlab(c.dx, c.speed, c.angle, x0, 12);
-      MESSAGE("worst particle compression " << 100 * preset.worstMax << " % (max_move 6), " << 100 * longer.worstMax
-                                            << " % (12); worst mean " << 100 * preset.worstMean << " %");
-      REQUIRE(preset.finite);
-      // tolerance_max 8 %, and what the last local iteration leaves (up to 10.1 % measured).
-      CHECK(preset.worstMax <= 0.125);
-      CHECK(preset.worstMean <= 0.03);
-      CHECK(preset.outside == 0);
-      worst = std::max(worst, preset.worstMax);
-      piledLong += longer.worstMax > 0.125;
-      ++throws;
-    }
-  }
-  // The same throws discriminate: at twice the move some leave a pile-up the iterations did not undo.
-  MESSAGE("worst particle over the throws " << 100 * worst << " %; at max_move 12, " << piledLong << " of " << throws
-                                            << " throws above 12.5 %");
-  CHECK(piledLong >= 2);
+  // The class: spacings 5, 4 and 3 mm; from head-on at the right wall to 60° down, where the
+  // slab meets the floor first and runs into the corner; moves of 10 and 12 supports a frame;
+  // two starts each, since how deep a front runs into a wall depends on where the substeps
+  // fall. With the local passes plain, one of these throws (4 mm, 10°, 12 supports a frame,
+  // from x0 = 0.11) left a pile of 62 % at the wall for a frame: the local passes ran out
+  // before they had undone it (pbf_local.cpp).
+  double worst = 0, worstMean = 0, worstLong = 0;
+  int throws = 0, piledLong = 0, longThrows = 0;
+  for (const double dx : {0.005, 0.004, 0.003})
+    for (const double angle : {0.0, 10.0, 20.0, 30.0, 45.0, 60.0})
+      for (const double supports : {10.0, 12.0})
+        for (const double x0 : {0.05, 0.11}) {
+          CAPTURE(dx);
+          CAPTURE(angle);
+          CAPTURE(supports);
+          CAPTURE(x0);
+          const Throw t = throwSlab(dx, speedFor(dx, supports), angle, x0, 6);
+          REQUIRE(t.finite);
+          // tolerance_max 8 %, and what the last local pass leaves: up to 13.7 % over 432
+          // throws of this class (spacings, eight angles, six starts, 8 to 12 supports a frame).
+          CHECK(t.worstMax <= 0.15);
+          CHECK(t.worstMean <= 0.03);
+          CHECK(t.outside == 0);
+          worst = std::max(worst, t.worstMax);
+          worstMean = std::max(worstMean, t.worstMean);
+          ++throws;
+          if (supports == 12) {
+            // The same throw at max_move 12: every substep a frame long, about 23 spacings.
+            const Throw longer = throwSlab(dx, speedFor(dx, supports), angle, x0, 12);
+            REQUIRE(longer.finite);
+            piledLong += longer.worstMax > 0.15;
+            worstLong = std::max(worstLong, longer.worstMax);
+            ++longThrows;
+          }
+        }
+  MESSAGE("worst particle over " << throws << " throws " << 100 * worst << " %, worst mean " << 100 * worstMean
+                                 << " %; at max_move 12, " << piledLong << " of " << longThrows
+                                 << " throws above 15 %, the worst " << 100 * worstLong << " %");
+  // The throws discriminate: at twice the move some leave a pile-up the passes did not undo
+  // (5 of the 36, up to 133 %).
+  CHECK(piledLong >= 3);
 }

@@ -204,76 +204,15 @@ std::size_t Pbf::solve(StepContext& c) {
   // Local iterations: only the particles near a compression above tolerance_max
   // (and their neighbours) take further Jacobi steps; the rest keep their place.
   int local = 0;
+  if (localIterations_ > 0 && endedOnCorrection_) {
+    // The full passes ended with a correction: where it left the particles decides (a last
+    // Chebyshev step can overshoot into a compression the pass before it did not show).
+    const std::size_t bad = constraint(c, lambda);
+    if (bad != kNone) return bad;
+  }
   if (localIterations_ > 0 && maxCompression_ > toleranceMax_) {
-    active_.reset(n);
-    moved_.reset(n);
-    const Real thr = Real(0.5) * toleranceMax_;
-    const bool pending = used < maxIt;  // the last constraint pass's step is not applied yet
-    if (!pending) {
-      const std::size_t bad = constraint(c, lambda);
-      if (bad != kNone) return bad;
-    }
-    const Real limit = c.rho0 * (Real(1) + thr);
-    bool first = true;  // every ρ and Δλ is the last full pass's
-    while (local < localIterations_) {
-      for (; local < localIterations_ && maxCompression_ > toleranceMax_; ++local) {
-        // Active: compressed above half the tolerance, or next to such a particle.
-        // After a full scan only the last list's ρ changed, and every particle off
-        // that list kept the ρ it had when it was found at or below the threshold
-        // (or was summed again in the halo pass), so the compressed ones are on the
-        // list: they and their neighbours (the lists are symmetric) are the new
-        // active set, the same set a full scan finds.
-        if (first) {
-          // A block of kBlock slots owns its words of the set (64 slots each).
-          static_assert(kBlock % 64 == 0, "a job block covers whole words of a SlotSet");
-          c.pool.parallelFor(n, kBlock, [&](std::size_t b, std::size_t e) {
-            for (std::size_t w0 = b; w0 < e; w0 += 64) {
-              std::uint64_t bits = 0;
-              for (std::size_t i = w0; i < std::min(e, w0 + 64); ++i) {
-                bool a = c.P.rho[i] > limit;
-                const std::uint32_t* nb = c.nbr.of(i);
-                for (std::uint32_t k = 0; k < c.nbr.count[i] && !a; ++k) a = c.P.rho[nb[k]] > limit;
-                if (a)
-                  bits |= std::uint64_t(1) << (i - w0);
-                else
-                  dLambda_[i] = 0;  // only the listed particles take their step of the full pass
-              }
-              active_.setWord(w0 / 64, bits);
-            }
-          });
-          active_.summarise();
-          first = false;
-        } else {
-          neighbourhood(c, lastList_, &limit, active_);
-          // Off the new list, only the last list's Δλ can be non-zero: those are cleared.
-          for (const std::uint32_t i : lastList_)
-            if (!active_.has(i)) dLambda_[i] = 0;
-        }
-        active_.list(activeList_);
-        active_.clear();
-        std::size_t bad = correct(c, lambda, Real(1), &activeList_);
-        if (bad != kNone) return bad;
-        // Every particle moved in this phase: its neighbours' ρ changed too.
-        for (const std::uint32_t i : activeList_) moved_.add(i);
-        bad = constraint(c, lambda, &activeList_);
-        if (bad != kNone) return bad;
-        lastList_.swap(activeList_);
-      }
-      if (local == 0) break;
-      // The particles moved in this phase, and their neighbours, have their density
-      // summed again (the rest kept ρ and W of the last full pass). A neighbour off the
-      // lists may have been pushed above the tolerance: then the iterations go on from
-      // this halo, whose ρ are all fresh.
-      moved_.list(movedList_);
-      neighbourhood(c, movedList_, nullptr, active_);
-      active_.list(activeList_);
-      active_.clear();
-      const std::size_t bad = constraint(c, lambda, &activeList_);
-      if (bad != kNone) return bad;
-      lastList_.swap(activeList_);
-      rhoCurrent_ = true;  // every ρ (and W) is that of the current positions again
-      if (maxCompression_ <= toleranceMax_) break;
-    }
+    const std::size_t bad = localPhase(c, lambda, local);
+    if (bad != kNone) return bad;
   }
   if (!ownVel_.empty()) ownMoves(c);
   stats_.pressureIterations = used + local;  // corrections applied
@@ -303,30 +242,23 @@ std::size_t Pbf::iterate(StepContext& c, std::vector<Real>& lambda, int maxIt, i
   const Real rho2 = chebyshev_ * chebyshev_;
   Real omega = 1;
   bool plain = false;
+  endedOnCorrection_ = true;
   for (int k = 0; k < maxIt; ++k, ++used) {
     const std::size_t bad = constraint(c, lambda);
     if (bad != kNone) return bad;
-    if (k >= iterations_ && (localIterations_ > 0 ? meanCompression_ <= tolerance_ : converged())) break;
+    if (k >= iterations_ && (localIterations_ > 0 ? meanCompression_ <= tolerance_ : converged())) {
+      endedOnCorrection_ = false;
+      break;
+    }
     // Chebyshev weights (Wang 2015): ω1 = 1, ω2 = 2/(2 − ρ²), ω_{k+1} = 4/(4 − ρ²ω_k); none
     // in a substep whose first pass finds a compression above chebyshev_plain_above.
     if (k == 0) plain = chebPlainAbove_ > 0 && maxCompression_ > chebPlainAbove_;  // an impact (pbf.hpp)
+    plainSubstep_ = plain;
     omega = plain || k == 0 ? Real(1) : k == 1 ? Real(2) / (Real(2) - rho2) : Real(4) / (Real(4) - rho2 * omega);
     const std::size_t badC = correct(c, lambda, omega);
     if (badC != kNone) return badC;
   }
   return kNone;
-}
-
-void Pbf::neighbourhood(const StepContext& c, const std::vector<std::uint32_t>& list, const Real* limit,
-                        SlotSet& out) const {
-  // Serial over the list (a local iteration's few particles); a set, so the result
-  // does not depend on the order the list was built in.
-  for (const std::uint32_t i : list) {
-    if (limit && !(c.P.rho[i] > *limit)) continue;
-    out.add(i);
-    const std::uint32_t* nb = c.nbr.of(i);
-    for (std::uint32_t k = 0; k < c.nbr.count[i]; ++k) out.add(nb[k]);
-  }
 }
 
 std::size_t Pbf::predict(StepContext& c, std::vector<Real>& lambda) {

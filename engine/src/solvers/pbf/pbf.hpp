@@ -1,8 +1,8 @@
 // solvers/pbf/pbf.hpp (internal) — the Pbf class, shared by pbf.cpp (the
 // substep: prediction, the solve loop, the final density and the velocity),
 // pbf_constraint.cpp (the two passes of one Jacobi iteration: constraint and
-// correction) and pbf_params.cpp (the parameter table and the registrations of
-// pbf and game).
+// correction), pbf_local.cpp (the local passes after the full ones) and
+// pbf_params.cpp (the parameter table and the registrations of pbf and game).
 //
 // pbf — Position Based Fluids (Macklin & Müller 2013, "Position Based Fluids",
 // ACM TOG 32(4)) in 2D, for games: substeps up to a frame (max_dt, 1/60 s).
@@ -44,11 +44,12 @@
 // The game solver ("game" in solvers.def, quality "game") is this code with the
 // defaults of pbfParams(true) and support 2 dx, no viscosity: 1 to 4 iterations
 // a substep under a tolerance band, then local iterations over the particles still
-// compressed (an active list); a substep set by a speed quantile and a per-particle
-// move cap instead of the fastest particle; corrections that move positions only;
-// and, before the prediction, the coarse-grid pressure projection of the
-// velocities (grid_projection.hpp: Hybrid SPH, Raveendran et al. 2011), which
-// carries the long hydrostatic mode that Jacobi iterations reach only slowly.
+// compressed (an active list, Chebyshev-weighted as the full passes: pbf_local.cpp);
+// a substep set by a speed quantile and a per-particle move cap instead of the
+// fastest particle; corrections that move positions only; and, before the
+// prediction, the coarse-grid pressure projection of the velocities
+// (grid_projection.hpp: Hybrid SPH, Raveendran et al. 2011), which carries the
+// long hydrostatic mode that Jacobi iterations reach only slowly.
 //
 // Design choices (the measurements behind them and the variants dropped:
 // docs/SOLVERS.md and docs/SCENES.md, sections pbf):
@@ -186,7 +187,8 @@ class Pbf final : public Solver {
   /// a second buffer), combined with the previous iterate by the Chebyshev weight ω and
   /// swept out of the solids; λ follows the same combination.
   /// With `list` (a local iteration): only the listed particles move, in place (the
-  /// pass reads no neighbour position), and without Chebyshev.
+  /// pass reads no neighbour position); Chebyshev-weighted when the phase is
+  /// (startLocalPhase), each particle from the iterate the last local pass left it.
   std::size_t correct(StepContext& c, std::vector<Real>& lambda, Real omega,
                       const std::vector<std::uint32_t>* list = nullptr);
 
@@ -239,6 +241,32 @@ class Pbf final : public Solver {
   std::vector<std::uint32_t> activeList_;  ///< the particles of a local iteration (sorted)
   std::vector<std::uint32_t> lastList_;    ///< the particles the last constraint pass of the local phase wrote Δλ for
   std::vector<std::uint32_t> movedList_;   ///< moved_ listed for the halo pass (sorted)
+  /// pbf_local.cpp: the local passes after the full ones (while a compression above
+  /// tolerance_max is left, at most local_iterations); counts them in `local`. A bad slot, or kNone.
+  std::size_t localPhase(StepContext& c, std::vector<Real>& lambda, int& local);
+  /// Before a substep's local passes: whether they are Chebyshev-weighted (localChebyshev_), and
+  /// a new phase's pass numbers.
+  void startLocalPhase(const StepContext& c);
+  bool localChebyshev_ = false;     ///< this substep's local passes take the Chebyshev weights
+  bool plainSubstep_ = false;       ///< this substep's full passes ran plain Jacobi (chebyshev_plain_above)
+  bool endedOnCorrection_ = false;  ///< the last iterate() ended with a correction (ρ not summed since)
+  std::uint32_t localPass_ = 0;     ///< the number of the current local pass (counted across substeps)
+  /// Per particle: the local pass that last moved it (0: none), so that the next pass knows
+  /// whether xOld_ and lOld_ hold its iterate before that one.
+  std::vector<std::uint32_t> localMoved_;
+  /// The moving bodies' reach over the substep (centre, squared radius): the particles within
+  /// it take plain local steps (startLocalPhase).
+  struct BodyReach {
+    Vec2 centre;
+    Real r2;
+  };
+  std::vector<BodyReach> localBodies_;
+  /// Within a moving body's reach (localBodies_).
+  bool nearBody(const Vec2& x) const {
+    for (const BodyReach& b : localBodies_)
+      if ((x - b.centre).squaredNorm() < b.r2) return true;
+    return false;
+  }
   static constexpr std::size_t kLocalBlock = 32;       ///< particles per job of a local iteration (few, clustered)
   mutable std::vector<Real> speedScratch_, speedTop_;  ///< robustSpeed(): squared speeds, each block's largest
   mutable std::vector<Real> depthScratch_;             ///< maxTimeStep(): the highest particle per strip (columnDepths)

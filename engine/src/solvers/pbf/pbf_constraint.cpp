@@ -424,7 +424,24 @@ std::size_t Pbf::correct(StepContext& c, std::vector<Real>& lambda, Real omega,
       const Vec2 x0 = P.x[i];
       Vec2 x = x0 + d;
       const Real lk = lambda[i];
-      if (cheb) {
+      if (list && localChebyshev_) {
+        // A local pass: the iterate before is the one this particle had when the last pass
+        // moved it; a particle that pass did not move (new to the list) starts from where it is.
+        // An elastic group's particle steps plainly (its cross moves are not combined), as does
+        // one beside a moving body (startLocalPhase).
+        if ((elastic && ownVel_[i]) || nearBody(x0)) {
+          lambda[i] = lk + li;
+          localMoved_[i] = 0;
+        } else {
+          const bool moving = localMoved_[i] + 1 == localPass_;
+          const Vec2 xo = moving ? xOld_[i] : x0;
+          const Real lo = moving ? lOld_[i] : lk;
+          x = xo + (x - xo) * omega;
+          lambda[i] = lo + (lk + li - lo) * omega;
+          xOld_[i] = x0;
+          localMoved_[i] = localPass_;
+        }
+      } else if (cheb) {
         x = xOld_[i] + (x - xOld_[i]) * omega;
         lambda[i] = lOld_[i] + (lk + li - lOld_[i]) * omega;
       } else {
