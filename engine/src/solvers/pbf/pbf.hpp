@@ -44,10 +44,10 @@
 // The game solver ("game" in solvers.def, quality "game") is this code with the
 // defaults of pbfParams(true) and support 2 dx, no viscosity: 1 to 4 iterations
 // a substep under a tolerance band, then local iterations over the particles still
-// compressed (an active list, Chebyshev-weighted as the full passes: pbf_local.cpp);
-// a substep set by a speed quantile and a per-particle move cap instead of the
-// fastest particle; corrections that move positions only; and, before the
-// prediction, the coarse-grid pressure projection of the velocities
+// compressed (an active list; on a deep pile Chebyshev-weighted as the full passes:
+// pbf_local.cpp); a substep set by a speed quantile and a per-particle move cap
+// instead of the fastest particle; corrections that move positions only; and,
+// before the prediction, the coarse-grid pressure projection of the velocities
 // (grid_projection.hpp: Hybrid SPH, Raveendran et al. 2011), which carries the
 // long hydrostatic mode that Jacobi iterations reach only slowly.
 //
@@ -249,10 +249,10 @@ class Pbf final : public Solver {
   void startLocalPhase(const StepContext& c);
   bool localChebyshev_ = false;     ///< this substep's local passes take the Chebyshev weights
   bool plainSubstep_ = false;       ///< this substep's full passes ran plain Jacobi (chebyshev_plain_above)
-  bool endedOnCorrection_ = false;  ///< the last iterate() ended with a correction (ρ not summed since)
+  bool endedOnCorrection_ = false;  ///< the last iterate() ended with a correction (solve() then sums ρ once more)
   std::uint32_t localPass_ = 0;     ///< the number of the current local pass (counted across substeps)
-  /// Per particle: the local pass that last moved it (0: none), so that the next pass knows
-  /// whether xOld_ and lOld_ hold its iterate before that one.
+  /// Per particle: the local pass that last took a weighted step for it (0: none, or a plain
+  /// step), so that the next pass knows whether xOld_ and lOld_ hold its iterate before that one.
   std::vector<std::uint32_t> localMoved_;
   /// The moving bodies' reach over the substep (centre, squared radius): the particles within
   /// it take plain local steps (startLocalPhase).

@@ -433,9 +433,9 @@ std::size_t Pbf::correct(StepContext& c, std::vector<Real>& lambda, Real omega,
           lambda[i] = lk + li;
           localMoved_[i] = 0;
         } else {
-          const bool moving = localMoved_[i] + 1 == localPass_;
-          const Vec2 xo = moving ? xOld_[i] : x0;
-          const Real lo = moving ? lOld_[i] : lk;
+          const bool hasPrevious = localMoved_[i] + 1 == localPass_;
+          const Vec2 xo = hasPrevious ? xOld_[i] : x0;
+          const Real lo = hasPrevious ? lOld_[i] : lk;
           x = xo + (x - xo) * omega;
           lambda[i] = lo + (lk + li - lo) * omega;
           xOld_[i] = x0;

@@ -95,8 +95,8 @@ namespace {
 /// beyond this many times tolerance_max: a pile deeper than a few plain passes undo (a slab's
 /// run into a wall: 20 to 60 %). Below it plain passes end in a few (the dam break's phases:
 /// 1 to 15), and the weights would only overshoot them: with weights in every phase, the 20k
-/// dam break took 12.0 → 15.1 local and full passes a frame and its 100k 29 → 39, a sand pile
-/// under water stood 8 % lower, and a sinking crate pressed more water under it.
+/// dam break took 12.0 → 15.1 local and full passes a frame and its 100k 29 → 39, and a sand
+/// pile under water stood 8 % lower.
 constexpr Real kDeepPile = 2;
 }  // namespace
 
@@ -110,7 +110,7 @@ void Pbf::startLocalPhase(const StepContext& c) {
   // The moving bodies are no part of this solve (the grid and the `bodies` stage keep the water
   // out of them): an extrapolated step beside one ran particles into it, and a sinking crate
   // took 18 of them to the floor with it. Particles within a body's reach over the substep (and
-  // a support) step plainly.
+  // two supports) step plainly.
   localBodies_.clear();
   if (c.solids) {
     const double tau = c.time - c.solids->time0 + 0.5 * double(c.dt);
